@@ -1,0 +1,2 @@
+//! The `stickslip` command (being written).
+fn main() {}

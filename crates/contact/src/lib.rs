@@ -1,0 +1,1 @@
+//! stickslip-contact (being written).

@@ -1,0 +1,1 @@
+//! stickslip-fem (being written).

@@ -1,0 +1,1 @@
+//! stickslip-time (being written).
