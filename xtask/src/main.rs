@@ -1,1 +1,161 @@
-fn main() {}
+//! `cargo xtask`: the project's own commands (rust-analyzer's convention).
+//!
+//! This crate has no dependencies on purpose: it must build on a fresh
+//! machine without HDF5 so that it can install HDF5 before anything that
+//! links it is compiled (DEVELOPERS.md, the set-up promise).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+mod bench_mesh;
+mod meshes;
+mod python;
+
+const USAGE: &str = "\
+usage: cargo xtask <command> [args]
+
+  demo              install what is missing (HDF5), build, and run the paper's
+                    slab (central difference, eps = 1e-4) into target/demo/slab.h5
+  test              install what is missing (HDF5, h5py), then run the whole
+                    test suite (what .ci/run and CI run)
+  setup             only install what is missing: libhdf5-dev, h5py, numpy
+  meshes            regenerate cases/meshes/*.msh with Gmsh (installs gmsh from PyPI)
+  bench mesh        .msh read throughput on a 1M-node mesh against gmsh.open
+";
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let root = project_root();
+    let (cmd, rest) = match args.split_first() {
+        Some((c, r)) => (c.as_str(), r),
+        None => {
+            eprint!("{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    let result = match cmd {
+        "demo" => demo(&root, rest),
+        "test" | "ci" => test(&root, rest),
+        "setup" => setup(true),
+        "meshes" => meshes::run(&root, rest),
+        "bench" => match rest.split_first() {
+            Some((what, more)) if what == "mesh" => bench_mesh::run(&root, more),
+            _ => Err(format!("cargo xtask bench: say what to benchmark (mesh)\n{USAGE}")),
+        },
+        "help" | "--help" | "-h" => {
+            print!("{USAGE}");
+            Ok(())
+        }
+        other => Err(format!("unknown command {other:?}\n{USAGE}")),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The workspace root: xtask/ sits directly inside it.
+fn project_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask/ has a parent").to_path_buf()
+}
+
+/// Runs a command, echoing it, and fails with its exit status.
+pub fn run(cmd: &mut Command) -> Result<(), String> {
+    eprintln!("$ {}", describe(cmd));
+    let status = cmd.status().map_err(|e| format!("cannot start {}: {e}", describe(cmd)))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("{} failed ({status})", describe(cmd)))
+    }
+}
+
+fn describe(cmd: &Command) -> String {
+    let mut s = cmd.get_program().to_string_lossy().into_owned();
+    for a in cmd.get_args() {
+        s.push(' ');
+        s.push_str(&a.to_string_lossy());
+    }
+    s
+}
+
+fn cargo() -> Command {
+    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+}
+
+/// HDF5's C library and headers, found the way hdf5-metno-sys finds them
+/// (pkg-config), or Debian's serial header path.
+fn hdf5_present() -> bool {
+    let pkg = Command::new("pkg-config")
+        .args(["--exists", "hdf5"])
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
+    pkg || Path::new("/usr/include/hdf5/serial/hdf5.h").exists()
+}
+
+/// Installs libhdf5-dev (and h5py/numpy for the tests' Python checks)
+/// when missing, saying so.
+fn setup(python_too: bool) -> Result<(), String> {
+    if hdf5_present() {
+        eprintln!("setup: HDF5 development files found");
+    } else {
+        eprintln!("setup: HDF5 is missing; installing Debian's libhdf5-dev and hdf5-tools (about 20 s)");
+        let sudo = if is_root() { None } else { Some("sudo") };
+        let apt = |args: &[&str]| {
+            let mut c = match sudo {
+                Some(s) => {
+                    let mut c = Command::new(s);
+                    c.arg("apt-get");
+                    c
+                }
+                None => Command::new("apt-get"),
+            };
+            c.args(args).env("DEBIAN_FRONTEND", "noninteractive");
+            c
+        };
+        run(&mut apt(&["update", "-q"]))?;
+        run(&mut apt(&["install", "-y", "-q", "libhdf5-dev", "hdf5-tools", "pkg-config"]))?;
+        if !hdf5_present() {
+            return Err("libhdf5-dev was installed but HDF5 is still not found by pkg-config".into());
+        }
+    }
+    if python_too {
+        python::ensure_python_modules(&[("h5py", "h5py"), ("numpy", "numpy")])?;
+    }
+    Ok(())
+}
+
+fn is_root() -> bool {
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+        .unwrap_or(false)
+}
+
+/// The main job: the paper's slab under a step load, central difference.
+fn demo(root: &Path, rest: &[String]) -> Result<(), String> {
+    setup(false)?;
+    let case = root.join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let out = root.join("target/demo/slab.h5");
+    std::fs::create_dir_all(out.parent().expect("has parent")).map_err(|e| e.to_string())?;
+    let mut cmd = cargo();
+    cmd.current_dir(root).args(["run", "--quiet", "-p", "stickslip", "--", "run"]);
+    cmd.arg(&case).arg("-o").arg(&out).arg("--force").args(rest);
+    run(&mut cmd)?;
+    eprintln!("demo: results in {}", out.display());
+    Ok(())
+}
+
+/// The whole test suite: every crate's tests in the (optimized) dev
+/// profile, built once.
+fn test(root: &Path, rest: &[String]) -> Result<(), String> {
+    setup(true)?;
+    let mut cmd = cargo();
+    cmd.current_dir(root).args(["test", "--workspace"]).args(rest);
+    run(&mut cmd)
+}
