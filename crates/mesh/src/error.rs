@@ -29,6 +29,158 @@ pub enum MeshErrorKind {
         /// The names the mesh has.
         available: Vec<String>,
     },
+    /// The file does not start with `$MeshFormat`.
+    #[error("this is not a Gmsh .msh file (it does not start with $MeshFormat); export the mesh from Gmsh with File > Export > .msh or `gmsh -2 FILE.geo -o FILE.msh`")]
+    NotMsh,
+    /// A `$MeshFormat` version other than 2.2 or 4.1.
+    #[error("MSH version {version} is not supported; write the mesh as MSH 4.1 or 2.2 (`gmsh -2 FILE.geo -format msh41` or `-format msh22`, or Mesh.MshFileVersion = 4.1)")]
+    UnsupportedVersion {
+        /// The version as written in the file.
+        version: String,
+    },
+    /// A binary file written on a big-endian machine.
+    #[error("the binary .msh file is big-endian; only little-endian binary files are read: re-export it as ASCII (Mesh.Binary = 0) or on a little-endian machine")]
+    BigEndian,
+    /// A binary file whose data size is not 8 bytes.
+    #[error("the binary .msh file declares data-size {size}; only 8 (64-bit Gmsh) is read: re-export it as ASCII (Mesh.Binary = 0)")]
+    UnsupportedDataSize {
+        /// The data size from `$MeshFormat`.
+        size: u64,
+    },
+    /// The file ends in the middle of a section.
+    #[error("the file ends in the middle of {what}; it was probably cut short: copy it again or re-export it from Gmsh")]
+    Truncated {
+        /// What was being read.
+        what: &'static str,
+    },
+    /// A section without its closing keyword.
+    #[error("the {section} section has no closing {end}; the file is damaged or was edited by hand: re-export it from Gmsh")]
+    MissingEnd {
+        /// The section keyword, e.g. `$Nodes`.
+        section: String,
+        /// The closing keyword expected, e.g. `$EndNodes`.
+        end: String,
+    },
+    /// A section the reader needs is not in the file.
+    #[error("the file has no {section} section; a mesh file needs $MeshFormat, $Nodes and $Elements: generate the 2-D mesh (`gmsh -2`) before saving")]
+    MissingSection {
+        /// The missing section keyword.
+        section: &'static str,
+    },
+    /// A section given twice, or out of order.
+    #[error("{found} appears where it cannot ({why}); the file is damaged or was assembled by hand: re-export it from Gmsh")]
+    SectionOrder {
+        /// The section keyword found.
+        found: String,
+        /// Why it is out of place.
+        why: &'static str,
+    },
+    /// The number of entries in a section disagrees with its header.
+    #[error("{section} declares {expected} {what}, but the section holds a different number; the file is damaged or was edited by hand: re-export it from Gmsh")]
+    WrongCount {
+        /// The section keyword.
+        section: &'static str,
+        /// What is counted ("nodes", "elements", "entity blocks" ...).
+        what: &'static str,
+        /// The count the header declares.
+        expected: u64,
+    },
+    /// A field that should be a number is not (or does not fit its type).
+    #[error("expected {what}, found {found:?}; the file is damaged or was edited by hand: fix that field or re-export the mesh from Gmsh")]
+    NotANumber {
+        /// What the field is.
+        what: &'static str,
+        /// The text found (shortened).
+        found: String,
+    },
+    /// Something else that does not follow the MSH format.
+    #[error("malformed file: {what}; re-export the mesh from Gmsh")]
+    Malformed {
+        /// What is wrong.
+        what: String,
+    },
+    /// Two nodes with the same tag.
+    #[error("node tag {tag} is given twice; node tags must be unique: re-export the mesh from Gmsh (Mesh.Renumber = 1)")]
+    DuplicateNode {
+        /// The repeated node tag.
+        tag: u64,
+    },
+    /// An element uses a node tag that `$Nodes` does not define.
+    #[error("element {element} uses node {node}, which $Nodes does not define; re-export the mesh from Gmsh (with Mesh.SaveAll = 0 only nodes of saved elements are written, so save the whole mesh)")]
+    MissingNode {
+        /// The element's Gmsh tag.
+        element: u64,
+        /// The undefined node tag.
+        node: i64,
+    },
+    /// An element block refers to a geometric entity that `$Entities` does not
+    /// list, so its physical groups are unknown.
+    #[error("elements are on entity (dim {dim}, tag {tag}), which $Entities does not list, so their physical groups are unknown; re-export the mesh from Gmsh")]
+    UnknownEntity {
+        /// Entity dimension.
+        dim: i32,
+        /// Entity tag.
+        tag: i32,
+    },
+    /// An element type that stickslip cannot use.
+    #[error("element {element} has type {type_id} ({name}); stickslip reads 2-D meshes of quad4 or quad9 cells with line2/line3 boundary elements and points: mesh in 2-D (`gmsh -2`) and keep 3-D entities out of the physical groups")]
+    UnsupportedElement {
+        /// The element's Gmsh tag.
+        element: u64,
+        /// Gmsh element type number.
+        type_id: i32,
+        /// Its Gmsh name, when known.
+        name: &'static str,
+    },
+    /// 2-D cells that are not all quad4 or all quad9.
+    #[error("the 2-D cells include {found}; stickslip needs all quad4 or all quad9 cells: in Gmsh add `Recombine Surface{{...}};` (or Mesh.RecombineAll = 1) for quadrilaterals, and for quad9 use Mesh.ElementOrder = 2 (or `gmsh -order 2`) with Mesh.SecondOrderIncomplete = 0")]
+    NotQuads {
+        /// The offending cell types, e.g. "tri3 (type 2)" or "quad4 and quad9".
+        found: String,
+    },
+    /// Boundary elements of another order than the cells (line2 with quad9, line3 with quad4).
+    #[error("boundary element {element} is a {line} but the cells are {cells}; regenerate the whole mesh with one element order (`gmsh -order 1` or `-order 2`)")]
+    OrderMismatch {
+        /// The element's Gmsh tag.
+        element: u64,
+        /// "line2" or "line3".
+        line: &'static str,
+        /// "quad4" or "quad9".
+        cells: &'static str,
+    },
+    /// A cell with zero area or a non-positive Jacobian at a corner.
+    #[error("cell {element} is degenerate or tangled (zero area, or a corner angle of 180 degrees or more); fix the geometry or the mesh size there and mesh again")]
+    DegenerateCell {
+        /// The cell's Gmsh tag.
+        element: u64,
+    },
+    /// A boundary element of a physical group that is not the side of any cell.
+    #[error("boundary element {element} of group {group:?} is not a side of any cell; a boundary group must consist of lines of the meshed surface's boundary (mesh curves and surface together, and do not mix meshes)")]
+    EdgeNotOnCell {
+        /// The element's Gmsh tag.
+        element: u64,
+        /// The group's name.
+        group: String,
+    },
+    /// The file has no 2-D cells.
+    #[error("the file has no quad cells; mesh the surface (`gmsh -2`), and either put the surface in a physical group or save all elements (Mesh.SaveAll = 1)")]
+    NoCells,
+    /// A node off the z = 0 plane.
+    #[error("node {node} has z = {z}; stickslip reads plane meshes in the z = 0 plane: build the geometry in the xy-plane")]
+    NotPlanar {
+        /// The node's tag.
+        node: u64,
+        /// Its z coordinate.
+        z: f64,
+    },
+    /// More nodes or cells than the reader indexes.
+    #[error("the mesh has more than {limit} {what}; split the problem")]
+    TooLarge {
+        /// What is too many.
+        what: &'static str,
+        /// The limit.
+        limit: u64,
+    },
 }
 
 /// A mesh error with its file and location.
@@ -45,15 +197,27 @@ pub struct MeshError {
 impl MeshError {
     /// An error not tied to a place in a file.
     pub fn new(kind: MeshErrorKind) -> Self {
-        MeshError { path: None, location: Location::Nowhere, kind }
+        MeshError {
+            path: None,
+            location: Location::Nowhere,
+            kind,
+        }
     }
     /// An error at a place in the file.
     pub fn at(location: Location, kind: MeshErrorKind) -> Self {
-        MeshError { path: None, location, kind }
+        MeshError {
+            path: None,
+            location,
+            kind,
+        }
     }
     /// An I/O error on `path`.
     pub fn io(path: &Path, e: std::io::Error) -> Self {
-        MeshError { path: Some(path.to_path_buf()), location: Location::Nowhere, kind: MeshErrorKind::Io(e.to_string()) }
+        MeshError {
+            path: Some(path.to_path_buf()),
+            location: Location::Nowhere,
+            kind: MeshErrorKind::Io(e.to_string()),
+        }
     }
     /// Attaches the file name.
     pub fn with_path(mut self, path: &Path) -> Self {

@@ -1,7 +1,280 @@
-//! The .msh reader (being written; see issue 2).
+//! The .msh reader: MSH 2.2 and 4.1, ASCII and binary (`../shared/DEPENDENCIES.md` §2
+//! describes the layouts).
+//!
+//! One pass over the bytes: `$MeshFormat` decides the version and encoding,
+//! then each section is parsed where it stands (`$PhysicalNames`,
+//! `$Entities`, `$Nodes`, `$Elements`; anything else, e.g. `$Periodic` or
+//! `$NodeData`, is skipped up to its `$End…`). Elements are mapped to dense
+//! node indices and checked as they are read, so `$Nodes` must come before
+//! `$Elements` (and `$Entities` before `$Elements` in 4.1), as Gmsh writes them.
 
-use crate::{Mesh, MeshError, MeshErrorKind};
+mod build;
+mod cursor;
+mod v2;
+mod v4;
 
-pub(crate) fn read(_bytes: &[u8]) -> Result<Mesh, MeshError> {
-    Err(MeshError::new(MeshErrorKind::Io("the .msh reader is not written yet".into())))
+use build::Builder;
+use cursor::{Cursor, Result};
+
+use crate::{Mesh, MeshErrorKind};
+
+pub(crate) fn read(bytes: &[u8]) -> Result<Mesh> {
+    let mut cur = Cursor::new(bytes);
+    match cur.token() {
+        Some((_, b"$MeshFormat")) => {}
+        _ => return Err(cur.error(0, MeshErrorKind::NotMsh)),
+    }
+    let (version, binary) = mesh_format(&mut cur)?;
+    let mut b = Builder::new(version, binary);
+    let mut entities: Option<v4::Entities> = None;
+    let mut seen_nodes = false;
+    let mut seen_elements = false;
+    while let Some((p, t)) = cur.token() {
+        match t {
+            b"$PhysicalNames" => physical_names(&mut cur, &mut b)?,
+            b"$Entities" if version == "4.1" => {
+                if seen_elements || entities.is_some() {
+                    return Err(out_of_place(
+                        &cur,
+                        p,
+                        t,
+                        "$Entities must come once, before $Elements",
+                    ));
+                }
+                entities = Some(v4::entities(&mut cur, &mut b)?);
+            }
+            b"$Nodes" => {
+                if seen_nodes {
+                    return Err(out_of_place(&cur, p, t, "a second $Nodes section"));
+                }
+                seen_nodes = true;
+                if version == "2.2" {
+                    v2::nodes(&mut cur, &mut b)?;
+                } else {
+                    v4::nodes(&mut cur, &mut b)?;
+                }
+            }
+            b"$Elements" => {
+                if !seen_nodes {
+                    return Err(out_of_place(
+                        &cur,
+                        p,
+                        t,
+                        "$Nodes must come before $Elements",
+                    ));
+                }
+                if seen_elements {
+                    return Err(out_of_place(&cur, p, t, "a second $Elements section"));
+                }
+                seen_elements = true;
+                if version == "2.2" {
+                    v2::elements(&mut cur, &mut b)?;
+                } else {
+                    v4::elements(&mut cur, &mut b, entities.as_ref())?;
+                }
+            }
+            _ if t.first() == Some(&b'$') && !t.starts_with(b"$End") => {
+                skip_section(&mut cur, p, t)?
+            }
+            _ => {
+                let shown = String::from_utf8_lossy(t.get(..40).unwrap_or(t)).into_owned();
+                return Err(cur.error(
+                    p,
+                    MeshErrorKind::Malformed {
+                        what: format!("expected a section keyword such as $Nodes or $Elements, found {shown:?}"),
+                    },
+                ));
+            }
+        }
+    }
+    let end = bytes.len();
+    if !seen_nodes {
+        return Err(cur.error(end, MeshErrorKind::MissingSection { section: "$Nodes" }));
+    }
+    if !seen_elements {
+        return Err(cur.error(
+            end,
+            MeshErrorKind::MissingSection {
+                section: "$Elements",
+            },
+        ));
+    }
+    b.finish(&cur)
+}
+
+fn out_of_place(cur: &Cursor<'_>, pos: usize, t: &[u8], why: &'static str) -> crate::MeshError {
+    cur.error(
+        pos,
+        MeshErrorKind::SectionOrder {
+            found: String::from_utf8_lossy(t).into_owned(),
+            why,
+        },
+    )
+}
+
+/// `$MeshFormat`: version, file type, data size, and for binary files the
+/// integer 1 that tells the byte order.
+fn mesh_format(cur: &mut Cursor<'_>) -> Result<(&'static str, bool)> {
+    cur.enter("$MeshFormat", "$EndMeshFormat");
+    let Some((vp, vt)) = cur.token() else {
+        return Err(cur.error(
+            cur.pos,
+            MeshErrorKind::Truncated {
+                what: "the $MeshFormat section",
+            },
+        ));
+    };
+    let version = match vt {
+        b"2.2" => "2.2",
+        b"4.1" => "4.1",
+        _ => {
+            let version = String::from_utf8_lossy(vt.get(..20).unwrap_or(vt)).into_owned();
+            return Err(cur.error(vp, MeshErrorKind::UnsupportedVersion { version }));
+        }
+    };
+    cur.skip_ws();
+    let tp = cur.pos;
+    let file_type = cur.u64("the file type (0 for ASCII, 1 for binary)")?;
+    let data_size = cur.u64("the data size")?;
+    let binary = match file_type {
+        0 => false,
+        1 => true,
+        _ => {
+            return Err(cur.error(
+                tp,
+                MeshErrorKind::Malformed {
+                    what: format!("file type {file_type} is neither 0 (ASCII) nor 1 (binary)"),
+                },
+            ))
+        }
+    };
+    if binary {
+        cur.binary = true;
+        if data_size != 8 {
+            return Err(cur.error(tp, MeshErrorKind::UnsupportedDataSize { size: data_size }));
+        }
+        cur.end_of_line()?;
+        let p = cur.pos;
+        match cur.take(4, "the byte-order check")? {
+            [1, 0, 0, 0] => {}
+            [0, 0, 0, 1] => return Err(cur.error(p, MeshErrorKind::BigEndian)),
+            other => return Err(cur.error(
+                p,
+                MeshErrorKind::Malformed {
+                    what: format!(
+                        "the byte-order check after $MeshFormat is {other:?}, not the integer 1"
+                    ),
+                },
+            )),
+        }
+    }
+    cur.expect_end()?;
+    Ok((version, binary))
+}
+
+/// `$PhysicalNames` (ASCII in every encoding): `dim tag "name"` lines.
+fn physical_names(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
+    cur.enter("$PhysicalNames", "$EndPhysicalNames");
+    let n = cur.u64("the number of physical names")?;
+    cur.counts("physical names", n);
+    for _ in 0..n {
+        cur.skip_ws();
+        let p = cur.pos;
+        let dim = cur.i32("the dimension of a physical group")?;
+        let tag = cur.i32("the tag of a physical group")?;
+        let dim = match u8::try_from(dim) {
+            Ok(d) if d <= 3 => d,
+            _ => {
+                return Err(cur.error(
+                    p,
+                    MeshErrorKind::Malformed {
+                        what: format!("physical group dimension {dim} is not 0 to 3"),
+                    },
+                ))
+            }
+        };
+        let name = quoted(cur)?;
+        b.names.insert((dim, tag), name);
+    }
+    cur.expect_end()
+}
+
+/// A double-quoted name on the current line.
+fn quoted(cur: &mut Cursor<'_>) -> Result<String> {
+    cur.skip_ws();
+    let start = cur.pos;
+    let bad = |cur: &Cursor<'_>| {
+        cur.error(
+            start,
+            MeshErrorKind::Malformed {
+                what: "a physical name must be written in double quotes on its line".into(),
+            },
+        )
+    };
+    if cur.bytes.get(start) != Some(&b'"') {
+        return match cur.bytes.get(start) {
+            None => Err(cur.error(
+                start,
+                MeshErrorKind::Truncated {
+                    what: "the $PhysicalNames section",
+                },
+            )),
+            Some(b'$')
+                if cur
+                    .bytes
+                    .get(start..)
+                    .is_some_and(|r| r.starts_with(b"$EndPhysicalNames")) =>
+            {
+                Err(cur.wrong_count(start))
+            }
+            _ => Err(bad(cur)),
+        };
+    }
+    let rest = cur.bytes.get(start + 1..).unwrap_or_default();
+    match rest.iter().position(|&c| c == b'"' || c == b'\n') {
+        Some(k) if rest.get(k) == Some(&b'"') => {
+            let name = String::from_utf8_lossy(&rest[..k]).into_owned();
+            cur.pos = start + 1 + k + 1;
+            Ok(name)
+        }
+        Some(_) => Err(bad(cur)),
+        None => Err(cur.error(
+            start,
+            MeshErrorKind::Truncated {
+                what: "the $PhysicalNames section",
+            },
+        )),
+    }
+}
+
+/// Skips a section the reader does not use, up to `$End<name>`.
+fn skip_section(cur: &mut Cursor<'_>, pos: usize, keyword: &[u8]) -> Result<()> {
+    let name = keyword.get(1..).unwrap_or_default();
+    let mut end = Vec::with_capacity(4 + name.len());
+    end.extend_from_slice(b"$End");
+    end.extend_from_slice(name);
+    let bytes = cur.bytes;
+    let mut p = cur.pos;
+    while let Some(k) = bytes
+        .get(p..)
+        .and_then(|r| r.iter().position(|&c| c == b'$'))
+    {
+        let at = p + k;
+        let after = at + end.len();
+        if bytes.get(at..after) == Some(&end[..])
+            && bytes.get(after).is_none_or(|c| c.is_ascii_whitespace())
+        {
+            cur.pos = after;
+            return Ok(());
+        }
+        p = at + 1;
+    }
+    let section = String::from_utf8_lossy(keyword).into_owned();
+    Err(cur.error(
+        pos,
+        MeshErrorKind::MissingEnd {
+            end: format!("$End{}", section.get(1..).unwrap_or_default()),
+            section,
+        },
+    ))
 }

@@ -1,0 +1,700 @@
+//! Collects what the version-specific parsers read (nodes, then elements)
+//! into a [`Mesh`], checking as it goes: node tags map to dense indices,
+//! every cell is oriented counter-clockwise with a positive Jacobian at its
+//! corners, boundary elements of groups lie on cell sides and are oriented
+//! with their cell on the left.
+
+use std::collections::{BTreeMap, HashMap};
+
+use super::cursor::{Cursor, Result};
+use crate::{CellKind, Edge, Group, Mesh, MeshError, MeshErrorKind, SourceInfo};
+
+/// Gmsh element types the reader knows by name.
+pub(crate) const POINT: i32 = 15;
+pub(crate) const LINE2: i32 = 1;
+pub(crate) const LINE3: i32 = 8;
+pub(crate) const QUAD4: i32 = 3;
+pub(crate) const QUAD9: i32 = 10;
+
+/// Nodes per element for the types the reader accepts.
+pub(crate) fn nodes_of(type_id: i32) -> Option<usize> {
+    match type_id {
+        POINT => Some(1),
+        LINE2 => Some(2),
+        LINE3 => Some(3),
+        QUAD4 => Some(4),
+        QUAD9 => Some(9),
+        _ => None,
+    }
+}
+
+/// Gmsh's name and dimension of an element type (for messages).
+fn describe(type_id: i32) -> (&'static str, u8) {
+    match type_id {
+        2 => ("tri3", 2),
+        9 => ("tri6", 2),
+        16 => ("quad8", 2),
+        20 => ("tri9", 2),
+        21 => ("tri10", 2),
+        22 => ("tri12", 2),
+        23 | 24 => ("tri15", 2),
+        25 => ("tri21", 2),
+        36 | 40 => ("quad16", 2),
+        37 | 41 => ("quad25", 2),
+        38 => ("quad36", 2),
+        39 => ("quad12", 2),
+        42..=46 | 52..=55 => ("high-order triangle", 2),
+        47..=51 | 56..=59 => ("high-order quadrangle", 2),
+        4 => ("tet4", 3),
+        5 => ("hex8", 3),
+        6 => ("prism6", 3),
+        7 => ("pyramid5", 3),
+        11 => ("tet10", 3),
+        12 => ("hex27", 3),
+        13 => ("prism18", 3),
+        14 => ("pyramid14", 3),
+        17 => ("hex20", 3),
+        18 => ("prism15", 3),
+        19 => ("pyramid13", 3),
+        26 => ("line4", 1),
+        27 => ("line5", 1),
+        28 => ("line6", 1),
+        _ => ("unknown type", 9),
+    }
+}
+
+/// The error for an element type the reader does not take.
+pub(crate) fn unsupported(cur: &Cursor<'_>, pos: usize, element: u64, type_id: i32) -> MeshError {
+    let (name, dim) = describe(type_id);
+    if dim == 2 {
+        cur.error(
+            pos,
+            MeshErrorKind::NotQuads {
+                found: format!("{name} (Gmsh type {type_id})"),
+            },
+        )
+    } else {
+        cur.error(
+            pos,
+            MeshErrorKind::UnsupportedElement {
+                element,
+                type_id,
+                name,
+            },
+        )
+    }
+}
+
+/// Dense indices from Gmsh node tags.
+#[derive(Debug)]
+enum NodeIndex {
+    /// Tags are `first, first + 1, …` in file order (Gmsh's usual output).
+    Offset(u64),
+    /// `table[tag - min]`, `u32::MAX` where no node has that tag.
+    Table { min: u64, table: Vec<u32> },
+    /// Sparse tags.
+    Map(HashMap<u64, u32>),
+}
+
+/// Relative tolerance on corner Jacobians: `det <= TOL * |a| |b|` means the
+/// corner angle is 0 or 180 degrees within rounding of Gmsh's coordinates.
+const JACOBIAN_TOL: f64 = 1e-10;
+
+/// A z coordinate up to this times the xy extent counts as 0 (Gmsh writes
+/// rounded coordinates).
+const Z_TOL: f64 = 1e-12;
+
+/// Which physical groups an element belongs to: an index into
+/// `Builder::memberships` (0 is "no group").
+pub(crate) type Membership = u32;
+
+/// The previous element, to merge the copies MSH 2.2 writes of an element
+/// that is in several physical groups (one copy per group, consecutive).
+#[derive(Debug, Default)]
+struct Previous {
+    type_id: i32,
+    elementary: i32,
+    nodes: [u64; 9],
+    /// Index of the element in its list (cells, lines or points).
+    index: usize,
+    valid: bool,
+}
+
+#[derive(Debug)]
+pub(crate) struct Builder {
+    pub(crate) version: &'static str,
+    pub(crate) binary: bool,
+    pub(crate) nodes: Vec<[f64; 2]>,
+    pub(crate) node_tags: Vec<u64>,
+    /// The z of largest magnitude seen and the node's tag.
+    pub(crate) max_z: (f64, u64),
+    index: Option<NodeIndex>,
+    /// Physical tag lists; entry 0 is empty.
+    pub(crate) memberships: Vec<Vec<i32>>,
+    membership_ids: HashMap<Vec<i32>, Membership>,
+    pub(crate) names: BTreeMap<(u8, i32), String>,
+    kind: Option<CellKind>,
+    cells: Vec<usize>,
+    cell_tags: Vec<u64>,
+    cell_member: Vec<Membership>,
+    reoriented: usize,
+    /// Boundary lines: end, end, mid (`usize::MAX` for line2).
+    lines: Vec<[usize; 3]>,
+    line_tags: Vec<u64>,
+    line_member: Vec<Membership>,
+    line_pos: Vec<usize>,
+    points: Vec<usize>,
+    point_member: Vec<Membership>,
+    counts: [usize; 3],
+    prev: Previous,
+}
+
+impl Builder {
+    pub(crate) fn new(version: &'static str, binary: bool) -> Self {
+        Builder {
+            version,
+            binary,
+            nodes: Vec::new(),
+            node_tags: Vec::new(),
+            max_z: (0.0, 0),
+            index: None,
+            memberships: vec![Vec::new()],
+            membership_ids: HashMap::new(),
+            names: BTreeMap::new(),
+            kind: None,
+            cells: Vec::new(),
+            cell_tags: Vec::new(),
+            cell_member: Vec::new(),
+            reoriented: 0,
+            lines: Vec::new(),
+            line_tags: Vec::new(),
+            line_member: Vec::new(),
+            line_pos: Vec::new(),
+            points: Vec::new(),
+            point_member: Vec::new(),
+            counts: [0; 3],
+            prev: Previous::default(),
+        }
+    }
+
+    /// The membership id of a list of physical tags (sorted, without repeats).
+    pub(crate) fn membership(&mut self, mut tags: Vec<i32>) -> Membership {
+        tags.sort_unstable();
+        tags.dedup();
+        if tags.is_empty() {
+            return 0;
+        }
+        if let Some(&id) = self.membership_ids.get(&tags) {
+            return id;
+        }
+        let id = self.memberships.len() as Membership;
+        self.memberships.push(tags.clone());
+        self.membership_ids.insert(tags, id);
+        id
+    }
+
+    #[inline]
+    pub(crate) fn push_node(&mut self, tag: u64, x: f64, y: f64, z: f64) {
+        self.node_tags.push(tag);
+        self.push_xyz(x, y, z, tag);
+    }
+
+    /// Coordinates of a node whose tag was pushed before (4.1 gives a
+    /// block's tags first, then its coordinates).
+    #[inline]
+    pub(crate) fn push_xyz(&mut self, x: f64, y: f64, z: f64, tag: u64) {
+        if z.abs() > self.max_z.0.abs() {
+            self.max_z = (z, tag);
+        }
+        self.nodes.push([x, y]);
+    }
+
+    /// Called once all nodes are read: builds the tag → index map.
+    pub(crate) fn finish_nodes(&mut self, cur: &Cursor<'_>, pos: usize) -> Result<()> {
+        let n = self.node_tags.len();
+        if n >= u32::MAX as usize {
+            return Err(cur.error(
+                pos,
+                MeshErrorKind::TooLarge {
+                    what: "nodes",
+                    limit: u64::from(u32::MAX) - 1,
+                },
+            ));
+        }
+        let first = self.node_tags.first().copied().unwrap_or(0);
+        let consecutive = self
+            .node_tags
+            .iter()
+            .enumerate()
+            .all(|(i, &t)| first.checked_add(i as u64) == Some(t));
+        let index = if consecutive {
+            NodeIndex::Offset(first)
+        } else {
+            let min = self.node_tags.iter().copied().min().unwrap_or(0);
+            let max = self.node_tags.iter().copied().max().unwrap_or(0);
+            let span = max - min;
+            if span <= 4 * n as u64 + 1024 {
+                let mut table = vec![u32::MAX; span as usize + 1];
+                for (i, &t) in self.node_tags.iter().enumerate() {
+                    let slot = &mut table[(t - min) as usize];
+                    if *slot != u32::MAX {
+                        return Err(cur.error(pos, MeshErrorKind::DuplicateNode { tag: t }));
+                    }
+                    *slot = i as u32;
+                }
+                NodeIndex::Table { min, table }
+            } else {
+                let mut map = HashMap::with_capacity(n);
+                for (i, &t) in self.node_tags.iter().enumerate() {
+                    if map.insert(t, i as u32).is_some() {
+                        return Err(cur.error(pos, MeshErrorKind::DuplicateNode { tag: t }));
+                    }
+                }
+                NodeIndex::Map(map)
+            }
+        };
+        self.index = Some(index);
+        Ok(())
+    }
+
+    #[inline]
+    fn node_index(&self, tag: u64) -> Option<usize> {
+        match self.index.as_ref()? {
+            NodeIndex::Offset(first) => {
+                let i = tag.checked_sub(*first)?;
+                (i < self.nodes.len() as u64).then_some(i as usize)
+            }
+            NodeIndex::Table { min, table } => {
+                let i = *table.get(usize::try_from(tag.checked_sub(*min)?).ok()?)?;
+                (i != u32::MAX).then_some(i as usize)
+            }
+            NodeIndex::Map(map) => map.get(&tag).map(|&i| i as usize),
+        }
+    }
+
+    /// Adds one element. `nodes` holds its Gmsh node tags (negative tags of
+    /// 2.2 files are passed as `-1`, which never matches a node).
+    /// `elementary` is the 2.2 elementary tag (to merge per-group copies);
+    /// 4.1 passes `None` since it writes each element once.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn element(
+        &mut self,
+        cur: &Cursor<'_>,
+        pos: usize,
+        type_id: i32,
+        tag: u64,
+        nodes: &[u64],
+        member: Membership,
+        elementary: Option<i32>,
+    ) -> Result<()> {
+        if let Some(elementary) = elementary {
+            let p = &self.prev;
+            if p.valid
+                && p.type_id == type_id
+                && p.elementary == elementary
+                && p.nodes.get(..nodes.len()) == Some(nodes)
+            {
+                return self.merge_previous(type_id, member);
+            }
+        }
+        let mut idx = [0usize; 9];
+        for (k, &t) in nodes.iter().enumerate() {
+            match self.node_index(t) {
+                Some(i) => idx[k] = i,
+                None => {
+                    let node = i64::try_from(t).unwrap_or(-1);
+                    return Err(cur.error(pos, MeshErrorKind::MissingNode { element: tag, node }));
+                }
+            }
+        }
+        let index = match type_id {
+            QUAD4 | QUAD9 => {
+                let kind = if type_id == QUAD4 {
+                    CellKind::Quad4
+                } else {
+                    CellKind::Quad9
+                };
+                match self.kind {
+                    None => {
+                        self.kind = Some(kind);
+                        // Cells are usually the bulk of what is left.
+                        let per = if self.binary {
+                            8 * (1 + nodes.len())
+                        } else {
+                            2 * (1 + nodes.len())
+                        };
+                        let cap = cur.capped(u64::MAX, per);
+                        self.cells.reserve(cap * nodes.len());
+                        self.cell_tags.reserve(cap);
+                        self.cell_member.reserve(cap);
+                    }
+                    Some(k) if k != kind => {
+                        return Err(cur.error(
+                            pos,
+                            MeshErrorKind::NotQuads {
+                                found: "quad4 and quad9 cells together".into(),
+                            },
+                        ))
+                    }
+                    Some(_) => {}
+                }
+                let cell = &mut idx[..nodes.len()];
+                match self.orientation(cell) {
+                    Some(true) => {}
+                    Some(false) => {
+                        reverse(cell);
+                        self.reoriented += 1;
+                    }
+                    None => {
+                        return Err(cur.error(pos, MeshErrorKind::DegenerateCell { element: tag }))
+                    }
+                }
+                self.cells.extend_from_slice(cell);
+                self.cell_tags.push(tag);
+                self.cell_member.push(member);
+                self.cell_tags.len() - 1
+            }
+            LINE2 | LINE3 => {
+                let mid = if type_id == LINE3 { idx[2] } else { usize::MAX };
+                self.lines.push([idx[0], idx[1], mid]);
+                self.line_tags.push(tag);
+                self.line_member.push(member);
+                self.line_pos.push(pos);
+                self.counts[usize::from(type_id == LINE3)] += 1;
+                self.lines.len() - 1
+            }
+            POINT => {
+                self.points.push(idx[0]);
+                self.point_member.push(member);
+                self.counts[2] += 1;
+                self.points.len() - 1
+            }
+            _ => return Err(unsupported(cur, pos, tag, type_id)),
+        };
+        if let Some(elementary) = elementary {
+            self.prev.type_id = type_id;
+            self.prev.elementary = elementary;
+            self.prev.nodes[..nodes.len()].copy_from_slice(nodes);
+            self.prev.index = index;
+            self.prev.valid = true;
+        }
+        Ok(())
+    }
+
+    /// A 2.2 copy of the previous element for another physical group.
+    fn merge_previous(&mut self, type_id: i32, member: Membership) -> Result<()> {
+        let i = self.prev.index;
+        let slot = match type_id {
+            QUAD4 | QUAD9 => self.cell_member.get_mut(i),
+            LINE2 | LINE3 => self.line_member.get_mut(i),
+            _ => self.point_member.get_mut(i),
+        };
+        if let Some(slot) = slot {
+            let old = *slot as usize;
+            let mut tags = self.memberships.get(old).cloned().unwrap_or_default();
+            tags.extend(
+                self.memberships
+                    .get(member as usize)
+                    .into_iter()
+                    .flatten()
+                    .copied(),
+            );
+            let id = self.membership(tags);
+            if let Some(slot) = match type_id {
+                QUAD4 | QUAD9 => self.cell_member.get_mut(i),
+                LINE2 | LINE3 => self.line_member.get_mut(i),
+                _ => self.point_member.get_mut(i),
+            } {
+                *slot = id;
+            }
+        }
+        Ok(())
+    }
+
+    /// `Some(true)` if the cell is counter-clockwise with positive Jacobian
+    /// determinants at all four corners, `Some(false)` if all four are
+    /// negative (clockwise), `None` if degenerate or tangled.
+    fn orientation(&self, cell: &[usize]) -> Option<bool> {
+        let p = |k: usize| self.nodes[cell[k]];
+        let mut sign = 0i8;
+        for i in 0..4 {
+            let (next, prev) = ((i + 1) % 4, (i + 3) % 4);
+            let c = p(i);
+            // Tangents of the two sides leaving corner i: for quad4 the
+            // sides themselves; for quad9 the derivative of the quadratic
+            // side through corner, mid-side node and far corner at the
+            // corner, (-3 c + 4 m - far) / 2.
+            let (a, b) = if cell.len() == 9 {
+                let (mn, mp) = (p(4 + i), p(4 + prev));
+                let (fnx, fpr) = (p(next), p(prev));
+                let t = |m: [f64; 2], f: [f64; 2]| {
+                    [
+                        0.5 * (-3.0 * c[0] + 4.0 * m[0] - f[0]),
+                        0.5 * (-3.0 * c[1] + 4.0 * m[1] - f[1]),
+                    ]
+                };
+                (t(mn, fnx), t(mp, fpr))
+            } else {
+                let (n, q) = (p(next), p(prev));
+                ([n[0] - c[0], n[1] - c[1]], [q[0] - c[0], q[1] - c[1]])
+            };
+            let det = a[0] * b[1] - a[1] * b[0];
+            let scale = a[0].hypot(a[1]) * b[0].hypot(b[1]);
+            let s = if det > JACOBIAN_TOL * scale {
+                1
+            } else if det < -JACOBIAN_TOL * scale {
+                -1
+            } else {
+                return None;
+            };
+            if sign != 0 && s != sign {
+                return None;
+            }
+            sign = s;
+        }
+        Some(sign > 0)
+    }
+
+    /// Checks the whole mesh and assembles the groups.
+    pub(crate) fn finish(self, cur: &Cursor<'_>) -> Result<Mesh> {
+        let Builder {
+            version,
+            binary,
+            nodes,
+            node_tags,
+            max_z,
+            memberships,
+            names,
+            kind,
+            cells,
+            cell_tags,
+            cell_member,
+            reoriented,
+            lines,
+            line_tags,
+            line_member,
+            line_pos,
+            points,
+            point_member,
+            counts,
+            ..
+        } = self;
+        let Some(kind) = kind else {
+            return Err(MeshError::new(MeshErrorKind::NoCells));
+        };
+        let npc = kind.nodes_per_cell();
+        // z must be 0 up to rounding relative to the mesh size.
+        let mut bb = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
+        for p in &nodes {
+            for k in 0..2 {
+                bb[0][k] = bb[0][k].min(p[k]);
+                bb[1][k] = bb[1][k].max(p[k]);
+            }
+        }
+        let extent = (bb[1][0] - bb[0][0]).max(bb[1][1] - bb[0][1]).max(0.0);
+        if max_z.0.abs() > Z_TOL * extent {
+            return Err(MeshError::new(MeshErrorKind::NotPlanar {
+                node: max_z.1,
+                z: max_z.0,
+            }));
+        }
+
+        // Groups, keyed (dim, tag) so the BTreeMap gives the required order.
+        let mut acc: BTreeMap<(u8, i32), Group> = BTreeMap::new();
+        fn ensure(
+            acc: &mut BTreeMap<(u8, i32), Group>,
+            names: &BTreeMap<(u8, i32), String>,
+            dim: u8,
+            tag: i32,
+        ) -> (u8, i32) {
+            acc.entry((dim, tag)).or_insert_with(|| Group {
+                name: names
+                    .get(&(dim, tag))
+                    .cloned()
+                    .unwrap_or_else(|| format!("#{tag}")),
+                tag,
+                dim,
+                edges: Vec::new(),
+                cells: Vec::new(),
+                points: Vec::new(),
+                nodes: Vec::new(),
+                elements: 0,
+            });
+            (dim, tag)
+        }
+        let group =
+            |acc: &mut BTreeMap<(u8, i32), Group>, dim: u8, tag: i32| ensure(acc, &names, dim, tag);
+        // Named groups of dimension 0-2 exist even without elements.
+        for &(dim, tag) in names.keys() {
+            if dim <= 2 {
+                group(&mut acc, dim, tag);
+            }
+        }
+        let mut keys: Vec<(u8, i32)> = Vec::new();
+        let mut last = Membership::MAX;
+        for (c, &m) in cell_member.iter().enumerate() {
+            if m != last {
+                last = m;
+                keys.clear();
+                for &t in memberships.get(m as usize).into_iter().flatten() {
+                    keys.push(group(&mut acc, 2, t));
+                }
+            }
+            for k in &keys {
+                if let Some(g) = acc.get_mut(k) {
+                    g.cells.push(c);
+                    g.elements += 1;
+                }
+            }
+        }
+        for (i, &m) in point_member.iter().enumerate() {
+            for &t in memberships.get(m as usize).into_iter().flatten() {
+                let k = group(&mut acc, 0, t);
+                if let Some(g) = acc.get_mut(&k) {
+                    g.points.push(points[i]);
+                    g.elements += 1;
+                }
+            }
+        }
+
+        // Boundary lines of groups: find the cell side each one is.
+        let grouped: Vec<usize> = (0..lines.len()).filter(|&l| line_member[l] != 0).collect();
+        let mut marked = vec![false; if grouped.is_empty() { 0 } else { nodes.len() }];
+        let mut sides: HashMap<(usize, usize), Option<(usize, usize)>> =
+            HashMap::with_capacity(grouped.len());
+        for &l in &grouped {
+            let [a, b, mid] = lines[l];
+            if (mid == usize::MAX) != (kind == CellKind::Quad4) {
+                let line = if mid == usize::MAX { "line2" } else { "line3" };
+                return Err(cur.error(
+                    line_pos[l],
+                    MeshErrorKind::OrderMismatch {
+                        element: line_tags[l],
+                        line,
+                        cells: kind.name(),
+                    },
+                ));
+            }
+            marked[a] = true;
+            marked[b] = true;
+            sides.insert((a.min(b), a.max(b)), None);
+        }
+        if !grouped.is_empty() {
+            for (c, cell) in cells.chunks_exact(npc).enumerate() {
+                for i in 0..4 {
+                    let (a, b) = (cell[i], cell[(i + 1) % 4]);
+                    if marked[a] && marked[b] {
+                        if let Some(slot @ None) = sides.get_mut(&(a.min(b), a.max(b))) {
+                            *slot = Some((c, i));
+                        }
+                    }
+                }
+            }
+        }
+        for &l in &grouped {
+            let [a, b, mid] = lines[l];
+            let found = sides.get(&(a.min(b), a.max(b))).copied().flatten();
+            let edge = found.and_then(|(c, i)| {
+                let cell = cells.get(c * npc..(c + 1) * npc)?;
+                if mid != usize::MAX && cell.get(4 + i) != Some(&mid) {
+                    return None;
+                }
+                let nodes = if cell[i] == a { [a, b] } else { [b, a] };
+                Some(Edge {
+                    nodes,
+                    mid: (mid != usize::MAX).then_some(mid),
+                    cell: c,
+                })
+            });
+            for &t in memberships
+                .get(line_member[l] as usize)
+                .into_iter()
+                .flatten()
+            {
+                let k = group(&mut acc, 1, t);
+                let Some(g) = acc.get_mut(&k) else { continue };
+                match edge {
+                    Some(e) => {
+                        g.edges.push(e);
+                        g.elements += 1;
+                    }
+                    None => {
+                        return Err(cur.error(
+                            line_pos[l],
+                            MeshErrorKind::EdgeNotOnCell {
+                                element: line_tags[l],
+                                group: g.name.clone(),
+                            },
+                        ))
+                    }
+                }
+            }
+        }
+
+        // Node sets: a mark array for big groups, sort + dedup for small ones.
+        let mut mark = Vec::new();
+        for g in acc.values_mut() {
+            let touched: usize = g.cells.len() * npc + g.edges.len() * 3 + g.points.len();
+            let mut list = Vec::with_capacity(touched.min(nodes.len()));
+            let push_all = |f: &mut dyn FnMut(usize)| {
+                for &c in &g.cells {
+                    for &n in &cells[c * npc..(c + 1) * npc] {
+                        f(n);
+                    }
+                }
+                for e in &g.edges {
+                    f(e.nodes[0]);
+                    f(e.nodes[1]);
+                    if let Some(m) = e.mid {
+                        f(m);
+                    }
+                }
+                for &p in &g.points {
+                    f(p);
+                }
+            };
+            if touched > nodes.len() / 8 {
+                mark.clear();
+                mark.resize(nodes.len(), false);
+                push_all(&mut |n| mark[n] = true);
+                list.extend(mark.iter().enumerate().filter(|(_, &m)| m).map(|(i, _)| i));
+            } else {
+                push_all(&mut |n| list.push(n));
+                list.sort_unstable();
+                list.dedup();
+            }
+            g.nodes = list;
+        }
+
+        let mut boundary_elements = BTreeMap::new();
+        for (name, n) in ["line2", "line3", "point"].into_iter().zip(counts) {
+            if n > 0 {
+                boundary_elements.insert(name.to_string(), n);
+            }
+        }
+        Ok(Mesh {
+            nodes,
+            node_tags,
+            kind,
+            cells,
+            cell_tags,
+            groups: acc.into_values().collect(),
+            source: SourceInfo {
+                version: version.to_string(),
+                binary,
+                reoriented,
+                boundary_elements,
+            },
+        })
+    }
+}
+
+/// Reverses a cell's orientation keeping node 0: corners 0 3 2 1, and for
+/// quad9 the mid-side nodes follow their sides (7 6 5 4), the centre stays.
+fn reverse(cell: &mut [usize]) {
+    cell.swap(1, 3);
+    if cell.len() == 9 {
+        cell.swap(4, 7);
+        cell.swap(5, 6);
+    }
+}

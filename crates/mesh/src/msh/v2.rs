@@ -1,0 +1,229 @@
+//! MSH 2.2 `$Nodes` and `$Elements`, ASCII and binary.
+//!
+//! Physical membership is the element's first tag. Gmsh writes an element
+//! that is in several physical groups once per group, consecutively and
+//! under new element numbers; [`Builder::element`] merges those copies
+//! (same type, elementary tag and nodes as the previous element).
+
+use std::collections::HashMap;
+
+use super::build::{nodes_of, unsupported, Builder, Membership};
+use super::cursor::{le_f64, le_i32, Cursor, Result};
+use crate::MeshErrorKind;
+
+pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
+    cur.enter("$Nodes", "$EndNodes");
+    cur.skip_ws();
+    let header = cur.pos;
+    let n = cur.u64("the number of nodes")?;
+    cur.counts("nodes", n);
+    if cur.binary {
+        cur.end_of_line()?;
+        let start = cur.pos;
+        let data = cur.take_items(n, 28, "nodes")?;
+        b.nodes.reserve(data.len() / 28);
+        b.node_tags.reserve(data.len() / 28);
+        for (i, rec) in data.chunks_exact(28).enumerate() {
+            let at = start + 28 * i;
+            let tag = u64::try_from(le_i32(rec)).map_err(|_| {
+                cur.error(
+                    at,
+                    MeshErrorKind::Malformed {
+                        what: format!("node tag {} is negative", le_i32(rec)),
+                    },
+                )
+            })?;
+            let (x, y, z) = (le_f64(&rec[4..]), le_f64(&rec[12..]), le_f64(&rec[20..]));
+            if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+                return Err(cur.error(
+                    at + 4,
+                    MeshErrorKind::NotANumber {
+                        what: "a node coordinate",
+                        found: format!("{x} {y} {z}"),
+                    },
+                ));
+            }
+            b.push_node(tag, x, y, z);
+        }
+    } else {
+        // A node line is at least "1 0 0 0\n".
+        let cap = cur.capped(n, 8);
+        b.nodes.reserve(cap);
+        b.node_tags.reserve(cap);
+        for _ in 0..n {
+            let tag = cur.u64("a node tag")?;
+            let x = cur.f64("a node coordinate")?;
+            let y = cur.f64("a node coordinate")?;
+            let z = cur.f64("a node coordinate")?;
+            b.push_node(tag, x, y, z);
+        }
+    }
+    cur.expect_end()?;
+    b.finish_nodes(cur, header)
+}
+
+/// Physical tag → membership id, without a Vec per element.
+#[derive(Default)]
+struct Members {
+    last: Option<(i32, Membership)>,
+    ids: HashMap<i32, Membership>,
+}
+
+impl Members {
+    fn get(&mut self, b: &mut Builder, phys: i32) -> Membership {
+        if phys == 0 {
+            return 0;
+        }
+        if let Some((p, id)) = self.last {
+            if p == phys {
+                return id;
+            }
+        }
+        let id = *self
+            .ids
+            .entry(phys)
+            .or_insert_with(|| b.membership(vec![phys]));
+        self.last = Some((phys, id));
+        id
+    }
+}
+
+pub(crate) fn elements(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
+    cur.enter("$Elements", "$EndElements");
+    let n = cur.u64("the number of elements")?;
+    cur.counts("elements", n);
+    let mut members = Members::default();
+    let mut nodes = [0u64; 9];
+    if cur.binary {
+        cur.end_of_line()?;
+        let mut read: u64 = 0;
+        while read < n {
+            if cur.at_keyword() {
+                return Err(cur.wrong_count(cur.pos));
+            }
+            let hp = cur.pos;
+            let type_id = cur.bin_i32("an element type")?;
+            let following = cur.bin_i32("an element count")?;
+            let ntags = cur.bin_i32("a number of tags")?;
+            let (Ok(following), Ok(ntags)) = (u64::try_from(following), usize::try_from(ntags))
+            else {
+                return Err(cur.error(
+                    hp,
+                    MeshErrorKind::Malformed {
+                        what: "negative element count in a binary element header".into(),
+                    },
+                ));
+            };
+            if following == 0 || following > n - read {
+                return Err(cur.wrong_count(hp));
+            }
+            let Some(nn) = nodes_of(type_id) else {
+                let first = cur
+                    .bytes
+                    .get(cur.pos..cur.pos + 4)
+                    .map_or(0, |t| u64::try_from(le_i32(t)).unwrap_or(0));
+                return Err(unsupported(cur, hp, first, type_id));
+            };
+            let size = ntags.checked_add(1 + nn).and_then(|k| k.checked_mul(4));
+            let Some(size) = size else {
+                return Err(cur.error(
+                    hp,
+                    MeshErrorKind::Truncated {
+                        what: "the $Elements section",
+                    },
+                ));
+            };
+            let start = cur.pos;
+            let data = cur.take_items(following, size, "elements")?;
+            for (i, rec) in data.chunks_exact(size).enumerate() {
+                let at = start + size * i;
+                let tag = u64::try_from(le_i32(rec)).map_err(|_| {
+                    cur.error(
+                        at,
+                        MeshErrorKind::Malformed {
+                            what: format!("element tag {} is negative", le_i32(rec)),
+                        },
+                    )
+                })?;
+                let tags = &rec[4..4 + 4 * ntags];
+                let phys = tags.get(..4).map_or(0, le_i32);
+                let elementary = tags.get(4..8).map_or(0, le_i32);
+                for (k, t) in rec[4 + 4 * ntags..].chunks_exact(4).enumerate() {
+                    let v = le_i32(t);
+                    nodes[k] = u64::try_from(v).map_err(|_| {
+                        cur.error(
+                            at,
+                            MeshErrorKind::MissingNode {
+                                element: tag,
+                                node: i64::from(v),
+                            },
+                        )
+                    })?;
+                }
+                let member = members.get(b, phys);
+                b.element(
+                    cur,
+                    at,
+                    type_id,
+                    tag,
+                    &nodes[..nn],
+                    member,
+                    Some(elementary),
+                )?;
+            }
+            read += following;
+        }
+    } else {
+        for _ in 0..n {
+            cur.skip_ws();
+            let at = cur.pos;
+            let tag = cur.u64("an element tag")?;
+            let type_id = cur.i32("an element type")?;
+            let ntags = cur.u64("the number of element tags")?;
+            let (mut phys, mut elementary) = (0i32, 0i32);
+            for k in 0..ntags {
+                let (p, v) = cur.i64("an element tag (physical, elementary, ...)")?;
+                let v = i32::try_from(v).map_err(|_| {
+                    cur.error(
+                        p,
+                        MeshErrorKind::NotANumber {
+                            what: "a 32-bit element tag",
+                            found: v.to_string(),
+                        },
+                    )
+                })?;
+                match k {
+                    0 => phys = v,
+                    1 => elementary = v,
+                    _ => {}
+                }
+            }
+            let Some(nn) = nodes_of(type_id) else {
+                return Err(unsupported(cur, at, tag, type_id));
+            };
+            for slot in nodes.iter_mut().take(nn) {
+                let (_, v) = cur.i64("a node tag")?;
+                *slot = u64::try_from(v).map_err(|_| {
+                    cur.error(
+                        at,
+                        MeshErrorKind::MissingNode {
+                            element: tag,
+                            node: v,
+                        },
+                    )
+                })?;
+            }
+            let member = members.get(b, phys);
+            b.element(
+                cur,
+                at,
+                type_id,
+                tag,
+                &nodes[..nn],
+                member,
+                Some(elementary),
+            )?;
+        }
+    }
+    cur.expect_end()
+}
