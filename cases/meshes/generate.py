@@ -91,7 +91,9 @@ def make_mesh(geo, order, params, snap):
     if set(counts) != {QUAD_TYPES[order]}:
         names = {t: gmsh.model.mesh.getElementProperties(t)[0] for t in counts}
         raise SystemExit(f"{geo} order {order}: expected only Gmsh type {QUAD_TYPES[order]} cells, got {names} {counts}")
-    nodes = len(gmsh.model.mesh.getNodes()[0])
+    # Nodes written = nodes of the cells (getNodes() would also count
+    # geometry points that no cell uses, e.g. the hole's centre).
+    nodes = len(set(int(n) for n in gmsh.model.mesh.getElements(2)[2][0]))
     return nodes, counts[QUAD_TYPES[order]]
 
 

@@ -1,0 +1,155 @@
+//! Read-speed and memory benchmark of the .msh reader (issue 2, Performance),
+//! driven by `cargo xtask bench mesh`, usable alone:
+//!
+//! ```text
+//! cargo run -p stickslip-mesh --example bench_read -- FILE.msh [RUNS]
+//! ```
+//!
+//! Times `Mesh::from_file` (file read from the page cache + parse + checks)
+//! RUNS times (default 5) and prints the median and MB/s. Memory: the peak
+//! resident set (`VmHWM` of /proc/self/status) during one read, above the
+//! resident set before it, compared with the `Mesh`'s own size estimated from
+//! its Vec lengths. That peak includes the file's bytes, which `from_file`
+//! holds while parsing, so it is reported as is, not netted out.
+//! The last line is `RESULT key=value …` for xtask to parse.
+
+use std::process::ExitCode;
+use std::time::Instant;
+
+use stickslip_mesh::{Edge, Group, Mesh};
+
+fn main() -> ExitCode {
+    let mut args = std::env::args().skip(1);
+    let Some(path) = args.next() else {
+        eprintln!("usage: bench_read FILE.msh [RUNS]");
+        return ExitCode::from(2);
+    };
+    let runs: usize = match args.next().map(|s| s.parse()) {
+        None => 5,
+        Some(Ok(n)) if n > 0 => n,
+        Some(_) => {
+            eprintln!("RUNS must be a positive integer");
+            return ExitCode::from(2);
+        }
+    };
+    let file_bytes = match std::fs::metadata(&path) {
+        Ok(m) => m.len(),
+        Err(e) => {
+            eprintln!("{path}: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+
+    // Memory: one read with the peak counter reset just before it.
+    let hwm_reset = reset_peak_rss();
+    let rss_before = proc_status_kib("VmRSS");
+    let mesh = match Mesh::from_file(&path) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let hwm = proc_status_kib("VmHWM");
+    let mesh_bytes = mesh_size_bytes(&mesh);
+    println!(
+        "{path}: MSH {} {}, {} nodes, {} {} cells, {} groups",
+        mesh.source.version,
+        if mesh.source.binary {
+            "binary"
+        } else {
+            "ASCII"
+        },
+        mesh.nodes.len(),
+        mesh.n_cells(),
+        mesh.kind.name(),
+        mesh.groups.len()
+    );
+    drop(mesh);
+
+    // Speed: median of `runs` reads (the first read above warmed the page cache).
+    let mut times = Vec::with_capacity(runs);
+    for _ in 0..runs {
+        let t = Instant::now();
+        let m = Mesh::from_file(&path);
+        let dt = t.elapsed().as_secs_f64();
+        if let Err(e) = m {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+        drop(m);
+        times.push(dt);
+    }
+    times.sort_by(f64::total_cmp);
+    let median = times[times.len() / 2];
+    let mbps = file_bytes as f64 / 1e6 / median;
+
+    println!("file size        {:>10.1} MB", file_bytes as f64 / 1e6);
+    println!(
+        "read (median/{runs})  {:>10.3} s   ({:.3} .. {:.3} s)",
+        median,
+        times[0],
+        times[times.len() - 1]
+    );
+    println!("throughput       {mbps:>10.1} MB/s");
+    println!(
+        "Mesh size        {:>10.1} MB (from Vec lengths)",
+        mesh_bytes as f64 / 1e6
+    );
+    let (peak, ratio) = match (hwm, rss_before) {
+        (Some(h), Some(b)) if hwm_reset => {
+            let peak = h.saturating_sub(b) * 1024;
+            let ratio = peak as f64 / mesh_bytes as f64;
+            println!(
+                "peak RSS growth  {:>10.1} MB during one read = {ratio:.2} x the Mesh (includes the {:.1} MB of file bytes held while parsing)",
+                peak as f64 / 1e6,
+                file_bytes as f64 / 1e6
+            );
+            (peak.to_string(), format!("{ratio:.3}"))
+        }
+        (Some(h), _) => {
+            println!(
+                "peak RSS         {:>10.1} MB (whole process; could not reset VmHWM, so not a per-read figure)",
+                (h * 1024) as f64 / 1e6
+            );
+            ("nan".into(), "nan".into())
+        }
+        _ => {
+            println!("peak RSS         unavailable (no /proc/self/status)");
+            ("nan".into(), "nan".into())
+        }
+    };
+    println!("RESULT file_bytes={file_bytes} median_s={median:.6} mb_per_s={mbps:.3} mesh_bytes={mesh_bytes} peak_bytes={peak} peak_ratio={ratio}");
+    ExitCode::SUCCESS
+}
+
+/// The Mesh's heap and inline size from its Vec lengths (not capacities).
+fn mesh_size_bytes(m: &Mesh) -> usize {
+    use std::mem::size_of;
+    let mut n = size_of::<Mesh>()
+        + m.nodes.len() * size_of::<[f64; 2]>()
+        + m.node_tags.len() * size_of::<u64>()
+        + m.cells.len() * size_of::<usize>()
+        + m.cell_tags.len() * size_of::<u64>()
+        + m.source.version.len();
+    for g in &m.groups {
+        n += size_of::<Group>()
+            + g.name.len()
+            + g.edges.len() * size_of::<Edge>()
+            + (g.cells.len() + g.points.len() + g.nodes.len()) * size_of::<usize>();
+    }
+    n
+}
+
+/// Resets the process's peak RSS counter (Linux ≥ 4.0: "5" > clear_refs).
+fn reset_peak_rss() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+/// A `kB` field of /proc/self/status, in KiB.
+fn proc_status_kib(key: &str) -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    s.lines()
+        .find_map(|l| l.strip_prefix(key)?.strip_prefix(':'))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+}
