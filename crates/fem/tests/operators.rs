@@ -1,0 +1,193 @@
+//! Assembled operators: rigid-body modes, mass totals, HRZ ratios, shared
+//! pattern, `combine`, and thread-count independence.
+
+use nalgebra_sparse::CsrMatrix;
+use stickslip_fem::testing::{map_nodes, rectangle};
+use stickslip_fem::{Hypothesis, Material, Model};
+use stickslip_mesh::{CellKind, Mesh};
+
+fn material() -> Material {
+    Material::new(1000.0, 0.3, 2.5, Hypothesis::PlaneStrain).unwrap()
+}
+
+/// A 3 × 2 rectangle whose interior nodes are moved by a smooth map that
+/// vanishes on the boundary: distorted Q1 cells, curved Q2 cells; the
+/// domain (and so its area, 6) is unchanged.
+fn distorted(kind: CellKind, nx: usize, ny: usize) -> Mesh {
+    let mut m = rectangle(kind, nx, ny, [0.0, 0.0], [3.0, 2.0]);
+    map_nodes(&mut m, |[x, y]| {
+        let b = (std::f64::consts::PI * x / 3.0).sin() * (std::f64::consts::PI * y / 2.0).sin();
+        [
+            x + 0.18 * b * (1.3 * y).cos(),
+            y + 0.12 * b * (0.7 * x).sin(),
+        ]
+    });
+    m
+}
+
+fn spmv(a: &CsrMatrix<f64>, x: &[f64]) -> Vec<f64> {
+    a.row_iter()
+        .map(|r| {
+            r.col_indices()
+                .iter()
+                .zip(r.values())
+                .map(|(&j, v)| v * x[j])
+                .sum()
+        })
+        .collect()
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Expected (theory): a rigid motion has zero strain, so K r = 0. With no
+/// conditions all DOFs are free and K is the full stiffness. Tolerance
+/// 1e-10 relative to ‖K‖_F ‖r‖ (issue 3).
+#[test]
+fn stiffness_annihilates_the_three_rigid_body_motions() {
+    for kind in [CellKind::Quad4, CellKind::Quad9] {
+        let mesh = distorted(kind, 5, 4);
+        let model = Model::new(&mesh, &material(), &[]).unwrap();
+        assert_eq!(model.dofs.n_free(), 2 * mesh.nodes.len());
+        let k_norm = norm(model.stiffness.values());
+        let motions: [Box<dyn Fn([f64; 2]) -> [f64; 2]>; 3] = [
+            Box::new(|_| [1.0, 0.0]),
+            Box::new(|_| [0.0, 1.0]),
+            Box::new(|[x, y]| [-(y - 1.0), x - 1.5]),
+        ];
+        for (m, motion) in motions.iter().enumerate() {
+            let r: Vec<f64> = mesh.nodes.iter().flat_map(|&p| motion(p)).collect();
+            let kr = spmv(&model.stiffness, &r);
+            let rel = norm(&kr) / (k_norm * norm(&r));
+            assert!(
+                rel < 1e-10,
+                "{kind:?} motion {m}: |K r| / (|K| |r|) = {rel:e}"
+            );
+        }
+    }
+}
+
+/// Expected (closed form): Σ_ab M_ab over one direction = ∫ρ dA = ρ·area,
+/// area = 3 × 2 = 6 (the map moves only interior nodes, so the domain is the
+/// rectangle; det J is a polynomial the full rule integrates exactly). HRZ
+/// preserves the element mass, so the lumped masses sum to the same; no
+/// coupling between directions.
+#[test]
+fn consistent_and_lumped_mass_sum_to_rho_area_per_direction() {
+    let rho = material().density;
+    for kind in [CellKind::Quad4, CellKind::Quad9] {
+        let mesh = distorted(kind, 5, 4);
+        let model = Model::new(&mesh, &material(), &[]).unwrap();
+        assert!(
+            (model.area - 6.0).abs() < 1e-12,
+            "{kind:?} area {}",
+            model.area
+        );
+        for dir in 0..2 {
+            let e: Vec<f64> = (0..mesh.nodes.len())
+                .flat_map(|_| [(dir == 0) as u8 as f64, (dir == 1) as u8 as f64])
+                .collect();
+            let other: Vec<f64> = e.iter().map(|v| 1.0 - v).collect();
+            let me = spmv(&model.mass, &e);
+            let total: f64 = me.iter().zip(&e).map(|(a, b)| a * b).sum();
+            let cross: f64 = me.iter().zip(&other).map(|(a, b)| a * b).sum();
+            assert!(
+                (total - rho * 6.0).abs() < 1e-12,
+                "{kind:?} dir {dir}: consistent {total}"
+            );
+            assert!(cross.abs() < 1e-12);
+            let lumped: f64 = model.lumped_mass.iter().zip(&e).map(|(a, b)| a * b).sum();
+            assert!(
+                (lumped - rho * 6.0).abs() < 1e-12,
+                "{kind:?} dir {dir}: lumped {lumped}"
+            );
+            assert!(model.lumped_mass.iter().all(|&m| m > 0.0));
+        }
+    }
+}
+
+/// Expected (BENCHMARK.md, closed form): HRZ on a rectangular Q2 element
+/// gives corner : mid-side : centre = 1 : 4 : 16 in units of (element
+/// mass)/36, for both components.
+#[test]
+fn hrz_lumped_mass_of_one_rectangular_q2_element_is_1_4_16() {
+    let mesh = rectangle(CellKind::Quad9, 1, 1, [2.0, -1.0], [1.0, 0.5]);
+    let mat = material();
+    let model = Model::new(&mesh, &mat, &[]).unwrap();
+    let unit = mat.density * 0.5 / 36.0;
+    let cell = mesh.cell(0);
+    let expected = [1.0, 1.0, 1.0, 1.0, 4.0, 4.0, 4.0, 4.0, 16.0];
+    for (a, &v) in cell.iter().enumerate() {
+        for comp in 0..2 {
+            let m = model.lumped_mass[model.dofs.free(v, comp).unwrap()];
+            assert!(
+                (m / unit - expected[a]).abs() < 1e-12,
+                "node {a}: {}",
+                m / unit
+            );
+        }
+    }
+}
+
+/// K and M share one pattern, K is symmetric, and `combine` gives a·K + b·M
+/// entry by entry (checked against the stored values).
+#[test]
+fn k_and_m_share_a_pattern_and_combine_in_place() {
+    let mesh = distorted(CellKind::Quad9, 3, 2);
+    let model = Model::new(
+        &mesh,
+        &material(),
+        &[stickslip_fem::Dirichlet::new("left", 0, 0.0)],
+    )
+    .unwrap();
+    assert_eq!(model.stiffness.pattern(), model.mass.pattern());
+    let kt = model.stiffness.transpose();
+    let scale = model
+        .stiffness
+        .values()
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    for (a, b) in model.stiffness.values().iter().zip(kt.values()) {
+        assert!((a - b).abs() <= 1e-13 * scale);
+    }
+    let mut out = model.stiffness.clone();
+    let ptr = out.values().as_ptr();
+    model.combine(0.25, 40.0, &mut out);
+    assert_eq!(ptr, out.values().as_ptr(), "combine must not reallocate");
+    for ((o, k), m) in out
+        .values()
+        .iter()
+        .zip(model.stiffness.values())
+        .zip(model.mass.values())
+    {
+        assert_eq!(*o, 0.25 * k + 40.0 * m);
+    }
+}
+
+/// Element matrices are computed in parallel and scattered in cell order,
+/// so the result must be bitwise the same on 1 and on several threads
+/// (mesh large enough for several chunks of cells).
+#[test]
+fn assembly_is_bitwise_identical_for_any_thread_count() {
+    let mesh = distorted(CellKind::Quad9, 48, 30);
+    let mat = material();
+    let bcs = [
+        stickslip_fem::Dirichlet::new("left", 0, 0.01),
+        stickslip_fem::Dirichlet::new("bottom", 1, 0.0),
+    ];
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| Model::new(&mesh, &mat, &bcs).unwrap())
+    };
+    let one = run(1);
+    let many = run(4);
+    assert_eq!(one.stiffness.values(), many.stiffness.values());
+    assert_eq!(one.mass.values(), many.mass.values());
+    assert_eq!(one.lumped_mass, many.lumped_mass);
+    assert_eq!(one.dirichlet_load, many.dirichlet_load);
+    assert!(one.dirichlet_load.iter().any(|&v| v != 0.0));
+}
