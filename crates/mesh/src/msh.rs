@@ -158,14 +158,16 @@ fn mesh_format(cur: &mut Cursor<'_>) -> Result<(&'static str, bool)> {
         match cur.take(4, "the byte-order check")? {
             [1, 0, 0, 0] => {}
             [0, 0, 0, 1] => return Err(cur.error(p, MeshErrorKind::BigEndian)),
-            other => return Err(cur.error(
-                p,
-                MeshErrorKind::Malformed {
-                    what: format!(
+            other => {
+                return Err(cur.error(
+                    p,
+                    MeshErrorKind::Malformed {
+                        what: format!(
                         "the byte-order check after $MeshFormat is {other:?}, not the integer 1"
                     ),
-                },
-            )),
+                    },
+                ))
+            }
         }
     }
     cur.expect_end()?;

@@ -130,14 +130,16 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
         let extra = match (parametric, dim) {
             (0, 0..=3) => 0,
             (1, 0..=3) => dim as usize,
-            _ => return Err(cur.error(
-                bp,
-                MeshErrorKind::Malformed {
-                    what: format!(
+            _ => {
+                return Err(cur.error(
+                    bp,
+                    MeshErrorKind::Malformed {
+                        what: format!(
                         "node block with entity dimension {dim} and parametric flag {parametric}"
                     ),
-                },
-            )),
+                    },
+                ))
+            }
         };
         let first = b.node_tags.len();
         if cur.binary {
