@@ -105,6 +105,8 @@ struct Row {
     file_mb: f64,
     rust_s: f64,
     rust_mbps: f64,
+    read_s: f64,
+    parse_s: f64,
     target_mbps: f64,
     mesh_mb: f64,
     peak_mb: f64,
@@ -237,6 +239,8 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
             file_mb: get(&r, "file_bytes", "bench_read")? / 1e6,
             rust_s: get(&r, "median_s", "bench_read")?,
             rust_mbps: get(&r, "mb_per_s", "bench_read")?,
+            read_s: get(&r, "read_s", "bench_read")?,
+            parse_s: get(&r, "parse_s", "bench_read")?,
             target_mbps: *target_mbps,
             mesh_mb: get(&r, "mesh_bytes", "bench_read")? / 1e6,
             peak_mb: get(&r, "peak_bytes", "bench_read").unwrap_or(f64::NAN) / 1e6,
@@ -286,6 +290,15 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
             r.peak_ratio,
             if mem_ok { "ok" } else { "MISS" },
             r.gmsh_rss_mb
+        );
+    }
+    for r in &rows {
+        println!(
+            "{}: std::fs::read {:.3} s + Mesh::from_bytes {:.3} s ({:.0} MB/s on bytes in memory)",
+            r.label,
+            r.read_s,
+            r.parse_s,
+            r.file_mb / r.parse_s
         );
     }
     println!(
