@@ -1,1 +1,28 @@
-//! stickslip-time (being written).
+//! Time integration of M r̈ + J(ṙ) + K r = R(t) with regularized friction.
+//!
+//! This crate owns the time-stepping schemes of the paper (§4.1, METHOD.md
+//! §4): Newmark (β, γ) written with the velocity as the unknown, central
+//! difference (β = 0, γ = ½) with the lumped mass as a truly explicit scheme
+//! whose nodal friction is solved in closed form, the consistent initial
+//! state (Remark 4.1), the step reduction after sticking (Remark 4.3), the
+//! critical step of the explicit scheme, and the energy ledger. It works on
+//! free-DOF vectors and CSR matrices ([`Dynamics`]); it knows nothing of
+//! files, meshes or the terminal. Output is the caller's business: it calls
+//! [`Integrator::step`] and reads the state after each step.
+//!
+//! Work done is what the scene needs: no contact surface means no friction
+//! code runs; the explicit scheme solves no linear system; the implicit
+//! operator is analysed once and refactorized only when Δt or the set of
+//! stuck nodes changes.
+
+mod history;
+mod implicit;
+mod integrator;
+pub mod linalg;
+pub mod stability;
+
+pub use history::History;
+pub use integrator::{
+    Dynamics, Energy, ExplicitFriction, Integrator, Load, MassKind, Scheme, Settings, StepInfo,
+    StickReduction, TimeError,
+};

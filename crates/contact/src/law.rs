@@ -1,0 +1,135 @@
+//! The regularized friction law (METHOD.md §2; paper eqs. (2.6)-(2.8)).
+
+/// The regularization of |v| by ψ_ε and its derivative φ_ε, for ε > 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrictionLaw {
+    /// Regularization parameter ε (a velocity): below it a node is a stiff
+    /// viscous damper g/ε, above it the friction force has magnitude g.
+    pub eps: f64,
+}
+
+/// The class of a contact node in the stick/slip iteration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(i8)]
+pub enum SlipState {
+    /// |v_T| ≤ ε: contributes the damping w g/ε ττᵀ to C.
+    Stuck = 0,
+    /// v_T > ε: contributes the constant force +w g τ to F.
+    SlipPositive = 1,
+    /// v_T < −ε: contributes the constant force −w g τ to F.
+    SlipNegative = -1,
+}
+
+impl SlipState {
+    /// 0 stuck, +1 / −1 slipping (the HDF5 `contact/state` code).
+    pub fn code(self) -> i8 {
+        self as i8
+    }
+    /// Sign of the slip, 0 when stuck.
+    pub fn sign(self) -> f64 {
+        f64::from(self.code())
+    }
+    /// True when stuck.
+    pub fn is_stuck(self) -> bool {
+        self == SlipState::Stuck
+    }
+}
+
+impl FrictionLaw {
+    /// ψ_ε(|v|): s − ε/2 for s > ε, s²/(2ε) otherwise (METHOD.md §2).
+    pub fn psi(&self, v: f64) -> f64 {
+        let s = v.abs();
+        if s > self.eps {
+            s - 0.5 * self.eps
+        } else {
+            s * s / (2.0 * self.eps)
+        }
+    }
+
+    /// φ_ε(v) = ψ_ε'(v): v/|v| when |v| > ε, v/ε otherwise. |φ_ε| ≤ 1.
+    pub fn phi(&self, v: f64) -> f64 {
+        if v > self.eps {
+            1.0
+        } else if v < -self.eps {
+            -1.0
+        } else {
+            v / self.eps
+        }
+    }
+
+    /// Class of a node moving with tangential velocity `v`.
+    pub fn classify(&self, v: f64) -> SlipState {
+        if v > self.eps {
+            SlipState::SlipPositive
+        } else if v < -self.eps {
+            SlipState::SlipNegative
+        } else {
+            SlipState::Stuck
+        }
+    }
+
+    /// φ_ε(v) evaluated the way a node of class `class` contributes it: v/ε
+    /// for a stuck node (damping), ±1 for a slipping one (constant force).
+    /// Equal to [`FrictionLaw::phi`] when `class == classify(v)`.
+    pub fn phi_as(&self, class: SlipState, v: f64) -> f64 {
+        match class {
+            SlipState::Stuck => v / self.eps,
+            s => s.sign(),
+        }
+    }
+
+    /// Solves the scalar nodal equation t + c·φ_ε(t) = p for t, with c ≥ 0.
+    ///
+    /// The left side is continuous, piecewise linear and strictly increasing
+    /// in t, so there is exactly one root, found in closed form: stuck if
+    /// p/(1 + c/ε) lies in [−ε, ε], otherwise t = p ∓ c. This is the
+    /// explicit scheme's friction update at one node.
+    pub fn solve_nodal(&self, p: f64, c: f64) -> f64 {
+        let stuck = p / (1.0 + c / self.eps);
+        if stuck.abs() <= self.eps {
+            stuck
+        } else {
+            p - c * p.signum()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn psi_is_c1_and_phi_is_its_derivative() {
+        let law = FrictionLaw { eps: 0.25 };
+        // Continuity of ψ and of φ at s = ε (METHOD.md §2 definitions).
+        let e = law.eps;
+        assert!((law.psi(e) - e / 2.0).abs() < 1e-15);
+        assert!((law.phi(e) - 1.0).abs() < 1e-15);
+        // φ = dψ/dv by central differences away from the kinks.
+        for &v in &[-2.0, -0.2, -0.01, 0.0, 0.1, 0.24, 0.3, 5.0] {
+            let h = 1e-6;
+            let fd = (law.psi(v + h) - law.psi(v - h)) / (2.0 * h);
+            assert!(
+                (fd - law.phi(v)).abs() < 1e-6,
+                "v = {v}: {fd} vs {}",
+                law.phi(v)
+            );
+        }
+    }
+
+    #[test]
+    fn nodal_solution_satisfies_its_equation() {
+        let law = FrictionLaw { eps: 1e-3 };
+        for &c in &[0.0, 1e-4, 0.5, 3.0] {
+            for i in -50..=50 {
+                let p = f64::from(i) * 0.1;
+                let t = law.solve_nodal(p, c);
+                let residual = t + c * law.phi(t) - p;
+                assert!(
+                    residual.abs() < 1e-12,
+                    "p = {p}, c = {c}: residual {residual}"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,245 @@
+//! The contact surface Γ_C: its friction-carrying nodes, their nodal
+//! quadrature weights, tangents and friction bounds (METHOD.md §3).
+
+use stickslip_fem::{boundary_quadrature, DofMap, FemError};
+use stickslip_mesh::Mesh;
+
+use crate::law::{FrictionLaw, SlipState};
+
+/// Why a contact surface could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum ContactError {
+    /// The group is missing, not a line, or not a chain of edges.
+    #[error("contact group {group:?}: {source}")]
+    Group {
+        /// The group name from the case.
+        group: String,
+        /// What the fem crate found wrong.
+        source: Box<FemError>,
+    },
+    /// A parameter out of range.
+    #[error("contact: {0}")]
+    Parameter(String),
+}
+
+/// One node of Γ_C that carries friction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactNode {
+    /// Mesh node index.
+    pub node: usize,
+    /// Free DOF indices of the node's x and y components (`None` = fixed).
+    pub dofs: [Option<usize>; 2],
+    /// Nodal quadrature weight w_J (trapezoid for Q1, Simpson for Q2).
+    pub weight: f64,
+    /// Unit tangent τ_J, counter-clockwise along the boundary.
+    pub tangent: [f64; 2],
+    /// Arc length along the surface.
+    pub s: f64,
+    /// Friction bound g_J = μ·|F_n| (a traction).
+    pub bound: f64,
+}
+
+impl ContactNode {
+    /// Tangential velocity v_T = τ·ṙ_J from a free-DOF velocity vector
+    /// (fixed components are prescribed constants, so their velocity is 0).
+    #[inline]
+    pub fn tangential(&self, free: &[f64]) -> f64 {
+        let mut v = 0.0;
+        for c in 0..2 {
+            if let Some(d) = self.dofs[c] {
+                v += self.tangent[c] * free[d];
+            }
+        }
+        v
+    }
+
+    /// w_J g_J: the magnitude of the nodal slip force, and ε times the
+    /// nodal damping coefficient.
+    #[inline]
+    pub fn force_scale(&self) -> f64 {
+        self.weight * self.bound
+    }
+}
+
+/// The friction surface: the nodes of one named line group that carry
+/// friction, ordered along the line, and the regularized law.
+#[derive(Clone, Debug)]
+pub struct ContactSurface {
+    /// Name of the physical group.
+    pub group: String,
+    /// Friction-carrying nodes in order along the surface.
+    pub nodes: Vec<ContactNode>,
+    /// Mesh nodes of the group left out because a Dirichlet condition fixes
+    /// their tangential motion (e.g. the slab's corner (0, 0)).
+    pub excluded: Vec<usize>,
+    /// The regularized law with its ε.
+    pub law: FrictionLaw,
+}
+
+impl ContactSurface {
+    /// Builds Γ_C from a named line group of `mesh`, with a uniform normal
+    /// pressure `pressure` (F_n) and friction coefficient `mu`.
+    ///
+    /// # Errors
+    /// A missing or non-line group, ε ≤ 0, μ < 0, or a non-finite value.
+    pub fn from_group(
+        mesh: &Mesh,
+        dofs: &DofMap,
+        group: &str,
+        pressure: f64,
+        mu: f64,
+        eps: f64,
+    ) -> Result<ContactSurface, ContactError> {
+        check_parameters(pressure, mu, eps)?;
+        let quadrature = boundary_quadrature(mesh, group).map_err(|e| ContactError::Group {
+            group: group.to_string(),
+            source: Box::new(e),
+        })?;
+        let bound = mu * pressure.abs();
+        let mut nodes = Vec::with_capacity(quadrature.len());
+        let mut excluded = Vec::new();
+        for b in &quadrature {
+            let node_dofs = [dofs.free(b.node, 0), dofs.free(b.node, 1)];
+            // Tangential motion is fixed when the tangent has no component
+            // along a free DOF: such a node carries no friction (BENCHMARK.md,
+            // the slab's corner (0, 0)).
+            let free_tangent: f64 = (0..2)
+                .filter(|&c| node_dofs[c].is_some())
+                .map(|c| b.tangent[c] * b.tangent[c])
+                .sum();
+            if free_tangent < 1e-20 {
+                excluded.push(b.node);
+                continue;
+            }
+            nodes.push(ContactNode {
+                node: b.node,
+                dofs: node_dofs,
+                weight: b.weight,
+                tangent: b.tangent,
+                s: b.s,
+                bound,
+            });
+        }
+        Ok(ContactSurface {
+            group: group.to_string(),
+            nodes,
+            excluded,
+            law: FrictionLaw { eps },
+        })
+    }
+
+    /// Builds a surface from nodes given directly (tests, lumped models).
+    ///
+    /// # Errors
+    /// ε ≤ 0 or a non-finite value.
+    pub fn from_nodes(
+        group: &str,
+        nodes: Vec<ContactNode>,
+        eps: f64,
+    ) -> Result<ContactSurface, ContactError> {
+        check_parameters(0.0, 0.0, eps)?;
+        Ok(ContactSurface {
+            group: group.to_string(),
+            nodes,
+            excluded: Vec::new(),
+            law: FrictionLaw { eps },
+        })
+    }
+
+    /// Number of friction-carrying nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// True when no node carries friction.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// True when every tangent is along x or y, so the damping matrix C is
+    /// diagonal (DESIGN.md: a straight axis-aligned contact line keeps C
+    /// diagonal).
+    pub fn is_axis_aligned(&self) -> bool {
+        self.nodes
+            .iter()
+            .all(|n| n.tangent[0].abs() < 1e-14 || n.tangent[1].abs() < 1e-14)
+    }
+
+    /// Classifies every node from a free-DOF velocity vector.
+    pub fn classify(&self, velocity: &[f64], classes: &mut [SlipState]) {
+        for (n, c) in self.nodes.iter().zip(classes.iter_mut()) {
+            *c = self.law.classify(n.tangential(velocity));
+        }
+    }
+
+    /// Nodal friction force magnitudes f_J = w_J g_J φ_ε(v_TJ) along τ_J
+    /// (the friction force vector is J = Σ f_J τ_J, paper eq. (4.5)).
+    pub fn nodal_forces(&self, velocity: &[f64], out: &mut [f64]) {
+        for (n, f) in self.nodes.iter().zip(out.iter_mut()) {
+            *f = n.force_scale() * self.law.phi(n.tangential(velocity));
+        }
+    }
+
+    /// Friction stress σ_T = −g φ_ε(v_T) at each node (paper eq. (4.10)).
+    pub fn friction_stress(&self, velocity: &[f64], out: &mut [f64]) {
+        for (n, s) in self.nodes.iter().zip(out.iter_mut()) {
+            *s = -n.bound * self.law.phi(n.tangential(velocity));
+        }
+    }
+
+    /// Adds the damping of stuck nodes, w g/ε ττᵀ, through `add(i, j, value)`
+    /// on free DOFs (METHOD.md §3, C of J = C ṙ + F).
+    pub fn add_damping(&self, classes: &[SlipState], mut add: impl FnMut(usize, usize, f64)) {
+        for (n, c) in self.nodes.iter().zip(classes) {
+            if !c.is_stuck() {
+                continue;
+            }
+            let k = n.force_scale() / self.law.eps;
+            for a in 0..2 {
+                for b in 0..2 {
+                    if let (Some(i), Some(j)) = (n.dofs[a], n.dofs[b]) {
+                        let v = k * n.tangent[a] * n.tangent[b];
+                        if v != 0.0 {
+                            add(i, j, v);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Subtracts the slip forces F = Σ w g sign(v) τ of slipping nodes from a
+    /// right-hand side on free DOFs (F moves to the right as −F).
+    pub fn subtract_slip_forces(&self, classes: &[SlipState], rhs: &mut [f64]) {
+        for (n, c) in self.nodes.iter().zip(classes) {
+            if c.is_stuck() {
+                continue;
+            }
+            let f = n.force_scale() * c.sign();
+            for a in 0..2 {
+                if let Some(i) = n.dofs[a] {
+                    rhs[i] -= f * n.tangent[a];
+                }
+            }
+        }
+    }
+}
+
+fn check_parameters(pressure: f64, mu: f64, eps: f64) -> Result<(), ContactError> {
+    if !(eps > 0.0 && eps.is_finite()) {
+        return Err(ContactError::Parameter(format!(
+            "eps = {eps}: the regularization ε must be a positive velocity (the paper uses 1e-4 to 1)"
+        )));
+    }
+    if !(mu >= 0.0 && mu.is_finite()) {
+        return Err(ContactError::Parameter(format!(
+            "mu = {mu}: the friction coefficient must be ≥ 0"
+        )));
+    }
+    if !pressure.is_finite() {
+        return Err(ContactError::Parameter(format!(
+            "pressure = {pressure} is not finite"
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,210 @@
+//! The implicit Newmark step: the operator (β/γ)ΔtK + M/(γΔt) + C and its
+//! factorization, kept until Δt or the stuck set changes (METHOD.md §4-5).
+
+use nalgebra_sparse::CsrMatrix;
+use stickslip_contact::{ContactSurface, SlipState, StepSystem};
+use stickslip_fem::{SolverError, SparseCholesky};
+
+use crate::linalg::csr_index;
+
+/// The implicit operator and its factorization for the current (Δt, stuck
+/// set); `factorizations` counts numeric factorizations over the run.
+pub(crate) struct ImplicitOperator {
+    /// A₀ = c_K K + c_M M for the current Δt (values only change).
+    a0: CsrMatrix<f64>,
+    /// A₀ + C for the current stuck set: what is factorized.
+    work: CsrMatrix<f64>,
+    cholesky: SparseCholesky,
+    /// Positions of (xx, xy, yx, yy) of each contact node in the CSR values.
+    entries: Vec<[Option<usize>; 4]>,
+    key_dt: f64,
+    key_stuck: Vec<bool>,
+    valid: bool,
+    pub factorizations: u64,
+}
+
+impl ImplicitOperator {
+    /// Analyses the pattern of K (which M shares) once for the run.
+    pub fn new(
+        stiffness: &CsrMatrix<f64>,
+        contact: Option<&ContactSurface>,
+    ) -> Result<ImplicitOperator, SolverError> {
+        let cholesky = SparseCholesky::analyze(stiffness)?;
+        let entries = contact
+            .map(|s| {
+                s.nodes
+                    .iter()
+                    .map(|n| {
+                        let mut e = [None; 4];
+                        for a in 0..2 {
+                            for b in 0..2 {
+                                if let (Some(i), Some(j)) = (n.dofs[a], n.dofs[b]) {
+                                    e[2 * a + b] = csr_index(stiffness, i, j);
+                                }
+                            }
+                        }
+                        e
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        Ok(ImplicitOperator {
+            a0: stiffness.clone(),
+            work: stiffness.clone(),
+            cholesky,
+            entries,
+            key_dt: f64::NAN,
+            key_stuck: contact.map(|s| vec![false; s.len()]).unwrap_or_default(),
+            valid: false,
+            factorizations: 0,
+        })
+    }
+
+    /// Sets A₀ = c_k K + c_m M for a new Δt (M has K's pattern).
+    pub fn set_dt(
+        &mut self,
+        dt: f64,
+        c_k: f64,
+        stiffness: &CsrMatrix<f64>,
+        c_m: f64,
+        mass: &CsrMatrix<f64>,
+    ) {
+        if dt == self.key_dt {
+            return;
+        }
+        for ((a, k), m) in self
+            .a0
+            .values_mut()
+            .iter_mut()
+            .zip(stiffness.values())
+            .zip(mass.values())
+        {
+            *a = c_k * k + c_m * m;
+        }
+        self.key_dt = dt;
+        self.valid = false;
+    }
+
+    /// Makes the factorization match the stuck set of `classes`,
+    /// refactorizing only if it changed.
+    fn ensure_factorized(
+        &mut self,
+        surface: Option<&ContactSurface>,
+        classes: &[SlipState],
+    ) -> Result<(), SolverError> {
+        let same = self.valid
+            && self
+                .key_stuck
+                .iter()
+                .zip(classes)
+                .all(|(&k, c)| k == c.is_stuck());
+        if same {
+            return Ok(());
+        }
+        self.work.values_mut().copy_from_slice(self.a0.values());
+        if let Some(surface) = surface {
+            let values = self.work.values_mut();
+            for ((n, c), e) in surface.nodes.iter().zip(classes).zip(&self.entries) {
+                if !c.is_stuck() {
+                    continue;
+                }
+                // Stuck: the damping w g/ε ττᵀ (METHOD.md §3).
+                let k = n.force_scale() / surface.law.eps;
+                for a in 0..2 {
+                    for b in 0..2 {
+                        if let Some(p) = e[2 * a + b] {
+                            values[p] += k * n.tangent[a] * n.tangent[b];
+                        }
+                    }
+                }
+            }
+            for (k, c) in self.key_stuck.iter_mut().zip(classes) {
+                *k = c.is_stuck();
+            }
+        }
+        self.valid = false;
+        self.cholesky.factorize(&self.work)?;
+        self.factorizations += 1;
+        self.valid = true;
+        Ok(())
+    }
+
+    /// Solves (A₀ + C) x = rhs for a contact-free scene.
+    pub fn solve_plain(&mut self, rhs: &[f64], x: &mut [f64]) -> Result<(), SolverError> {
+        self.ensure_factorized(None, &[])?;
+        x.copy_from_slice(rhs);
+        self.cholesky.solve_in_place(x);
+        Ok(())
+    }
+}
+
+/// One step's linear system for the stick/slip iteration: b is the
+/// right-hand side without friction (R̂_K of METHOD.md §4).
+pub(crate) struct ImplicitStep<'a> {
+    pub operator: &'a mut ImplicitOperator,
+    pub b: &'a [f64],
+}
+
+impl StepSystem for ImplicitStep<'_> {
+    type Error = SolverError;
+
+    fn solve(
+        &mut self,
+        surface: &ContactSurface,
+        classes: &[SlipState],
+        velocity: &mut [f64],
+    ) -> Result<(), SolverError> {
+        self.operator.ensure_factorized(Some(surface), classes)?;
+        velocity.copy_from_slice(self.b);
+        surface.subtract_slip_forces(classes, velocity);
+        self.operator.cholesky.solve_in_place(velocity);
+        Ok(())
+    }
+}
+
+/// The explicit step's system with a diagonal operator d (lumped mass over
+/// γΔt): solved node by node, stuck nodes by Sherman-Morrison on their 2×2
+/// block d + k ττᵀ. Used to check the closed form against the iteration.
+pub(crate) struct DiagonalStep<'a> {
+    pub diagonal: &'a [f64],
+    pub b: &'a [f64],
+}
+
+impl StepSystem for DiagonalStep<'_> {
+    type Error = std::convert::Infallible;
+
+    fn solve(
+        &mut self,
+        surface: &ContactSurface,
+        classes: &[SlipState],
+        velocity: &mut [f64],
+    ) -> Result<(), Self::Error> {
+        velocity.copy_from_slice(self.b);
+        surface.subtract_slip_forces(classes, velocity);
+        for (v, d) in velocity.iter_mut().zip(self.diagonal) {
+            *v /= d;
+        }
+        for (n, c) in surface.nodes.iter().zip(classes) {
+            if !c.is_stuck() {
+                continue;
+            }
+            let k = n.force_scale() / surface.law.eps;
+            // (D + k ττᵀ)⁻¹ r = D⁻¹r − D⁻¹τ k (τᵀD⁻¹r) / (1 + k τᵀD⁻¹τ).
+            let mut t_dinv_r = 0.0;
+            let mut t_dinv_t = 0.0;
+            for a in 0..2 {
+                if let Some(i) = n.dofs[a] {
+                    t_dinv_r += n.tangent[a] * velocity[i];
+                    t_dinv_t += n.tangent[a] * n.tangent[a] / self.diagonal[i];
+                }
+            }
+            let factor = k * t_dinv_r / (1.0 + k * t_dinv_t);
+            for a in 0..2 {
+                if let Some(i) = n.dofs[a] {
+                    velocity[i] -= factor * n.tangent[a] / self.diagonal[i];
+                }
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,871 @@
+//! The Newmark family in velocity form with friction (paper §4.1-4.2).
+
+use nalgebra_sparse::CsrMatrix;
+use stickslip_contact::{iterate, ContactSurface, IterationFailure, IterationOptions, SlipState};
+use stickslip_fem::{Model, SolverError, SparseCholesky};
+
+use crate::history::History;
+use crate::implicit::{DiagonalStep, ImplicitOperator, ImplicitStep};
+use crate::linalg::{dot, quadratic_form, spmv};
+use crate::stability::critical_step;
+
+/// The semi-discrete system on free DOFs: K, M (consistent, with K's
+/// sparsity pattern), the HRZ lumped mass, and loads that never change
+/// (e.g. the lifting of nonzero prescribed displacements).
+#[derive(Clone, Debug)]
+pub struct Dynamics {
+    /// Stiffness K.
+    pub stiffness: CsrMatrix<f64>,
+    /// Consistent mass M, same pattern as K.
+    pub consistent_mass: CsrMatrix<f64>,
+    /// Lumped mass, one value per free DOF.
+    pub lumped_mass: Vec<f64>,
+    /// A load acting at all times, also before t = 0.
+    pub constant_load: Vec<f64>,
+}
+
+impl Dynamics {
+    /// The system of a finite-element model.
+    pub fn from_model(model: &Model) -> Dynamics {
+        Dynamics {
+            stiffness: model.stiffness.clone(),
+            consistent_mass: model.mass.clone(),
+            lumped_mass: model.lumped_mass.clone(),
+            constant_load: model.dirichlet_load.clone(),
+        }
+    }
+
+    /// Number of free DOFs.
+    pub fn n(&self) -> usize {
+        self.lumped_mass.len()
+    }
+}
+
+/// A load vector on free DOFs scaled by a history θ(t).
+#[derive(Clone, Debug)]
+pub struct Load {
+    /// The load at θ = 1.
+    pub vector: Vec<f64>,
+    /// θ(t).
+    pub history: History,
+}
+
+/// The time-stepping scheme.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Scheme {
+    /// β = 0, γ = ½ with the lumped mass: explicit, Δt < Δt_crit.
+    CentralDifference,
+    /// Newmark (β, γ): unconditionally stable for 2β ≥ γ ≥ ½.
+    Newmark {
+        /// β.
+        beta: f64,
+        /// γ.
+        gamma: f64,
+    },
+}
+
+impl Scheme {
+    /// (β, γ).
+    pub fn parameters(self) -> (f64, f64) {
+        match self {
+            Scheme::CentralDifference => (0.0, 0.5),
+            Scheme::Newmark { beta, gamma } => (beta, gamma),
+        }
+    }
+}
+
+/// Which mass matrix the scheme uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MassKind {
+    /// Consistent mass (the paper's choice for Newmark).
+    Consistent,
+    /// HRZ lumped mass (the paper's choice for central difference).
+    Lumped,
+}
+
+/// How the explicit scheme solves the friction of a step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExplicitFriction {
+    /// Each node's piecewise-linear monotone equation in closed form.
+    ClosedForm,
+    /// The stick/slip iteration of §5 (to check the closed form).
+    Iterate,
+}
+
+/// Remark 4.3: after a step in which a node went from slip to stick, the
+/// next `steps` steps use `dt`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StickReduction {
+    /// The reduced step.
+    pub dt: f64,
+    /// How many steps use it after each sticking event.
+    pub steps: usize,
+}
+
+/// Everything about the time discretization.
+#[derive(Clone, Debug)]
+pub struct Settings {
+    /// Scheme.
+    pub scheme: Scheme,
+    /// Mass; `None` = the paper's (lumped for central difference, consistent
+    /// for Newmark).
+    pub mass: Option<MassKind>,
+    /// Normal time step.
+    pub dt: f64,
+    /// End time.
+    pub t_end: f64,
+    /// Step reduction after sticking.
+    pub stick_reduction: Option<StickReduction>,
+    /// Stick/slip iteration settings.
+    pub iteration: IterationOptions,
+    /// Run an explicit scheme above its critical step anyway.
+    pub allow_unstable: bool,
+    /// Closed-form or iterated friction in explicit steps.
+    pub explicit_friction: ExplicitFriction,
+    /// ṙ₀ (default zero).
+    pub initial_velocity: Option<Vec<f64>>,
+}
+
+impl Settings {
+    /// Defaults for a scheme, Δt and end time.
+    pub fn new(scheme: Scheme, dt: f64, t_end: f64) -> Settings {
+        Settings {
+            scheme,
+            mass: None,
+            dt,
+            t_end,
+            stick_reduction: None,
+            iteration: IterationOptions::default(),
+            allow_unstable: false,
+            explicit_friction: ExplicitFriction::ClosedForm,
+            initial_velocity: None,
+        }
+    }
+}
+
+/// Why a run could not start or a step failed.
+#[derive(Debug, thiserror::Error)]
+pub enum TimeError {
+    /// A setting out of range; says which and what to do.
+    #[error("{0}")]
+    Settings(String),
+    /// Δt above the explicit scheme's critical step.
+    #[error(
+        "time.dt = {dt:e} is above the critical step of central difference, Δt_crit = {dt_crit:.6e} \
+         (2/ω_max, ω_max² the largest eigenvalue of M⁻¹K): use time.dt < {dt_crit:.4e}, \
+         or set time.allow_unstable = true to run anyway"
+    )]
+    Unstable {
+        /// The step asked for.
+        dt: f64,
+        /// The estimated critical step.
+        dt_crit: f64,
+    },
+    /// The initial static solve failed (rigid-body motion left free).
+    #[error(
+        "the initial static solve failed: {0}; the supports leave a rigid-body motion free: \
+         add Dirichlet conditions that fix translation in x and y and rotation"
+    )]
+    Static(SolverError),
+    /// A factorization failed during the run.
+    #[error("step {step} (t = {t:.6e}): the linear solve failed: {source}")]
+    Solve {
+        /// Step number (1-based).
+        step: u64,
+        /// Time the step was going to.
+        t: f64,
+        /// The solver's error.
+        source: SolverError,
+    },
+    /// The stick/slip iteration did not settle.
+    #[error(
+        "step {step} (t = {t:.6e}): the stick/slip iteration did not converge in {iterations} \
+         iterations ({changing} nodes still changing class); enable Remark 4.2 \
+         (contact.remark_4_2 = true), raise contact.max_iterations, or reduce time.dt"
+    )]
+    IterationCap {
+        /// Step number (1-based).
+        step: u64,
+        /// Time the step was going to.
+        t: f64,
+        /// Iterations performed.
+        iterations: usize,
+        /// Nodes still changing class.
+        changing: usize,
+    },
+    /// NaN or infinity in the state.
+    #[error("step {step} (t = {t:.6e}): the solution is no longer finite; reduce time.dt{hint}")]
+    NonFinite {
+        /// Step number (1-based).
+        step: u64,
+        /// Time reached.
+        t: f64,
+        /// Extra advice (the critical step of an explicit run).
+        hint: String,
+    },
+}
+
+/// The energy ledger (METHOD.md §6), all at the current time.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Energy {
+    /// ½ ṙᵀMṙ with the mass the scheme uses.
+    pub kinetic: f64,
+    /// ½ rᵀKr.
+    pub strain: f64,
+    /// ∫ R·ṙ dt, trapezoidal rule: Σ ½(R_K + R_{K−1})·(r_K − r_{K−1}).
+    pub external_work: f64,
+    /// ∫ J·ṙ dt, trapezoidal rule: Σ ½(J_K + J_{K−1})·(r_K − r_{K−1}) ≥ 0
+    /// step by step since φ_ε is odd and increasing.
+    pub dissipated: f64,
+    /// kinetic + strain − rᵀR(t): the paper's total energy (Fig. 9).
+    pub total: f64,
+    /// kinetic + strain − initial − work + dissipated; zero up to round-off
+    /// for the trapezoidal rule (Newmark ¼, ½).
+    pub balance: f64,
+}
+
+/// What one step did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepInfo {
+    /// The step size used.
+    pub dt: f64,
+    /// Linear solves (implicit) or iterations (explicit) of the stick/slip
+    /// iteration; 1 without contact.
+    pub iterations: usize,
+    /// Nodes that went from slip to stick in this step.
+    pub stick_events: usize,
+}
+
+/// Integrates from the initial state to `t_end`, one step per call.
+pub struct Integrator {
+    dynamics: Dynamics,
+    contact: Option<ContactSurface>,
+    loads: Vec<Load>,
+    settings: Settings,
+    beta: f64,
+    gamma: f64,
+    mass_kind: MassKind,
+    explicit: bool,
+    dt_crit: Option<f64>,
+    /// Mass as a CSR matrix with K's pattern (a diagonal one when lumped).
+    mass_matrix: CsrMatrix<f64>,
+    implicit: Option<ImplicitOperator>,
+    // State at the current time.
+    t: f64,
+    steps: u64,
+    r: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    load: Vec<f64>,
+    classes: Vec<SlipState>,
+    forces: Vec<f64>,
+    energy: Energy,
+    initial_mechanical: f64,
+    reduced_remaining: usize,
+    total_iterations: u64,
+    // Scratch, reused every step.
+    r_new: Vec<f64>,
+    v_new: Vec<f64>,
+    load_new: Vec<f64>,
+    b: Vec<f64>,
+    tmp: Vec<f64>,
+    diagonal: Vec<f64>,
+    /// The classes being iterated on in this step.
+    scratch_classes: Vec<SlipState>,
+    /// The iteration's own scratch classes.
+    iter_scratch: Vec<SlipState>,
+    forces_new: Vec<f64>,
+}
+
+impl std::fmt::Debug for Integrator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Integrator")
+            .field("n", &self.dynamics.n())
+            .field("t", &self.t)
+            .field("steps", &self.steps)
+            .field("scheme", &self.settings.scheme)
+            .finish()
+    }
+}
+
+fn check_settings(s: &Settings, n: usize) -> Result<(f64, f64, MassKind), TimeError> {
+    let bad = |m: String| Err(TimeError::Settings(m));
+    if !(s.dt > 0.0 && s.dt.is_finite()) {
+        return bad(format!(
+            "time.dt = {}: the time step must be positive",
+            s.dt
+        ));
+    }
+    if !(s.t_end > 0.0 && s.t_end.is_finite()) {
+        return bad(format!(
+            "time.t_end = {}: the end time must be positive",
+            s.t_end
+        ));
+    }
+    if let Some(r) = s.stick_reduction {
+        if !(r.dt > 0.0 && r.dt <= s.dt) {
+            return bad(format!(
+                "time.stick_reduction.dt = {}: the reduced step must be positive and at most time.dt = {}",
+                r.dt, s.dt
+            ));
+        }
+    }
+    if s.iteration.max_iterations == 0 {
+        return bad("contact.max_iterations must be at least 1".into());
+    }
+    let (beta, gamma) = s.scheme.parameters();
+    let mass = match (s.scheme, s.mass) {
+        (Scheme::CentralDifference, Some(MassKind::Consistent)) => {
+            return bad(
+                "time.mass = \"consistent\" with central difference would need a linear solve per step; \
+                 central difference uses the lumped mass: remove time.mass or set it to \"lumped\""
+                    .into(),
+            )
+        }
+        (Scheme::CentralDifference, _) => MassKind::Lumped,
+        (Scheme::Newmark { .. }, m) => {
+            if !(gamma >= 0.5 && 2.0 * beta >= gamma && beta.is_finite() && gamma.is_finite()) {
+                return bad(format!(
+                    "Newmark β = {beta}, γ = {gamma} is outside the unconditionally stable range 2β ≥ γ ≥ ½ \
+                     (the paper uses β = 0.25, γ = 0.5 or β = 0.3025, γ = 0.6); for an explicit run use \
+                     time.scheme = \"central_difference\""
+                ));
+            }
+            m.unwrap_or(MassKind::Consistent)
+        }
+    };
+    if let Some(v0) = &s.initial_velocity {
+        if v0.len() != n {
+            return bad(format!(
+                "initial velocity has {} entries, the model {n} free DOFs",
+                v0.len()
+            ));
+        }
+    }
+    Ok((beta, gamma, mass))
+}
+
+impl Integrator {
+    /// Sets up the run and computes the initial state of Remark 4.1:
+    /// r₀ the frictionless static equilibrium under the loads present at
+    /// t = 0⁻, ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀.
+    ///
+    /// # Errors
+    /// Settings out of range, Δt above the explicit critical step (unless
+    /// allowed), or a singular static problem.
+    pub fn new(
+        dynamics: Dynamics,
+        contact: Option<ContactSurface>,
+        loads: Vec<Load>,
+        settings: Settings,
+    ) -> Result<Integrator, TimeError> {
+        let n = dynamics.n();
+        let (beta, gamma, mass_kind) = check_settings(&settings, n)?;
+        // A scene without friction nodes runs no friction code.
+        let contact = contact.filter(|c| !c.is_empty());
+        let explicit = beta == 0.0 && mass_kind == MassKind::Lumped;
+        let dt_crit = if explicit {
+            Some(critical_step(&dynamics.stiffness, &dynamics.lumped_mass))
+        } else {
+            None
+        };
+        if let Some(crit) = dt_crit {
+            if settings.dt > crit && !settings.allow_unstable {
+                return Err(TimeError::Unstable {
+                    dt: settings.dt,
+                    dt_crit: crit,
+                });
+            }
+        }
+        let mass_matrix = match mass_kind {
+            MassKind::Consistent => dynamics.consistent_mass.clone(),
+            MassKind::Lumped => {
+                let mut m = dynamics.stiffness.clone();
+                let (offsets, cols, values) = m.csr_data_mut();
+                for i in 0..n {
+                    for k in offsets[i]..offsets[i + 1] {
+                        values[k] = if cols[k] == i {
+                            dynamics.lumped_mass[i]
+                        } else {
+                            0.0
+                        };
+                    }
+                }
+                m
+            }
+        };
+        let implicit = if explicit {
+            None
+        } else {
+            Some(
+                ImplicitOperator::new(&dynamics.stiffness, contact.as_ref())
+                    .map_err(TimeError::Static)?,
+            )
+        };
+
+        // Remark 4.1: r₀ from K r₀ = R(0⁻), frictionless.
+        let mut static_load = dynamics.constant_load.clone();
+        for l in &loads {
+            let theta = l.history.before_start();
+            for (s, f) in static_load.iter_mut().zip(&l.vector) {
+                *s += theta * f;
+            }
+        }
+        let mut static_solver =
+            SparseCholesky::analyze(&dynamics.stiffness).map_err(TimeError::Static)?;
+        static_solver
+            .factorize(&dynamics.stiffness)
+            .map_err(TimeError::Static)?;
+        let mut r = static_load;
+        static_solver.solve_in_place(&mut r);
+        drop(static_solver);
+
+        let v = settings
+            .initial_velocity
+            .clone()
+            .unwrap_or_else(|| vec![0.0; n]);
+        let n_c = contact.as_ref().map_or(0, |c| c.len());
+        let mut this = Integrator {
+            beta,
+            gamma,
+            mass_kind,
+            explicit,
+            dt_crit,
+            mass_matrix,
+            implicit,
+            t: 0.0,
+            steps: 0,
+            a: vec![0.0; n],
+            load: vec![0.0; n],
+            classes: vec![SlipState::Stuck; n_c],
+            forces: vec![0.0; n_c],
+            energy: Energy::default(),
+            initial_mechanical: 0.0,
+            reduced_remaining: 0,
+            total_iterations: 0,
+            r_new: vec![0.0; n],
+            v_new: vec![0.0; n],
+            load_new: vec![0.0; n],
+            b: vec![0.0; n],
+            tmp: vec![0.0; n],
+            diagonal: vec![0.0; n],
+            scratch_classes: vec![SlipState::Stuck; n_c],
+            iter_scratch: vec![SlipState::Stuck; n_c],
+            forces_new: vec![0.0; n_c],
+            r,
+            v,
+            dynamics,
+            contact,
+            loads,
+            settings,
+        };
+        this.load_at(0.0, false);
+        // r̈₀ from M r̈₀ = R(0) − K r₀, without friction (Remark 4.1).
+        spmv(&this.dynamics.stiffness, &this.r, &mut this.tmp);
+        for i in 0..n {
+            this.tmp[i] = this.load[i] - this.tmp[i];
+        }
+        match this.mass_kind {
+            MassKind::Lumped => {
+                for i in 0..n {
+                    this.a[i] = this.tmp[i] / this.dynamics.lumped_mass[i];
+                }
+            }
+            MassKind::Consistent => {
+                let mut m =
+                    SparseCholesky::analyze(&this.mass_matrix).map_err(TimeError::Static)?;
+                m.factorize(&this.mass_matrix).map_err(TimeError::Static)?;
+                this.a.copy_from_slice(&this.tmp);
+                m.solve_in_place(&mut this.a);
+            }
+        }
+        if let Some(c) = &this.contact {
+            c.classify(&this.v, &mut this.classes);
+            c.nodal_forces(&this.v, &mut this.forces);
+        }
+        let kinetic = 0.5 * this.mass_product(&this.v.clone());
+        let strain = 0.5 * quadratic_form(&this.dynamics.stiffness, &this.r);
+        this.initial_mechanical = kinetic + strain;
+        this.energy = Energy {
+            kinetic,
+            strain,
+            external_work: 0.0,
+            dissipated: 0.0,
+            total: kinetic + strain - dot(&this.r, &this.load),
+            balance: 0.0,
+        };
+        Ok(this)
+    }
+
+    /// R(t) into `load` (or `load_new`).
+    fn load_at(&mut self, t: f64, new: bool) {
+        let out = if new {
+            &mut self.load_new
+        } else {
+            &mut self.load
+        };
+        out.copy_from_slice(&self.dynamics.constant_load);
+        for l in &self.loads {
+            let theta = l.history.value(t);
+            if theta != 0.0 {
+                for (o, f) in out.iter_mut().zip(&l.vector) {
+                    *o += theta * f;
+                }
+            }
+        }
+    }
+
+    /// xᵀ M x with the scheme's mass.
+    fn mass_product(&self, x: &[f64]) -> f64 {
+        match self.mass_kind {
+            MassKind::Lumped => x
+                .iter()
+                .zip(&self.dynamics.lumped_mass)
+                .map(|(v, m)| m * v * v)
+                .sum(),
+            MassKind::Consistent => quadratic_form(&self.mass_matrix, x),
+        }
+    }
+
+    /// The step size of the next step: Remark 4.3's reduced step while its
+    /// count runs, and the last step shortened to land on t_end.
+    fn next_dt(&self) -> f64 {
+        let dt = match self.settings.stick_reduction {
+            Some(r) if self.reduced_remaining > 0 => r.dt,
+            _ => self.settings.dt,
+        };
+        let left = self.settings.t_end - self.t;
+        // Do not leave a sliver of a step at the end.
+        if dt >= left * (1.0 - 1e-9) {
+            left
+        } else {
+            dt
+        }
+    }
+
+    /// True once t_end is reached.
+    pub fn done(&self) -> bool {
+        self.t >= self.settings.t_end * (1.0 - 1e-14)
+    }
+
+    /// Advances one step.
+    ///
+    /// # Errors
+    /// A failed linear solve, a stick/slip iteration that hits its cap, or a
+    /// non-finite state. The state is left at the last completed step.
+    pub fn step(&mut self) -> Result<StepInfo, TimeError> {
+        let n = self.dynamics.n();
+        let dt = self.next_dt();
+        let t_new = self.t + dt;
+        let (beta, gamma) = (self.beta, self.gamma);
+        let step_number = self.steps + 1;
+        self.load_at(t_new, true);
+
+        // Predictor: r_K = r_pred + (β/γ)Δt ṙ_K (METHOD.md §4).
+        let c1 = dt * (1.0 - beta / gamma);
+        let c2 = 0.5 * dt * dt * (1.0 - 2.0 * beta / gamma);
+        for i in 0..n {
+            self.r_new[i] = self.r[i] + c1 * self.v[i] + c2 * self.a[i];
+        }
+        // R̂_K = R_K − K r_pred + M[ṙ/(γΔt) + (1/γ − 1) r̈].
+        spmv(&self.dynamics.stiffness, &self.r_new, &mut self.b);
+        let cv = 1.0 / (gamma * dt);
+        let ca = 1.0 / gamma - 1.0;
+        for i in 0..n {
+            self.tmp[i] = cv * self.v[i] + ca * self.a[i];
+        }
+        match self.mass_kind {
+            MassKind::Lumped => {
+                for i in 0..n {
+                    self.b[i] =
+                        self.load_new[i] - self.b[i] + self.dynamics.lumped_mass[i] * self.tmp[i];
+                }
+            }
+            MassKind::Consistent => {
+                let b = std::mem::take(&mut self.b);
+                spmv(&self.mass_matrix, &self.tmp, &mut self.v_new);
+                self.b = b;
+                for i in 0..n {
+                    self.b[i] = self.load_new[i] - self.b[i] + self.v_new[i];
+                }
+            }
+        }
+
+        self.scratch_classes.copy_from_slice(&self.classes);
+        let iterations = if self.explicit {
+            self.explicit_velocity(dt, step_number, t_new)?
+        } else {
+            self.implicit_velocity(dt, step_number, t_new)?
+        };
+
+        // Corrector.
+        let c3 = beta / gamma * dt;
+        for i in 0..n {
+            self.r_new[i] += c3 * self.v_new[i];
+        }
+        let finite = self.r_new.iter().chain(&self.v_new).all(|x| x.is_finite());
+        if !finite {
+            let hint = match self.dt_crit {
+                Some(c) => format!(" below the critical step Δt_crit = {c:.4e}"),
+                None => String::new(),
+            };
+            return Err(TimeError::NonFinite {
+                step: step_number,
+                t: t_new,
+                hint,
+            });
+        }
+
+        // Energy ledger, before the state is overwritten.
+        let mut work = 0.0;
+        for i in 0..n {
+            work += 0.5 * (self.load_new[i] + self.load[i]) * (self.r_new[i] - self.r[i]);
+        }
+        let mut stick_events = 0;
+        let mut dissipated = 0.0;
+        if let Some(c) = &self.contact {
+            c.nodal_forces(&self.v_new, &mut self.forces_new);
+            for i in 0..n {
+                self.tmp[i] = self.r_new[i] - self.r[i];
+            }
+            for ((node, f_new), f_old) in c.nodes.iter().zip(&self.forces_new).zip(&self.forces) {
+                dissipated += 0.5 * (f_new + f_old) * node.tangential(&self.tmp);
+            }
+            stick_events = self
+                .scratch_classes
+                .iter()
+                .zip(&self.classes)
+                .filter(|(new, old)| new.is_stuck() && !old.is_stuck())
+                .count();
+        }
+
+        // Commit the step.
+        for i in 0..n {
+            let a_new =
+                (self.v_new[i] - self.v[i]) / (gamma * dt) - (1.0 - gamma) / gamma * self.a[i];
+            self.a[i] = a_new;
+        }
+        std::mem::swap(&mut self.r, &mut self.r_new);
+        std::mem::swap(&mut self.v, &mut self.v_new);
+        std::mem::swap(&mut self.load, &mut self.load_new);
+        std::mem::swap(&mut self.forces, &mut self.forces_new);
+        self.classes.copy_from_slice(&self.scratch_classes);
+        self.t = if t_new >= self.settings.t_end * (1.0 - 1e-14) {
+            self.settings.t_end
+        } else {
+            t_new
+        };
+        self.steps = step_number;
+        self.total_iterations += iterations as u64;
+
+        let v = std::mem::take(&mut self.v);
+        let kinetic = 0.5 * self.mass_product(&v);
+        self.v = v;
+        let strain = 0.5 * quadratic_form(&self.dynamics.stiffness, &self.r);
+        let e = &mut self.energy;
+        e.kinetic = kinetic;
+        e.strain = strain;
+        e.external_work += work;
+        e.dissipated += dissipated;
+        e.total = kinetic + strain - dot(&self.r, &self.load);
+        e.balance = kinetic + strain - self.initial_mechanical - e.external_work + e.dissipated;
+
+        // Remark 4.3: a sticking restarts the reduced-step count.
+        if let Some(r) = self.settings.stick_reduction {
+            if stick_events > 0 {
+                self.reduced_remaining = r.steps;
+            } else if self.reduced_remaining > 0 && dt <= r.dt * (1.0 + 1e-12) {
+                self.reduced_remaining -= 1;
+            }
+        }
+        Ok(StepInfo {
+            dt,
+            iterations,
+            stick_events,
+        })
+    }
+
+    /// Explicit step: d = M_L/(γΔt), friction node by node.
+    fn explicit_velocity(&mut self, dt: f64, step: u64, t: f64) -> Result<usize, TimeError> {
+        let scale = 1.0 / (self.gamma * dt);
+        for (d, m) in self.diagonal.iter_mut().zip(&self.dynamics.lumped_mass) {
+            *d = m * scale;
+        }
+        for ((v, b), d) in self.v_new.iter_mut().zip(&self.b).zip(&self.diagonal) {
+            *v = b / d;
+        }
+        let Some(contact) = &self.contact else {
+            return Ok(1);
+        };
+        match self.settings.explicit_friction {
+            ExplicitFriction::ClosedForm => {
+                // Per node: with t = τ·ṙ, t + w g q φ_ε(t) = p where
+                // p = τᵀD⁻¹b, q = τᵀD⁻¹τ; then ṙ = D⁻¹(b − w g φ_ε(t) τ).
+                for node in &contact.nodes {
+                    let (mut p, mut q) = (0.0, 0.0);
+                    for c in 0..2 {
+                        if let Some(i) = node.dofs[c] {
+                            p += node.tangent[c] * self.b[i] / self.diagonal[i];
+                            q += node.tangent[c] * node.tangent[c] / self.diagonal[i];
+                        }
+                    }
+                    let wg = node.force_scale();
+                    let vt = contact.law.solve_nodal(p, wg * q);
+                    let phi = contact.law.phi(vt);
+                    for c in 0..2 {
+                        if let Some(i) = node.dofs[c] {
+                            self.v_new[i] =
+                                (self.b[i] - wg * phi * node.tangent[c]) / self.diagonal[i];
+                        }
+                    }
+                }
+                contact.classify(&self.v_new, &mut self.scratch_classes);
+                Ok(1)
+            }
+            ExplicitFriction::Iterate => {
+                let mut system = DiagonalStep {
+                    diagonal: &self.diagonal,
+                    b: &self.b,
+                };
+                match iterate(
+                    contact,
+                    &mut system,
+                    &mut self.scratch_classes,
+                    &mut self.iter_scratch,
+                    &mut self.v_new,
+                    self.settings.iteration,
+                ) {
+                    Ok(report) => Ok(report.iterations),
+                    Err(IterationFailure::Cap {
+                        iterations,
+                        changing,
+                    }) => Err(TimeError::IterationCap {
+                        step,
+                        t,
+                        iterations,
+                        changing,
+                    }),
+                    Err(IterationFailure::Solve(never)) => match never {},
+                }
+            }
+        }
+    }
+
+    /// Implicit step: (β/γ)ΔtK + M/(γΔt) + C, the iteration of §5.
+    fn implicit_velocity(&mut self, dt: f64, step: u64, t: f64) -> Result<usize, TimeError> {
+        let op = self
+            .implicit
+            .as_mut()
+            .expect("implicit operator exists for implicit schemes");
+        op.set_dt(
+            dt,
+            self.beta / self.gamma * dt,
+            &self.dynamics.stiffness,
+            1.0 / (self.gamma * dt),
+            &self.mass_matrix,
+        );
+        let Some(contact) = &self.contact else {
+            op.solve_plain(&self.b, &mut self.v_new)
+                .map_err(|source| TimeError::Solve { step, t, source })?;
+            return Ok(1);
+        };
+        let mut system = ImplicitStep {
+            operator: op,
+            b: &self.b,
+        };
+        let result = iterate(
+            contact,
+            &mut system,
+            &mut self.scratch_classes,
+            &mut self.iter_scratch,
+            &mut self.v_new,
+            self.settings.iteration,
+        );
+        match result {
+            Ok(report) => Ok(report.iterations),
+            Err(IterationFailure::Cap {
+                iterations,
+                changing,
+            }) => Err(TimeError::IterationCap {
+                step,
+                t,
+                iterations,
+                changing,
+            }),
+            Err(IterationFailure::Solve(source)) => Err(TimeError::Solve { step, t, source }),
+        }
+    }
+
+    // ---- read access for observers ----
+
+    /// Current time.
+    pub fn time(&self) -> f64 {
+        self.t
+    }
+    /// Steps completed.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+    /// End time.
+    pub fn t_end(&self) -> f64 {
+        self.settings.t_end
+    }
+    /// Displacement r on free DOFs.
+    pub fn displacement(&self) -> &[f64] {
+        &self.r
+    }
+    /// Velocity ṙ on free DOFs.
+    pub fn velocity(&self) -> &[f64] {
+        &self.v
+    }
+    /// Acceleration r̈ on free DOFs.
+    pub fn acceleration(&self) -> &[f64] {
+        &self.a
+    }
+    /// Stick/slip class of each contact node.
+    pub fn classes(&self) -> &[SlipState] {
+        &self.classes
+    }
+    /// The contact surface, if the scene has friction.
+    pub fn contact(&self) -> Option<&ContactSurface> {
+        self.contact.as_ref()
+    }
+    /// The energy ledger now.
+    pub fn energy(&self) -> Energy {
+        self.energy
+    }
+    /// Numeric factorizations of the implicit operator so far.
+    pub fn factorizations(&self) -> u64 {
+        self.implicit.as_ref().map_or(0, |op| op.factorizations)
+    }
+    /// Stick/slip iterations (linear solves) summed over all steps.
+    pub fn total_iterations(&self) -> u64 {
+        self.total_iterations
+    }
+    /// Estimated critical step of an explicit run.
+    pub fn dt_crit(&self) -> Option<f64> {
+        self.dt_crit
+    }
+    /// True when the run is explicit (no linear solves).
+    pub fn is_explicit(&self) -> bool {
+        self.explicit
+    }
+    /// The mass the scheme uses.
+    pub fn mass_kind(&self) -> MassKind {
+        self.mass_kind
+    }
+    /// Friction stress σ_T = −g φ_ε(v_T) at each contact node.
+    pub fn friction_stress(&self, out: &mut [f64]) {
+        if let Some(c) = &self.contact {
+            c.friction_stress(&self.v, out);
+        }
+    }
+    /// Tangential (slip) velocity at each contact node.
+    pub fn slip_velocity(&self, out: &mut [f64]) {
+        if let Some(c) = &self.contact {
+            for (o, n) in out.iter_mut().zip(&c.nodes) {
+                *o = n.tangential(&self.v);
+            }
+        }
+    }
+}
