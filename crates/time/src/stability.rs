@@ -142,8 +142,13 @@ mod tests {
                 .sin()
                 .powi(2);
         let lambda = largest_eigenvalue(&k, &m, 300);
+        // The top Ritz value approaches λ_max from below; on this chain the
+        // upper spectrum is clustered (relative gap 2.5e-4), and 300 steps
+        // leave about 1.4e-6. Δt_crit = 2/√λ then errs by < 1e-5, far below
+        // the 2% the stability map asks for.
+        assert!(lambda <= exact * (1.0 + 1e-12), "Ritz value above λ_max");
         assert!(
-            (lambda - exact).abs() < 1e-6 * exact,
+            (lambda - exact).abs() < 1e-5 * exact,
             "λ = {lambda}, closed form {exact}"
         );
         // Masses of 4 halve ω: Δt_crit doubles.
