@@ -167,3 +167,61 @@ pub fn same_mesh(a: &Mesh, b: &Mesh, what: &str) {
     assert_eq!(a.cell_tags, b.cell_tags, "{what}: cell_tags");
     assert_eq!(a.groups, b.groups, "{what}: groups");
 }
+
+/// One element record of an MSH 2.2 binary `$Elements` section.
+#[derive(Debug, Clone, Copy)]
+pub struct Record {
+    /// Offset of the block header `{type, following, ntags}` it came under.
+    pub header: usize,
+    /// Offset of the record (`tag, tags[ntags], nodes[n]`).
+    pub offset: usize,
+    pub type_id: i32,
+    pub ntags: usize,
+    pub nn: usize,
+}
+
+fn i32_at(b: &[u8], at: usize) -> i32 {
+    i32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+}
+
+/// Walks a Gmsh 2.2 binary `$Elements` section (layout from the MSH 2.2
+/// specification, DEPENDENCIES.md §2) independently of the reader.
+pub fn v22_bin_elements(b: &[u8]) -> Vec<Record> {
+    let mut pos = find(b, b"$Elements\n") + 10;
+    let eol = pos + b[pos..].iter().position(|&c| c == b'\n').unwrap();
+    let count: usize = std::str::from_utf8(&b[pos..eol])
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    pos = eol + 1;
+    let mut out = Vec::new();
+    while out.len() < count {
+        let header = pos;
+        let (type_id, following, ntags) = (
+            i32_at(b, pos),
+            i32_at(b, pos + 4) as usize,
+            i32_at(b, pos + 8) as usize,
+        );
+        pos += 12;
+        let nn = match type_id {
+            15 => 1,
+            1 => 2,
+            8 => 3,
+            3 => 4,
+            10 => 9,
+            t => panic!("type {t}"),
+        };
+        for _ in 0..following {
+            out.push(Record {
+                header,
+                offset: pos,
+                type_id,
+                ntags,
+                nn,
+            });
+            pos += 4 * (1 + ntags + nn);
+        }
+    }
+    out
+}

@@ -1,0 +1,514 @@
+//! Every malformed-input class gets its own typed error, located by line
+//! (ASCII) or byte offset (binary). Each test damages a Gmsh-written fixture
+//! in one known place and expects exactly that place back.
+
+mod common;
+use common::*;
+use stickslip_mesh::{Location, Mesh, MeshError, MeshErrorKind as K};
+
+fn err_bytes(b: &[u8]) -> MeshError {
+    match Mesh::from_bytes(b) {
+        Ok(_) => panic!("damaged input was accepted"),
+        Err(e) => e,
+    }
+}
+
+fn err(s: &str) -> MeshError {
+    err_bytes(s.as_bytes())
+}
+
+const Q4_22: &str = "slab_q4_v22_ascii.msh";
+const Q4_41: &str = "slab_q4_v41_ascii.msh";
+
+// ---- truncated file ----
+
+#[test]
+fn truncated_ascii() {
+    let t = text(Q4_41);
+    let keep = line_no(&t, "$Nodes") + 3; // header, first block header, first tag
+    let lines: Vec<&str> = t.lines().collect();
+    // Whole lines, then the first 3 characters ("0 0") of the next one.
+    let cut = lines[..keep].join("\n") + "\n" + &lines[keep][..3];
+    let e = err(&cut);
+    assert!(matches!(e.kind, K::Truncated { .. }), "{e}");
+    assert_eq!(e.location, Location::Line(keep + 1));
+}
+
+#[test]
+fn truncated_binary() {
+    let b = bytes("slab_q4_v22_bin.msh");
+    let data = find(&b, b"$Nodes\n15\n") + 10;
+    // 5 whole 28-byte node records and 3 bytes: the 15 records do not fit.
+    let e = err_bytes(&b[..data + 28 * 5 + 3]);
+    assert!(matches!(e.kind, K::Truncated { .. }), "{e}");
+    assert_eq!(e.location, Location::Byte(data));
+}
+
+// ---- missing $End… ----
+
+#[test]
+fn missing_end_ascii() {
+    let t = replace_line(&text(Q4_22), "$EndNodes", "");
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::MissingEnd {
+            section: "$Nodes".into(),
+            end: "$EndNodes".into()
+        }
+    );
+    assert_eq!(e.location, Location::Line(line_no(&t, "$Elements")));
+}
+
+#[test]
+fn missing_end_binary() {
+    let mut b = bytes("slab_q4_v41_bin.msh");
+    let at = find(&b, b"$EndElements");
+    b[at + 11] = b'X';
+    let e = err_bytes(&b);
+    assert!(
+        matches!(&e.kind, K::MissingEnd { end, .. } if end == "$EndElements"),
+        "{e}"
+    );
+    assert_eq!(e.location, Location::Byte(at));
+}
+
+#[test]
+fn skipped_section_without_end() {
+    let t = text(Q4_22) + "$Comments\nno end\n";
+    let e = err(&t);
+    assert!(
+        matches!(&e.kind, K::MissingEnd { section, .. } if section == "$Comments"),
+        "{e}"
+    );
+    assert_eq!(e.location, Location::Line(line_no(&t, "$Comments")));
+}
+
+// ---- wrong counts ----
+
+#[test]
+fn wrong_count_ascii_too_many_declared() {
+    let t = replace_line(&text(Q4_22), "15", "16");
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::WrongCount {
+            section: "$Nodes",
+            what: "nodes",
+            expected: 16
+        }
+    );
+    assert_eq!(e.location, Location::Line(line_no(&t, "$EndNodes")));
+}
+
+#[test]
+fn wrong_count_ascii_too_few_declared() {
+    let t = replace_line(&text(Q4_22), "15", "14");
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::WrongCount {
+            section: "$Nodes",
+            what: "nodes",
+            expected: 14
+        }
+    );
+    assert_eq!(
+        e.location,
+        Location::Line(line_no(&t, "15 5.999999999998746 0.6874999999984586 0"))
+    );
+}
+
+#[test]
+fn wrong_count_v41_block_sum() {
+    // $Elements declares 20 of the 21 elements: the last block (8 quads)
+    // takes the sum past the header.
+    let t = replace_line(&text(Q4_41), "6 21 1 21", "6 20 1 21");
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::WrongCount {
+            section: "$Elements",
+            what: "elements",
+            expected: 20
+        }
+    );
+    assert_eq!(e.location, Location::Line(line_no(&t, "2 1 3 8")));
+}
+
+#[test]
+fn wrong_count_binary() {
+    let mut b = bytes("slab_q4_v22_bin.msh");
+    let at = find(&b, b"$Elements\n21\n") + 10;
+    b[at + 1] = b'2'; // 21 -> 22
+    let e = err_bytes(&b);
+    assert_eq!(
+        e.kind,
+        K::WrongCount {
+            section: "$Elements",
+            what: "elements",
+            expected: 22
+        }
+    );
+    assert_eq!(e.location, Location::Byte(find(&b, b"\n$EndElements")));
+}
+
+#[test]
+fn huge_counts_are_errors_not_allocations() {
+    // 10^18 nodes in a binary 2.2 file: more than the input holds.
+    let b = bytes("slab_q4_v22_bin.msh");
+    let at = find(&b, b"$Nodes\n15\n") + 7;
+    let mut huge = b[..at].to_vec();
+    huge.extend_from_slice(b"1000000000000000000");
+    huge.extend_from_slice(&b[at + 2..]);
+    let e = err_bytes(&huge);
+    assert!(matches!(e.kind, K::Truncated { .. }), "{e}");
+    assert_eq!(e.location, Location::Byte(at + 20));
+    // And in a 4.1 ASCII header: the blocks hold 15, not 10^18.
+    let t = replace_line(&text(Q4_41), "9 15 1 15", "9 1000000000000000000 1 15");
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::WrongCount {
+            section: "$Nodes",
+            what: "nodes",
+            expected: 1_000_000_000_000_000_000
+        }
+    );
+    assert_eq!(
+        e.location,
+        Location::Line(line_no(&t, "9 1000000000000000000 1 15"))
+    );
+}
+
+// ---- non-numeric field ----
+
+#[test]
+fn non_numeric_ascii() {
+    let t = replace_line(&text(Q4_22), "5 1.999999999995288 0 0", "5 1.99x 0 0");
+    let e = err(&t);
+    assert!(
+        matches!(&e.kind, K::NotANumber { found, .. } if found == "1.99x"),
+        "{e}"
+    );
+    assert_eq!(e.location, Location::Line(line_no(&t, "5 1.99x 0 0")));
+    let t = replace_line(&text(Q4_41), "14 1 5 13 12", "14 1 5 six 12");
+    let e = err(&t);
+    assert!(
+        matches!(&e.kind, K::NotANumber { found, .. } if found == "six"),
+        "{e}"
+    );
+    assert_eq!(e.location, Location::Line(line_no(&t, "14 1 5 six 12")));
+}
+
+#[test]
+fn non_numeric_binary() {
+    let mut b = bytes("slab_q4_v22_bin.msh");
+    let data = find(&b, b"$Nodes\n15\n") + 10;
+    let x = data + 28 * 2 + 4; // x of the third node
+    b[x..x + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+    let e = err_bytes(&b);
+    assert!(matches!(e.kind, K::NotANumber { .. }), "{e}");
+    assert_eq!(e.location, Location::Byte(x));
+}
+
+// ---- element referencing a missing node ----
+
+#[test]
+fn missing_node_ascii() {
+    let t = replace_line(
+        &text(Q4_22),
+        "14 3 2 10 1 1 5 13 12",
+        "14 3 2 10 1 1 5 13 99",
+    );
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::MissingNode {
+            element: 14,
+            node: 99
+        }
+    );
+    assert_eq!(
+        e.location,
+        Location::Line(line_no(&t, "14 3 2 10 1 1 5 13 99"))
+    );
+}
+
+#[test]
+fn missing_node_binary() {
+    let mut b = bytes("slab_q4_v22_bin.msh");
+    let r = *v22_bin_elements(&b)
+        .iter()
+        .find(|r| r.type_id == 3)
+        .unwrap();
+    let last = r.offset + 4 * (1 + r.ntags + 3);
+    b[last..last + 4].copy_from_slice(&999i32.to_le_bytes());
+    let e = err_bytes(&b);
+    assert!(matches!(e.kind, K::MissingNode { node: 999, .. }), "{e}");
+    assert_eq!(e.location, Location::Byte(r.offset));
+}
+
+// ---- unknown physical group (4.1: an entity $Entities does not list) ----
+
+#[test]
+fn unknown_entity_ascii() {
+    let t = replace_line(&text(Q4_41), "2 1 3 8", "2 7 3 8");
+    let e = err(&t);
+    assert_eq!(e.kind, K::UnknownEntity { dim: 2, tag: 7 });
+    assert_eq!(e.location, Location::Line(line_no(&t, "2 7 3 8")));
+}
+
+fn block_header(dim: i32, tag: i32, ty: i32, n: u64) -> Vec<u8> {
+    [
+        &dim.to_le_bytes()[..],
+        &tag.to_le_bytes(),
+        &ty.to_le_bytes(),
+        &n.to_le_bytes(),
+    ]
+    .concat()
+}
+
+#[test]
+fn unknown_entity_binary() {
+    let mut b = bytes("slab_q4_v41_bin.msh");
+    let at = find(&b, &block_header(2, 1, 3, 8));
+    b[at + 4] = 7;
+    let e = err_bytes(&b);
+    assert_eq!(e.kind, K::UnknownEntity { dim: 2, tag: 7 });
+    assert_eq!(e.location, Location::Byte(at));
+}
+
+// ---- unsupported element type ----
+
+#[test]
+fn unsupported_element_ascii() {
+    let t = replace_line(&text(Q4_41), "2 1 3 8", "2 1 5 8");
+    let e = err(&t);
+    // Element 14 is the first of that block in the fixture.
+    assert_eq!(
+        e.kind,
+        K::UnsupportedElement {
+            element: 14,
+            type_id: 5,
+            name: "hex8"
+        }
+    );
+    assert_eq!(e.location, Location::Line(line_no(&t, "2 1 5 8")));
+}
+
+#[test]
+fn unsupported_element_binary() {
+    let mut b = bytes("slab_q4_v22_bin.msh");
+    let r = *v22_bin_elements(&b)
+        .iter()
+        .find(|r| r.type_id == 3)
+        .unwrap();
+    b[r.header..r.header + 4].copy_from_slice(&4i32.to_le_bytes());
+    let e = err_bytes(&b);
+    assert!(
+        matches!(
+            e.kind,
+            K::UnsupportedElement {
+                type_id: 4,
+                name: "tet4",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert_eq!(e.location, Location::Byte(r.header));
+}
+
+#[test]
+fn mixed_quad4_quad9_refused() {
+    let t = replace_line(
+        &text(Q4_22),
+        "15 3 2 10 1 12 13 11 4",
+        "15 10 2 10 1 12 13 11 4 5 6 7 8 9",
+    );
+    let e = err(&t);
+    assert!(
+        matches!(&e.kind, K::NotQuads { found } if found.contains("quad4 and quad9")),
+        "{e}"
+    );
+    assert_eq!(
+        e.location,
+        Location::Line(line_no(&t, "15 10 2 10 1 12 13 11 4 5 6 7 8 9"))
+    );
+}
+
+// ---- unsupported version, big-endian, data size ----
+
+#[test]
+fn unsupported_version() {
+    for v in ["3", "4.0", "2.1"] {
+        let e = err(&replace_line(&text(Q4_22), "2.2 0 8", &format!("{v} 0 8")));
+        assert_eq!(e.kind, K::UnsupportedVersion { version: v.into() });
+        assert_eq!(e.location, Location::Line(2));
+    }
+}
+
+#[test]
+fn big_endian_binary() {
+    let mut b = bytes("slab_q4_v41_bin.msh");
+    let at = find(&b, b"4.1 1 8\n") + 8;
+    assert_eq!(&b[at..at + 4], &[1, 0, 0, 0]);
+    b[at..at + 4].copy_from_slice(&[0, 0, 0, 1]);
+    let e = err_bytes(&b);
+    assert_eq!(e.kind, K::BigEndian);
+    assert_eq!(e.location, Location::Byte(at));
+}
+
+#[test]
+fn unsupported_data_size() {
+    let mut b = bytes("slab_q4_v41_bin.msh");
+    let at = find(&b, b"4.1 1 8\n");
+    b[at + 6] = b'4';
+    let e = err_bytes(&b);
+    assert_eq!(e.kind, K::UnsupportedDataSize { size: 4 });
+    assert_eq!(e.location, Location::Byte(at + 4));
+}
+
+// ---- checks: degenerate cells, boundary elements off the cells ----
+
+#[test]
+fn degenerate_cells() {
+    // A repeated corner (zero-length side) and a bow-tie (crossed sides).
+    for bad in ["16 3 2 10 1 5 6 6 13", "16 3 2 10 1 5 14 6 13"] {
+        let t = replace_line(&text(Q4_22), "16 3 2 10 1 5 6 14 13", bad);
+        let e = err(&t);
+        assert_eq!(e.kind, K::DegenerateCell { element: 16 }, "{bad}");
+        assert_eq!(e.location, Location::Line(line_no(&t, bad)));
+    }
+}
+
+#[test]
+fn boundary_element_not_on_a_cell_edge() {
+    // 5-14 is a diagonal of cell 16 (5 6 14 13), not a side.
+    let t = replace_line(&text(Q4_22), "3 1 2 1 1 5 6", "3 1 2 1 1 5 14");
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::EdgeNotOnCell {
+            element: 3,
+            group: "contact".into()
+        }
+    );
+    assert_eq!(e.location, Location::Line(line_no(&t, "3 1 2 1 1 5 14")));
+}
+
+#[test]
+fn line_order_mismatch() {
+    let t = replace_line(&text(Q4_22), "3 1 2 1 1 5 6", "3 8 2 1 1 5 6 1");
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::OrderMismatch {
+            element: 3,
+            line: "line3",
+            cells: "quad4"
+        }
+    );
+    assert_eq!(e.location, Location::Line(line_no(&t, "3 8 2 1 1 5 6 1")));
+}
+
+#[test]
+fn no_cells() {
+    let t = text(Q4_22);
+    let cut: Vec<&str> = t
+        .lines()
+        .filter(|l| l.split_whitespace().nth(1) != Some("3") || l.split_whitespace().count() != 9)
+        .collect();
+    let t = replace_line(&(cut.join("\n") + "\n"), "21", "13");
+    let e = err(&t);
+    assert_eq!(e.kind, K::NoCells);
+    assert_eq!(e.location, Location::Nowhere);
+}
+
+#[test]
+fn not_planar() {
+    let t = replace_line(
+        &text(Q4_22),
+        "9 6.000000000002768 1.375000000000173 0",
+        "9 6.000000000002768 1.375000000000173 0.5",
+    );
+    assert_eq!(err(&t).kind, K::NotPlanar { node: 9, z: 0.5 });
+    // Rounding-level z (1e-14 of an 8-long mesh) is accepted.
+    let t = replace_line(
+        &text(Q4_22),
+        "9 6.000000000002768 1.375000000000173 0",
+        "9 6.000000000002768 1.375000000000173 1e-14",
+    );
+    assert!(Mesh::from_bytes(t.as_bytes()).is_ok());
+}
+
+#[test]
+fn duplicate_node_tag() {
+    let t = text("slab_q4_gaps_v41_ascii.msh");
+    let t = replace_line(&t, "106", "103");
+    let e = err(&t);
+    assert_eq!(e.kind, K::DuplicateNode { tag: 103 });
+    assert_eq!(e.location, Location::Line(line_no(&t, "9 15 103 145")));
+}
+
+// ---- file structure ----
+
+#[test]
+fn not_an_msh_file() {
+    let e = err("hello\n");
+    assert_eq!(e.kind, K::NotMsh);
+    assert_eq!(e.location, Location::Line(1));
+    assert_eq!(err_bytes(b"").kind, K::NotMsh);
+}
+
+#[test]
+fn sections_out_of_order_or_missing() {
+    let t = text(Q4_22);
+    let (n0, n1) = (t.find("$Nodes").unwrap(), t.find("$Elements").unwrap());
+    let swapped = format!("{}{}{}", &t[..n0], &t[n1..], &t[n0..n1]);
+    let e = err(&swapped);
+    assert!(
+        matches!(&e.kind, K::SectionOrder { found, .. } if found == "$Elements"),
+        "{e}"
+    );
+    assert_eq!(e.location, Location::Line(line_no(&swapped, "$Elements")));
+    let e = err(&t[..n1]);
+    assert_eq!(
+        e.kind,
+        K::MissingSection {
+            section: "$Elements"
+        }
+    );
+}
+
+/// Sections the reader does not use are skipped, whatever they hold.
+#[test]
+fn unused_sections_are_skipped() {
+    let t = text(Q4_41);
+    let extra = "$Comments\nanything $Nodes 1 2 3\n$EndComments\n$NodeData\n1\n\"u\"\n1\n0.0\n3\n0\n1\n15\n1 0.5\n$EndNodeData\n$Periodic\n0\n$EndPeriodic\n";
+    let at = t.find("$Elements").unwrap();
+    let with = format!("{}{}{}", &t[..at], extra, &t[at..]) + extra;
+    same_mesh(
+        &Mesh::from_bytes(with.as_bytes()).unwrap(),
+        &load(Q4_41),
+        "with extra sections",
+    );
+}
+
+#[test]
+fn file_errors_name_the_file_and_line() {
+    let dir = std::env::temp_dir().join(format!("stickslip-mesh-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("bad.msh");
+    std::fs::write(&p, replace_line(&text(Q4_22), "2.2 0 8", "3 0 8")).unwrap();
+    let e = Mesh::from_file(&p).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with(&format!("{}:2: MSH version 3", p.display())),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    let e = Mesh::from_file(dir.join("none.msh")).unwrap_err();
+    assert!(matches!(e.kind, K::Io(_)));
+}
