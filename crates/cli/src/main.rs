@@ -1,2 +1,195 @@
-//! The `stickslip` command (being written).
-fn main() {}
+//! The `stickslip` command: 2-D linear elastodynamics with regularized
+//! Coulomb friction (Martins & Oden 1983).
+//!
+//! This crate owns everything that touches files other than meshes and the
+//! terminal: the command line (this file), case files ([`case`]), the HDF5
+//! results ([`output`]), the `mesh` report ([`mesh_cmd`]) and the `probe`
+//! reader ([`probe`]). The numerics live in the library crates; `run.rs`
+//! wires them together.
+//!
+//! Exit codes: 0 success; 2 bad input (case, mesh, arguments — clap's usage
+//! errors exit 2 too); 1 a run that failed after it started.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod case;
+mod error;
+mod mesh_cmd;
+mod output;
+mod probe;
+mod run;
+
+use error::InputError;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "stickslip",
+    version,
+    about = "2-D elastodynamics with Coulomb friction (Martins & Oden 1983)",
+    after_help = "Examples:\n  stickslip mesh cases/meshes/slab-q2-8x2.msh\n  stickslip check cases/martins-oden/cd-eps1e-4.toml\n  stickslip run cases/martins-oden/cd-eps1e-4.toml -o slab.h5 --set time.dt=5e-4\n  stickslip probe slab.h5 --at 8,0 --field ux"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run a case and write the results to HDF5.
+    #[command(
+        after_help = "Example:\n  stickslip run case.toml -o out.h5 --set time.dt=5e-4 --set contact.eps=1e-2\n\n\
+Exit codes: 0 complete, 1 the run failed midway (the file keeps every step written, complete = false), 2 bad input."
+    )]
+    Run {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Results file (default: output.file of the case, relative to the case file).
+        #[arg(short, long, value_name = "OUT.h5")]
+        output: Option<PathBuf>,
+        /// Override a case value by its dotted path, e.g. time.scheme=newmark (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+        /// Overwrite an existing results file.
+        #[arg(long)]
+        force: bool,
+        /// No progress bar or summary.
+        #[arg(short, long)]
+        quiet: bool,
+    },
+    /// Validate a case and print the model size, the critical time step and the solver; no run.
+    #[command(after_help = "Example:\n  stickslip check case.toml --set time.scheme=newmark")]
+    Check {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Override a case value by its dotted path (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+    },
+    /// Describe a Gmsh .msh file: format, counts by element type, physical groups, bounding box.
+    #[command(after_help = "Example:\n  stickslip mesh cases/meshes/slab-q2-8x2.msh --json")]
+    Mesh {
+        /// The mesh file (MSH 2.2 or 4.1, ASCII or binary).
+        file: PathBuf,
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Print the time history of one field at the node nearest to a point.
+    #[command(
+        after_help = "Example:\n  stickslip probe slab.h5 --at 8,0 --field ux --csv > node81.csv"
+    )]
+    Probe {
+        /// A results file written by `stickslip run`.
+        file: PathBuf,
+        /// The point X,Y; the nearest node is used.
+        #[arg(long, value_name = "X,Y", allow_hyphen_values = true)]
+        at: String,
+        /// The field to print.
+        #[arg(long, value_enum, default_value_t = probe::Field::Ux)]
+        field: probe::Field,
+        /// Comma-separated values with a header line instead of a table.
+        #[arg(long)]
+        csv: bool,
+    },
+}
+
+/// Prints each line of a message as `error: ...` on stderr.
+fn report(msg: &str) {
+    for line in msg.lines() {
+        eprintln!("error: {line}");
+    }
+}
+
+/// Exit code for an error from a run or a check: 2 for bad input, else 1.
+fn fail(e: &anyhow::Error) -> ExitCode {
+    if let Some(input) = e.downcast_ref::<InputError>() {
+        report(&input.0);
+        ExitCode::from(2)
+    } else {
+        report(&format!("{e:#}"));
+        ExitCode::from(1)
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run {
+            case,
+            output,
+            sets,
+            force,
+            quiet,
+        } => {
+            let case = match case::load(&case, &sets) {
+                Ok(c) => c,
+                Err(e) => {
+                    report(&e.0);
+                    return ExitCode::from(2);
+                }
+            };
+            let out = output.unwrap_or_else(|| case.output.file.clone());
+            if out.exists() && !force {
+                report(&format!(
+                    "{} already exists; use --force to overwrite it, or -o to write elsewhere",
+                    out.display()
+                ));
+                return ExitCode::from(2);
+            }
+            match run::execute(&case, &out, quiet) {
+                Ok(run::Outcome::Complete) => ExitCode::SUCCESS,
+                Ok(run::Outcome::Failed) => ExitCode::from(1),
+                Err(e) => fail(&e),
+            }
+        }
+        Command::Check { case, sets } => {
+            let case = match case::load(&case, &sets) {
+                Ok(c) => c,
+                Err(e) => {
+                    report(&e.0);
+                    return ExitCode::from(2);
+                }
+            };
+            match run::check(&case) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&e),
+            }
+        }
+        Command::Mesh { file, json } => match mesh_cmd::report(&file, json) {
+            Ok(text) => {
+                print!("{text}");
+                if json {
+                    println!();
+                }
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                report(&e.0);
+                ExitCode::from(2)
+            }
+        },
+        Command::Probe {
+            file,
+            at,
+            field,
+            csv,
+        } => match probe::probe(&file, &at, field, csv) {
+            Ok(p) => {
+                if csv {
+                    eprint!("{}", p.info);
+                } else {
+                    print!("{}", p.info);
+                }
+                print!("{}", p.table);
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                report(&e.0);
+                ExitCode::from(2)
+            }
+        },
+    }
+}

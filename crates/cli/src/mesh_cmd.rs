@@ -1,0 +1,115 @@
+//! `stickslip mesh FILE.msh [--json]`: what is in a mesh file, or what is
+//! wrong with it (issue 2, deliverable 3; JSON keys in DESIGN.md).
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde_json::json;
+use stickslip_mesh::Mesh;
+
+use crate::error::InputError;
+
+/// Reads `path` and returns the report to print (a table, or one JSON object).
+///
+/// # Errors
+/// The mesh reader's error (file, line or byte offset, what to do).
+pub fn report(path: &Path, as_json: bool) -> Result<String, InputError> {
+    let mesh = Mesh::from_file(path)?;
+    Ok(if as_json {
+        to_json(&mesh).to_string()
+    } else {
+        to_table(path, &mesh)
+    })
+}
+
+/// The DESIGN.md object: format, version, binary, nodes, cells,
+/// boundary_elements, groups, bbox, reoriented.
+pub fn to_json(mesh: &Mesh) -> serde_json::Value {
+    let groups: serde_json::Map<String, serde_json::Value> = mesh
+        .groups
+        .iter()
+        .map(|g| {
+            (
+                g.name.clone(),
+                json!({"dim": g.dim, "elements": g.elements, "nodes": g.nodes.len()}),
+            )
+        })
+        .collect();
+    let cells: BTreeMap<&str, usize> = [(mesh.kind.name(), mesh.n_cells())].into();
+    json!({
+        "format": "msh",
+        "version": mesh.source.version,
+        "binary": mesh.source.binary,
+        "nodes": mesh.nodes.len(),
+        "cells": cells,
+        "boundary_elements": mesh.source.boundary_elements,
+        "groups": groups,
+        "bbox": mesh.bbox(),
+        "reoriented": mesh.source.reoriented,
+    })
+}
+
+fn to_table(path: &Path, mesh: &Mesh) -> String {
+    let mut s = String::new();
+    let enc = if mesh.source.binary {
+        "binary"
+    } else {
+        "ASCII"
+    };
+    let _ = writeln!(
+        s,
+        "{}: Gmsh MSH {} {enc}",
+        path.display(),
+        mesh.source.version
+    );
+    let _ = writeln!(s, "  nodes        {}", mesh.nodes.len());
+    let _ = writeln!(s, "  cells        {} {}", mesh.n_cells(), mesh.kind.name());
+    let boundary: Vec<String> = mesh
+        .source
+        .boundary_elements
+        .iter()
+        .map(|(k, v)| format!("{v} {k}"))
+        .collect();
+    let boundary = if boundary.is_empty() {
+        "none".to_string()
+    } else {
+        boundary.join(", ")
+    };
+    let _ = writeln!(s, "  boundary     {boundary}");
+    let [[x0, y0], [x1, y1]] = mesh.bbox();
+    let _ = writeln!(s, "  bbox         x in [{x0}, {x1}], y in [{y0}, {y1}]");
+    let _ = writeln!(
+        s,
+        "  reoriented   {} cells (given clockwise, turned counter-clockwise)",
+        mesh.source.reoriented
+    );
+    if mesh.groups.is_empty() {
+        let _ = writeln!(s, "  no physical groups: name the boundary parts in Gmsh (Physical Curve(\"contact\") = {{..}};)");
+        return s;
+    }
+    let w = mesh
+        .groups
+        .iter()
+        .map(|g| g.name.len())
+        .max()
+        .unwrap_or(0)
+        .max(5);
+    let _ = writeln!(s, "  physical groups:");
+    let _ = writeln!(
+        s,
+        "    {:<w$}  {:>3}  {:>8}  {:>6}",
+        "name", "dim", "elements", "nodes"
+    );
+    for g in &mesh.groups {
+        let _ = writeln!(
+            s,
+            "    {:<w$}  {:>3}  {:>8}  {:>6}",
+            g.name,
+            g.dim,
+            g.elements,
+            g.nodes.len()
+        );
+    }
+    s
+}

@@ -1,0 +1,825 @@
+//! The HDF5 results writer (DESIGN.md "Results").
+//!
+//! The file is created with the mesh and the contact surface, then grows by
+//! one row per output step in every time-dependent dataset (unlimited first
+//! dimension, chunked along time, shuffle + deflate). It is flushed every
+//! [`ResultsWriter::flush_every_steps`] appends or
+//! [`ResultsWriter::flush_every_secs`] seconds, so a run that stops early
+//! leaves a readable file with `complete = false`; [`ResultsWriter::finish`]
+//! writes the solver summary and sets `complete`.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{ensure, Context, Result};
+use hdf5::types::VarLenUnicode;
+use hdf5::{Dataset, File, Group, H5Type};
+use ndarray::{s, Array1, Array2, ArrayView1, ArrayView2};
+
+/// What the file holds before the first step.
+#[derive(Clone, Copy, Debug)]
+pub struct Header<'a> {
+    /// The case TOML as run (root attribute `case`).
+    pub case_source: &'a str,
+    /// The mesh (`/mesh/*`).
+    pub mesh: &'a stickslip_mesh::Mesh,
+    /// Contact node indices along the surface (empty: no `/contact`).
+    pub contact_nodes: &'a [usize],
+    /// Arc length of each contact node.
+    pub contact_s: &'a [f64],
+}
+
+/// One output step. Vectors are full, `2 * n_nodes` long, interleaved
+/// (x, y) per node; contact arrays are `n_c` long (empty without contact).
+#[derive(Clone, Copy, Debug)]
+pub struct Record<'a> {
+    /// Time.
+    pub t: f64,
+    /// Displacement r.
+    pub displacement: &'a [f64],
+    /// Velocity ṙ.
+    pub velocity: &'a [f64],
+    /// Acceleration r̈.
+    pub acceleration: &'a [f64],
+    /// Friction stress σ_T along τ at each contact node.
+    pub friction_stress: &'a [f64],
+    /// Slip velocity v_T along τ at each contact node.
+    pub slip_velocity: &'a [f64],
+    /// 0 stuck, +1 / −1 slipping.
+    pub state: &'a [i8],
+    /// ½ṙᵀMṙ.
+    pub kinetic: f64,
+    /// ½rᵀKr.
+    pub strain: f64,
+    /// Work of the external loads so far.
+    pub external_work: f64,
+    /// Friction dissipation so far.
+    pub dissipated: f64,
+    /// kinetic + strain − rᵀR(t) (the paper's Fig. 9).
+    pub total: f64,
+    /// kinetic + strain − initial − work + dissipated.
+    pub balance: f64,
+    /// The step that led here.
+    pub dt: f64,
+    /// Friction iterations of that step.
+    pub iterations: u32,
+}
+
+/// Written at the end (`/solver` attributes).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Summary {
+    /// Wall time of the run in seconds.
+    pub wall_time_s: f64,
+    /// Time steps taken (not only those written).
+    pub steps: u64,
+    /// Numeric factorizations done.
+    pub factorizations: u64,
+    /// Critical time step of the explicit scheme, if estimated.
+    pub dt_crit: Option<f64>,
+    /// Why the run stopped early, if it did (root attribute `failure`).
+    pub failure: Option<String>,
+}
+
+/// Growing datasets, one row per output step.
+#[derive(Debug)]
+struct Series {
+    time: Dataset,
+    displacement: Dataset,
+    velocity: Dataset,
+    acceleration: Dataset,
+    contact: Option<ContactSeries>,
+    energy: [Dataset; 6],
+    dt: Dataset,
+    iterations: Dataset,
+}
+
+#[derive(Debug)]
+struct ContactSeries {
+    friction_stress: Dataset,
+    slip_velocity: Dataset,
+    state: Dataset,
+}
+
+/// Writes one results file as a run goes.
+#[derive(Debug)]
+pub struct ResultsWriter {
+    file: File,
+    series: Series,
+    n_nodes: usize,
+    n_c: usize,
+    rows: usize,
+    since_flush: usize,
+    last_flush: Instant,
+    /// Flush after this many appends (default 100).
+    pub flush_every_steps: usize,
+    /// Flush after this many seconds since the last flush (default 5).
+    pub flush_every_secs: f64,
+}
+
+/// Node order written in `/mesh/cells` attribute `node_order`.
+fn node_order(kind: stickslip_mesh::CellKind) -> &'static str {
+    match kind {
+        stickslip_mesh::CellKind::Quad4 => "quad4: the 4 corners counter-clockwise",
+        stickslip_mesh::CellKind::Quad9 => {
+            "quad9: the 4 corners counter-clockwise, then the mid-side nodes of edges (0,1), (1,2), \
+             (2,3), (3,0), then the centre (Gmsh's and VTK's Quadrilateral_9 order)"
+        }
+    }
+}
+
+fn string_attr(loc: &hdf5::Location, name: &str, value: &str) -> Result<()> {
+    let v: VarLenUnicode = value
+        .replace('\0', " ")
+        .parse()
+        .map_err(|e| anyhow::anyhow!("attribute {name}: {e:?}"))?;
+    loc.new_attr::<VarLenUnicode>()
+        .create(name)?
+        .write_scalar(&v)?;
+    Ok(())
+}
+
+fn scalar_attr<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<()> {
+    loc.new_attr::<T>().create(name)?.write_scalar(&value)?;
+    Ok(())
+}
+
+/// Rows per chunk along time so that a chunk stays within HDF5's default
+/// 1 MiB chunk cache (a partly written chunk then stays in memory instead of
+/// being re-read and re-compressed on every append).
+fn chunk_rows(row_bytes: usize) -> usize {
+    (1 << 20) / row_bytes.max(1)
+}
+
+fn series_1d<T: H5Type>(g: &Group, name: &str) -> Result<Dataset> {
+    Ok(g.new_dataset::<T>()
+        .chunk(1024)
+        .shape(0..)
+        .shuffle()
+        .deflate(4)
+        .create(name)?)
+}
+
+fn series_2d<T: H5Type>(g: &Group, name: &str, n: usize) -> Result<Dataset> {
+    let rows = chunk_rows(n * std::mem::size_of::<T>()).clamp(1, 64);
+    Ok(g.new_dataset::<T>()
+        .chunk((rows, n))
+        .shape((0.., n))
+        .shuffle()
+        .deflate(4)
+        .create(name)?)
+}
+
+fn series_3d(g: &Group, name: &str, n: usize) -> Result<Dataset> {
+    let rows = chunk_rows(n * 16).clamp(1, 16);
+    Ok(g.new_dataset::<f64>()
+        .chunk((rows, n, 2))
+        .shape((0.., n, 2))
+        .shuffle()
+        .deflate(4)
+        .create(name)?)
+}
+
+fn index_array(v: impl ExactSizeIterator<Item = usize>) -> Array1<i64> {
+    v.map(|i| i as i64).collect()
+}
+
+impl ResultsWriter {
+    /// Creates (truncates) `path` and writes everything known before the
+    /// first step: root attributes (`program`, `version`, `case`,
+    /// `complete = false`), `/mesh`, and `/contact/{nodes,s}` when there is a
+    /// contact surface.
+    ///
+    /// # Errors
+    /// File system / HDF5 errors, or contact arrays of different lengths.
+    pub fn create(path: &Path, header: &Header) -> Result<ResultsWriter> {
+        ensure!(
+            header.contact_nodes.len() == header.contact_s.len(),
+            "contact_nodes has {} entries but contact_s {}",
+            header.contact_nodes.len(),
+            header.contact_s.len()
+        );
+        let mesh = header.mesh;
+        let n_nodes = mesh.nodes.len();
+        ensure!(n_nodes > 0, "the mesh has no nodes");
+        let file =
+            File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+        let root: &hdf5::Location = &file;
+        string_attr(root, "program", "stickslip")?;
+        string_attr(root, "version", env!("CARGO_PKG_VERSION"))?;
+        string_attr(root, "case", header.case_source)?;
+        scalar_attr(root, "complete", false)?;
+
+        let g = file.create_group("mesh")?;
+        string_attr(&g, "kind", mesh.kind.name())?;
+        let nodes = Array2::from_shape_fn((n_nodes, 2), |(i, k)| mesh.nodes[i][k]);
+        g.new_dataset_builder().with_data(&nodes).create("nodes")?;
+        let npc = mesh.kind.nodes_per_cell();
+        let cells = Array2::from_shape_fn((mesh.n_cells(), npc), |(c, k)| {
+            mesh.cells[c * npc + k] as i64
+        });
+        let ds = g.new_dataset_builder().with_data(&cells).create("cells")?;
+        string_attr(&ds, "node_order", node_order(mesh.kind))?;
+        let tags: Array1<i64> = mesh.node_tags.iter().map(|&t| t as i64).collect();
+        g.new_dataset_builder()
+            .with_data(&tags)
+            .create("node_tags")?;
+        let groups = g.create_group("groups")?;
+        for grp in &mesh.groups {
+            // '/' would make a nested HDF5 path.
+            let name = grp.name.replace('/', "_");
+            let ds = groups
+                .new_dataset_builder()
+                .with_data(&index_array(grp.nodes.iter().copied()))
+                .create(name.as_str())?;
+            scalar_attr(&ds, "dim", grp.dim as i64)?;
+            scalar_attr(&ds, "tag", grp.tag as i64)?;
+        }
+
+        let n_c = header.contact_nodes.len();
+        let contact = if n_c > 0 {
+            let c = file.create_group("contact")?;
+            c.new_dataset_builder()
+                .with_data(&index_array(header.contact_nodes.iter().copied()))
+                .create("nodes")?;
+            c.new_dataset_builder()
+                .with_data(&ArrayView1::from(header.contact_s))
+                .create("s")?;
+            Some(ContactSeries {
+                friction_stress: series_2d::<f64>(&c, "friction_stress", n_c)?,
+                slip_velocity: series_2d::<f64>(&c, "slip_velocity", n_c)?,
+                state: series_2d::<i8>(&c, "state", n_c)?,
+            })
+        } else {
+            None
+        };
+        let e = file.create_group("energy")?;
+        let energy = [
+            series_1d::<f64>(&e, "kinetic")?,
+            series_1d::<f64>(&e, "strain")?,
+            series_1d::<f64>(&e, "external_work")?,
+            series_1d::<f64>(&e, "dissipated")?,
+            series_1d::<f64>(&e, "total")?,
+            series_1d::<f64>(&e, "balance")?,
+        ];
+        let solver = file.create_group("solver")?;
+        let series = Series {
+            time: series_1d::<f64>(&file, "time")?,
+            displacement: series_3d(&file, "displacement", n_nodes)?,
+            velocity: series_3d(&file, "velocity", n_nodes)?,
+            acceleration: series_3d(&file, "acceleration", n_nodes)?,
+            contact,
+            energy,
+            dt: series_1d::<f64>(&solver, "dt")?,
+            iterations: series_1d::<u32>(&solver, "iterations")?,
+        };
+        file.flush()?;
+        Ok(ResultsWriter {
+            file,
+            series,
+            n_nodes,
+            n_c,
+            rows: 0,
+            since_flush: 0,
+            last_flush: Instant::now(),
+            flush_every_steps: 100,
+            flush_every_secs: 5.0,
+        })
+    }
+
+    /// Appends one output step to every dataset.
+    ///
+    /// # Errors
+    /// HDF5 errors, or slices whose lengths do not match the header.
+    pub fn append(&mut self, rec: &Record) -> Result<()> {
+        let (n, n_c, k) = (self.n_nodes, self.n_c, self.rows);
+        for (name, v) in [
+            ("displacement", rec.displacement),
+            ("velocity", rec.velocity),
+            ("acceleration", rec.acceleration),
+        ] {
+            ensure!(
+                v.len() == 2 * n,
+                "record {k}: {name} has {} values, expected 2 * {n} nodes",
+                v.len()
+            );
+        }
+        for (name, len) in [
+            ("friction_stress", rec.friction_stress.len()),
+            ("slip_velocity", rec.slip_velocity.len()),
+            ("state", rec.state.len()),
+        ] {
+            ensure!(
+                len == n_c,
+                "record {k}: {name} has {len} values, expected {n_c} contact nodes"
+            );
+        }
+        let s = &self.series;
+        let one = |ds: &Dataset, v: &f64| -> Result<()> {
+            ds.resize(k + 1)?;
+            ds.write_slice(ArrayView1::from(std::slice::from_ref(v)), s![k..k + 1])?;
+            Ok(())
+        };
+        one(&s.time, &rec.t)?;
+        for (ds, v) in [
+            (&s.displacement, rec.displacement),
+            (&s.velocity, rec.velocity),
+            (&s.acceleration, rec.acceleration),
+        ] {
+            ds.resize((k + 1, n, 2))?;
+            ds.write_slice(ArrayView2::from_shape((n, 2), v)?, s![k, .., ..])?;
+        }
+        if let Some(c) = &s.contact {
+            c.friction_stress.resize((k + 1, n_c))?;
+            c.friction_stress
+                .write_slice(ArrayView1::from(rec.friction_stress), s![k, ..])?;
+            c.slip_velocity.resize((k + 1, n_c))?;
+            c.slip_velocity
+                .write_slice(ArrayView1::from(rec.slip_velocity), s![k, ..])?;
+            c.state.resize((k + 1, n_c))?;
+            c.state
+                .write_slice(ArrayView1::from(rec.state), s![k, ..])?;
+        }
+        let e = [
+            rec.kinetic,
+            rec.strain,
+            rec.external_work,
+            rec.dissipated,
+            rec.total,
+            rec.balance,
+        ];
+        for (ds, v) in s.energy.iter().zip(&e) {
+            one(ds, v)?;
+        }
+        one(&s.dt, &rec.dt)?;
+        s.iterations.resize(k + 1)?;
+        s.iterations.write_slice(
+            ArrayView1::from(std::slice::from_ref(&rec.iterations)),
+            s![k..k + 1],
+        )?;
+
+        self.rows += 1;
+        self.since_flush += 1;
+        if self.since_flush >= self.flush_every_steps
+            || self.last_flush.elapsed().as_secs_f64() >= self.flush_every_secs
+        {
+            self.file.flush()?;
+            self.since_flush = 0;
+            self.last_flush = Instant::now();
+        }
+        Ok(())
+    }
+
+    /// Writes the `/solver` attributes (`wall_time_s`, `steps`,
+    /// `factorizations`, `dt_crit` when known), the root attribute `failure`
+    /// when the run stopped early, sets root `complete`, and closes the file.
+    ///
+    /// # Errors
+    /// HDF5 errors.
+    pub fn finish(self, complete: bool, summary: &Summary) -> Result<()> {
+        let solver = self.file.group("solver")?;
+        scalar_attr(&solver, "wall_time_s", summary.wall_time_s)?;
+        scalar_attr(&solver, "steps", summary.steps)?;
+        scalar_attr(&solver, "factorizations", summary.factorizations)?;
+        if let Some(d) = summary.dt_crit {
+            scalar_attr(&solver, "dt_crit", d)?;
+        }
+        if let Some(f) = &summary.failure {
+            string_attr(&self.file, "failure", f)?;
+        }
+        self.file.attr("complete")?.write_scalar(&complete)?;
+        self.file.flush()?;
+        drop(self.series);
+        self.file.close()?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use stickslip_mesh::{CellKind, Edge, Group, Mesh, SourceInfo};
+
+    /// Tests that hold an HDF5 file open or spawn python3 take this lock: a
+    /// child forked by one test inherits the file descriptors other tests
+    /// have open, and with them HDF5's file lock (EAGAIN on the next open).
+    pub(crate) fn h5_lock() -> std::sync::MutexGuard<'static, ()> {
+        static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+        LOCK.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Two Q1 cells side by side: nodes 0..6 on a 3 × 2 grid, a contact
+    /// line along the bottom (nodes 0, 1, 2).
+    pub(crate) fn tiny_mesh() -> Mesh {
+        let nodes = vec![
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [2.0, 0.0],
+            [0.0, 1.0],
+            [1.0, 1.0],
+            [2.0, 1.0],
+        ];
+        let edge = |a, b, cell| Edge {
+            nodes: [a, b],
+            mid: None,
+            cell,
+        };
+        Mesh {
+            node_tags: (1..=6).collect(),
+            nodes,
+            kind: CellKind::Quad4,
+            cells: vec![0, 1, 4, 3, 1, 2, 5, 4],
+            cell_tags: vec![7, 8],
+            groups: vec![
+                Group {
+                    name: "contact".into(),
+                    tag: 1,
+                    dim: 1,
+                    edges: vec![edge(0, 1, 0), edge(1, 2, 1)],
+                    cells: vec![],
+                    points: vec![],
+                    nodes: vec![0, 1, 2],
+                    elements: 2,
+                },
+                Group {
+                    name: "body".into(),
+                    tag: 10,
+                    dim: 2,
+                    edges: vec![],
+                    cells: vec![0, 1],
+                    points: vec![],
+                    nodes: (0..6).collect(),
+                    elements: 2,
+                },
+            ],
+            source: SourceInfo::default(),
+        }
+    }
+
+    /// Values of step k are simple functions of (k, index) so the read-back
+    /// can be checked against the same formulas.
+    fn u(k: usize, i: usize) -> f64 {
+        k as f64 * 100.0 + i as f64 * 0.5
+    }
+
+    fn write_file(path: &Path, steps: usize, finish: Option<bool>) {
+        let mesh = tiny_mesh();
+        let header = Header {
+            case_source: "title = \"tiny\"\n",
+            mesh: &mesh,
+            contact_nodes: &[0, 1, 2],
+            contact_s: &[0.0, 1.0, 2.0],
+        };
+        let mut w = ResultsWriter::create(path, &header).unwrap();
+        let mut d = vec![0.0; 12];
+        let mut v = vec![0.0; 12];
+        let mut a = vec![0.0; 12];
+        for k in 0..steps {
+            for i in 0..12 {
+                d[i] = u(k, i);
+                v[i] = -u(k, i);
+                a[i] = 2.0 * u(k, i);
+            }
+            let fs = [k as f64, 1.0 + k as f64, 2.0 + k as f64];
+            let sv = [0.5 * k as f64, 0.0, -1.0];
+            let st: [i8; 3] = [0, 1, -1];
+            w.append(&Record {
+                t: 0.1 * k as f64,
+                displacement: &d,
+                velocity: &v,
+                acceleration: &a,
+                friction_stress: &fs,
+                slip_velocity: &sv,
+                state: &st,
+                kinetic: 1.0 + k as f64,
+                strain: 2.0 + k as f64,
+                external_work: 3.0 + k as f64,
+                dissipated: 4.0 + k as f64,
+                total: 5.0 + k as f64,
+                balance: 6.0 + k as f64,
+                dt: 0.1,
+                iterations: k as u32 + 1,
+            })
+            .unwrap();
+        }
+        if let Some(c) = finish {
+            w.finish(
+                c,
+                &Summary {
+                    wall_time_s: 1.5,
+                    steps: 30,
+                    factorizations: 2,
+                    dt_crit: Some(0.25),
+                    failure: (!c).then(|| "iteration cap hit at step 3".to_string()),
+                },
+            )
+            .unwrap();
+        }
+    }
+
+    fn scratch(name: &str) -> std::path::PathBuf {
+        std::env::temp_dir().join(format!("stickslip-out-{}-{name}.h5", std::process::id()))
+    }
+
+    #[test]
+    fn three_records_read_back() {
+        let _guard = h5_lock();
+        let path = scratch("three");
+        write_file(&path, 3, Some(true));
+        let f = File::open(&path).unwrap();
+        let attr_s = |n: &str| {
+            f.attr(n)
+                .unwrap()
+                .read_scalar::<VarLenUnicode>()
+                .unwrap()
+                .as_str()
+                .to_string()
+        };
+        assert_eq!(attr_s("program"), "stickslip");
+        assert_eq!(attr_s("case"), "title = \"tiny\"\n");
+        assert!(f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
+        assert!(
+            f.attr("failure").is_err(),
+            "no failure attribute on a complete run"
+        );
+
+        let nodes = f.dataset("mesh/nodes").unwrap().read_2d::<f64>().unwrap();
+        assert_eq!(nodes.shape(), &[6, 2]);
+        assert_eq!(nodes[[4, 0]], 1.0);
+        let cells = f.dataset("mesh/cells").unwrap();
+        assert_eq!(
+            cells.read_2d::<i64>().unwrap().row(1).to_vec(),
+            vec![1, 2, 5, 4]
+        );
+        assert!(cells.attr("node_order").is_ok());
+        assert_eq!(
+            f.dataset("mesh/groups/contact")
+                .unwrap()
+                .read_1d::<i64>()
+                .unwrap()
+                .to_vec(),
+            vec![0, 1, 2]
+        );
+        assert_eq!(
+            f.dataset("mesh/node_tags")
+                .unwrap()
+                .read_1d::<i64>()
+                .unwrap()
+                .to_vec(),
+            vec![1, 2, 3, 4, 5, 6]
+        );
+
+        assert_eq!(
+            f.dataset("time")
+                .unwrap()
+                .read_1d::<f64>()
+                .unwrap()
+                .to_vec(),
+            vec![0.0, 0.1, 0.2]
+        );
+        let disp = f
+            .dataset("displacement")
+            .unwrap()
+            .read_dyn::<f64>()
+            .unwrap();
+        assert_eq!(disp.shape(), &[3, 6, 2]);
+        // Interleaved input: value i of step k is node i/2, component i%2.
+        for k in 0..3 {
+            for i in 0..12 {
+                assert_eq!(disp[[k, i / 2, i % 2]], u(k, i));
+            }
+        }
+        let vel = f.dataset("velocity").unwrap().read_dyn::<f64>().unwrap();
+        assert_eq!(vel[[2, 5, 1]], -u(2, 11));
+        let acc = f
+            .dataset("acceleration")
+            .unwrap()
+            .read_dyn::<f64>()
+            .unwrap();
+        assert_eq!(acc[[1, 3, 0]], 2.0 * u(1, 6));
+
+        assert_eq!(
+            f.dataset("contact/nodes")
+                .unwrap()
+                .read_1d::<i64>()
+                .unwrap()
+                .to_vec(),
+            vec![0, 1, 2]
+        );
+        assert_eq!(
+            f.dataset("contact/s")
+                .unwrap()
+                .read_1d::<f64>()
+                .unwrap()
+                .to_vec(),
+            vec![0.0, 1.0, 2.0]
+        );
+        let fs = f
+            .dataset("contact/friction_stress")
+            .unwrap()
+            .read_2d::<f64>()
+            .unwrap();
+        assert_eq!(fs.shape(), &[3, 3]);
+        assert_eq!(fs.row(2).to_vec(), vec![2.0, 3.0, 4.0]);
+        let st = f.dataset("contact/state").unwrap().read_2d::<i8>().unwrap();
+        assert_eq!(st.row(1).to_vec(), vec![0, 1, -1]);
+        assert_eq!(
+            f.dataset("contact/slip_velocity")
+                .unwrap()
+                .read_2d::<f64>()
+                .unwrap()[[2, 0]],
+            1.0
+        );
+
+        for (i, name) in [
+            "kinetic",
+            "strain",
+            "external_work",
+            "dissipated",
+            "total",
+            "balance",
+        ]
+        .iter()
+        .enumerate()
+        {
+            let e = f
+                .dataset(&format!("energy/{name}"))
+                .unwrap()
+                .read_1d::<f64>()
+                .unwrap()
+                .to_vec();
+            let want: Vec<f64> = (0..3).map(|k| 1.0 + i as f64 + k as f64).collect();
+            assert_eq!(e, want, "energy/{name}");
+        }
+        assert_eq!(
+            f.dataset("solver/iterations")
+                .unwrap()
+                .read_1d::<u32>()
+                .unwrap()
+                .to_vec(),
+            vec![1, 2, 3]
+        );
+        assert_eq!(
+            f.dataset("solver/dt")
+                .unwrap()
+                .read_1d::<f64>()
+                .unwrap()
+                .to_vec(),
+            vec![0.1; 3]
+        );
+        let solver = f.group("solver").unwrap();
+        assert_eq!(
+            solver.attr("steps").unwrap().read_scalar::<u64>().unwrap(),
+            30
+        );
+        assert_eq!(
+            solver
+                .attr("factorizations")
+                .unwrap()
+                .read_scalar::<u64>()
+                .unwrap(),
+            2
+        );
+        assert_eq!(
+            solver
+                .attr("dt_crit")
+                .unwrap()
+                .read_scalar::<f64>()
+                .unwrap(),
+            0.25
+        );
+        assert_eq!(
+            solver
+                .attr("wall_time_s")
+                .unwrap()
+                .read_scalar::<f64>()
+                .unwrap(),
+            1.5
+        );
+        // Growing datasets are chunked along time and compressed.
+        let d = f.dataset("displacement").unwrap();
+        assert_eq!(d.chunk().unwrap()[1..], [6, 2]);
+        assert!(
+            d.filters().len() >= 2,
+            "shuffle + deflate: {:?}",
+            d.filters()
+        );
+        drop(f);
+        h5py_check(&path, 3, true);
+        std::fs::remove_file(&path).ok();
+    }
+
+    #[test]
+    fn unfinished_file_is_readable_and_incomplete() {
+        let _guard = h5_lock();
+        // A run that dies after flushing keeps the rows written (here the
+        // writer is dropped without finish, as when a run errors out).
+        let path = scratch("unfinished");
+        write_file(&path, 2, None);
+        let f = File::open(&path).unwrap();
+        assert!(!f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
+        assert_eq!(f.dataset("time").unwrap().shape(), vec![2]);
+        drop(f);
+        h5py_check(&path, 2, false);
+        // finish(false) records the failure reason.
+        write_file(&path, 1, Some(false));
+        let f = File::open(&path).unwrap();
+        assert!(!f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
+        let why = f
+            .attr("failure")
+            .unwrap()
+            .read_scalar::<VarLenUnicode>()
+            .unwrap();
+        assert_eq!(why.as_str(), "iteration cap hit at step 3");
+        std::fs::remove_file(&path).ok();
+    }
+
+    #[test]
+    fn wrong_lengths_are_errors_not_panics() {
+        let _guard = h5_lock();
+        let path = scratch("lengths");
+        let mesh = tiny_mesh();
+        let header = Header {
+            case_source: "",
+            mesh: &mesh,
+            contact_nodes: &[],
+            contact_s: &[],
+        };
+        let mut w = ResultsWriter::create(&path, &header).unwrap();
+        let z = vec![0.0; 12];
+        let mut rec = Record {
+            t: 0.0,
+            displacement: &z,
+            velocity: &z,
+            acceleration: &z[..10],
+            friction_stress: &[],
+            slip_velocity: &[],
+            state: &[],
+            kinetic: 0.0,
+            strain: 0.0,
+            external_work: 0.0,
+            dissipated: 0.0,
+            total: 0.0,
+            balance: 0.0,
+            dt: 0.0,
+            iterations: 0,
+        };
+        assert!(w
+            .append(&rec)
+            .unwrap_err()
+            .to_string()
+            .contains("acceleration"));
+        rec.acceleration = &z;
+        w.append(&rec).unwrap();
+        w.finish(true, &Summary::default()).unwrap();
+        let f = File::open(&path).unwrap();
+        assert!(
+            !f.link_exists("contact"),
+            "no /contact without a contact surface"
+        );
+        assert_eq!(f.dataset("displacement").unwrap().shape(), vec![1, 6, 2]);
+        std::fs::remove_file(&path).ok();
+    }
+
+    /// Reads the file with h5py, as users do (skipped, with a message, when
+    /// h5py is not installed).
+    fn h5py_check(path: &Path, rows: usize, complete: bool) {
+        let script = format!(
+            r#"
+import sys
+try:
+    import h5py
+except ImportError:
+    print("h5py missing"); sys.exit(3)
+f = h5py.File(sys.argv[1], "r")
+assert f["displacement"].shape == ({rows}, 6, 2), f["displacement"].shape
+assert f["displacement"].maxshape == (None, 6, 2)
+assert f["displacement"].compression == "gzip" and f["displacement"].shuffle
+assert f["contact/friction_stress"].shape == ({rows}, 3)
+assert f["contact/state"].dtype == "int8"
+assert f["energy/total"].shape == ({rows},)
+assert bool(f.attrs["complete"]) == {complete}
+assert f.attrs["program"] == "stickslip"
+assert f["mesh/cells"].dtype == "int64"
+print("ok")
+"#,
+            complete = if complete { "True" } else { "False" }
+        );
+        let out = std::process::Command::new("python3")
+            .arg("-c")
+            .arg(&script)
+            .arg(path)
+            .output();
+        match out {
+            Ok(o) if o.status.code() == Some(3) => {
+                eprintln!("skipped the h5py check: h5py is not installed")
+            }
+            Ok(o) => assert!(
+                o.status.success(),
+                "h5py check failed: {}{}",
+                String::from_utf8_lossy(&o.stdout),
+                String::from_utf8_lossy(&o.stderr)
+            ),
+            Err(e) => eprintln!("skipped the h5py check: cannot run python3 ({e})"),
+        }
+    }
+}
