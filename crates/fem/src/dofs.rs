@@ -209,64 +209,165 @@ impl DofMap {
     }
 }
 
-/// Which rigid motions u = (a − c·y, b + c·x) satisfy every homogeneous
-/// constraint. Each fixed x-DOF at (x, y) adds the row (1, 0, −y), each fixed
-/// y-DOF the row (0, 1, x); the free motions span the null space of the
-/// 3×3 Gram matrix of these rows (coordinates centred and scaled so the
-/// test is independent of units).
+/// Which rigid motions u = (a − c·y, b + c·x) of each connected part of the
+/// mesh satisfy every homogeneous constraint on that part. Each fixed x-DOF
+/// at (x, y) adds the row (1, 0, −y), each fixed y-DOF the row (0, 1, x);
+/// the free motions span the null space of the 3×3 Gram matrix of these
+/// rows (coordinates centred and scaled per part so the test is independent
+/// of units). Parts are the connected components of the cell graph: a part
+/// that touches no support is as singular as an unsupported mesh, and the
+/// Cholesky cannot be relied on to notice (rounding leaves a tiny positive
+/// pivot).
 fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> Vec<String> {
-    let [[x0, y0], [x1, y1]] = if mesh.nodes.is_empty() {
-        [[0.0; 2]; 2]
-    } else {
-        mesh.bbox()
-    };
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let scale = (x1 - x0).max(y1 - y0).max(f64::MIN_POSITIVE);
-    let mut g = [[0.0; 3]; 3];
-    let (mut any_x, mut any_y) = (false, false);
-    for (dof, &f) in free_index.iter().enumerate() {
-        if f != FIXED {
+    let n_nodes = mesh.nodes.len();
+    let part = connected_parts(mesh);
+    let n_parts = part
+        .iter()
+        .filter(|&&p| p != usize::MAX)
+        .max()
+        .map_or(0, |&p| p + 1);
+    let mut motions = Vec::new();
+    // Nodes in no cell have no stiffness at all.
+    for v in 0..n_nodes {
+        if part[v] == usize::MAX && (free_index[2 * v] != FIXED || free_index[2 * v + 1] != FIXED) {
+            let p = mesh.nodes[v];
+            motions.push(format!(
+                "node {v} at ({}, {}) belongs to no cell, so nothing holds it",
+                p[0], p[1]
+            ));
+        }
+    }
+    let mut bbox = vec![
+        [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY
+        ];
+        n_parts
+    ];
+    let mut first_node = vec![usize::MAX; n_parts];
+    for v in 0..n_nodes {
+        if part[v] == usize::MAX {
             continue;
         }
+        let (b, p) = (&mut bbox[part[v]], mesh.nodes[v]);
+        b[0] = b[0].min(p[0]);
+        b[1] = b[1].min(p[1]);
+        b[2] = b[2].max(p[0]);
+        b[3] = b[3].max(p[1]);
+        if first_node[part[v]] == usize::MAX {
+            first_node[part[v]] = v;
+        }
+    }
+    let mut gram = vec![[[0.0; 3]; 3]; n_parts];
+    let mut any = vec![[false; 2]; n_parts];
+    for (dof, &f) in free_index.iter().enumerate() {
+        let k = part[dof / 2];
+        if f != FIXED || k == usize::MAX {
+            continue;
+        }
+        let b = bbox[k];
+        let (cx, cy) = (0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3]));
+        let scale = (b[2] - b[0]).max(b[3] - b[1]).max(f64::MIN_POSITIVE);
         let p = mesh.nodes[dof / 2];
         let (x, y) = ((p[0] - cx) / scale, (p[1] - cy) / scale);
         let row = if dof % 2 == 0 {
-            any_x = true;
             [1.0, 0.0, -y]
         } else {
-            any_y = true;
             [0.0, 1.0, x]
         };
+        any[k][dof % 2] = true;
         for i in 0..3 {
             for j in 0..3 {
-                g[i][j] += row[i] * row[j];
+                gram[k][i][j] += row[i] * row[j];
             }
         }
     }
-    let (values, vectors) = symmetric_eigen3(g);
-    let largest = values.iter().fold(0.0f64, |m, &v| m.max(v));
-    let null: Vec<usize> = (0..3)
-        .filter(|&k| values[k] <= 1e-12 * largest.max(1e-300) || largest == 0.0)
-        .collect();
-    let mut motions = Vec::new();
-    if !any_x {
-        motions.push("translation in x".to_string());
-    }
-    if !any_y {
-        motions.push("translation in y".to_string());
-    }
-    if null.len() > motions.len() {
-        if motions.is_empty() {
-            // The null vector (a, b, c) is a rotation about (−b/c, a/c).
-            let k = null[0];
-            let (a, b, c) = (vectors[0][k], vectors[1][k], vectors[2][k]);
-            let (px, py) = (cx - b / c * scale, cy + a / c * scale);
-            motions.push(format!("rotation about ({px:.6}, {py:.6})"));
-        } else {
-            motions.push("rotation".to_string());
+    for k in 0..n_parts {
+        let b = bbox[k];
+        let (cx, cy) = (0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3]));
+        let scale = (b[2] - b[0]).max(b[3] - b[1]).max(f64::MIN_POSITIVE);
+        let (values, vectors) = symmetric_eigen3(gram[k]);
+        let largest = values.iter().fold(0.0f64, |m, &v| m.max(v));
+        let null: Vec<usize> = (0..3)
+            .filter(|&i| largest == 0.0 || values[i] <= 1e-12 * largest)
+            .collect();
+        let mut free = Vec::new();
+        if !any[k][0] {
+            free.push("translation in x".to_string());
         }
+        if !any[k][1] {
+            free.push("translation in y".to_string());
+        }
+        if null.len() > free.len() {
+            if free.is_empty() {
+                // The null vector (a, b, c) is a rotation about (−b/c, a/c).
+                let i = null[0];
+                let (a, bb, c) = (vectors[0][i], vectors[1][i], vectors[2][i]);
+                let (px, py) = (cx - bb / c * scale, cy + a / c * scale);
+                free.push(format!("rotation about ({px:.6}, {py:.6})"));
+            } else {
+                free.push("rotation".to_string());
+            }
+        }
+        if n_parts > 1 {
+            let v = first_node[k];
+            let p = mesh.nodes[v];
+            let whose = format!(
+                " of the separate part of the mesh containing node {v} at ({}, {})",
+                p[0], p[1]
+            );
+            for m in &mut free {
+                m.push_str(&whose);
+            }
+        }
+        motions.extend(free);
     }
     motions
+}
+
+/// Connected component of each node in the graph where the nodes of a cell
+/// are connected (`usize::MAX` for nodes in no cell), numbered in order of
+/// their first node.
+fn connected_parts(mesh: &Mesh) -> Vec<usize> {
+    let n = mesh.nodes.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut v: usize) -> usize {
+        while parent[v] != v {
+            parent[v] = parent[parent[v]];
+            v = parent[v];
+        }
+        v
+    }
+    let mut in_cell = vec![false; n];
+    for c in 0..mesh.n_cells() {
+        let cell = mesh.cell(c);
+        let r0 = root(&mut parent, cell[0]);
+        in_cell[cell[0]] = true;
+        for &v in &cell[1..] {
+            in_cell[v] = true;
+            let r = root(&mut parent, v);
+            if r != r0 {
+                parent[r] = r0;
+            }
+        }
+    }
+    let mut label = vec![usize::MAX; n];
+    let mut part = vec![usize::MAX; n];
+    let mut next = 0;
+    for v in 0..n {
+        if !in_cell[v] {
+            continue;
+        }
+        let r = root(&mut parent, v);
+        if label[r] == usize::MAX {
+            label[r] = next;
+            next += 1;
+        }
+        part[v] = label[r];
+    }
+    part
 }
 
 /// Eigenvalues and eigenvectors (columns) of a symmetric 3×3 matrix by

@@ -41,7 +41,7 @@ pub fn static_solve(model: &Model, load_free: &[f64]) -> Result<Vec<f64>, FemErr
             .map_err(|e| FemError::Solver(e.to_string()))?;
         chol.factorize(&model.stiffness).map_err(|e| match e {
             SolverError::NotPositiveDefinite { .. } => FemError::RigidBodyMotion {
-                motions: "the stiffness matrix is singular although every rigid motion of the whole mesh is held, so a part of the mesh is not connected to the supports (or a cell is degenerate)".to_string(),
+                motions: "the stiffness matrix is singular although the supports hold every rigid motion of each part of the mesh: a mechanism (cells joined only at a corner node) or a degenerate cell".to_string(),
             },
             other => FemError::Solver(other.to_string()),
         })?;

@@ -51,10 +51,11 @@ fn stiffness_annihilates_the_three_rigid_body_motions() {
         let model = Model::new(&mesh, &material(), &[]).unwrap();
         assert_eq!(model.dofs.n_free(), 2 * mesh.nodes.len());
         let k_norm = norm(model.stiffness.values());
-        let motions: [Box<dyn Fn([f64; 2]) -> [f64; 2]>; 3] = [
-            Box::new(|_| [1.0, 0.0]),
-            Box::new(|_| [0.0, 1.0]),
-            Box::new(|[x, y]| [-(y - 1.0), x - 1.5]),
+        // x-translation, y-translation, rotation about (1.5, 1).
+        let motions = [
+            |_: [f64; 2]| [1.0, 0.0],
+            |_: [f64; 2]| [0.0, 1.0],
+            |[x, y]: [f64; 2]| [-(y - 1.0), x - 1.5],
         ];
         for (m, motion) in motions.iter().enumerate() {
             let r: Vec<f64> = mesh.nodes.iter().flat_map(|&p| motion(p)).collect();
