@@ -214,8 +214,8 @@ pub struct Energy {
     pub strain: f64,
     /// ∫ R·ṙ dt, trapezoidal rule: Σ ½(R_K + R_{K−1})·(r_K − r_{K−1}).
     pub external_work: f64,
-    /// ∫ J·ṙ dt, trapezoidal rule: Σ ½(J_K + J_{K−1})·(r_K − r_{K−1}) ≥ 0
-    /// step by step since φ_ε is odd and increasing.
+    /// ∫ J·ṙ dt, trapezoidal rule: Σ ½(J_K + J_{K−1})·½Δt(ṙ_K + ṙ_{K−1}),
+    /// ≥ 0 step by step since φ_ε is odd and increasing.
     pub dissipated: f64,
     /// kinetic + strain − rᵀR(t): the paper's total energy (Fig. 9).
     pub total: f64,
@@ -626,7 +626,11 @@ impl Integrator {
         if let Some(c) = &self.contact {
             c.nodal_forces(&self.v_new, &mut self.forces_new);
             for i in 0..n {
-                self.tmp[i] = self.r_new[i] - self.r[i];
+                // Trapezoidal increment ½Δt(ṙ_K + ṙ_{K−1}): equal to r_K − r_{K−1}
+                // for Newmark ¼, ½ (so the balance closes to round-off) and,
+                // with φ_ε odd and increasing, making every increment ≥ 0 for
+                // any scheme.
+                self.tmp[i] = 0.5 * dt * (self.v_new[i] + self.v[i]);
             }
             for ((node, f_new), f_old) in c.nodes.iter().zip(&self.forces_new).zip(&self.forces) {
                 dissipated += 0.5 * (f_new + f_old) * node.tangential(&self.tmp);
