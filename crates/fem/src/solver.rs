@@ -10,12 +10,12 @@
 use std::cell::RefCell;
 
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltError;
 use faer::linalg::cholesky::llt::factor::LltParams;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
     SymmetricOrdering,
 };
-use faer::linalg::cholesky::llt::factor::LltError;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
@@ -97,7 +97,10 @@ impl SparseCholesky {
     /// [`SolverError::NotSquare`], or [`SolverError::Analysis`] if faer fails.
     pub fn analyze(a: &CsrMatrix<f64>) -> Result<SparseCholesky, SolverError> {
         if a.nrows() != a.ncols() {
-            return Err(SolverError::NotSquare { rows: a.nrows(), cols: a.ncols() });
+            return Err(SolverError::NotSquare {
+                rows: a.nrows(),
+                cols: a.ncols(),
+            });
         }
         let symbolic = factorize_symbolic_cholesky(
             as_csc(a).symbolic(),
@@ -109,8 +112,9 @@ impl SparseCholesky {
         let factor_scratch = MemBuffer::new(
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
         );
-        let solve_scratch =
-            RefCell::new(MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)));
+        let solve_scratch = RefCell::new(MemBuffer::new(
+            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ));
         Ok(SparseCholesky {
             l_values: vec![0.0; symbolic.len_val()],
             symbolic,
@@ -140,7 +144,10 @@ impl SparseCholesky {
     /// matrix, [`SolverError::PatternChanged`] for another pattern.
     pub fn factorize(&mut self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
         if a.nrows() != self.n || a.nnz() != self.nnz {
-            return Err(SolverError::PatternChanged { analysed: self.nnz, given: a.nnz() });
+            return Err(SolverError::PatternChanged {
+                analysed: self.nnz,
+                given: a.nnz(),
+            });
         }
         self.factorized = false;
         let result = self.symbolic.factorize_numeric_llt(
@@ -157,9 +164,10 @@ impl SparseCholesky {
                 self.factorized = true;
                 Ok(())
             }
-            Err(LltError::NonPositivePivot { index }) => {
-                Err(SolverError::NotPositiveDefinite { pivot: index, n: self.n })
-            }
+            Err(LltError::NonPositivePivot { index }) => Err(SolverError::NotPositiveDefinite {
+                pivot: index,
+                n: self.n,
+            }),
         }
     }
 
@@ -169,7 +177,10 @@ impl SparseCholesky {
     /// If called before a successful [`SparseCholesky::factorize`] or with
     /// `x.len() != n` (programming errors, not input errors).
     pub fn solve_in_place(&self, x: &mut [f64]) {
-        assert!(self.factorized, "SparseCholesky::solve_in_place before factorize");
+        assert!(
+            self.factorized,
+            "SparseCholesky::solve_in_place before factorize"
+        );
         assert_eq!(x.len(), self.n, "right-hand side length");
         let llt = LltRef::<'_, usize, f64>::new(&self.symbolic, &self.l_values);
         let n = self.n;
@@ -213,7 +224,10 @@ mod tests {
         for (i, xi) in x.iter().enumerate() {
             let (i1, k1) = ((i + 1) as f64, (k + 1) as f64);
             let exact = i1.min(k1) * ((n + 1) as f64 - i1.max(k1)) / (n + 1) as f64;
-            assert!((xi - exact).abs() < 1e-12, "x[{i}] = {xi}, closed form {exact}");
+            assert!(
+                (xi - exact).abs() < 1e-12,
+                "x[{i}] = {xi}, closed form {exact}"
+            );
         }
     }
 
@@ -231,7 +245,12 @@ mod tests {
         let mut x = b.clone();
         chol.solve_in_place(&mut x);
         for (i, row) in a.row_iter().enumerate() {
-            let ax: f64 = row.col_indices().iter().zip(row.values()).map(|(&j, v)| v * x[j]).sum();
+            let ax: f64 = row
+                .col_indices()
+                .iter()
+                .zip(row.values())
+                .map(|(&j, v)| v * x[j])
+                .sum();
             assert!((ax - b[i]).abs() < 1e-12, "residual at row {i}");
         }
     }
