@@ -7,7 +7,7 @@
 use std::collections::{BTreeMap, HashMap};
 
 use super::cursor::{Cursor, Result};
-use crate::{CellKind, Edge, Group, Mesh, MeshError, MeshErrorKind, SourceInfo};
+use crate::{CellKind, Edge, Group, Mesh, MeshError, MeshErrorKind, SourceInfo, GMSH_TO_FEM_QUAD9};
 
 /// Gmsh element types the reader knows by name.
 pub(crate) const POINT: i32 = 15;
@@ -257,6 +257,22 @@ impl Builder {
         Ok(())
     }
 
+    /// Reserves room for `count` more cells of `nodes` nodes, each taking at
+    /// least `min_bytes` of the input left (so a false count cannot make a
+    /// large allocation).
+    pub(crate) fn expect_cells(
+        &mut self,
+        cur: &Cursor<'_>,
+        count: u64,
+        nodes: usize,
+        min_bytes: usize,
+    ) {
+        let n = cur.capped(count, min_bytes);
+        self.cells.reserve(n * nodes);
+        self.cell_tags.reserve(n);
+        self.cell_member.reserve(n);
+    }
+
     #[inline]
     fn node_index(&self, tag: u64) -> Option<usize> {
         match self.index.as_ref()? {
@@ -315,19 +331,7 @@ impl Builder {
                     CellKind::Quad9
                 };
                 match self.kind {
-                    None => {
-                        self.kind = Some(kind);
-                        // Cells are usually the bulk of what is left.
-                        let per = if self.binary {
-                            8 * (1 + nodes.len())
-                        } else {
-                            2 * (1 + nodes.len())
-                        };
-                        let cap = cur.capped(u64::MAX, per);
-                        self.cells.reserve(cap * nodes.len());
-                        self.cell_tags.reserve(cap);
-                        self.cell_member.reserve(cap);
-                    }
+                    None => self.kind = Some(kind),
                     Some(k) if k != kind => {
                         return Err(cur.error(
                             pos,
@@ -337,6 +341,13 @@ impl Builder {
                         ))
                     }
                     Some(_) => {}
+                }
+                if kind == CellKind::Quad9 {
+                    // Gmsh's node order to the fem crate's, in one table (lib.rs).
+                    let gmsh = idx;
+                    for (fem, &g) in idx.iter_mut().zip(&GMSH_TO_FEM_QUAD9) {
+                        *fem = gmsh[g];
+                    }
                 }
                 let cell = &mut idx[..nodes.len()];
                 match self.orientation(cell) {
@@ -439,14 +450,14 @@ impl Builder {
                 ([n[0] - c[0], n[1] - c[1]], [q[0] - c[0], q[1] - c[1]])
             };
             let det = a[0] * b[1] - a[1] * b[0];
-            let scale = a[0].hypot(a[1]) * b[0].hypot(b[1]);
-            let s = if det > JACOBIAN_TOL * scale {
-                1
-            } else if det < -JACOBIAN_TOL * scale {
-                -1
-            } else {
+            // |det| > TOL |a| |b|, squared to save two square roots per corner.
+            let scale2 = (a[0] * a[0] + a[1] * a[1]) * (b[0] * b[0] + b[1] * b[1]);
+            // False also for NaN (coordinates so large that products overflow).
+            let clear = det * det > JACOBIAN_TOL * JACOBIAN_TOL * scale2;
+            if !clear {
                 return None;
-            };
+            }
+            let s = if det > 0.0 { 1 } else { -1 };
             if sign != 0 && s != sign {
                 return None;
             }

@@ -122,7 +122,7 @@ impl<'a> Cursor<'a> {
     }
 
     /// A token where a data field is expected; classifies what else was found.
-    fn field(&mut self, what: &'static str) -> Result<(usize, &'a [u8])> {
+    fn field(&mut self, _what: &'static str) -> Result<(usize, &'a [u8])> {
         match self.token() {
             None => Err(self.error(
                 self.pos,
@@ -137,10 +137,7 @@ impl<'a> Cursor<'a> {
                     Err(self.missing_end(p))
                 }
             }
-            Some((p, t)) => {
-                let _ = what;
-                Ok((p, t))
-            }
+            Some((p, t)) => Ok((p, t)),
         }
     }
 
@@ -247,8 +244,7 @@ impl<'a> Cursor<'a> {
     }
 
     /// `n` raw bytes of binary data.
-    pub(crate) fn take(&mut self, n: usize, what: &'static str) -> Result<&'a [u8]> {
-        let _ = what;
+    pub(crate) fn take(&mut self, n: usize, _what: &'static str) -> Result<&'a [u8]> {
         match self
             .pos
             .checked_add(n)

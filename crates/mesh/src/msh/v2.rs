@@ -94,6 +94,9 @@ pub(crate) fn elements(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
     cur.counts("elements", n);
     let mut members = Members::default();
     let mut nodes = [0u64; 9];
+    // Mostly cells (Gmsh writes few boundary elements); at least a quad4
+    // record each: 20 bytes binary, "1 3 0 1 2 3 4\n" ASCII.
+    b.expect_cells(cur, n, 4, if cur.binary { 20 } else { 14 });
     if cur.binary {
         cur.end_of_line()?;
         let mut read: u64 = 0;

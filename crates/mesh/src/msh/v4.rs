@@ -215,6 +215,14 @@ pub(crate) fn elements(
             let first = peek_tag(cur);
             return Err(unsupported(cur, bp, first, type_id));
         };
+        if nn >= 4 {
+            let min_bytes = if cur.binary {
+                8 * (1 + nn)
+            } else {
+                2 * (1 + nn)
+            };
+            b.expect_cells(cur, n, nn, min_bytes);
+        }
         if cur.binary {
             let size = 8 * (1 + nn);
             let start = cur.pos;
