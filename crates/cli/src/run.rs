@@ -55,7 +55,9 @@ fn history(h: &case::History) -> History {
         case::History::Constant => History::Constant,
         case::History::Step => History::Step,
         case::History::Sin { omega } => History::Sin { omega: *omega },
-        case::History::Table(points) => History::Table(points.iter().map(|p| (p[0], p[1])).collect()),
+        case::History::Table(points) => {
+            History::Table(points.iter().map(|p| (p[0], p[1])).collect())
+        }
     }
 }
 
@@ -71,13 +73,22 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
         case::Hypothesis::PlaneStrain => FemHypothesis::PlaneStrain,
         case::Hypothesis::PlaneStress => FemHypothesis::PlaneStress,
     };
-    let material = Material::new(case.material.e, case.material.nu, case.material.rho, hypothesis)
-        .map_err(|e| input(format!("{case_name}: [material]: {e}")))?;
+    let material = Material::new(
+        case.material.e,
+        case.material.nu,
+        case.material.rho,
+        hypothesis,
+    )
+    .map_err(|e| input(format!("{case_name}: [material]: {e}")))?;
     let mut conditions = Vec::new();
     for d in &case.dirichlet {
         for (component, value) in [(0, d.ux), (1, d.uy)] {
             if let Some(value) = value {
-                conditions.push(Dirichlet { group: d.group.clone(), component, value });
+                conditions.push(Dirichlet {
+                    group: d.group.clone(),
+                    component,
+                    value,
+                });
             }
         }
     }
@@ -97,16 +108,27 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
         let traction = match (t.t, t.pressure) {
             (Some(v), None) => Traction::Vector(v),
             (None, Some(p)) => Traction::Pressure(p),
-            _ => return Err(input(format!("{case_name}: [[traction]] on {:?}: give exactly one of t or pressure", t.group))),
+            _ => {
+                return Err(input(format!(
+                    "{case_name}: [[traction]] on {:?}: give exactly one of t or pressure",
+                    t.group
+                )))
+            }
         };
         traction_load(&mesh, &t.group, traction, &mut full)
             .map_err(|e| input(format!("{case_name}: [[traction]]: {e}")))?;
-        loads.push(Load { vector: restrict(&full), history: history(&t.history) });
+        loads.push(Load {
+            vector: restrict(&full),
+            history: history(&t.history),
+        });
     }
     if let Some(f) = case.body_force {
         full.iter_mut().for_each(|x| *x = 0.0);
         body_force_load(&mesh, f, &mut full);
-        loads.push(Load { vector: restrict(&full), history: History::Constant });
+        loads.push(Load {
+            vector: restrict(&full),
+            history: History::Constant,
+        });
     }
     let mut iteration = IterationOptions::default();
     let contact = match &case.contact {
@@ -117,8 +139,14 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
             full.iter_mut().for_each(|x| *x = 0.0);
             traction_load(&mesh, &c.group, Traction::Pressure(c.pressure), &mut full)
                 .map_err(|e| input(format!("{case_name}: [contact]: {e}")))?;
-            loads.push(Load { vector: restrict(&full), history: History::Constant });
-            iteration = IterationOptions { remark_4_2: c.remark_4_2, max_iterations: c.max_iterations };
+            loads.push(Load {
+                vector: restrict(&full),
+                history: History::Constant,
+            });
+            iteration = IterationOptions {
+                remark_4_2: c.remark_4_2,
+                max_iterations: c.max_iterations,
+            };
             Some(
                 ContactSurface::from_group(&mesh, &model.dofs, &c.group, c.pressure, c.mu, c.eps)
                     .map_err(|e| input(format!("{case_name}: [contact]: {e}")))?,
@@ -127,7 +155,10 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
     };
     let scheme = match case.time.scheme {
         case::Scheme::CentralDifference => Scheme::CentralDifference,
-        case::Scheme::Newmark => Scheme::Newmark { beta: case.time.beta, gamma: case.time.gamma },
+        case::Scheme::Newmark => Scheme::Newmark {
+            beta: case.time.beta,
+            gamma: case.time.gamma,
+        },
     };
     let settings = Settings {
         scheme,
@@ -137,7 +168,10 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
         }),
         dt: case.time.dt,
         t_end: case.time.t_end,
-        stick_reduction: case.time.stick_reduction.as_ref().map(|r| StickReduction { dt: r.dt, steps: r.steps }),
+        stick_reduction: case.time.stick_reduction.as_ref().map(|r| StickReduction {
+            dt: r.dt,
+            steps: r.steps,
+        }),
         iteration,
         allow_unstable: case.time.allow_unstable,
         explicit_friction: ExplicitFriction::ClosedForm,
@@ -145,7 +179,11 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
     };
     let integrator = Integrator::new(Dynamics::from_model(&model), contact, loads, settings)
         .map_err(|e| input(format!("{case_name}: [time]: {e}")))?;
-    Ok(Prepared { mesh, model, integrator })
+    Ok(Prepared {
+        mesh,
+        model,
+        integrator,
+    })
 }
 
 /// `stickslip check`: validate, print the model size, Δt_crit and solver.
@@ -166,7 +204,11 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         p.mesh.kind.name(),
         case.mesh.file.display()
     );
-    println!("DOFs        {} free of {}", p.model.dofs.n_free(), 2 * p.mesh.nodes.len());
+    println!(
+        "DOFs        {} free of {}",
+        p.model.dofs.n_free(),
+        2 * p.mesh.nodes.len()
+    );
     match i.contact() {
         Some(c) => println!(
             "contact     {:?}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
@@ -181,14 +223,19 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     println!("dt_crit     {crit:.6e} (central difference, lumped mass: 2/omega_max)");
     let steps = (case.time.t_end / case.time.dt).ceil();
     if i.is_explicit() {
-        println!("solver      explicit: no linear system; friction solved node by node in closed form");
+        println!(
+            "solver      explicit: no linear system; friction solved node by node in closed form"
+        );
     } else {
         println!(
             "solver      implicit Newmark: sparse Cholesky (faer, AMD), analysed once, refactorized when dt or the stuck set changes; nnz(K) = {}",
             p.model.stiffness.nnz()
         );
     }
-    println!("steps       about {steps} to t_end = {} with dt = {:e}", case.time.t_end, case.time.dt);
+    println!(
+        "steps       about {steps} to t_end = {} with dt = {:e}",
+        case.time.t_end, case.time.dt
+    );
     Ok(())
 }
 
@@ -202,7 +249,13 @@ struct FullState {
     state: Vec<i8>,
 }
 
-fn record<'a>(i: &Integrator, model: &Model, s: &'a mut FullState, dt: f64, iterations: u32) -> Record<'a> {
+fn record<'a>(
+    i: &Integrator,
+    model: &Model,
+    s: &'a mut FullState,
+    dt: f64,
+    iterations: u32,
+) -> Record<'a> {
     model.dofs.expand(i.displacement(), &mut s.u);
     model.dofs.expand_homogeneous(i.velocity(), &mut s.v);
     model.dofs.expand_homogeneous(i.acceleration(), &mut s.a);
@@ -237,13 +290,22 @@ fn record<'a>(i: &Integrator, model: &Model, s: &'a mut FullState, dt: f64, iter
 /// Input problems as [`InputError`]; I/O failures of the results file.
 pub fn execute(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Outcome> {
     let started = Instant::now();
-    let Prepared { mesh, model, mut integrator } = prepare(case)?;
+    let Prepared {
+        mesh,
+        model,
+        mut integrator,
+    } = prepare(case)?;
     let (contact_nodes, contact_s): (Vec<usize>, Vec<f64>) = integrator
         .contact()
         .map(|c| c.nodes.iter().map(|n| (n.node, n.s)).unzip())
         .unwrap_or_default();
     let n_c = contact_nodes.len();
-    let header = Header { case_source: &case.source, mesh: &mesh, contact_nodes: &contact_nodes, contact_s: &contact_s };
+    let header = Header {
+        case_source: &case.source,
+        mesh: &mesh,
+        contact_nodes: &contact_nodes,
+        contact_s: &contact_s,
+    };
     let mut writer = ResultsWriter::create(out, &header)
         .with_context(|| format!("cannot create the results file {}", out.display()))?;
     let n_full = 2 * mesh.nodes.len();
@@ -276,7 +338,13 @@ pub fn execute(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Outcome> 
             Ok(info) => {
                 max_balance = max_balance.max(integrator.energy().balance.abs());
                 if integrator.steps() % every == 0 || integrator.done() {
-                    writer.append(&record(&integrator, &model, &mut full, info.dt, info.iterations as u32))?;
+                    writer.append(&record(
+                        &integrator,
+                        &model,
+                        &mut full,
+                        info.dt,
+                        info.iterations as u32,
+                    ))?;
                 }
                 if let Some(bar) = &bar {
                     bar.set_position((1000.0 * integrator.time() / t_end) as u64);
@@ -323,7 +391,9 @@ pub fn execute(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Outcome> 
         Some(e) => {
             eprintln!("error: {}: {e}", case.path.display());
             if matches!(e, TimeError::NonFinite { .. }) {
-                eprintln!("the file keeps every step completed before the failure (complete = false)");
+                eprintln!(
+                    "the file keeps every step completed before the failure (complete = false)"
+                );
             }
             Ok(Outcome::Failed)
         }
