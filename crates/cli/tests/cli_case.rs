@@ -1,0 +1,320 @@
+//! End-to-end tests of `stickslip check`, `run` and `probe` on case files:
+//! bad input exits 2 with `file:line`, a good case runs and can be probed.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_stickslip"))
+}
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A scratch directory per test.
+fn scratch(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-case-{name}"));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// tests/data/slab.toml with the mesh path made absolute, after `edit`,
+/// written to a scratch directory. Returns the case path and its text.
+fn case_with(name: &str, edit: impl Fn(String) -> String) -> (PathBuf, String) {
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes/slab-q2-8x2.msh");
+    let text = std::fs::read_to_string(data("slab.toml")).unwrap().replace(
+        "../../../../cases/meshes/slab-q2-8x2.msh",
+        &mesh.display().to_string().replace('\\', "/"),
+    );
+    let text = edit(text);
+    let path = scratch(name).join(format!("{name}.toml"));
+    std::fs::write(&path, &text).unwrap();
+    (path, text)
+}
+
+/// 1-based line of the first line containing `needle` (the expected location
+/// comes from the test's own text).
+/// A needle starting with '\n' must start its line.
+fn line_of(text: &str, needle: &str) -> usize {
+    match needle.strip_prefix('\n') {
+        Some(n) => text.lines().position(|l| l.starts_with(n)),
+        None => text.lines().position(|l| l.contains(needle)),
+    }
+    .expect("needle in text")
+        + 1
+}
+
+#[test]
+fn check_accepts_the_slab_case() {
+    let o = bin().arg("check").arg(data("slab.toml")).output().unwrap();
+    assert!(
+        o.status.success(),
+        "exit {:?}: {}",
+        o.status.code(),
+        stderr(&o)
+    );
+}
+
+#[test]
+fn case_errors_exit_2_with_file_and_line() {
+    // (case name, edit of slab.toml, text on the line to blame, message)
+    type BadCase = (
+        &'static str,
+        fn(String) -> String,
+        &'static str,
+        &'static str,
+    );
+    let cases: [BadCase; 7] = [
+        (
+            "unknown-key",
+            |t| t.replace("eps = 1e-4", "eps = 1e-4\nepsilon = 1"),
+            "epsilon",
+            "unknown field `epsilon`",
+        ),
+        (
+            "eps-zero",
+            |t| t.replace("eps = 1e-4", "eps = 0"),
+            "eps = 0",
+            "contact.eps = 0 must be > 0",
+        ),
+        (
+            "mu-negative",
+            |t| t.replace("\nmu = 0.3", "\nmu = -0.3"),
+            "\nmu = -0.3",
+            "contact.mu = -0.3 must be >= 0",
+        ),
+        (
+            "dt-negative",
+            |t| t.replace("dt = 1e-3", "dt = -1e-3"),
+            "dt = -1e-3",
+            "time.dt = -0.001 must be > 0",
+        ),
+        (
+            "t-end-zero",
+            |t| t.replace("t_end = 0.05", "t_end = 0.0"),
+            "t_end = 0.0",
+            "time.t_end = 0 must be > 0",
+        ),
+        (
+            "newmark-unstable",
+            |t| {
+                t.replace(
+                    "scheme = \"central_difference\"",
+                    "scheme = \"newmark\"\nbeta = 0.1\ngamma = 0.5",
+                )
+            },
+            "gamma = 0.5",
+            "not unconditionally stable",
+        ),
+        (
+            "bad-scheme",
+            |t| t.replace("\"central_difference\"", "\"leapfrog\""),
+            "leapfrog",
+            "unknown variant `leapfrog`",
+        ),
+    ];
+    for (name, edit, needle, what) in cases {
+        let (path, text) = case_with(name, edit);
+        let o = bin().arg("check").arg(&path).output().unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {e}");
+        let at = format!("{name}.toml:{}:", line_of(&text, needle));
+        assert!(
+            e.starts_with("error: ") && e.contains(&at) && e.contains(what),
+            "{name}: expected '{at}' and '{what}' in: {e}"
+        );
+        // run refuses it the same way, before creating any output.
+        let out = path.with_extension("h5");
+        let o = bin()
+            .arg("run")
+            .arg(&path)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{name} run: {}", stderr(&o));
+        assert!(!out.exists(), "{name}: no results file for bad input");
+    }
+}
+
+#[test]
+fn several_problems_are_reported_together() {
+    let (path, text) = case_with("several", |t| {
+        t.replace("eps = 1e-4", "eps = -1")
+            .replace("\nmu = 0.3", "\nmu = -1")
+    });
+    let o = bin().arg("check").arg(&path).output().unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2));
+    // (The slab's [contact] comment also says "mu = 0.3": only the key line is edited.)
+    for needle in ["eps = -1", "mu = -1"] {
+        assert!(
+            e.contains(&format!("several.toml:{}:", line_of(&text, needle))),
+            "{needle}: {e}"
+        );
+    }
+    assert_eq!(
+        e.lines().filter(|l| l.starts_with("error: ")).count(),
+        2,
+        "{e}"
+    );
+}
+
+#[test]
+fn set_overrides_and_names_itself_in_errors() {
+    let o = bin()
+        .arg("check")
+        .arg(data("slab.toml"))
+        .args(["--set", "contact.eps=-1e-2"])
+        .output()
+        .unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("--set contact.eps=-1e-2") && e.contains("must be > 0"),
+        "{e}"
+    );
+    let o = bin()
+        .arg("check")
+        .arg(data("slab.toml"))
+        .args(["--set", "time.scheme=newmark", "--set", "time.dt=5e-3"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = bin()
+        .arg("check")
+        .arg(data("slab.toml"))
+        .args(["--set", "time.dtt=5e-3"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("unknown field `dtt`"), "{}", stderr(&o));
+}
+
+#[test]
+fn missing_group_lists_the_mesh_groups() {
+    let o = bin()
+        .arg("check")
+        .arg(data("slab.toml"))
+        .args(["--set", "contact.group=bottom"])
+        .output()
+        .unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("bottom") && e.contains("support") && e.contains("left"),
+        "{e}"
+    );
+}
+
+#[test]
+fn run_refuses_to_overwrite_without_force() {
+    let dir = scratch("overwrite");
+    let out = dir.join("exists.h5");
+    std::fs::write(&out, b"precious").unwrap();
+    let o = bin()
+        .arg("run")
+        .arg(data("slab.toml"))
+        .arg("-o")
+        .arg(&out)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("use --force"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&out).unwrap(), b"precious");
+    let o = bin()
+        .arg("run")
+        .arg(data("slab.toml"))
+        .arg("-o")
+        .arg(&out)
+        .args(["--quiet", "--force"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_ne!(std::fs::read(&out).unwrap(), b"precious");
+}
+
+#[test]
+fn run_then_probe_node_81() {
+    let out = scratch("probe").join("slab.h5");
+    let o = bin()
+        .arg("run")
+        .arg(data("slab.toml"))
+        .arg("-o")
+        .arg(&out)
+        .args(["--quiet", "--force"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    // Node 81 of the paper = (8, 0). BENCHMARK.md: the initial static state is
+    // u_x = 0.117 x, so u_x(8, 0) = 0.936 at t = 0, and it decreases under
+    // the compressive end load.
+    let o = bin()
+        .arg("probe")
+        .arg(&out)
+        .args(["--at", "8,0", "--field", "ux", "--csv"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("at (8, 0)"),
+        "node info on stderr with --csv: {}",
+        stderr(&o)
+    );
+    let csv = String::from_utf8(o.stdout).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("t,ux"));
+    let rows: Vec<(f64, f64)> = lines
+        .map(|l| {
+            let (t, v) = l.split_once(',').unwrap();
+            (t.parse().unwrap(), v.parse().unwrap())
+        })
+        .collect();
+    assert_eq!(rows.len(), 51, "t = 0, 0.001, ..., 0.05 with every = 1");
+    assert_eq!(rows[0].0, 0.0);
+    assert!(
+        (rows[0].1 - 0.936).abs() < 1e-3,
+        "u_x(8,0) at t = 0: {}",
+        rows[0].1
+    );
+    assert!(rows.last().unwrap().1 < rows[0].1, "the end moves in -x");
+
+    // |σ_T| <= g = μ F_n = 90 (the regularized law never exceeds the bound).
+    let o = bin()
+        .arg("probe")
+        .arg(&out)
+        .args(["--at", "8,0", "--field", "friction_stress"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    let vals: Vec<f64> = text
+        .lines()
+        .skip(2)
+        .map(|l| l.split_whitespace().nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(vals.len(), 51, "{text}");
+    assert!(
+        vals.iter().all(|v| v.abs() <= 90.0 * (1.0 + 1e-12)),
+        "{vals:?}"
+    );
+
+    // The top-right corner (8, 1) is not on the contact surface.
+    let o = bin()
+        .arg("probe")
+        .arg(&out)
+        .args(["--at", "8,1", "--field", "friction_stress"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("not a contact node"), "{}", stderr(&o));
+}

@@ -1,0 +1,182 @@
+//! End-to-end tests of `stickslip mesh` and of the command line itself,
+//! driving the built binary as a user does.
+//!
+//! Expected counts come from the slab's geometry (shared/BENCHMARK.md): an
+//! 8 × 2 grid of quad9 cells is a 17 × 5 grid of 85 nodes; the bottom
+//! (`contact`) and top (`support`) each have 8 line3 elements and 17 nodes,
+//! the ends (`left`, `load`) 2 line3 elements and 5 nodes; bbox [0, 8] × [0, 1].
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_stickslip"))
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn mesh_json(file: &Path) -> serde_json::Value {
+    let o = bin().arg("mesh").arg(file).arg("--json").output().unwrap();
+    assert!(
+        o.status.success(),
+        "exit {:?}: {}",
+        o.status.code(),
+        stderr(&o)
+    );
+    serde_json::from_slice(&o.stdout).expect("stdout is one JSON object")
+}
+
+fn check_slab_q2_8x2(j: &serde_json::Value, version: &str) {
+    assert_eq!(j["format"], "msh");
+    assert_eq!(j["version"], version);
+    assert_eq!(j["binary"], false);
+    assert_eq!(j["nodes"], 85);
+    assert_eq!(j["cells"], serde_json::json!({"quad9": 16}));
+    assert_eq!(j["boundary_elements"], serde_json::json!({"line3": 20}));
+    assert_eq!(j["reoriented"], 0);
+    let g = &j["groups"];
+    assert_eq!(
+        g["contact"],
+        serde_json::json!({"dim": 1, "elements": 8, "nodes": 17})
+    );
+    assert_eq!(
+        g["support"],
+        serde_json::json!({"dim": 1, "elements": 8, "nodes": 17})
+    );
+    assert_eq!(
+        g["left"],
+        serde_json::json!({"dim": 1, "elements": 2, "nodes": 5})
+    );
+    assert_eq!(
+        g["load"],
+        serde_json::json!({"dim": 1, "elements": 2, "nodes": 5})
+    );
+    assert_eq!(
+        g["body"],
+        serde_json::json!({"dim": 2, "elements": 16, "nodes": 85})
+    );
+    assert_eq!(
+        g.as_object().unwrap().len(),
+        5,
+        "exactly the groups of cases/slab.geo"
+    );
+    // Gmsh's transfinite coordinates are not exact (DEPENDENCIES.md §2).
+    let bbox: Vec<f64> = j["bbox"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|p| p.as_array().unwrap().clone())
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    for (got, want) in bbox.iter().zip([0.0, 0.0, 8.0, 1.0]) {
+        assert!((got - want).abs() < 1e-9, "bbox {bbox:?}");
+    }
+}
+
+#[test]
+fn mesh_json_of_the_paper_mesh() {
+    check_slab_q2_8x2(
+        &mesh_json(&root().join("cases/meshes/slab-q2-8x2.msh")),
+        "4.1",
+    );
+}
+
+#[test]
+fn mesh_json_of_the_msh22_copy() {
+    check_slab_q2_8x2(
+        &mesh_json(&root().join("cases/meshes/slab-q2-8x2-v22.msh")),
+        "2.2",
+    );
+}
+
+#[test]
+fn mesh_table_lists_groups() {
+    let o = bin()
+        .arg("mesh")
+        .arg(root().join("cases/meshes/slab-q2-8x2.msh"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8(o.stdout).unwrap();
+    assert!(out.contains("MSH 4.1 ASCII"), "{out}");
+    assert!(out.contains("16 quad9"), "{out}");
+    let contact = out
+        .lines()
+        .find(|l| l.trim_start().starts_with("contact"))
+        .expect("a contact row");
+    assert_eq!(
+        contact.split_whitespace().collect::<Vec<_>>(),
+        ["contact", "1", "8", "17"]
+    );
+}
+
+#[test]
+fn bad_meshes_exit_2_naming_the_file() {
+    for (name, line) in [
+        ("not-a-mesh.msh", Some(1)),
+        ("truncated.msh", None),
+        ("no-such-file.msh", None),
+    ] {
+        let path = data(name);
+        let o = bin().arg("mesh").arg(&path).output().unwrap();
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.starts_with("error: ") && e.contains(name), "{name}: {e}");
+        if let Some(l) = line {
+            assert!(e.contains(&format!("{name}:{l}:")), "{name}: {e}");
+        }
+        assert!(o.stdout.is_empty(), "nothing on stdout for a bad mesh");
+    }
+}
+
+#[test]
+fn truncated_mesh_names_a_line() {
+    // truncated.msh is the first 40 lines of slab-q2-8x2.msh: the reader
+    // runs out inside $Nodes, at the end of the file (line 41).
+    let o = bin()
+        .arg("mesh")
+        .arg(data("truncated.msh"))
+        .output()
+        .unwrap();
+    let e = stderr(&o);
+    assert!(e.contains("truncated.msh:41:"), "{e}");
+}
+
+#[test]
+fn usage_errors_exit_2_and_help_has_examples() {
+    for args in [
+        &["mesh"][..],
+        &["frobnicate"],
+        &["run"],
+        &["probe", "x.h5"],
+        &["mesh", "a.msh", "--jsn"],
+    ] {
+        let o = bin().args(args).output().unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+    }
+    for sub in ["run", "check", "mesh", "probe"] {
+        let o = bin().args([sub, "--help"]).output().unwrap();
+        assert!(o.status.success());
+        let out = String::from_utf8(o.stdout).unwrap();
+        assert!(
+            out.contains("Example"),
+            "{sub} --help has no example:\n{out}"
+        );
+    }
+    let o = bin().arg("--version").output().unwrap();
+    assert!(String::from_utf8(o.stdout)
+        .unwrap()
+        .starts_with("stickslip "));
+}
