@@ -120,3 +120,35 @@ fn parametric_coordinates_are_skipped() {
         same_mesh(&plain, &load(&format!("slab_q9_param_{e}.msh")), e);
     }
 }
+
+/// Gmsh's 2.2 writer puts an element that is in several physical groups
+/// into the file once per group, consecutively, under new element numbers
+/// (seen with Gmsh 4.15.2: `Physical Surface(10)` and `(11)` on one surface
+/// give `8 3 2 10 1 …` then `9 3 2 11 1 …` with the same nodes). Emulated
+/// here on slab_q4: each cell line is followed by a copy in group 11.
+#[test]
+fn v22_copies_per_group_are_one_cell() {
+    let t = text("slab_q4_v22_ascii.msh");
+    let mut out = Vec::new();
+    let mut extra = 0;
+    for l in t.lines() {
+        out.push(l.to_string());
+        let f: Vec<&str> = l.split_whitespace().collect();
+        if f.len() == 9 && f[1] == "3" {
+            extra += 1;
+            out.push(format!("{} 3 2 11 1 {}", 1000 + extra, f[5..].join(" ")));
+        }
+    }
+    let text2 = out.join("\n").replacen(
+        "$Elements\n21\n",
+        &format!("$Elements\n{}\n", 21 + extra),
+        1,
+    ) + "\n";
+    let m = stickslip_mesh::Mesh::from_bytes(text2.as_bytes()).unwrap();
+    let plain = load("slab_q4_v22_ascii.msh");
+    assert_eq!(m.cells, plain.cells);
+    assert_eq!(m.cell_tags, plain.cell_tags, "the first copy's tag is kept");
+    let g11 = m.group("#11").unwrap();
+    assert_eq!(g11.cells, plain.group("body").unwrap().cells);
+    assert_eq!(g11.dim, 2);
+}
