@@ -126,6 +126,15 @@ fn every_paper_case_runs_and_writes_the_documented_layout() {
         ran += 1;
     }
     assert_eq!(ran, 8, "the paper's table has 8 cases here");
+
+    // The README's tour ends with examples/slab_node81.py on this file.
+    let out = dir.join("cd-step-eps1e-4.h5");
+    let script = std::fs::read_to_string(root().join("examples/slab_node81.py")).unwrap();
+    if let Some(stdout) = python_h5py(&script, &[out.to_str().unwrap()]) {
+        // Node 81 starts at u_x = 0.117·8 = 0.936 (BENCHMARK.md) with E = −187.2.
+        assert!(stdout.contains("at (8, 0)"), "{stdout}");
+        assert!(stdout.contains("   0.000    0.93600"), "{stdout}");
+    }
 }
 
 /// Writes a variant of the paper's first case with `edit` applied to its text.
