@@ -134,34 +134,56 @@ impl CellBasis {
         }
         let mut area = 0.0;
         let mut g = [[0.0; 2]; MAX_NODES];
+        let isotropic = d[0][2] == 0.0 && d[1][2] == 0.0 && d[2][0] == 0.0 && d[2][1] == 0.0;
         for q in 0..self.n_points() {
             let j = self.jacobian(coords, q)?;
             let w = self.weights[q] * j.det;
             area += w;
             j.physical_gradients(self.gradients(q), &mut g[..n]);
             // Upper triangle of node-pair blocks: B_aᵀ D B_b with
-            // B_b = [[bx, 0], [0, by], [by, bx]].
-            for a in 0..n {
-                let ax = w * g[a][0];
-                let ay = w * g[a][1];
-                for b in a..n {
-                    let (bx, by) = (g[b][0], g[b][1]);
-                    let c0 = [
-                        d[0][0] * bx + d[0][2] * by,
-                        d[1][0] * bx + d[1][2] * by,
-                        d[2][0] * bx + d[2][2] * by,
-                    ];
-                    let c1 = [
-                        d[0][1] * by + d[0][2] * bx,
-                        d[1][1] * by + d[1][2] * bx,
-                        d[2][1] * by + d[2][2] * bx,
-                    ];
-                    let r0 = 2 * a * nd + 2 * b;
-                    let r1 = r0 + nd;
-                    ke[r0] += ax * c0[0] + ay * c0[2];
-                    ke[r0 + 1] += ax * c1[0] + ay * c1[2];
-                    ke[r1] += ay * c0[1] + ax * c0[2];
-                    ke[r1 + 1] += ay * c1[1] + ax * c1[2];
+            // B_b = [[bx, 0], [0, by], [by, bx]]. Isotropic D (no normal-shear
+            // coupling, the only kind `Material` makes) takes the short path.
+            if isotropic {
+                let (d00, d01, d11, d22) = (d[0][0], d[0][1], d[1][1], d[2][2]);
+                for a in 0..n {
+                    let ax = w * g[a][0];
+                    let ay = w * g[a][1];
+                    let row0 = &mut ke[2 * a * nd..(2 * a + 1) * nd];
+                    for b in a..n {
+                        let (bx, by) = (g[b][0], g[b][1]);
+                        row0[2 * b] += d00 * ax * bx + d22 * ay * by;
+                        row0[2 * b + 1] += d01 * ax * by + d22 * ay * bx;
+                    }
+                    let row1 = &mut ke[(2 * a + 1) * nd..(2 * a + 2) * nd];
+                    for b in a..n {
+                        let (bx, by) = (g[b][0], g[b][1]);
+                        row1[2 * b] += d01 * ay * bx + d22 * ax * by;
+                        row1[2 * b + 1] += d11 * ay * by + d22 * ax * bx;
+                    }
+                }
+            } else {
+                for a in 0..n {
+                    let ax = w * g[a][0];
+                    let ay = w * g[a][1];
+                    for b in a..n {
+                        let (bx, by) = (g[b][0], g[b][1]);
+                        let c0 = [
+                            d[0][0] * bx + d[0][2] * by,
+                            d[1][0] * bx + d[1][2] * by,
+                            d[2][0] * bx + d[2][2] * by,
+                        ];
+                        let c1 = [
+                            d[0][1] * by + d[0][2] * bx,
+                            d[1][1] * by + d[1][2] * bx,
+                            d[2][1] * by + d[2][2] * bx,
+                        ];
+                        let r0 = 2 * a * nd + 2 * b;
+                        let r1 = r0 + nd;
+                        ke[r0] += ax * c0[0] + ay * c0[2];
+                        ke[r0 + 1] += ax * c1[0] + ay * c1[2];
+                        ke[r1] += ay * c0[1] + ax * c0[2];
+                        ke[r1 + 1] += ay * c1[1] + ax * c1[2];
+                    }
                 }
             }
             if with_mass {
