@@ -376,6 +376,8 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
             "; add it (DESIGN.md \"Case file\" lists the keys)"
         } else if msg.contains("variant") {
             "; use one of the values listed"
+        } else if msg.starts_with("invalid type") || msg.starts_with("invalid length") {
+            "; numbers go without quotes, text in quotes, vectors as [x, y]"
         } else {
             ""
         };
