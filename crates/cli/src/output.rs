@@ -787,6 +787,64 @@ pub(crate) mod tests {
         std::fs::remove_file(&path).ok();
     }
 
+    #[test]
+    fn flushed_rows_are_readable_while_the_run_goes_on() {
+        // What a user sees when peeking at (or inheriting, after a crash) a
+        // file mid-run: every flushed row. HDF5's file lock is turned off for
+        // the reader only, as h5py users do for a file still being written.
+        let _guard = h5_lock();
+        let path = scratch("midrun");
+        let mesh = tiny_mesh();
+        let header = Header {
+            case_source: "",
+            mesh: &mesh,
+            contact_nodes: &[],
+            contact_s: &[],
+        };
+        let mut w = ResultsWriter::create(&path, &header).unwrap();
+        w.flush_every_steps = 2;
+        w.flush_every_secs = f64::INFINITY;
+        let z = vec![0.5; 12];
+        for k in 0..2 {
+            let rec = Record {
+                t: k as f64,
+                displacement: &z,
+                velocity: &z,
+                acceleration: &z,
+                friction_stress: &[],
+                slip_velocity: &[],
+                state: &[],
+                kinetic: 0.0,
+                strain: 0.0,
+                external_work: 0.0,
+                dissipated: 0.0,
+                total: 0.0,
+                balance: 0.0,
+                dt: 1.0,
+                iterations: 1,
+            };
+            w.append(&rec).unwrap();
+        }
+        let script = "import sys\ntry:\n import h5py\nexcept ImportError:\n sys.exit(3)\nf = h5py.File(sys.argv[1], 'r')\nprint(f['time'].shape[0], f['displacement'][1, 5, 1], bool(f.attrs['complete']))";
+        let out = std::process::Command::new("python3")
+            .env("HDF5_USE_FILE_LOCKING", "FALSE")
+            .args(["-c", script])
+            .arg(&path)
+            .output();
+        match out {
+            Ok(o) if o.status.code() == Some(3) => eprintln!("skipped: h5py is not installed"),
+            Ok(o) => assert_eq!(
+                String::from_utf8_lossy(&o.stdout).trim(),
+                "2 0.5 False",
+                "{}",
+                String::from_utf8_lossy(&o.stderr)
+            ),
+            Err(e) => eprintln!("skipped: cannot run python3 ({e})"),
+        }
+        w.finish(true, &Summary::default()).unwrap();
+        std::fs::remove_file(&path).ok();
+    }
+
     /// Throughput figure, not a check: `cargo test -p stickslip write_speed
     /// -- --ignored --nocapture` (100k nodes, 50 records, 3 vector fields).
     #[test]
