@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
+mod bench_fem;
 mod bench_mesh;
 mod meshes;
 mod python;
@@ -21,6 +22,8 @@ usage: cargo xtask <command> [args]
   setup             only install what is missing: libhdf5-dev, h5py, numpy
   meshes            regenerate cases/meshes/*.msh with Gmsh (installs gmsh from PyPI)
   bench mesh        .msh read throughput on a 1M-node mesh against gmsh.open
+  bench fem         assembly and Cholesky on the Q2 slab ladder against
+                    scikit-fem and scipy's splu (--refine 8,16,32,64 --no-peer)
 ";
 
 fn main() -> ExitCode {
@@ -40,7 +43,8 @@ fn main() -> ExitCode {
         "meshes" => meshes::run(&root, rest),
         "bench" => match rest.split_first() {
             Some((what, more)) if what == "mesh" => bench_mesh::run(&root, more),
-            _ => Err(format!("cargo xtask bench: say what to benchmark (mesh)\n{USAGE}")),
+            Some((what, more)) if what == "fem" => bench_fem::run(&root, more),
+            _ => Err(format!("cargo xtask bench: say what to benchmark (mesh, fem)\n{USAGE}")),
         },
         "help" | "--help" | "-h" => {
             print!("{USAGE}");
