@@ -139,8 +139,16 @@ impl Mesh {
     /// as a [`MeshError`] naming the file and the line or byte offset.
     pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|e| MeshError::io(path, e))?;
-        Mesh::from_bytes(&bytes).map_err(|e| e.with_path(path))
+        let file = std::fs::File::open(path).map_err(|e| MeshError::io(path, e))?;
+        let meta = file.metadata().map_err(|e| MeshError::io(path, e))?;
+        if !meta.is_file() {
+            // A pipe or device has no length to check counts against: read it whole.
+            let bytes = std::fs::read(path).map_err(|e| MeshError::io(path, e))?;
+            return Mesh::from_bytes(&bytes).map_err(|e| e.with_path(path));
+        }
+        // Streamed through a window of a few MB: the file's bytes are never
+        // all resident next to the mesh (peak memory target of issue 2).
+        msh::read_file(path, file, meta.len(), msh::CHUNK).map_err(|e| e.with_path(path))
     }
 
     /// Reads and checks a `.msh` file held in memory.

@@ -13,69 +13,90 @@ mod cursor;
 mod v2;
 mod v4;
 
+use std::fs::File;
+use std::path::Path;
+
 use build::Builder;
-use cursor::{Cursor, Result};
+pub(crate) use cursor::CHUNK;
+use cursor::{Cursor, Result, Source};
 
-use crate::{Mesh, MeshErrorKind};
+use crate::{Mesh, MeshError, MeshErrorKind};
 
+/// Reads a mesh held in memory.
 pub(crate) fn read(bytes: &[u8]) -> Result<Mesh> {
-    let mut cur = Cursor::new(bytes);
+    parse(Cursor::new(bytes))
+}
+
+/// Reads a regular file of `len` bytes through a window of `chunk` bytes
+/// (the file is never resident as a whole). An I/O error while reading
+/// is reported as such, whatever the parse made of the input ending there.
+pub(crate) fn read_file(path: &Path, file: File, len: u64, chunk: usize) -> Result<Mesh> {
+    let Ok(len) = usize::try_from(len) else {
+        return Err(MeshError::io(path, std::io::Error::other("file too large")));
+    };
+    let mut cur = Cursor::with_source(Source::File { file, path }, len, chunk);
+    let res = parse_with(&mut cur);
+    match cur.io_error.take() {
+        Some(e) => Err(MeshError::io(path, e)),
+        None => res,
+    }
+}
+
+fn parse(mut cur: Cursor<'_>) -> Result<Mesh> {
+    parse_with(&mut cur)
+}
+
+fn parse_with(cur: &mut Cursor<'_>) -> Result<Mesh> {
     match cur.token() {
-        Some((_, b"$MeshFormat")) => {}
+        Some((_, t)) if t == b"$MeshFormat" => {}
         _ => return Err(cur.error(0, MeshErrorKind::NotMsh)),
     }
-    let (version, binary) = mesh_format(&mut cur)?;
+    let (version, binary) = mesh_format(cur)?;
     let mut b = Builder::new(version, binary);
     let mut entities: Option<v4::Entities> = None;
     let mut seen_nodes = false;
     let mut seen_elements = false;
     while let Some((p, t)) = cur.token() {
+        let t = &t[..];
         match t {
-            b"$PhysicalNames" => physical_names(&mut cur, &mut b)?,
+            b"$PhysicalNames" => physical_names(cur, &mut b)?,
             b"$Entities" if version == "4.1" => {
                 if seen_elements || entities.is_some() {
                     return Err(out_of_place(
-                        &cur,
+                        cur,
                         p,
                         t,
                         "$Entities must come once, before $Elements",
                     ));
                 }
-                entities = Some(v4::entities(&mut cur, &mut b)?);
+                entities = Some(v4::entities(cur, &mut b)?);
             }
             b"$Nodes" => {
                 if seen_nodes {
-                    return Err(out_of_place(&cur, p, t, "a second $Nodes section"));
+                    return Err(out_of_place(cur, p, t, "a second $Nodes section"));
                 }
                 seen_nodes = true;
                 if version == "2.2" {
-                    v2::nodes(&mut cur, &mut b)?;
+                    v2::nodes(cur, &mut b)?;
                 } else {
-                    v4::nodes(&mut cur, &mut b)?;
+                    v4::nodes(cur, &mut b)?;
                 }
             }
             b"$Elements" => {
                 if !seen_nodes {
-                    return Err(out_of_place(
-                        &cur,
-                        p,
-                        t,
-                        "$Nodes must come before $Elements",
-                    ));
+                    return Err(out_of_place(cur, p, t, "$Nodes must come before $Elements"));
                 }
                 if seen_elements {
-                    return Err(out_of_place(&cur, p, t, "a second $Elements section"));
+                    return Err(out_of_place(cur, p, t, "a second $Elements section"));
                 }
                 seen_elements = true;
                 if version == "2.2" {
-                    v2::elements(&mut cur, &mut b)?;
+                    v2::elements(cur, &mut b)?;
                 } else {
-                    v4::elements(&mut cur, &mut b, entities.as_ref())?;
+                    v4::elements(cur, &mut b, entities.as_ref())?;
                 }
             }
-            _ if t.first() == Some(&b'$') && !t.starts_with(b"$End") => {
-                skip_section(&mut cur, p, t)?
-            }
+            _ if t.first() == Some(&b'$') && !t.starts_with(b"$End") => skip_section(cur, p, t)?,
             _ => {
                 let shown = String::from_utf8_lossy(t.get(..40).unwrap_or(t)).into_owned();
                 return Err(cur.error(
@@ -87,7 +108,7 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Mesh> {
             }
         }
     }
-    let end = bytes.len();
+    let end = cur.len();
     if !seen_nodes {
         return Err(cur.error(end, MeshErrorKind::MissingSection { section: "$Nodes" }));
     }
@@ -99,7 +120,7 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Mesh> {
             },
         ));
     }
-    b.finish(&cur)
+    b.finish(cur)
 }
 
 fn out_of_place(cur: &Cursor<'_>, pos: usize, t: &[u8], why: &'static str) -> crate::MeshError {
@@ -118,22 +139,22 @@ fn mesh_format(cur: &mut Cursor<'_>) -> Result<(&'static str, bool)> {
     cur.enter("$MeshFormat", "$EndMeshFormat");
     let Some((vp, vt)) = cur.token() else {
         return Err(cur.error(
-            cur.pos,
+            cur.pos(),
             MeshErrorKind::Truncated {
                 what: "the $MeshFormat section",
             },
         ));
     };
-    let version = match vt {
+    let version = match &vt[..] {
         b"2.2" => "2.2",
         b"4.1" => "4.1",
         _ => {
-            let version = String::from_utf8_lossy(vt.get(..20).unwrap_or(vt)).into_owned();
+            let version = String::from_utf8_lossy(vt.get(..20).unwrap_or(&vt)).into_owned();
             return Err(cur.error(vp, MeshErrorKind::UnsupportedVersion { version }));
         }
     };
     cur.skip_ws();
-    let tp = cur.pos;
+    let tp = cur.pos();
     let file_type = cur.u64("the file type (0 for ASCII, 1 for binary)")?;
     let data_size = cur.u64("the data size")?;
     let binary = match file_type {
@@ -154,8 +175,8 @@ fn mesh_format(cur: &mut Cursor<'_>) -> Result<(&'static str, bool)> {
             return Err(cur.error(tp, MeshErrorKind::UnsupportedDataSize { size: data_size }));
         }
         cur.end_of_line()?;
-        let p = cur.pos;
-        match cur.take(4, "the byte-order check")? {
+        let p = cur.pos();
+        match cur.take::<4>()? {
             [1, 0, 0, 0] => {}
             [0, 0, 0, 1] => return Err(cur.error(p, MeshErrorKind::BigEndian)),
             other => {
@@ -181,7 +202,7 @@ fn physical_names(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
     cur.counts("physical names", n);
     for _ in 0..n {
         cur.skip_ws();
-        let p = cur.pos;
+        let p = cur.pos();
         let dim = cur.i32("the dimension of a physical group")?;
         let tag = cur.i32("the tag of a physical group")?;
         let dim = match u8::try_from(dim) {
@@ -204,7 +225,7 @@ fn physical_names(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
 /// A double-quoted name on the current line.
 fn quoted(cur: &mut Cursor<'_>) -> Result<String> {
     cur.skip_ws();
-    let start = cur.pos;
+    let start = cur.pos();
     let bad = |cur: &Cursor<'_>| {
         cur.error(
             start,
@@ -213,63 +234,68 @@ fn quoted(cur: &mut Cursor<'_>) -> Result<String> {
             },
         )
     };
-    if cur.bytes.get(start) != Some(&b'"') {
-        return match cur.bytes.get(start) {
-            None => Err(cur.error(
-                start,
-                MeshErrorKind::Truncated {
-                    what: "the $PhysicalNames section",
-                },
-            )),
-            Some(b'$')
-                if cur
-                    .bytes
-                    .get(start..)
-                    .is_some_and(|r| r.starts_with(b"$EndPhysicalNames")) =>
-            {
-                Err(cur.wrong_count(start))
-            }
-            _ => Err(bad(cur)),
-        };
-    }
-    let rest = cur.bytes.get(start + 1..).unwrap_or_default();
-    match rest.iter().position(|&c| c == b'"' || c == b'\n') {
-        Some(k) if rest.get(k) == Some(&b'"') => {
-            let name = String::from_utf8_lossy(&rest[..k]).into_owned();
-            cur.pos = start + 1 + k + 1;
-            Ok(name)
-        }
-        Some(_) => Err(bad(cur)),
-        None => Err(cur.error(
+    let truncated = |cur: &Cursor<'_>| {
+        cur.error(
             start,
             MeshErrorKind::Truncated {
                 what: "the $PhysicalNames section",
             },
-        )),
+        )
+    };
+    match cur.peek_byte() {
+        Some(b'"') => cur.advance(1),
+        None => return Err(truncated(cur)),
+        Some(b'$') => {
+            const END: &[u8] = b"$EndPhysicalNames";
+            return if cur.peek(END.len()) == END {
+                Err(cur.wrong_count(start))
+            } else {
+                Err(bad(cur))
+            };
+        }
+        Some(_) => return Err(bad(cur)),
+    }
+    let mut name = Vec::new();
+    loop {
+        match cur.peek_byte() {
+            Some(b'"') => {
+                cur.advance(1);
+                return Ok(String::from_utf8_lossy(&name).into_owned());
+            }
+            Some(b'\n') => return Err(bad(cur)),
+            Some(c) => {
+                name.push(c);
+                cur.advance(1);
+            }
+            None => return Err(truncated(cur)),
+        }
     }
 }
 
-/// Skips a section the reader does not use, up to `$End<name>`.
+/// Skips a section the reader does not use, up to `$End<name>` followed by
+/// white space or the end of the input.
 fn skip_section(cur: &mut Cursor<'_>, pos: usize, keyword: &[u8]) -> Result<()> {
     let name = keyword.get(1..).unwrap_or_default();
     let mut end = Vec::with_capacity(4 + name.len());
     end.extend_from_slice(b"$End");
     end.extend_from_slice(name);
-    let bytes = cur.bytes;
-    let mut p = cur.pos;
-    while let Some(k) = bytes
-        .get(p..)
-        .and_then(|r| r.iter().position(|&c| c == b'$'))
-    {
-        let at = p + k;
-        let after = at + end.len();
-        if bytes.get(at..after) == Some(&end[..])
-            && bytes.get(after).is_none_or(|c| c.is_ascii_whitespace())
-        {
-            cur.pos = after;
+    loop {
+        let w = cur.available();
+        if w.is_empty() {
+            break;
+        }
+        let Some(k) = w.iter().position(|&c| c == b'$') else {
+            let n = w.len();
+            cur.advance(n);
+            continue;
+        };
+        cur.advance(k);
+        let w = cur.peek(end.len() + 1);
+        if w.starts_with(&end) && w.get(end.len()).is_none_or(|c| c.is_ascii_whitespace()) {
+            cur.advance(end.len());
             return Ok(());
         }
-        p = at + 1;
+        cur.advance(1);
     }
     let section = String::from_utf8_lossy(keyword).into_owned();
     Err(cur.error(

@@ -14,36 +14,41 @@ use crate::MeshErrorKind;
 pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
     cur.enter("$Nodes", "$EndNodes");
     cur.skip_ws();
-    let header = cur.pos;
+    let header = cur.pos();
     let n = cur.u64("the number of nodes")?;
     cur.counts("nodes", n);
     if cur.binary {
         cur.end_of_line()?;
-        let start = cur.pos;
-        let data = cur.take_items(n, 28, "nodes")?;
-        b.nodes.reserve(data.len() / 28);
-        b.node_tags.reserve(data.len() / 28);
-        for (i, rec) in data.chunks_exact(28).enumerate() {
-            let at = start + 28 * i;
-            let tag = u64::try_from(le_i32(rec)).map_err(|_| {
-                cur.error(
-                    at,
-                    MeshErrorKind::Malformed {
-                        what: format!("node tag {} is negative", le_i32(rec)),
-                    },
-                )
-            })?;
-            let (x, y, z) = (le_f64(&rec[4..]), le_f64(&rec[12..]), le_f64(&rec[20..]));
-            if !(x.is_finite() && y.is_finite() && z.is_finite()) {
-                return Err(cur.error(
-                    at + 4,
-                    MeshErrorKind::NotANumber {
-                        what: "a node coordinate",
-                        found: format!("{x} {y} {z}"),
-                    },
-                ));
+        let bytes = cur.check_items(n, 28)?;
+        b.nodes.reserve(bytes / 28);
+        b.node_tags.reserve(bytes / 28);
+        let mut left = n;
+        while left > 0 {
+            let (start, k) = cur.batch(left, 28)?;
+            left -= k as u64;
+            let cur = &*cur;
+            for (i, rec) in cur.records(start, 28 * k).chunks_exact(28).enumerate() {
+                let at = start + 28 * i;
+                let tag = u64::try_from(le_i32(rec)).map_err(|_| {
+                    cur.error(
+                        at,
+                        MeshErrorKind::Malformed {
+                            what: format!("node tag {} is negative", le_i32(rec)),
+                        },
+                    )
+                })?;
+                let (x, y, z) = (le_f64(&rec[4..]), le_f64(&rec[12..]), le_f64(&rec[20..]));
+                if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+                    return Err(cur.error(
+                        at + 4,
+                        MeshErrorKind::NotANumber {
+                            what: "a node coordinate",
+                            found: format!("{x} {y} {z}"),
+                        },
+                    ));
+                }
+                b.push_node(tag, x, y, z);
             }
-            b.push_node(tag, x, y, z);
         }
     } else {
         // A node line is at least "1 0 0 0\n".
@@ -102,12 +107,12 @@ pub(crate) fn elements(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
         let mut read: u64 = 0;
         while read < n {
             if cur.at_keyword() {
-                return Err(cur.wrong_count(cur.pos));
+                return Err(cur.wrong_count(cur.pos()));
             }
-            let hp = cur.pos;
-            let type_id = cur.bin_i32("an element type")?;
-            let following = cur.bin_i32("an element count")?;
-            let ntags = cur.bin_i32("a number of tags")?;
+            let hp = cur.pos();
+            let type_id = cur.bin_i32()?;
+            let following = cur.bin_i32()?;
+            let ntags = cur.bin_i32()?;
             let (Ok(following), Ok(ntags)) = (u64::try_from(following), usize::try_from(ntags))
             else {
                 return Err(cur.error(
@@ -121,10 +126,8 @@ pub(crate) fn elements(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                 return Err(cur.wrong_count(hp));
             }
             let Some(nn) = nodes_of(type_id) else {
-                let first = cur
-                    .bytes
-                    .get(cur.pos..cur.pos + 4)
-                    .map_or(0, |t| u64::try_from(le_i32(t)).unwrap_or(0));
+                let first = <[u8; 4]>::try_from(cur.peek(4))
+                    .map_or(0, |t| u64::try_from(i32::from_le_bytes(t)).unwrap_or(0));
                 return Err(unsupported(cur, hp, first, type_id));
             };
             let size = ntags.checked_add(1 + nn).and_then(|k| k.checked_mul(4));
@@ -136,50 +139,55 @@ pub(crate) fn elements(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                     },
                 ));
             };
-            let start = cur.pos;
-            let data = cur.take_items(following, size, "elements")?;
-            for (i, rec) in data.chunks_exact(size).enumerate() {
-                let at = start + size * i;
-                let tag = u64::try_from(le_i32(rec)).map_err(|_| {
-                    cur.error(
-                        at,
-                        MeshErrorKind::Malformed {
-                            what: format!("element tag {} is negative", le_i32(rec)),
-                        },
-                    )
-                })?;
-                let tags = &rec[4..4 + 4 * ntags];
-                let phys = tags.get(..4).map_or(0, le_i32);
-                let elementary = tags.get(4..8).map_or(0, le_i32);
-                for (k, t) in rec[4 + 4 * ntags..].chunks_exact(4).enumerate() {
-                    let v = le_i32(t);
-                    nodes[k] = u64::try_from(v).map_err(|_| {
+            cur.check_items(following, size)?;
+            let mut left = following;
+            while left > 0 {
+                let (start, k) = cur.batch(left, size)?;
+                left -= k as u64;
+                let cur = &*cur;
+                for (i, rec) in cur.records(start, size * k).chunks_exact(size).enumerate() {
+                    let at = start + size * i;
+                    let tag = u64::try_from(le_i32(rec)).map_err(|_| {
                         cur.error(
                             at,
-                            MeshErrorKind::MissingNode {
-                                element: tag,
-                                node: i64::from(v),
+                            MeshErrorKind::Malformed {
+                                what: format!("element tag {} is negative", le_i32(rec)),
                             },
                         )
                     })?;
+                    let tags = &rec[4..4 + 4 * ntags];
+                    let phys = tags.get(..4).map_or(0, le_i32);
+                    let elementary = tags.get(4..8).map_or(0, le_i32);
+                    for (k, t) in rec[4 + 4 * ntags..].chunks_exact(4).enumerate() {
+                        let v = le_i32(t);
+                        nodes[k] = u64::try_from(v).map_err(|_| {
+                            cur.error(
+                                at,
+                                MeshErrorKind::MissingNode {
+                                    element: tag,
+                                    node: i64::from(v),
+                                },
+                            )
+                        })?;
+                    }
+                    let member = members.get(b, phys);
+                    b.element(
+                        cur,
+                        at,
+                        type_id,
+                        tag,
+                        &nodes[..nn],
+                        member,
+                        Some(elementary),
+                    )?;
                 }
-                let member = members.get(b, phys);
-                b.element(
-                    cur,
-                    at,
-                    type_id,
-                    tag,
-                    &nodes[..nn],
-                    member,
-                    Some(elementary),
-                )?;
             }
             read += following;
         }
     } else {
         for _ in 0..n {
             cur.skip_ws();
-            let at = cur.pos;
+            let at = cur.pos();
             let tag = cur.u64("an element tag")?;
             let type_id = cur.i32("an element type")?;
             let ntags = cur.u64("the number of element tags")?;

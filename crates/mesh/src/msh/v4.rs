@@ -7,7 +7,7 @@
 use std::collections::HashMap;
 
 use super::build::{nodes_of, unsupported, Builder, Membership};
-use super::cursor::{le_f64, le_i32, le_u64, Cursor, Result};
+use super::cursor::{le_f64, le_u64, Cursor, Result};
 use crate::MeshErrorKind;
 
 /// (entity dimension, entity tag) → membership id.
@@ -21,7 +21,7 @@ pub(crate) fn entities(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<Entities
     let mut counts = [0u64; 4];
     for c in &mut counts {
         *c = if cur.binary {
-            cur.bin_u64("an entity count")?
+            cur.bin_u64()?
         } else {
             cur.u64("an entity count")?
         };
@@ -35,20 +35,22 @@ pub(crate) fn entities(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<Entities
     for (dim, &count) in counts.iter().enumerate() {
         for _ in 0..count {
             if cur.binary && cur.at_keyword() {
-                return Err(cur.wrong_count(cur.pos));
+                return Err(cur.wrong_count(cur.pos()));
             }
             phys.clear();
             let tag;
             if cur.binary {
-                tag = cur.bin_i32("an entity tag")?;
+                tag = cur.bin_i32()?;
                 // A point has x y z, other entities a bounding box.
-                cur.take(if dim == 0 { 24 } else { 48 }, "an entity's coordinates")?;
-                let np = cur.bin_u64("a number of physical tags")?;
-                let tags = cur.take_items(np, 4, "physical tags")?;
-                phys.extend(tags.chunks_exact(4).map(le_i32));
+                cur.skip(if dim == 0 { 24 } else { 48 })?;
+                let np = cur.bin_u64()?;
+                for _ in 0..cur.check_items(np, 4)? / 4 {
+                    phys.push(cur.bin_i32()?);
+                }
                 if dim > 0 {
-                    let nb = cur.bin_u64("a number of bounding entities")?;
-                    cur.take_items(nb, 4, "bounding entities")?;
+                    let nb = cur.bin_u64()?;
+                    let bytes = cur.check_items(nb, 4)?;
+                    cur.skip(bytes)?;
                 }
             } else {
                 tag = cur.i32("an entity tag")?;
@@ -83,11 +85,11 @@ fn header(cur: &mut Cursor<'_>, what: &'static str) -> Result<(usize, u64, u64)>
     } else {
         cur.skip_ws();
     }
-    let at = cur.pos;
+    let at = cur.pos();
     let mut h = [0u64; 4];
     for v in &mut h {
         *v = if cur.binary {
-            cur.bin_u64(what)?
+            cur.bin_u64()?
         } else {
             cur.u64(what)?
         };
@@ -99,14 +101,14 @@ fn header(cur: &mut Cursor<'_>, what: &'static str) -> Result<(usize, u64, u64)>
 fn block(cur: &mut Cursor<'_>, what: &'static str) -> Result<(usize, [i32; 3], u64)> {
     if cur.binary {
         if cur.at_keyword() {
-            return Err(cur.wrong_count(cur.pos));
+            return Err(cur.wrong_count(cur.pos()));
         }
-        let at = cur.pos;
-        let a = [cur.bin_i32(what)?, cur.bin_i32(what)?, cur.bin_i32(what)?];
-        Ok((at, a, cur.bin_u64(what)?))
+        let at = cur.pos();
+        let a = [cur.bin_i32()?, cur.bin_i32()?, cur.bin_i32()?];
+        Ok((at, a, cur.bin_u64()?))
     } else {
         cur.skip_ws();
-        let at = cur.pos;
+        let at = cur.pos();
         let a = [cur.i32(what)?, cur.i32(what)?, cur.i32(what)?];
         Ok((at, a, cur.u64(what)?))
     }
@@ -143,24 +145,36 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
         };
         let first = b.node_tags.len();
         if cur.binary {
-            let tags = cur.take_items(n, 8, "node tags")?;
-            b.node_tags.extend(tags.chunks_exact(8).map(le_u64));
+            cur.check_items(n, 8)?;
+            let mut left = n;
+            while left > 0 {
+                let (start, k) = cur.batch(left, 8)?;
+                left -= k as u64;
+                let tags = cur.records(start, 8 * k);
+                b.node_tags.extend(tags.chunks_exact(8).map(le_u64));
+            }
             let size = 8 * (3 + extra);
-            let start = cur.pos;
-            let xyz = cur.take_items(n, size, "node coordinates")?;
-            for (i, rec) in xyz.chunks_exact(size).enumerate() {
-                let (x, y, z) = (le_f64(rec), le_f64(&rec[8..]), le_f64(&rec[16..]));
-                if !(x.is_finite() && y.is_finite() && z.is_finite()) {
-                    return Err(cur.error(
-                        start + size * i,
-                        MeshErrorKind::NotANumber {
-                            what: "a node coordinate",
-                            found: format!("{x} {y} {z}"),
-                        },
-                    ));
+            cur.check_items(n, size)?;
+            let (mut left, mut i) = (n, first);
+            while left > 0 {
+                let (start, k) = cur.batch(left, size)?;
+                left -= k as u64;
+                let cur = &*cur;
+                for (j, rec) in cur.records(start, size * k).chunks_exact(size).enumerate() {
+                    let (x, y, z) = (le_f64(rec), le_f64(&rec[8..]), le_f64(&rec[16..]));
+                    if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+                        return Err(cur.error(
+                            start + size * j,
+                            MeshErrorKind::NotANumber {
+                                what: "a node coordinate",
+                                found: format!("{x} {y} {z}"),
+                            },
+                        ));
+                    }
+                    let tag = b.node_tags.get(i).copied().unwrap_or(0);
+                    b.push_xyz(x, y, z, tag);
+                    i += 1;
                 }
-                let tag = b.node_tags.get(first + i).copied().unwrap_or(0);
-                b.push_xyz(x, y, z, tag);
             }
         } else {
             for _ in 0..n {
@@ -225,27 +239,32 @@ pub(crate) fn elements(
         }
         if cur.binary {
             let size = 8 * (1 + nn);
-            let start = cur.pos;
-            let data = cur.take_items(n, size, "elements")?;
-            for (i, rec) in data.chunks_exact(size).enumerate() {
-                let tag = le_u64(rec);
-                for (slot, t) in nodes.iter_mut().zip(rec[8..].chunks_exact(8)) {
-                    *slot = le_u64(t);
+            cur.check_items(n, size)?;
+            let mut left = n;
+            while left > 0 {
+                let (start, k) = cur.batch(left, size)?;
+                left -= k as u64;
+                let cur = &*cur;
+                for (i, rec) in cur.records(start, size * k).chunks_exact(size).enumerate() {
+                    let tag = le_u64(rec);
+                    for (slot, t) in nodes.iter_mut().zip(rec[8..].chunks_exact(8)) {
+                        *slot = le_u64(t);
+                    }
+                    b.element(
+                        cur,
+                        start + size * i,
+                        type_id,
+                        tag,
+                        &nodes[..nn],
+                        member,
+                        None,
+                    )?;
                 }
-                b.element(
-                    cur,
-                    start + size * i,
-                    type_id,
-                    tag,
-                    &nodes[..nn],
-                    member,
-                    None,
-                )?;
             }
         } else {
             for _ in 0..n {
                 cur.skip_ws();
-                let ep = cur.pos;
+                let ep = cur.pos();
                 let tag = cur.u64("an element tag")?;
                 for slot in nodes.iter_mut().take(nn) {
                     *slot = cur.u64("a node tag")?;
@@ -261,14 +280,12 @@ pub(crate) fn elements(
 }
 
 /// The tag of the first element of a block, for an error message.
-fn peek_tag(cur: &Cursor<'_>) -> u64 {
+fn peek_tag(cur: &mut Cursor<'_>) -> u64 {
     if cur.binary {
-        cur.bytes.get(cur.pos..cur.pos + 8).map_or(0, le_u64)
+        <[u8; 8]>::try_from(cur.peek(8)).map_or(0, u64::from_le_bytes)
     } else {
-        let mut c = Cursor::new(cur.bytes);
-        c.pos = cur.pos;
-        c.token()
-            .and_then(|(_, t)| super::cursor::parse_u64(t))
+        cur.token()
+            .and_then(|(_, t)| super::cursor::parse_u64(&t))
             .unwrap_or(0)
     }
 }
