@@ -236,6 +236,37 @@ pub struct StepInfo {
     pub stick_events: usize,
 }
 
+/// Everything needed to continue a run bit-identically
+/// ([`Integrator::checkpoint`], [`Integrator::restore`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checkpoint {
+    /// Time reached.
+    pub t: f64,
+    /// Steps completed.
+    pub steps: u64,
+    /// r on free DOFs.
+    pub displacement: Vec<f64>,
+    /// ṙ on free DOFs.
+    pub velocity: Vec<f64>,
+    /// r̈ on free DOFs.
+    pub acceleration: Vec<f64>,
+    /// [`SlipState::code`] per contact node.
+    pub classes: Vec<i8>,
+    /// Nodal friction forces f_J of the last step (the energy ledger's
+    /// trapezoidal rule needs them).
+    pub forces: Vec<f64>,
+    /// The energy ledger.
+    pub energy: Energy,
+    /// Kinetic + strain energy at t = 0 (for the balance).
+    pub initial_mechanical: f64,
+    /// Remark 4.3 step-reduction counter.
+    pub reduced_remaining: u64,
+    /// Stick/slip iterations so far.
+    pub total_iterations: u64,
+    /// Numeric factorizations so far.
+    pub factorizations: u64,
+}
+
 /// Integrates from the initial state to `t_end`, one step per call.
 pub struct Integrator {
     dynamics: Dynamics,
@@ -798,6 +829,113 @@ impl Integrator {
             }),
             Err(IterationFailure::Solve(source)) => Err(TimeError::Solve { step, t, source }),
         }
+    }
+
+    // ---- checkpoint / restart ----
+
+    /// Everything needed to continue this run bit-identically
+    /// ([`Integrator::restore`] on a fresh integrator of the same case).
+    pub fn checkpoint(&self) -> Checkpoint {
+        Checkpoint {
+            t: self.t,
+            steps: self.steps,
+            displacement: self.r.clone(),
+            velocity: self.v.clone(),
+            acceleration: self.a.clone(),
+            classes: self.classes.iter().map(|c| c.code()).collect(),
+            forces: self.forces.clone(),
+            energy: self.energy,
+            initial_mechanical: self.initial_mechanical,
+            reduced_remaining: self.reduced_remaining as u64,
+            total_iterations: self.total_iterations,
+            factorizations: self.factorizations(),
+        }
+    }
+
+    /// Replaces the state of a freshly built integrator (same case) by the
+    /// checkpoint's. R(t) is recomputed from the loads at the checkpoint's
+    /// time; factorizations are recomputed on demand (they are functions of
+    /// Δt and the stuck set only, so the continued run is bit-identical to
+    /// an uninterrupted one).
+    ///
+    /// # Errors
+    /// [`TimeError::Settings`] when a vector length does not match the model
+    /// or the contact surface, a class code is not −1, 0 or 1, or a value is
+    /// not finite.
+    pub fn restore(&mut self, c: &Checkpoint) -> Result<(), TimeError> {
+        let n = self.dynamics.n();
+        let n_c = self.classes.len();
+        let bad = |m: String| Err(TimeError::Settings(format!("checkpoint: {m}")));
+        for (name, len, want) in [
+            ("displacement", c.displacement.len(), n),
+            ("velocity", c.velocity.len(), n),
+            ("acceleration", c.acceleration.len(), n),
+        ] {
+            if len != want {
+                return bad(format!(
+                    "{name} has {len} entries, the model {want} free DOFs: \
+                     restart from a checkpoint of the same case (mesh and supports)"
+                ));
+            }
+        }
+        for (name, len) in [("classes", c.classes.len()), ("forces", c.forces.len())] {
+            if len != n_c {
+                return bad(format!(
+                    "{name} has {len} entries, the contact surface {n_c} friction nodes: \
+                     restart from a checkpoint of the same case (contact group and supports)"
+                ));
+            }
+        }
+        if !(c.t.is_finite() && c.t >= 0.0) {
+            return bad(format!("t = {} is not a time ≥ 0", c.t));
+        }
+        let finite = c
+            .displacement
+            .iter()
+            .chain(&c.velocity)
+            .chain(&c.acceleration)
+            .chain(&c.forces)
+            .all(|x| x.is_finite());
+        if !finite {
+            return bad("the state holds NaN or infinity".into());
+        }
+        let mut classes = Vec::with_capacity(n_c);
+        for (k, &code) in c.classes.iter().enumerate() {
+            classes.push(match code {
+                0 => SlipState::Stuck,
+                1 => SlipState::SlipPositive,
+                -1 => SlipState::SlipNegative,
+                other => {
+                    return bad(format!(
+                        "class code {other} at contact node {k}: expected −1, 0 or 1"
+                    ))
+                }
+            });
+        }
+        self.t = c.t;
+        self.steps = c.steps;
+        self.r.copy_from_slice(&c.displacement);
+        self.v.copy_from_slice(&c.velocity);
+        self.a.copy_from_slice(&c.acceleration);
+        self.classes.copy_from_slice(&classes);
+        self.forces.copy_from_slice(&c.forces);
+        self.energy = c.energy;
+        self.initial_mechanical = c.initial_mechanical;
+        self.reduced_remaining = usize::try_from(c.reduced_remaining).unwrap_or(usize::MAX);
+        self.total_iterations = c.total_iterations;
+        if let Some(op) = self.implicit.as_mut() {
+            op.factorizations = c.factorizations;
+        }
+        self.load_at(self.t, false);
+        Ok(())
+    }
+
+    /// Extends (or shortens) the end time, e.g. for a restart with a later
+    /// t_end. A run that already stopped at its old t_end had its last step
+    /// shortened to land there, so continuing it is not bit-identical to a
+    /// run that never stopped; a checkpoint taken before the end is.
+    pub fn set_t_end(&mut self, t_end: f64) {
+        self.settings.t_end = t_end;
     }
 
     // ---- read access for observers ----

@@ -23,6 +23,6 @@ pub mod stability;
 
 pub use history::History;
 pub use integrator::{
-    Dynamics, Energy, ExplicitFriction, Integrator, Load, MassKind, Scheme, Settings, StepInfo,
-    StickReduction, TimeError,
+    Checkpoint, Dynamics, Energy, ExplicitFriction, Integrator, Load, MassKind, Scheme, Settings,
+    StepInfo, StickReduction, TimeError,
 };
