@@ -139,6 +139,17 @@ fn main() -> ExitCode {
                 ));
                 return ExitCode::from(2);
             }
+            if let Some(dir) = out
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
+            {
+                report(&format!(
+                    "{}: the directory {} does not exist; create it, or choose another file with -o",
+                    out.display(),
+                    dir.display()
+                ));
+                return ExitCode::from(2);
+            }
             match run::execute(&case, &out, quiet) {
                 Ok(run::Outcome::Complete) => ExitCode::SUCCESS,
                 Ok(run::Outcome::Failed) => ExitCode::from(1),

@@ -243,6 +243,21 @@ fn run_refuses_to_overwrite_without_force() {
 }
 
 #[test]
+fn run_into_a_missing_directory_is_bad_input() {
+    let out = scratch("nodir").join("no/such/dir/out.h5");
+    let o = bin()
+        .arg("run")
+        .arg(data("slab.toml"))
+        .arg("-o")
+        .arg(&out)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("does not exist"), "{}", stderr(&o));
+}
+
+#[test]
 fn run_then_probe_node_81() {
     let out = scratch("probe").join("slab.h5");
     let o = bin()
