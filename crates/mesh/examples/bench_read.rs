@@ -10,8 +10,9 @@
 //! of `std::fs::read` alone and of `Mesh::from_bytes` alone. Memory: the peak
 //! resident set (`VmHWM` of /proc/self/status) during one read, above the
 //! resident set before it, compared with the `Mesh`'s own size estimated from
-//! its Vec lengths. That peak includes the file's bytes, which `from_file`
-//! holds while parsing, so it is reported as is, not netted out.
+//! its Vec lengths. That peak includes whatever `from_file` holds while
+//! parsing (its read window of a few MB, the builder's side tables); it is
+//! reported as is, not netted out.
 //! The last line is `RESULT key=value …` for xtask to parse.
 
 use std::process::ExitCode;
@@ -128,7 +129,7 @@ fn main() -> ExitCode {
             let peak = h.saturating_sub(b) * 1024;
             let ratio = peak as f64 / mesh_bytes as f64;
             println!(
-                "peak RSS growth  {:>10.1} MB during one read = {ratio:.2} x the Mesh (includes the {:.1} MB of file bytes held while parsing)",
+                "peak RSS growth  {:>10.1} MB during one read = {ratio:.2} x the Mesh (all from_file holds while parsing; the {:.1} MB file is streamed)",
                 peak as f64 / 1e6,
                 file_bytes as f64 / 1e6
             );

@@ -306,3 +306,6 @@ fn skip_section(cur: &mut Cursor<'_>, pos: usize, keyword: &[u8]) -> Result<()> 
         },
     ))
 }
+
+#[cfg(test)]
+mod stream_tests;
