@@ -148,10 +148,13 @@ fn variant(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
     path
 }
 
+/// A named edit of the base case and a word its error message must contain.
+type BadCase = (&'static str, fn(String) -> String, &'static str);
+
 #[test]
 fn bad_input_is_refused_with_exit_code_2_before_any_work() {
     let dir = scratch("bad");
-    let cases: [(&str, fn(String) -> String, &str); 8] = [
+    let cases: [BadCase; 8] = [
         (
             "missing-group",
             |s| s.replace("group = \"contact\"", "group = \"bottom\""),
