@@ -7,6 +7,7 @@ use stickslip_fem::{Model, SolverError, SparseCholesky};
 use crate::history::History;
 use crate::implicit::{DiagonalStep, ImplicitOperator, ImplicitStep};
 use crate::linalg::{dot, quadratic_form, spmv};
+use crate::schur::{ImplicitSolver, SchurOperator};
 use crate::stability::critical_step;
 
 /// The semi-discrete system on free DOFs: K, M (consistent, with K's
@@ -280,7 +281,13 @@ pub struct Integrator {
     dt_crit: Option<f64>,
     /// Mass as a CSR matrix with K's pattern (a diagonal one when lumped).
     mass_matrix: CsrMatrix<f64>,
+    /// The direct path (A₀ + C refactorized per stuck set), when chosen.
     implicit: Option<ImplicitOperator>,
+    /// The Schur-complement path (the default for implicit schemes).
+    schur: Option<SchurOperator>,
+    solver: ImplicitSolver,
+    /// Nodal tangential velocities of the Schur path's iteration.
+    nodal_velocity: Vec<f64>,
     // State at the current time.
     t: f64,
     steps: u64,
@@ -425,11 +432,11 @@ impl Integrator {
                 m
             }
         };
-        let implicit = if explicit {
+        let schur = if explicit {
             None
         } else {
             Some(
-                ImplicitOperator::new(&dynamics.stiffness, contact.as_ref())
+                SchurOperator::new(&dynamics.stiffness, contact.as_ref(), ImplicitSolver::Schur)
                     .map_err(TimeError::Static)?,
             )
         };
@@ -463,7 +470,10 @@ impl Integrator {
             explicit,
             dt_crit,
             mass_matrix,
-            implicit,
+            implicit: None,
+            schur,
+            solver: ImplicitSolver::Schur,
+            nodal_velocity: vec![0.0; n_c],
             t: 0.0,
             steps: 0,
             a: vec![0.0; n],
@@ -786,8 +796,63 @@ impl Integrator {
         }
     }
 
+    /// Implicit step by the Schur complement on the contact DOFs (see
+    /// `schur.rs`): one solve, the iteration of §5 on the n_c nodal
+    /// unknowns, the correction.
+    fn schur_velocity(&mut self, dt: f64, step: u64, t: f64) -> Result<usize, TimeError> {
+        let op = self
+            .schur
+            .as_mut()
+            .expect("Schur operator exists for the Schur path");
+        op.set_dt(
+            dt,
+            self.beta / self.gamma * dt,
+            &self.dynamics.stiffness,
+            1.0 / (self.gamma * dt),
+            &self.mass_matrix,
+        )
+        .map_err(|source| TimeError::Solve { step, t, source })?;
+        if self.contact.is_none() {
+            op.solve_plain(&self.b, &mut self.v_new);
+            return Ok(1);
+        }
+        op.begin(&self.b, &mut self.v_new);
+        let reduced = op
+            .reduced
+            .take()
+            .expect("a contact surface has its nodal surface");
+        let result = iterate(
+            &reduced,
+            &mut op.nodal_system(),
+            &mut self.scratch_classes,
+            &mut self.iter_scratch,
+            &mut self.nodal_velocity,
+            self.settings.iteration,
+        );
+        op.reduced = Some(reduced);
+        match result {
+            Ok(report) => {
+                op.finish(&self.b, &mut self.v_new);
+                Ok(report.iterations)
+            }
+            Err(IterationFailure::Cap {
+                iterations,
+                changing,
+            }) => Err(TimeError::IterationCap {
+                step,
+                t,
+                iterations,
+                changing,
+            }),
+            Err(IterationFailure::Solve(source)) => Err(TimeError::Solve { step, t, source }),
+        }
+    }
+
     /// Implicit step: (β/γ)ΔtK + M/(γΔt) + C, the iteration of §5.
     fn implicit_velocity(&mut self, dt: f64, step: u64, t: f64) -> Result<usize, TimeError> {
+        if self.schur.is_some() {
+            return self.schur_velocity(dt, step, t);
+        }
         let op = self
             .implicit
             .as_mut()
@@ -926,6 +991,9 @@ impl Integrator {
         if let Some(op) = self.implicit.as_mut() {
             op.factorizations = c.factorizations;
         }
+        if let Some(op) = self.schur.as_mut() {
+            op.factorizations = c.factorizations;
+        }
         self.load_at(self.t, false);
         Ok(())
     }
@@ -979,6 +1047,49 @@ impl Integrator {
     /// Numeric factorizations of the implicit operator so far.
     pub fn factorizations(&self) -> u64 {
         self.implicit.as_ref().map_or(0, |op| op.factorizations)
+            + self.schur.as_ref().map_or(0, |op| op.factorizations)
+    }
+
+    /// Values stored per factor of A₀ (Schur path; 0 otherwise): with 8
+    /// bytes each, the memory of one Δt's factor and the data one
+    /// forward+back solve reads twice.
+    pub fn factor_len(&self) -> usize {
+        self.schur.as_ref().map_or(0, |op| op.factor_len())
+    }
+
+    /// How implicit steps solve their linear systems.
+    pub fn implicit_solver(&self) -> ImplicitSolver {
+        self.solver
+    }
+
+    /// Chooses how implicit steps solve their linear systems (default
+    /// [`ImplicitSolver::Schur`]); meant before the first step. The
+    /// factorization count carries over. Does nothing for an explicit run.
+    ///
+    /// # Errors
+    /// [`TimeError::Static`] if the symbolic analysis fails.
+    pub fn set_implicit_solver(&mut self, solver: ImplicitSolver) -> Result<(), TimeError> {
+        if self.explicit || solver == self.solver {
+            self.solver = solver;
+            return Ok(());
+        }
+        let count = self.factorizations();
+        self.implicit = None;
+        self.schur = None;
+        if solver == ImplicitSolver::Direct {
+            let mut op = ImplicitOperator::new(&self.dynamics.stiffness, self.contact.as_ref())
+                .map_err(TimeError::Static)?;
+            op.factorizations = count;
+            self.implicit = Some(op);
+        } else {
+            let mut op =
+                SchurOperator::new(&self.dynamics.stiffness, self.contact.as_ref(), solver)
+                    .map_err(TimeError::Static)?;
+            op.factorizations = count;
+            self.schur = Some(op);
+        }
+        self.solver = solver;
+        Ok(())
     }
     /// Stick/slip iterations (linear solves) summed over all steps.
     pub fn total_iterations(&self) -> u64 {

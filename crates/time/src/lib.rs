@@ -12,13 +12,16 @@
 //!
 //! Work done is what the scene needs: no contact surface means no friction
 //! code runs; the explicit scheme solves no linear system; the implicit
-//! operator is analysed once and refactorized only when Δt or the set of
-//! stuck nodes changes.
+//! operator A₀ is analysed once and factorized once per distinct Δt, the
+//! friction handled by a Schur complement on the contact DOFs
+//! ([`ImplicitSolver::Schur`], the default; [`ImplicitSolver::Direct`]
+//! refactorizes A₀ + C per stuck set and is kept as the reference).
 
 mod history;
 mod implicit;
 mod integrator;
 pub mod linalg;
+mod schur;
 pub mod stability;
 
 pub use history::History;
@@ -26,3 +29,4 @@ pub use integrator::{
     Checkpoint, Dynamics, Energy, ExplicitFriction, Integrator, Load, MassKind, Scheme, Settings,
     StepInfo, StickReduction, TimeError,
 };
+pub use schur::ImplicitSolver;

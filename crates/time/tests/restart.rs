@@ -39,7 +39,11 @@ fn assert_same_state(a: &Integrator, b: &Integrator, what: &str) {
     assert_eq!(a.acceleration(), b.acceleration(), "{what}: r̈");
     assert_eq!(a.classes(), b.classes(), "{what}: classes");
     assert_eq!(a.energy(), b.energy(), "{what}: energy ledger");
-    assert_eq!(a.total_iterations(), b.total_iterations(), "{what}: iterations");
+    assert_eq!(
+        a.total_iterations(),
+        b.total_iterations(),
+        "{what}: iterations"
+    );
 }
 
 #[test]

@@ -1,0 +1,531 @@
+//! The implicit Newmark step by a Schur complement on the contact DOFs
+//! (issue 7, deliverable 1; METHOD.md §4-5).
+//!
+//! The step's operator is A₀ + C with A₀ = (β/γ)ΔtK + M/(γΔt) and C the
+//! damping of the stuck nodes, which lives on the contact tangential DOFs
+//! only: C = Pᵀ D P, P the n_c × n restriction whose row J is τ_J on node
+//! J's free DOFs, D = diag(w_J g_J/ε) over stuck nodes. So A₀ is factorized
+//! once per distinct Δt (one symbolic analysis for the run), and with
+//! Z = A₀⁻¹Pᵀ and S = P Z (dense n_c × n_c) a step is
+//!
+//! * v₀ = A₀⁻¹ b (one solve), p = P v₀;
+//! * the nodal tangential velocities u solve u + S f(u) = p, where
+//!   f_J = w_J g_J φ_ε(u_J): the stick/slip iteration of §5 with Remark 4.2
+//!   runs on these n_c unknowns (a [`ContactSurface`] of unit nodes, so it
+//!   is literally [`iterate`]); for given classes, f = F on slipping nodes
+//!   and f_s = D_s u_s on stuck ones, with u_s from the SPD system
+//!   (I + W S_ss W) y = W (p_s − S_sl F_l), W = D_s^{1/2}, f_s = W y;
+//! * v = v₀ − Z f (Woodbury: (A₀ + PᵀDP)v = b − PᵀF gives the same v).
+//!
+//! Z costs n·n_c values; when that exceeds the factor's size the
+//! correction is a second solve v = A₀⁻¹(b − Pᵀf) instead (both cost about
+//! one pass over their data; the second solve keeps memory at the factor's).
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{LltError, LltParams};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
+    SymmetricOrdering,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, MatRef, Par, Side, Spec};
+use nalgebra_sparse::CsrMatrix;
+use stickslip_contact::{ContactNode, ContactSurface, SlipState, StepSystem};
+use stickslip_fem::SolverError;
+
+/// Right-hand sides solved together when building Z and S: one pass over
+/// the factor serves the whole block.
+const BLOCK: usize = 32;
+
+/// How many Δt keep their factor (the normal and the reduced step).
+const CACHE: usize = 2;
+
+/// How the implicit step solves its linear systems.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ImplicitSolver {
+    /// A₀ factorized once per Δt, friction on the contact DOFs through the
+    /// Schur complement; the correction −Z f or a second solve, whichever
+    /// costs less memory traffic (n·n_c against the factor's size).
+    #[default]
+    Schur,
+    /// As [`ImplicitSolver::Schur`], always storing Z.
+    SchurStoredZ,
+    /// As [`ImplicitSolver::Schur`], always correcting by a second solve.
+    SchurSecondSolve,
+    /// A₀ + C refactorized whenever Δt or the stuck set changes, the
+    /// iteration on the full system (the reference).
+    Direct,
+}
+
+fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
+    // Symmetric: the CSR arrays read as the CSC arrays of the same matrix.
+    let sym = SymbolicSparseColMatRef::new_checked(
+        a.nrows(),
+        a.ncols(),
+        a.row_offsets(),
+        None,
+        a.col_indices(),
+    );
+    SparseColMatRef::new(sym, a.values())
+}
+
+/// One Δt's factor of A₀ and its Schur data.
+struct Entry {
+    dt_bits: u64,
+    /// Values of L (the pattern is the shared symbolic factor's).
+    l_values: Vec<f64>,
+    /// S = P A₀⁻¹ Pᵀ, column-major n_c × n_c.
+    s: Vec<f64>,
+    /// Z = A₀⁻¹ Pᵀ, column-major n × n_c; empty when not stored.
+    z: Vec<f64>,
+    /// Distinguishes entries for the dense factor's cache.
+    id: u64,
+    last_used: u64,
+}
+
+/// The dense Cholesky factor of I + W S_ss W for one (entry, stuck set).
+struct DenseFactor {
+    entry_id: u64,
+    stuck: Vec<bool>,
+    valid: bool,
+    /// Stuck node indices.
+    index: Vec<usize>,
+    /// W = √(w g/ε) of the stuck nodes.
+    w: Vec<f64>,
+    /// The factor, column-major n_s × n_s in the first n_s² values.
+    l: Vec<f64>,
+    scratch: MemBuffer,
+}
+
+/// A₀'s factors per Δt and the Schur complement on the contact DOFs.
+pub(crate) struct SchurOperator {
+    n: usize,
+    a0: CsrMatrix<f64>,
+    symbolic: SymbolicCholesky<usize>,
+    factor_scratch: MemBuffer,
+    solve_scratch: MemBuffer,
+    entries: Vec<Entry>,
+    current: usize,
+    clock: u64,
+    next_id: u64,
+    store_z: Option<bool>,
+    /// The contact nodes as seen by P.
+    nodes: Vec<ContactNode>,
+    /// The same nodes as unit nodes on the n_c nodal unknowns, for the
+    /// iteration.
+    pub reduced: Option<ContactSurface>,
+    eps: f64,
+    dense: DenseFactor,
+    /// p = P v₀.
+    p: Vec<f64>,
+    /// f of the last solve of the iteration.
+    f: Vec<f64>,
+    rhs: Vec<f64>,
+    pub factorizations: u64,
+}
+
+impl SchurOperator {
+    /// Analyses K's pattern (which M shares) once for the run.
+    pub fn new(
+        stiffness: &CsrMatrix<f64>,
+        contact: Option<&ContactSurface>,
+        solver: ImplicitSolver,
+    ) -> Result<SchurOperator, SolverError> {
+        let n = stiffness.nrows();
+        if n != stiffness.ncols() {
+            return Err(SolverError::NotSquare {
+                rows: n,
+                cols: stiffness.ncols(),
+            });
+        }
+        let symbolic = factorize_symbolic_cholesky(
+            as_csc(stiffness).symbolic(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| SolverError::Analysis(format!("{e:?}")))?;
+        let factor_scratch = MemBuffer::new(
+            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+        );
+        let solve_scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+        let nodes = contact.map(|c| c.nodes.clone()).unwrap_or_default();
+        let n_c = nodes.len();
+        let reduced = match contact {
+            Some(c) if n_c > 0 => {
+                let unit: Vec<ContactNode> = c
+                    .nodes
+                    .iter()
+                    .enumerate()
+                    .map(|(j, node)| ContactNode {
+                        dofs: [Some(j), None],
+                        tangent: [1.0, 0.0],
+                        ..*node
+                    })
+                    .collect();
+                Some(
+                    ContactSurface::from_nodes(&c.group, unit, c.law.eps)
+                        .map_err(|e| SolverError::Analysis(e.to_string()))?,
+                )
+            }
+            _ => None,
+        };
+        let store_z = match solver {
+            ImplicitSolver::SchurStoredZ => Some(true),
+            ImplicitSolver::SchurSecondSolve => Some(false),
+            _ => None,
+        };
+        let dense = DenseFactor {
+            entry_id: u64::MAX,
+            stuck: vec![false; n_c],
+            valid: false,
+            index: Vec::with_capacity(n_c),
+            w: Vec::with_capacity(n_c),
+            l: vec![0.0; n_c * n_c],
+            scratch: MemBuffer::new(
+                faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(
+                    n_c,
+                    Par::Seq,
+                    Default::default(),
+                )
+                .and(
+                    faer::linalg::cholesky::llt::solve::solve_in_place_scratch::<f64>(
+                        n_c,
+                        1,
+                        Par::Seq,
+                    ),
+                ),
+            ),
+        };
+        Ok(SchurOperator {
+            n,
+            a0: stiffness.clone(),
+            symbolic,
+            factor_scratch,
+            solve_scratch,
+            entries: Vec::with_capacity(CACHE),
+            current: usize::MAX,
+            clock: 0,
+            next_id: 0,
+            store_z,
+            eps: contact.map_or(1.0, |c| c.law.eps),
+            nodes,
+            reduced,
+            dense,
+            p: vec![0.0; n_c],
+            f: vec![0.0; n_c],
+            rhs: vec![0.0; n],
+            factorizations: 0,
+        })
+    }
+
+    /// Numeric factors of L kept (for memory figures).
+    pub fn factor_len(&self) -> usize {
+        self.symbolic.len_val()
+    }
+
+    /// Makes the factor of A₀ = c_k K + c_m M for this Δt current: from the
+    /// cache, or factorized (with S and Z) once.
+    pub fn set_dt(
+        &mut self,
+        dt: f64,
+        c_k: f64,
+        stiffness: &CsrMatrix<f64>,
+        c_m: f64,
+        mass: &CsrMatrix<f64>,
+    ) -> Result<(), SolverError> {
+        self.clock += 1;
+        let bits = dt.to_bits();
+        if let Some(k) = self.entries.iter().position(|e| e.dt_bits == bits) {
+            self.current = k;
+            self.entries[k].last_used = self.clock;
+            return Ok(());
+        }
+        for ((a, k), m) in self
+            .a0
+            .values_mut()
+            .iter_mut()
+            .zip(stiffness.values())
+            .zip(mass.values())
+        {
+            *a = c_k * k + c_m * m;
+        }
+        // Reuse the least recently used entry's storage once the cache is full.
+        let slot = if self.entries.len() < CACHE {
+            self.entries.push(Entry {
+                dt_bits: bits,
+                l_values: vec![0.0; self.symbolic.len_val()],
+                s: Vec::new(),
+                z: Vec::new(),
+                id: 0,
+                last_used: 0,
+            });
+            self.entries.len() - 1
+        } else {
+            let (k, _) = self
+                .entries
+                .iter()
+                .enumerate()
+                .min_by_key(|(_, e)| e.last_used)
+                .expect("cache is full");
+            k
+        };
+        self.current = usize::MAX;
+        let entry = &mut self.entries[slot];
+        entry.dt_bits = u64::MAX; // invalid until factorized
+        let result = self.symbolic.factorize_numeric_llt(
+            &mut entry.l_values,
+            as_csc(&self.a0),
+            Side::Lower,
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut self.factor_scratch),
+            Spec::<LltParams, f64>::default(),
+        );
+        match result {
+            Ok(_) => {}
+            Err(LltError::NonPositivePivot { index }) => {
+                return Err(SolverError::NotPositiveDefinite {
+                    pivot: index,
+                    n: self.n,
+                })
+            }
+        }
+        self.factorizations += 1;
+        entry.dt_bits = bits;
+        entry.id = self.next_id;
+        self.next_id += 1;
+        entry.last_used = self.clock;
+        self.current = slot;
+        self.build_schur(slot);
+        Ok(())
+    }
+
+    /// Z = A₀⁻¹Pᵀ and S = P Z for entry `slot`, BLOCK columns per solve.
+    fn build_schur(&mut self, slot: usize) {
+        let n = self.n;
+        let n_c = self.nodes.len();
+        let store = self
+            .store_z
+            .unwrap_or(n.saturating_mul(n_c) <= self.symbolic.len_val());
+        let entry = &mut self.entries[slot];
+        entry.s.clear();
+        entry.s.resize(n_c * n_c, 0.0);
+        entry.z.clear();
+        if n_c == 0 {
+            return;
+        }
+        if store {
+            entry.z.resize(n * n_c, 0.0);
+        }
+        let llt = LltRef::<'_, usize, f64>::new(&self.symbolic, &entry.l_values);
+        let width = BLOCK.min(n_c);
+        let mut block = vec![0.0; n * width];
+        let mut scratch =
+            MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(width, Par::Seq));
+        for start in (0..n_c).step_by(width) {
+            let cols = width.min(n_c - start);
+            let x = &mut block[..n * cols];
+            x.fill(0.0);
+            for c in 0..cols {
+                let node = &self.nodes[start + c];
+                for (d, t) in node.dofs.iter().zip(node.tangent) {
+                    if let Some(i) = d {
+                        x[c * n + i] = t;
+                    }
+                }
+            }
+            llt.solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(x, n, cols),
+                Par::Seq,
+                MemStack::new(&mut scratch),
+            );
+            for c in 0..cols {
+                let col = &x[c * n..(c + 1) * n];
+                let j = start + c;
+                for (i, node) in self.nodes.iter().enumerate() {
+                    entry.s[j * n_c + i] = node.tangential(col);
+                }
+                if store {
+                    entry.z[j * n..(j + 1) * n].copy_from_slice(col);
+                }
+            }
+        }
+        // S is symmetric in exact arithmetic; make it so in floating point
+        // so that the dense Cholesky sees one matrix.
+        for j in 0..n_c {
+            for i in 0..j {
+                let m = 0.5 * (entry.s[j * n_c + i] + entry.s[i * n_c + j]);
+                entry.s[j * n_c + i] = m;
+                entry.s[i * n_c + j] = m;
+            }
+        }
+    }
+
+    fn solve(&mut self, x: &mut [f64]) {
+        let entry = &self.entries[self.current];
+        let llt = LltRef::<'_, usize, f64>::new(&self.symbolic, &entry.l_values);
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(x, self.n, 1),
+            Par::Seq,
+            MemStack::new(&mut self.solve_scratch),
+        );
+    }
+
+    /// v = A₀⁻¹ b without friction.
+    pub fn solve_plain(&mut self, b: &[f64], v: &mut [f64]) {
+        v.copy_from_slice(b);
+        self.solve(v);
+    }
+
+    /// v₀ = A₀⁻¹ b into `v` and p = P v₀: the start of a step with friction.
+    pub fn begin(&mut self, b: &[f64], v: &mut [f64]) {
+        v.copy_from_slice(b);
+        self.solve(v);
+        for (p, node) in self.p.iter_mut().zip(&self.nodes) {
+            *p = node.tangential(v);
+        }
+    }
+
+    /// The nodal system of this step for the iteration.
+    pub fn nodal_system(&mut self) -> NodalStep<'_> {
+        NodalStep { op: self }
+    }
+
+    /// v = v₀ − Z f (or A₀⁻¹(b − Pᵀf)) with the f of the converged
+    /// iteration; `v` holds v₀ on entry.
+    pub fn finish(&mut self, b: &[f64], v: &mut [f64]) {
+        let n = self.n;
+        let entry = &self.entries[self.current];
+        if entry.z.is_empty() {
+            self.rhs.copy_from_slice(b);
+            for (node, f) in self.nodes.iter().zip(&self.f) {
+                for (d, t) in node.dofs.iter().zip(node.tangent) {
+                    if let Some(i) = d {
+                        self.rhs[*i] -= f * t;
+                    }
+                }
+            }
+            v.copy_from_slice(&self.rhs);
+            self.solve(v);
+        } else {
+            // Column by column: a stuck node with f = 0 costs nothing.
+            for (j, &f) in self.f.iter().enumerate() {
+                if f != 0.0 {
+                    let z = &entry.z[j * n..(j + 1) * n];
+                    for (vi, zi) in v.iter_mut().zip(z) {
+                        *vi -= f * zi;
+                    }
+                }
+            }
+        }
+    }
+
+    /// f for `classes` into self.f and u = p − S f into `u`.
+    fn nodal_solve(&mut self, classes: &[SlipState], u: &mut [f64]) -> Result<(), SolverError> {
+        let n_c = self.nodes.len();
+        let entry = &self.entries[self.current];
+        let s = &entry.s;
+        // Slip forces F_J = w g sign.
+        for ((f, node), c) in self.f.iter_mut().zip(&self.nodes).zip(classes) {
+            *f = if c.is_stuck() {
+                0.0
+            } else {
+                node.force_scale() * c.sign()
+            };
+        }
+        let d = &mut self.dense;
+        let same = d.valid
+            && d.entry_id == entry.id
+            && d.stuck.iter().zip(classes).all(|(&k, c)| k == c.is_stuck());
+        if !same {
+            d.valid = false;
+            d.index.clear();
+            d.w.clear();
+            for (j, (node, c)) in self.nodes.iter().zip(classes).enumerate() {
+                d.stuck[j] = c.is_stuck();
+                if c.is_stuck() {
+                    d.index.push(j);
+                    d.w.push((node.force_scale() / self.eps).sqrt());
+                }
+            }
+            let m = d.index.len();
+            let l = &mut d.l[..m * m];
+            for (b, &jb) in d.index.iter().enumerate() {
+                for (a, &ja) in d.index.iter().enumerate() {
+                    l[b * m + a] = d.w[a] * s[jb * n_c + ja] * d.w[b];
+                }
+                l[b * m + b] += 1.0;
+            }
+            if m > 0 {
+                let result = faer::linalg::cholesky::llt::factor::cholesky_in_place(
+                    MatMut::from_column_major_slice_mut(l, m, m),
+                    Default::default(),
+                    Par::Seq,
+                    MemStack::new(&mut d.scratch),
+                    Spec::<LltParams, f64>::default(),
+                );
+                if let Err(LltError::NonPositivePivot { index }) = result {
+                    return Err(SolverError::NotPositiveDefinite { pivot: index, n: m });
+                }
+            }
+            d.entry_id = entry.id;
+            d.valid = true;
+        }
+        let m = d.index.len();
+        if m > 0 {
+            // y = (I + W S_ss W)⁻¹ W (p_s − S_s· F); f_s = W y.
+            let y = &mut u[..m];
+            for (a, &ja) in d.index.iter().enumerate() {
+                let mut r = self.p[ja];
+                for (j, f) in self.f.iter().enumerate() {
+                    if *f != 0.0 {
+                        r -= s[j * n_c + ja] * f;
+                    }
+                }
+                y[a] = d.w[a] * r;
+            }
+            faer::linalg::cholesky::llt::solve::solve_in_place_with_conj(
+                MatRef::from_column_major_slice(&d.l[..m * m], m, m),
+                Conj::No,
+                MatMut::from_column_major_slice_mut(y, m, 1),
+                Par::Seq,
+                MemStack::new(&mut d.scratch),
+            );
+            for (a, &ja) in d.index.iter().enumerate() {
+                self.f[ja] = d.w[a] * y[a];
+            }
+        }
+        // u = p − S f (S symmetric: row i of S is column i).
+        for (i, ui) in u.iter_mut().enumerate() {
+            let col = &s[i * n_c..(i + 1) * n_c];
+            let mut sum = self.p[i];
+            for (sij, fj) in col.iter().zip(&self.f) {
+                sum -= sij * fj;
+            }
+            *ui = sum;
+        }
+        Ok(())
+    }
+}
+
+/// The iteration's linear system on the n_c nodal unknowns: for given
+/// classes, u + S f = p with f = F (slipping) or D u (stuck).
+pub(crate) struct NodalStep<'a> {
+    op: &'a mut SchurOperator,
+}
+
+impl StepSystem for NodalStep<'_> {
+    type Error = SolverError;
+
+    fn solve(
+        &mut self,
+        _surface: &ContactSurface,
+        classes: &[SlipState],
+        velocity: &mut [f64],
+    ) -> Result<(), SolverError> {
+        self.op.nodal_solve(classes, velocity)
+    }
+}

@@ -1,0 +1,186 @@
+//! The Schur-complement path of the implicit step against the direct path
+//! (A₀ + C refactorized per stuck set) on every paper case: the two solve
+//! the same regularized step (Woodbury's identity), by the same active-set
+//! iteration, so they agree to round-off (issue 7: 1e-10), and the Schur
+//! path factorizes A₀ exactly once per distinct Δt.
+//!
+//! Whole runs with the step reduction of Remark 4.3 are compared step by
+//! step from the same state (each step of the Schur path starts from the
+//! direct path's checkpoint): there r̈ = (ṙ_K − ṙ_{K−1})/(γΔt) − … with
+//! γΔt = 5e-8 turns the 1e-14 round-off of any two ways of solving the step
+//! into 1e-7 in r̈ (measured: 2e-14 → 9e-8), and the next normal step carries
+//! M(1/γ − 1)r̈ into ṙ at 1e-10, so two correct solvers drift apart over a
+//! run by round-off amplification alone; the per-step comparison measures
+//! the solver, and the whole-run classes must still agree.
+
+mod common;
+use std::collections::BTreeSet;
+
+use common::*;
+use stickslip_time::{History, ImplicitSolver, Integrator, Scheme, Settings, StickReduction};
+
+fn cases() -> Vec<(&'static str, Scheme, Option<StickReduction>)> {
+    let trapezoidal = Scheme::Newmark {
+        beta: 0.25,
+        gamma: 0.5,
+    };
+    let damped = Scheme::Newmark {
+        beta: 0.3025,
+        gamma: 0.6,
+    };
+    let reduction = Some(StickReduction {
+        dt: 1e-7,
+        steps: 10,
+    });
+    vec![
+        ("¼,½", trapezoidal, None),
+        ("¼,½ + reduction", trapezoidal, reduction),
+        ("0.3025,0.6", damped, None),
+        ("0.3025,0.6 + reduction", damped, reduction),
+    ]
+}
+
+fn build(
+    s: &Slab,
+    scheme: Scheme,
+    reduction: Option<StickReduction>,
+    solver: ImplicitSolver,
+) -> Integrator {
+    let mut settings = Settings::new(scheme, 5e-3, 0.5);
+    settings.stick_reduction = reduction;
+    let mut i = s.integrator(settings);
+    i.set_implicit_solver(solver).unwrap();
+    assert_eq!(i.implicit_solver(), solver);
+    i
+}
+
+#[test]
+fn schur_path_equals_the_direct_path_on_every_paper_case() {
+    for mesh in ["slab-q2-8x2.msh", "slab-q1-32x8.msh"] {
+        let s = paper_slab(mesh, 1e-4, History::Step);
+        for (name, scheme, reduction) in cases() {
+            let mut direct = build(&s, scheme, reduction, ImplicitSolver::Direct);
+            let mut schur: Vec<Integrator> = [
+                ImplicitSolver::Schur,
+                ImplicitSolver::SchurStoredZ,
+                ImplicitSolver::SchurSecondSolve,
+            ]
+            .into_iter()
+            .map(|solver| build(&s, scheme, reduction, solver))
+            .collect();
+            let mut dts = BTreeSet::new();
+            let (mut worst_v, mut worst_r): (f64, f64) = (0.0, 0.0);
+            let mut slips = 0;
+            while !direct.done() {
+                let info = direct.step().unwrap();
+                dts.insert(info.dt.to_bits());
+                slips += direct.classes().iter().filter(|c| !c.is_stuck()).count();
+                for i in schur.iter_mut() {
+                    let other = i.step().unwrap();
+                    assert_eq!(other.dt.to_bits(), info.dt.to_bits(), "{mesh} {name}: Δt");
+                    assert_eq!(
+                        i.classes(),
+                        direct.classes(),
+                        "{mesh} {name} t = {}: classes",
+                        direct.time()
+                    );
+                    for (a, b) in i.velocity().iter().zip(direct.velocity()) {
+                        worst_v = worst_v.max((a - b).abs());
+                    }
+                    for (a, b) in i.displacement().iter().zip(direct.displacement()) {
+                        worst_r = worst_r.max((a - b).abs());
+                    }
+                }
+            }
+            println!(
+                "{mesh} {name}: {} steps, {} distinct Δt, max |Δṙ| {worst_v:.2e}, max |Δr| {worst_r:.2e}, \
+                 factorizations: direct {}, Schur {}",
+                direct.steps(),
+                dts.len(),
+                direct.factorizations(),
+                schur[0].factorizations()
+            );
+            assert!(slips > 0, "{mesh} {name}: the case must slip somewhere");
+            // Velocities are O(1) (the end moves at about 5), displacements
+            // O(1): 1e-10 is the issue's agreement. With the reduction the
+            // runs drift apart by round-off amplification (module comment);
+            // the step-by-step test below holds them to 1e-10.
+            if reduction.is_none() {
+                assert!(
+                    worst_v < 1e-10,
+                    "{mesh} {name}: velocity differs by {worst_v:e}"
+                );
+                assert!(
+                    worst_r < 1e-10,
+                    "{mesh} {name}: displacement differs by {worst_r:e}"
+                );
+            }
+            for i in &schur {
+                assert_eq!(i.time(), direct.time());
+                assert_eq!(
+                    i.factorizations(),
+                    dts.len() as u64,
+                    "{mesh} {name} {:?}: one factorization per distinct Δt",
+                    i.implicit_solver()
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn every_schur_step_equals_the_direct_step_from_the_same_state() {
+    for mesh in ["slab-q2-8x2.msh", "slab-q1-32x8.msh"] {
+        let s = paper_slab(mesh, 1e-4, History::Step);
+        for (name, scheme, reduction) in cases() {
+            let mut direct = build(&s, scheme, reduction, ImplicitSolver::Direct);
+            let mut probes: Vec<Integrator> = [
+                ImplicitSolver::Schur,
+                ImplicitSolver::SchurStoredZ,
+                ImplicitSolver::SchurSecondSolve,
+            ]
+            .into_iter()
+            .map(|solver| build(&s, scheme, reduction, solver))
+            .collect();
+            let (mut worst_v, mut worst_r): (f64, f64) = (0.0, 0.0);
+            let mut reduced_steps = 0;
+            while !direct.done() {
+                let c = direct.checkpoint();
+                let info = direct.step().unwrap();
+                if reduction.is_some_and(|r| info.dt == r.dt) {
+                    reduced_steps += 1;
+                }
+                for p in probes.iter_mut() {
+                    p.restore(&c).unwrap();
+                    let other = p.step().unwrap();
+                    assert_eq!(
+                        other.iterations, info.iterations,
+                        "{mesh} {name}: iterations"
+                    );
+                    assert_eq!(p.classes(), direct.classes(), "{mesh} {name}: classes");
+                    for (a, b) in p.velocity().iter().zip(direct.velocity()) {
+                        worst_v = worst_v.max((a - b).abs());
+                    }
+                    for (a, b) in p.displacement().iter().zip(direct.displacement()) {
+                        worst_r = worst_r.max((a - b).abs());
+                    }
+                }
+            }
+            println!(
+                "{mesh} {name}: step by step, max |Δṙ| {worst_v:.2e}, max |Δr| {worst_r:.2e}, {reduced_steps} reduced steps"
+            );
+            assert!(
+                reduction.is_none() || reduced_steps > 0,
+                "{mesh} {name}: no reduced step"
+            );
+            assert!(
+                worst_v < 1e-10,
+                "{mesh} {name}: velocity differs by {worst_v:e}"
+            );
+            assert!(
+                worst_r < 1e-10,
+                "{mesh} {name}: displacement differs by {worst_r:e}"
+            );
+        }
+    }
+}
