@@ -1,2 +1,125 @@
-//! The solver's proof of itself: closed-form checks, convergence rates, the
-//! paper's experiments, committed reference runs, and the paper's figures.
+//! The solver's proof of itself (`cargo xtask verify`) and the paper's
+//! figures redrawn from our runs (`cargo xtask figures`).
+//!
+//! This crate owns the verification suites — closed-form problems
+//! (`analytic`), measured convergence orders against the theory's
+//! (`rates`), the properties Martins & Oden report for their experiments
+//! (`paper`), and committed reference runs of every paper case
+//! (`reference`) — the table they print, and the plots. It runs the
+//! integrators in-process through the library crates (no HDF5, no CLI), so
+//! a defect can be injected through the public API ([`Fault`]) to show that
+//! a check catches it.
+
+pub mod figures;
+pub mod report;
+pub mod scene;
+pub mod suites;
+
+use std::path::{Path, PathBuf};
+
+pub use report::{Report, Row};
+pub use scene::{Case, Fault, Scene, Trace};
+use stickslip_time::Scheme;
+
+/// Newmark ¼, ½ (average acceleration).
+pub const NEWMARK: Scheme = Scheme::Newmark {
+    beta: 0.25,
+    gamma: 0.5,
+};
+
+/// What `verify` runs.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// The CI subset.
+    pub quick: bool,
+    /// Rewrite the reference runs instead of comparing.
+    pub bless: bool,
+    /// Only this suite (analytic, rates, paper, reference).
+    pub only: Option<String>,
+    /// A defect to inject into the paper cases.
+    pub fault: Option<Fault>,
+    /// Only the cases whose name contains one of these (all when empty).
+    pub cases: Vec<String>,
+}
+
+/// The suites by name, in the order they run.
+pub const SUITES: [&str; 4] = ["analytic", "rates", "paper", "reference"];
+
+/// One paper case and its run.
+#[derive(Debug)]
+pub struct Run {
+    /// The case.
+    pub case: Case,
+    /// Its time histories (with the error that stopped it early, if any).
+    pub trace: Trace,
+}
+
+/// The directory of the paper's cases.
+pub fn cases_dir(root: &Path) -> PathBuf {
+    root.join("cases/martins-oden")
+}
+
+/// Runs every case of `cases/martins-oden` (those selected), with `fault`.
+///
+/// # Errors
+/// An unreadable case directory or case file.
+pub fn run_cases(root: &Path, fault: Option<Fault>, only: &[String]) -> Result<Vec<Run>, String> {
+    let cases = Case::read_dir(&cases_dir(root))?;
+    let mut runs = Vec::new();
+    for case in cases {
+        if !only.is_empty() && !only.iter().any(|o| case.name.contains(o.as_str())) {
+            continue;
+        }
+        let trace = match Scene::from_case(&case) {
+            Ok(mut s) => {
+                if let Some(f) = fault {
+                    s.inject(f);
+                }
+                s.run()
+            }
+            Err(e) => Trace {
+                error: Some(e),
+                ..Trace::default()
+            },
+        };
+        runs.push(Run { case, trace });
+    }
+    Ok(runs)
+}
+
+/// Runs the selected suites, adding rows to `report`.
+///
+/// # Errors
+/// `--only` naming no suite, or unreadable case files.
+pub fn verify(root: &Path, opts: &Options, report: &mut Report) -> Result<(), String> {
+    if let Some(o) = &opts.only {
+        if !SUITES.contains(&o.as_str()) {
+            return Err(format!(
+                "--only {o:?}: the suites are {}",
+                SUITES.join(", ")
+            ));
+        }
+    }
+    let wants = |s: &str| opts.only.as_deref().is_none_or(|o| o == s);
+    if opts.bless {
+        let runs = run_cases(root, opts.fault, &opts.cases)?;
+        suites::reference::run(root, &runs, true, report);
+        return Ok(());
+    }
+    if wants("analytic") {
+        suites::analytic::run(root, opts, report);
+    }
+    if wants("rates") {
+        suites::rates::run(root, opts, report);
+    }
+    if wants("paper") || wants("reference") {
+        let runs = run_cases(root, opts.fault, &opts.cases)?;
+        if wants("paper") {
+            suites::paper::run(&runs, report);
+        }
+        if wants("reference") {
+            suites::reference::run(root, &runs, false, report);
+        }
+    }
+    Ok(())
+}

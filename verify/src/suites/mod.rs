@@ -1,0 +1,6 @@
+//! The four suites of `verify`.
+
+pub mod analytic;
+pub mod paper;
+pub mod rates;
+pub mod reference;

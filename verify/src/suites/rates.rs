@@ -1,0 +1,377 @@
+//! Measured orders of convergence against the theory's: in h (static
+//! manufactured solution, Q1 and Q2, L2 and H1), in Δt (smooth frictionless
+//! dynamics against a fine-Δt run) and in ε (the regularization error).
+
+use std::path::Path;
+
+use stickslip_fem::element::CellBasis;
+use stickslip_fem::geometry::Jacobian;
+use stickslip_fem::loads::body_force_load_with;
+use stickslip_fem::testing::{map_nodes, rectangle};
+use stickslip_fem::{static_solve, traction_load_with, Dirichlet, Hypothesis, Material, Model};
+use stickslip_mesh::{CellKind, Mesh};
+use stickslip_time::{Integrator, Scheme};
+
+use crate::report::{num, Report};
+use crate::scene::{sdof, Case, Scene};
+use crate::suites::analytic::SCHEMES;
+use crate::{Options, NEWMARK};
+
+/// Least-squares slope of log(e) against log(x).
+pub fn fitted_order(x: &[f64], e: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let lx: Vec<f64> = x.iter().map(|v| v.ln()).collect();
+    let le: Vec<f64> = e.iter().map(|v| v.ln()).collect();
+    let mx = lx.iter().sum::<f64>() / n;
+    let me = le.iter().sum::<f64>() / n;
+    let sxy: f64 = lx.iter().zip(&le).map(|(a, b)| (a - mx) * (b - me)).sum();
+    let sxx: f64 = lx.iter().map(|a| (a - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+fn list(v: &[f64]) -> String {
+    v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(", ")
+}
+
+/// Runs the suite.
+pub fn run(root: &Path, opts: &Options, r: &mut Report) {
+    r.suite("rates");
+    h_rates(opts, r);
+    dt_rates(root, opts, r);
+    eps_rates(root, opts, r);
+}
+
+// ---- h: the manufactured solution of crates/fem/tests/convergence.rs ----
+// u_x = sin(αx)·sin(βy), u_y = sin(γx)·(1 − cos(δy)) on the unit square
+// with interior nodes moved by a smooth map; clamped on x = 0 and y = 0,
+// the traction σ(u)·n on x = 1 and y = 1, body force f = −div σ(u).
+
+const A: f64 = 2.0;
+const B: f64 = 3.0;
+const G: f64 = 1.5;
+const DL: f64 = 2.0;
+
+fn material() -> Material {
+    Material::new(1.0, 0.3, 1.0, Hypothesis::PlaneStrain).expect("valid material")
+}
+
+fn exact(p: [f64; 2]) -> ([f64; 2], [[f64; 2]; 2]) {
+    let [x, y] = p;
+    let u = [
+        (A * x).sin() * (B * y).sin(),
+        (G * x).sin() * (1.0 - (DL * y).cos()),
+    ];
+    let g = [
+        [
+            A * (A * x).cos() * (B * y).sin(),
+            B * (A * x).sin() * (B * y).cos(),
+        ],
+        [
+            G * (G * x).cos() * (1.0 - (DL * y).cos()),
+            DL * (G * x).sin() * (DL * y).sin(),
+        ],
+    ];
+    (u, g)
+}
+
+fn stress(p: [f64; 2]) -> [f64; 3] {
+    let d = material().elasticity();
+    let (_, g) = exact(p);
+    let e = [g[0][0], g[1][1], g[0][1] + g[1][0]];
+    [0, 1, 2].map(|i| (0..3).map(|j| d[i][j] * e[j]).sum())
+}
+
+/// f = −div σ, differentiated by hand (the fem crate's convergence test
+/// checks this derivation by finite differences).
+fn body_force(p: [f64; 2]) -> [f64; 2] {
+    let d = material().elasticity();
+    let [x, y] = p;
+    let ux = (A * x).sin() * (B * y).sin();
+    let ux_xx = -A * A * ux;
+    let ux_yy = -B * B * ux;
+    let ux_xy = A * B * (A * x).cos() * (B * y).cos();
+    let uy_xx = -G * G * (G * x).sin() * (1.0 - (DL * y).cos());
+    let uy_yy = DL * DL * (G * x).sin() * (DL * y).cos();
+    let uy_xy = G * DL * (G * x).cos() * (DL * y).sin();
+    let div_x = d[0][0] * ux_xx + d[0][1] * uy_xy + d[2][2] * (ux_yy + uy_xy);
+    let div_y = d[2][2] * (ux_xy + uy_xx) + d[1][0] * ux_xy + d[1][1] * uy_yy;
+    [-div_x, -div_y]
+}
+
+fn manufactured_mesh(kind: CellKind, n: usize) -> Mesh {
+    let mut m = rectangle(kind, n, n, [0.0, 0.0], [1.0, 1.0]);
+    let pi = std::f64::consts::PI;
+    map_nodes(&mut m, |[x, y]| {
+        [
+            x + 0.04 * (2.0 * pi * x).sin() * (pi * y).sin(),
+            y + 0.04 * (pi * x).sin() * (2.0 * pi * y).sin(),
+        ]
+    });
+    m
+}
+
+/// (L2 error, H1-seminorm error) on an n × n mesh.
+fn h_errors(kind: CellKind, n: usize) -> Result<(f64, f64), String> {
+    let mesh = manufactured_mesh(kind, n);
+    let bcs: Vec<Dirichlet> = ["left", "bottom"]
+        .iter()
+        .flat_map(|g| [Dirichlet::new(*g, 0, 0.0), Dirichlet::new(*g, 1, 0.0)])
+        .collect();
+    let model = Model::new(&mesh, &material(), &bcs).map_err(|e| e.to_string())?;
+    let mut full = vec![0.0; 2 * mesh.nodes.len()];
+    body_force_load_with(&mesh, body_force, &mut full);
+    for g in ["right", "top"] {
+        traction_load_with(
+            &mesh,
+            g,
+            |x, nrm| {
+                let s = stress(x);
+                [s[0] * nrm[0] + s[2] * nrm[1], s[2] * nrm[0] + s[1] * nrm[1]]
+            },
+            &mut full,
+        )
+        .map_err(|e| e.to_string())?;
+    }
+    let mut free = vec![0.0; model.dofs.n_free()];
+    model.dofs.restrict(&full, &mut free);
+    let u = static_solve(&model, &free).map_err(|e| e.to_string())?;
+    // 5 × 5 Gauss points per cell: their own error is far below the
+    // discretization error at these h.
+    let basis = CellBasis::new(kind, 5);
+    let nn = kind.nodes_per_cell();
+    let (mut l2, mut h1) = (0.0, 0.0);
+    let mut g = [[0.0; 2]; 9];
+    let mut coords = [[0.0; 2]; 9];
+    for c in 0..mesh.n_cells() {
+        let cell = mesh.cell(c);
+        for (a, &v) in cell.iter().enumerate() {
+            coords[a] = mesh.nodes[v];
+        }
+        for q in 0..basis.n_points() {
+            let j = Jacobian::from_gradients(&coords[..nn], basis.gradients(q));
+            j.physical_gradients(basis.gradients(q), &mut g[..nn]);
+            let nv = basis.values(q);
+            let (mut x, mut uh, mut gh) = ([0.0; 2], [0.0; 2], [[0.0; 2]; 2]);
+            for a in 0..nn {
+                for i in 0..2 {
+                    x[i] += nv[a] * coords[a][i];
+                    let ua = u[2 * cell[a] + i];
+                    uh[i] += nv[a] * ua;
+                    gh[i][0] += g[a][0] * ua;
+                    gh[i][1] += g[a][1] * ua;
+                }
+            }
+            let (ue, ge) = exact(x);
+            let w = basis.weight(q) * j.det;
+            l2 += w * ((ue[0] - uh[0]).powi(2) + (ue[1] - uh[1]).powi(2));
+            for i in 0..2 {
+                for k in 0..2 {
+                    h1 += w * (ge[i][k] - gh[i][k]).powi(2);
+                }
+            }
+        }
+    }
+    Ok((l2.sqrt(), h1.sqrt()))
+}
+
+fn h_rates(opts: &Options, r: &mut Report) {
+    let ladders: [(CellKind, &str, &[usize], f64); 2] = if opts.quick {
+        [
+            (CellKind::Quad4, "Q1", &[8, 16, 32], 1.0),
+            (CellKind::Quad9, "Q2", &[4, 8, 16], 2.0),
+        ]
+    } else {
+        [
+            (CellKind::Quad4, "Q1", &[8, 16, 32, 64], 1.0),
+            (CellKind::Quad9, "Q2", &[4, 8, 16, 32], 2.0),
+        ]
+    };
+    for (kind, name, ns, k) in ladders {
+        let case = format!("manufactured static {name}");
+        let errs: Result<Vec<(f64, f64)>, String> = ns.iter().map(|&n| h_errors(kind, n)).collect();
+        let errs = match errs {
+            Ok(e) => e,
+            Err(e) => {
+                r.holds(&case, "solve", e, "solves", false);
+                continue;
+            }
+        };
+        let h: Vec<f64> = ns.iter().map(|&n| 1.0 / n as f64).collect();
+        let l2: Vec<f64> = errs.iter().map(|e| e.0).collect();
+        let h1: Vec<f64> = errs.iter().map(|e| e.1).collect();
+        let span = format!("h = 1/{}..1/{}", ns[0], ns[ns.len() - 1]);
+        r.close(
+            &case,
+            &format!("L2 order, {span}"),
+            fitted_order(&h, &l2),
+            k + 1.0,
+            "Ciarlet: O(h^(k+1))",
+            0.15,
+        );
+        r.close(
+            &case,
+            &format!("H1 order, {span}"),
+            fitted_order(&h, &h1),
+            k,
+            "Ciarlet: O(h^k)",
+            0.15,
+        );
+    }
+}
+
+// ---- Δt: the frictionless slab under the smooth end load −150·sin(8πt) ----
+
+/// max-norm difference of the displacement at t_end between a run at `dt`
+/// and one at `dt_ref`, same scheme.
+fn final_state(scene: &Scene, scheme: Scheme, dt: f64, t_end: f64) -> Result<Vec<f64>, String> {
+    let mut s = stickslip_time::Settings::new(scheme, dt, t_end);
+    s.mass = None;
+    let mut i = Integrator::new(scene.dynamics.clone(), None, scene.loads.clone(), s)
+        .map_err(|e| e.to_string())?;
+    while !i.done() {
+        i.step().map_err(|e| e.to_string())?;
+    }
+    Ok(i.displacement().to_vec())
+}
+
+fn dt_rates(root: &Path, opts: &Options, r: &mut Report) {
+    let case_file = root.join("cases/martins-oden/cd-sin-eps1e-4.toml");
+    let scene = match Case::read(&case_file).and_then(|c| Scene::from_case(&c)) {
+        Ok(s) => s,
+        Err(e) => {
+            r.holds("Δt rates", "scene", e, "builds", false);
+            return;
+        }
+    };
+    // A smooth solution: sin(8πt) starts at 0, so r̈₀ = 0 and nothing jumps;
+    // the low modes it drives dominate the error.
+    let t_end = 0.25;
+    let runs: [(&str, Scheme, f64, &[f64], f64); 3] = [
+        (
+            "CD",
+            Scheme::CentralDifference,
+            2.0,
+            &[4e-4, 2e-4, 1e-4, 5e-5],
+            6.25e-6,
+        ),
+        ("NM ¼,½", NEWMARK, 2.0, &[4e-3, 2e-3, 1e-3, 5e-4], 3.125e-5),
+        (
+            "NM 0.3025,0.6",
+            Scheme::Newmark {
+                beta: 0.3025,
+                gamma: 0.6,
+            },
+            1.0,
+            &[4e-3, 2e-3, 1e-3, 5e-4],
+            3.125e-5,
+        ),
+    ];
+    for (name, scheme, order, dts, dt_ref) in runs {
+        let dts = if opts.quick { &dts[..3] } else { dts };
+        let case = format!("frictionless slab sin {name}");
+        let result = (|| -> Result<Vec<f64>, String> {
+            let reference = final_state(&scene, scheme, dt_ref, t_end)?;
+            dts.iter()
+                .map(|&dt| {
+                    let u = final_state(&scene, scheme, dt, t_end)?;
+                    Ok(u.iter()
+                        .zip(&reference)
+                        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())))
+                })
+                .collect()
+        })();
+        match result {
+            Ok(errs) => r.close(
+                &case,
+                &format!("Δt order (errors {})", list(&errs)),
+                fitted_order(dts, &errs),
+                order,
+                if order == 2.0 {
+                    "Newmark γ=½: 2nd order"
+                } else {
+                    "Newmark γ≠½: 1st order"
+                },
+                0.2,
+            ),
+            Err(e) => r.holds(&case, "run completes", e, "completes", false),
+        }
+    }
+}
+
+// ---- ε: the regularization error ----
+
+fn eps_rates(root: &Path, opts: &Options, r: &mut Report) {
+    // Paper Thm 2.3: the error is O(√ε) in the energy norm, so the fitted
+    // order must be at least ½. Δt = 2e-6 keeps the time error (O(Δt) at the
+    // stick/slip kinks) well below the smallest ε error measured.
+    let epsilons = [1e-2, 1e-3, 1e-4];
+    let loads: &[f64] = if opts.quick { &[2.5] } else { &[2.5, 5.0, 0.8] };
+    for (name, scheme) in SCHEMES {
+        for &p in loads {
+            let case = format!("1-DOF Coulomb P={p} {name}");
+            let errs: Result<Vec<f64>, String> = epsilons
+                .iter()
+                .map(|&e| sdof::max_error(p, e, scheme, 2e-6).map(|x| x.0))
+                .collect();
+            match errs {
+                Ok(errs) => {
+                    r.at_least(
+                        &case,
+                        &format!("ε order, ε=1e-2..1e-4 (errors {})", list(&errs)),
+                        fitted_order(&epsilons, &errs),
+                        0.5,
+                        "Thm 2.3: O(√ε)",
+                    );
+                    r.at_most(
+                        &case,
+                        "max |x − x_Coulomb| at ε=1e-4",
+                        errs[2],
+                        1e-4,
+                        "closed form; amplitude 0.08",
+                    );
+                }
+                Err(e) => r.holds(&case, "run completes", e, "completes", false),
+            }
+        }
+    }
+    if opts.quick {
+        return;
+    }
+    // The slab (central difference, Δt = 1e-3, H(t)): u_x(81) history against
+    // the run at ε = 1e-6.
+    let case_file = root.join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let case = "slab CD H(t)";
+    let result = (|| -> Result<(Vec<f64>, Vec<f64>), String> {
+        let c = Case::read(&case_file)?;
+        let history = |eps: f64| -> Result<Vec<f64>, String> {
+            let mut scene = Scene::from_case(&c)?;
+            if let Some(s) = &mut scene.contact {
+                s.law.eps = eps;
+            }
+            let t = scene.run();
+            t.error.map_or(Ok(t.ux81), Err)
+        };
+        let reference = history(1e-6)?;
+        let eps = vec![1e-1, 1e-2, 1e-3];
+        let errs = eps
+            .iter()
+            .map(|&e| {
+                let u = history(e)?;
+                Ok(u.iter()
+                    .zip(&reference)
+                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())))
+            })
+            .collect::<Result<Vec<f64>, String>>()?;
+        Ok((eps, errs))
+    })();
+    match result {
+        Ok((eps, errs)) => r.at_least(
+            case,
+            &format!("ε order of u_x(81) vs ε=1e-6 (errors {})", list(&errs)),
+            fitted_order(&eps, &errs),
+            0.5,
+            "Thm 2.3: O(√ε)",
+        ),
+        Err(e) => r.holds(case, "run completes", e, "completes", false),
+    }
+}
