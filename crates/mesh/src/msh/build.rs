@@ -308,6 +308,7 @@ impl Builder {
             if p.valid
                 && p.type_id == type_id
                 && p.elementary == elementary
+                && p.nodes.first() == nodes.first()
                 && p.nodes.get(..nodes.len()) == Some(nodes)
             {
                 return self.merge_previous(type_id, member);
@@ -427,15 +428,31 @@ impl Builder {
     /// negative (clockwise), `None` if degenerate or tangled.
     fn orientation(&self, cell: &[usize]) -> Option<bool> {
         let p = |k: usize| self.nodes[cell[k]];
+        let sq = |v: [f64; 2]| v[0] * v[0] + v[1] * v[1];
         let mut sign = 0i8;
-        for i in 0..4 {
-            let (next, prev) = ((i + 1) % 4, (i + 3) % 4);
-            let c = p(i);
-            // Tangents of the two sides leaving corner i: for quad4 the
-            // sides themselves; for quad9 the derivative of the quadratic
-            // side through corner, mid-side node and far corner at the
-            // corner, (-3 c + 4 m - far) / 2.
-            let (a, b) = if cell.len() == 9 {
+        if cell.len() == 4 {
+            // Quad4: the tangents at corner i are the sides e_i = p_{i+1} - p_i
+            // and -e_{i-1}; each side and its squared length is computed
+            // once for its two corners (the same numbers, bit for bit, as
+            // computing them per corner).
+            let c = [p(0), p(1), p(2), p(3)];
+            let e: [[f64; 2]; 4] = std::array::from_fn(|i| {
+                let n = c[(i + 1) % 4];
+                [n[0] - c[i][0], n[1] - c[i][1]]
+            });
+            let l2 = e.map(sq);
+            for i in 0..4 {
+                let prev = (i + 3) % 4;
+                let b = [-e[prev][0], -e[prev][1]];
+                corner_sign(e[i], b, l2[i], l2[prev], &mut sign)?;
+            }
+        } else {
+            for i in 0..4 {
+                let (next, prev) = ((i + 1) % 4, (i + 3) % 4);
+                let c = p(i);
+                // Quad9: the tangents of the two sides leaving corner i are
+                // the derivatives of the quadratic side through corner,
+                // mid-side node and far corner, (-3 c + 4 m - far) / 2.
                 let (mn, mp) = (p(4 + i), p(4 + prev));
                 let (fnx, fpr) = (p(next), p(prev));
                 let t = |m: [f64; 2], f: [f64; 2]| {
@@ -444,35 +461,9 @@ impl Builder {
                         0.5 * (-3.0 * c[1] + 4.0 * m[1] - f[1]),
                     ]
                 };
-                (t(mn, fnx), t(mp, fpr))
-            } else {
-                let (n, q) = (p(next), p(prev));
-                ([n[0] - c[0], n[1] - c[1]], [q[0] - c[0], q[1] - c[1]])
-            };
-            let det = a[0] * b[1] - a[1] * b[0];
-            // |det| > TOL |a| |b|, squared to save two square roots per
-            // corner (glibc's hypot was a fifth of the read time).
-            let scale2 = (a[0] * a[0] + a[1] * a[1]) * (b[0] * b[0] + b[1] * b[1]);
-            let bound2 = JACOBIAN_TOL * JACOBIAN_TOL * scale2;
-            let clear = if bound2 >= f64::MIN_POSITIVE && scale2.is_finite() {
-                // No square overflowed or lost precision below the normal
-                // range (a det² that did is below bound2 either way).
-                // False also for NaN.
-                det * det > bound2
-            } else {
-                // Extreme coordinates (below ~1e-70 or above ~1e150), a
-                // zero-length side, or NaN: decide unsquared, as hypot
-                // neither overflows nor underflows.
-                det.abs() > JACOBIAN_TOL * a[0].hypot(a[1]) * b[0].hypot(b[1])
-            };
-            if !clear {
-                return None;
+                let (a, b) = (t(mn, fnx), t(mp, fpr));
+                corner_sign(a, b, sq(a), sq(b), &mut sign)?;
             }
-            let s = if det > 0.0 { 1 } else { -1 };
-            if sign != 0 && s != sign {
-                return None;
-            }
-            sign = s;
         }
         Some(sign > 0)
     }
@@ -723,6 +714,37 @@ impl Builder {
     }
 }
 
+/// One corner of [`Builder::orientation`]: tangents `a`, `b` with squared
+/// lengths `a2`, `b2`. `None` if the corner is degenerate
+/// (`|det| <= TOL |a| |b|`) or its sign differs from the corners before.
+#[inline(always)]
+fn corner_sign(a: [f64; 2], b: [f64; 2], a2: f64, b2: f64, sign: &mut i8) -> Option<()> {
+    let det = a[0] * b[1] - a[1] * b[0];
+    // |det| > TOL |a| |b|, squared to save two square roots per corner
+    // (glibc's hypot was a fifth of the read time).
+    let scale2 = a2 * b2;
+    let bound2 = JACOBIAN_TOL * JACOBIAN_TOL * scale2;
+    let clear = if bound2 >= f64::MIN_POSITIVE && scale2.is_finite() {
+        // No square overflowed or lost precision below the normal range
+        // (a det² that did is below bound2 either way). False also for NaN.
+        det * det > bound2
+    } else {
+        // Extreme coordinates (below ~1e-70 or above ~1e150), a zero-length
+        // side, or NaN: decide unsquared, as hypot neither overflows nor
+        // underflows.
+        det.abs() > JACOBIAN_TOL * a[0].hypot(a[1]) * b[0].hypot(b[1])
+    };
+    if !clear {
+        return None;
+    }
+    let s = if det > 0.0 { 1 } else { -1 };
+    if *sign != 0 && s != *sign {
+        return None;
+    }
+    *sign = s;
+    Some(())
+}
+
 /// Reverses a cell's orientation keeping node 0: corners 0 3 2 1, and for
 /// quad9 the mid-side nodes follow their sides (7 6 5 4), the centre stays.
 fn reverse(cell: &mut [usize]) {
@@ -730,5 +752,116 @@ fn reverse(cell: &mut [usize]) {
     if cell.len() == 9 {
         cell.swap(4, 7);
         cell.swap(5, 6);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Builder, JACOBIAN_TOL};
+
+    /// The corner test as first written (hypot per corner): the reference
+    /// the squared form must agree with.
+    fn reference(p: &[[f64; 2]]) -> Option<bool> {
+        let mut sign = 0i8;
+        for i in 0..4 {
+            let (next, prev) = ((i + 1) % 4, (i + 3) % 4);
+            let c = p[i];
+            let (a, b) = if p.len() == 9 {
+                let t = |m: [f64; 2], f: [f64; 2]| {
+                    [
+                        0.5 * (-3.0 * c[0] + 4.0 * m[0] - f[0]),
+                        0.5 * (-3.0 * c[1] + 4.0 * m[1] - f[1]),
+                    ]
+                };
+                (t(p[4 + i], p[next]), t(p[4 + prev], p[prev]))
+            } else {
+                let (n, q) = (p[next], p[prev]);
+                ([n[0] - c[0], n[1] - c[1]], [q[0] - c[0], q[1] - c[1]])
+            };
+            let det = a[0] * b[1] - a[1] * b[0];
+            let scale = a[0].hypot(a[1]) * b[0].hypot(b[1]);
+            let s = if det > JACOBIAN_TOL * scale {
+                1
+            } else if det < -JACOBIAN_TOL * scale {
+                -1
+            } else {
+                return None;
+            };
+            if sign != 0 && s != sign {
+                return None;
+            }
+            sign = s;
+        }
+        Some(sign > 0)
+    }
+
+    /// Random quads (convex, clockwise, tangled, nearly flat, repeated
+    /// corners) at magnitudes from 1e-200 to 1e200: same decision as the
+    /// reference. Cells whose |det| is within rounding of the tolerance
+    /// could differ in principle; none of these is that close.
+    #[test]
+    fn squared_corner_test_decides_as_hypot_does() {
+        let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut rnd = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut seen = [0usize; 3];
+        for k in 0..200_000 {
+            let scale = [1e-200, 1e-160, 1e-75, 1e-3, 1.0, 1e6, 1e150, 1e160, 1e200][k % 9];
+            let n = if k % 2 == 0 { 4 } else { 9 };
+            let mut p: Vec<[f64; 2]> = (0..n).map(|_| [rnd(), rnd()]).collect();
+            match k % 7 {
+                // A unit square with small perturbations (valid, maybe flipped).
+                0 | 1 => {
+                    let sq = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+                    for (i, q) in p.iter_mut().enumerate().take(4) {
+                        *q = [sq[i][0] + 0.1 * rnd(), sq[i][1] + 0.1 * rnd()];
+                    }
+                    if n == 9 {
+                        for i in 0..4 {
+                            let (a, b) = (p[i], p[(i + 1) % 4]);
+                            p[4 + i] = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+                        }
+                        p[8] = [0.5, 0.5];
+                    }
+                    if k % 7 == 1 {
+                        p.swap(1, 3);
+                        if n == 9 {
+                            p.swap(4, 7);
+                            p.swap(5, 6);
+                        }
+                    }
+                }
+                // Nearly flat: corner 2 almost on the line through 1 and 3.
+                2 => {
+                    let t = 1e-9 * (rnd() - 0.5);
+                    p[2] = [0.5 * (p[1][0] + p[3][0]) + t, 0.5 * (p[1][1] + p[3][1]) - t];
+                }
+                // Two corners equal.
+                3 => p[2] = p[1],
+                _ => {}
+            }
+            for q in &mut p {
+                q[0] *= scale;
+                q[1] *= scale;
+            }
+            let mut b = Builder::new("4.1", false);
+            for (i, q) in p.iter().enumerate() {
+                b.push_node(i as u64 + 1, q[0], q[1], 0.0);
+            }
+            let cell: Vec<usize> = (0..n).collect();
+            let got = b.orientation(&cell);
+            assert_eq!(got, reference(&p), "cell {p:?}");
+            seen[match got {
+                Some(true) => 0,
+                Some(false) => 1,
+                None => 2,
+            }] += 1;
+        }
+        // All three outcomes occur, or the test checks little.
+        assert!(seen.iter().all(|&s| s > 1000), "{seen:?}");
     }
 }

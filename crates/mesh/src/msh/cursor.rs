@@ -590,9 +590,14 @@ impl<'a> Cursor<'a> {
                 return Err(self.truncated(self.pos()));
             }
         }
-        let k = usize::try_from(left)
-            .unwrap_or(usize::MAX)
-            .min((self.filled - self.i) / size);
+        let k = if left == 1 {
+            // MSH 2.2 binary: one record per header, no division.
+            1
+        } else {
+            usize::try_from(left)
+                .unwrap_or(usize::MAX)
+                .min((self.filled - self.i) / size)
+        };
         let at = self.pos();
         self.i += k * size;
         Ok((at, k))

@@ -145,7 +145,11 @@ pub(crate) fn elements(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                 let (start, k) = cur.batch(left, size)?;
                 left -= k as u64;
                 let cur = &*cur;
-                for (i, rec) in cur.records(start, size * k).chunks_exact(size).enumerate() {
+                let data = cur.records(start, size * k);
+                // Gmsh writes one header per element (k = 1): slice by
+                // offsets, not chunks_exact, which divides by `size`.
+                for i in 0..k {
+                    let rec = &data[size * i..size * (i + 1)];
                     let at = start + size * i;
                     let tag = u64::try_from(le_i32(rec)).map_err(|_| {
                         cur.error(
