@@ -17,9 +17,10 @@ usage: cargo xtask <command> [args]
 
   demo              install what is missing (HDF5), build, and run the paper's
                     slab (central difference, eps = 1e-4) into target/demo/slab.h5
-  test              install what is missing (HDF5, h5py), then run the whole
+  test              install what is missing (HDF5, Python modules), then run the whole
                     test suite (what .ci/run and CI run)
-  setup             only install what is missing: libhdf5-dev, h5py, numpy
+  setup             only install what is missing: libhdf5-dev, and h5py, numpy,
+                    gmsh, matplotlib, meshio for the tests
   meshes            regenerate cases/meshes/*.msh with Gmsh (installs gmsh from PyPI)
   bench mesh        .msh read throughput on a 1M-node mesh against gmsh.open
   bench fem         assembly and Cholesky on the Q2 slab ladder against
@@ -44,7 +45,9 @@ fn main() -> ExitCode {
         "bench" => match rest.split_first() {
             Some((what, more)) if what == "mesh" => bench_mesh::run(&root, more),
             Some((what, more)) if what == "fem" => bench_fem::run(&root, more),
-            _ => Err(format!("cargo xtask bench: say what to benchmark (mesh, fem)\n{USAGE}")),
+            _ => Err(format!(
+                "cargo xtask bench: say what to benchmark (mesh, fem)\n{USAGE}"
+            )),
         },
         "help" | "--help" | "-h" => {
             print!("{USAGE}");
@@ -63,13 +66,18 @@ fn main() -> ExitCode {
 
 /// The workspace root: xtask/ sits directly inside it.
 fn project_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask/ has a parent").to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask/ has a parent")
+        .to_path_buf()
 }
 
 /// Runs a command, echoing it, and fails with its exit status.
 pub fn run(cmd: &mut Command) -> Result<(), String> {
     eprintln!("$ {}", describe(cmd));
-    let status = cmd.status().map_err(|e| format!("cannot start {}: {e}", describe(cmd)))?;
+    let status = cmd
+        .status()
+        .map_err(|e| format!("cannot start {}: {e}", describe(cmd)))?;
     if status.success() {
         Ok(())
     } else {
@@ -107,7 +115,9 @@ fn setup(python_too: bool) -> Result<(), String> {
     if hdf5_present() {
         eprintln!("setup: HDF5 development files found");
     } else {
-        eprintln!("setup: HDF5 is missing; installing Debian's libhdf5-dev and hdf5-tools (about 20 s)");
+        eprintln!(
+            "setup: HDF5 is missing; installing Debian's libhdf5-dev and hdf5-tools (about 20 s)"
+        );
         let sudo = if is_root() { None } else { Some("sudo") };
         let apt = |args: &[&str]| {
             let mut c = match sudo {
@@ -122,13 +132,30 @@ fn setup(python_too: bool) -> Result<(), String> {
             c
         };
         run(&mut apt(&["update", "-q"]))?;
-        run(&mut apt(&["install", "-y", "-q", "libhdf5-dev", "hdf5-tools", "pkg-config"]))?;
+        run(&mut apt(&[
+            "install",
+            "-y",
+            "-q",
+            "libhdf5-dev",
+            "hdf5-tools",
+            "pkg-config",
+        ]))?;
         if !hdf5_present() {
-            return Err("libhdf5-dev was installed but HDF5 is still not found by pkg-config".into());
+            return Err(
+                "libhdf5-dev was installed but HDF5 is still not found by pkg-config".into(),
+            );
         }
     }
     if python_too {
-        python::ensure_python_modules(&[("h5py", "h5py"), ("numpy", "numpy")])?;
+        // What the end-to-end tests and examples read results and make
+        // meshes and pictures with, as users do.
+        python::ensure_python_modules(&[
+            ("h5py", "h5py"),
+            ("numpy", "numpy"),
+            ("gmsh", "gmsh"),
+            ("matplotlib", "matplotlib"),
+            ("meshio", "meshio"),
+        ])?;
     }
     Ok(())
 }
@@ -148,7 +175,8 @@ fn demo(root: &Path, rest: &[String]) -> Result<(), String> {
     let out = root.join("target/demo/slab.h5");
     std::fs::create_dir_all(out.parent().expect("has parent")).map_err(|e| e.to_string())?;
     let mut cmd = cargo();
-    cmd.current_dir(root).args(["run", "--quiet", "-p", "stickslip", "--", "run"]);
+    cmd.current_dir(root)
+        .args(["run", "--quiet", "-p", "stickslip", "--", "run"]);
     cmd.arg(&case).arg("-o").arg(&out).arg("--force").args(rest);
     run(&mut cmd)?;
     eprintln!("demo: results in {}", out.display());
@@ -156,10 +184,71 @@ fn demo(root: &Path, rest: &[String]) -> Result<(), String> {
 }
 
 /// The whole test suite: every crate's tests in the (optimized) dev
-/// profile, built once.
+/// profile, built once. Ends with one plain line `tests: N passed, M failed,
+/// K skipped` summed over every test binary, so the total is not lost among
+/// the per-binary lines (the last of which is often an empty doc-test run).
 fn test(root: &Path, rest: &[String]) -> Result<(), String> {
     setup(true)?;
     let mut cmd = cargo();
-    cmd.current_dir(root).args(["test", "--workspace"]).args(rest);
-    run(&mut cmd)
+    cmd.current_dir(root)
+        .args(["test", "--workspace"])
+        .args(rest);
+    let totals = run_counting(&mut cmd)?;
+    println!(
+        "tests: {} passed, {} failed, {} skipped",
+        totals.passed, totals.failed, totals.ignored
+    );
+    if totals.failed > 0 {
+        return Err(format!("{} test(s) failed", totals.failed));
+    }
+    if !totals.ok {
+        return Err("cargo test failed (see its messages above)".into());
+    }
+    if totals.passed == 0 {
+        return Err("no test ran".into());
+    }
+    Ok(())
+}
+
+#[derive(Default)]
+struct Totals {
+    passed: u64,
+    failed: u64,
+    ignored: u64,
+    ok: bool,
+}
+
+/// Runs a test command, echoing its output, and sums its `test result:` lines.
+fn run_counting(cmd: &mut Command) -> Result<Totals, String> {
+    use std::io::{BufRead, BufReader};
+    eprintln!("$ {}", describe(cmd));
+    let mut child = cmd
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cannot start {}: {e}", describe(cmd)))?;
+    let mut totals = Totals::default();
+    let stdout = child.stdout.take().expect("piped stdout");
+    for line in BufReader::new(stdout).lines() {
+        let line = line.map_err(|e| e.to_string())?;
+        println!("{line}");
+        if let Some(rest) = line.strip_prefix("test result: ") {
+            // "ok. 3 passed; 0 failed; 1 ignored; 0 measured; ..."
+            for part in rest.split(['.', ';']) {
+                let mut words = part.split_whitespace();
+                if let (Some(n), Some(what)) = (words.next(), words.next()) {
+                    if let Ok(n) = n.parse::<u64>() {
+                        match what {
+                            "passed" => totals.passed += n,
+                            "failed" => totals.failed += n,
+                            "ignored" => totals.ignored += n,
+                            _ => {}
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let status = child.wait().map_err(|e| e.to_string())?;
+    totals.ok = status.success();
+    Ok(totals)
 }
