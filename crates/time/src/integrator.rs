@@ -6,6 +6,7 @@ use stickslip_fem::{Model, SolverError, SparseCholesky};
 
 use crate::history::History;
 use crate::implicit::{DiagonalStep, ImplicitOperator, ImplicitStep};
+use crate::kernels;
 use crate::linalg::{dot, quadratic_form, spmv};
 use crate::schur::{ImplicitSolver, SchurOperator};
 use crate::stability::critical_step;
@@ -313,6 +314,10 @@ pub struct Integrator {
     /// The iteration's own scratch classes.
     iter_scratch: Vec<SlipState>,
     forces_new: Vec<f64>,
+    /// θ_l(t) of each load for the step being taken.
+    thetas: Vec<f64>,
+    /// Per-chunk partial sums of the explicit passes.
+    partials: kernels::Partials,
 }
 
 impl std::fmt::Debug for Integrator {
@@ -493,6 +498,8 @@ impl Integrator {
             scratch_classes: vec![SlipState::Stuck; n_c],
             iter_scratch: vec![SlipState::Stuck; n_c],
             forces_new: vec![0.0; n_c],
+            thetas: vec![0.0; loads.len()],
+            partials: vec![[0.0; 4]; kernels::chunks(n)],
             r,
             v,
             dynamics,
@@ -595,6 +602,9 @@ impl Integrator {
     /// A failed linear solve, a stick/slip iteration that hits its cap, or a
     /// non-finite state. The state is left at the last completed step.
     pub fn step(&mut self) -> Result<StepInfo, TimeError> {
+        if self.explicit {
+            return self.explicit_step();
+        }
         let n = self.dynamics.n();
         let dt = self.next_dt();
         let t_new = self.t + dt;
@@ -715,7 +725,16 @@ impl Integrator {
         e.total = kinetic + strain - dot(&self.r, &self.load);
         e.balance = kinetic + strain - self.initial_mechanical - e.external_work + e.dissipated;
 
-        // Remark 4.3: a sticking restarts the reduced-step count.
+        self.count_reduced_steps(dt, stick_events);
+        Ok(StepInfo {
+            dt,
+            iterations,
+            stick_events,
+        })
+    }
+
+    /// Remark 4.3: a sticking restarts the reduced-step count.
+    fn count_reduced_steps(&mut self, dt: f64, stick_events: usize) {
         if let Some(r) = self.settings.stick_reduction {
             if stick_events > 0 {
                 self.reduced_remaining = r.steps;
@@ -723,6 +742,151 @@ impl Integrator {
                 self.reduced_remaining -= 1;
             }
         }
+    }
+
+    /// The explicit step (β = 0, lumped mass) in three fused, threaded
+    /// passes (`kernels.rs`); the same arithmetic per entry as the general
+    /// step, with one SpMV (K r_K serves R̂_K and the strain energy, since
+    /// β = 0 leaves no corrector).
+    fn explicit_step(&mut self) -> Result<StepInfo, TimeError> {
+        let dt = self.next_dt();
+        let t_new = self.t + dt;
+        let gamma = self.gamma;
+        let step_number = self.steps + 1;
+        for (theta, l) in self.thetas.iter_mut().zip(&self.loads) {
+            *theta = l.history.value(t_new);
+        }
+        // β = 0: r_K = r + Δt ṙ + ½Δt² r̈ is final (no corrector).
+        let c1 = dt;
+        let c2 = 0.5 * dt * dt;
+        kernels::load_and_predict(
+            &self.dynamics.constant_load,
+            &self.loads,
+            &self.thetas,
+            &self.r,
+            &self.v,
+            &self.a,
+            c1,
+            c2,
+            &mut self.load_new,
+            &mut self.r_new,
+        );
+        kernels::spmv(&self.dynamics.stiffness, &self.r_new, &mut self.b);
+        let scale = 1.0 / (gamma * dt);
+        let strain = kernels::rhs_and_velocity(
+            &self.load_new,
+            &self.dynamics.lumped_mass,
+            &self.r_new,
+            &self.v,
+            &self.a,
+            1.0 / (gamma * dt),
+            1.0 / gamma - 1.0,
+            scale,
+            &mut self.b,
+            &mut self.v_new,
+            &mut self.partials,
+        );
+        self.scratch_classes.copy_from_slice(&self.classes);
+        let iterations = match &self.contact {
+            None => 1,
+            Some(contact) => match self.settings.explicit_friction {
+                ExplicitFriction::ClosedForm => {
+                    let mass = &self.dynamics.lumped_mass;
+                    for node in &contact.nodes {
+                        // As in explicit_velocity, d = m·scale inline.
+                        let (mut p, mut q) = (0.0, 0.0);
+                        for c in 0..2 {
+                            if let Some(i) = node.dofs[c] {
+                                let d = mass[i] * scale;
+                                p += node.tangent[c] * self.b[i] / d;
+                                q += node.tangent[c] * node.tangent[c] / d;
+                            }
+                        }
+                        let wg = node.force_scale();
+                        let vt = contact.law.solve_nodal(p, wg * q);
+                        let phi = contact.law.phi(vt);
+                        for c in 0..2 {
+                            if let Some(i) = node.dofs[c] {
+                                self.v_new[i] =
+                                    (self.b[i] - wg * phi * node.tangent[c]) / (mass[i] * scale);
+                            }
+                        }
+                    }
+                    contact.classify(&self.v_new, &mut self.scratch_classes);
+                    1
+                }
+                ExplicitFriction::Iterate => self.explicit_velocity(dt, step_number, t_new)?,
+            },
+        };
+        let ratio = (1.0 - gamma) / gamma;
+        let sums = kernels::accelerate_and_sum(
+            &self.dynamics.lumped_mass,
+            &self.load,
+            &self.load_new,
+            &self.r,
+            &self.r_new,
+            &self.v,
+            &self.v_new,
+            &self.a,
+            gamma * dt,
+            ratio,
+            &mut self.tmp,
+            &mut self.partials,
+        );
+        if !sums.finite {
+            let hint = match self.dt_crit {
+                Some(c) => format!(" below the critical step Δt_crit = {c:.4e}"),
+                None => String::new(),
+            };
+            return Err(TimeError::NonFinite {
+                step: step_number,
+                t: t_new,
+                hint,
+            });
+        }
+        let mut stick_events = 0;
+        let mut dissipated = 0.0;
+        if let Some(c) = &self.contact {
+            c.nodal_forces(&self.v_new, &mut self.forces_new);
+            for ((node, f_new), f_old) in c.nodes.iter().zip(&self.forces_new).zip(&self.forces) {
+                // ½Δt(ṙ_K + ṙ_{K−1}) at the node, as in the general step.
+                let mut increment = 0.0;
+                for k in 0..2 {
+                    if let Some(i) = node.dofs[k] {
+                        increment += node.tangent[k] * (0.5 * dt * (self.v_new[i] + self.v[i]));
+                    }
+                }
+                dissipated += 0.5 * (f_new + f_old) * increment;
+            }
+            stick_events = self
+                .scratch_classes
+                .iter()
+                .zip(&self.classes)
+                .filter(|(new, old)| new.is_stuck() && !old.is_stuck())
+                .count();
+        }
+        std::mem::swap(&mut self.a, &mut self.tmp);
+        std::mem::swap(&mut self.r, &mut self.r_new);
+        std::mem::swap(&mut self.v, &mut self.v_new);
+        std::mem::swap(&mut self.load, &mut self.load_new);
+        std::mem::swap(&mut self.forces, &mut self.forces_new);
+        self.classes.copy_from_slice(&self.scratch_classes);
+        self.t = if t_new >= self.settings.t_end * (1.0 - 1e-14) {
+            self.settings.t_end
+        } else {
+            t_new
+        };
+        self.steps = step_number;
+        self.total_iterations += iterations as u64;
+        let e = &mut self.energy;
+        e.kinetic = sums.kinetic;
+        e.strain = strain;
+        e.external_work += sums.work;
+        e.dissipated += dissipated;
+        e.total = sums.kinetic + strain - sums.load_dot;
+        e.balance =
+            sums.kinetic + strain - self.initial_mechanical - e.external_work + e.dissipated;
+        self.count_reduced_steps(dt, stick_events);
         Ok(StepInfo {
             dt,
             iterations,

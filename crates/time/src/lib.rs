@@ -20,6 +20,7 @@
 mod history;
 mod implicit;
 mod integrator;
+mod kernels;
 pub mod linalg;
 mod schur;
 pub mod stability;
