@@ -267,7 +267,8 @@ fn dt_rates(root: &Path, opts: &Options, r: &mut Report) {
         ),
     ];
     for (name, scheme, order, dts, dt_ref) in runs {
-        let dts = if opts.quick { &dts[..3] } else { dts };
+        // Quick: the three finest steps (the coarsest is not yet asymptotic).
+        let dts = if opts.quick { &dts[1..] } else { dts };
         let case = format!("frictionless slab sin {name}");
         let result = (|| -> Result<Vec<f64>, String> {
             let reference = final_state(&scene, scheme, dt_ref, t_end)?;
