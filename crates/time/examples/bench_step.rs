@@ -1,0 +1,430 @@
+//! Time per step of both schemes on the slab ladder (issue 7, deliverable 3)
+//! with the hardware figures measured in the same run: STREAM triad
+//! bandwidth against the bytes one explicit step moves, and for Newmark the
+//! time of one forward+back solve with the factor of A₀.
+//!
+//!     cargo run -p stickslip-time --example bench_step [-- --quick] [-- --max-dofs N]
+//!
+//! Every rung runs in its own process (`--case NAME`) so that its peak RSS
+//! (VmHWM) is the rung's; the parent prints a table and writes
+//! target/bench/step.csv. Meshes: the committed slab ladder
+//! (cases/meshes) and larger structured slabs built here in code.
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::Instant;
+
+use stickslip_contact::ContactSurface;
+use stickslip_fem::{
+    traction_load, Dirichlet, Hypothesis, Material, Model, SparseCholesky, Traction,
+};
+use stickslip_mesh::{CellKind, Edge, Group, Mesh, SourceInfo};
+use stickslip_time::{Dynamics, History, Integrator, Load, Scheme, Settings};
+
+/// The structured slab [0, 8] × [0, 1] with nx × ny Q1 or Q2 cells and the
+/// groups of cases/meshes/README.md (edges oriented with the cell on the
+/// left, counter-clockwise cells).
+fn structured_slab(nx: usize, ny: usize, q2: bool) -> Mesh {
+    let q = if q2 { 2 } else { 1 };
+    let (gx, gy) = (q * nx + 1, q * ny + 1);
+    let id = |i: usize, j: usize| j * gx + i;
+    let mut nodes = Vec::with_capacity(gx * gy);
+    for j in 0..gy {
+        for i in 0..gx {
+            nodes.push([8.0 * i as f64 / (gx - 1) as f64, j as f64 / (gy - 1) as f64]);
+        }
+    }
+    let per = if q2 { 9 } else { 4 };
+    let mut cells = Vec::with_capacity(nx * ny * per);
+    for cy in 0..ny {
+        for cx in 0..nx {
+            let (i, j) = (q * cx, q * cy);
+            cells.extend([id(i, j), id(i + q, j), id(i + q, j + q), id(i, j + q)]);
+            if q2 {
+                cells.extend([
+                    id(i + 1, j),
+                    id(i + 2, j + 1),
+                    id(i + 1, j + 2),
+                    id(i, j + 1),
+                    id(i + 1, j + 1),
+                ]);
+            }
+        }
+    }
+    let cell = |cx: usize, cy: usize| cy * nx + cx;
+    let mid = |i: usize, j: usize| if q2 { Some(id(i, j)) } else { None };
+    let line = |name: &str, tag: i32, edges: Vec<Edge>| {
+        let mut ns: Vec<usize> = edges
+            .iter()
+            .flat_map(|e| e.nodes.into_iter().chain(e.mid))
+            .collect();
+        ns.sort_unstable();
+        ns.dedup();
+        Group {
+            name: name.into(),
+            tag,
+            dim: 1,
+            elements: edges.len(),
+            edges,
+            cells: vec![],
+            points: vec![],
+            nodes: ns,
+        }
+    };
+    let top = gy - 1;
+    let right = gx - 1;
+    let contact = (0..nx)
+        .map(|cx| Edge {
+            nodes: [id(q * cx, 0), id(q * cx + q, 0)],
+            mid: mid(q * cx + 1, 0),
+            cell: cell(cx, 0),
+        })
+        .collect();
+    let load = (0..ny)
+        .map(|cy| Edge {
+            nodes: [id(right, q * cy), id(right, q * cy + q)],
+            mid: mid(right, q * cy + 1),
+            cell: cell(nx - 1, cy),
+        })
+        .collect();
+    let support = (0..nx)
+        .map(|cx| Edge {
+            nodes: [id(q * cx + q, top), id(q * cx, top)],
+            mid: mid(q * cx + 1, top),
+            cell: cell(cx, ny - 1),
+        })
+        .collect();
+    let left = (0..ny)
+        .map(|cy| Edge {
+            nodes: [id(0, q * cy + q), id(0, q * cy)],
+            mid: mid(0, q * cy + 1),
+            cell: cell(0, cy),
+        })
+        .collect();
+    let n_cells = nx * ny;
+    let groups = vec![
+        line("contact", 1, contact),
+        line("load", 2, load),
+        line("support", 3, support),
+        line("left", 4, left),
+        Group {
+            name: "body".into(),
+            tag: 10,
+            dim: 2,
+            edges: vec![],
+            cells: (0..n_cells).collect(),
+            points: vec![],
+            nodes: (0..nodes.len()).collect(),
+            elements: n_cells,
+        },
+    ];
+    Mesh {
+        node_tags: (1..=nodes.len() as u64).collect(),
+        nodes,
+        kind: if q2 { CellKind::Quad9 } else { CellKind::Quad4 },
+        cells,
+        cell_tags: (1..=n_cells as u64).collect(),
+        groups,
+        source: SourceInfo::default(),
+    }
+}
+
+/// The paper's slab problem (BENCHMARK.md) on `mesh`.
+fn problem(mesh: &Mesh) -> (Model, ContactSurface, Vec<Load>) {
+    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let conditions = vec![
+        Dirichlet::new("support", 1, 0.0),
+        Dirichlet::new("left", 0, 0.0),
+    ];
+    let model = Model::new(mesh, &material, &conditions).unwrap();
+    let n_full = 2 * mesh.nodes.len();
+    let restrict = |full: &[f64]| {
+        let mut free = vec![0.0; model.dofs.n_free()];
+        model.dofs.restrict(full, &mut free);
+        free
+    };
+    let mut p = vec![0.0; n_full];
+    traction_load(mesh, "contact", Traction::Pressure(300.0), &mut p).unwrap();
+    let mut e = vec![0.0; n_full];
+    traction_load(mesh, "load", Traction::Vector([-150.0, 0.0]), &mut e).unwrap();
+    let loads = vec![
+        Load {
+            vector: restrict(&p),
+            history: History::Constant,
+        },
+        Load {
+            vector: restrict(&e),
+            history: History::Step,
+        },
+    ];
+    let contact =
+        ContactSurface::from_group(mesh, &model.dofs, "contact", 300.0, 0.3, 1e-4).unwrap();
+    (model, contact, loads)
+}
+
+fn mesh_named(name: &str) -> Mesh {
+    // "gen-q1-NXxNY" / "gen-q2-NXxNY" are built here; others are files.
+    if let Some(rest) = name.strip_prefix("gen-") {
+        let (order, size) = rest.split_once('-').expect("gen-qK-NXxNY");
+        let (nx, ny) = size.split_once('x').expect("NXxNY");
+        return structured_slab(nx.parse().unwrap(), ny.parse().unwrap(), order == "q2");
+    }
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../cases/meshes")
+        .join(format!("{name}.msh"));
+    Mesh::from_file(path).expect("committed mesh reads")
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Peak resident memory of this process (VmHWM), bytes.
+fn peak_rss() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kb| kb * 1024.0)
+}
+
+/// STREAM triad a = b + s c, bytes per second (3 × 8 bytes per entry, the
+/// STREAM convention), best of 10, on the rayon pool.
+fn stream_triad() -> f64 {
+    use rayon::prelude::*;
+    let n = 20_000_000;
+    let b = vec![1.0_f64; n];
+    let c = vec![2.0_f64; n];
+    let mut a = vec![0.0_f64; n];
+    let mut best = f64::INFINITY;
+    for _ in 0..10 {
+        let t = Instant::now();
+        a.par_chunks_mut(65536)
+            .zip(b.par_chunks(65536))
+            .zip(c.par_chunks(65536))
+            .for_each(|((a, b), c)| {
+                for i in 0..a.len() {
+                    a[i] = b[i] + 3.0 * c[i];
+                }
+            });
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    std::hint::black_box(&a);
+    24.0 * n as f64 / best
+}
+
+/// One rung: prints a RESULT line.
+fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize) {
+    let mesh = mesh_named(name);
+    let (model, contact, loads) = problem(&mesh);
+    let n = model.dofs.n_free();
+    let nnz = model.stiffness.nnz();
+    let n_c = contact.len();
+    let explicit = scheme == "cd";
+    let make = |dt: f64, t_end: f64| {
+        let s = if explicit {
+            Settings::new(Scheme::CentralDifference, dt, t_end)
+        } else {
+            Settings::new(
+                Scheme::Newmark {
+                    beta: 0.25,
+                    gamma: 0.5,
+                },
+                dt,
+                t_end,
+            )
+        };
+        Integrator::new(
+            Dynamics::from_model(&model),
+            Some(contact.clone()),
+            loads.clone(),
+            s,
+        )
+        .unwrap()
+    };
+    let t_setup = Instant::now();
+    let mut i = if explicit {
+        let probe = make(1e-12, 1.0);
+        let dt = 0.9 * probe.dt_crit().unwrap();
+        drop(probe);
+        make(dt, 1e9)
+    } else {
+        make(5e-3, 1e9)
+    };
+    let setup = t_setup.elapsed().as_secs_f64();
+    // Warm-up: the thread pool and the factor of the normal Δt.
+    let run = |i: &mut Integrator, k: usize| {
+        for _ in 0..k {
+            i.step().unwrap();
+        }
+    };
+    let pool = rayon::ThreadPoolBuilder::new().build().unwrap();
+    let per_step = pool.install(|| {
+        let t = Instant::now();
+        run(&mut i, 2);
+        let first = t.elapsed().as_secs_f64();
+        let mut times = Vec::new();
+        for _ in 0..repeats {
+            let t = Instant::now();
+            run(&mut i, steps);
+            times.push(t.elapsed().as_secs_f64() / steps as f64);
+        }
+        (median(times), first)
+    });
+    let slipping = i.classes().iter().filter(|c| !c.is_stuck()).count();
+    // Before the STREAM arrays and the solve's own factor exist.
+    let peak = peak_rss();
+    let extra = if explicit {
+        // Bytes the three passes and the SpMV must move (kernels.rs):
+        // K values and column indices, row offsets; vectors: pass A reads
+        // constant, 2 loads, r, ṙ, r̈ and writes R_K, r_K (7 + 2); the SpMV
+        // reads r_K and writes K r_K (2); pass B reads R_K, m, r_K, ṙ, r̈,
+        // K r_K and writes b, ṙ_K (8); pass C reads m, R, R_K, r, r_K, ṙ,
+        // ṙ_K, r̈ and writes r̈_K (9). 27 vectors of n f64.
+        let bytes = 16.0 * nnz as f64 + 8.0 * (n + 1) as f64 + 27.0 * 8.0 * n as f64;
+        let bw = pool.install(stream_triad);
+        format!(
+            "bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
+            bytes / per_step.0,
+            100.0 * bytes / per_step.0 / bw
+        )
+    } else {
+        // One forward+back solve with a factor of A₀ (fem's wrapper: the
+        // same AMD ordering and faer supernodal Cholesky as the step's).
+        let dt = 5e-3;
+        let a0 = model.combined(0.5 * dt, 1.0 / (0.5 * dt));
+        let mut chol = SparseCholesky::analyze(&a0).unwrap();
+        chol.factorize(&a0).unwrap();
+        let mut x = vec![1.0; n];
+        let mut times = Vec::new();
+        for _ in 0..repeats.max(5) {
+            x.fill(1.0);
+            let t = Instant::now();
+            chol.solve_in_place(&mut x);
+            times.push(t.elapsed().as_secs_f64());
+        }
+        let solve = median(times);
+        format!(
+            "solve={solve:.4e} step_over_solve={:.2} factor_len={} factorizations={}",
+            per_step.0 / solve,
+            i.factor_len(),
+            i.factorizations()
+        )
+    };
+    println!(
+        "RESULT scheme={scheme} mesh={name} dofs={n} nnz={nnz} contact_nodes={n_c} steps={steps} repeats={repeats} \
+         step={:.4e} first2={:.4e} setup={setup:.3e} slipping={slipping} peak_rss={:.0} {extra}",
+        per_step.0,
+        per_step.1,
+        peak
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if let Some(k) = args.iter().position(|a| a == "--case") {
+        let scheme = &args[k + 1];
+        let name = &args[k + 2];
+        let steps: usize = args[k + 3].parse().unwrap();
+        let repeats: usize = args[k + 4].parse().unwrap();
+        run_case(scheme, name, steps, repeats);
+        return;
+    }
+    let quick = args.iter().any(|a| a == "--quick");
+    let max_dofs: f64 = args
+        .iter()
+        .position(|a| a == "--max-dofs")
+        .and_then(|k| args.get(k + 1)?.parse().ok())
+        .unwrap_or(f64::INFINITY);
+    // (scheme, mesh, approximate DOFs, steps per repeat, repeats)
+    let mut ladder: Vec<(&str, String, f64, usize, usize)> = Vec::new();
+    for m in [
+        "slab-q2-8x2",
+        "slab-q1-32x8",
+        "slab-q1-128x32",
+        "slab-q2-64x16",
+    ] {
+        ladder.push(("cd", m.into(), 0.0, 2000, 5));
+        ladder.push(("newmark", m.into(), 0.0, 200, 5));
+    }
+    // Generated: Q1 nx = 4 ny; DOFs ≈ 2(nx+1)(ny+1).
+    for (ny, q2) in [
+        (88, false),
+        (177, false),
+        (354, false),
+        (44, true),
+        (88, true),
+        (125, true),
+    ] {
+        let nx = 4 * ny;
+        let q = if q2 { 2 } else { 1 };
+        let dofs = 2.0 * ((q * nx + 1) * (q * ny + 1)) as f64;
+        let name = format!("gen-q{}-{nx}x{ny}", q);
+        ladder.push(("cd", name.clone(), dofs, if quick { 20 } else { 100 }, 5));
+        if dofs <= 300_000.0 {
+            ladder.push(("newmark", name, dofs, if quick { 3 } else { 10 }, 5));
+        }
+    }
+    let exe = std::env::current_exe().unwrap();
+    let mut rows = Vec::new();
+    for (scheme, name, dofs, steps, repeats) in ladder {
+        if dofs > max_dofs {
+            continue;
+        }
+        let steps = if quick { steps.min(200) } else { steps };
+        let out = Command::new(&exe)
+            .args([
+                "--case",
+                scheme,
+                &name,
+                &steps.to_string(),
+                &repeats.to_string(),
+            ])
+            .output()
+            .expect("runs itself");
+        let text = String::from_utf8_lossy(&out.stdout);
+        match text.lines().find(|l| l.starts_with("RESULT ")) {
+            Some(l) => {
+                println!("{l}");
+                rows.push(l.trim_start_matches("RESULT ").to_string());
+            }
+            None => eprintln!(
+                "{scheme} {name}: failed: {}",
+                String::from_utf8_lossy(&out.stderr)
+            ),
+        }
+    }
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/bench");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut csv = String::new();
+    let mut header: Vec<String> = Vec::new();
+    for row in &rows {
+        for kv in row.split_whitespace() {
+            let k = kv.split('=').next().unwrap().to_string();
+            if !header.contains(&k) {
+                header.push(k);
+            }
+        }
+    }
+    csv.push_str(&header.join(","));
+    csv.push('\n');
+    for row in &rows {
+        let line: Vec<&str> = header
+            .iter()
+            .map(|h| {
+                row.split_whitespace()
+                    .find_map(|kv| kv.strip_prefix(&format!("{h}=")))
+                    .unwrap_or("")
+            })
+            .collect();
+        csv.push_str(&line.join(","));
+        csv.push('\n');
+    }
+    let path = dir.join("step.csv");
+    std::fs::write(&path, csv).unwrap();
+    println!("wrote {}", path.display());
+}
