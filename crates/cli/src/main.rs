@@ -1,28 +1,21 @@
 //! The `stickslip` command: 2-D linear elastodynamics with regularized
 //! Coulomb friction (Martins & Oden 1983).
 //!
-//! This crate owns everything that touches files other than meshes and the
-//! terminal: the command line (this file), case files ([`case`]), the HDF5
-//! results ([`output`]), the `mesh` report ([`mesh_cmd`]) and the `probe`
-//! reader ([`probe`]). The numerics live in the library crates; `run.rs`
-//! wires them together.
+//! This file is the command line only; the work is in the `stickslip`
+//! library (case files, HDF5 results, runs; see `lib.rs`).
 //!
 //! Exit codes: 0 success; 2 bad input (case, mesh, arguments — clap's usage
-//! errors exit 2 too); 1 a run that failed after it started.
+//! errors exit 2 too); 1 a run that failed after it started (the file keeps
+//! every step written); 130 interrupted by SIGINT or SIGTERM (the file is
+//! valid and holds a checkpoint to `--restart` from).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-mod case;
-mod error;
-mod mesh_cmd;
-mod output;
-mod probe;
-mod run;
-
-use error::InputError;
+use stickslip::error::InputError;
+use stickslip::{case, mesh_cmd, probe, run};
 
 #[derive(Debug, Parser)]
 #[command(
@@ -41,7 +34,9 @@ enum Command {
     /// Run a case and write the results to HDF5.
     #[command(
         after_help = "Example:\n  stickslip run case.toml -o out.h5 --set time.dt=5e-4 --set contact.eps=1e-2\n\n\
-Exit codes: 0 complete, 1 the run failed midway (the file keeps every step written, complete = false), 2 bad input."
+Exit codes: 0 complete, 1 the run failed midway (the file keeps every step written, complete = false), \
+2 bad input, 130 interrupted by SIGINT/SIGTERM (the file is valid, complete = false; continue it with --restart OUT.h5).\n\n\
+A second Ctrl-C while the first is being handled exits at once (the file keeps every step up to its last flush)."
     )]
     Run {
         /// The case file (TOML).
@@ -58,6 +53,14 @@ Exit codes: 0 complete, 1 the run failed midway (the file keeps every step writt
         /// No progress bar or summary.
         #[arg(short, long)]
         quiet: bool,
+        /// Print the closing summary as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+        /// Continue the run saved in this results file from its last
+        /// checkpoint, appending to it (t_end may grow, output settings may
+        /// change; physics and discretization must be as stored in the file).
+        #[arg(long, value_name = "OUT.h5", conflicts_with_all = ["output", "force"])]
+        restart: Option<PathBuf>,
     },
     /// Validate a case and print the model size, the critical time step and the solver; no run.
     #[command(after_help = "Example:\n  stickslip check case.toml --set time.scheme=newmark")]
@@ -85,14 +88,21 @@ Exit codes: 0 complete, 1 the run failed midway (the file keeps every step writt
         /// A results file written by `stickslip run`.
         file: PathBuf,
         /// The point X,Y; the nearest node is used.
-        #[arg(long, value_name = "X,Y", allow_hyphen_values = true)]
-        at: String,
+        #[arg(
+            long,
+            value_name = "X,Y",
+            allow_hyphen_values = true,
+            required_unless_present = "along"
+        )]
+        at: Option<String>,
         /// The field to print.
         #[arg(long, value_enum, default_value_t = probe::Field::Ux)]
         field: probe::Field,
         /// Comma-separated values with a header line instead of a table.
         #[arg(long)]
         csv: bool,
+        #[command(flatten)]
+        along: probe::AlongArgs,
     },
 }
 
@@ -123,6 +133,8 @@ fn main() -> ExitCode {
             sets,
             force,
             quiet,
+            json,
+            restart,
         } => {
             let case = match case::load(&case, &sets) {
                 Ok(c) => c,
@@ -131,28 +143,49 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            let out = output.unwrap_or_else(|| case.output.file.clone());
-            if out.exists() && !force {
-                report(&format!(
-                    "{} already exists; use --force to overwrite it, or -o to write elsewhere",
-                    out.display()
-                ));
-                return ExitCode::from(2);
+            let out = match &restart {
+                Some(r) => r.clone(),
+                None => output.unwrap_or_else(|| case.output.file.clone()),
+            };
+            if restart.is_none() {
+                if out.exists() && !force {
+                    report(&format!(
+                        "{} already exists; use --force to overwrite it, -o to write elsewhere, \
+                         or --restart {} to continue it",
+                        out.display(),
+                        out.display()
+                    ));
+                    return ExitCode::from(2);
+                }
+                if let Some(dir) = out
+                    .parent()
+                    .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
+                {
+                    report(&format!(
+                        "{}: the directory {} does not exist; create it, or choose another file with -o",
+                        out.display(),
+                        dir.display()
+                    ));
+                    return ExitCode::from(2);
+                }
             }
-            if let Some(dir) = out
-                .parent()
-                .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
-            {
-                report(&format!(
-                    "{}: the directory {} does not exist; create it, or choose another file with -o",
-                    out.display(),
-                    dir.display()
-                ));
-                return ExitCode::from(2);
-            }
-            match run::execute(&case, &out, quiet) {
+            let stop = match run::StopFlags::install() {
+                Ok(s) => s,
+                Err(e) => {
+                    report(&format!("cannot install the SIGINT/SIGTERM handlers: {e}"));
+                    return ExitCode::from(1);
+                }
+            };
+            let options = run::RunOptions {
+                quiet,
+                json,
+                restart: restart.is_some(),
+                stop,
+            };
+            match run::execute(&case, &out, &options) {
                 Ok(run::Outcome::Complete) => ExitCode::SUCCESS,
                 Ok(run::Outcome::Failed) => ExitCode::from(1),
+                Ok(run::Outcome::Interrupted) => ExitCode::from(130),
                 Err(e) => fail(&e),
             }
         }
@@ -187,20 +220,30 @@ fn main() -> ExitCode {
             at,
             field,
             csv,
-        } => match probe::probe(&file, &at, field, csv) {
-            Ok(p) => {
-                if csv {
-                    eprint!("{}", p.info);
-                } else {
-                    print!("{}", p.info);
+            along,
+        } => match at {
+            None => match probe::along_command(&file, &along, field) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    report(&e.0);
+                    ExitCode::from(2)
                 }
-                print!("{}", p.table);
-                ExitCode::SUCCESS
-            }
-            Err(e) => {
-                report(&e.0);
-                ExitCode::from(2)
-            }
+            },
+            Some(at) => match probe::probe(&file, &at, field, csv) {
+                Ok(p) => {
+                    if csv {
+                        eprint!("{}", p.info);
+                    } else {
+                        print!("{}", p.info);
+                    }
+                    print!("{}", p.table);
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    report(&e.0);
+                    ExitCode::from(2)
+                }
+            },
         },
     }
 }

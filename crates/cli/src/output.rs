@@ -2,19 +2,27 @@
 //!
 //! The file is created with the mesh and the contact surface, then grows by
 //! one row per output step in every time-dependent dataset (unlimited first
-//! dimension, chunked along time, shuffle + deflate). It is flushed every
-//! [`ResultsWriter::flush_every_steps`] appends or
-//! [`ResultsWriter::flush_every_secs`] seconds, so a run that stops early
-//! leaves a readable file with `complete = false`; [`ResultsWriter::finish`]
-//! writes the solver summary and sets `complete`.
+//! dimension, chunked along time, shuffle + deflate unless `compression` is
+//! 0). It is flushed every [`ResultsWriter::flush_every_steps`] appends or
+//! [`ResultsWriter::flush_every_secs`] seconds (or when the run says so,
+//! with a checkpoint), so a run that stops early leaves a readable file with
+//! `complete = false`; [`ResultsWriter::finish`] writes the solver summary
+//! and sets `complete`.
+//!
+//! `/checkpoint` holds the integrator's full state at the last flush
+//! ([`ResultsWriter::write_checkpoint`]: the `stickslip_time::Checkpoint`
+//! fields and the number of output rows at that moment), rewritten in place
+//! at every flush; [`read_checkpoint`] and [`ResultsWriter::open_append`]
+//! continue a file from it (`stickslip run --restart`).
 
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{ensure, Context, Result};
+use anyhow::{bail, ensure, Context, Result};
 use hdf5::types::VarLenUnicode;
 use hdf5::{Dataset, File, Group, H5Type};
 use ndarray::{s, Array1, Array2, ArrayView1, ArrayView2};
+use stickslip_time::{Checkpoint, Energy};
 
 /// What the file holds before the first step.
 #[derive(Clone, Copy, Debug)]
@@ -114,6 +122,37 @@ pub struct ResultsWriter {
     pub flush_every_steps: usize,
     /// Flush after this many seconds since the last flush (default 5).
     pub flush_every_secs: f64,
+    /// Flush inside [`ResultsWriter::append`] (default true). A run that
+    /// checkpoints turns it off and calls [`ResultsWriter::write_checkpoint`]
+    /// when [`ResultsWriter::flush_due`] says so.
+    pub auto_flush: bool,
+}
+
+/// What a run keeps in `/checkpoint` besides the integrator's state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CheckpointExtra {
+    /// Output rows in the file that belong to the checkpointed state (rows
+    /// written later are dropped on restart).
+    pub rows: usize,
+    /// Wall time spent so far (summed over restarts).
+    pub wall_time_s: f64,
+    /// Largest |energy balance| so far.
+    pub max_balance: f64,
+}
+
+/// A results file's `/checkpoint` and what a restart needs besides.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stored {
+    /// The integrator's state.
+    pub checkpoint: Checkpoint,
+    /// Rows, wall time, largest balance.
+    pub extra: CheckpointExtra,
+    /// The case TOML as run (root attribute `case`).
+    pub case_source: String,
+    /// Root attribute `complete`.
+    pub complete: bool,
+    /// `/time`, the first `extra.rows` entries.
+    pub times: Vec<f64>,
 }
 
 /// Node order written in `/mesh/cells` attribute `node_order`.
@@ -150,6 +189,16 @@ fn scalar_attr<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<
 /// compression 1.4 ms per record.
 const DEFLATE_LEVEL: u8 = 4;
 
+/// Names of the `/energy` series, in [`Record`] order.
+const ENERGY_NAMES: [&str; 6] = [
+    "kinetic",
+    "strain",
+    "external_work",
+    "dissipated",
+    "total",
+    "balance",
+];
+
 /// Rows per chunk along time so that a chunk stays within HDF5's default
 /// 1 MiB chunk cache (a partly written chunk then stays in memory instead of
 /// being re-read and re-compressed on every append).
@@ -157,33 +206,165 @@ fn chunk_rows(row_bytes: usize) -> usize {
     (1 << 20) / row_bytes.max(1)
 }
 
-fn series_1d<T: H5Type>(g: &Group, name: &str) -> Result<Dataset> {
-    Ok(g.new_dataset::<T>()
+/// Shuffle + deflate at `level`, or no filter at level 0.
+fn filtered(b: hdf5::DatasetBuilderEmpty, level: u8) -> hdf5::DatasetBuilderEmpty {
+    if level == 0 {
+        b
+    } else {
+        b.shuffle().deflate(level.min(9))
+    }
+}
+
+fn series_1d<T: H5Type>(g: &Group, name: &str, level: u8) -> Result<Dataset> {
+    Ok(filtered(g.new_dataset::<T>(), level)
         .chunk(1024)
         .shape(0..)
-        .shuffle()
-        .deflate(DEFLATE_LEVEL)
         .create(name)?)
 }
 
-fn series_2d<T: H5Type>(g: &Group, name: &str, n: usize) -> Result<Dataset> {
+fn series_2d<T: H5Type>(g: &Group, name: &str, n: usize, level: u8) -> Result<Dataset> {
     let rows = chunk_rows(n * std::mem::size_of::<T>()).clamp(1, 64);
-    Ok(g.new_dataset::<T>()
+    Ok(filtered(g.new_dataset::<T>(), level)
         .chunk((rows, n))
         .shape((0.., n))
-        .shuffle()
-        .deflate(DEFLATE_LEVEL)
         .create(name)?)
 }
 
-fn series_3d(g: &Group, name: &str, n: usize) -> Result<Dataset> {
+fn series_3d(g: &Group, name: &str, n: usize, level: u8) -> Result<Dataset> {
     let rows = chunk_rows(n * 16).clamp(1, 16);
-    Ok(g.new_dataset::<f64>()
+    Ok(filtered(g.new_dataset::<f64>(), level)
         .chunk((rows, n, 2))
         .shape((0.., n, 2))
-        .shuffle()
-        .deflate(DEFLATE_LEVEL)
         .create(name)?)
+}
+
+/// Writes `v` into the 1-D dataset `name` of `g`, creating it (contiguous,
+/// unfiltered: a checkpoint must be exact and quick) on first use.
+fn put_vector<T: H5Type>(g: &Group, name: &str, v: &[T]) -> Result<()> {
+    let ds = if g.link_exists(name) {
+        let ds = g.dataset(name)?;
+        ensure!(
+            ds.shape() == [v.len()],
+            "checkpoint/{name} has shape {:?}, the state {} values",
+            ds.shape(),
+            v.len()
+        );
+        ds
+    } else {
+        g.new_dataset::<T>().shape(v.len()).create(name)?
+    };
+    if !v.is_empty() {
+        ds.write(ArrayView1::from(v))?;
+    }
+    Ok(())
+}
+
+fn get_vector<T: H5Type>(g: &Group, name: &str) -> Result<Vec<T>> {
+    let ds = g
+        .dataset(name)
+        .with_context(|| format!("/checkpoint/{name} is missing"))?;
+    if ds.size() == 0 {
+        return Ok(Vec::new());
+    }
+    Ok(ds.read_raw::<T>()?)
+}
+
+/// Writes (or rewrites) a scalar attribute.
+fn put_scalar<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<()> {
+    match loc.attr(name) {
+        Ok(a) => a.write_scalar(&value)?,
+        Err(_) => scalar_attr(loc, name, value)?,
+    }
+    Ok(())
+}
+
+fn get_scalar<T: H5Type>(loc: &hdf5::Location, name: &str) -> Result<T> {
+    loc.attr(name)
+        .with_context(|| format!("/checkpoint attribute {name} is missing"))?
+        .read_scalar::<T>()
+        .with_context(|| format!("/checkpoint attribute {name}"))
+}
+
+/// Order of `/checkpoint/energy`.
+const ENERGY_ORDER: &str = "kinetic, strain, external_work, dissipated, total, balance";
+
+/// Reads `/checkpoint`, the case and `complete` of a results file.
+///
+/// # Errors
+/// The file cannot be opened, was not written by `stickslip run`, or has no
+/// checkpoint (written before any flush, or by a version without restart).
+pub fn read_checkpoint(path: &Path) -> Result<Stored> {
+    let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    let program = file
+        .attr("program")
+        .and_then(|a| a.read_scalar::<VarLenUnicode>())
+        .map(|v| v.as_str().to_string())
+        .unwrap_or_default();
+    ensure!(
+        program == "stickslip",
+        "{} was not written by stickslip run (no program = \"stickslip\" attribute)",
+        path.display()
+    );
+    let case_source = file
+        .attr("case")?
+        .read_scalar::<VarLenUnicode>()?
+        .as_str()
+        .to_string();
+    let complete = file.attr("complete")?.read_scalar::<bool>()?;
+    if !file.link_exists("checkpoint") {
+        bail!(
+            "{} holds no checkpoint (the run stopped before its first flush); run the case again",
+            path.display()
+        );
+    }
+    let g = file.group("checkpoint")?;
+    let e: Vec<f64> = get_vector(&g, "energy")?;
+    ensure!(
+        e.len() == 6,
+        "/checkpoint/energy has {} values, expected 6",
+        e.len()
+    );
+    let checkpoint = Checkpoint {
+        t: get_scalar(&g, "t")?,
+        steps: get_scalar(&g, "steps")?,
+        displacement: get_vector(&g, "displacement")?,
+        velocity: get_vector(&g, "velocity")?,
+        acceleration: get_vector(&g, "acceleration")?,
+        classes: get_vector(&g, "classes")?,
+        forces: get_vector(&g, "forces")?,
+        energy: Energy {
+            kinetic: e[0],
+            strain: e[1],
+            external_work: e[2],
+            dissipated: e[3],
+            total: e[4],
+            balance: e[5],
+        },
+        initial_mechanical: get_scalar(&g, "initial_mechanical")?,
+        reduced_remaining: get_scalar(&g, "reduced_remaining")?,
+        total_iterations: get_scalar(&g, "total_iterations")?,
+        factorizations: get_scalar(&g, "factorizations")?,
+    };
+    let extra = CheckpointExtra {
+        rows: get_scalar::<u64>(&g, "rows")? as usize,
+        wall_time_s: get_scalar(&g, "wall_time_s")?,
+        max_balance: get_scalar(&g, "max_balance")?,
+    };
+    let time = file.dataset("time")?;
+    let n = time.shape().first().copied().unwrap_or(0);
+    ensure!(
+        extra.rows <= n && extra.rows >= 1,
+        "/checkpoint says {} rows but /time has {n}: the file is damaged; run the case again",
+        extra.rows
+    );
+    let times = time.read_slice_1d::<f64, _>(s![..extra.rows])?.to_vec();
+    Ok(Stored {
+        checkpoint,
+        extra,
+        case_source,
+        complete,
+        times,
+    })
 }
 
 fn index_array(v: impl ExactSizeIterator<Item = usize>) -> Array1<i64> {
@@ -199,6 +380,16 @@ impl ResultsWriter {
     /// # Errors
     /// File system / HDF5 errors, or contact arrays of different lengths.
     pub fn create(path: &Path, header: &Header) -> Result<ResultsWriter> {
+        Self::create_with(path, header, DEFLATE_LEVEL)
+    }
+
+    /// [`ResultsWriter::create`] with the deflate level of the growing
+    /// datasets: 0 (none) to 9.
+    ///
+    /// # Errors
+    /// As [`ResultsWriter::create`].
+    pub fn create_with(path: &Path, header: &Header, compression: u8) -> Result<ResultsWriter> {
+        let level = compression.min(9);
         ensure!(
             header.contact_nodes.len() == header.contact_s.len(),
             "contact_nodes has {} entries but contact_s {}",
@@ -252,32 +443,29 @@ impl ResultsWriter {
                 .with_data(&ArrayView1::from(header.contact_s))
                 .create("s")?;
             Some(ContactSeries {
-                friction_stress: series_2d::<f64>(&c, "friction_stress", n_c)?,
-                slip_velocity: series_2d::<f64>(&c, "slip_velocity", n_c)?,
-                state: series_2d::<i8>(&c, "state", n_c)?,
+                friction_stress: series_2d::<f64>(&c, "friction_stress", n_c, level)?,
+                slip_velocity: series_2d::<f64>(&c, "slip_velocity", n_c, level)?,
+                state: series_2d::<i8>(&c, "state", n_c, level)?,
             })
         } else {
             None
         };
         let e = file.create_group("energy")?;
-        let energy = [
-            series_1d::<f64>(&e, "kinetic")?,
-            series_1d::<f64>(&e, "strain")?,
-            series_1d::<f64>(&e, "external_work")?,
-            series_1d::<f64>(&e, "dissipated")?,
-            series_1d::<f64>(&e, "total")?,
-            series_1d::<f64>(&e, "balance")?,
-        ];
+        let mut energy = Vec::new();
+        for name in ENERGY_NAMES {
+            energy.push(series_1d::<f64>(&e, name, level)?);
+        }
+        let energy: [Dataset; 6] = energy.try_into().expect("six energy series");
         let solver = file.create_group("solver")?;
         let series = Series {
-            time: series_1d::<f64>(&file, "time")?,
-            displacement: series_3d(&file, "displacement", n_nodes)?,
-            velocity: series_3d(&file, "velocity", n_nodes)?,
-            acceleration: series_3d(&file, "acceleration", n_nodes)?,
+            time: series_1d::<f64>(&file, "time", level)?,
+            displacement: series_3d(&file, "displacement", n_nodes, level)?,
+            velocity: series_3d(&file, "velocity", n_nodes, level)?,
+            acceleration: series_3d(&file, "acceleration", n_nodes, level)?,
             contact,
             energy,
-            dt: series_1d::<f64>(&solver, "dt")?,
-            iterations: series_1d::<u32>(&solver, "iterations")?,
+            dt: series_1d::<f64>(&solver, "dt", level)?,
+            iterations: series_1d::<u32>(&solver, "iterations", level)?,
         };
         file.flush()?;
         Ok(ResultsWriter {
@@ -290,7 +478,204 @@ impl ResultsWriter {
             last_flush: Instant::now(),
             flush_every_steps: 100,
             flush_every_secs: 5.0,
+            auto_flush: true,
         })
+    }
+
+    /// Opens a results file written by [`ResultsWriter::create`] to append
+    /// to it after row `rows` (later rows, written after the checkpoint, are
+    /// dropped), marks it `complete = false` and removes a `failure`
+    /// attribute. `n_nodes` and `n_c` must match the file (the same mesh and
+    /// contact surface).
+    ///
+    /// # Errors
+    /// HDF5 errors (e.g. the file is open in another program), or a file
+    /// whose layout does not match.
+    pub fn open_append(
+        path: &Path,
+        rows: usize,
+        n_nodes: usize,
+        n_c: usize,
+    ) -> Result<ResultsWriter> {
+        let file = File::open_rw(path).with_context(|| {
+            format!(
+                "cannot open {} for appending (is it open in another program?)",
+                path.display()
+            )
+        })?;
+        let ds = |name: &str| -> Result<Dataset> {
+            file.dataset(name)
+                .with_context(|| format!("{}: /{name} is missing", path.display()))
+        };
+        let nodes = ds("mesh/nodes")?.shape();
+        ensure!(
+            nodes.first() == Some(&n_nodes),
+            "{} has {} nodes, the case's mesh {n_nodes}: restart with the mesh the run used",
+            path.display(),
+            nodes.first().copied().unwrap_or(0)
+        );
+        let contact = if file.link_exists("contact") {
+            ContactSeries {
+                friction_stress: ds("contact/friction_stress")?,
+                slip_velocity: ds("contact/slip_velocity")?,
+                state: ds("contact/state")?,
+            }
+            .into()
+        } else {
+            None
+        };
+        let file_n_c = contact.as_ref().map_or(0, |c: &ContactSeries| {
+            c.state.shape().get(1).copied().unwrap_or(0)
+        });
+        ensure!(
+            file_n_c == n_c,
+            "{} has {file_n_c} contact nodes, the case {n_c}: restart with the contact group the run used",
+            path.display()
+        );
+        let mut energy = Vec::new();
+        for name in ENERGY_NAMES {
+            energy.push(ds(&format!("energy/{name}"))?);
+        }
+        let series = Series {
+            time: ds("time")?,
+            displacement: ds("displacement")?,
+            velocity: ds("velocity")?,
+            acceleration: ds("acceleration")?,
+            contact,
+            energy: energy.try_into().expect("six energy series"),
+            dt: ds("solver/dt")?,
+            iterations: ds("solver/iterations")?,
+        };
+        let have = series.time.shape().first().copied().unwrap_or(0);
+        ensure!(
+            rows <= have,
+            "{}: cannot continue after row {rows}, the file has {have}",
+            path.display()
+        );
+        // Rows past the checkpoint (written before a crash) are recomputed.
+        let s = &series;
+        for d in [&s.time, &s.dt, &s.iterations].into_iter().chain(&s.energy) {
+            d.resize(rows)?;
+        }
+        for d in [&s.displacement, &s.velocity, &s.acceleration] {
+            d.resize((rows, n_nodes, 2))?;
+        }
+        if let Some(c) = &s.contact {
+            for d in [&c.friction_stress, &c.slip_velocity, &c.state] {
+                d.resize((rows, n_c))?;
+            }
+        }
+        file.attr("complete")?.write_scalar(&false)?;
+        if file.attr("failure").is_ok() {
+            file.delete_attr("failure")?;
+        }
+        file.flush()?;
+        Ok(ResultsWriter {
+            file,
+            series,
+            n_nodes,
+            n_c,
+            rows,
+            since_flush: 0,
+            last_flush: Instant::now(),
+            flush_every_steps: 100,
+            flush_every_secs: 5.0,
+            auto_flush: true,
+        })
+    }
+
+    /// Output rows written so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Rewrites the root attribute `case` (a restart stores the case it
+    /// continued with, so that the next restart compares against it).
+    ///
+    /// # Errors
+    /// HDF5 errors.
+    pub fn set_case(&mut self, source: &str) -> Result<()> {
+        self.file.delete_attr("case")?;
+        string_attr(&self.file, "case", source)
+    }
+
+    /// True when [`ResultsWriter::flush_every_steps`] rows or
+    /// [`ResultsWriter::flush_every_secs`] seconds have gone by since the
+    /// last flush.
+    pub fn flush_due(&self) -> bool {
+        self.since_flush >= self.flush_every_steps
+            || self.last_flush.elapsed().as_secs_f64() >= self.flush_every_secs
+    }
+
+    /// Counts a step toward [`ResultsWriter::flush_due`] without writing a
+    /// row (steps between output rows still count, so a checkpoint is taken
+    /// every `flush_every_steps` steps).
+    pub fn count_step(&mut self) {
+        self.since_flush += 1;
+    }
+
+    /// Rewrites `/checkpoint` with `cp` and `extra`, then flushes the file:
+    /// after this returns, the file on disk holds every row so far and the
+    /// state to continue from.
+    ///
+    /// # Errors
+    /// HDF5 errors, or a state whose lengths changed since the last checkpoint.
+    pub fn write_checkpoint(&mut self, cp: &Checkpoint, extra: &CheckpointExtra) -> Result<()> {
+        let g = if self.file.link_exists("checkpoint") {
+            self.file.group("checkpoint")?
+        } else {
+            let g = self.file.create_group("checkpoint")?;
+            string_attr(
+                &g,
+                "about",
+                "the integrator's state at the last flush (stickslip run --restart continues from it); \
+                 vectors on the free DOFs; rows = output rows that belong to this state",
+            )?;
+            g
+        };
+        put_vector(&g, "displacement", &cp.displacement)?;
+        put_vector(&g, "velocity", &cp.velocity)?;
+        put_vector(&g, "acceleration", &cp.acceleration)?;
+        put_vector(&g, "forces", &cp.forces)?;
+        put_vector(&g, "classes", &cp.classes)?;
+        let e = &cp.energy;
+        put_vector(
+            &g,
+            "energy",
+            &[
+                e.kinetic,
+                e.strain,
+                e.external_work,
+                e.dissipated,
+                e.total,
+                e.balance,
+            ],
+        )?;
+        let energy = g.dataset("energy")?;
+        if energy.attr("order").is_err() {
+            string_attr(&energy, "order", ENERGY_ORDER)?;
+        }
+        put_scalar(&g, "t", cp.t)?;
+        put_scalar(&g, "steps", cp.steps)?;
+        put_scalar(&g, "initial_mechanical", cp.initial_mechanical)?;
+        put_scalar(&g, "reduced_remaining", cp.reduced_remaining)?;
+        put_scalar(&g, "total_iterations", cp.total_iterations)?;
+        put_scalar(&g, "factorizations", cp.factorizations)?;
+        put_scalar(&g, "rows", extra.rows as u64)?;
+        put_scalar(&g, "wall_time_s", extra.wall_time_s)?;
+        put_scalar(&g, "max_balance", extra.max_balance)?;
+        self.flush()
+    }
+
+    /// Flushes the file to disk.
+    ///
+    /// # Errors
+    /// HDF5 errors.
+    pub fn flush(&mut self) -> Result<()> {
+        self.file.flush()?;
+        self.since_flush = 0;
+        self.last_flush = Instant::now();
+        Ok(())
     }
 
     /// Appends one output step to every dataset.
@@ -365,13 +750,11 @@ impl ResultsWriter {
         )?;
 
         self.rows += 1;
-        self.since_flush += 1;
-        if self.since_flush >= self.flush_every_steps
-            || self.last_flush.elapsed().as_secs_f64() >= self.flush_every_secs
-        {
-            self.file.flush()?;
-            self.since_flush = 0;
-            self.last_flush = Instant::now();
+        if self.auto_flush {
+            self.since_flush += 1;
+            if self.flush_due() {
+                self.flush()?;
+            }
         }
         Ok(())
     }
@@ -384,11 +767,14 @@ impl ResultsWriter {
     /// HDF5 errors.
     pub fn finish(self, complete: bool, summary: &Summary) -> Result<()> {
         let solver = self.file.group("solver")?;
-        scalar_attr(&solver, "wall_time_s", summary.wall_time_s)?;
-        scalar_attr(&solver, "steps", summary.steps)?;
-        scalar_attr(&solver, "factorizations", summary.factorizations)?;
+        put_scalar(&solver, "wall_time_s", summary.wall_time_s)?;
+        put_scalar(&solver, "steps", summary.steps)?;
+        put_scalar(&solver, "factorizations", summary.factorizations)?;
         if let Some(d) = summary.dt_crit {
-            scalar_attr(&solver, "dt_crit", d)?;
+            put_scalar(&solver, "dt_crit", d)?;
+        }
+        if self.file.attr("failure").is_ok() {
+            self.file.delete_attr("failure")?;
         }
         if let Some(f) = &summary.failure {
             string_attr(&self.file, "failure", f)?;

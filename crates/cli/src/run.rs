@@ -8,6 +8,8 @@
 
 use std::io::IsTerminal;
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
@@ -24,19 +26,25 @@ use stickslip_time::{
 
 use crate::case::{self, Case};
 use crate::error::InputError;
-use crate::output::{Header, Record, ResultsWriter, Summary};
+use crate::output::{self, CheckpointExtra, Header, Record, ResultsWriter, Summary};
+use crate::xdmf::XdmfInfo;
 
 /// How a run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Outcome {
     /// Reached t_end; the file is complete.
     Complete,
-    /// Stopped early (iteration cap, non-finite state); the file holds every
-    /// completed step and `complete = false`.
+    /// Stopped early (iteration cap, non-finite state, energy blow-up); the
+    /// file holds every completed step, `complete = false` and the reason in
+    /// its `failure` attribute.
     Failed,
+    /// Stopped by SIGINT/SIGTERM after a completed step; the file holds every
+    /// output step so far and a checkpoint to `--restart` from.
+    Interrupted,
 }
 
 /// A case turned into the objects that run it.
+#[derive(Debug)]
 pub struct Prepared {
     /// The mesh.
     pub mesh: Mesh,
@@ -61,25 +69,119 @@ fn history(h: &case::History) -> History {
     }
 }
 
-/// Builds mesh, model, loads, contact surface and integrator; every problem
-/// with the input is an [`InputError`] naming the case file.
+/// Checks a group the case names against the mesh: it exists (else the
+/// message lists the mesh's groups) and, when `dim` is given, has that
+/// dimension.
+fn check_group(
+    mesh: &Mesh,
+    case: &Case,
+    key: &str,
+    name: &str,
+    dim: Option<u8>,
+    purpose: &str,
+    problems: &mut Vec<String>,
+) -> bool {
+    match mesh.group(name) {
+        Err(_) => {
+            let have: Vec<String> = mesh
+                .groups
+                .iter()
+                .map(|g| format!("{:?} (dim {})", g.name, g.dim))
+                .collect();
+            problems.push(format!(
+                "{}{key} = {name:?}: the mesh {} has no physical group {name:?}; it has: {}; \
+                 use one of those, or add the group in Gmsh (Physical Curve/Surface)",
+                case.at(key),
+                case.mesh.file.display(),
+                if have.is_empty() {
+                    "none".to_string()
+                } else {
+                    have.join(", ")
+                }
+            ));
+            false
+        }
+        Ok(g) => match dim {
+            Some(d) if g.dim != d => {
+                problems.push(format!(
+                    "{}{key} = {name:?}: {purpose} needs a group of boundary lines (dimension {d}), \
+                     but {name:?} has dimension {}; name the boundary edges in Gmsh with a Physical Curve",
+                    case.at(key),
+                    g.dim
+                ));
+                false
+            }
+            _ => true,
+        },
+    }
+}
+
+/// Builds mesh, model, loads, contact surface and integrator. Every problem
+/// with the input is collected (groups the mesh lacks, groups of the wrong
+/// dimension, free rigid-body motions, Δt above the critical step, ...) and
+/// reported together as one [`InputError`], each naming the case file and
+/// line.
 ///
 /// # Errors
 /// Input problems (exit 2) as [`InputError`]; nothing else is expected.
 pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
-    let case_name = case.path.display().to_string();
-    let mesh = Mesh::from_file(&case.mesh.file).map_err(|e| input(format!("{e}")))?;
+    let mesh = Mesh::from_file(&case.mesh.file)
+        .map_err(|e| input(format!("{}{e}", case.at("mesh.file"))))?;
+    let mut problems = Vec::new();
+
+    // Groups first: everything after needs them.
+    let mut groups_ok = true;
+    for (i, d) in case.dirichlet.iter().enumerate() {
+        groups_ok &= check_group(
+            &mesh,
+            case,
+            &format!("dirichlet.{i}.group"),
+            &d.group,
+            None,
+            "a Dirichlet condition",
+            &mut problems,
+        );
+    }
+    let dirichlet_ok = groups_ok;
+    for (i, t) in case.traction.iter().enumerate() {
+        groups_ok &= check_group(
+            &mesh,
+            case,
+            &format!("traction.{i}.group"),
+            &t.group,
+            Some(1),
+            "a traction",
+            &mut problems,
+        );
+    }
+    if let Some(c) = &case.contact {
+        groups_ok &= check_group(
+            &mesh,
+            case,
+            "contact.group",
+            &c.group,
+            Some(1),
+            "the contact surface",
+            &mut problems,
+        );
+    }
+
     let hypothesis = match case.material.hypothesis {
         case::Hypothesis::PlaneStrain => FemHypothesis::PlaneStrain,
         case::Hypothesis::PlaneStress => FemHypothesis::PlaneStress,
     };
-    let material = Material::new(
+    let material = match Material::new(
         case.material.e,
         case.material.nu,
         case.material.rho,
         hypothesis,
-    )
-    .map_err(|e| input(format!("{case_name}: [material]: {e}")))?;
+    ) {
+        Ok(m) => Some(m),
+        Err(e) => {
+            problems.push(format!("{}[material]: {e}", case.at("material.E")));
+            None
+        }
+    };
     let mut conditions = Vec::new();
     for d in &case.dirichlet {
         for (component, value) in [(0, d.ux), (1, d.uy)] {
@@ -92,8 +194,33 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
             }
         }
     }
-    let model = Model::new(&mesh, &material, &conditions)
-        .map_err(|e| input(format!("{case_name}: [[dirichlet]]: {e}")))?;
+    let dirichlet_at = case.at("dirichlet.0.group");
+    let model = match (&material, dirichlet_ok) {
+        (Some(material), true) => match Model::new(&mesh, material, &conditions) {
+            Ok(m) => Some(m),
+            Err(e) => {
+                problems.push(format!("{dirichlet_at}[[dirichlet]]: {e}"));
+                None
+            }
+        },
+        _ => None,
+    };
+    if let Some(m) = &model {
+        // The initial static solve (Remark 4.1) is frictionless: the
+        // supports alone must hold the body (DofMap checks each connected part).
+        let free = m.dofs.free_rigid_motions();
+        if !free.is_empty() {
+            problems.push(format!(
+                "{dirichlet_at}the supports leave a rigid-body motion free for the initial static solve: {}; \
+                 add [[dirichlet]] conditions that prevent it (e.g. uy = 0 on a bottom or top group and ux = 0 on an end)",
+                free.join(", ")
+            ));
+        }
+    }
+    let Some(model) = model.filter(|_| groups_ok && problems.is_empty()) else {
+        return Err(input(problems.join("\n")));
+    };
+
     let n_full = 2 * mesh.nodes.len();
     let n_free = model.dofs.n_free();
     let mut full = vec![0.0; n_full];
@@ -103,24 +230,30 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
         model.dofs.restrict(full, &mut free);
         free
     };
-    for t in &case.traction {
+    for (i, t) in case.traction.iter().enumerate() {
         full.iter_mut().for_each(|x| *x = 0.0);
         let traction = match (t.t, t.pressure) {
             (Some(v), None) => Traction::Vector(v),
             (None, Some(p)) => Traction::Pressure(p),
             _ => {
-                return Err(input(format!(
-                    "{case_name}: [[traction]] on {:?}: give exactly one of t or pressure",
+                problems.push(format!(
+                    "{}[[traction]] on {:?}: give exactly one of t or pressure",
+                    case.at(&format!("traction.{i}.group")),
                     t.group
-                )))
+                ));
+                continue;
             }
         };
-        traction_load(&mesh, &t.group, traction, &mut full)
-            .map_err(|e| input(format!("{case_name}: [[traction]]: {e}")))?;
-        loads.push(Load {
-            vector: restrict(&full),
-            history: history(&t.history),
-        });
+        match traction_load(&mesh, &t.group, traction, &mut full) {
+            Ok(()) => loads.push(Load {
+                vector: restrict(&full),
+                history: history(&t.history),
+            }),
+            Err(e) => problems.push(format!(
+                "{}[[traction]]: {e}",
+                case.at(&format!("traction.{i}.group"))
+            )),
+        }
     }
     if let Some(f) = case.body_force {
         full.iter_mut().for_each(|x| *x = 0.0);
@@ -131,28 +264,30 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
         });
     }
     let mut iteration = IterationOptions::default();
-    let contact = match &case.contact {
-        None => None,
-        Some(c) => {
-            // The prescribed normal traction on Γ_C is a load like any other,
-            // present before t = 0 (it makes the initial static state).
-            full.iter_mut().for_each(|x| *x = 0.0);
-            traction_load(&mesh, &c.group, Traction::Pressure(c.pressure), &mut full)
-                .map_err(|e| input(format!("{case_name}: [contact]: {e}")))?;
-            loads.push(Load {
+    let mut contact = None;
+    if let Some(c) = &case.contact {
+        // The prescribed normal traction on Γ_C is a load like any other,
+        // present before t = 0 (it makes the initial static state).
+        full.iter_mut().for_each(|x| *x = 0.0);
+        match traction_load(&mesh, &c.group, Traction::Pressure(c.pressure), &mut full) {
+            Ok(()) => loads.push(Load {
                 vector: restrict(&full),
                 history: History::Constant,
-            });
-            iteration = IterationOptions {
-                remark_4_2: c.remark_4_2,
-                max_iterations: c.max_iterations,
-            };
-            Some(
-                ContactSurface::from_group(&mesh, &model.dofs, &c.group, c.pressure, c.mu, c.eps)
-                    .map_err(|e| input(format!("{case_name}: [contact]: {e}")))?,
-            )
+            }),
+            Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
         }
-    };
+        iteration = IterationOptions {
+            remark_4_2: c.remark_4_2,
+            max_iterations: c.max_iterations,
+        };
+        match ContactSurface::from_group(&mesh, &model.dofs, &c.group, c.pressure, c.mu, c.eps) {
+            Ok(s) => contact = Some(s),
+            Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
+        }
+    }
+    if !problems.is_empty() {
+        return Err(input(problems.join("\n")));
+    }
     let scheme = match case.time.scheme {
         case::Scheme::CentralDifference => Scheme::CentralDifference,
         case::Scheme::Newmark => Scheme::Newmark {
@@ -178,7 +313,14 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
         initial_velocity: None,
     };
     let integrator = Integrator::new(Dynamics::from_model(&model), contact, loads, settings)
-        .map_err(|e| input(format!("{case_name}: [time]: {e}")))?;
+        .map_err(|e| {
+            let key = match e {
+                TimeError::Unstable { .. } => "time.dt",
+                TimeError::Static(_) => "dirichlet.0.group",
+                _ => "time.scheme",
+            };
+            input(format!("{}[time]: {e}", case.at(key)))
+        })?;
     Ok(Prepared {
         mesh,
         model,
@@ -284,12 +426,100 @@ fn record<'a>(
     }
 }
 
-/// `stickslip run`: integrate to t_end writing every `output.every`-th step.
+/// The SIGINT / SIGTERM flags a run polls after each step.
+#[derive(Clone, Debug, Default)]
+pub struct StopFlags {
+    sigint: Arc<AtomicBool>,
+    sigterm: Arc<AtomicBool>,
+}
+
+impl StopFlags {
+    /// Flags that no signal sets (a library caller stops nothing).
+    pub fn none() -> StopFlags {
+        StopFlags::default()
+    }
+
+    /// Registers SIGINT and SIGTERM: the first sets the flag (the run
+    /// finishes its step, flushes, checkpoints and exits 130); a second
+    /// signal of either kind exits at once with 130, as users expect of a
+    /// second Ctrl-C (the file keeps every step up to its last flush).
+    ///
+    /// # Errors
+    /// The handlers cannot be installed.
+    pub fn install() -> std::io::Result<StopFlags> {
+        use signal_hook::consts::{SIGINT, SIGTERM};
+        let flags = StopFlags::default();
+        let any = Arc::new(AtomicBool::new(false));
+        for (sig, flag) in [(SIGINT, &flags.sigint), (SIGTERM, &flags.sigterm)] {
+            // Order matters: the shutdown hook must see `any` still false on
+            // the first signal (signal-hook's documented pattern).
+            signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&any))?;
+            signal_hook::flag::register(sig, Arc::clone(&any))?;
+            signal_hook::flag::register(sig, Arc::clone(flag))?;
+        }
+        Ok(flags)
+    }
+
+    /// The signal received, if any.
+    pub fn received(&self) -> Option<&'static str> {
+        if self.sigint.load(Ordering::Relaxed) {
+            Some("SIGINT")
+        } else if self.sigterm.load(Ordering::Relaxed) {
+            Some("SIGTERM")
+        } else {
+            None
+        }
+    }
+}
+
+/// How `stickslip run` behaves.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// No progress bar, no summary on stderr.
+    pub quiet: bool,
+    /// The closing summary as one JSON object on stdout.
+    pub json: bool,
+    /// Continue the results file from its checkpoint instead of creating it.
+    pub restart: bool,
+    /// Polled after every step.
+    pub stop: StopFlags,
+}
+
+/// Multiple of the physically possible mechanical energy above which an
+/// explicit run is declared unstable (see [`blow_up`]).
+const BLOW_UP_FACTOR: f64 = 10.0;
+
+/// Energy blow-up of an explicit run (issue 8).
+///
+/// The energy ledger (METHOD.md §6) says kinetic + strain = E₀ + W − D with
+/// D ≥ 0, so kinetic + strain ≤ E₀ + |W| + D for any run the scheme follows
+/// faithfully; a stable central-difference run breaks this only by its
+/// O(Δt²) energy error. Past Δt_crit the highest mode grows by |λ|² per step,
+/// λ the larger root of λ² − (2 − ω²Δt²)λ + 1 = 0 (|λ|² = 1.8 at ωΔt = 2.02,
+/// 5.9 at ωΔt = 2.2), from round-off: a growth that must cross any fixed
+/// multiple of the physical bound within a few steps of reaching it, while
+/// W grows only linearly in the amplitude (R·Δr) and the energies
+/// quadratically. Hence the test kinetic + strain > 10 (E₀ + |W| + D): the
+/// factor 10 leaves the stable scheme's error far behind and costs about
+/// log(10)/log(|λ|²) ≈ 1.3 to 4 steps of detection delay.
+fn blow_up(i: &Integrator, initial: f64) -> Option<f64> {
+    let e = i.energy();
+    let mechanical = e.kinetic + e.strain;
+    let bound = BLOW_UP_FACTOR * (initial.abs() + e.external_work.abs() + e.dissipated.abs());
+    (mechanical > bound && mechanical > f64::MIN_POSITIVE).then_some(bound)
+}
+
+/// `stickslip run`: integrate to t_end writing every `output.every`-th
+/// step; flush and checkpoint every `output.flush_every` steps or
+/// `output.flush_seconds` seconds; stop cleanly on SIGINT/SIGTERM; with
+/// `options.restart`, continue the file `out` from its checkpoint.
 ///
 /// # Errors
-/// Input problems as [`InputError`]; I/O failures of the results file.
-pub fn execute(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Outcome> {
+/// Input problems as [`InputError`] (also: a restart whose case changes the
+/// physics); I/O failures of the results file.
+pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<Outcome> {
     let started = Instant::now();
+    let quiet = options.quiet;
     let Prepared {
         mesh,
         model,
@@ -300,14 +530,6 @@ pub fn execute(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Outcome> 
         .map(|c| c.nodes.iter().map(|n| (n.node, n.s)).unzip())
         .unwrap_or_default();
     let n_c = contact_nodes.len();
-    let header = Header {
-        case_source: &case.source,
-        mesh: &mesh,
-        contact_nodes: &contact_nodes,
-        contact_s: &contact_s,
-    };
-    let mut writer = ResultsWriter::create(out, &header)
-        .with_context(|| format!("cannot create the results file {}", out.display()))?;
     let n_full = 2 * mesh.nodes.len();
     let mut full = FullState {
         u: vec![0.0; n_full],
@@ -317,42 +539,186 @@ pub fn execute(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Outcome> 
         slip: vec![0.0; n_c],
         state: vec![0; n_c],
     };
-    writer.append(&record(&integrator, &model, &mut full, 0.0, 0))?;
+    // E₀ for the blow-up test: kinetic + strain at t = 0.
+    let e0 = integrator.energy();
+    let mut initial_mechanical = e0.kinetic + e0.strain;
+    let (mut writer, wall_before, mut max_balance, mut times) = if options.restart {
+        let stored = output::read_checkpoint(out)
+            .map_err(|e| input(format!("--restart {}: {e:#}", out.display())))?;
+        let changes = case::restart_changes(&stored.case_source, &case.source)
+            .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
+        if !changes.is_empty() {
+            return Err(input(format!(
+                "{}: --restart {}: the case changes what the stored run computed:\n  {}\n\
+                 a restart may change only time.t_end and output.*; undo those changes, or start a new run with -o NEW.h5",
+                case.path.display(),
+                out.display(),
+                changes.join("\n  ")
+            )));
+        }
+        let cp = &stored.checkpoint;
+        if case.time.t_end < cp.t {
+            return Err(input(format!(
+                "{}time.t_end = {} is before the checkpoint's t = {} in {}; give a t_end >= {}",
+                case.at("time.t_end"),
+                case.time.t_end,
+                cp.t,
+                out.display(),
+                cp.t
+            )));
+        }
+        initial_mechanical = cp.initial_mechanical;
+        integrator
+            .restore(cp)
+            .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
+        let mut w = ResultsWriter::open_append(out, stored.extra.rows, mesh.nodes.len(), n_c)?;
+        w.set_case(&case.source)?;
+        if !quiet {
+            eprintln!(
+                "restart: continuing {} from step {}, t = {} ({} records kept)",
+                out.display(),
+                cp.steps,
+                cp.t,
+                stored.extra.rows
+            );
+        }
+        (
+            w,
+            stored.extra.wall_time_s,
+            stored.extra.max_balance,
+            stored.times,
+        )
+    } else {
+        let header = Header {
+            case_source: &case.source,
+            mesh: &mesh,
+            contact_nodes: &contact_nodes,
+            contact_s: &contact_s,
+        };
+        let mut w = ResultsWriter::create_with(out, &header, case.output.compression)
+            .with_context(|| format!("cannot create the results file {}", out.display()))?;
+        w.append(&record(&integrator, &model, &mut full, 0.0, 0))?;
+        (w, 0.0, 0.0, vec![integrator.time()])
+    };
+    writer.auto_flush = false;
+    writer.flush_every_steps = case.output.flush_every.max(1);
+    writer.flush_every_secs = case.output.flush_seconds;
+    let extra = |rows: usize, max_balance: f64| CheckpointExtra {
+        rows,
+        wall_time_s: wall_before + started.elapsed().as_secs_f64(),
+        max_balance,
+    };
+    let xdmf_path = out.with_extension("xdmf");
+    let xdmf = |times: &[f64]| {
+        let info = XdmfInfo {
+            n_nodes: mesh.nodes.len(),
+            kind: mesh.kind,
+            n_cells: mesh.n_cells(),
+            times,
+        };
+        crate::xdmf::write_xdmf(out, &xdmf_path, &info)
+            .with_context(|| format!("cannot write {}", xdmf_path.display()))
+    };
+    // A state to continue from exists from the start (the initial state, or
+    // the restored one).
+    writer.write_checkpoint(&integrator.checkpoint(), &extra(writer.rows(), max_balance))?;
+    xdmf(&times)?;
+    let mut last_xdmf = Instant::now();
 
     let every = case.output.every.max(1) as u64;
     let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
         let bar = indicatif::ProgressBar::new(1000);
         bar.set_style(
             indicatif::ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:40} t = {msg} ({eta} left)",
+                "{spinner} [{elapsed_precise}] {bar:30} {percent:>3}% {msg}, ETA {eta}",
             )
             .expect("valid template"),
         );
         bar
     });
     let t_end = integrator.t_end();
-    let mut max_balance: f64 = 0.0;
-    let mut failure = None;
+    let steps_before = integrator.steps();
+    let mut failure: Option<String> = None;
+    let mut interrupted: Option<&'static str> = None;
+    // The state before the last step (and the rows then): that step is
+    // shortened to land on t_end, so a restart with a later t_end must redo
+    // it at full length to match a run that never stopped.
+    let mut before_last: Option<(stickslip_time::Checkpoint, usize)> = None;
     while !integrator.done() {
+        let near_end = integrator.t_end() - integrator.time() <= case.time.dt * (1.0 + 1e-6);
+        let before = near_end.then(|| (integrator.checkpoint(), writer.rows()));
         match integrator.step() {
             Ok(info) => {
                 max_balance = max_balance.max(integrator.energy().balance.abs());
-                if integrator.steps() % every == 0 || integrator.done() {
+                writer.count_step();
+                let write = integrator.steps() % every == 0 || integrator.done();
+                let mut rec = |writer: &mut ResultsWriter, full: &mut FullState| {
+                    times.push(integrator.time());
                     writer.append(&record(
                         &integrator,
                         &model,
-                        &mut full,
+                        full,
                         info.dt,
                         info.iterations as u32,
-                    ))?;
+                    ))
+                };
+                if write {
+                    rec(&mut writer, &mut full)?;
+                }
+                if integrator.is_explicit() {
+                    if let Some(bound) = blow_up(&integrator, initial_mechanical) {
+                        if !write {
+                            rec(&mut writer, &mut full)?;
+                        }
+                        let e = integrator.energy();
+                        let crit = integrator.dt_crit().unwrap_or(f64::NAN);
+                        failure = Some(format!(
+                            "step {} (t = {:.6e}): energy blow-up: kinetic + strain = {:.3e} exceeds {BLOW_UP_FACTOR} x (initial + |work| + dissipated) = {bound:.3e}; \
+                             central difference is unstable at time.dt = {:e}, above its critical step dt_crit = {crit:.6e}: \
+                             use time.dt < {crit:.4e} (e.g. {:.4e}) and remove time.allow_unstable",
+                            integrator.steps(),
+                            integrator.time(),
+                            e.kinetic + e.strain,
+                            case.time.dt,
+                            0.9 * crit
+                        ));
+                        break;
+                    }
+                }
+                if integrator.done() {
+                    before_last = before;
+                    break;
+                }
+                if let Some(sig) = options.stop.received() {
+                    interrupted = Some(sig);
+                    break;
+                }
+                if writer.flush_due() {
+                    writer.write_checkpoint(
+                        &integrator.checkpoint(),
+                        &extra(writer.rows(), max_balance),
+                    )?;
+                    // The XML lists every row: rewrite it at most every
+                    // flush_seconds, not at every flush, so that it costs
+                    // O(rows) per interval, not per flush.
+                    if last_xdmf.elapsed().as_secs_f64() >= case.output.flush_seconds {
+                        xdmf(&times)?;
+                        last_xdmf = Instant::now();
+                    }
                 }
                 if let Some(bar) = &bar {
+                    let rate = (integrator.steps() - steps_before) as f64
+                        / started.elapsed().as_secs_f64().max(1e-9);
                     bar.set_position((1000.0 * integrator.time() / t_end) as u64);
-                    bar.set_message(format!("{:.4e}", integrator.time()));
+                    bar.set_message(format!(
+                        "t = {:.4e} of {t_end}, step {}, {rate:.0} steps/s",
+                        integrator.time(),
+                        integrator.steps()
+                    ));
                 }
             }
             Err(e) => {
-                failure = Some(e);
+                failure = Some(e.to_string());
                 break;
             }
         }
@@ -360,20 +726,48 @@ pub fn execute(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Outcome> 
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
+    let complete = failure.is_none() && interrupted.is_none();
+    if complete || interrupted.is_some() {
+        // A failed run keeps the checkpoint of its last flush: the state at
+        // the failure is not one to continue from.
+        let (cp, rows) = before_last.unwrap_or_else(|| (integrator.checkpoint(), writer.rows()));
+        writer.write_checkpoint(&cp, &extra(rows, max_balance))?;
+    }
+    let reason = match (&failure, interrupted) {
+        (Some(f), _) => Some(f.clone()),
+        (None, Some(sig)) => Some(format!(
+            "interrupted by {sig} at step {}, t = {}; continue with --restart",
+            integrator.steps(),
+            integrator.time()
+        )),
+        _ => None,
+    };
     let summary = Summary {
-        wall_time_s: started.elapsed().as_secs_f64(),
+        wall_time_s: wall_before + started.elapsed().as_secs_f64(),
         steps: integrator.steps(),
         factorizations: integrator.factorizations(),
         dt_crit: integrator.dt_crit(),
-        failure: failure.as_ref().map(|e| e.to_string()),
+        failure: reason.clone(),
     };
-    let complete = failure.is_none();
+    let rows = writer.rows();
     writer.finish(complete, &summary)?;
+    xdmf(&times)?;
+    let e = integrator.energy();
+    let status = if complete {
+        "complete"
+    } else if interrupted.is_some() {
+        "interrupted"
+    } else {
+        "failed"
+    };
     if !quiet {
-        let e = integrator.energy();
         eprintln!(
             "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations) in {:.3} s",
-            if complete { "done:" } else { "stopped:" },
+            match status {
+                "complete" => "done:",
+                "interrupted" => "interrupted:",
+                _ => "stopped:",
+            },
             integrator.steps(),
             integrator.time(),
             integrator.total_iterations(),
@@ -384,17 +778,61 @@ pub fn execute(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Outcome> 
             "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}); largest |balance| {:.3e}",
             e.total, e.kinetic, e.strain, e.external_work, e.dissipated, max_balance
         );
-        eprintln!("results: {}", out.display());
+        eprintln!("results: {} ({rows} records)", out.display());
+    }
+    if options.json {
+        let j = serde_json::json!({
+            "status": status,
+            "case": case.path.display().to_string(),
+            "output": out.display().to_string(),
+            "xdmf": xdmf_path.display().to_string(),
+            "complete": complete,
+            "steps": integrator.steps(),
+            "t": integrator.time(),
+            "t_end": t_end,
+            "records": rows,
+            "wall_time_s": summary.wall_time_s,
+            "iterations": integrator.total_iterations(),
+            "factorizations": integrator.factorizations(),
+            "dt": case.time.dt,
+            "dt_crit": integrator.dt_crit(),
+            "energy": {
+                "kinetic": e.kinetic,
+                "strain": e.strain,
+                "external_work": e.external_work,
+                "dissipated": e.dissipated,
+                "total": e.total,
+                "balance": e.balance,
+                "max_abs_balance": max_balance,
+            },
+            "failure": reason,
+            "restarted": options.restart,
+        });
+        println!("{j}");
+    }
+    if let Some(sig) = interrupted {
+        eprintln!(
+            "interrupted by {sig}: stopped after step {}, t = {} of t_end = {t_end}; {} holds {rows} records (up to t = {}) and a checkpoint (complete = false)",
+            integrator.steps(),
+            integrator.time(),
+            out.display(),
+            times.last().copied().unwrap_or(0.0)
+        );
+        eprintln!(
+            "continue with: stickslip run {} --restart {}",
+            case.path.display(),
+            out.display()
+        );
+        return Ok(Outcome::Interrupted);
     }
     match failure {
         None => Ok(Outcome::Complete),
         Some(e) => {
             eprintln!("error: {}: {e}", case.path.display());
-            if matches!(e, TimeError::NonFinite { .. }) {
-                eprintln!(
-                    "the file keeps every step completed before the failure (complete = false)"
-                );
-            }
+            eprintln!(
+                "error: {} keeps every step completed before the failure ({rows} records, complete = false, reason in its failure attribute)",
+                out.display()
+            );
             Ok(Outcome::Failed)
         }
     }

@@ -1,0 +1,19 @@
+//! The `stickslip` command's library: case files ([`case`]), the HDF5
+//! results and checkpoints ([`output`]), runs and checks ([`run`]), the
+//! `mesh` report ([`mesh_cmd`]) and the `probe` reader ([`probe`]).
+//!
+//! This crate owns everything that touches files other than meshes and the
+//! terminal; the numerics live in the library crates below it. It is a
+//! library as well as the binary (`main.rs`, the command line) so that the
+//! fuzz targets and tests can call the case reader directly.
+//!
+//! Exit codes (used by `main.rs`): 0 success; 2 bad input (case, mesh,
+//! arguments); 1 a run that failed after it started; 130 interrupted.
+
+pub mod case;
+pub mod error;
+pub mod mesh_cmd;
+pub mod output;
+pub mod probe;
+pub mod run;
+pub mod xdmf;
