@@ -11,6 +11,7 @@ mod bench_fem;
 mod bench_mesh;
 mod meshes;
 mod python;
+mod verify;
 
 const USAGE: &str = "\
 usage: cargo xtask <command> [args]
@@ -21,6 +22,11 @@ usage: cargo xtask <command> [args]
                     test suite (what .ci/run and CI run)
   setup             only install what is missing: libhdf5-dev, and h5py, numpy,
                     gmsh, matplotlib, meshio for the tests
+  verify            the proof of correctness: closed forms, convergence rates,
+                    the paper's experiments, committed reference runs
+                    [--quick] [--bless] [--only SUITE]
+  figures           redraw the paper's figures from our runs into docs/figures
+                    [--out DIR]
   meshes            regenerate cases/meshes/*.msh with Gmsh (installs gmsh from PyPI)
   bench mesh        .msh read throughput on a 1M-node mesh against gmsh.open
   bench fem         assembly and Cholesky on the Q2 slab ladder against
@@ -42,6 +48,8 @@ fn main() -> ExitCode {
         "test" | "ci" => test(&root, rest),
         "setup" => setup(true),
         "meshes" => meshes::run(&root, rest),
+        "verify" => verify::verify(&root, rest),
+        "figures" => verify::figures(&root, rest),
         "bench" => match rest.split_first() {
             Some((what, more)) if what == "mesh" => bench_mesh::run(&root, more),
             Some((what, more)) if what == "fem" => bench_fem::run(&root, more),
