@@ -136,9 +136,12 @@ impl<'a> Cursor<'a> {
         }
         let need = self.i.saturating_add(want);
         if need > self.buf.len() {
-            // One token or record larger than the window (only in odd files).
+            // One token or record larger than the window (only in odd
+            // files): grow geometrically, so a long token is not read
+            // byte by byte.
+            let grown = need.max(2 * self.buf.len());
             self.buf
-                .resize(need.min(self.len - self.base).max(self.buf.len()), 0);
+                .resize(grown.min(self.len - self.base).max(self.buf.len()), 0);
         }
         let before = self.filled;
         while self.filled - self.i < want && self.filled < self.buf.len() && self.read < self.len {

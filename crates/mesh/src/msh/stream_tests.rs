@@ -123,6 +123,24 @@ fn damaged_fixtures_fail_the_same_through_any_window() {
     assert!(errors > 1000, "only {errors} damaged copies were refused");
 }
 
+/// A token far longer than the window (a damaged file) makes the window
+/// grow and is reported as the whole-input read reports it.
+#[test]
+fn token_longer_than_the_window() {
+    let (_, bytes) = fixtures()
+        .into_iter()
+        .find(|(n, _)| n == "slab_q4_v41_ascii.msh")
+        .unwrap();
+    let text = String::from_utf8(bytes).unwrap();
+    let at = text.find("$Nodes").unwrap();
+    let at = at + text[at..].find('\n').unwrap() + 1;
+    let long = "7".repeat(300_000) + "x";
+    let broken = format!("{}{long} {}", &text[..at], &text[at..]);
+    let whole = read(broken.as_bytes());
+    assert!(whole.is_err());
+    check_same("long token", broken.as_bytes(), true);
+}
+
 /// An error far behind the window (a boundary line checked at the end of
 /// the read) still gets its exact line, counted again from the file.
 #[test]
