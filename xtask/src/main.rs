@@ -9,6 +9,7 @@ use std::process::{Command, ExitCode};
 
 mod bench_fem;
 mod bench_mesh;
+mod bench_step;
 mod meshes;
 mod python;
 mod verify;
@@ -29,6 +30,8 @@ usage: cargo xtask <command> [args]
                     [--out DIR]
   meshes            regenerate cases/meshes/*.msh with Gmsh (installs gmsh from PyPI)
   bench mesh        .msh read throughput on a 1M-node mesh against gmsh.open
+  bench step        time per step of both schemes on the slab ladders, against
+                    the STREAM bandwidth and one forward+back solve
   bench fem         assembly and Cholesky on the Q2 slab ladder against
                     scikit-fem and scipy's splu (--refine 8,16,32,64 --no-peer)
 ";
