@@ -56,8 +56,9 @@ fn main() -> ExitCode {
         "bench" => match rest.split_first() {
             Some((what, more)) if what == "mesh" => bench_mesh::run(&root, more),
             Some((what, more)) if what == "fem" => bench_fem::run(&root, more),
+            Some((what, more)) if what == "step" => bench_step::run(&root, more),
             _ => Err(format!(
-                "cargo xtask bench: say what to benchmark (mesh, fem)\n{USAGE}"
+                "cargo xtask bench: say what to benchmark (mesh, fem, step)\n{USAGE}"
             )),
         },
         "help" | "--help" | "-h" => {
