@@ -1,5 +1,7 @@
 //! `stickslip probe OUT.h5 --at X,Y [--field ..] [--csv]`: the time history
-//! of one field at the node nearest to a point, read from a results file.
+//! of one field at the node nearest to a point, read from a results file;
+//! and `stickslip probe OUT.h5 --along GROUP --times T1,T2,.. [--field ..]
+//! [-o FILE]` ([`along`]): one field along a boundary group at given times.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -27,6 +29,9 @@ pub enum Field {
     /// Friction stress σ_T along τ (contact nodes only).
     #[value(name = "friction_stress")]
     FrictionStress,
+    /// Slip velocity v_T along τ (contact nodes only).
+    #[value(name = "slip_velocity")]
+    SlipVelocity,
 }
 
 impl Field {
@@ -39,6 +44,21 @@ impl Field {
             Field::Ax => "ax",
             Field::Ay => "ay",
             Field::FrictionStress => "friction_stress",
+            Field::SlipVelocity => "slip_velocity",
+        }
+    }
+
+    /// The node dataset and component of a node field; `None` for the
+    /// contact fields.
+    fn node_dataset(self) -> Option<(&'static str, usize)> {
+        match self {
+            Field::Ux => Some(("displacement", 0)),
+            Field::Uy => Some(("displacement", 1)),
+            Field::Vx => Some(("velocity", 0)),
+            Field::Vy => Some(("velocity", 1)),
+            Field::Ax => Some(("acceleration", 0)),
+            Field::Ay => Some(("acceleration", 1)),
+            Field::FrictionStress | Field::SlipVelocity => None,
         }
     }
 }
@@ -109,8 +129,8 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
         .map_err(|e| h5("cannot read /time", e))?
         .to_vec();
 
-    let values: Vec<f64> = match field {
-        Field::FrictionStress => {
+    let values: Vec<f64> = match field.node_dataset() {
+        None => {
             let contact = f
                 .dataset("contact/nodes")
                 .and_then(|d| d.read_1d::<i64>())
@@ -130,29 +150,21 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
                     )
                 });
                 return Err(InputError(format!(
-                    "{name}: node {node} at ({}, {}), nearest to ({}, {}), is not a contact node, so it has no friction stress{hint}",
-                    nodes[[node, 0]], nodes[[node, 1]], p[0], p[1]
+                    "{name}: node {node} at ({}, {}), nearest to ({}, {}), is not a contact node, so it has no {}{hint}",
+                    nodes[[node, 0]], nodes[[node, 1]], p[0], p[1], field.name()
                 )));
             };
-            f.dataset("contact/friction_stress")
+            let ds = format!("contact/{}", field.name());
+            f.dataset(&ds)
                 .and_then(|d| d.read_slice_1d::<f64, _>(s![.., j]))
-                .map_err(|e| h5("cannot read /contact/friction_stress", e))?
-                .to_vec()
-        }
-        _ => {
-            let (ds, comp) = match field {
-                Field::Ux => ("displacement", 0),
-                Field::Uy => ("displacement", 1),
-                Field::Vx => ("velocity", 0),
-                Field::Vy => ("velocity", 1),
-                Field::Ax => ("acceleration", 0),
-                _ => ("acceleration", 1),
-            };
-            f.dataset(ds)
-                .and_then(|d| d.read_slice_1d::<f64, _>(s![.., node, comp]))
                 .map_err(|e| h5(&format!("cannot read /{ds}"), e))?
                 .to_vec()
         }
+        Some((ds, comp)) => f
+            .dataset(ds)
+            .and_then(|d| d.read_slice_1d::<f64, _>(s![.., node, comp]))
+            .map_err(|e| h5(&format!("cannot read /{ds}"), e))?
+            .to_vec(),
     };
     if values.len() != t.len() {
         return Err(InputError(format!(
@@ -199,6 +211,451 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
         t,
         values,
     })
+}
+
+// ---------------------------------------------------------------------------
+// --along GROUP --times T1,T2,..
+
+/// The `--along` arguments of `stickslip probe` (flattened into its clap
+/// command by `main.rs`).
+#[derive(Clone, Debug, Default, PartialEq, clap::Args)]
+pub struct AlongArgs {
+    /// Print the field along this boundary group (a physical line group, e.g.
+    /// contact) at the times of --times, as CSV, instead of a history at --at.
+    #[arg(long, value_name = "GROUP", conflicts_with = "at")]
+    pub along: Option<String>,
+    /// With --along: comma-separated times; each uses the nearest output step.
+    #[arg(
+        long,
+        value_name = "T1,T2,..",
+        requires = "along",
+        allow_hyphen_values = true
+    )]
+    pub times: Option<String>,
+    /// With --along: write the CSV to this file instead of stdout.
+    #[arg(short = 'o', long = "output", value_name = "FILE", requires = "along")]
+    pub output: Option<std::path::PathBuf>,
+}
+
+/// A field along a group at a few output steps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Along {
+    /// Which steps were used for which times (for stderr).
+    pub info: String,
+    /// `t_asked,t,step,node,x,y,s,FIELD`, one line per (time, node).
+    pub csv: String,
+    /// The group's nodes in order along it.
+    pub nodes: Vec<usize>,
+    /// Arc length of each node from the first.
+    pub s: Vec<f64>,
+    /// The output step used for each asked time.
+    pub steps: Vec<usize>,
+    /// The time of each of those steps.
+    pub t: Vec<f64>,
+    /// `values[i][j]`: the field at step `steps[i]`, node `nodes[j]` (NaN for
+    /// a contact field at a group node that carries no friction).
+    pub values: Vec<Vec<f64>>,
+}
+
+/// Parses `T1,T2,..` (at least one finite number).
+fn parse_times(times: &str) -> Result<Vec<f64>, InputError> {
+    let bad = |why: &str| {
+        InputError(format!(
+            "--times {times:?}: {why}; give comma-separated times, e.g. --times 0.1,0.25,0.5"
+        ))
+    };
+    let mut out = Vec::new();
+    for part in times.split(',') {
+        let v: f64 = part
+            .trim()
+            .parse()
+            .map_err(|_| bad(&format!("{:?} is not a number", part.trim())))?;
+        if !v.is_finite() {
+            return Err(bad(&format!("{v} is not finite")));
+        }
+        out.push(v);
+    }
+    Ok(out)
+}
+
+/// The nodes of a line group in order along it, with their arc lengths.
+///
+/// The group's edges are recovered from the cells: a cell side is a group
+/// edge when it lies on the boundary (no other cell shares it) and all its
+/// nodes (the mid-side node too, for quad9) are in the group. Each edge is
+/// taken in its cell's counter-clockwise order, so the walk has the body on
+/// its left (DESIGN.md's tangent convention). An open chain starts at its
+/// free end; a closed loop at its node of least x (then least y). s is
+/// summed over straight segments (through the mid-side node on quad9).
+fn order_along(
+    name: &str,
+    group: &str,
+    nodes: &ndarray::Array2<f64>,
+    cells: &ndarray::Array2<i64>,
+    members: &[i64],
+) -> Result<(Vec<usize>, Vec<f64>), InputError> {
+    use std::collections::{HashMap, HashSet};
+    let n = nodes.nrows();
+    let bad_index = || {
+        InputError(format!(
+            "{name}: /mesh/cells or /mesh/groups/{group} holds a node index outside 0..{n}"
+        ))
+    };
+    let index = |v: i64| usize::try_from(v).ok().filter(|&i| i < n);
+    let member: HashSet<usize> = members
+        .iter()
+        .map(|&v| index(v).ok_or_else(bad_index))
+        .collect::<Result<_, _>>()?;
+    let npc = cells.ncols();
+    if npc != 4 && npc != 9 {
+        return Err(InputError(format!(
+            "{name}: /mesh/cells has {npc} nodes per cell, expected 4 or 9"
+        )));
+    }
+    // Corner pairs of every cell side, counted to find the boundary.
+    let mut count: HashMap<(usize, usize), u32> = HashMap::new();
+    let mut sides = Vec::with_capacity(4 * cells.nrows());
+    for row in cells.rows() {
+        let c: Vec<usize> = row
+            .iter()
+            .map(|&v| index(v).ok_or_else(bad_index))
+            .collect::<Result<_, _>>()?;
+        for e in 0..4 {
+            let (a, b) = (c[e], c[(e + 1) % 4]);
+            let mid = (npc == 9).then(|| c[4 + e]);
+            *count.entry((a.min(b), a.max(b))).or_default() += 1;
+            sides.push((a, b, mid));
+        }
+    }
+    let mut next: HashMap<usize, (usize, Option<usize>)> = HashMap::new();
+    let mut has_incoming: HashSet<usize> = HashSet::new();
+    for &(a, b, mid) in &sides {
+        let on_boundary = count[&(a.min(b), a.max(b))] == 1;
+        let in_group =
+            member.contains(&a) && member.contains(&b) && mid.is_none_or(|m| member.contains(&m));
+        if on_boundary && in_group {
+            if next.insert(a, (b, mid)).is_some() {
+                return Err(InputError(format!(
+                    "{name}: group {group:?} branches at node {a}; --along needs a single chain of edges"
+                )));
+            }
+            has_incoming.insert(b);
+        }
+    }
+    if next.is_empty() {
+        return Err(InputError(format!(
+            "{name}: group {group:?} has no boundary edges (is it a line group on the boundary?); \
+             --along needs a line group"
+        )));
+    }
+    let least = |ids: &mut dyn Iterator<Item = usize>| {
+        ids.min_by(|&a, &b| {
+            nodes[[a, 0]]
+                .total_cmp(&nodes[[b, 0]])
+                .then(nodes[[a, 1]].total_cmp(&nodes[[b, 1]]))
+        })
+    };
+    let starts: Vec<usize> = next
+        .keys()
+        .copied()
+        .filter(|a| !has_incoming.contains(a))
+        .collect();
+    let start = match starts.len() {
+        0 => least(&mut next.keys().copied()).expect("non-empty"),
+        1 => starts[0],
+        k => {
+            return Err(InputError(format!(
+                "{name}: group {group:?} is {k} separate pieces; --along needs one chain of edges \
+                 (split it into one physical group per piece in Gmsh)"
+            )))
+        }
+    };
+    let len =
+        |a: usize, b: usize| (nodes[[b, 0]] - nodes[[a, 0]]).hypot(nodes[[b, 1]] - nodes[[a, 1]]);
+    let (mut order, mut s) = (vec![start], vec![0.0]);
+    let mut at = start;
+    let mut walked = 0;
+    while let Some(&(b, mid)) = next.get(&at) {
+        let s0 = *s.last().expect("non-empty");
+        let s_end = match mid {
+            Some(m) => {
+                order.push(m);
+                s.push(s0 + len(at, m));
+                s0 + len(at, m) + len(m, b)
+            }
+            None => s0 + len(at, b),
+        };
+        walked += 1;
+        if b == start {
+            break;
+        }
+        order.push(b);
+        s.push(s_end);
+        at = b;
+        if walked > next.len() {
+            break;
+        }
+    }
+    if walked != next.len() {
+        return Err(InputError(format!(
+            "{name}: group {group:?} is not one chain of edges ({walked} of {} edges reached from node {start}); \
+             --along needs one chain (split it into one physical group per piece in Gmsh)",
+            next.len()
+        )));
+    }
+    Ok((order, s))
+}
+
+/// The contact group of the case stored in the file, if any.
+fn contact_group(f: &File) -> Option<String> {
+    let case = f
+        .attr("case")
+        .ok()?
+        .read_scalar::<hdf5::types::VarLenUnicode>()
+        .ok()?;
+    let doc: toml::Table = case.as_str().parse().ok()?;
+    doc.get("contact")?
+        .get("group")?
+        .as_str()
+        .map(str::to_string)
+}
+
+/// `--along GROUP --times T1,..`: `field` at the nodes of `group`, in order
+/// along it (for the contact group: the order of /contact/nodes, the nodes
+/// without friction placed by arc length), at the output steps nearest to
+/// each time.
+///
+/// # Errors
+/// Bad times, a file that is not a stickslip results file, a group the file
+/// does not have or that is not one chain of boundary edges, or a contact
+/// field asked along a file without a contact surface.
+pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Along, InputError> {
+    let asked = parse_times(times)?;
+    let name = file.display().to_string();
+    let h5 = |what: &str, e: hdf5::Error| {
+        InputError(format!(
+            "{name}: {what}: {e}; give a results file written by `stickslip run`"
+        ))
+    };
+    let f = File::open(file).map_err(|e| h5("cannot open it as HDF5", e))?;
+    let nodes = f
+        .dataset("mesh/nodes")
+        .and_then(|d| d.read_2d::<f64>())
+        .map_err(|e| h5("cannot read /mesh/nodes", e))?;
+    if nodes.ncols() != 2 {
+        return Err(InputError(format!(
+            "{name}: /mesh/nodes has shape {:?}, expected [n, 2]",
+            nodes.shape()
+        )));
+    }
+    let cells = f
+        .dataset("mesh/cells")
+        .and_then(|d| d.read_2d::<i64>())
+        .map_err(|e| h5("cannot read /mesh/cells", e))?;
+    let groups = f
+        .group("mesh/groups")
+        .map_err(|e| h5("cannot read /mesh/groups", e))?;
+    let members = match groups.dataset(group) {
+        Ok(d) => d
+            .read_1d::<i64>()
+            .map_err(|e| h5(&format!("cannot read /mesh/groups/{group}"), e))?
+            .to_vec(),
+        Err(_) => {
+            let have = groups.member_names().unwrap_or_default().join(", ");
+            return Err(InputError(format!(
+                "{name}: no group {group:?} in this file; it has: {have}"
+            )));
+        }
+    };
+    let (mut order, mut s) = order_along(&name, group, &nodes, &cells, &members)?;
+
+    let contact_field = field.node_dataset().is_none();
+    let is_contact_group = contact_group(&f).as_deref() == Some(group);
+    let contact: Option<(Vec<i64>, Vec<f64>)> = if contact_field || is_contact_group {
+        let c = f
+            .dataset("contact/nodes")
+            .and_then(|d| d.read_1d::<i64>())
+            .and_then(|c| {
+                Ok((
+                    c.to_vec(),
+                    f.dataset("contact/s")?.read_1d::<f64>()?.to_vec(),
+                ))
+            });
+        match c {
+            Ok(c) => Some(c),
+            Err(e) if contact_field => {
+                return Err(h5(
+                    &format!(
+                        "{} needs a contact surface, and this file has none (/contact)",
+                        field.name()
+                    ),
+                    e,
+                ))
+            }
+            Err(_) => None,
+        }
+    } else {
+        None
+    };
+    // Position of each ordered node in /contact/nodes.
+    let slot = |order: &[usize]| -> Vec<Option<usize>> {
+        order
+            .iter()
+            .map(|&v| {
+                contact
+                    .as_ref()
+                    .and_then(|(c, _)| c.iter().position(|&x| x == v as i64))
+            })
+            .collect()
+    };
+    if is_contact_group {
+        if let Some((_, cs)) = &contact {
+            // The order of /contact/nodes: sort by /contact/s where the node
+            // carries friction, by the walk's s elsewhere (both are measured
+            // from the same end of the same chain).
+            let slots = slot(&order);
+            let key: Vec<f64> = (0..order.len())
+                .map(|i| slots[i].map_or(s[i], |j| cs[j]))
+                .collect();
+            let mut idx: Vec<usize> = (0..order.len()).collect();
+            idx.sort_by(|&a, &b| key[a].total_cmp(&key[b]));
+            order = idx.iter().map(|&i| order[i]).collect();
+            s = idx.iter().map(|&i| key[i]).collect();
+        }
+    }
+    let slots = slot(&order);
+
+    let t_all = f
+        .dataset("time")
+        .and_then(|d| d.read_1d::<f64>())
+        .map_err(|e| h5("cannot read /time", e))?
+        .to_vec();
+    if t_all.is_empty() {
+        return Err(InputError(format!(
+            "{name}: /time is empty: the run wrote no output step"
+        )));
+    }
+    let (t_first, t_last) = (t_all[0], t_all[t_all.len() - 1]);
+    let mut info = format!(
+        "{} along {group:?}: {} nodes, s from 0 to {:.6e}{}\n",
+        field.name(),
+        order.len(),
+        s.last().copied().unwrap_or(0.0),
+        if is_contact_group {
+            " (the contact group: ordered as /contact/nodes)"
+        } else {
+            ""
+        }
+    );
+    let missing = slots.iter().filter(|x| x.is_none()).count();
+    if contact_field && missing > 0 {
+        let _ = writeln!(
+            info,
+            "{missing} of the group's nodes carry no friction (not in /contact/nodes): their {} is nan",
+            field.name()
+        );
+    }
+    let (mut steps, mut t_used, mut values) = (Vec::new(), Vec::new(), Vec::new());
+    for &ta in &asked {
+        let k = (0..t_all.len())
+            .min_by(|&a, &b| (t_all[a] - ta).abs().total_cmp(&(t_all[b] - ta).abs()))
+            .expect("non-empty");
+        let _ = write!(
+            info,
+            "t = {ta}: output step {k} at t = {} (nearest; off by {:.3e})",
+            t_all[k],
+            (t_all[k] - ta).abs()
+        );
+        if ta < t_first || ta > t_last {
+            let _ = write!(info, "; outside the run's [{t_first}, {t_last}]");
+        }
+        info.push('\n');
+        let row: Vec<f64> = match field.node_dataset() {
+            Some((ds, comp)) => {
+                let all = f
+                    .dataset(ds)
+                    .and_then(|d| d.read_slice_1d::<f64, _>(s![k, .., comp]))
+                    .map_err(|e| h5(&format!("cannot read /{ds}"), e))?;
+                order
+                    .iter()
+                    .map(|&v| all.get(v).copied().unwrap_or(f64::NAN))
+                    .collect()
+            }
+            None => {
+                let ds = format!("contact/{}", field.name());
+                let all = f
+                    .dataset(&ds)
+                    .and_then(|d| d.read_slice_1d::<f64, _>(s![k, ..]))
+                    .map_err(|e| h5(&format!("cannot read /{ds}"), e))?;
+                slots
+                    .iter()
+                    .map(|j| j.and_then(|j| all.get(j).copied()).unwrap_or(f64::NAN))
+                    .collect()
+            }
+        };
+        steps.push(k);
+        t_used.push(t_all[k]);
+        values.push(row);
+    }
+    let complete = f
+        .attr("complete")
+        .and_then(|a| a.read_scalar::<bool>())
+        .unwrap_or(false);
+    if !complete {
+        info.push_str("(the run did not complete)\n");
+    }
+    let mut csv = format!("t_asked,t,step,node,x,y,s,{}\n", field.name());
+    for (i, &ta) in asked.iter().enumerate() {
+        for (j, &v) in order.iter().enumerate() {
+            let _ = writeln!(
+                csv,
+                "{ta:e},{:e},{},{v},{:e},{:e},{:e},{:e}",
+                t_used[i],
+                steps[i],
+                nodes[[v, 0]],
+                nodes[[v, 1]],
+                s[j],
+                values[i][j]
+            );
+        }
+    }
+    Ok(Along {
+        info,
+        csv,
+        nodes: order,
+        s,
+        steps,
+        t: t_used,
+        values,
+    })
+}
+
+/// `stickslip probe FILE --along GROUP --times ..`: runs [`along`], prints
+/// the step choices on stderr and the CSV on stdout or into `args.output`.
+///
+/// # Errors
+/// As [`along`]; `--times` missing; the output file not writable.
+pub fn along_command(file: &Path, args: &AlongArgs, field: Field) -> Result<(), InputError> {
+    let group = args.along.as_deref().unwrap_or_default();
+    let times = args.times.as_deref().ok_or_else(|| {
+        InputError(format!(
+            "--along {group}: give the times too, e.g. --times 0.1,0.25,0.5"
+        ))
+    })?;
+    let a = along(file, group, times, field)?;
+    eprint!("{}", a.info);
+    match &args.output {
+        Some(out) => std::fs::write(out, &a.csv).map_err(|e| {
+            InputError(format!(
+                "-o {}: cannot write the CSV: {e}; check the directory exists and is writable",
+                out.display()
+            ))
+        }),
+        None => {
+            print!("{}", a.csv);
+            Ok(())
+        }
+    }
 }
 
 #[cfg(test)]
