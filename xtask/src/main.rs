@@ -192,6 +192,10 @@ fn demo(root: &Path, rest: &[String]) -> Result<(), String> {
     cmd.arg(&case).arg("-o").arg(&out).arg("--force").args(rest);
     run(&mut cmd)?;
     eprintln!("demo: results in {}", out.display());
+    eprintln!(
+        "demo: read them with `python3 examples/slab_node81.py {}` (h5py)",
+        out.display()
+    );
     Ok(())
 }
 
