@@ -13,6 +13,8 @@
 //! its Vec lengths. That peak includes whatever `from_file` holds while
 //! parsing (its read window of a few MB, the builder's side tables); it is
 //! reported as is, not netted out.
+//! CPU time per read (user + system) is printed too, as the figure least
+//! disturbed by other processes on a shared machine.
 //! The last line is `RESULT key=value …` for xtask to parse.
 
 use std::process::ExitCode;
@@ -72,6 +74,7 @@ fn main() -> ExitCode {
 
     // Speed: median of `runs` reads (the first read above warmed the page cache).
     let mut times = Vec::with_capacity(runs);
+    let cpu0 = proc_cpu_seconds();
     for _ in 0..runs {
         let t = Instant::now();
         let m = Mesh::from_file(&path);
@@ -83,6 +86,12 @@ fn main() -> ExitCode {
         drop(m);
         times.push(dt);
     }
+    // CPU time (user + system) per read: less sensitive than wall time to
+    // other processes on a shared machine (10 ms ticks, averaged over RUNS).
+    let cpu_s = match (cpu0, proc_cpu_seconds()) {
+        (Some(a), Some(b)) => (b - a) / runs as f64,
+        _ => f64::NAN,
+    };
     let median = median_of(&mut times);
     let mbps = file_bytes as f64 / 1e6 / median;
 
@@ -117,6 +126,10 @@ fn main() -> ExitCode {
     );
     println!("throughput       {mbps:>10.1} MB/s");
     println!(
+        "CPU per read     {cpu_s:>10.3} s   (user + system, mean of {runs}; {:.1} MB per CPU-second)",
+        file_bytes as f64 / 1e6 / cpu_s
+    );
+    println!(
         "  of which        {read_median:>10.3} s std::fs::read, {parse_median:.3} s Mesh::from_bytes ({:.1} MB/s) (medians)",
         file_bytes as f64 / 1e6 / parse_median
     );
@@ -147,7 +160,7 @@ fn main() -> ExitCode {
             ("nan".into(), "nan".into())
         }
     };
-    println!("RESULT file_bytes={file_bytes} median_s={median:.6} mb_per_s={mbps:.3} read_s={read_median:.6} parse_s={parse_median:.6} mesh_bytes={mesh_bytes} peak_bytes={peak} peak_ratio={ratio}");
+    println!("RESULT file_bytes={file_bytes} median_s={median:.6} mb_per_s={mbps:.3} read_s={read_median:.6} parse_s={parse_median:.6} mesh_bytes={mesh_bytes} peak_bytes={peak} peak_ratio={ratio} cpu_s={cpu_s:.6}");
     ExitCode::SUCCESS
 }
 
@@ -178,6 +191,18 @@ fn mesh_size_bytes(m: &Mesh) -> usize {
 /// Resets the process's peak RSS counter (Linux ≥ 4.0: "5" > clear_refs).
 fn reset_peak_rss() -> bool {
     std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+/// User + system CPU seconds of this process so far (/proc/self/stat
+/// fields 14 and 15, in clock ticks assumed to be the usual 100 per second).
+fn proc_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name, which is in parentheses.
+    let rest = s.get(s.rfind(')')? + 2..)?;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = f.get(11)?.parse().ok()?;
+    let stime: f64 = f.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
 }
 
 /// A `kB` field of /proc/self/status, in KiB.
