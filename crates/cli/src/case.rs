@@ -589,6 +589,10 @@ const SECTIONS: &[(&str, &[(&str, Kind)])] = &[
     ("output", OUTPUT),
 ];
 
+/// A key whose value had the wrong type: its path, the placeholder put in
+/// its place (`None`: removed), and where it was.
+type Retyped = (Vec<Seg>, Option<Value>, Option<Range<usize>>);
+
 /// One step of a key path: a key or an index into a list of tables.
 #[derive(Clone, Debug)]
 enum Seg {
@@ -673,7 +677,7 @@ fn check_table(
     schema: &'static [(&'static str, Kind)],
     report: &mut dyn FnMut(Option<Range<usize>>, String),
     removals: &mut Vec<Vec<Seg>>,
-    typed: &mut Vec<(Vec<Seg>, Option<Value>, Option<Range<usize>>)>,
+    typed: &mut Vec<Retyped>,
 ) {
     let section = if path.is_empty() {
         "the top level".to_string()
