@@ -598,11 +598,3 @@ pub fn main(out: &Path, quick: bool) -> Result<(), String> {
     );
     Ok(())
 }
-
-/// Timing probe (development aid).
-///
-/// # Errors
-/// Any failure.
-pub fn probe() -> Result<(), String> {
-    Ok(())
-}

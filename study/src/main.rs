@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-const USAGE: &str = "usage: stickslip-study <chart|stability|probe> [--quick] [--out DIR]";
+const USAGE: &str = "usage: stickslip-study <chart|stability> [--quick] [--out DIR]";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -48,7 +48,6 @@ fn real_main(args: &[String]) -> Result<(), String> {
     match cmd.as_str() {
         "chart" => stickslip_study::chart::main(&out, quick),
         "stability" => stickslip_study::stability::main(&out, quick),
-        "probe" => stickslip_study::chart::probe(),
         _ => Err(USAGE.into()),
     }
 }
