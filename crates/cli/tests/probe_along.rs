@@ -76,7 +76,7 @@ fn write_fixture(path: &Path) {
         .create("cells")
         .unwrap();
     let g = m.create_group("groups").unwrap();
-    let mut group = |name: &str, pts: &[(usize, usize)]| {
+    let group = |name: &str, pts: &[(usize, usize)]| {
         let mut ids: Vec<i64> = pts.iter().map(|&(x, y)| id(x, y) as i64).collect();
         ids.sort_unstable();
         g.new_dataset_builder()
