@@ -11,7 +11,7 @@
 //! resident set (`VmHWM` of /proc/self/status) during one read, above the
 //! resident set before it, compared with the `Mesh`'s own size estimated from
 //! its Vec lengths. That peak includes whatever `from_file` holds while
-//! parsing (its read window of a few MB, the builder's side tables); it is
+//! parsing (its read window of 1 MiB, the builder's side tables); it is
 //! reported as is, not netted out.
 //! CPU time per read (user + system) is printed too, as the figure least
 //! disturbed by other processes on a shared machine.

@@ -146,7 +146,7 @@ impl Mesh {
             let bytes = std::fs::read(path).map_err(|e| MeshError::io(path, e))?;
             return Mesh::from_bytes(&bytes).map_err(|e| e.with_path(path));
         }
-        // Streamed through a window of a few MB: the file's bytes are never
+        // Streamed through a window of 1 MiB: the file's bytes are never
         // all resident next to the mesh (peak memory target of issue 2).
         msh::read_file(path, file, meta.len(), msh::CHUNK).map_err(|e| e.with_path(path))
     }
