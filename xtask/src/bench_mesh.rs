@@ -302,7 +302,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         );
     }
     println!(
-        "\npeak MB = growth of the resident set (VmHWM) during one Mesh::from_file, including the file's bytes held while parsing;\n\
+        "\npeak MB = growth of the resident set (VmHWM) during one Mesh::from_file, which streams regular files through a 1 MiB buffer;\n\
          target peak/Mesh < {TARGET_PEAK_RATIO}. gmsh RSS = peak resident set of the whole Python process (interpreter + libgmsh + model).\n\
          {}",
         if all_met { "All targets met." } else { "Some targets are MISSED (see MISS above)." }
