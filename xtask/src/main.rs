@@ -12,6 +12,7 @@ mod bench_mesh;
 mod bench_step;
 mod meshes;
 mod python;
+mod study;
 mod verify;
 
 const USAGE: &str = "\
@@ -28,6 +29,11 @@ usage: cargo xtask <command> [args]
                     [--quick] [--bless] [--only SUITE]
   figures           redraw the paper's figures from our runs into docs/figures
                     [--out DIR]
+  chart             work-precision study on the slab: error against wall time
+                    for each order, mesh, scheme and step into docs/ [--quick]
+  stability         where methods fail: central difference around its critical
+                    step, ringing after sticking, the iteration without
+                    Remark 4.2, into docs/ [--quick]
   meshes            regenerate cases/meshes/*.msh with Gmsh (installs gmsh from PyPI)
   bench mesh        .msh read throughput on a 1M-node mesh against gmsh.open
   bench step        time per step of both schemes on the slab ladders, against
@@ -53,6 +59,8 @@ fn main() -> ExitCode {
         "meshes" => meshes::run(&root, rest),
         "verify" => verify::verify(&root, rest),
         "figures" => verify::figures(&root, rest),
+        "chart" => study::chart(&root, rest),
+        "stability" => study::stability(&root, rest),
         "bench" => match rest.split_first() {
             Some((what, more)) if what == "mesh" => bench_mesh::run(&root, more),
             Some((what, more)) if what == "fem" => bench_fem::run(&root, more),
