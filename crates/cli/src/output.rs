@@ -11,9 +11,13 @@
 //!
 //! `/checkpoint` holds the integrator's full state at the last flush
 //! ([`ResultsWriter::write_checkpoint`]: the `stickslip_time::Checkpoint`
-//! fields and the number of output rows at that moment), rewritten in place
-//! at every flush; [`read_checkpoint`] and [`ResultsWriter::open_append`]
-//! continue a file from it (`stickslip run --restart`).
+//! fields and the number of output rows at that moment) in one of two slots,
+//! `/checkpoint/a` and `/checkpoint/b`, named by the attribute
+//! `/checkpoint.slot` (0 = a, 1 = b): a new checkpoint goes into the other
+//! slot, is flushed, and only then becomes the current one, so a `kill -9`
+//! in the middle of writing one leaves the previous one intact.
+//! [`read_checkpoint`] and [`ResultsWriter::open_append`] continue a file
+//! from it (`stickslip run --restart`).
 
 use std::path::Path;
 use std::time::Instant;
@@ -285,6 +289,9 @@ fn get_scalar<T: H5Type>(loc: &hdf5::Location, name: &str) -> Result<T> {
         .with_context(|| format!("/checkpoint attribute {name}"))
 }
 
+/// The two checkpoint slots.
+const SLOTS: [&str; 2] = ["a", "b"];
+
 /// Order of `/checkpoint/energy`.
 const ENERGY_ORDER: &str = "kinetic, strain, external_work, dissipated, total, balance";
 
@@ -317,7 +324,11 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
             path.display()
         );
     }
-    let g = file.group("checkpoint")?;
+    let cg = file.group("checkpoint")?;
+    let slot: u8 = get_scalar(&cg, "slot")?;
+    let g = cg
+        .group(SLOTS[usize::from(slot).min(1)])
+        .context("/checkpoint: the current slot is missing")?;
     let e: Vec<f64> = get_vector(&g, "energy")?;
     ensure!(
         e.len() == 6,
@@ -399,8 +410,16 @@ impl ResultsWriter {
         let mesh = header.mesh;
         let n_nodes = mesh.nodes.len();
         ensure!(n_nodes > 0, "the mesh has no nodes");
-        let file =
-            File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+        // No reuse of freed file space: a compressed chunk rewritten after a
+        // flush moves, and with reuse its old place (which the flushed
+        // metadata still points to) could be overwritten by later data, so a
+        // `kill -9` between flushes would leave flushed rows unreadable
+        // (seen as "inflate() failed" on restart). The cost: the space of a
+        // partly filled chunk's older copies, one per flush at most.
+        let file = File::with_options()
+            .with_fcpl(|p| p.file_space_strategy(hdf5::file::FileSpaceStrategy::None))
+            .create(path)
+            .with_context(|| format!("cannot create {}", path.display()))?;
         let root: &hdf5::Location = &file;
         string_attr(root, "program", "stickslip")?;
         string_attr(root, "version", env!("CARGO_PKG_VERSION"))?;
@@ -621,17 +640,26 @@ impl ResultsWriter {
     /// # Errors
     /// HDF5 errors, or a state whose lengths changed since the last checkpoint.
     pub fn write_checkpoint(&mut self, cp: &Checkpoint, extra: &CheckpointExtra) -> Result<()> {
-        let g = if self.file.link_exists("checkpoint") {
-            self.file.group("checkpoint")?
+        let (cg, slot) = if self.file.link_exists("checkpoint") {
+            let cg = self.file.group("checkpoint")?;
+            let current: u8 = get_scalar(&cg, "slot")?;
+            (cg, 1 - current.min(1))
         } else {
-            let g = self.file.create_group("checkpoint")?;
+            let cg = self.file.create_group("checkpoint")?;
             string_attr(
-                &g,
+                &cg,
                 "about",
-                "the integrator's state at the last flush (stickslip run --restart continues from it); \
-                 vectors on the free DOFs; rows = output rows that belong to this state",
+                "the integrator's state at the last flush (stickslip run --restart continues from it), \
+                 in the slot named by the attribute slot (0 = a, 1 = b); vectors on the free DOFs; \
+                 rows = output rows that belong to this state",
             )?;
-            g
+            (cg, 0)
+        };
+        let name = SLOTS[usize::from(slot)];
+        let g = if cg.link_exists(name) {
+            cg.group(name)?
+        } else {
+            cg.create_group(name)?
         };
         put_vector(&g, "displacement", &cp.displacement)?;
         put_vector(&g, "velocity", &cp.velocity)?;
@@ -664,6 +692,9 @@ impl ResultsWriter {
         put_scalar(&g, "rows", extra.rows as u64)?;
         put_scalar(&g, "wall_time_s", extra.wall_time_s)?;
         put_scalar(&g, "max_balance", extra.max_balance)?;
+        // The new slot is complete on disk before it becomes the current one.
+        self.file.flush()?;
+        put_scalar(&cg, "slot", slot)?;
         self.flush()
     }
 
