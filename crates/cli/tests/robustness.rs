@@ -559,8 +559,8 @@ fn slot(f: &hdf5::File) -> hdf5::Group {
 
 fn checkpoint_attr<T: hdf5::H5Type>(path: &Path, name: &str) -> T {
     let f = hdf5::File::open(path).unwrap();
-    let v = slot(&f).attr(name).unwrap().read_scalar::<T>().unwrap();
-    v
+    let g = slot(&f);
+    g.attr(name).unwrap().read_scalar::<T>().unwrap()
 }
 
 /// Python: `c` = the current checkpoint slot of file `f`.
