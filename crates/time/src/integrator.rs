@@ -318,6 +318,9 @@ pub struct Integrator {
     thetas: Vec<f64>,
     /// Per-chunk partial sums of the explicit passes.
     partials: kernels::Partials,
+    /// K in the explicit step's compact form (`kernels::Compact`); the CSR
+    /// K is then no longer held.
+    compact: Option<kernels::Compact>,
 }
 
 impl std::fmt::Debug for Integrator {
@@ -397,7 +400,7 @@ impl Integrator {
     /// Settings out of range, Δt above the explicit critical step (unless
     /// allowed), or a singular static problem.
     pub fn new(
-        dynamics: Dynamics,
+        mut dynamics: Dynamics,
         contact: Option<ContactSurface>,
         loads: Vec<Load>,
         settings: Settings,
@@ -420,8 +423,14 @@ impl Integrator {
                 });
             }
         }
+        // The consistent mass is held once: moved into `mass_matrix` when the
+        // scheme uses it, dropped otherwise; the explicit scheme needs no
+        // mass matrix.
+        let consistent_mass =
+            std::mem::replace(&mut dynamics.consistent_mass, CsrMatrix::zeros(n, n));
         let mass_matrix = match mass_kind {
-            MassKind::Consistent => dynamics.consistent_mass.clone(),
+            MassKind::Consistent => consistent_mass,
+            MassKind::Lumped if explicit => CsrMatrix::zeros(n, n),
             MassKind::Lumped => {
                 let mut m = dynamics.stiffness.clone();
                 let (offsets, cols, values) = m.csr_data_mut();
@@ -500,6 +509,7 @@ impl Integrator {
             forces_new: vec![0.0; n_c],
             thetas: vec![0.0; loads.len()],
             partials: vec![[0.0; 4]; kernels::chunks(n)],
+            compact: None,
             r,
             v,
             dynamics,
@@ -542,6 +552,15 @@ impl Integrator {
             total: kinetic + strain - dot(&this.r, &this.load),
             balance: 0.0,
         };
+        if this.explicit {
+            // From here on the explicit step reads K only through the
+            // compact form: 0.57× the CSR's bytes per step, and the CSR's
+            // memory returned.
+            this.compact = kernels::Compact::new(&this.dynamics.stiffness);
+            if this.compact.is_some() {
+                this.dynamics.stiffness = CsrMatrix::zeros(n, n);
+            }
+        }
         Ok(this)
     }
 
@@ -771,21 +790,38 @@ impl Integrator {
             &mut self.load_new,
             &mut self.r_new,
         );
-        kernels::spmv(&self.dynamics.stiffness, &self.r_new, &mut self.b);
         let scale = 1.0 / (gamma * dt);
-        let strain = kernels::rhs_and_velocity(
-            &self.load_new,
-            &self.dynamics.lumped_mass,
-            &self.r_new,
-            &self.v,
-            &self.a,
-            1.0 / (gamma * dt),
-            1.0 / gamma - 1.0,
-            scale,
-            &mut self.b,
-            &mut self.v_new,
-            &mut self.partials,
-        );
+        let strain = if let Some(k) = &self.compact {
+            kernels::spmv_rhs_and_velocity(
+                k,
+                &self.load_new,
+                &self.dynamics.lumped_mass,
+                &self.r_new,
+                &self.v,
+                &self.a,
+                1.0 / (gamma * dt),
+                1.0 / gamma - 1.0,
+                scale,
+                &mut self.b,
+                &mut self.v_new,
+                &mut self.partials,
+            )
+        } else {
+            kernels::spmv(&self.dynamics.stiffness, &self.r_new, &mut self.b);
+            kernels::rhs_and_velocity(
+                &self.load_new,
+                &self.dynamics.lumped_mass,
+                &self.r_new,
+                &self.v,
+                &self.a,
+                1.0 / (gamma * dt),
+                1.0 / gamma - 1.0,
+                scale,
+                &mut self.b,
+                &mut self.v_new,
+                &mut self.partials,
+            )
+        };
         self.scratch_classes.copy_from_slice(&self.classes);
         let iterations = match &self.contact {
             None => 1,
@@ -1219,6 +1255,20 @@ impl Integrator {
     /// forward+back solve reads twice.
     pub fn factor_len(&self) -> usize {
         self.schur.as_ref().map_or(0, |op| op.factor_len())
+    }
+
+    /// Bytes of K one explicit step streams (its compact form, see
+    /// `kernels.rs`; the CSR's values, column indices and row offsets when
+    /// the compact form does not apply); 0 for implicit runs.
+    pub fn explicit_matrix_bytes(&self) -> usize {
+        match (&self.compact, self.explicit) {
+            (Some(k), _) => k.bytes(),
+            (None, true) => {
+                let k = &self.dynamics.stiffness;
+                16 * k.nnz() + 8 * (k.nrows() + 1)
+            }
+            (None, false) => 0,
+        }
     }
 
     /// How implicit steps solve their linear systems.
