@@ -965,14 +965,14 @@ fn convert(
     let m = &raw.material;
     let (e, nu, rho) = (*m.e.get_ref(), *m.nu.get_ref(), *m.rho.get_ref());
     check(
-        e > 0.0,
+        e > 0.0 && e.is_finite(),
         m.e.span(),
-        format!("material.E = {e} must be > 0; give Young's modulus"),
+        format!("material.E = {e} must be a finite number > 0; give Young's modulus"),
     );
     check(
-        rho > 0.0,
+        rho > 0.0 && rho.is_finite(),
         m.rho.span(),
-        format!("material.rho = {rho} must be > 0; give the mass density"),
+        format!("material.rho = {rho} must be a finite number > 0; give the mass density"),
     );
     check(
         nu > -1.0 && nu < 0.5,
@@ -1075,13 +1075,13 @@ fn convert(
     // [contact]
     if let Some(c) = &raw.contact {
         let (p, mu, eps) = (*c.pressure.get_ref(), *c.mu.get_ref(), *c.eps.get_ref());
-        check(p >= 0.0, c.pressure.span(), format!("contact.pressure = {p} must be >= 0 (it presses the body onto the surface; g = mu * pressure)"));
+        check(p >= 0.0 && p.is_finite(), c.pressure.span(), format!("contact.pressure = {p} must be >= 0 and finite (it presses the body onto the surface; g = mu * pressure)"));
         check(
-            mu >= 0.0,
+            mu >= 0.0 && mu.is_finite(),
             c.mu.span(),
-            format!("contact.mu = {mu} must be >= 0; use 0 for frictionless contact"),
+            format!("contact.mu = {mu} must be >= 0 and finite; use 0 for frictionless contact"),
         );
-        check(eps > 0.0, c.eps.span(), format!("contact.eps = {eps} must be > 0 (the friction law's regularization; the paper uses 1e-4 to 1)"));
+        check(eps > 0.0 && eps.is_finite(), c.eps.span(), format!("contact.eps = {eps} must be > 0 and finite (the friction law's regularization; the paper uses 1e-4 to 1)"));
         if let Some(n) = &c.max_iterations {
             check(
                 *n.get_ref() > 0,
