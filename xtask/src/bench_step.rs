@@ -1,17 +1,22 @@
 //! `cargo xtask bench step`: time per step of central difference and of
 //! implicit Newmark (Schur path) on the slab ladder (issue 7, deliverable
-//! 3), with the hardware figures measured in the same run (STREAM triad
-//! bandwidth and the bytes an explicit step moves; one forward+back solve
-//! for Newmark).
+//! 3), with the figures it is compared with measured in the same run: STREAM
+//! triad bandwidth and the bytes an explicit step moves; one forward+back
+//! solve for Newmark; the scipy peer (bench/peer.py, numpy + scipy,
+//! installed with pip if missing) on the paper's 85-node mesh and the rungs
+//! of ≥ 100k DOFs, checked against our state (1e-8) before it is timed;
+//! peak memory against what the run must hold.
 //!
 //! Runs `crates/time/examples/bench_step.rs`, which times each rung in its
-//! own process (so its peak RSS is the rung's), prints one `RESULT` line per
-//! rung and writes target/bench/step.csv. Figures are printed, not asserted.
+//! own process (so its peak RSS is the rung's), prints one row per rung and
+//! writes target/bench/step.csv. Figures are printed, not asserted.
 //!
-//!     cargo xtask bench step [--quick] [--max-dofs N]
+//!     cargo xtask bench step [--quick] [--max-dofs N] [--no-peer]
 
 use std::path::Path;
 use std::process::Command;
+
+use crate::python;
 
 /// Builds and runs the bench example, passing `--quick` / `--max-dofs N`.
 ///
@@ -19,10 +24,12 @@ use std::process::Command;
 /// Bad arguments or a failing cargo run.
 pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     let mut pass: Vec<String> = Vec::new();
+    let mut peer = true;
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
             "--quick" => pass.push(a.clone()),
+            "--no-peer" => peer = false,
             "--max-dofs" => {
                 let v = it.next().ok_or("--max-dofs needs a number of DOFs")?;
                 v.parse::<u64>()
@@ -31,7 +38,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                 pass.push(v.clone());
             }
             "-h" | "--help" => {
-                println!("cargo xtask bench step [--quick] [--max-dofs N]");
+                println!("cargo xtask bench step [--quick] [--max-dofs N] [--no-peer]");
                 return Ok(());
             }
             other => {
@@ -40,6 +47,10 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                 ))
             }
         }
+    }
+    if peer {
+        python::ensure_python_modules(&[("numpy", "numpy"), ("scipy", "scipy")])?;
+        pass.push("--peer".into());
     }
     let status = Command::new("cargo")
         .current_dir(root)

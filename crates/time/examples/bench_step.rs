@@ -19,6 +19,7 @@ use stickslip_fem::{
     traction_load, Dirichlet, Hypothesis, Material, Model, SparseCholesky, Traction,
 };
 use stickslip_mesh::{CellKind, Edge, Group, Mesh, SourceInfo};
+use stickslip_time::stability::critical_step;
 use stickslip_time::{Dynamics, History, Integrator, Load, Scheme, Settings};
 
 /// The structured slab [0, 8] × [0, 1] with nx × ny Q1 or Q2 cells and the
@@ -180,16 +181,100 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Peak resident memory of this process (VmHWM), bytes.
-fn peak_rss() -> f64 {
+/// A memory figure of this process from /proc/self/status ("VmHWM:" the
+/// peak resident set, "VmRSS:" the current one), bytes.
+fn status_bytes(key: &str) -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
             s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
+                .find(|l| l.starts_with(key))
                 .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
         })
         .map_or(f64::NAN, |kb| kb * 1024.0)
+}
+
+/// Peak resident memory of this process (VmHWM), bytes.
+fn peak_rss() -> f64 {
+    status_bytes("VmHWM:")
+}
+
+/// Resets VmHWM to the current RSS (Linux clear_refs "5"), so that a later
+/// [`peak_rss`] is the peak of what ran since. False if refused.
+fn reset_peak_rss() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+fn write_f64(path: &std::path::Path, v: &[f64]) {
+    let mut bytes = Vec::with_capacity(8 * v.len());
+    for x in v {
+        bytes.extend_from_slice(&x.to_le_bytes());
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+fn write_i64(path: &std::path::Path, v: &[usize]) {
+    let mut bytes = Vec::with_capacity(8 * v.len());
+    for &x in v {
+        bytes.extend_from_slice(&(x as i64).to_le_bytes());
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// Writes what bench/peer.py needs into `dir`: K and M (CSR: row offsets,
+/// column indices as little-endian i64, values as f64), the lumped mass,
+/// the constant load, the loads with their histories, the contact nodes
+/// (free DOFs, tangent, w·g) and the scheme's parameters (meta.json).
+#[allow(clippy::too_many_arguments)]
+fn dump_problem(
+    dir: &std::path::Path,
+    model: &Model,
+    contact: &ContactSurface,
+    loads: &[Load],
+    scheme: &str,
+    dt: f64,
+    check_steps: usize,
+) {
+    std::fs::create_dir_all(dir).unwrap();
+    let k = &model.stiffness;
+    write_i64(&dir.join("indptr.i64"), k.row_offsets());
+    write_i64(&dir.join("indices.i64"), k.col_indices());
+    write_f64(&dir.join("k.f64"), k.values());
+    assert!(model.mass.pattern() == k.pattern(), "M has K's pattern");
+    write_f64(&dir.join("m.f64"), model.mass.values());
+    write_f64(&dir.join("lumped.f64"), &model.lumped_mass);
+    write_f64(&dir.join("constant.f64"), &model.dirichlet_load);
+    let mut histories = Vec::new();
+    for (l, load) in loads.iter().enumerate() {
+        write_f64(&dir.join(format!("load{l}.f64")), &load.vector);
+        histories.push(match load.history {
+            History::Constant => "\"constant\"",
+            History::Step => "\"step\"",
+            _ => panic!("the bench's loads are constant or step"),
+        });
+    }
+    let dof = |d: Option<usize>| d.map_or(-1, |i| i as i64).to_string();
+    let list = |f: &dyn Fn(&stickslip_contact::ContactNode) -> String| {
+        contact.nodes.iter().map(f).collect::<Vec<_>>().join(",")
+    };
+    let json = format!(
+        "{{\"scheme\": \"{scheme}\", \"n\": {}, \"nnz\": {}, \"dt\": {dt:e}, \"beta\": {}, \"gamma\": {}, \
+         \"eps\": {:e}, \"check_steps\": {check_steps}, \"histories\": [{}], \
+         \"contact_dof_x\": [{}], \"contact_dof_y\": [{}], \"contact_tx\": [{}], \"contact_ty\": [{}], \
+         \"contact_wg\": [{}]}}\n",
+        k.nrows(),
+        k.nnz(),
+        if scheme == "cd" { 0.0 } else { 0.25 },
+        0.5,
+        contact.law.eps,
+        histories.join(", "),
+        list(&|c| dof(c.dofs[0])),
+        list(&|c| dof(c.dofs[1])),
+        list(&|c| format!("{:e}", c.tangent[0])),
+        list(&|c| format!("{:e}", c.tangent[1])),
+        list(&|c| format!("{:e}", c.force_scale())),
+    );
+    std::fs::write(dir.join("meta.json"), json).unwrap();
 }
 
 /// STREAM triad a = b + s c, bytes per second (3 × 8 bytes per entry, the
@@ -217,52 +302,98 @@ fn stream_triad() -> f64 {
     24.0 * n as f64 / best
 }
 
-/// One rung: prints a RESULT line.
-fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize) {
+/// One rung: prints a RESULT line. With `dump`, first writes the problem
+/// and the state after a few steps for bench/peer.py.
+fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option<PathBuf>) {
+    let t_setup = Instant::now();
     let mesh = mesh_named(name);
     let (model, contact, loads) = problem(&mesh);
+    drop(mesh);
     let n = model.dofs.n_free();
     let nnz = model.stiffness.nnz();
     let n_c = contact.len();
     let explicit = scheme == "cd";
-    let make = |dt: f64, t_end: f64| {
-        let s = if explicit {
-            Settings::new(Scheme::CentralDifference, dt, t_end)
-        } else {
-            Settings::new(
-                Scheme::Newmark {
-                    beta: 0.25,
-                    gamma: 0.5,
-                },
-                dt,
-                t_end,
-            )
-        };
-        Integrator::new(
-            Dynamics::from_model(&model),
-            Some(contact.clone()),
-            loads.clone(),
-            s,
-        )
-        .unwrap()
-    };
-    let t_setup = Instant::now();
-    let mut i = if explicit {
-        let probe = make(1e-12, 1.0);
-        let dt = 0.9 * probe.dt_crit().unwrap();
-        drop(probe);
-        make(dt, 1e9)
+    let newmark_dt = 5e-3;
+    // Long enough on small meshes for nodes to slip (the friction branches
+    // are then part of the check); a few steps on large ones.
+    let check_steps = if n < 50_000 { 2000 } else { 10 };
+    // Newmark's hardware figure first, so that its matrix and factor are
+    // gone before the run (the run's peak is the run's).
+    let solve = if explicit {
+        None
     } else {
-        make(5e-3, 1e9)
+        // One forward+back solve with a factor of A₀ (fem's wrapper: the
+        // same AMD ordering and faer supernodal Cholesky as the step's).
+        let a0 = model.combined(0.5 * newmark_dt, 1.0 / (0.5 * newmark_dt));
+        let mut chol = SparseCholesky::analyze(&a0).unwrap();
+        chol.factorize(&a0).unwrap();
+        let mut x = vec![1.0; n];
+        let mut times = Vec::new();
+        for _ in 0..repeats.max(5) {
+            x.fill(1.0);
+            let t = Instant::now();
+            chol.solve_in_place(&mut x);
+            times.push(t.elapsed().as_secs_f64());
+        }
+        Some(median(times))
     };
+    let dt = if explicit {
+        0.9 * critical_step(&model.stiffness, &model.lumped_mass)
+    } else {
+        newmark_dt
+    };
+    if let Some(dir) = &dump {
+        dump_problem(dir, &model, &contact, &loads, scheme, dt, check_steps);
+    }
+    // The model's matrices move into the integrator: one copy of K and M.
+    let dynamics = Dynamics::from_model_owned(model);
+    let settings = if explicit {
+        Settings::new(Scheme::CentralDifference, dt, 1e9)
+    } else {
+        Settings::new(
+            Scheme::Newmark {
+                beta: 0.25,
+                gamma: 0.5,
+            },
+            dt,
+            1e9,
+        )
+    };
+    let pool = rayon::ThreadPoolBuilder::new().build().unwrap();
+    let mut i = pool.install(|| Integrator::new(dynamics, Some(contact), loads, settings).unwrap());
     let setup = t_setup.elapsed().as_secs_f64();
-    // Warm-up: the thread pool and the factor of the normal Δt.
+    let peak_setup = peak_rss();
+    let reset = reset_peak_rss();
+    let rss_start = status_bytes("VmRSS:");
     let run = |i: &mut Integrator, k: usize| {
         for _ in 0..k {
             i.step().unwrap();
         }
     };
-    let pool = rayon::ThreadPoolBuilder::new().build().unwrap();
+    if let Some(dir) = &dump {
+        // The peer starts from the same initial state (Remark 4.1) and
+        // checks its state after a few steps against ours.
+        write_f64(&dir.join("r0.f64"), i.displacement());
+        write_f64(&dir.join("v0.f64"), i.velocity());
+        write_f64(&dir.join("a0.f64"), i.acceleration());
+        // The most nodes slipping at once during the check steps.
+        let slipping = pool.install(|| {
+            let mut most = 0;
+            for _ in 0..check_steps {
+                i.step().unwrap();
+                most = most.max(i.classes().iter().filter(|c| !c.is_stuck()).count());
+            }
+            most
+        });
+        write_f64(&dir.join("r_check.f64"), i.displacement());
+        write_f64(&dir.join("v_check.f64"), i.velocity());
+        std::fs::write(
+            dir.join("check.json"),
+            format!("{{\"slipping\": {slipping}}}\n"),
+        )
+        .unwrap();
+    }
+    // Warm-up: the thread pool and the factor of the normal Δt.
     let per_step = pool.install(|| {
         let t = Instant::now();
         run(&mut i, 2);
@@ -276,16 +407,36 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize) {
         (median(times), first)
     });
     let slipping = i.classes().iter().filter(|c| !c.is_stuck()).count();
-    // Before the STREAM arrays and the solve's own factor exist.
-    let peak = peak_rss();
+    // Before the STREAM arrays exist.
+    let peak_run = if reset { peak_rss() } else { f64::NAN };
+    let peak = peak_rss().max(peak_setup);
+    // What the run must hold: the matrices it streams or factorizes, the
+    // factor, and the integrator's free-DOF vectors (r, ṙ, r̈, R and their
+    // new values, b, two scratch, the lumped mass, the constant load, the
+    // bench's two loads: 14 of n f64).
+    let vectors = 14.0 * 8.0 * n as f64;
+    let csr = 16.0 * nnz as f64 + 8.0 * (n + 1) as f64;
+    let (matrix, factor) = if explicit {
+        (i.explicit_matrix_bytes() as f64, 0.0)
+    } else {
+        // K, M and the Schur operator's A₀ (each a CSR with its own
+        // pattern), the factor's values.
+        (3.0 * csr, 8.0 * i.factor_len() as f64)
+    };
+    let need = matrix + factor + vectors;
+    let memory = format!(
+        "peak_rss={peak:.0} peak_run={peak_run:.0} rss_start={rss_start:.0} matrix_bytes={matrix:.0} \
+         factor_bytes={factor:.0} vector_bytes={vectors:.0} peak_run_over_need={:.3} peak_over_need={:.3}",
+        peak_run / need,
+        peak / need
+    );
     let extra = if explicit {
-        // Bytes the three passes and the SpMV must move (kernels.rs):
-        // K values and column indices, row offsets; vectors: pass A reads
-        // constant, 2 loads, r, ṙ, r̈ and writes R_K, r_K (7 + 2); the SpMV
-        // reads r_K and writes K r_K (2); pass B reads R_K, m, r_K, ṙ, r̈,
-        // K r_K and writes b, ṙ_K (8); pass C reads m, R, R_K, r, r_K, ṙ,
-        // ṙ_K, r̈ and writes r̈_K (9). 27 vectors of n f64.
-        let bytes = 16.0 * nnz as f64 + 8.0 * (n + 1) as f64 + 27.0 * 8.0 * n as f64;
+        // Bytes the passes must move (kernels.rs): K in its compact form;
+        // vectors: pass A reads the constant load, 2 loads, r, ṙ, r̈ and
+        // writes R_K, r_K (8); the SpMV fused with pass B reads r_K, R_K,
+        // m, ṙ, r̈ and writes b, ṙ_K (7); pass C reads m, R, R_K, r, r_K,
+        // ṙ, ṙ_K, r̈ and writes r̈_K (9). 24 vectors of n f64.
+        let bytes = i.explicit_matrix_bytes() as f64 + 24.0 * 8.0 * n as f64;
         let bw = pool.install(stream_triad);
         format!(
             "bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
@@ -293,21 +444,7 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize) {
             100.0 * bytes / per_step.0 / bw
         )
     } else {
-        // One forward+back solve with a factor of A₀ (fem's wrapper: the
-        // same AMD ordering and faer supernodal Cholesky as the step's).
-        let dt = 5e-3;
-        let a0 = model.combined(0.5 * dt, 1.0 / (0.5 * dt));
-        let mut chol = SparseCholesky::analyze(&a0).unwrap();
-        chol.factorize(&a0).unwrap();
-        let mut x = vec![1.0; n];
-        let mut times = Vec::new();
-        for _ in 0..repeats.max(5) {
-            x.fill(1.0);
-            let t = Instant::now();
-            chol.solve_in_place(&mut x);
-            times.push(t.elapsed().as_secs_f64());
-        }
-        let solve = median(times);
+        let solve = solve.expect("timed above");
         format!(
             "solve={solve:.4e} step_over_solve={:.2} factor_len={} factorizations={}",
             per_step.0 / solve,
@@ -317,11 +454,82 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize) {
     };
     println!(
         "RESULT scheme={scheme} mesh={name} dofs={n} nnz={nnz} contact_nodes={n_c} steps={steps} repeats={repeats} \
-         step={:.4e} first2={:.4e} setup={setup:.3e} slipping={slipping} peak_rss={:.0} {extra}",
-        per_step.0,
-        per_step.1,
-        peak
+         step={:.4e} first2={:.4e} setup={setup:.3e} slipping={slipping} {memory} {extra}",
+        per_step.0, per_step.1,
     );
+}
+
+/// Rungs the scipy peer runs on (both schemes where the ladder has them).
+const PEER_MESHES: [&str; 4] = [
+    "slab-q2-8x2",
+    "gen-q2-352x44",
+    "gen-q1-708x177",
+    "gen-q1-1416x354",
+];
+
+/// A value of a `key=value` row.
+fn field(row: &str, key: &str) -> Option<f64> {
+    row.split_whitespace()
+        .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+        .and_then(|v| v.parse().ok())
+}
+
+/// Runs bench/peer.py on a dumped rung; returns " peer_step=… peer_over_ours=…
+/// peer_check=…" (or " peer=failed"). Large rungs take fewer peer steps:
+/// scipy's step is slow enough that a few give a stable median.
+fn run_peer(
+    root: &std::path::Path,
+    dir: &std::path::Path,
+    row: &str,
+    scheme: &str,
+    steps: usize,
+    repeats: usize,
+) -> String {
+    let big = field(row, "dofs").unwrap_or(0.0) > 50_000.0;
+    let steps = match (big, scheme) {
+        (false, _) => steps,
+        (true, "cd") => 20,
+        (true, _) => 5,
+    };
+    let python = std::env::var("PYTHON")
+        .ok()
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "python3".into());
+    let out = Command::new(&python)
+        .arg(root.join("bench/peer.py"))
+        .arg(dir)
+        .args([
+            "--steps",
+            &steps.to_string(),
+            "--repeats",
+            &repeats.min(5).to_string(),
+        ])
+        .output();
+    let out = match out {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("peer: cannot run {python}: {e}");
+            return " peer=failed".into();
+        }
+    };
+    let text = String::from_utf8_lossy(&out.stdout);
+    match text.lines().find(|l| l.starts_with("PEER ")) {
+        Some(l) if out.status.success() => {
+            let fields = l.trim_start_matches("PEER ");
+            let ours = field(row, "step").unwrap_or(f64::NAN);
+            let theirs = field(fields, "peer_step").unwrap_or(f64::NAN);
+            format!(" {fields} peer_over_ours={:.1}", theirs / ours)
+        }
+        _ => {
+            eprintln!(
+                "peer on {}: failed:\n{}{}",
+                dir.display(),
+                text,
+                String::from_utf8_lossy(&out.stderr)
+            );
+            " peer=failed".into()
+        }
+    }
 }
 
 fn main() {
@@ -331,10 +539,15 @@ fn main() {
         let name = &args[k + 2];
         let steps: usize = args[k + 3].parse().unwrap();
         let repeats: usize = args[k + 4].parse().unwrap();
-        run_case(scheme, name, steps, repeats);
+        let dump = args
+            .iter()
+            .position(|a| a == "--dump")
+            .map(|k| PathBuf::from(&args[k + 1]));
+        run_case(scheme, name, steps, repeats, dump);
         return;
     }
     let quick = args.iter().any(|a| a == "--quick");
+    let peer = args.iter().any(|a| a == "--peer");
     let max_dofs: f64 = args
         .iter()
         .position(|a| a == "--max-dofs")
@@ -370,35 +583,47 @@ fn main() {
         }
     }
     let exe = std::env::current_exe().unwrap();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let dir = root.join("target/bench");
     let mut rows = Vec::new();
     for (scheme, name, dofs, steps, repeats) in ladder {
         if dofs > max_dofs {
             continue;
         }
         let steps = if quick { steps.min(200) } else { steps };
-        let out = Command::new(&exe)
-            .args([
-                "--case",
-                scheme,
-                &name,
-                &steps.to_string(),
-                &repeats.to_string(),
-            ])
-            .output()
-            .expect("runs itself");
+        // The scipy peer (bench/peer.py) on the paper's 85-node mesh and the
+        // generated rungs of ≥ 100k DOFs: it reads the problem our process
+        // dumps, checks its state after a few steps against ours
+        // (1e-8) and times its own steps, after ours (not concurrently).
+        let peer_dir = (peer && PEER_MESHES.contains(&name.as_str()))
+            .then(|| dir.join("peer").join(format!("{scheme}-{name}")));
+        let mut cmd = Command::new(&exe);
+        cmd.args([
+            "--case",
+            scheme,
+            &name,
+            &steps.to_string(),
+            &repeats.to_string(),
+        ]);
+        if let Some(d) = &peer_dir {
+            cmd.arg("--dump").arg(d);
+        }
+        let out = cmd.output().expect("runs itself");
         let text = String::from_utf8_lossy(&out.stdout);
-        match text.lines().find(|l| l.starts_with("RESULT ")) {
-            Some(l) => {
-                println!("{l}");
-                rows.push(l.trim_start_matches("RESULT ").to_string());
-            }
-            None => eprintln!(
+        let Some(line) = text.lines().find(|l| l.starts_with("RESULT ")) else {
+            eprintln!(
                 "{scheme} {name}: failed: {}",
                 String::from_utf8_lossy(&out.stderr)
-            ),
+            );
+            continue;
+        };
+        let mut row = line.trim_start_matches("RESULT ").to_string();
+        if let Some(d) = &peer_dir {
+            row.push_str(&run_peer(&root, d, &row, scheme, steps, repeats));
         }
+        println!("{row}");
+        rows.push(row);
     }
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/bench");
     std::fs::create_dir_all(&dir).unwrap();
     let mut csv = String::new();
     let mut header: Vec<String> = Vec::new();

@@ -37,6 +37,18 @@ impl Dynamics {
         }
     }
 
+    /// The system of a finite-element model, taking its matrices without a
+    /// copy (the model's K and M are the largest objects of a run; holding
+    /// them twice doubles its memory).
+    pub fn from_model_owned(model: Model) -> Dynamics {
+        Dynamics {
+            stiffness: model.stiffness,
+            consistent_mass: model.mass,
+            lumped_mass: model.lumped_mass,
+            constant_load: model.dirichlet_load,
+        }
+    }
+
     /// Number of free DOFs.
     pub fn n(&self) -> usize {
         self.lumped_mass.len()
@@ -426,11 +438,13 @@ impl Integrator {
         // The consistent mass is held once: moved into `mass_matrix` when the
         // scheme uses it, dropped otherwise; the explicit scheme needs no
         // mass matrix.
+        // (0 × 0 placeholders: an n × n empty CSR would still hold n + 1
+        // row offsets.)
         let consistent_mass =
-            std::mem::replace(&mut dynamics.consistent_mass, CsrMatrix::zeros(n, n));
+            std::mem::replace(&mut dynamics.consistent_mass, CsrMatrix::zeros(0, 0));
         let mass_matrix = match mass_kind {
             MassKind::Consistent => consistent_mass,
-            MassKind::Lumped if explicit => CsrMatrix::zeros(n, n),
+            MassKind::Lumped if explicit => CsrMatrix::zeros(0, 0),
             MassKind::Lumped => {
                 let mut m = dynamics.stiffness.clone();
                 let (offsets, cols, values) = m.csr_data_mut();
@@ -558,7 +572,7 @@ impl Integrator {
             // memory returned.
             this.compact = kernels::Compact::new(&this.dynamics.stiffness);
             if this.compact.is_some() {
-                this.dynamics.stiffness = CsrMatrix::zeros(n, n);
+                this.dynamics.stiffness = CsrMatrix::zeros(0, 0);
             }
         }
         Ok(this)

@@ -558,4 +558,179 @@ mod tests {
             assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "row {i}");
         }
     }
+
+    /// Kernel lab (issue 7: "K·r by CSR SpMV or element by element, choose
+    /// by measurement"): K·x on a structured Q1 slab (default 1416 × 354
+    /// cells, 1,004,298 free DOFs; `STICKSLIP_LAB_NY` sets ny, nx = 4 ny)
+    /// with the slab's supports, by nalgebra-sparse's CSR (the previous
+    /// kernel), by [`Compact`] and element by element with stored element
+    /// matrices (gather 8 values, 8×8 product, scatter; sequential, a
+    /// threaded one would need colouring). Prints medians of 10; checks the
+    /// element-by-element product against the CSR's to 1e-12 (different
+    /// summation order, so not bits).
+    ///
+    ///     cargo test -p stickslip-time --lib kernel_lab -- --ignored --nocapture
+    #[test]
+    #[ignore = "timing; run by hand (see the doc comment)"]
+    fn kernel_lab() {
+        use std::time::Instant;
+        use stickslip_fem::element::CellBasis;
+        use stickslip_mesh::{CellKind, Group, SourceInfo};
+
+        let ny: usize = std::env::var("STICKSLIP_LAB_NY")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(354);
+        let nx = 4 * ny;
+        let (gx, gy) = (nx + 1, ny + 1);
+        let mut nodes = Vec::with_capacity(gx * gy);
+        for j in 0..gy {
+            for i in 0..gx {
+                nodes.push([8.0 * i as f64 / nx as f64, j as f64 / ny as f64]);
+            }
+        }
+        let mut cells = Vec::with_capacity(4 * nx * ny);
+        for j in 0..ny {
+            for i in 0..nx {
+                let id = |i: usize, j: usize| j * gx + i;
+                cells.extend([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let group = |name: &str, nodes: Vec<usize>| Group {
+            name: name.into(),
+            tag: 1,
+            dim: 0,
+            edges: vec![],
+            cells: vec![],
+            points: nodes.clone(),
+            elements: nodes.len(),
+            nodes,
+        };
+        let mesh = Mesh {
+            node_tags: (1..=nodes.len() as u64).collect(),
+            nodes,
+            kind: CellKind::Quad4,
+            cell_tags: (1..=(nx * ny) as u64).collect(),
+            cells,
+            groups: vec![
+                group("support", (0..gx).map(|i| ny * gx + i).collect()),
+                group("left", (0..gy).map(|j| j * gx).collect()),
+            ],
+            source: SourceInfo::default(),
+        };
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let supports = [
+            Dirichlet::new("support", 1, 0.0),
+            Dirichlet::new("left", 0, 0.0),
+        ];
+        let model = Model::new(&mesh, &material, &supports).unwrap();
+        let k = &model.stiffness;
+        let n = k.nrows();
+        let compact = Compact::new(k).unwrap();
+        // Element matrices (64 values) and free DOFs (u32::MAX = fixed).
+        let basis = CellBasis::full(CellKind::Quad4);
+        let d = material.elasticity();
+        let n_cells = nx * ny;
+        let mut ke = vec![0.0; 64 * n_cells];
+        let mut edofs = vec![u32::MAX; 8 * n_cells];
+        for c in 0..n_cells {
+            let cell = &mesh.cells[4 * c..4 * c + 4];
+            let coords: Vec<[f64; 2]> = cell.iter().map(|&v| mesh.nodes[v]).collect();
+            basis
+                .stiffness(&coords, &d, &mut ke[64 * c..64 * c + 64])
+                .unwrap();
+            for (a, &v) in cell.iter().enumerate() {
+                for comp in 0..2 {
+                    if let Some(f) = model.dofs.free(v, comp) {
+                        edofs[8 * c + 2 * a + comp] = f as u32;
+                    }
+                }
+            }
+        }
+        let ebe = |x: &[f64], y: &mut [f64]| {
+            y.fill(0.0);
+            for (ke, dofs) in ke.chunks_exact(64).zip(edofs.chunks_exact(8)) {
+                let mut xe = [0.0; 8];
+                for (xa, &f) in xe.iter_mut().zip(dofs) {
+                    if f != u32::MAX {
+                        *xa = x[f as usize];
+                    }
+                }
+                for (a, &f) in dofs.iter().enumerate() {
+                    if f != u32::MAX {
+                        let row = &ke[8 * a..8 * a + 8];
+                        let mut s = 0.0;
+                        for b in 0..8 {
+                            s += row[b] * xe[b];
+                        }
+                        y[f as usize] += s;
+                    }
+                }
+            }
+        };
+        let x = x_of(n);
+        let (mut y0, mut y1) = (vec![0.0; n], vec![0.0; n]);
+        spmv(k, &x, &mut y0);
+        ebe(&x, &mut y1);
+        let scale = y0.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let diff = y0
+            .iter()
+            .zip(&y1)
+            .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(diff <= 1e-12 * scale, "EBE vs CSR: {diff:e} of {scale:e}");
+        let time = |f: &mut dyn FnMut()| {
+            let mut t: Vec<f64> = (0..10)
+                .map(|_| {
+                    let s = Instant::now();
+                    f();
+                    s.elapsed().as_secs_f64()
+                })
+                .collect();
+            t.sort_by(f64::total_cmp);
+            t[5]
+        };
+        let vectors = 16.0 * n as f64; // x read once, y written once
+        let csr_bytes = 16.0 * k.nnz() as f64 + 8.0 * (n + 1) as f64 + vectors;
+        let compact_bytes = compact.bytes() as f64 + vectors;
+        // y is read and written by the scatter.
+        let ebe_bytes = (512.0 + 32.0) * n_cells as f64 + vectors + 8.0 * n as f64;
+        println!(
+            "kernel lab: Q1 {nx}×{ny}, n = {n}, nnz = {}, load: {:?}",
+            k.nnz(),
+            std::fs::read_to_string("/proc/loadavg")
+                .unwrap_or_default()
+                .trim()
+        );
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let t = time(&mut || spmv(k, &x, &mut y0));
+                println!(
+                    "  {threads} thread(s) CSR usize   : {:.3} ms, {:.0} MB, {:.1} GB/s",
+                    1e3 * t,
+                    csr_bytes / 1e6,
+                    csr_bytes / t / 1e9
+                );
+                let t = time(&mut || compact.spmv(&x, &mut y1));
+                println!(
+                    "  {threads} thread(s) compact 2×2 : {:.3} ms, {:.0} MB, {:.1} GB/s",
+                    1e3 * t,
+                    compact_bytes / 1e6,
+                    compact_bytes / t / 1e9
+                );
+                if threads == 1 {
+                    let t = time(&mut || ebe(&x, &mut y1));
+                    println!(
+                        "  1 thread    element-by-element: {:.3} ms, {:.0} MB, {:.1} GB/s",
+                        1e3 * t,
+                        ebe_bytes / 1e6,
+                        ebe_bytes / t / 1e9
+                    );
+                }
+            });
+        }
+    }
 }
