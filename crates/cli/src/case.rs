@@ -73,6 +73,12 @@ impl Case {
 pub struct MeshSection {
     /// The `.msh` file, resolved against the case file's directory.
     pub file: PathBuf,
+    /// `mesh.ladder`: meshes of the same geometry and group names, coarse to
+    /// fine, resolved against the case file's directory (empty when the key
+    /// is absent). Only `stickslip advise` reads it; a run uses `file`.
+    pub ladder: Vec<PathBuf>,
+    /// The ladder entries as written in the case file (for `advise --write`).
+    pub ladder_text: Vec<String>,
 }
 
 /// Plane strain or plane stress.
@@ -286,6 +292,7 @@ struct RawCase {
 #[serde(deny_unknown_fields)]
 struct RawMesh {
     file: Spanned<String>,
+    ladder: Option<Spanned<Vec<String>>>,
 }
 
 #[derive(Deserialize)]
@@ -517,6 +524,8 @@ enum Kind {
     Bool,
     /// [x, y], two numbers.
     Vec2,
+    /// A list of strings (`mesh.ladder`).
+    StrList,
     /// A table with these keys.
     Table(&'static [(&'static str, Kind)]),
     /// A list of tables with these keys (`[[name]]`).
@@ -525,7 +534,7 @@ enum Kind {
     Any,
 }
 
-const MESH: &[(&str, Kind)] = &[("file", Kind::Str)];
+const MESH: &[(&str, Kind)] = &[("file", Kind::Str), ("ladder", Kind::StrList)];
 const MATERIAL: &[(&str, Kind)] = &[
     ("E", Kind::Num),
     ("nu", Kind::Num),
@@ -734,6 +743,12 @@ fn check_table(
             (Kind::Vec2, Item::Value(Value::Array(a)))
                 if a.len() == 2 && a.iter().all(is_number) => {}
             (Kind::Vec2, _) => wrong("a vector of two numbers", "write it as [x, y]"),
+            (Kind::StrList, Item::Value(Value::Array(a)))
+                if a.iter().all(|v| matches!(v, Value::String(_))) => {}
+            (Kind::StrList, _) => wrong(
+                "a list of mesh files",
+                "write it as [\"meshes/coarse.msh\", \"meshes/fine.msh\"]",
+            ),
             (Kind::Table(sub), Item::Table(t)) => {
                 check_table(t, path, sub, report, removals, typed)
             }
@@ -783,6 +798,7 @@ fn placeholder(key: &str, kind: &Kind) -> Option<Value> {
         (_, Kind::Int) => Value::from(1i64),
         (_, Kind::Bool) => Value::from(false),
         (_, Kind::Vec2) => Value::Array(toml_edit::Array::from_iter([0.0, 0.0])),
+        (_, Kind::StrList) => Value::Array(toml_edit::Array::new()),
         _ => return None,
     })
 }
@@ -832,7 +848,12 @@ fn remove_path(table: &mut dyn TableLike, path: &[Seg], with: Option<&Value>) {
 
 /// Keys a restart may change: the end time, the output settings, the title.
 fn restart_may_change(key: &str) -> bool {
-    key == "title" || key == "time.t_end" || key == "output" || key.starts_with("output.")
+    // mesh.ladder is read by `advise` only; a run never sees it.
+    key == "title"
+        || key == "time.t_end"
+        || key == "mesh.ladder"
+        || key == "output"
+        || key.starts_with("output.")
 }
 
 fn flatten(prefix: &str, v: &toml::Value, out: &mut BTreeMap<String, toml::Value>) {
@@ -930,6 +951,9 @@ fn convert(
         locations.insert(key, loc.at(Some(span)));
     };
     locate("mesh.file".into(), raw.mesh.file.span());
+    if let Some(l) = &raw.mesh.ladder {
+        locate("mesh.ladder".into(), l.span());
+    }
     locate("material.E".into(), raw.material.e.span());
     for (i, d) in raw.dirichlet.iter().enumerate() {
         locate(format!("dirichlet.{i}.group"), d.group.span());
@@ -960,6 +984,31 @@ fn convert(
             mesh_file.display()
         ),
     );
+
+    // mesh.ladder: every file exists; at least one entry.
+    let mut ladder = Vec::new();
+    let mut ladder_text = Vec::new();
+    if let Some(l) = &raw.mesh.ladder {
+        check(
+            !l.get_ref().is_empty(),
+            l.span(),
+            "mesh.ladder is empty; list the meshes coarse to fine, e.g. [\"a.msh\", \"b.msh\"], or remove the key".into(),
+        );
+        for f in l.get_ref() {
+            let p = base.join(f);
+            check(
+                p.is_file(),
+                l.span(),
+                format!(
+                    "mesh.ladder: {} does not exist (paths are relative to the case file's directory); \
+                     check the name, or make the mesh with Gmsh",
+                    p.display()
+                ),
+            );
+            ladder.push(p);
+            ladder_text.push(f.clone());
+        }
+    }
 
     // [material]
     let m = &raw.material;
@@ -1202,7 +1251,11 @@ fn convert(
         path: path.to_path_buf(),
         source,
         title: raw.title,
-        mesh: MeshSection { file: mesh_file },
+        mesh: MeshSection {
+            file: mesh_file,
+            ladder,
+            ladder_text,
+        },
         material: MaterialSection {
             e,
             nu,
@@ -1535,6 +1588,38 @@ t_end = 0.5
             .position(|l| l.contains(needle))
             .expect("needle in text")
             + 1
+    }
+
+    #[test]
+    fn mesh_ladder_is_read_resolved_and_checked() {
+        let text = GOOD.replace(
+            "file = \"m.msh\"",
+            "file = \"m.msh\"\nladder = [\"m.msh\", \"m.msh\"]  # coarse to fine",
+        );
+        let c = load_text("ladder", &text, &[]).unwrap();
+        let dir = c.path.parent().unwrap().to_path_buf();
+        assert_eq!(c.mesh.ladder, vec![dir.join("m.msh"), dir.join("m.msh")]);
+        assert_eq!(c.mesh.ladder_text, vec!["m.msh", "m.msh"]);
+        assert!(load_text("ladder-none", GOOD, &[]).unwrap().mesh.ladder.is_empty());
+        // A missing file, an empty list, a wrong type: each named at its line.
+        let missing = text.replace("[\"m.msh\", \"m.msh\"]", "[\"m.msh\", \"nope.msh\"]");
+        let e = load_text("ladder-missing", &missing, &[]).unwrap_err().0;
+        let line = line_of(&missing, "ladder");
+        assert!(e.contains(&format!("case.toml:{line}:")), "{e}");
+        assert!(e.contains("nope.msh does not exist"), "{e}");
+        let empty = text.replace("[\"m.msh\", \"m.msh\"]", "[]");
+        let e = load_text("ladder-empty", &empty, &[]).unwrap_err().0;
+        assert!(e.contains("mesh.ladder is empty"), "{e}");
+        let wrong = text.replace("[\"m.msh\", \"m.msh\"]", "\"m.msh\"");
+        let e = load_text("ladder-type", &wrong, &[]).unwrap_err().0;
+        assert!(e.contains("mesh.ladder: expected a list of mesh files"), "{e}");
+        assert!(e.contains(&format!("case.toml:{line}:")), "{e}");
+        // A typo is caught by the unknown-key machinery with a suggestion.
+        let typo = text.replace("ladder =", "ladders =");
+        let e = load_text("ladder-typo", &typo, &[]).unwrap_err().0;
+        assert!(e.contains("did you mean `ladder`?"), "{e}");
+        // A restart may add or change the ladder: advise reads it, a run does not.
+        assert!(restart_changes(GOOD, &text).unwrap().is_empty());
     }
 
     #[test]
