@@ -333,6 +333,11 @@ pub struct Integrator {
     /// K in the explicit step's compact form (`kernels::Compact`); the CSR
     /// K is then no longer held.
     compact: Option<kernels::Compact>,
+    /// (DOF, ṙ_K) at the contact DOFs, sorted by DOF: the closed-form
+    /// friction's velocities handed to `kernels::fused_step`.
+    friction: Vec<(usize, f64)>,
+    /// Per contact node and component, the entry of `friction`.
+    friction_slots: Vec<[Option<usize>; 2]>,
 }
 
 impl std::fmt::Debug for Integrator {
@@ -522,8 +527,10 @@ impl Integrator {
             iter_scratch: vec![SlipState::Stuck; n_c],
             forces_new: vec![0.0; n_c],
             thetas: vec![0.0; loads.len()],
-            partials: vec![[0.0; 4]; kernels::chunks(n)],
+            partials: kernels::partials(n),
             compact: None,
+            friction: Vec::new(),
+            friction_slots: Vec::new(),
             r,
             v,
             dynamics,
@@ -573,6 +580,17 @@ impl Integrator {
             this.compact = kernels::Compact::new(&this.dynamics.stiffness);
             if this.compact.is_some() {
                 this.dynamics.stiffness = CsrMatrix::zeros(0, 0);
+            }
+            if let Some(c) = &this.contact {
+                let mut dofs: Vec<usize> = c.nodes.iter().flat_map(|n| n.dofs).flatten().collect();
+                dofs.sort_unstable();
+                dofs.dedup();
+                this.friction_slots = c
+                    .nodes
+                    .iter()
+                    .map(|n| n.dofs.map(|d| d.map(|i| dofs.binary_search(&i).unwrap())))
+                    .collect();
+                this.friction = dofs.into_iter().map(|i| (i, 0.0)).collect();
             }
         }
         Ok(this)
@@ -805,50 +823,36 @@ impl Integrator {
             &mut self.r_new,
         );
         let scale = 1.0 / (gamma * dt);
-        let strain = if let Some(k) = &self.compact {
-            kernels::spmv_rhs_and_velocity(
-                k,
-                &self.load_new,
-                &self.dynamics.lumped_mass,
-                &self.r_new,
-                &self.v,
-                &self.a,
-                1.0 / (gamma * dt),
-                1.0 / gamma - 1.0,
-                scale,
-                &mut self.b,
-                &mut self.v_new,
-                &mut self.partials,
-            )
-        } else {
-            kernels::spmv(&self.dynamics.stiffness, &self.r_new, &mut self.b);
-            kernels::rhs_and_velocity(
-                &self.load_new,
-                &self.dynamics.lumped_mass,
-                &self.r_new,
-                &self.v,
-                &self.a,
-                1.0 / (gamma * dt),
-                1.0 / gamma - 1.0,
-                scale,
-                &mut self.b,
-                &mut self.v_new,
-                &mut self.partials,
-            )
-        };
-        self.scratch_classes.copy_from_slice(&self.classes);
-        let iterations = match &self.contact {
-            None => 1,
-            Some(contact) => match self.settings.explicit_friction {
-                ExplicitFriction::ClosedForm => {
+        let closed_form = self.settings.explicit_friction == ExplicitFriction::ClosedForm
+            || self.contact.is_none();
+        let (strain, sums, iterations) = match &self.compact {
+            Some(k) if closed_form => {
+                let data = kernels::StepData {
+                    load_new: &self.load_new,
+                    load: &self.load,
+                    mass: &self.dynamics.lumped_mass,
+                    r: &self.r,
+                    r_new: &self.r_new,
+                    v: &self.v,
+                    a: &self.a,
+                    cv: 1.0 / (gamma * dt),
+                    ca: 1.0 / gamma - 1.0,
+                    scale,
+                    gamma_dt: gamma * dt,
+                    ratio: (1.0 - gamma) / gamma,
+                };
+                if let Some(contact) = &self.contact {
+                    // The nodal friction first, from R̂_K at the contact DOFs
+                    // (the same bits as the sweep's), then one sweep.
                     let mass = &self.dynamics.lumped_mass;
-                    for node in &contact.nodes {
-                        // As in explicit_velocity, d = m·scale inline.
+                    for (node, slots) in contact.nodes.iter().zip(&self.friction_slots) {
+                        let mut b = [0.0; 2];
                         let (mut p, mut q) = (0.0, 0.0);
                         for c in 0..2 {
                             if let Some(i) = node.dofs[c] {
+                                b[c] = kernels::rhs_entry(&data, i, k.row(i, &self.r_new));
                                 let d = mass[i] * scale;
-                                p += node.tangent[c] * self.b[i] / d;
+                                p += node.tangent[c] * b[c] / d;
                                 q += node.tangent[c] * node.tangent[c] / d;
                             }
                         }
@@ -856,33 +860,111 @@ impl Integrator {
                         let vt = contact.law.solve_nodal(p, wg * q);
                         let phi = contact.law.phi(vt);
                         for c in 0..2 {
-                            if let Some(i) = node.dofs[c] {
-                                self.v_new[i] =
-                                    (self.b[i] - wg * phi * node.tangent[c]) / (mass[i] * scale);
+                            if let (Some(i), Some(slot)) = (node.dofs[c], slots[c]) {
+                                self.friction[slot].1 =
+                                    (b[c] - wg * phi * node.tangent[c]) / (mass[i] * scale);
                             }
                         }
                     }
-                    contact.classify(&self.v_new, &mut self.scratch_classes);
-                    1
                 }
-                ExplicitFriction::Iterate => self.explicit_velocity(dt, step_number, t_new)?,
-            },
+                let (strain, sums) = kernels::fused_step(
+                    k,
+                    &data,
+                    &self.friction,
+                    &mut self.v_new,
+                    &mut self.tmp,
+                    &mut self.partials,
+                );
+                self.scratch_classes.copy_from_slice(&self.classes);
+                if let Some(contact) = &self.contact {
+                    contact.classify(&self.v_new, &mut self.scratch_classes);
+                }
+                (strain, sums, 1)
+            }
+            _ => {
+                let strain = if let Some(k) = &self.compact {
+                    kernels::spmv_rhs_and_velocity(
+                        k,
+                        &self.load_new,
+                        &self.dynamics.lumped_mass,
+                        &self.r_new,
+                        &self.v,
+                        &self.a,
+                        1.0 / (gamma * dt),
+                        1.0 / gamma - 1.0,
+                        scale,
+                        &mut self.b,
+                        &mut self.v_new,
+                        &mut self.partials,
+                    )
+                } else {
+                    kernels::spmv(&self.dynamics.stiffness, &self.r_new, &mut self.b);
+                    kernels::rhs_and_velocity(
+                        &self.load_new,
+                        &self.dynamics.lumped_mass,
+                        &self.r_new,
+                        &self.v,
+                        &self.a,
+                        1.0 / (gamma * dt),
+                        1.0 / gamma - 1.0,
+                        scale,
+                        &mut self.b,
+                        &mut self.v_new,
+                        &mut self.partials,
+                    )
+                };
+                self.scratch_classes.copy_from_slice(&self.classes);
+                let iterations = match &self.contact {
+                    None => 1,
+                    Some(contact) => match self.settings.explicit_friction {
+                        ExplicitFriction::ClosedForm => {
+                            let mass = &self.dynamics.lumped_mass;
+                            for node in &contact.nodes {
+                                // As in explicit_velocity, d = m·scale inline.
+                                let (mut p, mut q) = (0.0, 0.0);
+                                for c in 0..2 {
+                                    if let Some(i) = node.dofs[c] {
+                                        let d = mass[i] * scale;
+                                        p += node.tangent[c] * self.b[i] / d;
+                                        q += node.tangent[c] * node.tangent[c] / d;
+                                    }
+                                }
+                                let wg = node.force_scale();
+                                let vt = contact.law.solve_nodal(p, wg * q);
+                                let phi = contact.law.phi(vt);
+                                for c in 0..2 {
+                                    if let Some(i) = node.dofs[c] {
+                                        self.v_new[i] = (self.b[i] - wg * phi * node.tangent[c])
+                                            / (mass[i] * scale);
+                                    }
+                                }
+                            }
+                            contact.classify(&self.v_new, &mut self.scratch_classes);
+                            1
+                        }
+                        ExplicitFriction::Iterate => {
+                            self.explicit_velocity(dt, step_number, t_new)?
+                        }
+                    },
+                };
+                let ratio = (1.0 - gamma) / gamma;
+                let sums = kernels::accelerate_and_sum(
+                    &self.dynamics.lumped_mass,
+                    &self.load,
+                    &self.load_new,
+                    &self.r,
+                    &self.r_new,
+                    &self.v,
+                    &self.v_new,
+                    &self.a,
+                    gamma * dt,
+                    ratio,
+                    &mut self.tmp,
+                    &mut self.partials,
+                );
+                (strain, sums, iterations)
+            }
         };
-        let ratio = (1.0 - gamma) / gamma;
-        let sums = kernels::accelerate_and_sum(
-            &self.dynamics.lumped_mass,
-            &self.load,
-            &self.load_new,
-            &self.r,
-            &self.r_new,
-            &self.v,
-            &self.v_new,
-            &self.a,
-            gamma * dt,
-            ratio,
-            &mut self.tmp,
-            &mut self.partials,
-        );
         if !sums.finite {
             let hint = match self.dt_crit {
                 Some(c) => format!(" below the critical step Δt_crit = {c:.4e}"),
