@@ -5,7 +5,6 @@
 //! Remark 4.2). Everything runs the integrators in-process; results go to
 //! CSV files and PNG/SVG charts in docs/.
 
-pub mod advise;
 pub mod chart;
 pub mod plot;
 pub mod run;

@@ -1,6 +1,7 @@
 //! The `stickslip` command's library: case files ([`case`]), the HDF5
 //! results and checkpoints ([`output`]), runs and checks ([`run`]), the
-//! `mesh` report ([`mesh_cmd`]) and the `probe` reader ([`probe`]).
+//! `mesh` report ([`mesh_cmd`]), the `probe` reader ([`probe`]) and the
+//! `advise` command ([`advise`]: the cheapest configuration for a tolerance).
 //!
 //! This crate owns everything that touches files other than meshes and the
 //! terminal; the numerics live in the library crates below it. It is a
@@ -10,6 +11,7 @@
 //! Exit codes (used by `main.rs`): 0 success; 2 bad input (case, mesh,
 //! arguments); 1 a run that failed after it started; 130 interrupted.
 
+pub mod advise;
 pub mod case;
 pub mod error;
 pub mod mesh_cmd;

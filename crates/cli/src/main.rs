@@ -15,7 +15,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use stickslip::error::InputError;
-use stickslip::{case, mesh_cmd, probe, run};
+use stickslip::{advise, case, mesh_cmd, probe, run};
 
 #[derive(Debug, Parser)]
 #[command(
@@ -77,6 +77,31 @@ A second Ctrl-C while the first is being handled exits at once (the file keeps e
         /// The mesh file (MSH 2.2 or 4.1, ASCII or binary).
         file: PathBuf,
         /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Choose the cheapest element order, mesh of mesh.ladder, scheme, dt and eps whose
+    /// estimated error on one output is below a tolerance (measured by pilot runs of the case).
+    #[command(
+        after_help = "Example:\n  stickslip advise cases/martins-oden/cd-step-eps1e-4.toml --tol 1e-2 --on ux --at 8,1 --write slab-1e-2.toml\n\n\
+Exit codes: 0 a configuration meets the tolerance (estimated), 1 none of the ladder does or a pilot run failed, 2 bad input."
+    )]
+    Advise {
+        /// The case file (TOML) with mesh.ladder.
+        case: PathBuf,
+        /// Relative error to reach: L2 in time (ux, uy, friction_stress) or of E(t_end) (energy).
+        #[arg(long, value_name = "X")]
+        tol: f64,
+        /// The output the tolerance is on: ux, uy, friction_stress or energy.
+        #[arg(long, value_name = "QUANTITY")]
+        on: String,
+        /// The point X,Y; the nearest node (contact node for friction_stress) is used.
+        #[arg(long, value_name = "X,Y", allow_hyphen_values = true)]
+        at: Option<String>,
+        /// Write the case with the chosen configuration here (comments kept).
+        #[arg(long, value_name = "OUT.toml")]
+        write: Option<PathBuf>,
+        /// Print one JSON object on stdout instead of the report.
         #[arg(long)]
         json: bool,
     },
@@ -199,6 +224,47 @@ fn main() -> ExitCode {
             };
             match run::check(&case) {
                 Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&e),
+            }
+        }
+        Command::Advise {
+            case,
+            tol,
+            on,
+            at,
+            write,
+            json,
+        } => {
+            let parsed = advise::Quantity::parse(&on)
+                .map_err(InputError)
+                .and_then(|q| {
+                    let at = at.as_deref().map(advise::parse_point).transpose()?;
+                    Ok((q, at))
+                });
+            let (quantity, at) = match parsed {
+                Ok(p) => p,
+                Err(e) => {
+                    report(&e.0);
+                    return ExitCode::from(2);
+                }
+            };
+            let case = match case::load(&case, &[]) {
+                Ok(c) => c,
+                Err(e) => {
+                    report(&e.0);
+                    return ExitCode::from(2);
+                }
+            };
+            let options = advise::Options {
+                tol,
+                quantity,
+                at,
+                write,
+                json,
+            };
+            match advise::command(&case, &options) {
+                Ok(advise::Verdict::Found) => ExitCode::SUCCESS,
+                Ok(advise::Verdict::NotReachable) => ExitCode::from(1),
                 Err(e) => fail(&e),
             }
         }

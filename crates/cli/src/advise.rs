@@ -1,0 +1,1466 @@
+//! `stickslip advise` (issue 6, deliverable 3): the cheapest configuration
+//! (element order, mesh of the case's `mesh.ladder`, scheme, Δt, ε) whose
+//! estimated error on one output is below a tolerance, from error
+//! estimates measured on the user's own case.
+//!
+//! The error of a configuration is modelled as the sum of three separately
+//! measured parts, e ≈ e_h + e_Δt + e_ε (a bound when they add with the
+//! same sign), each estimated Richardson-style from cheap pilot runs that
+//! differ only in that parameter: with solutions a (coarse) and b (fine) at
+//! refinement ratio r and order p, the error of b is about |a − b| /
+//! (r^p − 1), and p itself is observed from three levels (p = ln(|a − b| /
+//! |b − c|) / ln r) because the theoretical order does not hold (the slab's
+//! corner and the stick/slip kinks lower it). Coarser levels get e_k ≤
+//! e_{k+1} + |q_k − q_{k+1}| (triangle inequality); finer, unmeasured
+//! levels e_{k+1} = e_k / r^p.
+//!
+//! * h: the first three meshes of each element order in the ladder, run
+//!   with central difference at 0.9 Δt_crit of each mesh (its own family:
+//!   lumped mass, Δt tied to h) and with Newmark ¼/½ at Δt = t_end/200
+//!   (consistent mass; shared by the three Newmark variants).
+//! * Δt: on one pilot mesh (the second of the highest order), central
+//!   difference at 0.9, 0.45, 0.225 Δt_crit and each Newmark variant at
+//!   Δt = t_end/50, /100, /200, /400.
+//! * ε: the case's ε is the model the user asked for (its error part is 0);
+//!   10ε and 100ε are candidates whose part is the measured difference to
+//!   the case's ε on the pilot mesh (central difference, 0.9 Δt_crit). ε
+//!   enters as O(√ε) (METHOD.md §2, Theorem 2.3), so no extrapolation to
+//!   smaller ε is offered.
+//!
+//! Pilots run over the whole [0, t_end]: the error measures are integrals
+//! (or the end value) over that interval, so a shorter run would not
+//! measure them. The predicted time is the measured seconds per step per
+//! DOF of the pilots (the largest pilot of that order and scheme) times the
+//! candidate's DOFs and steps.
+
+use std::path::{Component, Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+
+use crate::case::{self, Case, Scheme as CaseScheme, StickReduction};
+use crate::error::InputError;
+use crate::run::prepare;
+
+/// The output the tolerance is on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// u_x at a node.
+    Ux,
+    /// u_y at a node.
+    Uy,
+    /// σ_T at a contact node.
+    FrictionStress,
+    /// Total energy at t_end.
+    Energy,
+}
+
+impl Quantity {
+    /// Parses `--on`.
+    ///
+    /// # Errors
+    /// An unknown name, with the accepted ones.
+    pub fn parse(s: &str) -> Result<Quantity, String> {
+        match s {
+            "ux" => Ok(Quantity::Ux),
+            "uy" => Ok(Quantity::Uy),
+            "friction_stress" => Ok(Quantity::FrictionStress),
+            "energy" => Ok(Quantity::Energy),
+            _ => Err(format!(
+                "--on {s:?}: expected ux, uy, friction_stress or energy"
+            )),
+        }
+    }
+
+    /// Name as given to `--on`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::Ux => "ux",
+            Quantity::Uy => "uy",
+            Quantity::FrictionStress => "friction_stress",
+            Quantity::Energy => "energy",
+        }
+    }
+}
+
+/// Error of the finer of two solutions at refinement ratio `ratio` (> 1)
+/// with convergence order `order` (> 0), from their difference.
+pub fn richardson(difference: f64, ratio: f64, order: f64) -> f64 {
+    difference.abs() / (ratio.powf(order) - 1.0)
+}
+
+/// Observed order from the differences of three levels (coarse−middle and
+/// middle−fine) at a constant ratio; None when the differences do not
+/// decrease (not in the asymptotic range).
+pub fn observed_order(d_coarse: f64, d_fine: f64, ratio: f64) -> Option<f64> {
+    let (a, b) = (d_coarse.abs(), d_fine.abs());
+    (a > b && b > 0.0 && ratio > 1.0).then(|| (a / b).ln() / ratio.ln())
+}
+
+/// Predicts the error at a finer level from the error at a measured level:
+/// e(level + k) = e(level) / ratio^(k·order).
+pub fn extrapolate(error: f64, ratio: f64, order: f64, levels: u32) -> f64 {
+    error / ratio.powf(order * f64::from(levels))
+}
+
+/// Lowest order used: an observed order below it, or differences that do
+/// not decrease, are taken as this (a conservative, slow convergence).
+pub const MIN_ORDER: f64 = 0.5;
+/// Order assumed from two levels only (no observed order): 1, below every
+/// theoretical order here, as the stick/slip kinks make it.
+pub const TWO_LEVEL_ORDER: f64 = 1.0;
+
+/// The correlation c of the errors of successive levels from the three
+/// differences of three levels. Model: e_1 = ρ1 R e_0, e_2 = ρ2 R e_1 with
+/// ⟨e_k, e_{k+1}⟩ = c |e_k| |e_{k+1}| and c² two levels apart (c = 1: the
+/// aligned power law of classical Richardson extrapolation; c = 0: errors
+/// that differ in phase, as stick/slip events at slightly different times
+/// make them). Then |q_0 − q_1|² = E²(1 + ρ1² − 2ρ1 c) and |q_0 − q_2|² =
+/// E²(1 + ρ1²ρ2² − 2ρ1ρ2 c²); their ratio fixes c. The root nearest 1 is
+/// taken (the larger error); no root in [−1, 1] gives 1.
+pub fn correlation(d01: f64, d02: f64, rho1: f64, rho2: f64) -> f64 {
+    let target = (d02 / d01).powi(2);
+    let f = |c: f64| {
+        (1.0 + (rho1 * rho2).powi(2) - 2.0 * rho1 * rho2 * c * c)
+            / (1.0 + rho1 * rho1 - 2.0 * rho1 * c)
+            - target
+    };
+    let mut prev = (1.0, f(1.0));
+    if prev.1 == 0.0 {
+        return 1.0;
+    }
+    for k in 1..=2000 {
+        let c = 1.0 - f64::from(k) * 1e-3;
+        let v = f(c);
+        if v == 0.0 || (v > 0.0) != (prev.1 > 0.0) {
+            // Linear interpolation inside the bracket.
+            return prev.0 + (c - prev.0) * prev.1 / (prev.1 - v);
+        }
+        prev = (c, v);
+    }
+    1.0
+}
+
+/// Errors at every level of a ladder from the differences of the measured
+/// levels. `diffs[k]` = ‖q_k − q_{k+1}‖ for the `diffs.len() + 1` measured
+/// levels; `skip` = ‖q_{n−2} − q_n‖ of the last three measured levels (None
+/// with two levels); `ratios[k]` = refinement ratio from level k to k + 1
+/// for all levels (measured and beyond); `max_order` caps the observed
+/// order (the theoretical one).
+///
+/// The last three measured levels give the order p (from the ratio of
+/// their differences) and the correlation c of successive errors
+/// ([`correlation`]); the first of them then has the error E =
+/// d / √(1 + ρ² − 2ρc), ρ = r^−p, and each finer level ρ times the one
+/// before (measured or not). With two levels, c = 1 and p =
+/// [`TWO_LEVEL_ORDER`]: classical Richardson, |q_0 − q_1| / (r^p − 1) for
+/// the finer. Coarser measured levels get the bound e_k ≤ e_{k+1} +
+/// |q_k − q_{k+1}|. Returns (errors per level, order, correlation).
+pub fn ladder_errors(
+    diffs: &[f64],
+    skip: Option<f64>,
+    ratios: &[f64],
+    max_order: f64,
+) -> (Vec<f64>, f64, f64) {
+    let levels = ratios.len() + 1;
+    let n = diffs.len();
+    let mut e = vec![f64::NAN; levels];
+    if n == 0 {
+        return (e, f64::NAN, f64::NAN);
+    }
+    let (first, p, c) = match skip.filter(|_| n >= 2) {
+        Some(d02) => {
+            let l = n - 2;
+            let p = observed_order(diffs[l], diffs[l + 1], ratios[l + 1])
+                .unwrap_or(MIN_ORDER)
+                .clamp(MIN_ORDER, max_order);
+            let (r1, r2) = (ratios[l].powf(-p), ratios[l + 1].powf(-p));
+            (l, p, correlation(diffs[l], d02, r1, r2))
+        }
+        None => (n - 1, TWO_LEVEL_ORDER.min(max_order), 1.0),
+    };
+    let rho = ratios[first].powf(-p);
+    e[first] = diffs[first].abs() / (1.0 + rho * rho - 2.0 * rho * c).max(0.0).sqrt();
+    for k in first + 1..levels {
+        e[k] = extrapolate(e[k - 1], ratios[k - 1], p, 1);
+    }
+    for k in (0..first).rev() {
+        e[k] = e[k + 1] + diffs[k].abs();
+    }
+    (e, p, c)
+}
+
+/// The time-stepping methods the advisor chooses from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Central difference, lumped mass.
+    CentralDifference,
+    /// Newmark ¼/½ (trapezoidal), consistent mass.
+    Trapezoidal,
+    /// Newmark ¼/½ with the step reduction of Remark 4.3.
+    TrapezoidalReduced,
+    /// Newmark 0.3025/0.6 (numerical damping).
+    Damped,
+}
+
+impl Method {
+    /// All of them.
+    pub const ALL: [Method; 4] = [
+        Method::CentralDifference,
+        Method::Trapezoidal,
+        Method::TrapezoidalReduced,
+        Method::Damped,
+    ];
+
+    /// Short name (as in docs/work-precision.csv).
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::CentralDifference => "cd",
+            Method::Trapezoidal => "nm-0.25-0.5",
+            Method::TrapezoidalReduced => "nm-0.25-0.5-reduced",
+            Method::Damped => "nm-0.3025-0.6",
+        }
+    }
+
+    /// Longer name for the report.
+    pub fn label(self) -> &'static str {
+        match self {
+            Method::CentralDifference => "central difference",
+            Method::Trapezoidal => "Newmark beta 1/4, gamma 1/2",
+            Method::TrapezoidalReduced => {
+                "Newmark beta 1/4, gamma 1/2 with step reduction (Remark 4.3)"
+            }
+            Method::Damped => "Newmark beta 0.3025, gamma 0.6",
+        }
+    }
+
+    fn newmark(self) -> Option<(f64, f64)> {
+        match self {
+            Method::CentralDifference => None,
+            Method::Trapezoidal | Method::TrapezoidalReduced => Some((0.25, 0.5)),
+            Method::Damped => Some((0.3025, 0.6)),
+        }
+    }
+}
+
+/// The paper's Remark 4.3 (Δt = 1e-7 for 10 steps after sticking), used
+/// when the case gives no `time.stick_reduction` of its own.
+pub const PAPER_REDUCTION: StickReduction = StickReduction {
+    dt: 1e-7,
+    steps: 10,
+};
+
+/// Central-difference Δt as fractions of Δt_crit (as in the chart).
+pub const CD_FRACTIONS: [f64; 3] = [0.9, 0.45, 0.225];
+/// Newmark Δt = t_end / these.
+pub const NEWMARK_DIVISIONS: [f64; 4] = [50.0, 100.0, 200.0, 400.0];
+/// ε candidates: the case's ε times these.
+pub const EPS_FACTORS: [f64; 3] = [1.0, 10.0, 100.0];
+/// Uniform sample times for the L2-in-time norms.
+pub const SAMPLES: usize = 5001;
+
+/// One configuration the advisor can choose.
+#[derive(Clone, Debug)]
+pub struct Candidate {
+    /// Element order.
+    pub order: u8,
+    /// Mesh file as written in the case's ladder.
+    pub mesh: String,
+    /// Index of the mesh in the ladder.
+    pub mesh_index: usize,
+    /// Method.
+    pub method: Method,
+    /// Normal Δt.
+    pub dt: f64,
+    /// ε.
+    pub eps: f64,
+    /// Estimated e_h, e_Δt, e_ε.
+    pub parts: [f64; 3],
+    /// Predicted wall time, seconds.
+    pub predicted_time: f64,
+    /// Free DOFs.
+    pub dofs: usize,
+    /// Predicted steps.
+    pub steps: f64,
+    /// Whether the mesh was a pilot of the h estimate (else extrapolated).
+    pub measured_h: bool,
+}
+
+impl Candidate {
+    /// The estimated error, e_h + e_Δt + e_ε.
+    pub fn estimate(&self) -> f64 {
+        self.parts.iter().sum()
+    }
+}
+
+/// The cheapest candidate whose estimate is at most `tol` (ties: the more
+/// accurate); None when none qualifies.
+pub fn pick(candidates: &[Candidate], tol: f64) -> Option<&Candidate> {
+    candidates
+        .iter()
+        .filter(|c| c.estimate().is_finite() && c.estimate() <= tol)
+        .min_by(|a, b| {
+            a.predicted_time
+                .total_cmp(&b.predicted_time)
+                .then(a.estimate().total_cmp(&b.estimate()))
+        })
+}
+
+/// One mesh of the ladder, as the case sees it.
+#[derive(Clone, Debug)]
+pub struct LadderMesh {
+    /// Resolved path.
+    pub path: PathBuf,
+    /// As written in the case.
+    pub text: String,
+    /// Element order.
+    pub order: u8,
+    /// Cells.
+    pub cells: usize,
+    /// Free DOFs.
+    pub dofs: usize,
+    /// Contact nodes.
+    pub contact_nodes: usize,
+    /// Central difference's critical step (lumped mass).
+    pub dt_crit: f64,
+    /// Position of the probed node (None for the energy).
+    pub node_at: Option<[f64; 2]>,
+}
+
+/// What a run of one configuration recorded.
+#[derive(Clone, Debug, Default)]
+pub struct Trace {
+    /// Times (t = 0 and each step).
+    pub t: Vec<f64>,
+    /// The quantity at those times (empty for the energy).
+    pub y: Vec<f64>,
+    /// Total energy at t = 0.
+    pub energy0: f64,
+    /// Total energy at t_end.
+    pub energy_end: f64,
+    /// Steps taken.
+    pub steps: u64,
+    /// Free DOFs.
+    pub dofs: usize,
+    /// Wall time (model assembly included), seconds.
+    pub secs: f64,
+}
+
+fn input(msg: impl Into<String>) -> anyhow::Error {
+    anyhow::Error::new(InputError(msg.into()))
+}
+
+/// The case with one configuration applied (mesh, method, Δt, ε).
+pub fn configured(case: &Case, mesh: &Path, method: Method, dt: f64, eps: f64) -> Case {
+    let mut c = case.clone();
+    c.mesh.file = mesh.to_path_buf();
+    c.time.dt = dt;
+    c.time.mass = None;
+    c.time.allow_unstable = false;
+    match method.newmark() {
+        None => c.time.scheme = CaseScheme::CentralDifference,
+        Some((beta, gamma)) => {
+            c.time.scheme = CaseScheme::Newmark;
+            c.time.beta = beta;
+            c.time.gamma = gamma;
+        }
+    }
+    c.time.stick_reduction = (method == Method::TrapezoidalReduced)
+        .then(|| case.time.stick_reduction.unwrap_or(PAPER_REDUCTION));
+    if let Some(contact) = &mut c.contact {
+        contact.eps = eps;
+    }
+    c
+}
+
+/// Where the quantity is read in one prepared model.
+enum Probe {
+    Dof(usize),
+    Contact(usize),
+    Energy,
+}
+
+fn nearest(
+    points: impl Iterator<Item = (usize, [f64; 2])>,
+    at: [f64; 2],
+) -> Option<(usize, [f64; 2])> {
+    points
+        .map(|(i, p)| (i, p, (p[0] - at[0]).powi(2) + (p[1] - at[1]).powi(2)))
+        .min_by(|a, b| a.2.total_cmp(&b.2))
+        .map(|(i, p, _)| (i, p))
+}
+
+fn probe_of(
+    case: &Case,
+    p: &crate::run::Prepared,
+    q: Quantity,
+    at: Option<[f64; 2]>,
+) -> anyhow::Result<(Probe, Option<[f64; 2]>)> {
+    let need_at = || {
+        at.ok_or_else(|| {
+            input(format!(
+                "--on {} needs --at X,Y (the node nearest to it is used)",
+                q.name()
+            ))
+        })
+    };
+    match q {
+        Quantity::Energy => Ok((Probe::Energy, None)),
+        Quantity::Ux | Quantity::Uy => {
+            let at = need_at()?;
+            let comp = usize::from(q == Quantity::Uy);
+            let (node, pos) =
+                nearest(p.mesh.nodes.iter().copied().enumerate(), at).ok_or_else(|| {
+                    input(format!(
+                        "{}: the mesh has no nodes",
+                        case.mesh.file.display()
+                    ))
+                })?;
+            match p.model.dofs.free(node, comp) {
+                Some(d) => Ok((Probe::Dof(d), Some(pos))),
+                None => Err(input(format!(
+                    "--on {} --at {},{}: the nearest node of {} at ({}, {}) has {} prescribed by a [[dirichlet]] condition; \
+                     nothing to estimate there, choose another point",
+                    q.name(),
+                    at[0],
+                    at[1],
+                    case.mesh.file.display(),
+                    pos[0],
+                    pos[1],
+                    q.name()
+                ))),
+            }
+        }
+        Quantity::FrictionStress => {
+            let at = need_at()?;
+            let c = p.integrator.contact().ok_or_else(|| {
+                input(format!(
+                    "{}: --on friction_stress needs a [contact] section; the case has none",
+                    case.path.display()
+                ))
+            })?;
+            let (k, pos) = nearest(
+                c.nodes
+                    .iter()
+                    .enumerate()
+                    .map(|(k, n)| (k, p.mesh.nodes[n.node])),
+                at,
+            )
+            .ok_or_else(|| {
+                input(format!(
+                    "{}: the contact group {:?} has no friction nodes",
+                    case.path.display(),
+                    c.group
+                ))
+            })?;
+            Ok((Probe::Contact(k), Some(pos)))
+        }
+    }
+}
+
+/// Runs `case` (already configured) to t_end recording `q` at the node
+/// nearest `at`; the time includes building the model.
+///
+/// # Errors
+/// Input problems as [`InputError`]; a step that fails.
+pub fn run_traced(case: &Case, q: Quantity, at: Option<[f64; 2]>) -> anyhow::Result<Trace> {
+    let start = Instant::now();
+    let mut p = prepare(case)?;
+    let (probe, _) = probe_of(case, &p, q, at)?;
+    let n_c = p.integrator.contact().map_or(0, |c| c.len());
+    let mut stress = vec![0.0; n_c];
+    let mut tr = Trace {
+        dofs: p.model.dofs.n_free(),
+        energy0: p.integrator.energy().total,
+        ..Trace::default()
+    };
+    let hint = ((case.time.t_end / case.time.dt) as usize + 2).min(1 << 22);
+    tr.t.reserve(hint);
+    tr.y.reserve(hint);
+    let i = &mut p.integrator;
+    let mut record = |i: &stickslip_time::Integrator, tr: &mut Trace| {
+        let y = match probe {
+            Probe::Dof(d) => i.displacement()[d],
+            Probe::Contact(k) => {
+                i.friction_stress(&mut stress);
+                stress[k]
+            }
+            Probe::Energy => return,
+        };
+        tr.t.push(i.time());
+        tr.y.push(y);
+    };
+    record(i, &mut tr);
+    while !i.done() {
+        i.step().map_err(|e| {
+            anyhow::anyhow!(
+                "{} on {} ({}, dt = {:e}): step {} failed: {e}",
+                case.path.display(),
+                case.mesh.file.display(),
+                match case.time.scheme {
+                    CaseScheme::CentralDifference => "central difference".to_string(),
+                    CaseScheme::Newmark =>
+                        format!("newmark {}/{}", case.time.beta, case.time.gamma),
+                },
+                case.time.dt,
+                i.steps() + 1
+            )
+        })?;
+        record(i, &mut tr);
+    }
+    tr.energy_end = i.energy().total;
+    tr.steps = i.steps();
+    tr.secs = start.elapsed().as_secs_f64();
+    Ok(tr)
+}
+
+/// Linear interpolation of (t, y) at the sorted times `grid`.
+pub fn sample(t: &[f64], y: &[f64], grid: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(grid.len());
+    let mut k = 0;
+    for &g in grid {
+        if t.len() < 2 {
+            out.push(y.first().copied().unwrap_or(0.0));
+            continue;
+        }
+        while k + 2 < t.len() && t[k + 1] < g {
+            k += 1;
+        }
+        let (t0, t1) = (t[k], t[k + 1]);
+        let s = if t1 > t0 {
+            ((g - t0) / (t1 - t0)).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        out.push(y[k] + s * (y[k + 1] - y[k]));
+    }
+    out
+}
+
+/// The uniform grid of [`SAMPLES`] times on [0, t_end].
+pub fn grid(t_end: f64) -> Vec<f64> {
+    (0..SAMPLES)
+        .map(|k| t_end * k as f64 / (SAMPLES - 1) as f64)
+        .collect()
+}
+
+/// The error measure of `a` against `b` (docs/work-precision.csv's):
+/// ‖a − b‖ / ‖b − b(0)‖ in the discrete L2-in-time norm for u_x, u_y
+/// (relative to the motion; the initial state is the static solution),
+/// ‖a − b‖ / ‖b‖ for σ_T, and |E_a(t_end) − E_b(t_end)| / |E_b(t_end) −
+/// E_b(0)| for the energy.
+pub fn distance(q: Quantity, a: &Trace, b: &Trace, grid: &[f64]) -> f64 {
+    if q == Quantity::Energy {
+        return (a.energy_end - b.energy_end).abs() / (b.energy_end - b.energy0).abs();
+    }
+    let sa = sample(&a.t, &a.y, grid);
+    let sb = sample(&b.t, &b.y, grid);
+    let offset = if q == Quantity::FrictionStress {
+        0.0
+    } else {
+        sb[0]
+    };
+    let num: f64 = sa.iter().zip(&sb).map(|(x, y)| (x - y).powi(2)).sum();
+    let den: f64 = sb.iter().map(|y| (y - offset).powi(2)).sum();
+    (num / den).sqrt()
+}
+
+/// One pilot run, for the report.
+#[derive(Clone, Debug)]
+pub struct Pilot {
+    /// Ladder index.
+    pub mesh_index: usize,
+    /// Method.
+    pub method: Method,
+    /// Δt.
+    pub dt: f64,
+    /// ε.
+    pub eps: f64,
+    /// Steps.
+    pub steps: u64,
+    /// Seconds.
+    pub secs: f64,
+}
+
+/// Everything the pilots measured: the candidates with their estimates.
+#[derive(Clone, Debug)]
+pub struct Estimates {
+    /// The quantity.
+    pub quantity: Quantity,
+    /// The ladder.
+    pub ladder: Vec<LadderMesh>,
+    /// Every candidate.
+    pub candidates: Vec<Candidate>,
+    /// The pilot runs.
+    pub pilots: Vec<Pilot>,
+    /// Total wall time of the pilots and the ladder's set-up, seconds.
+    pub seconds: f64,
+    /// Per ladder (h per order and scheme family, Δt per scheme): what,
+    /// the order used, the correlation of successive errors, and the
+    /// measured differences of consecutive levels.
+    pub orders: Vec<(String, f64, f64, Vec<f64>)>,
+    /// Remarks for the report (probe positions that differ, skipped meshes).
+    pub notes: Vec<String>,
+}
+
+struct Pilots<'a> {
+    case: &'a Case,
+    q: Quantity,
+    at: Option<[f64; 2]>,
+    ladder: &'a [LadderMesh],
+    runs: Vec<(usize, Method, f64, f64, Trace)>,
+    log: &'a mut dyn FnMut(&str),
+}
+
+impl Pilots<'_> {
+    /// Runs (or reuses) one configuration; returns its index in `runs`.
+    fn run(&mut self, m: usize, method: Method, dt: f64, eps: f64) -> anyhow::Result<usize> {
+        if let Some(k) = self
+            .runs
+            .iter()
+            .position(|r| r.0 == m && r.1 == method && r.2 == dt && r.3 == eps)
+        {
+            return Ok(k);
+        }
+        let c = configured(self.case, &self.ladder[m].path, method, dt, eps);
+        let tr = run_traced(&c, self.q, self.at).with_context(|| {
+            format!(
+                "pilot run on {} ({}, dt = {dt:.4e}, eps = {eps:e})",
+                self.ladder[m].text,
+                method.name()
+            )
+        })?;
+        (self.log)(&format!(
+            "pilot  {:28} {:20} dt {:.4e} eps {:.0e}: {:6} steps, {:.3} s",
+            self.ladder[m].text,
+            method.name(),
+            dt,
+            eps,
+            tr.steps,
+            tr.secs
+        ));
+        self.runs.push((m, method, dt, eps, tr));
+        Ok(self.runs.len() - 1)
+    }
+
+    fn trace(&self, k: usize) -> &Trace {
+        &self.runs[k].4
+    }
+
+    /// Differences of consecutive runs (finer normalizes).
+    fn diffs(&self, runs: &[usize], grid: &[f64]) -> Vec<f64> {
+        runs.windows(2)
+            .map(|w| distance(self.q, self.trace(w[0]), self.trace(w[1]), grid))
+            .collect()
+    }
+
+    /// ‖q_{n−2} − q_n‖ of the last three runs (None with fewer).
+    fn skip(&self, runs: &[usize], grid: &[f64]) -> Option<f64> {
+        (runs.len() >= 3).then(|| {
+            let n = runs.len();
+            distance(
+                self.q,
+                self.trace(runs[n - 3]),
+                self.trace(runs[n - 1]),
+                grid,
+            )
+        })
+    }
+
+    /// Seconds per step per DOF of a run.
+    fn cost(&self, k: usize) -> f64 {
+        let t = self.trace(k);
+        t.secs / (t.steps.max(1) as f64 * t.dofs.max(1) as f64)
+    }
+}
+
+/// Reads the ladder of `case`: each mesh prepared once (groups checked,
+/// order, DOFs, Δt_crit, probe position).
+///
+/// # Errors
+/// No ladder, a mesh the case does not fit, a probe that cannot be placed.
+pub fn read_ladder(
+    case: &Case,
+    q: Quantity,
+    at: Option<[f64; 2]>,
+) -> anyhow::Result<Vec<LadderMesh>> {
+    if case.mesh.ladder.len() < 2 {
+        return Err(input(format!(
+            "{}mesh.ladder: advise needs at least two meshes of one element order to estimate the \
+             discretization error in h; add e.g. ladder = [\"coarse.msh\", \"medium.msh\", \"fine.msh\"] \
+             to [mesh] (same geometry and group names, coarse to fine)",
+            case.at(if case.mesh.ladder.is_empty() { "mesh.file" } else { "mesh.ladder" })
+        )));
+    }
+    let mut out = Vec::new();
+    for (path, text) in case.mesh.ladder.iter().zip(&case.mesh.ladder_text) {
+        // A Newmark set-up never refuses a Δt; the static solve checks the supports.
+        let c = configured(
+            case,
+            path,
+            Method::Trapezoidal,
+            case.time.t_end / 50.0,
+            eps_of(case),
+        );
+        let p = prepare(&c).map_err(|e| {
+            let msg = match e.downcast_ref::<InputError>() {
+                Some(i) => i.0.clone(),
+                None => format!("{e:#}"),
+            };
+            input(format!(
+                "{}mesh.ladder entry {text:?}: {msg}",
+                case.at("mesh.ladder")
+            ))
+        })?;
+        let (_, node_at) = probe_of(&c, &p, q, at)?;
+        let dt_crit =
+            stickslip_time::stability::critical_step(&p.model.stiffness, &p.model.lumped_mass);
+        out.push(LadderMesh {
+            path: path.clone(),
+            text: text.clone(),
+            order: match p.mesh.kind {
+                stickslip_mesh::CellKind::Quad4 => 1,
+                stickslip_mesh::CellKind::Quad9 => 2,
+            },
+            cells: p.mesh.n_cells(),
+            dofs: p.model.dofs.n_free(),
+            contact_nodes: p.integrator.contact().map_or(0, |c| c.len()),
+            dt_crit,
+            node_at,
+        });
+    }
+    Ok(out)
+}
+
+fn eps_of(case: &Case) -> f64 {
+    case.contact.as_ref().map_or(f64::NAN, |c| c.eps)
+}
+
+/// The pilot runs and every candidate's estimate (independent of the
+/// tolerance: [`pick`] then chooses). `log` receives one line per pilot.
+///
+/// # Errors
+/// As [`read_ladder`]; a pilot run that fails.
+pub fn estimate(
+    case: &Case,
+    q: Quantity,
+    at: Option<[f64; 2]>,
+    log: &mut dyn FnMut(&str),
+) -> anyhow::Result<Estimates> {
+    let start = Instant::now();
+    let ladder = read_ladder(case, q, at)?;
+    let mut notes = Vec::new();
+    if let Some(first) = ladder.iter().find_map(|m| m.node_at) {
+        for m in &ladder {
+            if let Some(p) = m.node_at {
+                if (p[0] - first[0]).hypot(p[1] - first[1])
+                    > 1e-9 * (1.0 + first[0].hypot(first[1]))
+                {
+                    notes.push(format!(
+                        "the probed node of {} is at ({}, {}), not at ({}, {}) as on {}: its differences mix places",
+                        m.text, p[0], p[1], first[0], first[1], ladder[0].text
+                    ));
+                }
+            }
+        }
+    }
+    let t_end = case.time.t_end;
+    let eps0 = eps_of(case);
+    let g = grid(t_end);
+    let nm_dt: Vec<f64> = NEWMARK_DIVISIONS.iter().map(|d| t_end / d).collect();
+    let dt_h = t_end / 200.0;
+    let mut pilots = Pilots {
+        case,
+        q,
+        at,
+        ladder: &ladder,
+        runs: Vec::new(),
+        log,
+    };
+    let mut orders = Vec::new();
+
+    // h: per element order, the first three meshes of the ladder.
+    struct Group {
+        order: u8,
+        meshes: Vec<usize>,
+        /// e_h per mesh of the group: central difference, Newmark.
+        e_cd: Vec<f64>,
+        e_nm: Vec<f64>,
+        /// Seconds per step per DOF: central difference, Newmark ¼/½.
+        cost_cd: f64,
+        cost_nm: f64,
+        pilot_levels: usize,
+    }
+    let mut groups = Vec::new();
+    for order in [1u8, 2] {
+        let meshes: Vec<usize> = (0..ladder.len())
+            .filter(|&m| ladder[m].order == order)
+            .collect();
+        if meshes.len() < 2 {
+            if let Some(&m) = meshes.first() {
+                notes.push(format!(
+                    "{} is the only Q{order} mesh of the ladder: no h estimate for Q{order}, left out",
+                    ladder[m].text
+                ));
+            }
+            continue;
+        }
+        let ratios: Vec<f64> = meshes
+            .windows(2)
+            .map(|w| (ladder[w[1]].cells as f64 / ladder[w[0]].cells as f64).sqrt())
+            .collect();
+        if let Some(k) = ratios.iter().position(|r| r.is_nan() || *r <= 1.0) {
+            return Err(input(format!(
+                "{}mesh.ladder: {} has no more cells than {} before it; list the Q{order} meshes coarse to fine",
+                case.at("mesh.ladder"),
+                ladder[meshes[k + 1]].text,
+                ladder[meshes[k]].text
+            )));
+        }
+        let pilot_levels = meshes.len().min(3);
+        let mut cd_runs = Vec::new();
+        let mut nm_runs = Vec::new();
+        for &m in &meshes[..pilot_levels] {
+            cd_runs.push(pilots.run(
+                m,
+                Method::CentralDifference,
+                CD_FRACTIONS[0] * ladder[m].dt_crit,
+                eps0,
+            )?);
+            nm_runs.push(pilots.run(m, Method::Trapezoidal, dt_h, eps0)?);
+        }
+        let max_order = f64::from(order) + 1.0;
+        let (d_cd, d_nm) = (pilots.diffs(&cd_runs, &g), pilots.diffs(&nm_runs, &g));
+        let (s_cd, s_nm) = (pilots.skip(&cd_runs, &g), pilots.skip(&nm_runs, &g));
+        let (e_cd, p_cd, c_cd) = ladder_errors(&d_cd, s_cd, &ratios, max_order);
+        let (e_nm, p_nm, c_nm) = ladder_errors(&d_nm, s_nm, &ratios, max_order);
+        orders.push((
+            format!("h, Q{order}, central difference (dt = 0.9 dt_crit of each mesh)"),
+            p_cd,
+            c_cd,
+            d_cd,
+        ));
+        orders.push((
+            format!("h, Q{order}, Newmark (dt = t_end/200)"),
+            p_nm,
+            c_nm,
+            d_nm,
+        ));
+        groups.push(Group {
+            order,
+            cost_cd: pilots.cost(*cd_runs.last().expect("two levels")),
+            cost_nm: pilots.cost(*nm_runs.last().expect("two levels")),
+            meshes,
+            e_cd,
+            e_nm,
+            pilot_levels,
+        });
+    }
+    let Some(top) = groups.last() else {
+        return Err(input(format!(
+            "{}mesh.ladder: advise needs at least two meshes of one element order (Q1 or Q2); add a refinement",
+            case.at("mesh.ladder")
+        )));
+    };
+    // Δt and ε on the second mesh of the highest order.
+    let pm = top.meshes[1];
+    let crit = ladder[pm].dt_crit;
+    let cd_runs: Vec<usize> = CD_FRACTIONS
+        .iter()
+        .map(|f| pilots.run(pm, Method::CentralDifference, f * crit, eps0))
+        .collect::<anyhow::Result<_>>()?;
+    // Central difference: Δt is tied to h (a fraction of Δt_crit), so the
+    // h ladder above already is the error of the (h, 0.9 Δt_crit) path; a
+    // smaller fraction adds at most its measured distance from 0.9 Δt_crit.
+    let d = pilots.diffs(&cd_runs, &g);
+    let e_dt_cd: Vec<f64> = (0..cd_runs.len())
+        .map(|k| distance(q, pilots.trace(cd_runs[k]), pilots.trace(cd_runs[0]), &g))
+        .collect();
+    orders.push((
+        "dt, central difference (change from 0.9 dt_crit)".into(),
+        f64::NAN,
+        f64::NAN,
+        d,
+    ));
+    let mut e_dt_nm = Vec::new();
+    let mut nm_runs_by_method = Vec::new();
+    for method in [
+        Method::Trapezoidal,
+        Method::TrapezoidalReduced,
+        Method::Damped,
+    ] {
+        let runs: Vec<usize> = nm_dt
+            .iter()
+            .map(|&dt| pilots.run(pm, method, dt, eps0))
+            .collect::<anyhow::Result<_>>()?;
+        let ratios = vec![2.0; nm_dt.len() - 1];
+        // Newmark ¼/½ is second order; 0.3025/0.6 first (γ ≠ ½).
+        let max_order = if method == Method::Damped { 1.0 } else { 2.0 };
+        let d = pilots.diffs(&runs, &g);
+        let (e, p, c) = ladder_errors(&d, pilots.skip(&runs, &g), &ratios, max_order);
+        orders.push((format!("dt, {}", method.name()), p, c, d));
+        e_dt_nm.push((method, e));
+        nm_runs_by_method.push((method, runs));
+    }
+    let mut e_eps = vec![0.0];
+    let eps_list: Vec<f64> = if case.contact.is_some() {
+        let base = cd_runs[0];
+        for f in &EPS_FACTORS[1..] {
+            let k = pilots.run(
+                pm,
+                Method::CentralDifference,
+                CD_FRACTIONS[0] * crit,
+                eps0 * f,
+            )?;
+            e_eps.push(distance(q, pilots.trace(k), pilots.trace(base), &g));
+        }
+        EPS_FACTORS.iter().map(|f| eps0 * f).collect()
+    } else {
+        vec![eps0]
+    };
+
+    // Cost of the Newmark variants relative to Newmark ¼/½ at the same Δt on
+    // the pilot mesh; extra steps of the reduction per contact node.
+    let trap = &nm_runs_by_method[0].1;
+    let k_h = NEWMARK_DIVISIONS
+        .iter()
+        .position(|d| *d == 200.0)
+        .expect("t_end/200 in the ladder");
+    let mut candidates = Vec::new();
+    for gr in &groups {
+        for (level, &m) in gr.meshes.iter().enumerate() {
+            let lm = &ladder[m];
+            for method in Method::ALL {
+                let (dts, e_h, cost): (Vec<f64>, f64, f64) = match method {
+                    Method::CentralDifference => (
+                        CD_FRACTIONS.iter().map(|f| f * lm.dt_crit).collect(),
+                        gr.e_cd[level],
+                        gr.cost_cd,
+                    ),
+                    _ => {
+                        let runs = &nm_runs_by_method
+                            .iter()
+                            .find(|r| r.0 == method)
+                            .expect("run")
+                            .1;
+                        let rel = pilots.cost(runs[k_h]) / pilots.cost(trap[k_h]);
+                        (nm_dt.clone(), gr.e_nm[level], gr.cost_nm * rel)
+                    }
+                };
+                for (kd, &dt) in dts.iter().enumerate() {
+                    let e_dt = match method {
+                        Method::CentralDifference => e_dt_cd[kd],
+                        _ => e_dt_nm.iter().find(|e| e.0 == method).expect("estimated").1[kd],
+                    };
+                    let mut steps = (t_end / dt).ceil();
+                    if method == Method::TrapezoidalReduced {
+                        let runs = &nm_runs_by_method
+                            .iter()
+                            .find(|r| r.0 == method)
+                            .expect("run")
+                            .1;
+                        let extra = (pilots.trace(runs[kd]).steps as f64 - steps).max(0.0);
+                        let per_node = extra / ladder[pm].contact_nodes.max(1) as f64;
+                        steps += per_node * lm.contact_nodes as f64;
+                    }
+                    for (ke, &eps) in eps_list.iter().enumerate() {
+                        candidates.push(Candidate {
+                            order: gr.order,
+                            mesh: lm.text.clone(),
+                            mesh_index: m,
+                            method,
+                            dt,
+                            eps,
+                            parts: [e_h, e_dt, e_eps[ke]],
+                            predicted_time: cost * lm.dofs as f64 * steps,
+                            dofs: lm.dofs,
+                            steps,
+                            measured_h: level < gr.pilot_levels,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    let pilots_out = pilots
+        .runs
+        .iter()
+        .map(|r| Pilot {
+            mesh_index: r.0,
+            method: r.1,
+            dt: r.2,
+            eps: r.3,
+            steps: r.4.steps,
+            secs: r.4.secs,
+        })
+        .collect();
+    Ok(Estimates {
+        quantity: q,
+        ladder,
+        candidates,
+        pilots: pilots_out,
+        seconds: start.elapsed().as_secs_f64(),
+        orders,
+        notes,
+    })
+}
+
+/// `path` relative to the directory `base` (both made absolute first).
+fn relative_to(path: &Path, base: &Path) -> PathBuf {
+    let abs = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    let (p, b) = (abs(path), abs(base));
+    let pc: Vec<Component> = p.components().collect();
+    let bc: Vec<Component> = b.components().collect();
+    let common = pc.iter().zip(&bc).take_while(|(a, b)| a == b).count();
+    if common == 0 {
+        return p;
+    }
+    let mut out = PathBuf::new();
+    for _ in common..bc.len() {
+        out.push("..");
+    }
+    for c in &pc[common..] {
+        out.push(c.as_os_str());
+    }
+    out
+}
+
+/// The case text with the chosen configuration, for `--write OUT.toml`:
+/// the case as written (comments and layout kept, by toml_edit) with
+/// mesh.file, [time] and contact.eps changed; paths are rewritten relative
+/// to OUT's directory when it is not the case's.
+///
+/// # Errors
+/// The case text does not parse (it did when it was loaded).
+pub fn adjusted_case(
+    case: &Case,
+    c: &Candidate,
+    ladder: &[LadderMesh],
+    out: &Path,
+    header: &str,
+) -> anyhow::Result<String> {
+    use toml_edit::{value, Array, InlineTable, Item, Value};
+    let mut doc: toml_edit::DocumentMut = case
+        .source
+        .parse()
+        .with_context(|| format!("{}: the case text no longer parses", case.path.display()))?;
+    let case_dir = case.path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let out_dir = out.parent().unwrap_or(Path::new("")).to_path_buf();
+    let same_dir = std::fs::canonicalize(if case_dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        &case_dir
+    })
+    .ok()
+        == std::fs::canonicalize(if out_dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            &out_dir
+        })
+        .ok();
+    let rel = |m: &LadderMesh| -> String {
+        if same_dir {
+            m.text.clone()
+        } else {
+            relative_to(
+                &m.path,
+                if out_dir.as_os_str().is_empty() {
+                    Path::new(".")
+                } else {
+                    &out_dir
+                },
+            )
+            .display()
+            .to_string()
+        }
+    };
+    let set = |t: &mut toml_edit::Table, k: &str, v: Value| match t.get_mut(k) {
+        Some(Item::Value(old)) => {
+            let decor = old.decor().clone();
+            *old = v;
+            *old.decor_mut() = decor;
+        }
+        _ => {
+            t.insert(k, Item::Value(v));
+        }
+    };
+    let mesh = doc["mesh"]
+        .as_table_mut()
+        .context("[mesh] is not a table")?;
+    set(mesh, "file", Value::from(rel(&ladder[c.mesh_index])));
+    if !same_dir {
+        if let Some(Item::Value(Value::Array(a))) = mesh.get_mut("ladder") {
+            let new: Array = ladder.iter().map(|m| Value::from(rel(m))).collect();
+            for (slot, v) in a.iter_mut().zip(new.iter()) {
+                let decor = slot.decor().clone();
+                *slot = v.clone();
+                *slot.decor_mut() = decor;
+            }
+        }
+    }
+    let time = doc["time"]
+        .as_table_mut()
+        .context("[time] is not a table")?;
+    match c.method.newmark() {
+        None => {
+            set(time, "scheme", Value::from("central_difference"));
+            time.remove("beta");
+            time.remove("gamma");
+        }
+        Some((beta, gamma)) => {
+            set(time, "scheme", Value::from("newmark"));
+            set(time, "beta", Value::from(beta));
+            set(time, "gamma", Value::from(gamma));
+        }
+    }
+    set(time, "dt", Value::from(c.dt));
+    time.remove("mass");
+    time.remove("allow_unstable");
+    if c.method == Method::TrapezoidalReduced {
+        let r = case.time.stick_reduction.unwrap_or(PAPER_REDUCTION);
+        let mut t = InlineTable::new();
+        t.insert("dt", Value::from(r.dt));
+        t.insert("steps", Value::from(r.steps as i64));
+        time.remove("stick_reduction");
+        time.insert("stick_reduction", value(t));
+    } else {
+        time.remove("stick_reduction");
+    }
+    if case.contact.is_some() {
+        let contact = doc["contact"]
+            .as_table_like_mut()
+            .context("[contact] is not a table")?;
+        match contact.get_mut("eps") {
+            Some(Item::Value(old)) => {
+                let decor = old.decor().clone();
+                *old = Value::from(c.eps);
+                *old.decor_mut() = decor;
+            }
+            _ => {
+                contact.insert("eps", value(c.eps));
+            }
+        }
+    }
+    let mut text = String::new();
+    for line in header.lines() {
+        text.push_str("# ");
+        text.push_str(line);
+        text.push('\n');
+    }
+    text.push_str(&doc.to_string());
+    // What we write must load as a case.
+    case::load_str(out, &text, &[])
+        .map_err(|e| anyhow::anyhow!("the adjusted case does not load: {}", e.0))?;
+    Ok(text)
+}
+
+/// Parses `--at X,Y`.
+///
+/// # Errors
+/// Not two finite numbers.
+pub fn parse_point(s: &str) -> Result<[f64; 2], InputError> {
+    let bad = || {
+        InputError(format!(
+            "--at {s:?}: expected two numbers X,Y, e.g. --at 8,1"
+        ))
+    };
+    let (x, y) = s.split_once(',').ok_or_else(bad)?;
+    let x: f64 = x.trim().parse().map_err(|_| bad())?;
+    let y: f64 = y.trim().parse().map_err(|_| bad())?;
+    if x.is_finite() && y.is_finite() {
+        Ok([x, y])
+    } else {
+        Err(bad())
+    }
+}
+
+/// The command's options.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Tolerance on the relative error.
+    pub tol: f64,
+    /// The output.
+    pub quantity: Quantity,
+    /// The point (ux, uy, friction_stress).
+    pub at: Option<[f64; 2]>,
+    /// Write the adjusted case here.
+    pub write: Option<PathBuf>,
+    /// One JSON object on stdout instead of the report.
+    pub json: bool,
+}
+
+/// How `advise` ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// A configuration meets the tolerance (estimated).
+    Found,
+    /// None of the ladder's does.
+    NotReachable,
+}
+
+fn describe(c: &Candidate, ladder: &[LadderMesh]) -> String {
+    let extra = if c.method == Method::CentralDifference {
+        format!(" ({:.3} dt_crit)", c.dt / ladder[c.mesh_index].dt_crit)
+    } else {
+        String::new()
+    };
+    format!(
+        "Q{} {} ({} DOFs), {}, dt = {:.4e}{extra}, eps = {:e}",
+        c.order,
+        c.mesh,
+        c.dofs,
+        c.method.label(),
+        c.dt,
+        c.eps
+    )
+}
+
+/// `stickslip advise`: pilots, choice, report, `--write`.
+///
+/// # Errors
+/// Input problems as [`InputError`]; pilot runs that fail; an unwritable output.
+pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
+    if !(o.tol > 0.0 && o.tol.is_finite()) {
+        return Err(input(format!(
+            "--tol {}: give a relative error > 0, e.g. --tol 1e-2",
+            o.tol
+        )));
+    }
+    if let Some(w) = &o.write {
+        if let Some(dir) = w
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
+        {
+            return Err(input(format!(
+                "--write {}: the directory {} does not exist; create it or write elsewhere",
+                w.display(),
+                dir.display()
+            )));
+        }
+    }
+    let json = o.json;
+    let mut log = |l: &str| {
+        if !json {
+            eprintln!("{l}");
+        }
+    };
+    let est = estimate(case, o.quantity, o.at, &mut log)?;
+    let what = match (o.quantity, est.ladder[0].node_at) {
+        (Quantity::Energy, _) => "total energy at t_end, relative to E(0) - E(t_end)".to_string(),
+        (q, Some(p)) => format!(
+            "{} at the node ({}, {}), relative L2 in time",
+            match q {
+                Quantity::Ux => "u_x",
+                Quantity::Uy => "u_y",
+                _ => "friction stress",
+            },
+            p[0],
+            p[1]
+        ),
+        (q, None) => q.name().to_string(),
+    };
+    let choice = pick(&est.candidates, o.tol);
+    let best = est
+        .candidates
+        .iter()
+        .filter(|c| c.estimate().is_finite())
+        .min_by(|a, b| a.estimate().total_cmp(&b.estimate()));
+    let pilot_runs = est.pilots.len();
+    if json {
+        let cand = |c: &Candidate| {
+            serde_json::json!({
+                "order": c.order,
+                "mesh": c.mesh,
+                "dofs": c.dofs,
+                "method": c.method.name(),
+                "dt": c.dt,
+                "eps": c.eps,
+                "estimate": c.estimate(),
+                "estimate_h": c.parts[0],
+                "estimate_dt": c.parts[1],
+                "estimate_eps": c.parts[2],
+                "h_measured": c.measured_h,
+                "steps": c.steps,
+                "predicted_time_s": c.predicted_time,
+            })
+        };
+        let j = serde_json::json!({
+            "case": case.path.display().to_string(),
+            "on": o.quantity.name(),
+            "measure": what,
+            "tol": o.tol,
+            "found": choice.is_some(),
+            "choice": choice.map(cand),
+            "most_accurate": best.map(cand),
+            "pilot_runs": pilot_runs,
+            "pilot_time_s": est.seconds,
+            "orders": est.orders.iter().map(|(w, p, c, d)| serde_json::json!({"what": w, "order": p, "correlation": c, "differences": d})).collect::<Vec<_>>(),
+            "notes": est.notes,
+            "written": o.write.as_ref().filter(|_| choice.is_some()).map(|w| w.display().to_string()),
+        });
+        println!("{j}");
+    }
+    let Some(c) = choice else {
+        let b = best.map_or("none".to_string(), |b| {
+            format!("{:.3e} with {}", b.estimate(), describe(b, &est.ladder))
+        });
+        eprintln!(
+            "error: {}: no configuration of the ladder reaches an estimated error of {:e} on {what}; \
+             the smallest estimate is {b}; add finer meshes to mesh.ladder or loosen --tol",
+            case.path.display(),
+            o.tol
+        );
+        return Ok(Verdict::NotReachable);
+    };
+    if !json {
+        println!("case        {}", case.path.display());
+        println!("on          {what}, tol {:e}", o.tol);
+        println!("pilots      {pilot_runs} runs in {:.2} s", est.seconds);
+        for (w, p, c, d) in &est.orders {
+            let d: Vec<String> = d.iter().map(|x| format!("{x:.2e}")).collect();
+            println!(
+                "  ladder    {w}: differences {}; order {p:.2}, correlation {c:.2}",
+                d.join(", ")
+            );
+        }
+        for n in &est.notes {
+            println!("note        {n}");
+        }
+        println!("choice      {}", describe(c, &est.ladder));
+        println!(
+            "estimate    {:.3e} = h {:.3e}{} + dt {:.3e} + eps {:.3e}",
+            c.estimate(),
+            c.parts[0],
+            if c.measured_h { "" } else { " (extrapolated)" },
+            c.parts[1],
+            c.parts[2]
+        );
+        println!(
+            "predicted   {:.3} s ({:.0} steps x {} DOFs at the pilots' seconds per step per DOF)",
+            c.predicted_time, c.steps, c.dofs
+        );
+    }
+    if let Some(w) = &o.write {
+        let header = format!(
+            "Adjusted by `stickslip advise --tol {:e} --on {}`: {}\nestimated error {:.3e}, predicted run time {:.3} s",
+            o.tol,
+            o.quantity.name(),
+            describe(c, &est.ladder),
+            c.estimate(),
+            c.predicted_time
+        );
+        let text = adjusted_case(case, c, &est.ladder, w, &header)?;
+        std::fs::write(w, text).with_context(|| format!("cannot write {}", w.display()))?;
+        if !json {
+            println!("written     {}", w.display());
+        }
+    }
+    Ok(Verdict::Found)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn richardson_recovers_the_error_of_a_power_law() {
+        // e(h) = C h^p exactly: a − b = C h^p (1 − r^−p), e(h/r) = C (h/r)^p.
+        let (c, p, h, r) = (3.0_f64, 2.0_f64, 0.1_f64, 2.0_f64);
+        let e = |h: f64| c * h.powf(p);
+        let estimate = richardson(e(h) - e(h / r), r, p);
+        assert!((estimate - e(h / r)).abs() < 1e-14);
+        let order = observed_order(e(h) - e(h / r), e(h / r) - e(h / r / r), r).unwrap();
+        assert!((order - p).abs() < 1e-12);
+        assert!((extrapolate(e(h), r, p, 2) - e(h / 4.0)).abs() < 1e-14);
+        // Not asymptotic: differences that grow give no order.
+        assert!(observed_order(1.0, 2.0, 2.0).is_none());
+    }
+
+    #[test]
+    fn ladder_errors_of_a_power_law() {
+        // Levels h, h/2, h/4 measured, h/8 beyond; e = C h^p exactly (all
+        // errors aligned, c = 1) with p = 1.5 (below the cap 2): every
+        // level's error is recovered.
+        let (c, p, h) = (2.0_f64, 1.5_f64, 0.2_f64);
+        let e = |k: i32| c * (h / 2f64.powi(k)).powf(p);
+        let diffs = [e(0) - e(1), e(1) - e(2)];
+        let skip = Some(e(0) - e(2));
+        let (est, order, corr) = ladder_errors(&diffs, skip, &[2.0, 2.0, 2.0], 2.0);
+        assert!((order - p).abs() < 1e-12);
+        assert!((corr - 1.0).abs() < 1e-3, "{corr}");
+        for k in 0..4 {
+            assert!(
+                (est[k] - e(k as i32)).abs() < 1e-3 * e(k as i32),
+                "{k}: {est:?}"
+            );
+        }
+        // The cap: an observed order above it is not trusted.
+        let (_, capped, _) = ladder_errors(&diffs, skip, &[2.0, 2.0, 2.0], 1.0);
+        assert_eq!(capped, 1.0);
+        // Two levels: classical Richardson with the assumed order.
+        let (est, order, _) = ladder_errors(&[1.0], None, &[2.0, 2.0], 2.0);
+        assert_eq!(order, TWO_LEVEL_ORDER);
+        assert!((est[1] - 1.0 / (2f64.powf(TWO_LEVEL_ORDER) - 1.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn ladder_errors_of_errors_that_differ_in_phase() {
+        // Errors along three orthogonal directions (c = 0), halving per
+        // level: e_0 = (1, 0, 0), e_1 = (0, ½, 0), e_2 = (0, 0, ¼). The
+        // differences are not aligned with the errors; the model recovers
+        // |e_k| where classical Richardson (c = 1) would give |e_2| =
+        // |q_1 − q_2| = 0.56 (2.2 times too large).
+        let rho = 0.5_f64;
+        let d01 = (1.0 + rho * rho).sqrt();
+        let d12 = rho * d01;
+        let d02 = (1.0 + rho.powi(4)).sqrt();
+        assert!((correlation(d01, d02, rho, rho)).abs() < 1e-3);
+        let (est, order, _) = ladder_errors(&[d01, d12], Some(d02), &[2.0, 2.0], 2.0);
+        assert!((order - 1.0).abs() < 1e-12);
+        for (k, want) in [1.0, 0.5, 0.25].iter().enumerate() {
+            assert!((est[k] - want).abs() < 1e-3, "{k}: {est:?}");
+        }
+    }
+
+    #[test]
+    fn pick_takes_the_cheapest_that_meets_the_tolerance() {
+        let cand = |t: f64, e: f64| Candidate {
+            order: 2,
+            mesh: "m".into(),
+            mesh_index: 0,
+            method: Method::CentralDifference,
+            dt: 1e-3,
+            eps: 1e-4,
+            parts: [e, 0.0, 0.0],
+            predicted_time: t,
+            dofs: 1,
+            steps: 1.0,
+            measured_h: true,
+        };
+        let all = vec![
+            cand(1.0, 0.5),
+            cand(2.0, 0.05),
+            cand(3.0, 0.01),
+            cand(0.5, f64::NAN),
+        ];
+        assert_eq!(pick(&all, 0.1).unwrap().predicted_time, 2.0);
+        assert_eq!(pick(&all, 0.02).unwrap().predicted_time, 3.0);
+        assert!(pick(&all, 1e-3).is_none());
+        assert_eq!(
+            Quantity::parse("friction_stress"),
+            Ok(Quantity::FrictionStress)
+        );
+        assert!(Quantity::parse("sigma").is_err());
+    }
+
+    #[test]
+    fn points_and_relative_paths() {
+        assert_eq!(parse_point("8, -1").unwrap(), [8.0, -1.0]);
+        assert!(parse_point("8").is_err());
+        assert!(parse_point("8,nan").is_err());
+        assert_eq!(
+            relative_to(Path::new("/a/b/m.msh"), Path::new("/a/c")),
+            PathBuf::from("../b/m.msh")
+        );
+    }
+}
