@@ -694,6 +694,14 @@ pub fn read_ladder(
     }
     let mut out = Vec::new();
     for (path, text) in case.mesh.ladder.iter().zip(&case.mesh.ladder_text) {
+        if !path.is_file() {
+            return Err(input(format!(
+                "{}mesh.ladder entry {text:?}: {} does not exist (paths are relative to the case file's directory); \
+                 check the name, or make the mesh with Gmsh",
+                case.at("mesh.ladder"),
+                path.display()
+            )));
+        }
         // A Newmark set-up never refuses a Δt; the static solve checks the supports.
         let c = configured(
             case,
