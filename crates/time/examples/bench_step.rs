@@ -431,12 +431,11 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         peak / need
     );
     let extra = if explicit {
-        // Bytes the passes must move (kernels.rs): K in its compact form;
-        // vectors: pass A reads the constant load, 2 loads, r, ṙ, r̈ and
-        // writes R_K, r_K (8); the SpMV fused with pass B reads r_K, R_K,
-        // m, ṙ, r̈ and writes b, ṙ_K (7); pass C reads m, R, R_K, r, r_K,
-        // ṙ, ṙ_K, r̈ and writes r̈_K (9). 24 vectors of n f64.
-        let bytes = i.explicit_matrix_bytes() as f64 + 24.0 * 8.0 * n as f64;
+        // Bytes the two sweeps must move (kernels.rs): K in its compact
+        // form; vectors: the predictor reads the constant load, 2 loads, r,
+        // ṙ, r̈ and writes R_K, r_K (8); the sweep reads r_K, R_K, R, m, r,
+        // ṙ, r̈ and writes ṙ_K, r̈_K (9). 17 vectors of n f64.
+        let bytes = i.explicit_matrix_bytes() as f64 + 17.0 * 8.0 * n as f64;
         let bw = pool.install(stream_triad);
         format!(
             "bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
