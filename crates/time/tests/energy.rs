@@ -10,7 +10,7 @@ use stickslip_time::{History, Scheme, Settings};
 /// no contact surface) and E_0.
 fn energy_drift(mesh: &str, scheme: Scheme, dt: f64) -> (f64, f64) {
     let s = slab(mesh, 0.3, 300.0, None, 1.0, -150.0, History::Step);
-    let mut i = s.integrator(Settings::new(scheme, dt, 0.5));
+    let mut i = s.integrator(Settings::new(scheme, dt, 0.5)).unwrap();
     let e0 = i.energy().total;
     let mut drift: f64 = 0.0;
     while !i.done() {

@@ -66,9 +66,12 @@ fn steps_allocate_nothing() {
         let s = paper_slab(mesh, 1e-4, History::Step);
         let dt = 0.5
             * s.integrator(Settings::new(Scheme::CentralDifference, 1e-9, 1.0))
+                .unwrap()
                 .dt_crit()
                 .unwrap();
-        let mut i = s.integrator(Settings::new(Scheme::CentralDifference, dt, 1e3));
+        let mut i = s
+            .integrator(Settings::new(Scheme::CentralDifference, dt, 1e3))
+            .unwrap();
         // Inside the pool: a parallel loop started from outside it goes
         // through rayon's injector queue, which allocates a block per 63
         // jobs (measured: 13 allocations in 200 steps = 800 passes); a
@@ -102,7 +105,7 @@ fn steps_allocate_nothing() {
             dt: 1e-7,
             steps: 10,
         });
-        let mut i = s.integrator(settings);
+        let mut i = s.integrator(settings).unwrap();
         i.set_implicit_solver(solver).unwrap();
         while i.factorizations() < 2 {
             i.step().unwrap();

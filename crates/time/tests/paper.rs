@@ -31,10 +31,10 @@ fn initial_total_energy_is_the_papers() {
         ("slab-q1-16x4.msh", Scheme::CentralDifference),
     ] {
         let s = paper_slab(mesh, 1e-4, History::Step);
-        let i = s.integrator(Settings::new(scheme, 1e-3, 0.5));
+        let i = s.integrator(Settings::new(scheme, 1e-3, 0.5)).unwrap();
         let e = i.energy().total;
         assert!((e + 187.2).abs() < 0.01, "{mesh} {scheme:?}: E(0) = {e}");
-        let n81 = s.node_at(8.0, 0.0);
+        let n81 = s.node_at(8.0, 0.0).unwrap();
         assert!(
             (s.ux(i.displacement(), n81) - 0.936).abs() < 1e-10,
             "{mesh}: u_x(8, 0) = 0.117·8"
@@ -52,8 +52,8 @@ fn paper_properties(scheme: Scheme, dt: f64, energy_band: f64) -> (f64, f64) {
             steps: 10,
         });
     }
-    let mut i = s.integrator(settings);
-    let c81 = s.contact_index(s.node_at(8.0, 0.0));
+    let mut i = s.integrator(settings).unwrap();
+    let c81 = s.contact_index(s.node_at(8.0, 0.0).unwrap()).unwrap();
     let n_c = s.contact.as_ref().unwrap().len();
     let mut stress = vec![0.0; n_c];
     let (mut last_dissipated, mut last_total) = (0.0, i.energy().total);
@@ -121,10 +121,12 @@ fn newmark_keeps_the_papers_properties_and_balances_energy() {
 #[test]
 fn explicit_closed_form_friction_equals_the_iteration() {
     let s = paper_slab("slab-q2-8x2.msh", 1e-4, History::Step);
-    let mut closed = s.integrator(Settings::new(Scheme::CentralDifference, 1e-3, 0.5));
+    let mut closed = s
+        .integrator(Settings::new(Scheme::CentralDifference, 1e-3, 0.5))
+        .unwrap();
     let mut settings = Settings::new(Scheme::CentralDifference, 1e-3, 0.5);
     settings.explicit_friction = ExplicitFriction::Iterate;
-    let mut iterated = s.integrator(settings);
+    let mut iterated = s.integrator(settings).unwrap();
     let mut worst: f64 = 0.0;
     let mut iterations = 0;
     while !closed.done() {
@@ -161,7 +163,7 @@ fn remark_4_2_stops_the_iteration_from_cycling() {
                 remark_4_2: remark,
                 max_iterations: 50,
             };
-            let mut i = s.integrator(settings);
+            let mut i = s.integrator(settings).unwrap();
             let mut failure = None;
             while !i.done() {
                 if let Err(e) = i.step() {

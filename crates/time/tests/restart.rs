@@ -50,14 +50,14 @@ fn assert_same_state(a: &Integrator, b: &Integrator, what: &str) {
 fn restored_runs_are_bit_identical_to_uninterrupted_ones() {
     for scheme in [Scheme::CentralDifference, NEWMARK] {
         let s = paper_slab("slab-q2-8x2.msh", 1e-4, History::Step);
-        let mut whole = s.integrator(settings(scheme, 0.5));
+        let mut whole = s.integrator(settings(scheme, 0.5)).unwrap();
         finish(&mut whole);
         assert!(whole.steps() > 100, "{scheme:?}: the run must be long");
 
         // Checkpoints early, in the middle (after node 81 slipped) and
         // during a reduced-step phase for Newmark.
         for k in [1_u64, 37, whole.steps() / 2, whole.steps() - 3] {
-            let mut first = s.integrator(settings(scheme, 0.5));
+            let mut first = s.integrator(settings(scheme, 0.5)).unwrap();
             while first.steps() < k {
                 first.step().unwrap();
             }
@@ -65,14 +65,14 @@ fn restored_runs_are_bit_identical_to_uninterrupted_ones() {
             assert_eq!(c.steps, k);
 
             // Same t_end.
-            let mut second = s.integrator(settings(scheme, 0.5));
+            let mut second = s.integrator(settings(scheme, 0.5)).unwrap();
             second.restore(&c).unwrap();
             assert_eq!(second.checkpoint(), c, "{scheme:?} k = {k}: round trip");
             finish(&mut second);
             assert_same_state(&whole, &second, &format!("{scheme:?} k = {k}"));
 
             // A fresh integrator built for a shorter run, extended.
-            let mut third = s.integrator(settings(scheme, c.t + 1e-2));
+            let mut third = s.integrator(settings(scheme, c.t + 1e-2)).unwrap();
             third.restore(&c).unwrap();
             third.set_t_end(0.5);
             finish(&mut third);
@@ -87,13 +87,18 @@ fn a_checkpoint_of_another_model_is_refused() {
     let q1 = paper_slab("slab-q1-32x8.msh", 1e-4, History::Step);
     let c = q2
         .integrator(settings(Scheme::CentralDifference, 0.5))
+        .unwrap()
         .checkpoint();
-    let mut other = q1.integrator(settings(Scheme::CentralDifference, 0.5));
+    let mut other = q1
+        .integrator(settings(Scheme::CentralDifference, 0.5))
+        .unwrap();
     let e = other.restore(&c).unwrap_err().to_string();
     assert!(e.contains("free DOFs"), "{e}");
     let mut bad = c.clone();
     bad.classes[0] = 3;
-    let mut same = q2.integrator(settings(Scheme::CentralDifference, 0.5));
+    let mut same = q2
+        .integrator(settings(Scheme::CentralDifference, 0.5))
+        .unwrap();
     let e = same.restore(&bad).unwrap_err().to_string();
     assert!(e.contains("class code 3"), "{e}");
 }

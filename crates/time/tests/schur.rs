@@ -48,7 +48,7 @@ fn build(
 ) -> Integrator {
     let mut settings = Settings::new(scheme, 5e-3, 0.5);
     settings.stick_reduction = reduction;
-    let mut i = s.integrator(settings);
+    let mut i = s.integrator(settings).unwrap();
     i.set_implicit_solver(solver).unwrap();
     assert_eq!(i.implicit_solver(), solver);
     i

@@ -8,76 +8,17 @@
 //! at rest again at 2x_e − x_i. P = 2.5 slips once on [0, π/10] and sticks
 //! at 0.03; P = 5 slips forward to 0.08, back to 0.04 and sticks; P = 0.8
 //! never moves.
+//!
+//! The closed form and the oscillator are `stickslip_time::scenes::sdof`
+//! (shared with `cargo xtask verify`); the first test checks the closed form
+//! against the statement above.
 
-use nalgebra_sparse::{CooMatrix, CsrMatrix};
-use stickslip_contact::{ContactNode, ContactSurface};
-use stickslip_time::{Dynamics, History, Integrator, Load, Scheme, Settings};
+use stickslip_time::scenes::sdof::closed_form;
+use stickslip_time::Scheme;
 
-const K: f64 = 100.0;
-const G: f64 = 1.0;
-const OMEGA: f64 = 10.0;
-
-/// Exact Coulomb displacement at time t.
-fn closed_form(p: f64, t: f64) -> f64 {
-    let half = std::f64::consts::PI / OMEGA;
-    let (mut x, mut t0) = (0.0, 0.0);
-    loop {
-        let f = p - K * x;
-        if f.abs() <= G + 1e-12 {
-            return x; // stuck for good: the load is constant
-        }
-        let xe = (p - f.signum() * G) / K;
-        if t <= t0 + half {
-            return xe + (x - xe) * (OMEGA * (t - t0)).cos();
-        }
-        x = 2.0 * xe - x;
-        t0 += half;
-    }
-}
-
-fn one_dof(p: f64, eps: f64, scheme: Scheme, dt: f64, t_end: f64) -> Integrator {
-    let scalar = |v: f64| {
-        let mut coo = CooMatrix::new(1, 1);
-        coo.push(0, 0, v);
-        CsrMatrix::from(&coo)
-    };
-    let dynamics = Dynamics {
-        stiffness: scalar(K),
-        consistent_mass: scalar(1.0),
-        lumped_mass: vec![1.0],
-        constant_load: vec![0.0],
-    };
-    let node = ContactNode {
-        node: 0,
-        dofs: [Some(0), None],
-        weight: 1.0,
-        tangent: [1.0, 0.0],
-        s: 0.0,
-        bound: G,
-    };
-    let surface = ContactSurface::from_nodes("mass", vec![node], eps).unwrap();
-    let loads = vec![Load {
-        vector: vec![p],
-        history: History::Step,
-    }];
-    Integrator::new(
-        dynamics,
-        Some(surface),
-        loads,
-        Settings::new(scheme, dt, t_end),
-    )
-    .unwrap()
-}
-
-/// Largest |x − x_exact| over the run.
+/// Largest |x − x_exact| over the run, and x(1).
 fn max_error(p: f64, eps: f64, scheme: Scheme, dt: f64) -> (f64, f64) {
-    let mut i = one_dof(p, eps, scheme, dt, 1.0);
-    let mut err: f64 = 0.0;
-    while !i.done() {
-        i.step().unwrap();
-        err = err.max((i.displacement()[0] - closed_form(p, i.time())).abs());
-    }
-    (err, i.displacement()[0])
+    stickslip_time::scenes::sdof::max_error(p, eps, scheme, dt).unwrap()
 }
 
 const SCHEMES: [Scheme; 2] = [

@@ -13,9 +13,13 @@ fn run(s: &Slab, threads: usize, steps: usize) -> Integrator {
         .unwrap();
     pool.install(|| {
         assert_eq!(rayon::current_num_threads(), threads);
-        let probe = s.integrator(Settings::new(Scheme::CentralDifference, 1e-9, 0.5));
+        let probe = s
+            .integrator(Settings::new(Scheme::CentralDifference, 1e-9, 0.5))
+            .unwrap();
         let dt = 0.9 * probe.dt_crit().unwrap();
-        let mut i = s.integrator(Settings::new(Scheme::CentralDifference, dt, 0.5));
+        let mut i = s
+            .integrator(Settings::new(Scheme::CentralDifference, dt, 0.5))
+            .unwrap();
         for _ in 0..steps {
             i.step().unwrap();
         }

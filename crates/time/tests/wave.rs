@@ -4,80 +4,14 @@
 //! the end displacement: a triangle wave between 0 and −2pL/E with period
 //! 4L/c, u(L, t) = −(p c/E)·t for t ≤ 2L/c, then back to 0 at 4L/c.
 
-mod common;
-use common::*;
-use stickslip_fem::{traction_load, Dirichlet, Hypothesis, Material, Model, Traction};
-use stickslip_mesh::Mesh;
-use stickslip_time::{Dynamics, History, Integrator, Load, Scheme, Settings};
+use stickslip_time::scenes::{read_mesh, wave};
+use stickslip_time::Scheme;
 
-const E: f64 = 1000.0;
-const L: f64 = 8.0;
-const P: f64 = 1.0;
-
-fn exact_end_displacement(t: f64) -> f64 {
-    let c = E.sqrt();
-    let period = 4.0 * L / c;
-    let tau = t.rem_euclid(period);
-    let rise = if tau <= period / 2.0 {
-        tau
-    } else {
-        period - tau
-    };
-    -P * c / E * rise
-}
-
-/// Relative L2-in-time error of u_x(L, 0) over one period.
+/// Relative L2-in-time error of u_x(L, 0) over one period against
+/// d'Alembert (`scenes::wave::exact_end_displacement`, the closed form
+/// above; the scene is `scenes::wave::scene`).
 fn wave_error(mesh_file: &str, scheme: Scheme, dt: f64) -> f64 {
-    let mesh = Mesh::from_file(mesh_path(mesh_file)).unwrap();
-    let material = Material::new(E, 0.0, 1.0, Hypothesis::PlaneStrain).unwrap();
-    let conditions = vec![
-        Dirichlet {
-            group: "support".into(),
-            component: 1,
-            value: 0.0,
-        },
-        Dirichlet {
-            group: "contact".into(),
-            component: 1,
-            value: 0.0,
-        },
-        Dirichlet {
-            group: "left".into(),
-            component: 0,
-            value: 0.0,
-        },
-    ];
-    let model = Model::new(&mesh, &material, &conditions).unwrap();
-    let mut full = vec![0.0; 2 * mesh.nodes.len()];
-    traction_load(&mesh, "load", Traction::Vector([-P, 0.0]), &mut full).unwrap();
-    let mut free = vec![0.0; model.dofs.n_free()];
-    model.dofs.restrict(&full, &mut free);
-    let end = mesh
-        .nodes
-        .iter()
-        .position(|p| (p[0] - L).abs() < 1e-12 && p[1].abs() < 1e-12)
-        .unwrap();
-    let end_dof = model.dofs.free(end, 0).unwrap();
-    let period = 4.0 * L / E.sqrt();
-    let loads = vec![Load {
-        vector: free,
-        history: History::Step,
-    }];
-    let mut i = Integrator::new(
-        Dynamics::from_model(&model),
-        None,
-        loads,
-        Settings::new(scheme, dt, period),
-    )
-    .unwrap();
-    let (mut err2, mut ref2) = (0.0, 0.0);
-    while !i.done() {
-        i.step().unwrap();
-        let exact = exact_end_displacement(i.time());
-        err2 += (i.displacement()[end_dof] - exact).powi(2);
-        ref2 += exact * exact;
-    }
-    (err2 / ref2).sqrt()
+    wave::end_error(read_mesh(mesh_file).unwrap(), scheme, dt).unwrap()
 }
 
 #[test]
