@@ -1,13 +1,15 @@
 //! Scenes to run in-process: the paper's cases read from their TOML files
-//! (the few keys the slab needs), the single-DOF friction oscillator, and a
-//! run recorder that keeps the time histories the checks and figures use.
+//! (the few keys the slab needs) and assembled by
+//! `stickslip_time::scenes::Slab`, and a run recorder that keeps the time
+//! histories the checks and figures use. The single-DOF friction oscillator
+//! is `stickslip_time::scenes::sdof`.
 
 use std::path::{Path, PathBuf};
 
-use nalgebra_sparse::{CooMatrix, CsrMatrix};
-use stickslip_contact::{ContactNode, ContactSurface};
-use stickslip_fem::{traction_load, Dirichlet, Hypothesis, Material, Model, Traction};
+use stickslip_contact::ContactSurface;
+use stickslip_fem::{Dirichlet, Hypothesis, Material, Model, Traction};
 use stickslip_mesh::Mesh;
+use stickslip_time::scenes::{Slab, TractionLoad};
 use stickslip_time::{
     Dynamics, Energy, History, Integrator, Load, MassKind, Scheme, Settings, StickReduction,
 };
@@ -266,41 +268,31 @@ impl Scene {
             .iter()
             .map(|(g, c, v)| Dirichlet::new(g.clone(), *c, *v))
             .collect();
-        let model = Model::new(&mesh, &material, &conditions).map_err(|e| ctx(e.to_string()))?;
         let (group, pressure, mu, eps) = case.contact.clone();
-        let mut loads = Vec::new();
-        let n_full = 2 * mesh.nodes.len();
-        let restrict = |full: &[f64]| {
-            let mut free = vec![0.0; model.dofs.n_free()];
-            model.dofs.restrict(full, &mut free);
-            free
-        };
         // The prescribed normal traction on Γ_C is a load like any other
         // (METHOD.md §3), present before t = 0.
-        let mut full = vec![0.0; n_full];
-        traction_load(&mesh, &group, Traction::Pressure(pressure), &mut full)
-            .map_err(|e| ctx(e.to_string()))?;
-        loads.push(Load {
-            vector: restrict(&full),
-            history: History::Constant,
-        });
+        let mut tractions: Vec<TractionLoad> = vec![(
+            group.as_str(),
+            Traction::Pressure(pressure),
+            History::Constant,
+        )];
         for (g, t, h) in &case.tractions {
-            let mut full = vec![0.0; n_full];
-            traction_load(&mesh, g, Traction::Vector(*t), &mut full)
-                .map_err(|e| ctx(e.to_string()))?;
-            loads.push(Load {
-                vector: restrict(&full),
-                history: h.clone(),
-            });
+            tractions.push((g.as_str(), Traction::Vector(*t), h.clone()));
         }
-        let contact = ContactSurface::from_group(&mesh, &model.dofs, &group, pressure, mu, eps)
-            .map_err(|e| ctx(e.to_string()))?;
-        Ok(Scene {
-            dynamics: Dynamics::from_model(&model),
+        let slab = Slab::assemble(
             mesh,
-            model,
-            contact: Some(contact),
-            loads,
+            &material,
+            &conditions,
+            &tractions,
+            Some((group.as_str(), pressure, mu, eps)),
+        )
+        .map_err(|e| ctx(e.to_string()))?;
+        Ok(Scene {
+            dynamics: Dynamics::from_model(&slab.model),
+            mesh: slab.mesh,
+            model: slab.model,
+            contact: slab.contact,
+            loads: slab.loads,
             settings: case.settings.clone(),
         })
     }
@@ -448,96 +440,4 @@ pub struct Trace {
     pub mass: Option<MassKind>,
     /// Why the run stopped before t_end, if it did.
     pub error: Option<String>,
-}
-
-/// The single-DOF oscillator with Coulomb friction: m = 1, k = 100, friction
-/// force g = 1 (weight 1, bound 1), step force P from t = 0, at rest at 0.
-pub mod sdof {
-    use super::*;
-
-    /// Spring stiffness.
-    pub const K: f64 = 100.0;
-    /// Friction force.
-    pub const G: f64 = 1.0;
-    /// Natural frequency √(k/m).
-    pub const OMEGA: f64 = 10.0;
-
-    /// Exact Coulomb displacement at time t: from rest at x_i the mass moves
-    /// if |P − k x_i| > g, along x_e + (x_i − x_e) cos ω(t − t_i) with
-    /// x_e = (P − s g)/k, s = sign(P − k x_i), for half a period π/ω, and is
-    /// at rest again at 2x_e − x_i.
-    pub fn closed_form(p: f64, t: f64) -> f64 {
-        let half = std::f64::consts::PI / OMEGA;
-        let (mut x, mut t0) = (0.0, 0.0);
-        loop {
-            let f = p - K * x;
-            if f.abs() <= G + 1e-12 {
-                return x;
-            }
-            let xe = (p - f.signum() * G) / K;
-            if t <= t0 + half {
-                return xe + (x - xe) * (OMEGA * (t - t0)).cos();
-            }
-            x = 2.0 * xe - x;
-            t0 += half;
-        }
-    }
-
-    /// The integrator of the oscillator.
-    ///
-    /// # Errors
-    /// Settings the integrator refuses.
-    pub fn integrator(
-        p: f64,
-        eps: f64,
-        scheme: Scheme,
-        dt: f64,
-        t_end: f64,
-    ) -> Result<Integrator, String> {
-        let scalar = |v: f64| {
-            let mut coo = CooMatrix::new(1, 1);
-            coo.push(0, 0, v);
-            CsrMatrix::from(&coo)
-        };
-        let dynamics = Dynamics {
-            stiffness: scalar(K),
-            consistent_mass: scalar(1.0),
-            lumped_mass: vec![1.0],
-            constant_load: vec![0.0],
-        };
-        let node = ContactNode {
-            node: 0,
-            dofs: [Some(0), None],
-            weight: 1.0,
-            tangent: [1.0, 0.0],
-            s: 0.0,
-            bound: G,
-        };
-        let surface =
-            ContactSurface::from_nodes("mass", vec![node], eps).map_err(|e| e.to_string())?;
-        Integrator::new(
-            dynamics,
-            Some(surface),
-            vec![Load {
-                vector: vec![p],
-                history: History::Step,
-            }],
-            Settings::new(scheme, dt, t_end),
-        )
-        .map_err(|e| e.to_string())
-    }
-
-    /// (largest |x − x_exact| over [0, t_end], x(t_end)).
-    ///
-    /// # Errors
-    /// A refused setting or a failed step.
-    pub fn max_error(p: f64, eps: f64, scheme: Scheme, dt: f64) -> Result<(f64, f64), String> {
-        let mut i = integrator(p, eps, scheme, dt, 1.0)?;
-        let mut err: f64 = 0.0;
-        while !i.done() {
-            i.step().map_err(|e| e.to_string())?;
-            err = err.max((i.displacement()[0] - closed_form(p, i.time())).abs());
-        }
-        Ok((err, i.displacement()[0]))
-    }
 }

@@ -4,14 +4,12 @@
 use std::path::Path;
 
 use stickslip_fem::testing::{add_point_group, map_nodes, rectangle};
-use stickslip_fem::{
-    static_solve, traction_load, Dirichlet, Hypothesis, Material, Model, Traction,
-};
+use stickslip_fem::{static_solve, Dirichlet, Hypothesis, Material, Model};
 use stickslip_mesh::{CellKind, Mesh};
-use stickslip_time::{Dynamics, History, Integrator, Load, Scheme, Settings};
+use stickslip_time::scenes::{sdof, wave, Slab};
+use stickslip_time::{History, Scheme};
 
 use crate::report::Report;
-use crate::scene::sdof;
 use crate::{Options, NEWMARK};
 
 /// The two schemes of the paper.
@@ -48,70 +46,20 @@ fn coulomb_oscillator(opts: &Options, r: &mut Report) {
                     // |P − kx| ε / g ≤ ε, so 2e-5 over the run's unit time.
                     2e-5,
                 ),
-                Err(e) => r.holds(&case, "run completes", e, "completes", false),
+                Err(e) => r.holds(&case, "run completes", e.to_string(), "completes", false),
             }
         }
     }
 }
 
 /// Largest relative L2-in-time error of u_x(L, 0) over one period against
-/// d'Alembert's triangle wave (ν = 0 makes plane strain uniaxial: a bar
-/// with c = √(E/ρ)); the end moves as −(p c/E)·t up to 2L/c, then back.
+/// d'Alembert's triangle wave (`stickslip_time::scenes::wave`: ν = 0 makes
+/// plane strain uniaxial, a bar with c = √(E/ρ); the end moves as
+/// −(p c/E)·t up to 2L/c, then back).
 fn wave_error(root: &Path, mesh_file: &str, scheme: Scheme, dt: f64) -> Result<f64, String> {
-    const E: f64 = 1000.0;
-    const L: f64 = 8.0;
-    const P: f64 = 1.0;
     let mesh =
         Mesh::from_file(root.join("cases/meshes").join(mesh_file)).map_err(|e| e.to_string())?;
-    let material =
-        Material::new(E, 0.0, 1.0, Hypothesis::PlaneStrain).map_err(|e| e.to_string())?;
-    let conditions = vec![
-        Dirichlet::new("support", 1, 0.0),
-        Dirichlet::new("contact", 1, 0.0),
-        Dirichlet::new("left", 0, 0.0),
-    ];
-    let model = Model::new(&mesh, &material, &conditions).map_err(|e| e.to_string())?;
-    let mut full = vec![0.0; 2 * mesh.nodes.len()];
-    traction_load(&mesh, "load", Traction::Vector([-P, 0.0]), &mut full)
-        .map_err(|e| e.to_string())?;
-    let mut free = vec![0.0; model.dofs.n_free()];
-    model.dofs.restrict(&full, &mut free);
-    let end = mesh
-        .nodes
-        .iter()
-        .position(|p| (p[0] - L).abs() < 1e-12 && p[1].abs() < 1e-12)
-        .ok_or("no node at (8, 0)")?;
-    let end_dof = model.dofs.free(end, 0).ok_or("u_x(8, 0) fixed")?;
-    let c = E.sqrt();
-    let period = 4.0 * L / c;
-    let exact = |t: f64| {
-        let tau = t.rem_euclid(period);
-        let rise = if tau <= period / 2.0 {
-            tau
-        } else {
-            period - tau
-        };
-        -P * c / E * rise
-    };
-    let loads = vec![Load {
-        vector: free,
-        history: History::Step,
-    }];
-    let mut i = Integrator::new(
-        Dynamics::from_model(&model),
-        None,
-        loads,
-        Settings::new(scheme, dt, period),
-    )
-    .map_err(|e| e.to_string())?;
-    let (mut err2, mut ref2) = (0.0, 0.0);
-    while !i.done() {
-        i.step().map_err(|e| e.to_string())?;
-        let x = exact(i.time());
-        err2 += (i.displacement()[end_dof] - x).powi(2);
-        ref2 += x * x;
-    }
-    Ok((err2 / ref2).sqrt())
+    wave::end_error(mesh, scheme, dt).map_err(|e| e.to_string())
 }
 
 fn wave(root: &Path, opts: &Options, r: &mut Report) {
@@ -177,25 +125,13 @@ fn static_slab(root: &Path, r: &mut Report) {
         let result = (|| -> Result<f64, String> {
             let mesh = Mesh::from_file(root.join("cases/meshes").join(mesh_file))
                 .map_err(|e| e.to_string())?;
-            let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain)
+            // The slab of BENCHMARK.md with its pressure alone: no end load,
+            // no friction surface.
+            let slab = Slab::new(mesh, 0.3, 300.0, None, 1.0, 0.0, History::Step)
                 .map_err(|e| e.to_string())?;
-            let model = Model::new(
-                &mesh,
-                &material,
-                &[
-                    Dirichlet::new("support", 1, 0.0),
-                    Dirichlet::new("left", 0, 0.0),
-                ],
-            )
-            .map_err(|e| e.to_string())?;
-            let mut full = vec![0.0; 2 * mesh.nodes.len()];
-            traction_load(&mesh, "contact", Traction::Pressure(300.0), &mut full)
-                .map_err(|e| e.to_string())?;
-            let mut free = vec![0.0; model.dofs.n_free()];
-            model.dofs.restrict(&full, &mut free);
-            let u = static_solve(&model, &free).map_err(|e| e.to_string())?;
+            let u = static_solve(&slab.model, &slab.loads[0].vector).map_err(|e| e.to_string())?;
             let mut worst: f64 = 0.0;
-            for (v, p) in mesh.nodes.iter().enumerate() {
+            for (v, p) in slab.mesh.nodes.iter().enumerate() {
                 worst = worst
                     .max((u[2 * v] - 0.117 * p[0]).abs())
                     .max((u[2 * v + 1] - 0.273 * (1.0 - p[1])).abs());

@@ -6,10 +6,11 @@ use std::path::Path;
 
 use stickslip_fem::testing::manufactured;
 use stickslip_mesh::CellKind;
+use stickslip_time::scenes::sdof;
 use stickslip_time::{Integrator, Scheme};
 
 use crate::report::{num, Report};
-use crate::scene::{sdof, Case, Scene};
+use crate::scene::{Case, Scene};
 use crate::suites::analytic::SCHEMES;
 use crate::{Options, NEWMARK};
 
@@ -184,7 +185,11 @@ fn eps_rates(root: &Path, opts: &Options, r: &mut Report) {
             let case = format!("1-DOF Coulomb P={p} {name}");
             let errs: Result<Vec<f64>, String> = epsilons
                 .iter()
-                .map(|&e| sdof::max_error(p, e, scheme, 2e-6).map(|x| x.0))
+                .map(|&e| {
+                    sdof::max_error(p, e, scheme, 2e-6)
+                        .map(|x| x.0)
+                        .map_err(|e| e.to_string())
+                })
                 .collect();
             match errs {
                 Ok(errs) => {
