@@ -18,7 +18,7 @@ use stickslip_mesh::Mesh;
 
 use crate::plot::{self, Marker, Panel, Series, COLORS};
 use crate::run::{relative_l2, sample, timed_run, Method, Trace};
-use crate::slab::{read_mesh, LoadKind, Slab};
+use crate::slab::{self, read_mesh, LoadKind};
 
 /// End time of every run (the paper's plots end at 0.5).
 pub const T_END: f64 = 0.5;
@@ -276,7 +276,7 @@ impl Meshes {
             return Ok((&self.0[k].1, self.0[k].2));
         }
         let mesh = read_mesh(name)?;
-        let slab = Slab::new(&mesh, EPS, LoadKind::Step, true)?;
+        let slab = slab::paper(&mesh, EPS, LoadKind::Step, true)?;
         let crit = stickslip_time::stability::critical_step(
             &slab.model.stiffness,
             &slab.model.lumped_mass,

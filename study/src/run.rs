@@ -6,7 +6,7 @@ use std::time::Instant;
 use stickslip_mesh::Mesh;
 use stickslip_time::{Scheme, Settings, StickReduction};
 
-use crate::slab::{LoadKind, Slab};
+use crate::slab::{self, LoadKind, Slab};
 
 /// Remark 4.3 as the paper did it: Δt = 1e-7 for 10 steps after sticking.
 pub const REDUCTION: StickReduction = StickReduction {
@@ -113,9 +113,9 @@ pub struct Trace {
 /// # Errors
 /// A failed step or settings the time crate refuses.
 pub fn run_slab(slab: &Slab, settings: Settings) -> Result<Trace, String> {
-    let n81 = slab.node_at(8.0, 0.0)?;
-    let n85 = slab.node_at(8.0, 1.0)?;
-    let n71 = slab.node_at(7.0, 0.0)?;
+    let n81 = slab.node_at(8.0, 0.0).map_err(|e| e.to_string())?;
+    let n85 = slab.node_at(8.0, 1.0).map_err(|e| e.to_string())?;
+    let n71 = slab.node_at(7.0, 0.0).map_err(|e| e.to_string())?;
     let (d81, d85) = (slab.dof(n81, 0), slab.dof(n85, 0));
     let c71 = slab.contact_index(n71);
     let n_c = slab.contact.as_ref().map_or(0, |c| c.len());
@@ -163,7 +163,7 @@ pub fn timed_run(
     settings: Settings,
 ) -> Result<(Trace, f64), String> {
     let start = Instant::now();
-    let slab = Slab::new(mesh, eps, load, true)?;
+    let slab = slab::paper(mesh, eps, load, true)?;
     let trace = run_slab(&slab, settings)?;
     Ok((trace, start.elapsed().as_secs_f64()))
 }

@@ -18,7 +18,7 @@ use stickslip_time::{ExplicitFriction, Integrator, Scheme, Settings, TimeError};
 
 use crate::plot::{self, Marker, Panel, Series, COLORS};
 use crate::run::{Method, TRAPEZOIDAL};
-use crate::slab::{read_mesh, LoadKind, Slab, G};
+use crate::slab::{self, read_mesh, LoadKind, Slab, G};
 
 /// The Δt/Δt_crit ratios of the map.
 pub const RATIOS: [f64; 6] = [0.5, 0.9, 0.99, 1.01, 1.1, 2.0];
@@ -152,7 +152,7 @@ pub fn critical_map(meshes: &[(&str, Mesh)], steps: usize) -> Result<Vec<Critica
     let mut rows = Vec::new();
     for (name, mesh) in meshes {
         for friction in [false, true] {
-            let slab = Slab::new(mesh, 1e-4, LoadKind::Step, friction)?;
+            let slab = slab::paper(mesh, 1e-4, LoadKind::Step, friction)?;
             let runs = RATIOS
                 .iter()
                 .map(|&r| growth(&slab, r, steps).map(|g| (r, g)))
@@ -469,8 +469,8 @@ pub fn main(out: &Path, quick: bool) -> Result<(), String> {
     let mut rings = Vec::new();
     for method in Method::ALL {
         for &eps in eps_ladder {
-            let slab = Slab::new(mesh, eps, LoadKind::Step, true)?;
-            let node = slab.node_at(7.0, 0.0)?;
+            let slab = slab::paper(mesh, eps, LoadKind::Step, true)?;
+            let node = slab.node_at(7.0, 0.0).map_err(|e| e.to_string())?;
             if let Some(r) = ringing(&slab, node, method, paper_dt(method), eps, 0.5)? {
                 eprintln!(
                     "ringing {:20} eps {:.0e} x {:.3e} amplitude/g {:.3e} max {:.3e} steps {} intervals {}",
@@ -544,7 +544,7 @@ pub fn main(out: &Path, quick: bool) -> Result<(), String> {
     // 3. The iteration with and without Remark 4.2.
     let mut iters = Vec::new();
     for &eps in eps_ladder {
-        let slab = Slab::new(mesh, eps, LoadKind::Step, true)?;
+        let slab = slab::paper(mesh, eps, LoadKind::Step, true)?;
         for (scheme, dt) in [(Scheme::CentralDifference, 1e-3), (TRAPEZOIDAL, 5e-3)] {
             for remark in [true, false] {
                 let mut row = iteration_run(&slab, scheme, dt, remark, 0.5)?;

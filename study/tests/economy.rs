@@ -4,11 +4,11 @@
 use std::collections::BTreeSet;
 
 use stickslip_study::run::{Method, REDUCTION};
-use stickslip_study::slab::{read_mesh, LoadKind, Slab};
+use stickslip_study::slab::{self, read_mesh, LoadKind, Slab};
 use stickslip_time::{ImplicitSolver, Integrator};
 
 fn slab(mesh: &str, friction: bool) -> Slab {
-    Slab::new(&read_mesh(mesh).unwrap(), 1e-4, LoadKind::Step, friction).unwrap()
+    slab::paper(&read_mesh(mesh).unwrap(), 1e-4, LoadKind::Step, friction).unwrap()
 }
 
 /// Runs to the end; returns the distinct step sizes (bit patterns) and the

@@ -4,7 +4,7 @@
 //! step reduction of Remark 4.3; no iteration failures with Remark 4.2.
 
 use stickslip_study::run::{Method, TRAPEZOIDAL};
-use stickslip_study::slab::{read_mesh, LoadKind, Slab};
+use stickslip_study::slab::{self, read_mesh, LoadKind};
 use stickslip_study::stability::{growth, iteration_run, ringing, threshold, STABILITY_STEPS};
 use stickslip_time::Scheme;
 
@@ -13,7 +13,7 @@ fn central_difference_is_stable_below_and_unstable_above_the_estimate() {
     for mesh in ["slab-q1-16x4.msh", "slab-q2-8x2.msh"] {
         let m = read_mesh(mesh).unwrap();
         for friction in [false, true] {
-            let s = Slab::new(&m, 1e-4, LoadKind::Step, friction).unwrap();
+            let s = slab::paper(&m, 1e-4, LoadKind::Step, friction).unwrap();
             let tag = format!("{mesh} friction {friction}");
             for r in [0.5, 0.9, 0.99] {
                 let g = growth(&s, r, STABILITY_STEPS).unwrap();
@@ -48,7 +48,7 @@ fn step_reduction_removes_the_ringing_after_sticking() {
     // physical variation of σ_T. Newmark 0.3025/0.6 multiplies by about
     // −(1 − γ)/γ = −0.67 per step.
     let m = read_mesh("slab-q2-8x2.msh").unwrap();
-    let s = Slab::new(&m, 1e-4, LoadKind::Step, true).unwrap();
+    let s = slab::paper(&m, 1e-4, LoadKind::Step, true).unwrap();
     let node = s.node_at(7.0, 0.0).unwrap();
     let amp = |method| {
         ringing(&s, node, method, 5e-3, 1e-4, 0.5)
@@ -92,7 +92,7 @@ fn step_reduction_removes_the_ringing_after_sticking() {
 fn remark_4_2_leaves_no_failed_steps() {
     let m = read_mesh("slab-q2-8x2.msh").unwrap();
     for eps in [1e-1, 1e-2, 1e-4, 1e-6] {
-        let s = Slab::new(&m, eps, LoadKind::Step, true).unwrap();
+        let s = slab::paper(&m, eps, LoadKind::Step, true).unwrap();
         for (scheme, dt) in [(Scheme::CentralDifference, 1e-3), (TRAPEZOIDAL, 5e-3)] {
             let with = iteration_run(&s, scheme, dt, true, 0.5).unwrap();
             assert_eq!(with.failed, 0, "{scheme:?} ε = {eps}: {with:?}");
@@ -101,7 +101,7 @@ fn remark_4_2_leaves_no_failed_steps() {
     }
     // Without it the iteration cycles between the two slip directions on
     // unloading (paper, Remark 4.2) at the paper's ε.
-    let s = Slab::new(&m, 1e-4, LoadKind::Step, true).unwrap();
+    let s = slab::paper(&m, 1e-4, LoadKind::Step, true).unwrap();
     for (scheme, dt) in [(Scheme::CentralDifference, 1e-3), (TRAPEZOIDAL, 5e-3)] {
         let without = iteration_run(&s, scheme, dt, false, 0.5).unwrap();
         assert!(without.failed > 0, "{scheme:?}: {without:?}");
