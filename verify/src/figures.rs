@@ -3,11 +3,11 @@
 //! the font ships in verify/assets/).
 
 use std::path::{Path, PathBuf};
-use std::sync::Once;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::plotting::{axes, register_font, AxesStyle, COLORS};
 use crate::scene::Trace;
 use crate::{run_cases, Run};
 
@@ -39,29 +39,6 @@ struct Figure {
     panels: Vec<Panel>,
 }
 
-const COLORS: [RGBColor; 6] = [
-    RGBColor(0, 90, 181),
-    RGBColor(220, 50, 32),
-    RGBColor(0, 140, 70),
-    RGBColor(150, 80, 170),
-    RGBColor(230, 140, 0),
-    RGBColor(60, 60, 60),
-];
-
-fn register_font() -> Result<(), String> {
-    static ONCE: Once = Once::new();
-    let mut result = Ok(());
-    ONCE.call_once(|| {
-        result = plotters::style::register_font(
-            "sans-serif",
-            FontStyle::Normal,
-            include_bytes!("../assets/DejaVuSans.ttf"),
-        )
-        .map_err(|_| "verify/assets/DejaVuSans.ttf is not a usable font".to_string());
-    });
-    result
-}
-
 fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("{}: {e}", fig.stem);
     root.fill(&WHITE).map_err(err)?;
@@ -89,22 +66,22 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure) -> Resul
             y0 -= pad;
             y1 += pad;
         }
-        let mut chart = ChartBuilder::on(area)
-            .caption(&p.title, ("sans-serif", 20))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(p.x_label.as_str())
-            .y_desc(p.y_label.as_str())
-            .label_style(("sans-serif", 15))
-            .axis_desc_style(("sans-serif", 17))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(err)?;
+        let mut chart = axes(
+            area,
+            &p.title,
+            &p.x_label,
+            &p.y_label,
+            x0..x1,
+            y0..y1,
+            AxesStyle {
+                caption: 20,
+                margin: 12,
+                label: 15,
+                desc: 17,
+            },
+            None,
+        )
+        .map_err(err)?;
         for s in &p.series {
             let color = COLORS[s.color % COLORS.len()];
             chart

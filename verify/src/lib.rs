@@ -11,6 +11,7 @@
 //! a check catches it.
 
 pub mod figures;
+pub mod plotting;
 pub mod report;
 pub mod scene;
 pub mod suites;
