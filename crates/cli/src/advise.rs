@@ -3,21 +3,33 @@
 //! estimated error on one output is below a tolerance, from error
 //! estimates measured on the user's own case.
 //!
-//! The error of a configuration is modelled as the sum of three separately
-//! measured parts, e ≈ e_h + e_Δt + e_ε (a bound when they add with the
-//! same sign), each estimated Richardson-style from cheap pilot runs that
-//! differ only in that parameter: with solutions a (coarse) and b (fine) at
-//! refinement ratio r and order p, the error of b is about |a − b| /
-//! (r^p − 1), and p itself is observed from three levels (p = ln(|a − b| /
-//! |b − c|) / ln r) because the theoretical order does not hold (the slab's
-//! corner and the stick/slip kinks lower it). Coarser levels get e_k ≤
-//! e_{k+1} + |q_k − q_{k+1}| (triangle inequality); finer, unmeasured
-//! levels e_{k+1} = e_k / r^p.
+//! Error estimates. The pilots (below) include a reference run R, the
+//! most accurate one they afford: central difference at 0.9 Δt_crit on the
+//! mesh after the pilots of the highest element order. Every pilot run X
+//! then has the error √(‖X − R‖² + e_R²) ([`with_reference`]), e_R from
+//! the differences of R's own ladder (Richardson with the observed order
+//! and correlation, [`ladder_errors`]); e_R enters only in quadrature, so
+//! its uncertainty matters little. Measured this way, against the
+//! finest run rather than from differences of neighbouring levels, the
+//! estimate needs no model of how the errors of successive levels line up:
+//! on the slab they are only partly aligned (stick/slip events move between
+//! refinements; measured cosines 0.4-0.8), which made the Richardson
+//! estimates from neighbour differences off by up to 1.5×.
+//!
+//! A candidate that was not run is estimated from three measured parts
+//! combined in quadrature ([`Candidate::estimate`]): the error of its mesh
+//! with its family's base Δt (central difference at 0.9 Δt_crit: the
+//! combined h and Δt error of that path, since its Δt is tied to h;
+//! Newmark at t_end/200), the change its method and Δt make from that base
+//! on the pilot mesh, and the change its ε makes there. Meshes finer than
+//! the measured ones continue the last measured decrease (observed order,
+//! capped at the theoretical one; none when the errors stopped decreasing).
 //!
 //! * h: the first three meshes of each element order in the ladder, run
 //!   with central difference at 0.9 Δt_crit of each mesh (its own family:
 //!   lumped mass, Δt tied to h) and with Newmark ¼/½ at Δt = t_end/200
-//!   (consistent mass; shared by the three Newmark variants).
+//!   (consistent mass; shared by the three Newmark variants); the
+//!   reference R on the fourth mesh of the highest order.
 //! * Δt: on one pilot mesh (the second of the highest order), central
 //!   difference at 0.9, 0.45, 0.225 Δt_crit and each Newmark variant at
 //!   Δt = t_end/50, /100, /200, /400.
@@ -29,9 +41,8 @@
 //!
 //! Pilots run over the whole [0, t_end]: the error measures are integrals
 //! (or the end value) over that interval, so a shorter run would not
-//! measure them. The predicted time is the measured seconds per step per
-//! DOF of the pilots (the largest pilot of that order and scheme) times the
-//! candidate's DOFs and steps.
+//! measure them. The predicted time is steps × nnz(K) times one seconds-
+//! per-step-per-entry constant per scheme measured on the pilots.
 
 use std::path::{Component, Path, PathBuf};
 use std::time::Instant;
@@ -190,6 +201,41 @@ pub fn ladder_errors(
     (e, p, c)
 }
 
+/// The error of a run X from its distance to the reference run R and R's
+/// own error: √(‖X − R‖² + e_R²), the two taken as independent parts (a
+/// measured difference and the uncertainty of the standard it was measured
+/// against, combined as in the GUM). Between the bounds of the triangle
+/// inequality, ‖X − R‖ − e_R ≤ e_X ≤ ‖X − R‖ + e_R.
+pub fn with_reference(distance: f64, e_ref: f64) -> f64 {
+    distance.hypot(e_ref)
+}
+
+/// Errors on every level of a ladder from the errors of its first
+/// `measured.len()` levels: finer levels by e_{k+1} = e_k / r^p with p
+/// observed from the last two measured errors (capped at `max_order`, the
+/// theoretical order); when those do not decrease the ladder is not in its
+/// asymptotic range (another error, e.g. Δt's, dominates) and no further
+/// decrease is assumed (p = 0). With one measured level, p =
+/// [`TWO_LEVEL_ORDER`]. Returns (errors per level, p).
+pub fn continue_errors(measured: &[f64], ratios: &[f64], max_order: f64) -> (Vec<f64>, f64) {
+    let levels = ratios.len() + 1;
+    let n = measured.len().min(levels);
+    let mut e = measured[..n].to_vec();
+    if n == 0 {
+        return (vec![f64::NAN; levels], f64::NAN);
+    }
+    let p = if n >= 2 {
+        observed_order(e[n - 2], e[n - 1], ratios[n - 2]).map_or(0.0, |p| p.min(max_order))
+    } else {
+        TWO_LEVEL_ORDER.min(max_order)
+    };
+    for k in n..levels {
+        let next = extrapolate(e[k - 1], ratios[k - 1], p, 1);
+        e.push(next);
+    }
+    (e, p)
+}
+
 /// The time-stepping methods the advisor chooses from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
@@ -274,7 +320,11 @@ pub struct Candidate {
     pub dt: f64,
     /// ε.
     pub eps: f64,
-    /// Estimated e_h, e_Δt, e_ε.
+    /// Estimated parts: the error of this mesh with the family's base Δt
+    /// (central difference 0.9 Δt_crit, Newmark t_end/200), the change
+    /// that this method and Δt make on the pilot mesh, the change that
+    /// this ε makes there. A configuration that was run as a pilot has its
+    /// own measured error here and zeros.
     pub parts: [f64; 3],
     /// Predicted wall time, seconds.
     pub predicted_time: f64,
@@ -284,12 +334,18 @@ pub struct Candidate {
     pub steps: f64,
     /// Whether the mesh was a pilot of the h estimate (else extrapolated).
     pub measured_h: bool,
+    /// Whether this very configuration was a pilot run.
+    pub run: bool,
 }
 
 impl Candidate {
-    /// The estimated error, e_h + e_Δt + e_ε.
+    /// The estimated error: the parts in quadrature, √(e_h² + δ_Δt² +
+    /// δ_ε²). The parts are not independent errors of one kind that add
+    /// (their sum is a bound only when they are aligned); the changes a Δt
+    /// or ε makes are taken as uncorrelated with the mesh's error, as the
+    /// measured distances show for the runs that were made.
     pub fn estimate(&self) -> f64 {
-        self.parts.iter().sum()
+        self.parts.iter().map(|x| x * x).sum::<f64>().sqrt()
     }
 }
 
@@ -600,10 +656,10 @@ pub struct Estimates {
     pub pilots: Vec<Pilot>,
     /// Total wall time of the pilots and the ladder's set-up, seconds.
     pub seconds: f64,
-    /// Per ladder (h per order and scheme family, Δt per scheme): what,
-    /// the order used, the correlation of successive errors, and the
-    /// measured differences of consecutive levels.
-    pub orders: Vec<(String, f64, f64, Vec<f64>)>,
+    /// Per ladder: what, the order used (NaN where none is), and its
+    /// numbers: the reference's measured differences, the estimated errors
+    /// per mesh (h ladders), the changes per Δt or ε.
+    pub orders: Vec<(String, f64, Vec<f64>)>,
     /// Remarks for the report (probe positions that differ, skipped meshes).
     pub notes: Vec<String>,
 }
@@ -780,7 +836,7 @@ pub fn estimate(
     }
     let t_end = case.time.t_end;
     let eps0 = eps_of(case);
-    let g = grid(t_end);
+    let g_all = grid(t_end);
     let nm_dt: Vec<f64> = NEWMARK_DIVISIONS.iter().map(|d| t_end / d).collect();
     let dt_h = t_end / 200.0;
     let mut pilots = Pilots {
@@ -797,13 +853,13 @@ pub fn estimate(
     struct Group {
         order: u8,
         meshes: Vec<usize>,
-        /// e_h per mesh of the group: central difference, Newmark.
-        e_cd: Vec<f64>,
-        e_nm: Vec<f64>,
+        ratios: Vec<f64>,
+        /// Pilot runs per measured mesh: central difference, Newmark ¼/½.
+        cd_runs: Vec<usize>,
+        nm_runs: Vec<usize>,
         /// Seconds per step per stored entry of K: central difference, Newmark ¼/½.
         cost_cd: f64,
         cost_nm: f64,
-        pilot_levels: usize,
     }
     let mut groups = Vec::new();
     for order in [1u8, 2] {
@@ -843,60 +899,128 @@ pub fn estimate(
             )?);
             nm_runs.push(pilots.run(m, Method::Trapezoidal, dt_h, eps0)?);
         }
-        let max_order = f64::from(order) + 1.0;
-        let (d_cd, d_nm) = (pilots.diffs(&cd_runs, &g), pilots.diffs(&nm_runs, &g));
-        let (s_cd, s_nm) = (pilots.skip(&cd_runs, &g), pilots.skip(&nm_runs, &g));
-        let (e_cd, p_cd, c_cd) = ladder_errors(&d_cd, s_cd, &ratios, max_order);
-        let (e_nm, p_nm, c_nm) = ladder_errors(&d_nm, s_nm, &ratios, max_order);
-        orders.push((
-            format!("h, Q{order}, central difference (dt = 0.9 dt_crit of each mesh)"),
-            p_cd,
-            c_cd,
-            d_cd,
-        ));
-        orders.push((
-            format!("h, Q{order}, Newmark (dt = t_end/200)"),
-            p_nm,
-            c_nm,
-            d_nm,
-        ));
         groups.push(Group {
             order,
             cost_cd: pilots.cost(*cd_runs.last().expect("two levels")),
             cost_nm: pilots.cost(*nm_runs.last().expect("two levels")),
             meshes,
-            e_cd,
-            e_nm,
-            pilot_levels,
+            ratios,
+            cd_runs,
+            nm_runs,
         });
     }
-    let Some(top) = groups.last() else {
+    if groups.is_empty() {
         return Err(input(format!(
             "{}mesh.ladder: advise needs at least two meshes of one element order (Q1 or Q2); add a refinement",
             case.at("mesh.ladder")
         )));
+    }
+    // The reference R: central difference at 0.9 Δt_crit (explicit, the
+    // cheapest step) on the mesh after the pilots of the highest order, or
+    // on its finest pilot when the ladder has no more. Its own error e_R
+    // comes from the differences of its ladder ([`ladder_errors`]).
+    let top = groups.len() - 1;
+    {
+        let g = &mut groups[top];
+        if g.meshes.len() > g.cd_runs.len() {
+            let m = g.meshes[g.cd_runs.len()];
+            let k = pilots.run(
+                m,
+                Method::CentralDifference,
+                CD_FRACTIONS[0] * ladder[m].dt_crit,
+                eps0,
+            )?;
+            g.cd_runs.push(k);
+        }
+    }
+    let (r_run, e_ref) = {
+        let g = &groups[top];
+        let d = pilots.diffs(&g.cd_runs, &g_all);
+        let (e, p, c) = ladder_errors(
+            &d,
+            pilots.skip(&g.cd_runs, &g_all),
+            &g.ratios,
+            f64::from(g.order) + 1.0,
+        );
+        let n = g.cd_runs.len();
+        orders.push((
+            format!(
+                "reference R = Q{} {} (central difference, 0.9 dt_crit): error {:.2e} from the Q{} differences (correlation {c:.2})",
+                g.order,
+                ladder[g.meshes[n - 1]].text,
+                e[n - 1],
+                g.order
+            ),
+            p,
+            d,
+        ));
+        (g.cd_runs[n - 1], e[n - 1])
     };
-    // Δt and ε on the second mesh of the highest order.
-    let pm = top.meshes[1];
+    // The error of a pilot run X: X − R plus R's own error, added in
+    // quadrature, e_X = √(‖X − R‖² + e_R²): the measured difference and
+    // the reference's uncertainty combined as independent parts (as a
+    // measurement's uncertainty is combined with its reference standard's).
+    // This uses the distance to the most accurate run, not the differences
+    // of neighbours, whose errors are only partly aligned (stick/slip
+    // events move between refinements) so that Richardson's model of them
+    // misjudges the finer level's error.
+    let err_of = |pilots: &Pilots, k: usize| -> f64 {
+        if k == r_run {
+            e_ref
+        } else {
+            with_reference(
+                distance(q, pilots.trace(k), pilots.trace(r_run), &g_all),
+                e_ref,
+            )
+        }
+    };
+    // Errors of the (mesh, base Δt) configurations per order and family:
+    // measured pilots, then finer meshes by the order observed from the
+    // last two measured errors.
+    let mut e_cd_all = Vec::new();
+    let mut e_nm_all = Vec::new();
+    for g in &groups {
+        let max_order = f64::from(g.order) + 1.0;
+        let mc: Vec<f64> = g.cd_runs.iter().map(|&k| err_of(&pilots, k)).collect();
+        let mn: Vec<f64> = g.nm_runs.iter().map(|&k| err_of(&pilots, k)).collect();
+        let (ec, pc) = continue_errors(&mc, &g.ratios, max_order);
+        let (en, pn) = continue_errors(&mn, &g.ratios, max_order);
+        orders.push((
+            format!(
+                "errors, Q{} meshes, central difference (0.9 dt_crit)",
+                g.order
+            ),
+            pc,
+            ec.clone(),
+        ));
+        orders.push((
+            format!("errors, Q{} meshes, Newmark (t_end/200)", g.order),
+            pn,
+            en.clone(),
+        ));
+        e_cd_all.push(ec);
+        e_nm_all.push(en);
+    }
+    // Δt and ε on the second mesh of the highest order: each run's change
+    // from its family's base configuration on that mesh (central
+    // difference at 0.9 Δt_crit; Newmark ¼/½ at t_end/200).
+    let pm = groups[top].meshes[1];
     let crit = ladder[pm].dt_crit;
     let cd_runs: Vec<usize> = CD_FRACTIONS
         .iter()
         .map(|f| pilots.run(pm, Method::CentralDifference, f * crit, eps0))
         .collect::<anyhow::Result<_>>()?;
-    // Central difference: Δt is tied to h (a fraction of Δt_crit), so the
-    // h ladder above already is the error of the (h, 0.9 Δt_crit) path; a
-    // smaller fraction adds at most its measured distance from 0.9 Δt_crit.
-    let d = pilots.diffs(&cd_runs, &g);
-    let e_dt_cd: Vec<f64> = (0..cd_runs.len())
-        .map(|k| distance(q, pilots.trace(cd_runs[k]), pilots.trace(cd_runs[0]), &g))
+    let nm_base = pilots.run(pm, Method::Trapezoidal, dt_h, eps0)?;
+    let d_dt_cd: Vec<f64> = cd_runs
+        .iter()
+        .map(|&k| distance(q, pilots.trace(k), pilots.trace(cd_runs[0]), &g_all))
         .collect();
     orders.push((
-        "dt, central difference (change from 0.9 dt_crit)".into(),
+        "changes, dt, central difference (from 0.9 dt_crit)".into(),
         f64::NAN,
-        f64::NAN,
-        d,
+        d_dt_cd.clone(),
     ));
-    let mut e_dt_nm = Vec::new();
+    let mut d_dt_nm = Vec::new();
     let mut nm_runs_by_method = Vec::new();
     for method in [
         Method::Trapezoidal,
@@ -907,16 +1031,22 @@ pub fn estimate(
             .iter()
             .map(|&dt| pilots.run(pm, method, dt, eps0))
             .collect::<anyhow::Result<_>>()?;
-        let ratios = vec![2.0; nm_dt.len() - 1];
-        // Newmark ¼/½ is second order; 0.3025/0.6 first (γ ≠ ½).
-        let max_order = if method == Method::Damped { 1.0 } else { 2.0 };
-        let d = pilots.diffs(&runs, &g);
-        let (e, p, c) = ladder_errors(&d, pilots.skip(&runs, &g), &ratios, max_order);
-        orders.push((format!("dt, {}", method.name()), p, c, d));
-        e_dt_nm.push((method, e));
+        let d: Vec<f64> = runs
+            .iter()
+            .map(|&k| distance(q, pilots.trace(k), pilots.trace(nm_base), &g_all))
+            .collect();
+        orders.push((
+            format!(
+                "changes, dt, {} (from nm-0.25-0.5 at t_end/200)",
+                method.name()
+            ),
+            f64::NAN,
+            d.clone(),
+        ));
+        d_dt_nm.push((method, d));
         nm_runs_by_method.push((method, runs));
     }
-    let mut e_eps = vec![0.0];
+    let mut d_eps = vec![0.0];
     let eps_list: Vec<f64> = if case.contact.is_some() {
         let base = cd_runs[0];
         for f in &EPS_FACTORS[1..] {
@@ -926,8 +1056,9 @@ pub fn estimate(
                 CD_FRACTIONS[0] * crit,
                 eps0 * f,
             )?;
-            e_eps.push(distance(q, pilots.trace(k), pilots.trace(base), &g));
+            d_eps.push(distance(q, pilots.trace(k), pilots.trace(base), &g_all));
         }
+        orders.push(("changes, eps x 1, 10, 100".into(), f64::NAN, d_eps.clone()));
         EPS_FACTORS.iter().map(|f| eps0 * f).collect()
     } else {
         vec![eps0]
@@ -949,14 +1080,14 @@ pub fn estimate(
     };
     let (cost_cd, cost_nm) = (shared(|g| g.cost_cd), shared(|g| g.cost_nm));
     let mut candidates = Vec::new();
-    for gr in &groups {
+    for (gi, gr) in groups.iter().enumerate() {
         for (level, &m) in gr.meshes.iter().enumerate() {
             let lm = &ladder[m];
             for method in Method::ALL {
-                let (dts, e_h, cost): (Vec<f64>, f64, f64) = match method {
+                let (dts, e_base, cost): (Vec<f64>, f64, f64) = match method {
                     Method::CentralDifference => (
                         CD_FRACTIONS.iter().map(|f| f * lm.dt_crit).collect(),
-                        gr.e_cd[level],
+                        e_cd_all[gi][level],
                         cost_cd,
                     ),
                     _ => {
@@ -966,13 +1097,17 @@ pub fn estimate(
                             .expect("run")
                             .1;
                         let rel = pilots.cost(runs[k_h]) / pilots.cost(trap[k_h]);
-                        (nm_dt.clone(), gr.e_nm[level], cost_nm * rel)
+                        (nm_dt.clone(), e_nm_all[gi][level], cost_nm * rel)
                     }
                 };
+                let measured_h = match method {
+                    Method::CentralDifference => level < gr.cd_runs.len(),
+                    _ => level < gr.nm_runs.len(),
+                };
                 for (kd, &dt) in dts.iter().enumerate() {
-                    let e_dt = match method {
-                        Method::CentralDifference => e_dt_cd[kd],
-                        _ => e_dt_nm.iter().find(|e| e.0 == method).expect("estimated").1[kd],
+                    let d_dt = match method {
+                        Method::CentralDifference => d_dt_cd[kd],
+                        _ => d_dt_nm.iter().find(|e| e.0 == method).expect("estimated").1[kd],
                     };
                     let mut steps = (t_end / dt).ceil();
                     if method == Method::TrapezoidalReduced {
@@ -986,6 +1121,16 @@ pub fn estimate(
                         steps += per_node * lm.contact_nodes as f64;
                     }
                     for (ke, &eps) in eps_list.iter().enumerate() {
+                        // A configuration that was itself run: its error
+                        // against R directly.
+                        let own = pilots
+                            .runs
+                            .iter()
+                            .position(|r| r.0 == m && r.1 == method && r.2 == dt && r.3 == eps);
+                        let parts = match own {
+                            Some(k) => [err_of(&pilots, k), 0.0, 0.0],
+                            None => [e_base, d_dt, d_eps[ke]],
+                        };
                         candidates.push(Candidate {
                             order: gr.order,
                             mesh: lm.text.clone(),
@@ -993,11 +1138,12 @@ pub fn estimate(
                             method,
                             dt,
                             eps,
-                            parts: [e_h, e_dt, e_eps[ke]],
+                            parts,
                             predicted_time: cost * lm.nnz as f64 * steps,
                             dofs: lm.dofs,
                             steps,
-                            measured_h: level < gr.pilot_levels,
+                            measured_h,
+                            run: own.is_some(),
                         });
                     }
                 }
@@ -1302,6 +1448,7 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
                 "estimate_dt": c.parts[1],
                 "estimate_eps": c.parts[2],
                 "h_measured": c.measured_h,
+                "pilot": c.run,
                 "steps": c.steps,
                 "predicted_time_s": c.predicted_time,
             })
@@ -1316,7 +1463,7 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
             "most_accurate": best.map(cand),
             "pilot_runs": pilot_runs,
             "pilot_time_s": est.seconds,
-            "orders": est.orders.iter().map(|(w, p, c, d)| serde_json::json!({"what": w, "order": p, "correlation": c, "differences": d})).collect::<Vec<_>>(),
+            "orders": est.orders.iter().map(|(w, p, d)| serde_json::json!({"what": w, "order": p, "values": d})).collect::<Vec<_>>(),
             "notes": est.notes,
             "written": o.write.as_ref().filter(|_| choice.is_some()).map(|w| w.display().to_string()),
         });
@@ -1338,25 +1485,34 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
         println!("case        {}", case.path.display());
         println!("on          {what}, tol {:e}", o.tol);
         println!("pilots      {pilot_runs} runs in {:.2} s", est.seconds);
-        for (w, p, c, d) in &est.orders {
+        for (w, p, d) in &est.orders {
             let d: Vec<String> = d.iter().map(|x| format!("{x:.2e}")).collect();
-            println!(
-                "  ladder    {w}: differences {}; order {p:.2}, correlation {c:.2}",
-                d.join(", ")
-            );
+            let p = if p.is_nan() {
+                String::new()
+            } else {
+                format!("; order {p:.2}")
+            };
+            println!("  {w}: {}{p}", d.join(", "));
         }
         for n in &est.notes {
             println!("note        {n}");
         }
         println!("choice      {}", describe(c, &est.ladder));
-        println!(
-            "estimate    {:.3e} = h {:.3e}{} + dt {:.3e} + eps {:.3e}",
-            c.estimate(),
-            c.parts[0],
-            if c.measured_h { "" } else { " (extrapolated)" },
-            c.parts[1],
-            c.parts[2]
-        );
+        if c.run {
+            println!(
+                "estimate    {:.3e} (this configuration was a pilot: its distance to the reference, with the reference's error)",
+                c.estimate()
+            );
+        } else {
+            println!(
+                "estimate    {:.3e} = sqrt(mesh {:.3e}{}^2 + dt {:.3e}^2 + eps {:.3e}^2)",
+                c.estimate(),
+                c.parts[0],
+                if c.measured_h { "" } else { " (extrapolated)" },
+                c.parts[1],
+                c.parts[2]
+            );
+        }
         println!(
             "predicted   {:.3} s ({:.0} steps x {} DOFs; the pilots' seconds per step per entry of K)",
             c.predicted_time, c.steps, c.dofs
@@ -1445,6 +1601,37 @@ mod tests {
     }
 
     #[test]
+    fn errors_against_a_reference() {
+        // e_X = X − R + e_R with the two parts orthogonal: |e_X|² = d² +
+        // e_R² (Pythagoras), and inside the triangle-inequality bounds.
+        let (d, e_r) = (3.0, 4.0);
+        assert_eq!(with_reference(d, e_r), 5.0);
+        assert!(with_reference(d, e_r) <= d + e_r && with_reference(d, e_r) >= e_r - d);
+        assert_eq!(with_reference(d, 0.0), d);
+    }
+
+    #[test]
+    fn continue_errors_of_a_power_law_and_of_a_floor() {
+        // e = C h^p, p = 1.5, measured on three of five levels: the last
+        // two give p, the finer levels follow it exactly.
+        let e = |k: i32| 2.0 * (0.2 / 2f64.powi(k)).powf(1.5);
+        let (est, p) = continue_errors(&[e(0), e(1), e(2)], &[2.0; 4], 2.0);
+        assert!((p - 1.5).abs() < 1e-12);
+        for k in 0..5 {
+            assert!(
+                (est[k] - e(k as i32)).abs() < 1e-12 * e(k as i32),
+                "{k}: {est:?}"
+            );
+        }
+        // Capped at the theoretical order.
+        assert_eq!(continue_errors(&[e(0), e(1)], &[2.0; 2], 1.0).1, 1.0);
+        // Errors that stop decreasing (a Δt floor): no decrease assumed.
+        let (est, p) = continue_errors(&[0.04, 0.015, 0.017], &[2.0; 3], 3.0);
+        assert_eq!(p, 0.0);
+        assert_eq!(est[3], 0.017);
+    }
+
+    #[test]
     fn pick_takes_the_cheapest_that_meets_the_tolerance() {
         let cand = |t: f64, e: f64| Candidate {
             order: 2,
@@ -1458,6 +1645,7 @@ mod tests {
             dofs: 1,
             steps: 1.0,
             measured_h: true,
+            run: false,
         };
         let all = vec![
             cand(1.0, 0.5),

@@ -9,12 +9,15 @@
 //!    when the CSV has no such row, computed here by running it and the
 //!    reference;
 //! 2. take at most twice the wall time of the cheapest configuration of
-//!    the CSV that meets the tolerance, both timed here, in the same test
-//!    run (median of repeats), since the machine is shared and the CSV's
-//!    times were measured under another load.
+//!    the CSV that meets the tolerance: times from one run, the CSV's
+//!    (medians of 3) when the pick is one of its rows, else both re-timed
+//!    here side by side (median of 5).
 //!
 //! The tolerances are reachable per the CSV: its cheapest configurations
-//! meeting them have errors 2.96e-2, 1.67e-2 and 8.7e-3.
+//! meeting them have errors 2.96e-2, 1.67e-2 and 8.7e-3. The first is 1.2%
+//! below 3e-2, so that case asks for an estimate sharper than the 1.5× of
+//! differences of neighbouring refinements; advise measures each pilot
+//! against its finest pilot run instead (see crates/cli/src/advise.rs).
 
 use std::path::{Path, PathBuf};
 
@@ -92,27 +95,15 @@ fn time_of(case: &case::Case, mesh: &Path, method: Method, dt: f64, eps: f64, n:
 }
 
 #[test]
-fn advise_picks_meet_the_tolerance() {
-    // Every pick meets its tolerance against the converged reference; at
-    // 2e-2 it is also the cheapest configuration of the CSV that does.
-    picks_meet_the_tolerance_and_are_within_twice_the_cheapest(&TOLS, &[2e-2]);
+fn advise_picks_meet_the_tolerance_and_are_within_twice_the_cheapest() {
+    // Every pick meets its tolerance against the converged reference and
+    // takes at most twice the time of the cheapest configuration of the
+    // CSV that does.
+    picks_meet_the_tolerance_and_are_within_twice_the_cheapest(&TOLS);
 }
 
-/// Known failure, kept runnable (`cargo test -- --ignored`): by the chart's
-/// times (docs/work-precision.csv, one run), at 3e-2 advise picks Q2 16×4
-/// (0.028 s) where Q1 32×8 (0.009 s, true error 2.96e-2) would do, and at
-/// 1e-2 Q2 64×16 where Q2 32×8 would (about 7×): its estimates (Q1 32×8 over
-/// 3e-2, Q2 32×8 at 1.20e-2 against a true 8.7e-3) are not sharp enough for
-/// meshes 4× apart in cost. The issue asks for ≤ 2×.
-#[test]
-#[ignore = "advise's picks at 3e-2 and 1e-2 cost more than 2x the cheapest (estimator not sharp enough); see the doc comment"]
-fn advise_picks_are_within_twice_the_cheapest() {
-    picks_meet_the_tolerance_and_are_within_twice_the_cheapest(&TOLS, &TOLS);
-}
-
-/// Checks every pick's true error for `tols`, and the 2× time rule for
-/// those also in `timed`.
-fn picks_meet_the_tolerance_and_are_within_twice_the_cheapest(tols: &[f64], timed: &[f64]) {
+/// Checks every pick's true error for `tols`, and the 2× time rule.
+fn picks_meet_the_tolerance_and_are_within_twice_the_cheapest(tols: &[f64]) {
     let case_path = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
     let case = case::load(&case_path, &[]).expect("paper case loads");
     let meshes = root().join("cases/meshes");
@@ -218,7 +209,7 @@ fn picks_meet_the_tolerance_and_are_within_twice_the_cheapest(tols: &[f64], time
             Some(r) => (r.time_s, cheapest.time_s),
             None => (t_pick, t_cheap),
         };
-        if timed.contains(&tol) && t_pick > 2.0 * t_cheap {
+        if t_pick > 2.0 * t_cheap {
             failures.push(format!(
                 "tol {tol:e}: the pick {name} {} takes {t_pick:.3} s, more than twice the {t_cheap:.3} s of {} {} dt {:.4e} (CSV error {:.3e})",
                 pick.method.name(),
