@@ -1,21 +1,14 @@
 //! Scatter and line charts as PNG and SVG (plotters without system
-//! libraries; the font is the one shipped in verify/assets/).
+//! libraries; palette, font and axes from `stickslip_verify::plotting`).
 
 use std::path::{Path, PathBuf};
-use std::sync::Once;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use stickslip_verify::plotting::{axes, register_font, AxesStyle};
 
 /// Colours that survive greyscale printing in order.
-pub const COLORS: [RGBColor; 6] = [
-    RGBColor(0, 90, 181),
-    RGBColor(220, 50, 32),
-    RGBColor(0, 140, 70),
-    RGBColor(150, 80, 170),
-    RGBColor(230, 140, 0),
-    RGBColor(60, 60, 60),
-];
+pub use stickslip_verify::plotting::COLORS;
 
 /// Marker shape of a series.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,20 +62,6 @@ pub struct Panel {
     /// Draw the legend inside the panel (else only the figure's legend
     /// strip, see [`save`]).
     pub legend: bool,
-}
-
-fn register_font() -> Result<(), String> {
-    static ONCE: Once = Once::new();
-    let mut result = Ok(());
-    ONCE.call_once(|| {
-        result = plotters::style::register_font(
-            "sans-serif",
-            FontStyle::Normal,
-            include_bytes!("../../verify/assets/DejaVuSans.ttf"),
-        )
-        .map_err(|_| "verify/assets/DejaVuSans.ttf is not a usable font".to_string());
-    });
-    result
 }
 
 fn axis(v: f64, log: bool) -> Option<f64> {
@@ -155,25 +134,23 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
     let px = 0.05 * (x1 - x0).max(1e-9);
     let py = 0.05 * (y1 - y0).max(1e-9);
     let (x0, x1, y0, y1) = (x0 - px, x1 + px, y0 - py, y1 + py);
-    let mut chart = ChartBuilder::on(area)
-        .caption(&p.title, ("sans-serif", 18))
-        .margin(10)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
     let (xl, yl) = (p.x_log, p.y_log);
-    chart
-        .configure_mesh()
-        .x_desc(p.x_label.as_str())
-        .y_desc(p.y_label.as_str())
-        .x_label_formatter(&|v| tick(*v, xl))
-        .y_label_formatter(&|v| tick(*v, yl))
-        .label_style(("sans-serif", 13))
-        .axis_desc_style(("sans-serif", 15))
-        .light_line_style(WHITE.mix(0.0))
-        .draw()
-        .map_err(err)?;
+    let mut chart = axes(
+        area,
+        &p.title,
+        &p.x_label,
+        &p.y_label,
+        x0..x1,
+        y0..y1,
+        AxesStyle {
+            caption: 18,
+            margin: 10,
+            label: 13,
+            desc: 15,
+        },
+        Some((&|v| tick(*v, xl), &|v| tick(*v, yl))),
+    )
+    .map_err(err)?;
     for &v in &p.vlines {
         if let Some(x) = axis(v, p.x_log) {
             chart
