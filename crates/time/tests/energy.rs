@@ -9,7 +9,8 @@ use stickslip_time::{History, Scheme, Settings};
 /// Largest |E_K − E_0| of the frictionless slab (pressure and end load on,
 /// no contact surface) and E_0.
 fn energy_drift(mesh: &str, scheme: Scheme, dt: f64) -> (f64, f64) {
-    let s = slab(mesh, 0.3, 300.0, None, 1.0, -150.0, History::Step);
+    let mesh = read_mesh(mesh).unwrap();
+    let s = Slab::paper(mesh, 1.0, History::Step, false).unwrap();
     let mut i = s.integrator(Settings::new(scheme, dt, 0.5)).unwrap();
     let e0 = i.energy().total;
     let mut drift: f64 = 0.0;

@@ -54,20 +54,26 @@ fn build(
     i
 }
 
+/// One integrator per Schur variant, in the order Schur, SchurStoredZ,
+/// SchurSecondSolve.
+fn schur_variants(s: &Slab, scheme: Scheme, reduction: Option<StickReduction>) -> Vec<Integrator> {
+    [
+        ImplicitSolver::Schur,
+        ImplicitSolver::SchurStoredZ,
+        ImplicitSolver::SchurSecondSolve,
+    ]
+    .into_iter()
+    .map(|solver| build(s, scheme, reduction, solver))
+    .collect()
+}
+
 #[test]
 fn schur_path_equals_the_direct_path_on_every_paper_case() {
     for mesh in ["slab-q2-8x2.msh", "slab-q1-32x8.msh"] {
         let s = paper_slab(mesh, 1e-4, History::Step);
         for (name, scheme, reduction) in cases() {
             let mut direct = build(&s, scheme, reduction, ImplicitSolver::Direct);
-            let mut schur: Vec<Integrator> = [
-                ImplicitSolver::Schur,
-                ImplicitSolver::SchurStoredZ,
-                ImplicitSolver::SchurSecondSolve,
-            ]
-            .into_iter()
-            .map(|solver| build(&s, scheme, reduction, solver))
-            .collect();
+            let mut schur = schur_variants(&s, scheme, reduction);
             let mut dts = BTreeSet::new();
             let (mut worst_v, mut worst_r): (f64, f64) = (0.0, 0.0);
             let mut slips = 0;
@@ -134,14 +140,7 @@ fn every_schur_step_equals_the_direct_step_from_the_same_state() {
         let s = paper_slab(mesh, 1e-4, History::Step);
         for (name, scheme, reduction) in cases() {
             let mut direct = build(&s, scheme, reduction, ImplicitSolver::Direct);
-            let mut probes: Vec<Integrator> = [
-                ImplicitSolver::Schur,
-                ImplicitSolver::SchurStoredZ,
-                ImplicitSolver::SchurSecondSolve,
-            ]
-            .into_iter()
-            .map(|solver| build(&s, scheme, reduction, solver))
-            .collect();
+            let mut probes = schur_variants(&s, scheme, reduction);
             let (mut worst_v, mut worst_r): (f64, f64) = (0.0, 0.0);
             let mut reduced_steps = 0;
             while !direct.done() {
