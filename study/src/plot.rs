@@ -10,6 +10,14 @@ use stickslip_verify::plotting::{axes, register_font, AxesStyle};
 /// Colours that survive greyscale printing in order.
 pub use stickslip_verify::plotting::COLORS;
 
+/// Text sizes and margin of the study charts.
+const STYLE: AxesStyle = AxesStyle {
+    caption: 18,
+    margin: 10,
+    label: 13,
+    desc: 15,
+};
+
 /// Marker shape of a series.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Marker {
@@ -137,17 +145,10 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
     let (xl, yl) = (p.x_log, p.y_log);
     let mut chart = axes(
         area,
-        &p.title,
-        &p.x_label,
-        &p.y_label,
+        [&p.title, &p.x_label, &p.y_label],
         x0..x1,
         y0..y1,
-        AxesStyle {
-            caption: 18,
-            margin: 10,
-            label: 13,
-            desc: 15,
-        },
+        STYLE,
         Some((&|v| tick(*v, xl), &|v| tick(*v, yl))),
     )
     .map_err(err)?;

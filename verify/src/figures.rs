@@ -39,6 +39,14 @@ struct Figure {
     panels: Vec<Panel>,
 }
 
+/// Text sizes and margin of the paper's figures.
+const STYLE: AxesStyle = AxesStyle {
+    caption: 20,
+    margin: 12,
+    label: 15,
+    desc: 17,
+};
+
 fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| format!("{}: {e}", fig.stem);
     root.fill(&WHITE).map_err(err)?;
@@ -68,17 +76,10 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure) -> Resul
         }
         let mut chart = axes(
             area,
-            &p.title,
-            &p.x_label,
-            &p.y_label,
+            [&p.title, &p.x_label, &p.y_label],
             x0..x1,
             y0..y1,
-            AxesStyle {
-                caption: 20,
-                margin: 12,
-                label: 15,
-                desc: 17,
-            },
+            STYLE,
             None,
         )
         .map_err(err)?;
@@ -114,6 +115,14 @@ fn series(label: &str, t: &[f64], y: &[f64], color: usize) -> Series {
         points: t.iter().copied().zip(y.iter().copied()).collect(),
         color,
     }
+}
+
+/// σ_T at nodes 71 and 81 (the paper's friction-stress figures).
+fn friction_series(t: &Trace) -> Vec<Series> {
+    vec![
+        series("node 71 (7, 0)", &t.t, &t.sigma71, 0),
+        series("node 81 (8, 0)", &t.t, &t.sigma81, 1),
+    ]
 }
 
 fn trace<'a>(runs: &'a [Run], name: &str) -> Result<&'a Trace, String> {
@@ -208,10 +217,7 @@ fn figures(runs: &[Run]) -> Result<Vec<Figure>, String> {
             &format!("Friction stress, central difference, {label} (cf. Figs. 4, 8)"),
             "σ_T",
             Some((-20.0, 100.0)),
-            vec![
-                series("node 71 (7, 0)", &t.t, &t.sigma71, 0),
-                series("node 81 (8, 0)", &t.t, &t.sigma81, 1),
-            ],
+            friction_series(t),
         ));
     }
     figs.push(Figure {
@@ -333,10 +339,7 @@ fn figures(runs: &[Run]) -> Result<Vec<Figure>, String> {
             &format!("Friction stress, {label} (cf. {which})"),
             "σ_T",
             Some((-20.0, 100.0)),
-            vec![
-                series("node 71 (7, 0)", &t.t, &t.sigma71, 0),
-                series("node 81 (8, 0)", &t.t, &t.sigma81, 1),
-            ],
+            friction_series(t),
         ));
     }
     figs.push(Figure {
@@ -362,10 +365,7 @@ fn figures(runs: &[Run]) -> Result<Vec<Figure>, String> {
                 "Friction stress, θ = sin 8πt (cf. Figs. 17-18)",
                 "σ_T",
                 Some((-100.0, 100.0)),
-                vec![
-                    series("node 71 (7, 0)", &t.t, &t.sigma71, 0),
-                    series("node 81 (8, 0)", &t.t, &t.sigma81, 1),
-                ],
+                friction_series(t),
             ),
         ],
     });

@@ -57,17 +57,15 @@ pub type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, Ranged
 /// Tick label formatters for x and y.
 pub type Ticks<'a> = (&'a dyn Fn(&f64) -> String, &'a dyn Fn(&f64) -> String);
 
-/// A panel's axes on `area`: the title, axis descriptions, the ranges, tick
-/// labels (plotters' own unless `ticks`) and no light grid lines.
+/// A panel's axes on `area`: `[title, x description, y description]`, the
+/// ranges, tick labels (plotters' own unless `ticks`) and no light grid
+/// lines.
 ///
 /// # Errors
 /// A drawing error.
-#[allow(clippy::too_many_arguments)]
 pub fn axes<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
-    title: &str,
-    x_label: &str,
-    y_label: &str,
+    [title, x_label, y_label]: [&str; 3],
     x: Range<f64>,
     y: Range<f64>,
     style: AxesStyle,

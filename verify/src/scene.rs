@@ -108,6 +108,27 @@ fn history(v: Option<&toml::Value>, file: &Path) -> Result<History, String> {
     }
 }
 
+/// The entries of the array of tables `name` (none when absent), each with
+/// its `group`.
+fn grouped_tables<'a>(
+    t: &'a toml::Table,
+    name: &str,
+    file: &Path,
+) -> impl Iterator<Item = Result<(&'a toml::Value, &'a str), String>> + 'a {
+    let (name, file) = (name.to_string(), file.to_path_buf());
+    t.get(&name)
+        .and_then(|v| v.as_array())
+        .into_iter()
+        .flatten()
+        .map(move |d| {
+            let group = d
+                .get("group")
+                .and_then(|g| g.as_str())
+                .ok_or_else(|| format!("{}: {name} without group", file.display()))?;
+            Ok((d, group))
+        })
+}
+
 impl Case {
     /// Reads a case file.
     ///
@@ -127,16 +148,8 @@ impl Case {
             float(key(&t, "material.rho", path)?, "material.rho", path)?,
         ];
         let mut dirichlet = Vec::new();
-        for d in t
-            .get("dirichlet")
-            .and_then(|v| v.as_array())
-            .into_iter()
-            .flatten()
-        {
-            let group = d
-                .get("group")
-                .and_then(|g| g.as_str())
-                .ok_or_else(|| format!("{}: dirichlet without group", path.display()))?;
+        for entry in grouped_tables(&t, "dirichlet", path) {
+            let (d, group) = entry?;
             for (c, k) in ["ux", "uy"].iter().enumerate() {
                 if let Some(v) = d.get(*k) {
                     dirichlet.push((group.to_string(), c, float(v, k, path)?));
@@ -144,16 +157,8 @@ impl Case {
             }
         }
         let mut tractions = Vec::new();
-        for d in t
-            .get("traction")
-            .and_then(|v| v.as_array())
-            .into_iter()
-            .flatten()
-        {
-            let group = d
-                .get("group")
-                .and_then(|g| g.as_str())
-                .ok_or_else(|| format!("{}: traction without group", path.display()))?;
+        for entry in grouped_tables(&t, "traction", path) {
+            let (d, group) = entry?;
             let v = d
                 .get("t")
                 .and_then(|v| v.as_array())
