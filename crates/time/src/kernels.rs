@@ -22,17 +22,33 @@
 //!
 //! K·r row by row from [`Compact`] (2×2 blocks with u32 columns, 162 bytes
 //! per Q1 DOF) rather than nalgebra-sparse's CSR (usize columns, 288 bytes
-//! per Q1 DOF) or element by element. Chosen by measurement (the
-//! `kernel_lab` test below, Q1 slab, 1,004,298 DOFs, one K·x, medians of
-//! 10, one thread, load average ≈ 1.7 on the 2 cores, another job running):
-//! CSR 18.5 ms, compact 14.3 ms, element by element with stored 8×8
-//! element matrices 19.7 ms (297 MB per product: 512 bytes of matrix and 32
-//! of connectivity per element, one element per node, and a scatter that
-//! reads and writes y). The element-by-element product moves more bytes
-//! than the compact rows, and threading it deterministically needs a
-//! colouring (scatters of neighbouring elements collide); the rows are
-//! independent, so threads never share an output. For Q2 the element
-//! matrices (18×18 per 4 nodes, 324 bytes per DOF) lose more.
+//! per Q1 DOF) or element by element, chosen by measurement: the
+//! `kernel_lab` test below, Q1 slab of 1,004,298 DOFs, 2026-11-22, load
+//! average 3.7 on the 2 cores (other jobs running):
+//!
+//! | one K·x, fastest of 20        | 1 thread | 2 threads |
+//! |-------------------------------|----------|-----------|
+//! | CSR (313 MB)                  | 13.0 ms  | 10.4 ms   |
+//! | compact (183 MB)              | 12.7 ms  |  7.0 ms   |
+//! | element by element (297 MB)   | 16.4 ms  |  —        |
+//!
+//! | step after the predictor, median of 30 interleaved | 1 thread | 2 threads |
+//! |----------------------------------------------------|----------|-----------|
+//! | CSR, pass B, pass C                                | 20.9 ms  | 15.6 ms   |
+//! | compact fused with B, pass C                       | 23.9 ms  | 13.3 ms   |
+//! | one sweep ([`fused_step`])                         | 26.0 ms  | 13.2 ms   |
+//!
+//! On one thread the products are bound by the adder's latency (a row's sum
+//! is a chain in fixed order), not by memory, and the CSR's simpler loop
+//! wins; on the machine's two threads memory binds and the smaller stream
+//! wins. Element by element moves more bytes than the compact rows (512
+//! bytes of matrix and 32 of connectivity per element, one element per
+//! node, and a scatter that reads and writes y), and threading it
+//! deterministically would need a colouring (scatters of neighbouring
+//! elements collide); rows are independent, so threads never share an
+//! output. For Q2 the element matrices (18×18 per 4 nodes, 324 bytes per
+//! DOF) lose more. The one sweep measured equal to compact·B + C; it is
+//! kept for its 7 fewer vector streams.
 
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
