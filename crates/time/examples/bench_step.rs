@@ -1,9 +1,16 @@
 //! Time per step of both schemes on the slab ladder (issue 7, deliverable 3)
-//! with the hardware figures measured in the same run: STREAM triad
-//! bandwidth against the bytes one explicit step moves, and for Newmark the
-//! time of one forward+back solve with the factor of A₀.
+//! with what it is compared with in the same run: STREAM triad bandwidth
+//! against the bytes one explicit step moves; for Newmark the time of one
+//! forward+back solve with the factor of A₀; the scipy peer (bench/peer.py,
+//! `--peer`) on the paper's 85-node mesh and the generated rungs of ≥ 100k
+//! DOFs, which reads the problem this process dumps (target/bench/peer/),
+//! checks its state after a few steps against ours (≤ 1e-8) and times its
+//! own steps; peak memory: VmHWM of the whole process (`peak_rss`) and of
+//! the run after setup (`peak_run`, VmHWM reset through clear_refs), each
+//! over what the run must hold (`matrix_bytes` + `factor_bytes` +
+//! `vector_bytes`).
 //!
-//!     cargo run -p stickslip-time --example bench_step [-- --quick] [-- --max-dofs N]
+//!     cargo run -p stickslip-time --example bench_step [-- --quick] [-- --max-dofs N] [-- --peer]
 //!
 //! Every rung runs in its own process (`--case NAME`) so that its peak RSS
 //! (VmHWM) is the rung's; the parent prints a table and writes
