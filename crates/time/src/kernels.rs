@@ -23,20 +23,23 @@
 //! K·r row by row from [`Compact`] (2×2 blocks with u32 columns, 162 bytes
 //! per Q1 DOF) rather than nalgebra-sparse's CSR (usize columns, 288 bytes
 //! per Q1 DOF) or element by element, chosen by measurement: the
-//! `kernel_lab` test below, Q1 slab of 1,004,298 DOFs, 2026-11-22, load
-//! average 3.7 on the 2 cores (other jobs running):
+//! `kernel_lab` test below, Q1 slab of 1,004,298 DOFs, 2026-11-22 02:24,
+//! load average 1.1 on the 2 cores:
 //!
 //! | one K·x, fastest of 20        | 1 thread | 2 threads |
 //! |-------------------------------|----------|-----------|
-//! | CSR (313 MB)                  | 13.0 ms  | 10.4 ms   |
-//! | compact (183 MB)              | 12.7 ms  |  7.0 ms   |
-//! | element by element (297 MB)   | 16.4 ms  |  —        |
+//! | CSR (313 MB)                  | 12.3 ms  |  9.4 ms   |
+//! | compact (183 MB)              | 12.8 ms  |  6.8 ms   |
+//! | element by element (297 MB)   | 13.4 ms  |  —        |
 //!
-//! | step after the predictor, median of 30 interleaved | 1 thread | 2 threads |
-//! |----------------------------------------------------|----------|-----------|
-//! | CSR, pass B, pass C                                | 20.9 ms  | 15.6 ms   |
-//! | compact fused with B, pass C                       | 23.9 ms  | 13.3 ms   |
-//! | one sweep ([`fused_step`])                         | 26.0 ms  | 13.2 ms   |
+//! | step after the predictor, 30 interleaved rounds | 1 thread: median, min | 2 threads: median, min |
+//! |-------------------------------------------------|-----------------------|------------------------|
+//! | CSR, pass B, pass C                             | 20.2, 17.4 ms         | 15.7, 14.0 ms          |
+//! | compact fused with B, pass C                    | 25.1, 23.1 ms         | 14.3, 12.0 ms          |
+//! | one sweep ([`fused_step`])                      | 22.7, 20.2 ms         | 14.3, 13.0 ms          |
+//!
+//! (A run a minute earlier: 2 threads 18.8/16.2, 18.2/13.6, 18.1/13.3 ms;
+//! the machine is shared.)
 //!
 //! On one thread the products are bound by the adder's latency (a row's sum
 //! is a chain in fixed order), not by memory, and the CSR's simpler loop
@@ -48,7 +51,9 @@
 //! elements collide); rows are independent, so threads never share an
 //! output. For Q2 the element matrices (18×18 per 4 nodes, 324 bytes per
 //! DOF) lose more. The one sweep measured equal to compact·B + C; it is
-//! kept for its 7 fewer vector streams.
+//! kept for its 7 fewer vector streams. One K·x per row group costs about
+//! 8 cycles per 2×2 block on one thread whatever the bytes: the gain is the
+//! two-thread, memory-bound case this machine runs.
 
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
@@ -435,15 +440,15 @@ impl Compact {
             self.chunk_groups[c] as usize,
             self.chunk_groups[c + 1] as usize,
         );
-        let block = |b: usize, s: &mut [f64; 2]| {
-            let v = &self.vals[b];
-            let c = self.cols[b] as usize;
+        #[inline(always)]
+        fn block(col: u32, v: &[f64; 4], x: &[f64], s: &mut [f64; 2]) {
+            let c = col as usize;
             let xs = &x[c..c + 2];
             s[0] += v[0] * xs[0];
             s[0] += v[1] * xs[1];
             s[1] += v[2] * xs[0];
             s[1] += v[3] * xs[1];
-        };
+        }
         let mut emit = |g: usize, s: [f64; 2]| {
             let r0 = self.group_rows[g] as usize;
             f(r0, s[0]);
@@ -459,16 +464,23 @@ impl Compact {
             );
             let b1 = self.group_blocks[g + 2] as usize;
             let (mut sa, mut sb) = ([0.0; 2], [0.0; 2]);
-            let common = (a1 - a0).min(b1 - a1);
-            for t in 0..common {
-                block(a0 + t, &mut sa);
-                block(a1 + t, &mut sb);
+            let (ca, va) = (&self.cols[a0..a1], &self.vals[a0..a1]);
+            let (cb, vb) = (&self.cols[a1..b1], &self.vals[a1..b1]);
+            let common = ca.len().min(cb.len());
+            for (((ca, va), cb), vb) in ca[..common]
+                .iter()
+                .zip(&va[..common])
+                .zip(&cb[..common])
+                .zip(&vb[..common])
+            {
+                block(*ca, va, x, &mut sa);
+                block(*cb, vb, x, &mut sb);
             }
-            for b in a0 + common..a1 {
-                block(b, &mut sa);
+            for (c, v) in ca[common..].iter().zip(&va[common..]) {
+                block(*c, v, x, &mut sa);
             }
-            for b in a1 + common..b1 {
-                block(b, &mut sb);
+            for (c, v) in cb[common..].iter().zip(&vb[common..]) {
+                block(*c, v, x, &mut sb);
             }
             emit(g, sa);
             emit(g + 1, sb);
