@@ -707,15 +707,7 @@ impl Integrator {
         }
         let finite = self.r_new.iter().chain(&self.v_new).all(|x| x.is_finite());
         if !finite {
-            let hint = match self.dt_crit {
-                Some(c) => format!(" below the critical step Δt_crit = {c:.4e}"),
-                None => String::new(),
-            };
-            return Err(TimeError::NonFinite {
-                step: step_number,
-                t: t_new,
-                hint,
-            });
+            return Err(self.non_finite(step_number, t_new));
         }
 
         // Energy ledger, before the state is overwritten.
@@ -723,27 +715,7 @@ impl Integrator {
         for i in 0..n {
             work += 0.5 * (self.load_new[i] + self.load[i]) * (self.r_new[i] - self.r[i]);
         }
-        let mut stick_events = 0;
-        let mut dissipated = 0.0;
-        if let Some(c) = &self.contact {
-            c.nodal_forces(&self.v_new, &mut self.forces_new);
-            for i in 0..n {
-                // Trapezoidal increment ½Δt(ṙ_K + ṙ_{K−1}): equal to r_K − r_{K−1}
-                // for Newmark ¼, ½ (so the balance closes to round-off) and,
-                // with φ_ε odd and increasing, making every increment ≥ 0 for
-                // any scheme.
-                self.tmp[i] = 0.5 * dt * (self.v_new[i] + self.v[i]);
-            }
-            for ((node, f_new), f_old) in c.nodes.iter().zip(&self.forces_new).zip(&self.forces) {
-                dissipated += 0.5 * (f_new + f_old) * node.tangential(&self.tmp);
-            }
-            stick_events = self
-                .scratch_classes
-                .iter()
-                .zip(&self.classes)
-                .filter(|(new, old)| new.is_stuck() && !old.is_stuck())
-                .count();
-        }
+        let (dissipated, stick_events) = self.friction_ledger(dt);
 
         // Commit the step.
         for i in 0..n {
@@ -966,37 +938,9 @@ impl Integrator {
             }
         };
         if !sums.finite {
-            let hint = match self.dt_crit {
-                Some(c) => format!(" below the critical step Δt_crit = {c:.4e}"),
-                None => String::new(),
-            };
-            return Err(TimeError::NonFinite {
-                step: step_number,
-                t: t_new,
-                hint,
-            });
+            return Err(self.non_finite(step_number, t_new));
         }
-        let mut stick_events = 0;
-        let mut dissipated = 0.0;
-        if let Some(c) = &self.contact {
-            c.nodal_forces(&self.v_new, &mut self.forces_new);
-            for ((node, f_new), f_old) in c.nodes.iter().zip(&self.forces_new).zip(&self.forces) {
-                // ½Δt(ṙ_K + ṙ_{K−1}) at the node, as in the general step.
-                let mut increment = 0.0;
-                for k in 0..2 {
-                    if let Some(i) = node.dofs[k] {
-                        increment += node.tangent[k] * (0.5 * dt * (self.v_new[i] + self.v[i]));
-                    }
-                }
-                dissipated += 0.5 * (f_new + f_old) * increment;
-            }
-            stick_events = self
-                .scratch_classes
-                .iter()
-                .zip(&self.classes)
-                .filter(|(new, old)| new.is_stuck() && !old.is_stuck())
-                .count();
-        }
+        let (dissipated, stick_events) = self.friction_ledger(dt);
         std::mem::swap(&mut self.a, &mut self.tmp);
         std::mem::swap(&mut self.r, &mut self.r_new);
         std::mem::swap(&mut self.v, &mut self.v_new);
@@ -1300,6 +1244,46 @@ impl Integrator {
     /// run that never stopped; a checkpoint taken before the end is.
     pub fn set_t_end(&mut self, t_end: f64) {
         self.settings.t_end = t_end;
+    }
+
+    /// The step's NaN/infinity error, with the critical step as advice for
+    /// an explicit run.
+    fn non_finite(&self, step: u64, t: f64) -> TimeError {
+        let hint = match self.dt_crit {
+            Some(c) => format!(" below the critical step Δt_crit = {c:.4e}"),
+            None => String::new(),
+        };
+        TimeError::NonFinite { step, t, hint }
+    }
+
+    /// Friction dissipation of the step and the number of nodes that went
+    /// from slip to stick, from the new velocity (before the state is
+    /// overwritten); fills `forces_new`. The increment at a node is the
+    /// trapezoidal ½Δt(ṙ_K + ṙ_{K−1})·τ: equal to (r_K − r_{K−1})·τ for
+    /// Newmark ¼, ½ (so the balance closes to round-off) and, with φ_ε odd
+    /// and increasing, never negative for any scheme.
+    fn friction_ledger(&mut self, dt: f64) -> (f64, usize) {
+        let Some(c) = &self.contact else {
+            return (0.0, 0);
+        };
+        c.nodal_forces(&self.v_new, &mut self.forces_new);
+        let mut dissipated = 0.0;
+        for ((node, f_new), f_old) in c.nodes.iter().zip(&self.forces_new).zip(&self.forces) {
+            let mut increment = 0.0;
+            for k in 0..2 {
+                if let Some(i) = node.dofs[k] {
+                    increment += node.tangent[k] * (0.5 * dt * (self.v_new[i] + self.v[i]));
+                }
+            }
+            dissipated += 0.5 * (f_new + f_old) * increment;
+        }
+        let stick_events = self
+            .scratch_classes
+            .iter()
+            .zip(&self.classes)
+            .filter(|(new, old)| new.is_stuck() && !old.is_stuck())
+            .count();
+        (dissipated, stick_events)
     }
 
     // ---- read access for observers ----
