@@ -22,7 +22,7 @@ use stickslip::{advise, case, mesh_cmd, probe, run};
     name = "stickslip",
     version,
     about = "2-D elastodynamics with Coulomb friction (Martins & Oden 1983)",
-    after_help = "Examples:\n  stickslip mesh cases/meshes/slab-q2-8x2.msh\n  stickslip check cases/martins-oden/cd-eps1e-4.toml\n  stickslip run cases/martins-oden/cd-eps1e-4.toml -o slab.h5 --set time.dt=5e-4\n  stickslip probe slab.h5 --at 8,0 --field ux"
+    after_help = "Examples:\n  stickslip mesh cases/meshes/slab-q2-8x2.msh\n  stickslip check cases/martins-oden/cd-step-eps1e-4.toml\n  stickslip run cases/martins-oden/cd-step-eps1e-4.toml -o slab.h5 --set time.dt=5e-4\n  stickslip probe slab.h5 --at 8,0 --field ux"
 )]
 struct Cli {
     #[command(subcommand)]
