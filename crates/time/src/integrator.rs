@@ -723,6 +723,24 @@ impl Integrator {
                 (self.v_new[i] - self.v[i]) / (gamma * dt) - (1.0 - gamma) / gamma * self.a[i];
             self.a[i] = a_new;
         }
+        self.commit(t_new, step_number, iterations);
+
+        let v = std::mem::take(&mut self.v);
+        let kinetic = 0.5 * self.mass_product(&v);
+        self.v = v;
+        let strain = 0.5 * quadratic_form(&self.dynamics.stiffness, &self.r);
+        let load_dot = dot(&self.r, &self.load);
+        Ok(self.close_step(
+            [kinetic, strain, work, dissipated, load_dot],
+            dt,
+            iterations,
+            stick_events,
+        ))
+    }
+
+    /// Makes the new state current (r̈ is already in place), landing t
+    /// exactly on t_end at the last step.
+    fn commit(&mut self, t_new: f64, step_number: u64, iterations: usize) {
         std::mem::swap(&mut self.r, &mut self.r_new);
         std::mem::swap(&mut self.v, &mut self.v_new);
         std::mem::swap(&mut self.load, &mut self.load_new);
@@ -735,25 +753,31 @@ impl Integrator {
         };
         self.steps = step_number;
         self.total_iterations += iterations as u64;
+    }
 
-        let v = std::mem::take(&mut self.v);
-        let kinetic = 0.5 * self.mass_product(&v);
-        self.v = v;
-        let strain = 0.5 * quadratic_form(&self.dynamics.stiffness, &self.r);
+    /// Books the step in the energy ledger from [kinetic, strain, work of
+    /// the step, dissipation of the step, rᵀR] and advances the Remark 4.3
+    /// count.
+    fn close_step(
+        &mut self,
+        [kinetic, strain, work, dissipated, load_dot]: [f64; 5],
+        dt: f64,
+        iterations: usize,
+        stick_events: usize,
+    ) -> StepInfo {
         let e = &mut self.energy;
         e.kinetic = kinetic;
         e.strain = strain;
         e.external_work += work;
         e.dissipated += dissipated;
-        e.total = kinetic + strain - dot(&self.r, &self.load);
+        e.total = kinetic + strain - load_dot;
         e.balance = kinetic + strain - self.initial_mechanical - e.external_work + e.dissipated;
-
         self.count_reduced_steps(dt, stick_events);
-        Ok(StepInfo {
+        StepInfo {
             dt,
             iterations,
             stick_events,
-        })
+        }
     }
 
     /// Remark 4.3: a sticking restarts the reduced-step count.
@@ -942,32 +966,13 @@ impl Integrator {
         }
         let (dissipated, stick_events) = self.friction_ledger(dt);
         std::mem::swap(&mut self.a, &mut self.tmp);
-        std::mem::swap(&mut self.r, &mut self.r_new);
-        std::mem::swap(&mut self.v, &mut self.v_new);
-        std::mem::swap(&mut self.load, &mut self.load_new);
-        std::mem::swap(&mut self.forces, &mut self.forces_new);
-        self.classes.copy_from_slice(&self.scratch_classes);
-        self.t = if t_new >= self.settings.t_end * (1.0 - 1e-14) {
-            self.settings.t_end
-        } else {
-            t_new
-        };
-        self.steps = step_number;
-        self.total_iterations += iterations as u64;
-        let e = &mut self.energy;
-        e.kinetic = sums.kinetic;
-        e.strain = strain;
-        e.external_work += sums.work;
-        e.dissipated += dissipated;
-        e.total = sums.kinetic + strain - sums.load_dot;
-        e.balance =
-            sums.kinetic + strain - self.initial_mechanical - e.external_work + e.dissipated;
-        self.count_reduced_steps(dt, stick_events);
-        Ok(StepInfo {
+        self.commit(t_new, step_number, iterations);
+        Ok(self.close_step(
+            [sums.kinetic, strain, sums.work, dissipated, sums.load_dot],
             dt,
             iterations,
             stick_events,
-        })
+        ))
     }
 
     /// Explicit step: d = M_L/(γΔt), friction node by node.
