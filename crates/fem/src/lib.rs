@@ -27,6 +27,7 @@ pub mod quadrature;
 pub mod reference;
 mod solver;
 pub mod statics;
+mod supernodal;
 pub mod testing;
 
 pub use assembly::{free_dof_pattern, node_adjacency};
@@ -40,6 +41,7 @@ pub use material::{Hypothesis, Material};
 pub use model::Model;
 pub use solver::{SolverError, SparseCholesky};
 pub use statics::{gauss_point_stresses, nodal_stresses, static_solve, GaussPointStress};
+pub use supernodal::Supernodal;
 
 /// The physical group `name` of `mesh`, wanted for `purpose`.
 pub(crate) fn find_group<'m>(

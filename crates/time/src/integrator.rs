@@ -1077,7 +1077,7 @@ impl Integrator {
         op.reduced = Some(reduced);
         match result {
             Ok(report) => {
-                op.finish(&self.b, &mut self.v_new);
+                op.finish(&mut self.v_new);
                 Ok(report.iterations)
             }
             Err(IterationFailure::Cap {

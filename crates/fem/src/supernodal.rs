@@ -1,0 +1,876 @@
+//! Forward and back substitution with faer's supernodal LLᵀ factor, written
+//! for one right-hand side (the implicit step's and the static solve's;
+//! issue 7, deliverable 1).
+//!
+//! faer's own solve handles a block of right-hand sides through its
+//! general triangular-solve and matmul kernels; for one column its
+//! per-supernode dispatch and temporaries cost more than the arithmetic
+//! (measured in the module's `lab` test: see [`Supernodal`]). Here each
+//! supernode is a column-major (k + m) × k block, the k × k diagonal
+//! triangle above the m rows of its pattern, and the loops run straight
+//! over its columns: the forward solve pushes L_bot x_top into the pattern
+//! rows (a contiguous axpy per column, then one scatter), the back solve
+//! gathers the pattern rows once and takes contiguous dot products.
+//!
+//! The step also needs solves that touch only part of the tree: the
+//! velocities at the contact DOFs of A₀⁻¹b, and A₀⁻¹Pᵀf whose right-hand
+//! side lives on the contact DOFs. Both only involve the supernodes on the
+//! paths from the contact DOFs' supernodes to the root (a column's solution
+//! in the back solve depends only on its ancestors; a forward push from a
+//! supernode only reaches its ancestors), the *reach* set. So a step costs
+//! one full forward solve, one back solve restricted to the reach, the
+//! nodal iteration, one forward solve restricted to the reach, and one full
+//! back solve: one solve's worth of passes over the factor plus twice the
+//! reach's share of it.
+
+use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
+
+/// Owner of a column that belongs to neither thread's subtrees.
+const TOP: u8 = 2;
+
+/// Factors from this many values split the tree between two threads; below
+/// it a thread's dispatch costs more than the passes.
+const SPLIT_MIN: usize = 1 << 20;
+
+/// Supernodes to visit, ascending: two groups of disjoint subtrees (one per
+/// thread) and the rest (the top of the tree, visited on the calling
+/// thread after the groups in the forward solve, before them in the back
+/// solve).
+#[derive(Default)]
+struct Plan {
+    bins: [Vec<u32>; 2],
+    top: Vec<u32>,
+}
+
+/// One thread's working copy of its columns, its pushes into the top
+/// columns and its pattern buffer.
+#[derive(Default)]
+struct BinScratch {
+    x: Vec<f64>,
+    acc: Vec<f64>,
+    tmp: Vec<f64>,
+}
+
+/// The structure of a supernodal factor, copied out of faer's symbolic
+/// factor (u32 row indices: half the index bytes of the scatter/gather),
+/// and the split of its tree between two threads.
+///
+/// The split is a property of the factor, not of the number of threads:
+/// each group's arithmetic is the same whether the groups run in turn or
+/// at once, so results do not depend on the thread count.
+pub struct Supernodal {
+    n: usize,
+    /// x_perm[i] = x[fwd[i]].
+    fwd: Vec<u32>,
+    /// Supernode s owns columns begin[s]..begin[s + 1].
+    begin: Vec<usize>,
+    /// Pattern (rows below the diagonal block) of s: rows[row_ptr[s]..row_ptr[s + 1]].
+    row_ptr: Vec<usize>,
+    rows: Vec<u32>,
+    /// Values of s: l[val_ptr[s]..val_ptr[s + 1]].
+    val_ptr: Vec<usize>,
+    /// Per column: its group (0, 1) or TOP, and its index in the group's
+    /// columns or in the top columns.
+    owner: Vec<u8>,
+    slot: Vec<u32>,
+    bin_cols: [Vec<u32>; 2],
+    top_cols: Vec<u32>,
+    full: Plan,
+    reach: Plan,
+    /// Values of L inside the reach.
+    reach_len: usize,
+    /// The permuted vector, the reach solution, the reach correction.
+    xp: Vec<f64>,
+    xr: Vec<f64>,
+    w: Vec<f64>,
+    tmp: Vec<f64>,
+    scratch: [BinScratch; 2],
+}
+
+impl std::fmt::Debug for Supernodal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Supernodal")
+            .field("n", &self.n)
+            .field("supernodes", &self.supernodes())
+            .field("values", &self.val_ptr.last())
+            .field("split", &self.is_split())
+            .finish()
+    }
+}
+
+impl Supernodal {
+    /// The solver for `symbolic`'s layout (`None` only for a layout it does
+    /// not know).
+    pub fn new(symbolic: &SymbolicCholesky<usize>) -> Option<Supernodal> {
+        Supernodal::with_split_min(symbolic, SPLIT_MIN)
+    }
+
+    /// As [`Supernodal::new`], splitting the tree from `split_min` values.
+    pub fn with_split_min(
+        symbolic: &SymbolicCholesky<usize>,
+        split_min: usize,
+    ) -> Option<Supernodal> {
+        let n = symbolic.nrows();
+        let (begin, row_ptr, rows, val_ptr): (Vec<usize>, Vec<usize>, Vec<u32>, Vec<usize>) =
+            match symbolic.raw() {
+                SymbolicCholeskyRaw::Supernodal(sym) => {
+                    let ns = sym.n_supernodes();
+                    let mut begin: Vec<usize> = sym.supernode_begin().to_vec();
+                    begin.push(n);
+                    // faer packs the patterns: row_ptr[s + 1] − row_ptr[s] is
+                    // s's length.
+                    (
+                        begin,
+                        sym.col_ptr_for_row_idx()[..=ns].to_vec(),
+                        sym.row_idx().iter().map(|&r| r as u32).collect(),
+                        sym.col_ptr_for_val()[..=ns].to_vec(),
+                    )
+                }
+                SymbolicCholeskyRaw::Simplicial(sym) => {
+                    // faer keeps tiny factors simplicial even when asked for
+                    // supernodes: a column with its diagonal first is a
+                    // supernode of one column in the same layout.
+                    let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
+                    let mut row_ptr = vec![0];
+                    let mut rows = Vec::with_capacity(row_idx.len());
+                    for j in 0..n {
+                        let col = &row_idx[col_ptr[j]..col_ptr[j + 1]];
+                        if col.first() != Some(&j) {
+                            return None;
+                        }
+                        rows.extend(col[1..].iter().map(|&r| r as u32));
+                        row_ptr.push(rows.len());
+                    }
+                    ((0..=n).collect(), row_ptr, rows, col_ptr.to_vec())
+                }
+            };
+        let ns = begin.len() - 1;
+        let fwd: Vec<u32> = match symbolic.perm() {
+            Some(p) => p.arrays().0.iter().map(|&i| i as u32).collect(),
+            None => (0..n as u32).collect(),
+        };
+        let max_pattern = (0..ns)
+            .map(|s| row_ptr[s + 1] - row_ptr[s])
+            .max()
+            .unwrap_or(0);
+        let mut this = Supernodal {
+            n,
+            fwd,
+            begin,
+            row_ptr,
+            rows,
+            val_ptr,
+            owner: vec![TOP; n],
+            slot: vec![0; n],
+            bin_cols: Default::default(),
+            top_cols: Vec::new(),
+            full: Plan::default(),
+            reach: Plan::default(),
+            reach_len: 0,
+            xp: vec![0.0; n],
+            xr: vec![0.0; n],
+            w: vec![0.0; n],
+            tmp: vec![0.0; max_pattern],
+            scratch: Default::default(),
+        };
+        this.split_tree(split_min);
+        this.reach = Plan {
+            bins: this.full.bins.clone(),
+            top: this.full.top.clone(),
+        };
+        this.reach_len = this.val_ptr[ns];
+        Some(this)
+    }
+
+    /// Number of supernodes (columns, for a simplicial factor).
+    pub fn supernodes(&self) -> usize {
+        self.begin.len() - 1
+    }
+
+    fn len(&self, s: usize) -> usize {
+        self.val_ptr[s + 1] - self.val_ptr[s]
+    }
+
+    /// The parent of each supernode: the one holding its first pattern row.
+    fn parents(&self) -> Vec<Option<usize>> {
+        let mut owner = vec![0u32; self.n];
+        for s in 0..self.supernodes() {
+            owner[self.begin[s]..self.begin[s + 1]].fill(s as u32);
+        }
+        (0..self.supernodes())
+            .map(|s| {
+                let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
+                pattern.iter().min().map(|&r| owner[r as usize] as usize)
+            })
+            .collect()
+    }
+
+    /// Splits the tree into two groups of subtrees of about equal weight
+    /// (values of L) and a top: starting from the roots, the heaviest
+    /// subtree is opened (its root goes to the top, its children become
+    /// candidates) while that lowers max(group) + top, the time of a solve
+    /// on two threads.
+    fn split_tree(&mut self, split_min: usize) {
+        let ns = self.supernodes();
+        let total: usize = self.val_ptr[ns];
+        let mut group = vec![TOP; ns];
+        if total >= split_min {
+            let parent = self.parents();
+            let mut children = vec![Vec::new(); ns];
+            let mut weight: Vec<usize> = (0..ns).map(|s| self.len(s)).collect();
+            let mut roots = Vec::new();
+            for s in 0..ns {
+                match parent[s] {
+                    Some(p) => {
+                        children[p].push(s);
+                        weight[p] += weight[s];
+                    }
+                    None => roots.push(s),
+                }
+            }
+            let mut candidates = roots;
+            let mut top: Vec<usize> = Vec::new();
+            let mut top_weight = 0;
+            let mut best: Option<(usize, Vec<usize>, Vec<[usize; 2]>)> = None;
+            for _ in 0..256 {
+                candidates.sort_by_key(|&s| std::cmp::Reverse((weight[s], s)));
+                // Longest processing time first into the lighter group.
+                let mut loads = [0usize; 2];
+                let mut assign = Vec::with_capacity(candidates.len());
+                for &s in &candidates {
+                    let g = usize::from(loads[1] < loads[0]);
+                    loads[g] += weight[s];
+                    assign.push([s, g]);
+                }
+                let cost = loads[0].max(loads[1]) + top_weight;
+                if best.as_ref().is_none_or(|b| cost < b.0) {
+                    best = Some((cost, top.clone(), assign));
+                }
+                let Some(&h) = candidates.first() else { break };
+                if weight[h] * 8 < total {
+                    break;
+                }
+                candidates.remove(0);
+                top.push(h);
+                top_weight += self.len(h);
+                candidates.extend(&children[h]);
+            }
+            if let Some((cost, _top, assign)) = best {
+                // Splitting pays only if it saves a fifth of a solve.
+                if cost * 5 < total * 4 {
+                    for [s, g] in assign {
+                        group[s] = g as u8;
+                    }
+                    // Descendants follow their subtree's root; the top and
+                    // the parents come later in the descending walk.
+                    for s in (0..ns).rev() {
+                        if group[s] == TOP {
+                            if let Some(p) = parent[s] {
+                                if group[p] != TOP {
+                                    group[s] = group[p];
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let mut counts = [0u32; 3];
+        for s in 0..ns {
+            let g = group[s];
+            for c in self.begin[s]..self.begin[s + 1] {
+                self.owner[c] = g;
+                self.slot[c] = counts[g as usize];
+                counts[g as usize] += 1;
+                match g {
+                    TOP => self.top_cols.push(c as u32),
+                    _ => self.bin_cols[g as usize].push(c as u32),
+                }
+            }
+            match g {
+                TOP => self.full.top.push(s as u32),
+                _ => self.full.bins[g as usize].push(s as u32),
+            }
+        }
+        for (b, sc) in self.scratch.iter_mut().enumerate() {
+            if !self.full.bins[b].is_empty() {
+                sc.x = vec![0.0; self.bin_cols[b].len()];
+                sc.acc = vec![0.0; self.top_cols.len()];
+                sc.tmp = vec![0.0; self.tmp.len()];
+            }
+        }
+    }
+
+    /// Marks the supernodes on the paths from the supernodes holding `dofs`
+    /// (unpermuted indices) to the root.
+    pub fn set_reach(&mut self, dofs: &[usize]) {
+        let ns = self.supernodes();
+        let parent = self.parents();
+        let mut owner = vec![0u32; self.n];
+        for s in 0..ns {
+            owner[self.begin[s]..self.begin[s + 1]].fill(s as u32);
+        }
+        let mut inv = vec![0usize; self.n];
+        for (i, &f) in self.fwd.iter().enumerate() {
+            inv[f as usize] = i;
+        }
+        let mut marked = vec![false; ns];
+        for &d in dofs {
+            let mut s = Some(owner[inv[d]] as usize);
+            while let Some(k) = s.filter(|&k| !marked[k]) {
+                marked[k] = true;
+                s = parent[k];
+            }
+        }
+        let keep = |list: &[u32]| -> Vec<u32> {
+            list.iter()
+                .copied()
+                .filter(|&s| marked[s as usize])
+                .collect()
+        };
+        self.reach = Plan {
+            bins: [keep(&self.full.bins[0]), keep(&self.full.bins[1])],
+            top: keep(&self.full.top),
+        };
+        self.reach_len = (0..ns).filter(|&s| marked[s]).map(|s| self.len(s)).sum();
+    }
+
+    /// Values of L inside the reach (for the cost figures).
+    pub fn reach_len(&self) -> usize {
+        self.reach_len
+    }
+
+    /// True when the solves run on two groups of subtrees.
+    pub fn is_split(&self) -> bool {
+        !self.full.bins[0].is_empty()
+    }
+
+    /// x ← A⁻¹x with the factor values `l`.
+    pub fn solve(&mut self, l: &[f64], x: &mut [f64]) {
+        let mut xp = std::mem::take(&mut self.xp);
+        permute_in(&self.fwd, x, &mut xp);
+        self.forward(l, false, &mut xp);
+        self.backward(l, false, &mut xp);
+        permute_out(&self.fwd, &xp, x);
+        self.xp = xp;
+    }
+
+    /// Forward solve L y = P b into the internal vector, and the back solve
+    /// restricted to the reach: afterwards [`Supernodal::reach_value`] gives
+    /// (A⁻¹b) at the DOFs given to [`Supernodal::set_reach`].
+    pub fn begin_step(&mut self, l: &[f64], b: &[f64]) {
+        let mut xp = std::mem::take(&mut self.xp);
+        permute_in(&self.fwd, b, &mut xp);
+        self.forward(l, false, &mut xp);
+        let mut xr = std::mem::take(&mut self.xr);
+        xr.copy_from_slice(&xp);
+        self.backward(l, true, &mut xr);
+        self.xp = xp;
+        self.xr = xr;
+    }
+
+    /// (A⁻¹b) at the permuted index i after [`Supernodal::begin_step`].
+    pub fn reach_value(&self, permuted: usize) -> f64 {
+        self.xr[permuted]
+    }
+
+    /// The permuted index of each DOF.
+    pub fn permuted_indices(&self) -> Vec<usize> {
+        let mut inv = vec![0usize; self.n];
+        for (i, &f) in self.fwd.iter().enumerate() {
+            inv[f as usize] = i;
+        }
+        inv
+    }
+
+    /// Finishes the step: x = A⁻¹(b − c) with c nonzero only at DOFs given
+    /// to [`Supernodal::set_reach`], as (permuted index, value).
+    pub fn finish_step(&mut self, l: &[f64], c: &[(usize, f64)], x: &mut [f64]) {
+        let mut w = std::mem::take(&mut self.w);
+        w.fill(0.0);
+        for &(i, v) in c {
+            w[i] += v;
+        }
+        // L⁻¹c is zero outside the reach, so L⁻¹(b − c) = L⁻¹b − L⁻¹c
+        // changes only the reach's columns.
+        self.forward(l, true, &mut w);
+        let mut xp = std::mem::take(&mut self.xp);
+        for (y, wi) in xp.iter_mut().zip(&w) {
+            *y -= wi;
+        }
+        self.backward(l, false, &mut xp);
+        permute_out(&self.fwd, &xp, x);
+        self.xp = xp;
+        self.w = w;
+    }
+
+    /// The forward solve L y = x over the plan's supernodes, in place.
+    fn forward(&mut self, l: &[f64], reach: bool, x: &mut [f64]) {
+        let plan = if reach { &self.reach } else { &self.full };
+        if !self.full.bins[0].is_empty() {
+            let mut scratch = std::mem::take(&mut self.scratch);
+            let (s0, s1) = scratch.split_at_mut(1);
+            let shared = &*x;
+            rayon::join(
+                || self.bin_forward(0, l, &plan.bins[0], shared, &mut s0[0]),
+                || self.bin_forward(1, l, &plan.bins[1], shared, &mut s1[0]),
+            );
+            for (b, sc) in scratch.iter().enumerate() {
+                for (&c, v) in self.bin_cols[b].iter().zip(&sc.x) {
+                    x[c as usize] = *v;
+                }
+            }
+            for (&c, (a0, a1)) in self
+                .top_cols
+                .iter()
+                .zip(scratch[0].acc.iter().zip(&scratch[1].acc))
+            {
+                let xc = &mut x[c as usize];
+                *xc = (*xc - a0) - a1;
+            }
+            self.scratch = scratch;
+        }
+        let plan = if reach { &self.reach } else { &self.full };
+        for &s in &plan.top {
+            let s = s as usize;
+            let (c0, c1) = (self.begin[s], self.begin[s + 1]);
+            let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
+            let tmp = &mut self.tmp[..pattern.len()];
+            block_forward(
+                &l[self.val_ptr[s]..self.val_ptr[s + 1]],
+                &mut x[c0..c1],
+                tmp,
+            );
+            for (&r, t) in pattern.iter().zip(tmp.iter()) {
+                x[r as usize] -= t;
+            }
+        }
+    }
+
+    /// One group's forward solve on its own copy of its columns; pushes
+    /// into the top columns are summed in `sc.acc`.
+    fn bin_forward(&self, b: usize, l: &[f64], list: &[u32], x: &[f64], sc: &mut BinScratch) {
+        for (v, &c) in sc.x.iter_mut().zip(&self.bin_cols[b]) {
+            *v = x[c as usize];
+        }
+        sc.acc.fill(0.0);
+        for &s in list {
+            let s = s as usize;
+            let c0 = self.slot[self.begin[s]] as usize;
+            let k = self.begin[s + 1] - self.begin[s];
+            let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
+            let tmp = &mut sc.tmp[..pattern.len()];
+            block_forward(
+                &l[self.val_ptr[s]..self.val_ptr[s + 1]],
+                &mut sc.x[c0..c0 + k],
+                tmp,
+            );
+            for (&r, t) in pattern.iter().zip(tmp.iter()) {
+                let r = r as usize;
+                let i = self.slot[r] as usize;
+                if self.owner[r] == TOP {
+                    sc.acc[i] += t;
+                } else {
+                    sc.x[i] -= t;
+                }
+            }
+        }
+    }
+
+    /// The back solve Lᵀ x = y over the plan's supernodes, in place.
+    fn backward(&mut self, l: &[f64], reach: bool, x: &mut [f64]) {
+        let plan = if reach { &self.reach } else { &self.full };
+        for &s in plan.top.iter().rev() {
+            let s = s as usize;
+            let (c0, c1) = (self.begin[s], self.begin[s + 1]);
+            let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
+            let tmp = &mut self.tmp[..pattern.len()];
+            for (t, &r) in tmp.iter_mut().zip(pattern) {
+                *t = x[r as usize];
+            }
+            block_backward(
+                &l[self.val_ptr[s]..self.val_ptr[s + 1]],
+                &mut x[c0..c1],
+                tmp,
+            );
+        }
+        if !self.full.bins[0].is_empty() {
+            let mut scratch = std::mem::take(&mut self.scratch);
+            let (s0, s1) = scratch.split_at_mut(1);
+            let shared = &*x;
+            rayon::join(
+                || self.bin_backward(0, l, &plan.bins[0], shared, &mut s0[0]),
+                || self.bin_backward(1, l, &plan.bins[1], shared, &mut s1[0]),
+            );
+            for (b, sc) in scratch.iter().enumerate() {
+                for (&c, v) in self.bin_cols[b].iter().zip(&sc.x) {
+                    x[c as usize] = *v;
+                }
+            }
+            self.scratch = scratch;
+        }
+    }
+
+    /// One group's back solve on its own copy of its columns, reading the
+    /// (finished) top columns from `x`.
+    fn bin_backward(&self, b: usize, l: &[f64], list: &[u32], x: &[f64], sc: &mut BinScratch) {
+        for (v, &c) in sc.x.iter_mut().zip(&self.bin_cols[b]) {
+            *v = x[c as usize];
+        }
+        for &s in list.iter().rev() {
+            let s = s as usize;
+            let c0 = self.slot[self.begin[s]] as usize;
+            let k = self.begin[s + 1] - self.begin[s];
+            let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
+            let tmp = &mut sc.tmp[..pattern.len()];
+            for (t, &r) in tmp.iter_mut().zip(pattern) {
+                let r = r as usize;
+                *t = if self.owner[r] == TOP {
+                    x[r]
+                } else {
+                    sc.x[self.slot[r] as usize]
+                };
+            }
+            block_backward(
+                &l[self.val_ptr[s]..self.val_ptr[s + 1]],
+                &mut sc.x[c0..c0 + k],
+                tmp,
+            );
+        }
+    }
+}
+
+fn permute_in(fwd: &[u32], b: &[f64], xp: &mut [f64]) {
+    for (y, &f) in xp.iter_mut().zip(fwd) {
+        *y = b[f as usize];
+    }
+}
+
+fn permute_out(fwd: &[u32], xp: &[f64], x: &mut [f64]) {
+    for (y, &f) in xp.iter().zip(fwd) {
+        x[f as usize] = *y;
+    }
+}
+
+/// A supernode's forward step: the k × k triangle solved on its columns
+/// `xs`, then tmp = L_bot xs (m rows; one contiguous axpy per column). The
+/// block is column-major (k + m) × k.
+#[inline]
+fn block_forward(block: &[f64], xs: &mut [f64], tmp: &mut [f64]) {
+    let k = xs.len();
+    let ld = k + tmp.len();
+    for j in 0..k {
+        let col = &block[j * ld..j * ld + k];
+        let xj = xs[j] / col[j];
+        xs[j] = xj;
+        for (xi, lij) in xs[j + 1..].iter_mut().zip(&col[j + 1..]) {
+            *xi -= lij * xj;
+        }
+    }
+    if tmp.is_empty() {
+        return;
+    }
+    tmp.fill(0.0);
+    for j in 0..k {
+        let xj = xs[j];
+        for (t, lij) in tmp.iter_mut().zip(&block[j * ld + k..(j + 1) * ld]) {
+            *t += lij * xj;
+        }
+    }
+}
+
+/// A supernode's back step: xs −= L_botᵀ tmp (tmp = the pattern rows of
+/// x), then the k × k transposed triangle.
+#[inline]
+fn block_backward(block: &[f64], xs: &mut [f64], tmp: &[f64]) {
+    let k = xs.len();
+    let ld = k + tmp.len();
+    if !tmp.is_empty() {
+        for j in 0..k {
+            xs[j] -= dot(&block[j * ld + k..(j + 1) * ld], tmp);
+        }
+    }
+    for j in (0..k).rev() {
+        let col = &block[j * ld..j * ld + k];
+        let s = dot(&col[j + 1..], &xs[j + 1..]);
+        xs[j] = (xs[j] - s) / col[j];
+    }
+}
+
+/// Σ aᵢbᵢ with four independent partial sums (the adder's latency, not
+/// memory, would bind a single chain).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (a4, ar) = a.split_at(a.len() - a.len() % 4);
+    let (b4, br) = b.split_at(a4.len());
+    for (x, y) in a4.chunks_exact(4).zip(b4.chunks_exact(4)) {
+        acc[0] += x[0] * y[0];
+        acc[1] += x[1] * y[1];
+        acc[2] += x[2] * y[2];
+        acc[3] += x[3] * y[3];
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (x, y) in ar.iter().zip(br) {
+        s += x * y;
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::rectangle;
+    use crate::{Hypothesis, Material, Model};
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::sparse::linalg::cholesky::{
+        factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymmetricOrdering,
+    };
+    use faer::sparse::linalg::SupernodalThreshold;
+    use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+    use faer::{Conj, MatMut, Par, Side, Spec};
+    use nalgebra_sparse::CsrMatrix;
+    use stickslip_mesh::CellKind;
+
+    fn operator(kind: CellKind, nx: usize, ny: usize) -> CsrMatrix<f64> {
+        let mesh = rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let model = Model::new(&mesh, &material, &[]).unwrap();
+        // A₀ of the paper's Newmark step: (β/γ)Δt K + M/(γΔt), Δt = 1e-3.
+        model.combined(0.5e-3, 1.0 / 0.5e-3)
+    }
+
+    fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
+        let sym = SymbolicSparseColMatRef::new_checked(
+            a.nrows(),
+            a.ncols(),
+            a.row_offsets(),
+            None,
+            a.col_indices(),
+        );
+        SparseColMatRef::new(sym, a.values())
+    }
+
+    struct Factor {
+        symbolic: SymbolicCholesky<usize>,
+        l: Vec<f64>,
+    }
+
+    fn factor(a: &CsrMatrix<f64>) -> Factor {
+        let symbolic = factorize_symbolic_cholesky(
+            as_csc(a).symbolic(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let mut l = vec![0.0; symbolic.len_val()];
+        let mut scratch = MemBuffer::new(
+            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+        );
+        symbolic
+            .factorize_numeric_llt(
+                &mut l,
+                as_csc(a),
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut scratch),
+                Spec::default(),
+            )
+            .unwrap();
+        Factor { symbolic, l }
+    }
+
+    fn faer_solve(f: &Factor, x: &mut [f64]) {
+        let n = x.len();
+        let mut scratch = MemBuffer::new(f.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+        LltRef::<'_, usize, f64>::new(&f.symbolic, &f.l).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(x, n, 1),
+            Par::Seq,
+            MemStack::new(&mut scratch),
+        );
+    }
+
+    fn residual(a: &CsrMatrix<f64>, x: &[f64], b: &[f64]) -> f64 {
+        let mut worst: f64 = 0.0;
+        let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (i, row) in a.row_iter().enumerate() {
+            let ax: f64 = row
+                .col_indices()
+                .iter()
+                .zip(row.values())
+                .map(|(&j, v)| v * x[j])
+                .sum();
+            worst = worst.max((ax - b[i]).abs() / scale);
+        }
+        worst
+    }
+
+    fn rhs(n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| ((i * 7919) % 1000) as f64 / 500.0 - 1.0)
+            .collect()
+    }
+
+    /// The solve satisfies A x = b (residual against the matrix, not
+    /// against faer) and agrees with faer's solve, Q1 and Q2.
+    #[test]
+    fn solves_like_faer() {
+        for (kind, nx, ny) in [(CellKind::Quad4, 24, 6), (CellKind::Quad9, 8, 2)] {
+            let a = operator(kind, nx, ny);
+            let f = factor(&a);
+            let mut sn = Supernodal::new(&f.symbolic).expect("forced supernodal");
+            let b = rhs(a.nrows());
+            let mut x = b.clone();
+            sn.solve(&f.l, &mut x);
+            assert!(residual(&a, &x, &b) < 1e-12, "{kind:?}");
+            let mut y = b.clone();
+            faer_solve(&f, &mut y);
+            let d = x
+                .iter()
+                .zip(&y)
+                .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+            let s = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(d <= 1e-12 * s, "{kind:?}: {d} against {s}");
+        }
+    }
+
+    /// The split step (forward, back on the reach, forward on the reach,
+    /// back) gives A⁻¹b at the reach DOFs and A⁻¹(b − c) in the end.
+    #[test]
+    fn split_step_matches_two_solves() {
+        let a = operator(CellKind::Quad4, 24, 6);
+        let n = a.nrows();
+        let f = factor(&a);
+        let mut sn = Supernodal::new(&f.symbolic).unwrap();
+        // The bottom edge's x DOFs (nodes 0..=24 of the rectangle): DOF 2i.
+        let dofs: Vec<usize> = (0..=24).map(|i| 2 * i).collect();
+        sn.set_reach(&dofs);
+        assert!(sn.reach_len() < f.l.len(), "the reach is part of the tree");
+        let b = rhs(n);
+        let perm = sn.permuted_indices();
+        sn.begin_step(&f.l, &b);
+        let mut full = b.clone();
+        faer_solve(&f, &mut full);
+        for &d in &dofs {
+            let v = sn.reach_value(perm[d]);
+            assert!((v - full[d]).abs() <= 1e-12 * full[d].abs().max(1.0), "{d}");
+        }
+        let c: Vec<(usize, f64)> = dofs.iter().map(|&d| (perm[d], 0.1 * d as f64)).collect();
+        let mut x = vec![0.0; n];
+        sn.finish_step(&f.l, &c, &mut x);
+        let mut bc = b.clone();
+        for &d in &dofs {
+            bc[d] -= 0.1 * d as f64;
+        }
+        assert!(residual(&a, &x, &bc) < 1e-12);
+    }
+
+    /// The two-group solve (forced on a small factor) solves A x = b, and
+    /// gives the same bits on one thread and on two: the groups' arithmetic
+    /// does not depend on the thread count.
+    #[test]
+    fn split_solve_is_right_and_thread_independent() {
+        let a = operator(CellKind::Quad4, 40, 10);
+        let n = a.nrows();
+        let f = factor(&a);
+        let b = rhs(n);
+        let dofs: Vec<usize> = (0..=40).map(|i| 2 * i).collect();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut sn = Supernodal::with_split_min(&f.symbolic, 0).unwrap();
+                assert!(sn.is_split(), "the tree splits");
+                sn.set_reach(&dofs);
+                let mut x = b.clone();
+                sn.solve(&f.l, &mut x);
+                let perm = sn.permuted_indices();
+                sn.begin_step(&f.l, &b);
+                let at: Vec<f64> = dofs.iter().map(|&d| sn.reach_value(perm[d])).collect();
+                let c: Vec<(usize, f64)> = dofs.iter().map(|&d| (perm[d], 0.5)).collect();
+                let mut y = vec![0.0; n];
+                sn.finish_step(&f.l, &c, &mut y);
+                (x, at, y)
+            })
+        };
+        let (x1, at1, y1) = run(1);
+        let (x2, at2, y2) = run(2);
+        assert!(residual(&a, &x1, &b) < 1e-12);
+        for (k, &d) in dofs.iter().enumerate() {
+            assert!((at1[k] - x1[d]).abs() <= 1e-12 * x1[d].abs().max(1.0));
+        }
+        let mut bc = b.clone();
+        for &d in &dofs {
+            bc[d] -= 0.5;
+        }
+        assert!(residual(&a, &y1, &bc) < 1e-12);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&x1), bits(&x2));
+        assert_eq!(bits(&at1), bits(&at2));
+        assert_eq!(bits(&y1), bits(&y2));
+    }
+
+    /// Timing lab (run by hand): one solve with faer's and with this
+    /// module's loops on the Q1 slab of 252k DOFs, and the reach's share.
+    ///
+    ///     cargo test -p stickslip-fem --lib supernodal_lab -- --ignored --nocapture
+    #[test]
+    #[ignore = "timing lab, run by hand"]
+    fn supernodal_lab() {
+        for (kind, nx, ny) in [(CellKind::Quad4, 708, 177), (CellKind::Quad9, 352, 88)] {
+            let a = operator(kind, nx, ny);
+            let n = a.nrows();
+            let f = factor(&a);
+            let mut sn = Supernodal::new(&f.symbolic).unwrap();
+            let dofs: Vec<usize> = (0..=nx * if kind == CellKind::Quad9 { 2 } else { 1 })
+                .map(|i| 2 * i)
+                .collect();
+            sn.set_reach(&dofs);
+            let b = rhs(n);
+            let time = |f: &mut dyn FnMut()| {
+                let mut t = Vec::new();
+                for _ in 0..7 {
+                    let s = std::time::Instant::now();
+                    f();
+                    t.push(s.elapsed().as_secs_f64());
+                }
+                t.sort_by(f64::total_cmp);
+                t[3]
+            };
+            let mut x = b.clone();
+            let t_faer = time(&mut || {
+                x.copy_from_slice(&b);
+                faer_solve(&f, &mut x);
+            });
+            let t_ours = time(&mut || {
+                x.copy_from_slice(&b);
+                sn.solve(&f.l, &mut x);
+            });
+            let perm = sn.permuted_indices();
+            let c: Vec<(usize, f64)> = dofs.iter().map(|&d| (perm[d], 1.0)).collect();
+            let t_split = time(&mut || {
+                sn.begin_step(&f.l, &b);
+                sn.finish_step(&f.l, &c, &mut x);
+            });
+            println!(
+                "{kind:?} n={n} L={} ({:.0} MB) supernodes={} split={} reach {:.1}% of L: faer {:.2} ms, ours {:.2} ms, split step {:.2} ms",
+                f.l.len(),
+                f.l.len() as f64 * 8e-6,
+                sn.supernodes(),
+                sn.is_split(),
+                100.0 * sn.reach_len() as f64 / f.l.len() as f64,
+                t_faer * 1e3,
+                t_ours * 1e3,
+                t_split * 1e3
+            );
+        }
+    }
+}
