@@ -7,7 +7,9 @@ use stickslip_fem::{Model, SolverError, SparseCholesky};
 use crate::history::History;
 use crate::implicit::{DiagonalStep, ImplicitOperator, ImplicitStep};
 use crate::kernels;
-use crate::linalg::{dot, quadratic_form, spmv};
+use crate::linalg::{
+    dot, load_minus_k_plus_m, quadratic_form, row_chunks, same_pattern, spmv, two_forms,
+};
 use crate::schur::{ImplicitSolver, SchurOperator};
 use crate::stability::critical_step;
 
@@ -325,6 +327,11 @@ pub struct Integrator {
     scratch_classes: Vec<SlipState>,
     /// The iteration's own scratch classes.
     iter_scratch: Vec<SlipState>,
+    /// Per-chunk partial sums of the energies' quadratic forms.
+    row_partials: Vec<f64>,
+    /// K and the consistent M store one pattern: the implicit step's
+    /// products with both run as one pass.
+    shared_pattern: bool,
     forces_new: Vec<f64>,
     /// θ_l(t) of each load for the step being taken.
     thetas: Vec<f64>,
@@ -496,6 +503,7 @@ impl Integrator {
             .clone()
             .unwrap_or_else(|| vec![0.0; n]);
         let n_c = contact.as_ref().map_or(0, |c| c.len());
+        let shared_pattern = same_pattern(&dynamics.stiffness, &mass_matrix);
         let mut this = Integrator {
             beta,
             gamma,
@@ -525,6 +533,8 @@ impl Integrator {
             diagonal: vec![0.0; n],
             scratch_classes: vec![SlipState::Stuck; n_c],
             iter_scratch: vec![SlipState::Stuck; n_c],
+            row_partials: vec![0.0; 2 * row_chunks(n)],
+            shared_pattern,
             forces_new: vec![0.0; n_c],
             thetas: vec![0.0; loads.len()],
             partials: kernels::partials(n),
@@ -562,8 +572,11 @@ impl Integrator {
             c.classify(&this.v, &mut this.classes);
             c.nodal_forces(&this.v, &mut this.forces);
         }
-        let kinetic = 0.5 * this.mass_product(&this.v.clone());
-        let strain = 0.5 * quadratic_form(&this.dynamics.stiffness, &this.r);
+        let v = std::mem::take(&mut this.v);
+        let kinetic = 0.5 * this.mass_product(&v);
+        this.v = v;
+        let strain =
+            0.5 * quadratic_form(&this.dynamics.stiffness, &this.r, &mut this.row_partials);
         this.initial_mechanical = kinetic + strain;
         this.energy = Energy {
             kinetic,
@@ -615,14 +628,35 @@ impl Integrator {
     }
 
     /// xᵀ M x with the scheme's mass.
-    fn mass_product(&self, x: &[f64]) -> f64 {
+    /// (½ṙᵀMṙ, ½rᵀKr) of the current state; one pass over K and M when
+    /// they share their pattern.
+    fn kinetic_and_strain(&mut self) -> (f64, f64) {
+        if self.mass_kind == MassKind::Consistent && self.shared_pattern {
+            let (rkr, vmv) = two_forms(
+                &self.dynamics.stiffness,
+                &self.r,
+                &self.mass_matrix,
+                &self.v,
+                &mut self.row_partials,
+            );
+            return (0.5 * vmv, 0.5 * rkr);
+        }
+        let v = std::mem::take(&mut self.v);
+        let kinetic = 0.5 * self.mass_product(&v);
+        self.v = v;
+        let strain =
+            0.5 * quadratic_form(&self.dynamics.stiffness, &self.r, &mut self.row_partials);
+        (kinetic, strain)
+    }
+
+    fn mass_product(&mut self, x: &[f64]) -> f64 {
         match self.mass_kind {
             MassKind::Lumped => x
                 .iter()
                 .zip(&self.dynamics.lumped_mass)
                 .map(|(v, m)| m * v * v)
                 .sum(),
-            MassKind::Consistent => quadratic_form(&self.mass_matrix, x),
+            MassKind::Consistent => quadratic_form(&self.mass_matrix, x, &mut self.row_partials),
         }
     }
 
@@ -670,11 +704,13 @@ impl Integrator {
             self.r_new[i] = self.r[i] + c1 * self.v[i] + c2 * self.a[i];
         }
         // R̂_K = R_K − K r_pred + M[ṙ/(γΔt) + (1/γ − 1) r̈].
-        spmv(&self.dynamics.stiffness, &self.r_new, &mut self.b);
         let cv = 1.0 / (gamma * dt);
         let ca = 1.0 / gamma - 1.0;
         for i in 0..n {
             self.tmp[i] = cv * self.v[i] + ca * self.a[i];
+        }
+        if self.mass_kind != MassKind::Consistent || !self.shared_pattern {
+            spmv(&self.dynamics.stiffness, &self.r_new, &mut self.b);
         }
         match self.mass_kind {
             MassKind::Lumped => {
@@ -683,6 +719,14 @@ impl Integrator {
                         self.load_new[i] - self.b[i] + self.dynamics.lumped_mass[i] * self.tmp[i];
                 }
             }
+            MassKind::Consistent if self.shared_pattern => load_minus_k_plus_m(
+                &self.load_new,
+                &self.dynamics.stiffness,
+                &self.r_new,
+                &self.mass_matrix,
+                &self.tmp,
+                &mut self.b,
+            ),
             MassKind::Consistent => {
                 let b = std::mem::take(&mut self.b);
                 spmv(&self.mass_matrix, &self.tmp, &mut self.v_new);
@@ -725,10 +769,7 @@ impl Integrator {
         }
         self.commit(t_new, step_number, iterations);
 
-        let v = std::mem::take(&mut self.v);
-        let kinetic = 0.5 * self.mass_product(&v);
-        self.v = v;
-        let strain = 0.5 * quadratic_form(&self.dynamics.stiffness, &self.r);
+        let (kinetic, strain) = self.kinetic_and_strain();
         let load_dot = dot(&self.r, &self.load);
         Ok(self.close_step(
             [kinetic, strain, work, dissipated, load_dot],
