@@ -426,9 +426,9 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     let (matrix, factor) = if explicit {
         (i.explicit_matrix_bytes() as f64, 0.0)
     } else {
-        // K, M and the Schur operator's A₀ (each a CSR with its own
-        // pattern), the factor's values.
-        (3.0 * csr, 8.0 * i.factor_len() as f64)
+        // K and M (each a CSR with its own pattern), A₀'s values while it
+        // is factorized (on K's pattern), the factor's values.
+        (2.0 * csr + 8.0 * nnz as f64, 8.0 * i.factor_len() as f64)
     };
     let need = matrix + factor + vectors;
     let memory = format!(
