@@ -81,6 +81,18 @@ fn as_csc<'a>(a: &'a CsrMatrix<f64>, values: &'a [f64]) -> SparseColMatRef<'a, u
     SparseColMatRef::new(sym, values)
 }
 
+/// S is symmetric in exact arithmetic; make it so in floating point so that
+/// the dense Cholesky sees one matrix.
+fn symmetrize(s: &mut [f64], n_c: usize) {
+    for j in 0..n_c {
+        for i in 0..j {
+            let m = 0.5 * (s[j * n_c + i] + s[i * n_c + j]);
+            s[j * n_c + i] = m;
+            s[i * n_c + j] = m;
+        }
+    }
+}
+
 /// One Δt's factor of A₀ and its Schur data.
 struct Entry {
     dt_bits: u64,
@@ -346,6 +358,23 @@ impl SchurOperator {
         }
         if store {
             entry.z.resize(n * n_c, 0.0);
+        } else {
+            // S alone: solves restricted to the contact DOFs' paths, eight
+            // columns per pass (`Supernodal::schur_complement`).
+            let rows: Vec<Vec<(usize, f64)>> = self
+                .nodes
+                .iter()
+                .map(|node| {
+                    node.dofs
+                        .iter()
+                        .zip(node.tangent)
+                        .filter_map(|(d, t)| d.map(|i| (self.perm[i], t)))
+                        .collect()
+                })
+                .collect();
+            entry.s = self.sn.schur_complement(&entry.l_values, &rows);
+            symmetrize(&mut entry.s, n_c);
+            return;
         }
         let llt = LltRef::<'_, usize, f64>::new(&self.symbolic, &entry.l_values);
         let width = BLOCK.min(n_c);
@@ -383,16 +412,7 @@ impl SchurOperator {
                     Par::Seq,
                     MemStack::new(scratch),
                 );
-                if store {
-                    out.push((start, x.to_vec()));
-                } else {
-                    // Only P Z is kept: n_c values per column.
-                    let s: Vec<f64> = x
-                        .chunks_exact(n)
-                        .flat_map(|col| nodes.iter().map(|node| node.tangential(col)))
-                        .collect();
-                    out.push((start, s));
-                }
+                out.push((start, x.to_vec()));
             }
             out
         };
@@ -404,26 +424,14 @@ impl SchurOperator {
             let cols = width.min(n_c - start);
             for c in 0..cols {
                 let j = start + c;
-                if store {
-                    let col = &data[c * n..(c + 1) * n];
-                    for (i, node) in nodes.iter().enumerate() {
-                        entry.s[j * n_c + i] = node.tangential(col);
-                    }
-                    entry.z[j * n..(j + 1) * n].copy_from_slice(col);
-                } else {
-                    entry.s[j * n_c..(j + 1) * n_c].copy_from_slice(&data[c * n_c..(c + 1) * n_c]);
+                let col = &data[c * n..(c + 1) * n];
+                for (i, node) in nodes.iter().enumerate() {
+                    entry.s[j * n_c + i] = node.tangential(col);
                 }
+                entry.z[j * n..(j + 1) * n].copy_from_slice(col);
             }
         }
-        // S is symmetric in exact arithmetic; make it so in floating point
-        // so that the dense Cholesky sees one matrix.
-        for j in 0..n_c {
-            for i in 0..j {
-                let m = 0.5 * (entry.s[j * n_c + i] + entry.s[i * n_c + j]);
-                entry.s[j * n_c + i] = m;
-                entry.s[i * n_c + j] = m;
-            }
-        }
+        symmetrize(&mut entry.s, n_c);
     }
 
     fn solve(&mut self, x: &mut [f64]) {
