@@ -39,7 +39,7 @@ pub use loads::{
 };
 pub use material::{Hypothesis, Material};
 pub use model::Model;
-pub use solver::{SolverError, SparseCholesky};
+pub use solver::{csc_view, SolverError, SparseCholesky};
 pub use statics::{gauss_point_stresses, nodal_stresses, static_solve, GaussPointStress};
 pub use supernodal::Supernodal;
 

@@ -80,9 +80,11 @@ impl std::fmt::Debug for SparseCholesky {
     }
 }
 
-/// A symmetric CSR matrix is its own CSC transpose: its row offsets and
-/// column indices read as column pointers and row indices of the same matrix.
-fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
+/// `values` on `a`'s pattern as a faer CSC matrix: a symmetric CSR matrix
+/// is its own CSC transpose (its row offsets and column indices read as
+/// column pointers and row indices of the same matrix), and K, M and
+/// a·K + b·M share one pattern, so one pattern serves every combination.
+pub fn csc_view<'a>(a: &'a CsrMatrix<f64>, values: &'a [f64]) -> SparseColMatRef<'a, usize, f64> {
     let sym = SymbolicSparseColMatRef::new_checked(
         a.nrows(),
         a.ncols(),
@@ -90,7 +92,11 @@ fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
         None,
         a.col_indices(),
     );
-    SparseColMatRef::new(sym, a.values())
+    SparseColMatRef::new(sym, values)
+}
+
+fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
+    csc_view(a, a.values())
 }
 
 impl SparseCholesky {

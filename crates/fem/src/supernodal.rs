@@ -573,20 +573,10 @@ impl Supernodal {
 
     /// The forward solve L y = x over the plan's supernodes, in place.
     fn forward(&mut self, l: &[f64], reach: bool, x: &mut [f64]) {
-        let plan = if reach { &self.reach } else { &self.full };
         if !self.full.bins[0].is_empty() {
-            let mut scratch = std::mem::take(&mut self.scratch);
-            let (s0, s1) = scratch.split_at_mut(1);
-            let shared = &*x;
-            rayon::join(
-                || self.bin_forward(0, l, &plan.bins[0], shared, &mut s0[0]),
-                || self.bin_forward(1, l, &plan.bins[1], shared, &mut s1[0]),
-            );
-            for (b, sc) in scratch.iter().enumerate() {
-                for (&c, v) in self.bin_cols[b].iter().zip(&sc.x) {
-                    x[c as usize] = *v;
-                }
-            }
+            let scratch = self.run_bins(reach, x, |me, b, list, x, sc| {
+                me.bin_forward(b, l, list, x, sc)
+            });
             for (&c, (a0, a1)) in self
                 .top_cols
                 .iter()
@@ -612,6 +602,29 @@ impl Supernodal {
                 x[r as usize] -= t;
             }
         }
+    }
+
+    /// Runs `work` on the two groups at once (each on its own copy of its
+    /// columns, reading `x`), then writes the groups' columns back; returns
+    /// the scratch (the forward solve still needs its sums for the top).
+    fn run_bins<F>(&mut self, reach: bool, x: &mut [f64], work: F) -> [BinScratch; 2]
+    where
+        F: Fn(&Self, usize, &[u32], &[f64], &mut BinScratch) + Sync,
+    {
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let plan = if reach { &self.reach } else { &self.full };
+        let (s0, s1) = scratch.split_at_mut(1);
+        let shared = &*x;
+        rayon::join(
+            || work(self, 0, &plan.bins[0], shared, &mut s0[0]),
+            || work(self, 1, &plan.bins[1], shared, &mut s1[0]),
+        );
+        for (b, sc) in scratch.iter().enumerate() {
+            for (&c, v) in self.bin_cols[b].iter().zip(&sc.x) {
+                x[c as usize] = *v;
+            }
+        }
+        scratch
     }
 
     /// One group's forward solve on its own copy of its columns; pushes
@@ -662,19 +675,9 @@ impl Supernodal {
             );
         }
         if !self.full.bins[0].is_empty() {
-            let mut scratch = std::mem::take(&mut self.scratch);
-            let (s0, s1) = scratch.split_at_mut(1);
-            let shared = &*x;
-            rayon::join(
-                || self.bin_backward(0, l, &plan.bins[0], shared, &mut s0[0]),
-                || self.bin_backward(1, l, &plan.bins[1], shared, &mut s1[0]),
-            );
-            for (b, sc) in scratch.iter().enumerate() {
-                for (&c, v) in self.bin_cols[b].iter().zip(&sc.x) {
-                    x[c as usize] = *v;
-                }
-            }
-            self.scratch = scratch;
+            self.scratch = self.run_bins(reach, x, |me, b, list, x, sc| {
+                me.bin_backward(b, l, list, x, sc)
+            });
         }
     }
 
@@ -794,7 +797,7 @@ mod tests {
         factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymmetricOrdering,
     };
     use faer::sparse::linalg::SupernodalThreshold;
-    use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+    use faer::sparse::SparseColMatRef;
     use faer::{Conj, MatMut, Par, Side, Spec};
     use nalgebra_sparse::CsrMatrix;
     use stickslip_mesh::CellKind;
@@ -808,14 +811,7 @@ mod tests {
     }
 
     fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
-        let sym = SymbolicSparseColMatRef::new_checked(
-            a.nrows(),
-            a.ncols(),
-            a.row_offsets(),
-            None,
-            a.col_indices(),
-        );
-        SparseColMatRef::new(sym, a.values())
+        crate::csc_view(a, a.values())
     }
 
     struct Factor {

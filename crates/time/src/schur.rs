@@ -35,11 +35,10 @@ use faer::sparse::linalg::cholesky::{
     SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, MatRef, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{ContactNode, ContactSurface, SlipState, StepSystem};
-use stickslip_fem::SolverError;
+use stickslip_fem::{csc_view, SolverError};
 
 use stickslip_fem::Supernodal;
 
@@ -66,19 +65,6 @@ pub enum ImplicitSolver {
     /// A₀ + C refactorized whenever Δt or the stuck set changes, the
     /// iteration on the full system (the reference).
     Direct,
-}
-
-/// `values` on `a`'s pattern as a CSC matrix (symmetric: the CSR arrays
-/// read as the CSC arrays of the same matrix).
-fn as_csc<'a>(a: &'a CsrMatrix<f64>, values: &'a [f64]) -> SparseColMatRef<'a, usize, f64> {
-    let sym = SymbolicSparseColMatRef::new_checked(
-        a.nrows(),
-        a.ncols(),
-        a.row_offsets(),
-        None,
-        a.col_indices(),
-    );
-    SparseColMatRef::new(sym, values)
 }
 
 /// S is symmetric in exact arithmetic; make it so in floating point so that
@@ -165,7 +151,7 @@ impl SchurOperator {
             });
         }
         let symbolic = factorize_symbolic_cholesky(
-            as_csc(stiffness, stiffness.values()).symbolic(),
+            csc_view(stiffness, stiffness.values()).symbolic(),
             Side::Lower,
             SymmetricOrdering::Amd,
             // Supernodal whatever the size: `supernodal.rs` solves on its layout.
@@ -313,7 +299,7 @@ impl SchurOperator {
         entry.dt_bits = u64::MAX; // invalid until factorized
         let result = self.symbolic.factorize_numeric_llt(
             &mut entry.l_values,
-            as_csc(stiffness, &a0),
+            csc_view(stiffness, &a0),
             Side::Lower,
             Default::default(),
             Par::Seq,
