@@ -444,8 +444,9 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         // ṙ, r̈ and writes ṙ_K, r̈_K (9). 17 vectors of n f64.
         let bytes = i.explicit_matrix_bytes() as f64 + 17.0 * 8.0 * n as f64;
         let bw = pool.install(stream_triad);
+        let (dict, blocks) = i.explicit_dictionary().unwrap_or((0, 0));
         format!(
-            "bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
+            "dict_blocks={dict} of_blocks={blocks} bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
             bytes / per_step.0,
             100.0 * bytes / per_step.0 / bw
         )

@@ -1356,6 +1356,13 @@ impl Integrator {
         }
     }
 
+    /// (distinct blocks, stored blocks) of K's compact form when its values
+    /// are a dictionary (`kernels.rs`), `None` otherwise.
+    pub fn explicit_dictionary(&self) -> Option<(usize, usize)> {
+        let k = self.compact.as_ref()?;
+        (k.dictionary_len() > 0).then(|| (k.dictionary_len(), k.blocks()))
+    }
+
     /// How implicit steps solve their linear systems.
     pub fn implicit_solver(&self) -> ImplicitSolver {
         self.solver

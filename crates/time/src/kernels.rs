@@ -54,6 +54,16 @@
 //! kept for its 7 fewer vector streams. On one thread the compact K·x
 //! costs about 2.8 ns per 2×2 block whatever the bytes: the gain is in the
 //! two-thread, memory-bound case this machine runs.
+//!
+//! The block values go into a dictionary of the distinct blocks (exact
+//! bits) with a 2- or 4-byte index per block when that halves the matrix
+//! stream ([`Compact::new`]). Distinct blocks measured (2026-11-22): Q1
+//! slabs 128×32: 10,024 of 37,338 blocks, 708×177: 101,880 of 1,130,778,
+//! 1416×354: 211,770 of 4,517,896 (matrix stream 167 → 47 MB, the 6.8 MB
+//! dictionary read from cache); the Q2 slabs and the unstructured meshes
+//! have too many distinct blocks and keep them stored. Explicit step on
+//! the 1416×354 Q1 rung, bench_step, 3 interleaved runs, load 2.2-2.8:
+//! stored 24.8 ms, dictionary 11.9 ms (best runs).
 
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
@@ -308,17 +318,182 @@ pub struct Compact {
     group_blocks: Vec<u32>,
     /// First column of each block.
     cols: Vec<u32>,
-    /// [row 0 · col 0, row 0 · col 1, row 1 · col 0, row 1 · col 1].
-    vals: Vec<[f64; 4]>,
+    /// The blocks' values, stored or by dictionary.
+    values: Values,
     /// Groups of chunk c: chunk_groups[c]..chunk_groups[c + 1].
     chunk_groups: Vec<u32>,
+}
+
+/// The values of the blocks, [row 0 · col 0, row 0 · col 1, row 1 · col 0,
+/// row 1 · col 1] each: stored per block, or as an index per block into a
+/// dictionary of the distinct blocks (bit for bit: no tolerance, so a
+/// block read from the dictionary has the bits of the stored one).
+#[derive(Clone, Debug)]
+enum Values {
+    /// 32 bytes per block.
+    Stored(Vec<[f64; 4]>),
+    /// 2 bytes per block and the dictionary (≤ 65,536 distinct blocks).
+    Dict16 { ids: Vec<u16>, dict: Vec<[f64; 4]> },
+    /// 4 bytes per block and the dictionary.
+    Dict32 { ids: Vec<u32>, dict: Vec<[f64; 4]> },
+}
+
+/// Which form [`Compact::with_form`] builds (the step uses `Auto`; the
+/// tests and the lab force the others).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(not(test), allow(dead_code))]
+pub enum Form {
+    /// The dictionary when it cuts the matrix stream by ≥ 2× (see
+    /// [`Compact::new`]).
+    Auto,
+    /// Values stored per block.
+    Stored,
+    /// The dictionary whatever it saves.
+    Dictionary,
+}
+
+/// Block values as the kernels read them: a slice of per-block entries
+/// (`ids`) and how an entry gives its block.
+trait Blocks: Sync {
+    type Id: Sync;
+    fn ids(&self) -> &[Self::Id];
+    fn value<'a>(&'a self, id: &'a Self::Id) -> &'a [f64; 4];
+}
+
+struct StoredBlocks<'a>(&'a [[f64; 4]]);
+
+impl Blocks for StoredBlocks<'_> {
+    type Id = [f64; 4];
+    #[inline(always)]
+    fn ids(&self) -> &[[f64; 4]] {
+        self.0
+    }
+    #[inline(always)]
+    fn value<'a>(&'a self, id: &'a [f64; 4]) -> &'a [f64; 4] {
+        id
+    }
+}
+
+struct DictBlocks<'a, I> {
+    ids: &'a [I],
+    dict: &'a [[f64; 4]],
+}
+
+impl<I: Copy + Into<u32> + Sync> Blocks for DictBlocks<'_, I> {
+    type Id = I;
+    #[inline(always)]
+    fn ids(&self) -> &[I] {
+        self.ids
+    }
+    #[inline(always)]
+    fn value<'a>(&'a self, id: &'a I) -> &'a [f64; 4] {
+        let k: u32 = (*id).into();
+        &self.dict[k as usize]
+    }
+}
+
+/// A kernel over the block values in whichever form they are
+/// ([`Compact::with_blocks`]: one match per call, the loops monomorphic).
+trait Kernel<R> {
+    fn run<B: Blocks>(self, k: &Compact, b: &B) -> R;
+}
+
+/// One 2×2 block's contribution to a group's two sums, each in the CSR's
+/// order (column c, then c + 1).
+#[inline(always)]
+fn block(col: u32, v: &[f64; 4], x: &[f64], s: &mut [f64; 2]) {
+    let c = col as usize;
+    let xs = &x[c..c + 2];
+    s[0] += v[0] * xs[0];
+    s[0] += v[1] * xs[1];
+    s[1] += v[2] * xs[0];
+    s[1] += v[3] * xs[1];
+}
+
+impl Values {
+    fn bytes(&self) -> usize {
+        match self {
+            Values::Stored(v) => 32 * v.len(),
+            Values::Dict16 { ids, dict } => 2 * ids.len() + 32 * dict.len(),
+            Values::Dict32 { ids, dict } => 4 * ids.len() + 32 * dict.len(),
+        }
+    }
+}
+
+/// The dictionary of distinct blocks (equal bits, in order of first
+/// appearance) and each block's index into it; `None` as soon as it would
+/// hold more than `max` blocks.
+fn dictionary(blocks: &[[f64; 4]], max: usize) -> Option<Values> {
+    let mut index: std::collections::HashMap<[u64; 4], u32, BlockHash> =
+        std::collections::HashMap::with_capacity_and_hasher(max.min(blocks.len()) / 4, BlockHash);
+    let mut dict = Vec::new();
+    let mut ids = Vec::with_capacity(blocks.len());
+    for b in blocks {
+        let next = dict.len() as u32;
+        let id = *index.entry(b.map(f64::to_bits)).or_insert(next);
+        if id == next {
+            if dict.len() == max {
+                return None;
+            }
+            dict.push(*b);
+        }
+        ids.push(id);
+    }
+    dict.shrink_to_fit();
+    Some(if dict.len() <= 1 << 16 {
+        Values::Dict16 {
+            ids: ids.iter().map(|&k| k as u16).collect(),
+            dict,
+        }
+    } else {
+        Values::Dict32 { ids, dict }
+    })
+}
+
+/// A multiply-xor hash of a block's bits (SipHash, the default, made the
+/// dictionary of a 1M-DOF Q2 matrix take seconds; no adversary here).
+#[derive(Clone, Copy, Default)]
+struct BlockHash;
+
+impl std::hash::BuildHasher for BlockHash {
+    type Hasher = BlockHasher;
+    fn build_hasher(&self) -> BlockHasher {
+        BlockHasher(0)
+    }
+}
+
+struct BlockHasher(u64);
+
+impl std::hash::Hasher for BlockHasher {
+    fn finish(&self) -> u64 {
+        self.0 ^ (self.0 >> 29)
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for c in bytes.chunks(8) {
+            let mut w = [0u8; 8];
+            w[..c.len()].copy_from_slice(c);
+            self.write_u64(u64::from_le_bytes(w));
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(23) ^ x).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
 }
 
 impl Compact {
     /// The compact form of a square CSR matrix with sorted columns, or
     /// `None` when it does not apply (fewer than 2 rows, more than u32
-    /// indices can address).
+    /// indices can address). The block values go into a dictionary when
+    /// that cuts the bytes the SpMV streams from the matrix by ≥ 2×
+    /// (structured meshes: few distinct blocks), else they are stored per
+    /// block (unstructured meshes: nearly every block distinct, and a
+    /// dictionary would add an index per block and a scattered read).
     pub fn new(a: &CsrMatrix<f64>) -> Option<Compact> {
+        Compact::with_form(a, Form::Auto)
+    }
+
+    /// [`Compact::new`] with the form of the values chosen by the caller.
+    pub fn with_form(a: &CsrMatrix<f64>, form: Form) -> Option<Compact> {
         let n = a.nrows();
         let offsets = a.row_offsets();
         let cols = a.col_indices();
@@ -387,68 +562,123 @@ impl Compact {
         }
         block_cols.shrink_to_fit();
         block_vals.shrink_to_fit();
-        Some(Compact {
+        let mut compact = Compact {
             group_rows,
             group_blocks,
             cols: block_cols,
-            vals: block_vals,
+            values: Values::Stored(Vec::new()),
             chunk_groups,
-        })
+        };
+        compact.values = match form {
+            Form::Stored => Values::Stored(block_vals),
+            Form::Dictionary => dictionary(&block_vals, usize::MAX).expect("no limit"),
+            Form::Auto => {
+                // The largest dictionary that can halve the stream (with
+                // 2-byte indices, the least it can cost per block); the
+                // build stops there, so a mesh with nearly all blocks
+                // distinct pays for a fraction of it.
+                let blocks = block_vals.len();
+                let stored = compact.bytes_with(32 * blocks);
+                let max = (stored / 2).saturating_sub(compact.bytes_with(2 * blocks)) / 32;
+                match dictionary(&block_vals, max) {
+                    Some(values) if 2 * compact.bytes_with(values.bytes()) <= stored => values,
+                    _ => Values::Stored(block_vals),
+                }
+            }
+        };
+        Some(compact)
     }
 
-    /// Bytes the SpMV streams from the matrix.
+    /// Bytes the SpMV streams from the matrix: block columns, group
+    /// offsets and the values (a dictionary counted once: it stays in
+    /// cache over a step).
     pub fn bytes(&self) -> usize {
-        36 * self.cols.len() + 4 * (self.group_rows.len() + self.group_blocks.len())
+        self.bytes_with(self.values.bytes())
+    }
+
+    fn bytes_with(&self, values: usize) -> usize {
+        4 * (self.cols.len() + self.group_rows.len() + self.group_blocks.len()) + values
+    }
+
+    /// Distinct blocks in the dictionary (0 when the values are stored).
+    pub fn dictionary_len(&self) -> usize {
+        match &self.values {
+            Values::Stored(_) => 0,
+            Values::Dict16 { dict, .. } | Values::Dict32 { dict, .. } => dict.len(),
+        }
+    }
+
+    /// Stored blocks.
+    pub fn blocks(&self) -> usize {
+        self.cols.len()
+    }
+
+    /// Runs `k` with the block values in their form.
+    #[inline(always)]
+    fn with_blocks<R>(&self, k: impl Kernel<R>) -> R {
+        match &self.values {
+            Values::Stored(v) => k.run(self, &StoredBlocks(v)),
+            Values::Dict16 { ids, dict } => k.run(self, &DictBlocks { ids, dict }),
+            Values::Dict32 { ids, dict } => k.run(self, &DictBlocks { ids, dict }),
+        }
     }
 
     /// The sums of group g's rows (the second is 0 for a single row).
-    #[inline]
-    fn group_sums(&self, g: usize, x: &[f64]) -> (f64, f64) {
+    #[inline(always)]
+    fn group_sums_in<B: Blocks>(&self, b: &B, g: usize, x: &[f64]) -> [f64; 2] {
         let blocks = self.group_blocks[g] as usize..self.group_blocks[g + 1] as usize;
-        let (mut s0, mut s1) = (0.0, 0.0);
-        for (&col, v) in self.cols[blocks.clone()].iter().zip(&self.vals[blocks]) {
-            let c = col as usize;
-            let xs = &x[c..c + 2];
-            s0 += v[0] * xs[0];
-            s0 += v[1] * xs[1];
-            s1 += v[2] * xs[0];
-            s1 += v[3] * xs[1];
+        let mut s = [0.0; 2];
+        for (&col, v) in self.cols[blocks.clone()].iter().zip(&b.ids()[blocks]) {
+            block(col, b.value(v), x, &mut s);
         }
-        (s0, s1)
+        s
     }
 
     /// (K x)_i alone, with the bits the passes give it.
     pub fn row(&self, i: usize, x: &[f64]) -> f64 {
-        let g = self.group_rows.partition_point(|&r| r as usize <= i) - 1;
-        let (s0, s1) = self.group_sums(g, x);
-        if i == self.group_rows[g] as usize {
-            s0
-        } else {
-            s1
+        struct Row<'x>(usize, &'x [f64]);
+        impl Kernel<f64> for Row<'_> {
+            fn run<B: Blocks>(self, k: &Compact, b: &B) -> f64 {
+                let Row(i, x) = self;
+                let g = k.group_rows.partition_point(|&r| r as usize <= i) - 1;
+                let s = k.group_sums_in(b, g, x);
+                if i == k.group_rows[g] as usize {
+                    s[0]
+                } else {
+                    s[1]
+                }
+            }
         }
+        self.with_blocks(Row(i, x))
     }
 
     /// Calls `f(row, (K x)_row)` for every row of chunk `c`, in row order.
+    #[inline]
+    fn chunk_rows(&self, c: usize, x: &[f64], f: impl FnMut(usize, f64)) {
+        struct Rows<'x, F>(usize, &'x [f64], F);
+        impl<F: FnMut(usize, f64)> Kernel<()> for Rows<'_, F> {
+            #[inline(always)]
+            fn run<B: Blocks>(self, k: &Compact, b: &B) {
+                let Rows(c, x, f) = self;
+                k.chunk_rows_in(b, c, x, f)
+            }
+        }
+        self.with_blocks(Rows(c, x, f))
+    }
+
+    /// [`Compact::chunk_rows`] with the values in form `B`.
     ///
     /// Two groups are summed in lockstep: a row's sum is a chain of
     /// dependent additions in a fixed order (the CSR's, for the bits), so
     /// one group alone leaves the core waiting on the adder's latency; two
     /// give it four independent chains, each still in its own order.
-    #[inline]
-    fn chunk_rows(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, f64)) {
+    #[inline(always)]
+    fn chunk_rows_in<B: Blocks>(&self, b: &B, c: usize, x: &[f64], mut f: impl FnMut(usize, f64)) {
         let (g0, g1) = (
             self.chunk_groups[c] as usize,
             self.chunk_groups[c + 1] as usize,
         );
-        #[inline(always)]
-        fn block(col: u32, v: &[f64; 4], x: &[f64], s: &mut [f64; 2]) {
-            let c = col as usize;
-            let xs = &x[c..c + 2];
-            s[0] += v[0] * xs[0];
-            s[0] += v[1] * xs[1];
-            s[1] += v[2] * xs[0];
-            s[1] += v[3] * xs[1];
-        }
+        let ids = b.ids();
         let mut emit = |g: usize, s: [f64; 2]| {
             let r0 = self.group_rows[g] as usize;
             f(r0, s[0]);
@@ -464,8 +694,8 @@ impl Compact {
             );
             let b1 = self.group_blocks[g + 2] as usize;
             let (mut sa, mut sb) = ([0.0; 2], [0.0; 2]);
-            let (ca, va) = (&self.cols[a0..a1], &self.vals[a0..a1]);
-            let (cb, vb) = (&self.cols[a1..b1], &self.vals[a1..b1]);
+            let (ca, va) = (&self.cols[a0..a1], &ids[a0..a1]);
+            let (cb, vb) = (&self.cols[a1..b1], &ids[a1..b1]);
             let common = ca.len().min(cb.len());
             for (((ca, va), cb), vb) in ca[..common]
                 .iter()
@@ -473,22 +703,22 @@ impl Compact {
                 .zip(&cb[..common])
                 .zip(&vb[..common])
             {
-                block(*ca, va, x, &mut sa);
-                block(*cb, vb, x, &mut sb);
+                block(*ca, b.value(va), x, &mut sa);
+                block(*cb, b.value(vb), x, &mut sb);
             }
             for (c, v) in ca[common..].iter().zip(&va[common..]) {
-                block(*c, v, x, &mut sa);
+                block(*c, b.value(v), x, &mut sa);
             }
             for (c, v) in cb[common..].iter().zip(&vb[common..]) {
-                block(*c, v, x, &mut sb);
+                block(*c, b.value(v), x, &mut sb);
             }
             emit(g, sa);
             emit(g + 1, sb);
             g += 2;
         }
         if g < g1 {
-            let (s0, s1) = self.group_sums(g, x);
-            emit(g, [s0, s1]);
+            let s = self.group_sums_in(b, g, x);
+            emit(g, s);
         }
     }
 
@@ -701,18 +931,32 @@ mod tests {
                 let model = Model::new(&mesh, &material, conditions).unwrap();
                 for k in [&model.stiffness, &model.mass] {
                     let n = k.nrows();
-                    let compact = Compact::new(k).expect("applies");
                     let x = x_of(n);
-                    let (mut y0, mut y1) = (vec![0.0; n], vec![1.0; n]);
+                    let mut y0 = vec![0.0; n];
                     spmv(k, &x, &mut y0);
-                    compact.spmv(&x, &mut y1);
-                    for i in 0..n {
-                        assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "{name} row {i}");
+                    for form in [Form::Stored, Form::Dictionary, Form::Auto] {
+                        let compact = Compact::with_form(k, form).expect("applies");
+                        let mut y1 = vec![1.0; n];
+                        compact.spmv(&x, &mut y1);
+                        for i in 0..n {
+                            assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "{name} {form:?} row {i}");
+                            assert_eq!(
+                                y0[i].to_bits(),
+                                compact.row(i, &x).to_bits(),
+                                "{name} {form:?} row {i} alone"
+                            );
+                        }
+                        // A Q1 / Q2 node's two rows are one pair (the blocks
+                        // are at most 4/3 of the CSR's entries, the padding
+                        // is only at constrained nodes and chunk seams).
+                        assert!(3 * compact.cols.len() <= k.nnz(), "{name}");
+                        let dict = compact.dictionary_len();
+                        match form {
+                            Form::Stored => assert_eq!(dict, 0),
+                            Form::Dictionary => assert!(dict > 0 && dict <= compact.blocks()),
+                            Form::Auto => {}
+                        }
                     }
-                    // A Q1 / Q2 node's two rows are one pair (the blocks
-                    // are at most 4/3 of the CSR's entries, the padding
-                    // is only at constrained nodes and chunk seams).
-                    assert!(3 * compact.cols.len() <= k.nnz(), "{name}");
                 }
             }
         }
@@ -735,7 +979,11 @@ mod tests {
         let k = &model.stiffness;
         let n = k.nrows();
         assert!(chunks(n) >= 2, "{n} DOFs: one chunk");
-        let compact = Compact::new(k).unwrap();
+        let forms = [
+            Compact::with_form(k, Form::Stored).unwrap(),
+            Compact::with_form(k, Form::Dictionary).unwrap(),
+        ];
+        assert!(forms[1].dictionary_len() > 0);
         let vec =
             |shift: f64| -> Vec<f64> { x_of(n).iter().map(|x| x * shift + 0.1 * shift).collect() };
         let (r, r_new, v, a) = (vec(1.0), vec(1.1), vec(-0.7), vec(3.0));
@@ -760,7 +1008,10 @@ mod tests {
             .filter(|i| i % 97 == 0 || i % CHUNK == 0 || i % CHUNK == CHUNK - 1)
             .map(|i| (i, -0.25 * i as f64))
             .collect();
-        for threads in [1, 2] {
+        for (threads, compact) in [1, 2]
+            .into_iter()
+            .flat_map(|t| forms.iter().map(move |c| (t, c)))
+        {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
@@ -793,7 +1044,7 @@ mod tests {
                 let mut p1 = partials(n);
                 let (mut vn1, mut an1) = (vec![0.0; n], vec![0.0; n]);
                 let (strain1, sums1) =
-                    fused_step(&compact, &data, &friction, &mut vn1, &mut an1, &mut p1);
+                    fused_step(compact, &data, &friction, &mut vn1, &mut an1, &mut p1);
                 assert_eq!(strain0.to_bits(), strain1.to_bits(), "{threads}: strain");
                 for (x, y) in [
                     (sums0.work, sums1.work),
@@ -840,7 +1091,13 @@ mod tests {
                     let (i, j) = (free[2 * p + a], free[2 * q + b]);
                     if i != usize::MAX && j != usize::MAX {
                         let v = if q == p + 1 && a == b {
-                            0.0
+                            // Explicit zeros of both signs: distinct bits,
+                            // distinct dictionary entries.
+                            if p % 2 == 0 {
+                                0.0
+                            } else {
+                                -0.0
+                            }
                         } else {
                             ((i * 31 + j * 17) % 101) as f64 - 50.0
                         };
@@ -850,17 +1107,20 @@ mod tests {
             }
         }
         let k = CsrMatrix::from(&coo);
-        let compact = Compact::new(&k).unwrap();
-        let pairs = (0..compact.group_rows.len() - 1)
-            .filter(|&g| compact.group_rows[g + 1] - compact.group_rows[g] == 2)
-            .count();
-        assert!(pairs > n / 2 - 100, "{pairs} pairs of {n} rows");
         let x = x_of(n);
-        let (mut y0, mut y1) = (vec![0.0; n], vec![1.0; n]);
+        let mut y0 = vec![0.0; n];
         spmv(&k, &x, &mut y0);
-        compact.spmv(&x, &mut y1);
-        for i in 0..n {
-            assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "row {i}");
+        for form in [Form::Stored, Form::Dictionary] {
+            let compact = Compact::with_form(&k, form).unwrap();
+            let pairs = (0..compact.group_rows.len() - 1)
+                .filter(|&g| compact.group_rows[g + 1] - compact.group_rows[g] == 2)
+                .count();
+            assert!(pairs > n / 2 - 100, "{pairs} pairs of {n} rows");
+            let mut y1 = vec![1.0; n];
+            compact.spmv(&x, &mut y1);
+            for i in 0..n {
+                assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "{form:?} row {i}");
+            }
         }
     }
 
