@@ -68,12 +68,12 @@
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
 
-use crate::integrator::Load;
-
 /// DOFs per chunk of work.
 pub const CHUNK: usize = 8192;
 /// Chunks from which the passes go parallel.
 pub const PARALLEL_MIN: usize = 2;
+/// Rows per batch of the one-sweep step ([`Compact::chunk_batches`]).
+pub const BATCH: usize = 256;
 
 /// Number of chunks of a vector of length n.
 pub fn chunks(n: usize) -> usize {
@@ -125,48 +125,108 @@ fn total(partials: &[[f64; 5]], k: usize) -> f64 {
     partials.iter().map(|p| p[k]).sum()
 }
 
-/// Pass A: R_K = constant + Σ θ_l load_l into `load_new`, and the
-/// predictor r_K = r + c1 ṙ + c2 r̈ into `r_new`.
+/// The loads on the rows where the constant load or any load vector is
+/// nonzero (bit for bit: a −0 counts) — tractions act on a boundary, so a
+/// few rows. Elsewhere R_K = +0 + Σ θ_l·(+0) = +0 exactly for finite θ_l,
+/// and the step's pass A leaves those rows of R_K untouched.
+#[derive(Clone, Debug)]
+pub struct SparseLoads {
+    /// Rows, ascending.
+    rows: Vec<usize>,
+    /// The constant load on them.
+    constant: Vec<f64>,
+    /// Each load vector on them.
+    loads: Vec<Vec<f64>>,
+}
+
+impl SparseLoads {
+    /// The loads `constant` and `loads` (vectors of one length) on their
+    /// nonzero rows.
+    pub fn new(constant: &[f64], loads: &[&[f64]]) -> SparseLoads {
+        let rows: Vec<usize> = (0..constant.len())
+            .filter(|&i| constant[i].to_bits() != 0 || loads.iter().any(|l| l[i].to_bits() != 0))
+            .collect();
+        SparseLoads {
+            constant: rows.iter().map(|&i| constant[i]).collect(),
+            loads: loads
+                .iter()
+                .map(|l| rows.iter().map(|&i| l[i]).collect())
+                .collect(),
+            rows,
+        }
+    }
+
+    /// The rows, ascending.
+    pub fn rows(&self) -> &[usize] {
+        &self.rows
+    }
+
+    /// Bytes a step moves for them: the row indices and the loads read,
+    /// R_K written, R_{K−1}, r and r_K read at those rows (pass A's sums).
+    pub fn bytes(&self) -> usize {
+        self.rows.len() * (8 + 8 * (1 + self.loads.len()) + 8 * 4)
+    }
+}
+
+/// Pass A: the predictor r_K = r + c1 ṙ + c2 r̈ into `r_new` (every row),
+/// R_K = constant + Σ θ_l load_l into `load_new` at the loads' rows only
+/// (its other rows must hold +0: [`SparseLoads`]), and per chunk the sums
+/// work = Σ ½(R_K + R_{K−1})(r_K − r_{K−1}) and r_K·R_K over those rows
+/// into `partials[c][0]` and `[2]`. Every θ_l must be finite.
+///
+/// The per-entry arithmetic and per-chunk order of [`accelerate_and_sum`]'s
+/// sums: a row off the loads adds ½(+0)(r_K − r) = ±0, and a sum that
+/// starts at +0 is never −0 (x + (−x) = +0), so s ± 0 = s and leaving those
+/// rows out gives the same bits (for finite r_K − r; a non-finite r_K
+/// fails the step either way).
 #[allow(clippy::too_many_arguments)]
-pub fn load_and_predict(
-    constant: &[f64],
-    loads: &[Load],
+pub fn predict(
+    sparse: &SparseLoads,
     thetas: &[f64],
     r: &[f64],
     v: &[f64],
     a: &[f64],
     c1: f64,
     c2: f64,
+    load: &[f64],
     load_new: &mut [f64],
     r_new: &mut [f64],
+    partials: &mut Partials,
 ) {
-    let body = |c: usize, l: &mut [f64], rn: &mut [f64]| {
-        let range = c * CHUNK..c * CHUNK + l.len();
-        l.copy_from_slice(&constant[range.clone()]);
-        for (load, theta) in loads.iter().zip(thetas) {
-            if *theta != 0.0 {
-                for (o, f) in l.iter_mut().zip(&load.vector[range.clone()]) {
-                    *o += theta * f;
-                }
-            }
-        }
+    debug_assert!(thetas.iter().all(|t| t.is_finite()));
+    let body = |c: usize, rn: &mut [f64]| {
+        let range = c * CHUNK..c * CHUNK + rn.len();
         let (r, v, a) = (&r[range.clone()], &v[range.clone()], &a[range]);
         for i in 0..rn.len() {
             rn[i] = r[i] + c1 * v[i] + c2 * a[i];
         }
     };
     if parallel(r.len()) {
-        load_new
+        r_new
             .par_chunks_mut(CHUNK)
-            .zip(r_new.par_chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(c, (l, rn))| body(c, l, rn));
+            .for_each(|(c, rn)| body(c, rn));
     } else {
-        load_new
+        r_new
             .chunks_mut(CHUNK)
-            .zip(r_new.chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(c, (l, rn))| body(c, l, rn));
+            .for_each(|(c, rn)| body(c, rn));
+    }
+    for p in partials.iter_mut() {
+        p[0] = 0.0;
+        p[2] = 0.0;
+    }
+    for (k, &i) in sparse.rows.iter().enumerate() {
+        let mut l = sparse.constant[k];
+        for (load, theta) in sparse.loads.iter().zip(thetas) {
+            if *theta != 0.0 {
+                l += theta * load[k];
+            }
+        }
+        load_new[i] = l;
+        let p = &mut partials[i / CHUNK];
+        p[0] += 0.5 * (l + load[i]) * (r_new[i] - r[i]);
+        p[2] += r_new[i] * l;
     }
 }
 
@@ -660,24 +720,57 @@ impl Compact {
             #[inline(always)]
             fn run<B: Blocks>(self, k: &Compact, b: &B) {
                 let Rows(c, x, f) = self;
-                k.chunk_rows_in(b, c, x, f)
+                let (g0, g1) = (k.chunk_groups[c] as usize, k.chunk_groups[c + 1] as usize);
+                k.groups_in(b, g0, g1, x, f)
             }
         }
         self.with_blocks(Rows(c, x, f))
     }
 
-    /// [`Compact::chunk_rows`] with the values in form `B`.
+    /// Calls `f(first row, K x on the batch's rows)` for consecutive
+    /// batches of at most [`BATCH`] rows covering chunk `c`, in order: the
+    /// caller's per-row work then runs in loops over a batch held in L1
+    /// (the divisions of ṙ_K and r̈_K pipelined) instead of once per row
+    /// inside the product's loop.
+    #[inline]
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64])) {
+        struct Batches<'x, F>(usize, &'x [f64], F);
+        impl<F: FnMut(usize, &[f64])> Kernel<()> for Batches<'_, F> {
+            #[inline(always)]
+            fn run<B: Blocks>(self, k: &Compact, b: &B) {
+                let Batches(c, x, mut f) = self;
+                let (g0, g1) = (k.chunk_groups[c] as usize, k.chunk_groups[c + 1] as usize);
+                let mut buf = [0.0; BATCH];
+                let mut g = g0;
+                while g < g1 {
+                    let gb = (g + BATCH / 2).min(g1);
+                    let (ra, rb) = (k.group_rows[g] as usize, k.group_rows[gb] as usize);
+                    let out = &mut buf[..rb - ra];
+                    k.groups_in(b, g, gb, x, |i, s| out[i - ra] = s);
+                    f(ra, out);
+                    g = gb;
+                }
+            }
+        }
+        self.with_blocks(Batches(c, x, f))
+    }
+
+    /// `f(row, (K x)_row)` for the rows of groups g0..g1, in order, with
+    /// the values in form `B`.
     ///
     /// Two groups are summed in lockstep: a row's sum is a chain of
     /// dependent additions in a fixed order (the CSR's, for the bits), so
     /// one group alone leaves the core waiting on the adder's latency; two
     /// give it four independent chains, each still in its own order.
     #[inline(always)]
-    fn chunk_rows_in<B: Blocks>(&self, b: &B, c: usize, x: &[f64], mut f: impl FnMut(usize, f64)) {
-        let (g0, g1) = (
-            self.chunk_groups[c] as usize,
-            self.chunk_groups[c + 1] as usize,
-        );
+    fn groups_in<B: Blocks>(
+        &self,
+        b: &B,
+        g0: usize,
+        g1: usize,
+        x: &[f64],
+        mut f: impl FnMut(usize, f64),
+    ) {
         let ids = b.ids();
         let mut emit = |g: usize, s: [f64; 2]| {
             let r0 = self.group_rows[g] as usize;
@@ -722,9 +815,7 @@ impl Compact {
         }
     }
 
-    /// y = K x (the same bits as [`spmv`] on the CSR); the step uses the
-    /// fused [`spmv_rhs_and_velocity`].
-    #[cfg(test)]
+    /// y = K x (the same bits as [`spmv`] on the CSR).
     pub fn spmv(&self, x: &[f64], y: &mut [f64]) {
         let body = |c: usize, y: &mut [f64]| {
             let start = c * CHUNK;
@@ -790,14 +881,12 @@ pub fn spmv_rhs_and_velocity(
 
 /// The vectors and coefficients of one explicit step for [`fused_step`].
 pub struct StepData<'a> {
-    /// R_K.
+    /// R_K (+0 off `load_rows`).
     pub load_new: &'a [f64],
-    /// R_{K−1}.
-    pub load: &'a [f64],
+    /// The rows where R_K may be nonzero ([`SparseLoads::rows`]).
+    pub load_rows: &'a [usize],
     /// Lumped mass.
     pub mass: &'a [f64],
-    /// r_{K−1}.
-    pub r: &'a [f64],
     /// r_K (the predictor, final for β = 0).
     pub r_new: &'a [f64],
     /// ṙ_{K−1}.
@@ -822,50 +911,118 @@ pub fn rhs_entry(s: &StepData, i: usize, ku: f64) -> f64 {
     s.load_new[i] - ku + s.mass[i] * (s.cv * s.v[i] + s.ca * s.a[i])
 }
 
+/// The sweep's running sums over a chunk, in row order.
+struct Running {
+    strain: f64,
+    kinetic: f64,
+    finite: bool,
+    /// Next entries of `load_rows` and `friction`.
+    load: usize,
+    friction: usize,
+}
+
+/// The sweep's per-row work on rows r0..r0 + ku.len() given their K r_K:
+/// ṙ_K = R̂_K/(m·scale) (with R_K = +0 first, the literal, then again at
+/// the load rows with their R_K: [`rhs_entry`]'s operations either way),
+/// the friction's velocities at the contact DOFs, r̈_K, and the strain and
+/// kinetic sums in row order. Loops over the batch rather than one pass
+/// per row: the first two have no dependence between rows, so their
+/// divisions overlap.
+#[inline(always)]
+fn batch_rows(
+    s: &StepData,
+    friction: &[(usize, f64)],
+    r0: usize,
+    ku: &[f64],
+    vn: &mut [f64],
+    an: &mut [f64],
+    run: &mut Running,
+) {
+    let n = ku.len();
+    let rows = r0..r0 + n;
+    let (m, v, a) = (
+        &s.mass[rows.clone()],
+        &s.v[rows.clone()],
+        &s.a[rows.clone()],
+    );
+    let rn = &s.r_new[rows];
+    let (vn, an) = (&mut vn[..n], &mut an[..n]);
+    let (cv, ca, scale) = (s.cv, s.ca, s.scale);
+    for k in 0..n {
+        let zero = 0.0;
+        let bi = zero - ku[k] + m[k] * (cv * v[k] + ca * a[k]);
+        vn[k] = bi / (m[k] * scale);
+    }
+    while run.load < s.load_rows.len() && s.load_rows[run.load] < r0 + n {
+        let i = s.load_rows[run.load];
+        let k = i - r0;
+        vn[k] = rhs_entry(s, i, ku[k]) / (m[k] * scale);
+        run.load += 1;
+    }
+    while run.friction < friction.len() && friction[run.friction].0 < r0 + n {
+        let (i, vi) = friction[run.friction];
+        vn[i - r0] = vi;
+        run.friction += 1;
+    }
+    let (gamma_dt, ratio) = (s.gamma_dt, s.ratio);
+    for k in 0..n {
+        an[k] = (vn[k] - v[k]) / gamma_dt - ratio * a[k];
+    }
+    let (mut strain, mut kinetic, mut finite) = (run.strain, run.kinetic, run.finite);
+    for k in 0..n {
+        strain += rn[k] * ku[k];
+        kinetic += m[k] * vn[k] * vn[k];
+        finite &= rn[k].is_finite() && vn[k].is_finite();
+    }
+    (run.strain, run.kinetic, run.finite) = (strain, kinetic, finite);
+}
+
 /// Passes B and C and the SpMV in one sweep: per row, K r_K, R̂_K,
 /// ṙ_K = R̂_K/(m·scale) — or, at the contact DOFs, the velocity the nodal
 /// friction gave (`friction`, (DOF, ṙ_K) sorted by DOF, computed before
 /// from [`Compact::row`] and [`rhs_entry`]) — then r̈_K and the sums. Per
 /// entry the arithmetic of [`rhs_and_velocity`] and [`accelerate_and_sum`],
-/// per chunk the sums in row order: the same bits as the three passes, with
-/// 17 vector streams per step (with pass A) instead of 24, and R̂_K never
+/// per chunk the sums in row order: the same bits as the three passes.
+/// The work and load sums are pass A's ([`predict`], over the load rows,
+/// in `partials[c][0]` and `[2]`), so the sweep reads neither R_{K−1} nor
+/// r_{K−1}: with pass A, 10 vector streams per step (pass A reads r, ṙ,
+/// r̈ and writes r_K; the sweep reads r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K)
+/// instead of 24 for the three passes over dense loads, and R̂_K never
 /// stored.
+///
+/// `ku`: K r_K when the caller has it (the one-chunk step computes it
+/// first for the friction, [`Compact::spmv`]); else the sweep forms it.
 pub fn fused_step(
     k: &Compact,
     s: &StepData,
     friction: &[(usize, f64)],
+    ku: Option<&[f64]>,
     v_new: &mut [f64],
     a_new: &mut [f64],
     partials: &mut Partials,
 ) -> (f64, Sums) {
     let body = |c: usize, vn: &mut [f64], an: &mut [f64], partial: &mut [f64; 5]| {
         let start = c * CHUNK;
-        let mut next = friction.partition_point(|f| f.0 < start);
-        let (mut strain, mut work, mut kinetic, mut load_dot) = (0.0, 0.0, 0.0, 0.0);
-        let mut finite = true;
-        k.chunk_rows(c, s.r_new, |i, ku| {
-            let rn = s.r_new[i];
-            strain += rn * ku;
-            let bi = rhs_entry(s, i, ku);
-            let mut vi = bi / (s.mass[i] * s.scale);
-            if next < friction.len() && friction[next].0 == i {
-                vi = friction[next].1;
-                next += 1;
+        let mut run = Running {
+            strain: 0.0,
+            kinetic: 0.0,
+            finite: true,
+            load: s.load_rows.partition_point(|&i| i < start),
+            friction: friction.partition_point(|f| f.0 < start),
+        };
+        match ku {
+            Some(ku) => {
+                let ku = &ku[start..start + vn.len()];
+                batch_rows(s, friction, start, ku, vn, an, &mut run);
             }
-            vn[i - start] = vi;
-            an[i - start] = (vi - s.v[i]) / s.gamma_dt - s.ratio * s.a[i];
-            work += 0.5 * (s.load_new[i] + s.load[i]) * (rn - s.r[i]);
-            kinetic += s.mass[i] * vi * vi;
-            load_dot += rn * s.load_new[i];
-            finite &= rn.is_finite() && vi.is_finite();
-        });
-        *partial = [
-            work,
-            kinetic,
-            load_dot,
-            if finite { 0.0 } else { 1.0 },
-            strain,
-        ];
+            None => k.chunk_batches(c, s.r_new, |r0, ku| {
+                let (vn, an) = (&mut vn[r0 - start..], &mut an[r0 - start..]);
+                batch_rows(s, friction, r0, ku, vn, an, &mut run);
+            }),
+        }
+        partial[1] = run.kinetic;
+        partial[3] = if run.finite { 0.0 } else { 1.0 };
+        partial[4] = run.strain;
     };
     if parallel(v_new.len()) {
         v_new
@@ -962,10 +1119,12 @@ mod tests {
         }
     }
 
-    /// The one-sweep step (friction velocities handed in) has the bits of
-    /// the CSR SpMV and passes B and C with the friction written between
-    /// them, as the step did before the sweep: on a model of several
-    /// chunks, serial and on two threads.
+    /// The one-sweep step (friction velocities handed in, loads over their
+    /// rows) has the bits of the CSR SpMV and the dense passes A, B and C
+    /// with the friction written between B and C, as the step did before
+    /// the sweep: on a model of several chunks and on the paper's mesh (one
+    /// chunk, K r_K handed in and formed in the sweep), both value forms,
+    /// serial and on two threads.
     #[test]
     fn fused_step_has_the_bits_of_the_passes() {
         let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
@@ -974,26 +1133,97 @@ mod tests {
             Dirichlet::new("left", 0, 0.0),
         ];
         let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes");
-        let mesh = Mesh::from_file(dir.join("slab-q2-64x16.msh")).unwrap();
-        let model = Model::new(&mesh, &material, &supports).unwrap();
-        let k = &model.stiffness;
+        for (name, several) in [("slab-q2-64x16.msh", true), ("slab-q2-8x2.msh", false)] {
+            let mesh = Mesh::from_file(dir.join(name)).unwrap();
+            let model = Model::new(&mesh, &material, &supports).unwrap();
+            let k = &model.stiffness;
+            let n = k.nrows();
+            assert_eq!(chunks(n) >= 2, several, "{name}: {n} DOFs");
+            let forms = [
+                Compact::with_form(k, Form::Stored).unwrap(),
+                Compact::with_form(k, Form::Dictionary).unwrap(),
+            ];
+            assert!(forms[1].dictionary_len() > 0);
+            for threads in [1, 2] {
+                for compact in &forms {
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .unwrap();
+                    pool.install(|| check_fused(k, compact, &format!("{name} {threads}")));
+                }
+            }
+        }
+    }
+
+    /// See [`fused_step_has_the_bits_of_the_passes`].
+    fn check_fused(k: &CsrMatrix<f64>, compact: &Compact, name: &str) {
         let n = k.nrows();
-        assert!(chunks(n) >= 2, "{n} DOFs: one chunk");
-        let forms = [
-            Compact::with_form(k, Form::Stored).unwrap(),
-            Compact::with_form(k, Form::Dictionary).unwrap(),
-        ];
-        assert!(forms[1].dictionary_len() > 0);
         let vec =
             |shift: f64| -> Vec<f64> { x_of(n).iter().map(|x| x * shift + 0.1 * shift).collect() };
-        let (r, r_new, v, a) = (vec(1.0), vec(1.1), vec(-0.7), vec(3.0));
-        let (load, load_new) = (vec(0.3), vec(0.31));
+        let (r, v, a) = (vec(1.0), vec(-0.7), vec(3.0));
         let mass: Vec<f64> = x_of(n).iter().map(|x| 1.0 + x.abs()).collect();
+        // Loads on a few rows (both sides of chunk seams, a −0 entry, a row
+        // where two loads cancel), +0 elsewhere.
+        let mut constant = vec![0.0; n];
+        let mut l1 = vec![0.0; n];
+        let mut l2 = vec![0.0; n];
+        for i in (0..n).filter(|i| i % 61 == 5 || i % CHUNK == 0 || i % CHUNK == CHUNK - 1) {
+            l1[i] = 0.3 + 1e-3 * i as f64;
+        }
+        for i in (0..n).filter(|i| i % 89 == 7) {
+            l2[i] = -0.2 * (1.0 + (i % 5) as f64);
+            if i % 3 == 0 {
+                l1[i] = -l2[i];
+            }
+        }
+        constant[n / 2] = 0.25;
+        constant[n / 3] = -0.0;
+        let sparse = SparseLoads::new(&constant, &[&l1, &l2]);
+        assert!(sparse.rows().len() < n / 8 && sparse.rows().contains(&(n / 3)));
+        let (c1, c2) = (1e-3, 0.5e-6);
+        // The dense pass A of before, at θ = (0.7, 1.3) (step K) and at
+        // θ = (0.9, 0) (step K − 1).
+        let dense = |thetas: [f64; 2]| -> Vec<f64> {
+            let mut l = constant.clone();
+            for (load, theta) in [&l1, &l2].iter().zip(thetas) {
+                if theta != 0.0 {
+                    for (o, f) in l.iter_mut().zip(load.iter()) {
+                        *o += theta * f;
+                    }
+                }
+            }
+            l
+        };
+        let (load, load_new0) = (dense([0.9, 0.0]), dense([0.7, 1.3]));
+        let r_new0: Vec<f64> = (0..n).map(|i| r[i] + c1 * v[i] + c2 * a[i]).collect();
+        let (mut load_new, mut r_new) = (vec![0.0; n], vec![7.0; n]);
+        let mut p1 = partials(n);
+        predict(
+            &sparse,
+            &[0.7, 1.3],
+            &r,
+            &v,
+            &a,
+            c1,
+            c2,
+            &load,
+            &mut load_new,
+            &mut r_new,
+            &mut p1,
+        );
+        for i in 0..n {
+            assert_eq!(
+                load_new0[i].to_bits(),
+                load_new[i].to_bits(),
+                "{name}: R_K {i}"
+            );
+            assert_eq!(r_new0[i].to_bits(), r_new[i].to_bits(), "{name}: r_K {i}");
+        }
         let data = StepData {
             load_new: &load_new,
-            load: &load,
+            load_rows: sparse.rows(),
             mass: &mass,
-            r: &r,
             r_new: &r_new,
             v: &v,
             a: &a,
@@ -1003,65 +1233,59 @@ mod tests {
             gamma_dt: 0.5 * 1e-3,
             ratio: 1.0,
         };
-        // "Friction" at DOFs on both sides of chunk seams.
+        // "Friction" at DOFs on both sides of chunk seams and at load rows.
         let friction: Vec<(usize, f64)> = (0..n)
-            .filter(|i| i % 97 == 0 || i % CHUNK == 0 || i % CHUNK == CHUNK - 1)
+            .filter(|i| i % 97 == 0 || i % CHUNK == 0 || i % CHUNK == CHUNK - 1 || i % 61 == 5)
             .map(|i| (i, -0.25 * i as f64))
             .collect();
-        for (threads, compact) in [1, 2]
-            .into_iter()
-            .flat_map(|t| forms.iter().map(move |c| (t, c)))
-        {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
-                let mut p0 = partials(n);
-                let (mut b, mut vn0, mut an0) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-                spmv(k, &r_new, &mut b);
-                let strain0 = rhs_and_velocity(
-                    &load_new, &mass, &r_new, &v, &a, data.cv, data.ca, data.scale, &mut b,
-                    &mut vn0, &mut p0,
-                );
-                for &(i, vi) in &friction {
-                    vn0[i] = vi;
-                }
-                let sums0 = accelerate_and_sum(
-                    &mass,
-                    &load,
-                    &load_new,
-                    &r,
-                    &r_new,
-                    &v,
-                    &vn0,
-                    &a,
-                    data.gamma_dt,
-                    data.ratio,
-                    &mut an0,
-                    &mut p0,
-                );
-                let mut p1 = partials(n);
-                let (mut vn1, mut an1) = (vec![0.0; n], vec![0.0; n]);
-                let (strain1, sums1) =
-                    fused_step(compact, &data, &friction, &mut vn1, &mut an1, &mut p1);
-                assert_eq!(strain0.to_bits(), strain1.to_bits(), "{threads}: strain");
-                for (x, y) in [
-                    (sums0.work, sums1.work),
-                    (sums0.kinetic, sums1.kinetic),
-                    (sums0.load_dot, sums1.load_dot),
-                ] {
-                    assert_eq!(x.to_bits(), y.to_bits(), "{threads}: sums");
-                }
-                assert!(sums0.finite && sums1.finite);
-                for i in 0..n {
-                    assert_eq!(vn0[i].to_bits(), vn1[i].to_bits(), "{threads}: ṙ row {i}");
-                    assert_eq!(an0[i].to_bits(), an1[i].to_bits(), "{threads}: r̈ row {i}");
-                    // What the friction pre-pass reads.
-                    let bi = rhs_entry(&data, i, compact.row(i, &r_new));
-                    assert_eq!(b[i].to_bits(), bi.to_bits(), "{threads}: R̂ row {i}");
-                }
-            });
+        let mut p0 = partials(n);
+        let (mut b, mut vn0, mut an0) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        spmv(k, &r_new, &mut b);
+        let ku = b.clone();
+        let strain0 = rhs_and_velocity(
+            &load_new, &mass, &r_new, &v, &a, data.cv, data.ca, data.scale, &mut b, &mut vn0,
+            &mut p0,
+        );
+        for &(i, vi) in &friction {
+            vn0[i] = vi;
+        }
+        let sums0 = accelerate_and_sum(
+            &mass,
+            &load,
+            &load_new,
+            &r,
+            &r_new,
+            &v,
+            &vn0,
+            &a,
+            data.gamma_dt,
+            data.ratio,
+            &mut an0,
+            &mut p0,
+        );
+        assert!(sums0.work != 0.0 && sums0.load_dot != 0.0);
+        for given in [None, Some(&ku[..])] {
+            let mut p = p1.clone();
+            let (mut vn1, mut an1) = (vec![0.0; n], vec![0.0; n]);
+            let (strain1, sums1) =
+                fused_step(compact, &data, &friction, given, &mut vn1, &mut an1, &mut p);
+            let name = format!("{name} K r_K given: {}", given.is_some());
+            assert_eq!(strain0.to_bits(), strain1.to_bits(), "{name}: strain");
+            for (x, y) in [
+                (sums0.work, sums1.work),
+                (sums0.kinetic, sums1.kinetic),
+                (sums0.load_dot, sums1.load_dot),
+            ] {
+                assert_eq!(x.to_bits(), y.to_bits(), "{name}: sums");
+            }
+            assert!(sums0.finite && sums1.finite);
+            for i in 0..n {
+                assert_eq!(vn0[i].to_bits(), vn1[i].to_bits(), "{name}: ṙ row {i}");
+                assert_eq!(an0[i].to_bits(), an1[i].to_bits(), "{name}: r̈ row {i}");
+                // What the friction pre-pass reads.
+                let bi = rhs_entry(&data, i, compact.row(i, &r_new));
+                assert_eq!(b[i].to_bits(), bi.to_bits(), "{name}: R̂ row {i}");
+            }
         }
     }
 
@@ -1192,6 +1416,7 @@ mod tests {
         let k = &model.stiffness;
         let n = k.nrows();
         let compact = Compact::new(k).unwrap();
+        let stored = Compact::with_form(k, Form::Stored).unwrap();
         // Element matrices (64 values) and free DOFs (u32::MAX = fixed).
         let basis = CellBasis::full(CellKind::Quad4);
         let d = material.elasticity();
@@ -1282,21 +1507,30 @@ mod tests {
                 );
                 let t = time(&mut || compact.spmv(&x, &mut y1));
                 println!(
-                    "  {threads} thread(s) compact 2×2 : {:.3} ms, {:.0} MB, {:.1} GB/s",
+                    "  {threads} thread(s) compact 2×2 : {:.3} ms, {:.0} MB, {:.1} GB/s ({} distinct blocks)",
                     1e3 * t,
                     compact_bytes / 1e6,
-                    compact_bytes / t / 1e9
+                    compact_bytes / t / 1e9,
+                    compact.dictionary_len()
+                );
+                let t = time(&mut || stored.spmv(&x, &mut y1));
+                let stored_bytes = stored.bytes() as f64 + vectors;
+                println!(
+                    "  {threads} thread(s) stored 2×2  : {:.3} ms, {:.0} MB, {:.1} GB/s",
+                    1e3 * t,
+                    stored_bytes / 1e6,
+                    stored_bytes / t / 1e9
                 );
                 // The step's passes after the predictor, three ways, on
                 // distinct vectors as in a step.
                 let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
                 let (ln, l, m, r, rn, v, a) =
                     (w(1.0), w(1.1), w(1.2), w(1.3), w(1.4), w(1.5), w(1.6));
+                // (The sweep with no load rows: pass A does the loads'.)
                 let data = StepData {
                     load_new: &ln,
-                    load: &l,
+                    load_rows: &[],
                     mass: &m,
-                    r: &r,
                     r_new: &rn,
                     v: &v,
                     a: &a,
@@ -1328,7 +1562,7 @@ mod tests {
                     );
                     t[1].push(s.elapsed().as_secs_f64());
                     let s = Instant::now();
-                    fused_step(&compact, &data, &[], &mut vn, &mut an, &mut p);
+                    fused_step(&compact, &data, &[], None, &mut vn, &mut an, &mut p);
                     t[2].push(s.elapsed().as_secs_f64());
                 }
                 for (name, t) in ["CSR, B, C", "compact·B, C", "one sweep"]
