@@ -2,68 +2,87 @@
 //! deliverable 2).
 //!
 //! An explicit step is bound by memory traffic, so it makes as few sweeps
-//! over the free-DOF vectors as the data dependencies allow: (A) load and
-//! predictor r_K, then, once r_K exists everywhere, one sweep
-//! ([`fused_step`]) that per row forms K r_K, R̂_K, ṙ_K = R̂_K/(m·scale),
-//! r̈_K, and the strain, kinetic, work and load sums. The nodal friction
-//! needs R̂_K at the contact DOFs before their ṙ_K: those few rows are
-//! evaluated first ([`Compact::row`], [`rhs_entry`]) and their velocities
-//! handed to the sweep. Per entry and per sum this is the arithmetic of the
-//! earlier three passes (kept: [`rhs_and_velocity`], [`accelerate_and_sum`],
-//! used by the iterated friction, which needs R̂_K everywhere), so the
-//! results are bit-identical to them; 17 vector streams per step instead of
-//! 24.
+//! over the free-DOF vectors as the data dependencies allow: (A) the
+//! predictor r_K ([`predict`]), with R_K formed only on the rows where a
+//! load is nonzero ([`SparseLoads`]: tractions act on a boundary; the other
+//! rows of R_K are +0 and stay so) and the work and load sums over those
+//! rows; then, once r_K exists everywhere, one sweep ([`fused_step`]) that
+//! forms K r_K, R̂_K, ṙ_K = R̂_K/(m·scale), r̈_K, and the strain and
+//! kinetic sums. The nodal friction needs R̂_K at the contact DOFs before
+//! their ṙ_K: those few rows are evaluated first ([`Compact::row`],
+//! [`rhs_entry`]; a one-chunk run forms all of K r_K first instead, which
+//! stays in cache) and their velocities handed to the sweep. Per entry and
+//! per sum this is the arithmetic of the earlier three passes (kept:
+//! [`rhs_and_velocity`], [`accelerate_and_sum`], used by the iterated
+//! friction, which needs R̂_K everywhere), so the results are bit-identical
+//! to them (tests below; the verify references differ by 0): 10 vector
+//! streams per step (pass A reads r, ṙ, r̈ and writes r_K; the sweep reads
+//! r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K) instead of 17 with dense loads, 24
+//! for the three passes.
 //!
 //! Work is split into fixed chunks of [`CHUNK`] DOFs whatever the number of
 //! threads, and sums are formed per chunk and added in chunk order, so a
 //! run is bit-identical on one thread and on many. Below [`PARALLEL_MIN`]
 //! chunks the passes run on the calling thread (a rayon dispatch costs
-//! microseconds, more than a pass over the paper's 170 DOFs).
+//! microseconds, more than a pass over the paper's 148 free DOFs). Within
+//! a chunk the sweep forms K r_K for [`BATCH`] rows at a time into a buffer
+//! and then runs the per-row work in loops over the batch (the divisions
+//! of ṙ_K and r̈_K of different rows overlap; the sums stay in row order).
 //!
-//! K·r row by row from [`Compact`] (2×2 blocks with u32 columns, 162 bytes
-//! per Q1 DOF) rather than nalgebra-sparse's CSR (usize columns, 288 bytes
-//! per Q1 DOF) or element by element, chosen by measurement: the
-//! `kernel_lab` test below, Q1 slab of 1,004,298 DOFs, 2026-11-22 02:24,
-//! load average 1.1 on the 2 cores:
+//! K·r row by row from [`Compact`] (2×2 blocks with u32 columns, their
+//! values stored, 36 bytes per block, or indexed into a dictionary of the
+//! distinct blocks, 6 or 8) rather than nalgebra-sparse's CSR (usize
+//! columns, 16 bytes per entry) or element by element, chosen by
+//! measurement: the `kernel_lab` test below, Q1 slab of 1,004,298 DOFs,
+//! 2026-11-22 03:44, load average 1.1 on the 2 cores:
 //!
-//! | one K·x, fastest of 20        | 1 thread | 2 threads |
-//! |-------------------------------|----------|-----------|
-//! | CSR (313 MB)                  | 12.3 ms  |  9.4 ms   |
-//! | compact (183 MB)              | 12.8 ms  |  6.8 ms   |
-//! | element by element (297 MB)   | 13.4 ms  |  —        |
+//! | one K·x, fastest of 20             | 1 thread | 2 threads |
+//! |------------------------------------|----------|-----------|
+//! | CSR (313 MB)                       | 13.8 ms  |  9.2 ms   |
+//! | compact, stored (183 MB)           | 10.9 ms  |  6.0 ms   |
+//! | compact, dictionary (63 MB)        |  8.1 ms  |  4.1 ms   |
+//! | element by element (297 MB)        | 12.3 ms  |  —        |
 //!
 //! | step after the predictor, 30 interleaved rounds | 1 thread: median, min | 2 threads: median, min |
 //! |-------------------------------------------------|-----------------------|------------------------|
-//! | CSR, pass B, pass C                             | 20.2, 17.4 ms         | 15.7, 14.0 ms          |
-//! | compact fused with B, pass C                    | 25.1, 23.1 ms         | 14.3, 12.0 ms          |
-//! | one sweep ([`fused_step`])                      | 22.7, 20.2 ms         | 14.3, 13.0 ms          |
+//! | CSR, pass B, pass C                             | 16.9, 16.6 ms         | 13.6, 13.1 ms          |
+//! | compact fused with B, pass C                    | 18.0, 17.7 ms         |  9.9,  9.7 ms          |
+//! | one sweep ([`fused_step`], batches)             | 13.9, 13.6 ms         |  7.1,  7.0 ms          |
 //!
-//! (A run a minute earlier: 2 threads 18.8/16.2, 18.2/13.6, 18.1/13.3 ms;
-//! the machine is shared.)
+//! (The lab's sweep has no load rows; the first two read dense loads.)
+//! Element by element moves more bytes than the compact rows (512 bytes of
+//! matrix and 32 of connectivity per element, one element per node, and a
+//! scatter that reads and writes y), and threading it deterministically
+//! would need a colouring (scatters of neighbouring elements collide);
+//! rows are independent, so threads never share an output. For Q2 the
+//! element matrices (18×18 per 4 nodes, 324 bytes per DOF) lose more.
 //!
-//! On one thread the products are bound by the adder's latency (a row's sum
-//! is a chain in fixed order), not by memory, and the CSR's simpler loop
-//! wins; on the machine's two threads memory binds and the smaller stream
-//! wins. Element by element moves more bytes than the compact rows (512
-//! bytes of matrix and 32 of connectivity per element, one element per
-//! node, and a scatter that reads and writes y), and threading it
-//! deterministically would need a colouring (scatters of neighbouring
-//! elements collide); rows are independent, so threads never share an
-//! output. For Q2 the element matrices (18×18 per 4 nodes, 324 bytes per
-//! DOF) lose more. The one sweep measured equal to compact·B + C; it is
-//! kept for its 7 fewer vector streams. On one thread the compact K·x
-//! costs about 2.8 ns per 2×2 block whatever the bytes: the gain is in the
-//! two-thread, memory-bound case this machine runs.
+//! The dictionary ([`Compact::new`]: used when it halves the matrix
+//! stream; exact bits, so K·x keeps its bits) on the structured slabs,
+//! measured 2026-11-22: Q1 128×32: 10,024 distinct of 37,338 blocks;
+//! 708×177: 101,880 of 1,130,778 (matrix 41.7 → 13.3 MB); 1416×354:
+//! 211,770 of 4,517,896 (167 → 47 MB, the 6.8 MB dictionary read from
+//! cache). The Q2 slabs have 85% distinct blocks (352×88: 1,685,723 of
+//! 1,986,505; 75% distinct column pairs) but only 168,411 distinct values:
+//! a dictionary of values (a 4-byte index per entry, 20 bytes per block
+//! instead of 36) was tried and made the step slower (gen-q2-352x88, same
+//! session: 5.7 → 8.4 ms; four gathers per block, and the Q2 product is
+//! not memory-bound on this machine), so the Q2 and unstructured meshes
+//! keep their blocks stored.
 //!
-//! The block values go into a dictionary of the distinct blocks (exact
-//! bits) with a 2- or 4-byte index per block when that halves the matrix
-//! stream ([`Compact::new`]). Distinct blocks measured (2026-11-22): Q1
-//! slabs 128×32: 10,024 of 37,338 blocks, 708×177: 101,880 of 1,130,778,
-//! 1416×354: 211,770 of 4,517,896 (matrix stream 167 → 47 MB, the 6.8 MB
-//! dictionary read from cache); the Q2 slabs and the unstructured meshes
-//! have too many distinct blocks and keep them stored. Explicit step on
-//! the 1416×354 Q1 rung, bench_step, 3 interleaved runs, load 2.2-2.8:
-//! stored 24.8 ms, dictionary 11.9 ms (best runs).
+//! Each block costs a fixed set of operations (four products and four
+//! additions in the CSR's order per block, its column's bounds check, the
+//! value loads): the dev profile's opt-level 2 emits them scalar (rustc
+//! runs LLVM's SLP vectorizer at opt-level 3 only), about 1.5 ns per block
+//! on one core in cache (paper mesh: 1,088 blocks, ~1.6 µs of its step).
+//! Two groups (four row sums) in lockstep ([`Compact::groups_into`]);
+//! four were measured no faster (paper mesh 2.64 vs 2.49 µs per step, Q2
+//! equal within the noise): the loop is bound by instructions, not by
+//! the adder's latency. Storing the blocks by columns lets opt-level 3
+//! pair the two rows' operations (mulpd/addpd, same bits): the paper mesh
+//! then steps in 2.11 instead of 2.51 µs and Q1 708×177 in 1.61 instead
+//! of 1.89 ms (fastest of 3, same session); that is a profile choice for
+//! the workspace (Cargo.toml), not made here.
 
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
@@ -74,6 +93,8 @@ pub const CHUNK: usize = 8192;
 pub const PARALLEL_MIN: usize = 2;
 /// Rows per batch of the one-sweep step ([`Compact::chunk_batches`]).
 pub const BATCH: usize = 256;
+/// Groups the product sums in lockstep ([`Compact::groups_into`]).
+const LOCKSTEP: usize = 2;
 
 /// Number of chunks of a vector of length n.
 pub fn chunks(n: usize) -> usize {
@@ -353,11 +374,13 @@ pub fn accelerate_and_sum(
 /// K in the compact form the explicit step streams (built once per run):
 /// rows grouped in pairs of consecutive free DOFs with the same column
 /// pattern (the x and y DOF of one node; plane elasticity couples nodes by
-/// 2×2 blocks), each pair storing its row in 2-column blocks, 4 values and
-/// one u32 column index per block. A Q1 node's two rows then cost 9 blocks
-/// of 36 bytes, 162 bytes per DOF instead of 288 for nalgebra-sparse's CSR
+/// 2×2 blocks), each pair storing its row in 2-column blocks, 4 values (or
+/// their index in a dictionary of distinct blocks, [`Values`]) and one u32
+/// column index per block. A Q1 node's two rows then cost 9 blocks of 36
+/// bytes, 162 bytes per DOF instead of 288 for nalgebra-sparse's CSR
 /// (usize column index and value per entry); with the row pointers (4 bytes
-/// per pair) the matrix stream is 0.57× the CSR's.
+/// per pair) the matrix stream is 0.57× the CSR's, and with a dictionary
+/// of 2-byte (4-byte) indices 0.12× (0.16×) plus the dictionary.
 ///
 /// Rows that have no partner (a node with one DOF constrained, or a pair
 /// straddling a [`CHUNK`] boundary, so that threads never share a group)
@@ -384,8 +407,8 @@ pub struct Compact {
     chunk_groups: Vec<u32>,
 }
 
-/// The values of the blocks, [row 0 · col 0, row 0 · col 1, row 1 · col 0,
-/// row 1 · col 1] each: stored per block, or as an index per block into a
+/// The values of the blocks, [row 0 · col 0, row 1 · col 0, row 0 · col 1,
+/// row 1 · col 1] each (by columns): stored per block, or as an index per block into a
 /// dictionary of the distinct blocks (bit for bit: no tolerance, so a
 /// block read from the dictionary has the bits of the stored one).
 #[derive(Clone, Debug)]
@@ -417,7 +440,7 @@ pub enum Form {
 trait Blocks: Sync {
     type Id: Sync;
     fn ids(&self) -> &[Self::Id];
-    fn value<'a>(&'a self, id: &'a Self::Id) -> &'a [f64; 4];
+    fn value(&self, id: &Self::Id) -> [f64; 4];
 }
 
 struct StoredBlocks<'a>(&'a [[f64; 4]]);
@@ -429,8 +452,8 @@ impl Blocks for StoredBlocks<'_> {
         self.0
     }
     #[inline(always)]
-    fn value<'a>(&'a self, id: &'a [f64; 4]) -> &'a [f64; 4] {
-        id
+    fn value(&self, id: &[f64; 4]) -> [f64; 4] {
+        *id
     }
 }
 
@@ -446,9 +469,9 @@ impl<I: Copy + Into<u32> + Sync> Blocks for DictBlocks<'_, I> {
         self.ids
     }
     #[inline(always)]
-    fn value<'a>(&'a self, id: &'a I) -> &'a [f64; 4] {
+    fn value(&self, id: &I) -> [f64; 4] {
         let k: u32 = (*id).into();
-        &self.dict[k as usize]
+        self.dict[k as usize]
     }
 }
 
@@ -459,15 +482,18 @@ trait Kernel<R> {
 }
 
 /// One 2×2 block's contribution to a group's two sums, each in the CSR's
-/// order (column c, then c + 1).
+/// order (column c, then c + 1). The block is stored by columns, so that
+/// the two rows' operations on one column are a pair of adjacent lanes
+/// (the compiler's 2-wide vector operations).
 #[inline(always)]
-fn block(col: u32, v: &[f64; 4], x: &[f64], s: &mut [f64; 2]) {
+fn block(col: u32, v: [f64; 4], x: &[f64], s: &mut [f64; 2]) {
     let c = col as usize;
     let xs = &x[c..c + 2];
-    s[0] += v[0] * xs[0];
-    s[0] += v[1] * xs[1];
-    s[1] += v[2] * xs[0];
-    s[1] += v[3] * xs[1];
+    let (x0, x1) = (xs[0], xs[1]);
+    s[0] += v[0] * x0;
+    s[1] += v[1] * x0;
+    s[0] += v[2] * x1;
+    s[1] += v[3] * x1;
 }
 
 impl Values {
@@ -603,7 +629,7 @@ impl Compact {
                         block_vals.push([0.0; 4]);
                     }
                     debug_assert_eq!(block_cols[next], s);
-                    block_vals[next][2 * k + (c - s as usize)] = vals[p];
+                    block_vals[next][2 * (c - s as usize) + k] = vals[p];
                 }
             }
             if block_cols.len() >= u32::MAX as usize {
@@ -714,17 +740,12 @@ impl Compact {
 
     /// Calls `f(row, (K x)_row)` for every row of chunk `c`, in row order.
     #[inline]
-    fn chunk_rows(&self, c: usize, x: &[f64], f: impl FnMut(usize, f64)) {
-        struct Rows<'x, F>(usize, &'x [f64], F);
-        impl<F: FnMut(usize, f64)> Kernel<()> for Rows<'_, F> {
-            #[inline(always)]
-            fn run<B: Blocks>(self, k: &Compact, b: &B) {
-                let Rows(c, x, f) = self;
-                let (g0, g1) = (k.chunk_groups[c] as usize, k.chunk_groups[c + 1] as usize);
-                k.groups_in(b, g0, g1, x, f)
+    fn chunk_rows(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, f64)) {
+        self.chunk_batches(c, x, |r0, ku| {
+            for (k, &s) in ku.iter().enumerate() {
+                f(r0 + k, s);
             }
-        }
-        self.with_blocks(Rows(c, x, f))
+        });
     }
 
     /// Calls `f(first row, K x on the batch's rows)` for consecutive
@@ -746,7 +767,7 @@ impl Compact {
                     let gb = (g + BATCH / 2).min(g1);
                     let (ra, rb) = (k.group_rows[g] as usize, k.group_rows[gb] as usize);
                     let out = &mut buf[..rb - ra];
-                    k.groups_in(b, g, gb, x, |i, s| out[i - ra] = s);
+                    k.groups_into(b, g, gb, x, out);
                     f(ra, out);
                     g = gb;
                 }
@@ -755,72 +776,97 @@ impl Compact {
         self.with_blocks(Batches(c, x, f))
     }
 
-    /// `f(row, (K x)_row)` for the rows of groups g0..g1, in order, with
-    /// the values in form `B`.
+    /// K x on the rows of groups g0..g1 into `out` (from the first row of
+    /// g0 on), with the values in form `B`.
     ///
-    /// Two groups are summed in lockstep: a row's sum is a chain of
-    /// dependent additions in a fixed order (the CSR's, for the bits), so
-    /// one group alone leaves the core waiting on the adder's latency; two
-    /// give it four independent chains, each still in its own order.
+    /// [`LOCKSTEP`] groups are summed in lockstep: a row's sum is a chain
+    /// of dependent additions in a fixed order (the CSR's, for the bits),
+    /// so one group alone leaves the core waiting on the adder's latency;
+    /// G groups give it 2G independent chains, each still in its own order.
     #[inline(always)]
-    fn groups_in<B: Blocks>(
+    fn groups_into<B: Blocks>(&self, b: &B, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
+        let base = self.group_rows[g0] as usize;
+        let mut g = g0;
+        while g + LOCKSTEP <= g1 {
+            self.lockstep::<LOCKSTEP, B>(b, g, x, out, base);
+            g += LOCKSTEP;
+        }
+        while g < g1 {
+            self.lockstep::<1, B>(b, g, x, out, base);
+            g += 1;
+        }
+    }
+
+    /// Groups g..g + G in lockstep over their common length, then the
+    /// rest of each.
+    #[inline(always)]
+    fn lockstep<const G: usize, B: Blocks>(
         &self,
         b: &B,
-        g0: usize,
-        g1: usize,
+        g: usize,
         x: &[f64],
-        mut f: impl FnMut(usize, f64),
+        out: &mut [f64],
+        base: usize,
+    ) {
+        let mut at: [usize; G] = std::array::from_fn(|q| self.group_blocks[g + q] as usize);
+        let end: [usize; G] = std::array::from_fn(|q| self.group_blocks[g + q + 1] as usize);
+        let mut s = [[0.0; 2]; G];
+        self.common(b, x, &mut at, &end, &mut s);
+        if G > 1 {
+            for q in 0..G {
+                let mut one = [s[q]];
+                self.common(b, x, &mut [at[q]], &[end[q]], &mut one);
+                s[q] = one[0];
+            }
+        }
+        for (q, s) in s.iter().enumerate() {
+            let r0 = self.group_rows[g + q] as usize;
+            out[r0 - base] = s[0];
+            if self.group_rows[g + q + 1] as usize - r0 == 2 {
+                out[r0 + 1 - base] = s[1];
+            }
+        }
+    }
+
+    /// The blocks at[q]..at[q] + len of G groups in lockstep, len their
+    /// least remaining length; advances `at`.
+    #[inline(always)]
+    fn common<const G: usize, B: Blocks>(
+        &self,
+        b: &B,
+        x: &[f64],
+        at: &mut [usize; G],
+        end: &[usize; G],
+        s: &mut [[f64; 2]; G],
     ) {
         let ids = b.ids();
-        let mut emit = |g: usize, s: [f64; 2]| {
-            let r0 = self.group_rows[g] as usize;
-            f(r0, s[0]);
-            if self.group_rows[g + 1] as usize - r0 == 2 {
-                f(r0 + 1, s[1]);
+        let len = (0..G).map(|q| end[q] - at[q]).min().unwrap_or(0);
+        let cols: [&[u32]; G] = std::array::from_fn(|q| &self.cols[at[q]..at[q] + len]);
+        let vals: [&[B::Id]; G] = std::array::from_fn(|q| &ids[at[q]..at[q] + len]);
+        let mut acc = *s;
+        for j in 0..len {
+            for q in 0..G {
+                block(cols[q][j], b.value(&vals[q][j]), x, &mut acc[q]);
             }
-        };
-        let mut g = g0;
-        while g + 1 < g1 {
-            let (a0, a1) = (
-                self.group_blocks[g] as usize,
-                self.group_blocks[g + 1] as usize,
-            );
-            let b1 = self.group_blocks[g + 2] as usize;
-            let (mut sa, mut sb) = ([0.0; 2], [0.0; 2]);
-            let (ca, va) = (&self.cols[a0..a1], &ids[a0..a1]);
-            let (cb, vb) = (&self.cols[a1..b1], &ids[a1..b1]);
-            let common = ca.len().min(cb.len());
-            for (((ca, va), cb), vb) in ca[..common]
-                .iter()
-                .zip(&va[..common])
-                .zip(&cb[..common])
-                .zip(&vb[..common])
-            {
-                block(*ca, b.value(va), x, &mut sa);
-                block(*cb, b.value(vb), x, &mut sb);
-            }
-            for (c, v) in ca[common..].iter().zip(&va[common..]) {
-                block(*c, b.value(v), x, &mut sa);
-            }
-            for (c, v) in cb[common..].iter().zip(&vb[common..]) {
-                block(*c, b.value(v), x, &mut sb);
-            }
-            emit(g, sa);
-            emit(g + 1, sb);
-            g += 2;
         }
-        if g < g1 {
-            let s = self.group_sums_in(b, g, x);
-            emit(g, s);
+        *s = acc;
+        for a in at.iter_mut() {
+            *a += len;
         }
     }
 
     /// y = K x (the same bits as [`spmv`] on the CSR).
     pub fn spmv(&self, x: &[f64], y: &mut [f64]) {
-        let body = |c: usize, y: &mut [f64]| {
-            let start = c * CHUNK;
-            self.chunk_rows(c, x, |i, s| y[i - start] = s);
-        };
+        struct Into<'x, 'y>(usize, &'x [f64], &'y mut [f64]);
+        impl Kernel<()> for Into<'_, '_> {
+            #[inline(always)]
+            fn run<B: Blocks>(self, k: &Compact, b: &B) {
+                let Into(c, x, y) = self;
+                let (g0, g1) = (k.chunk_groups[c] as usize, k.chunk_groups[c + 1] as usize);
+                k.groups_into(b, g0, g1, x, y);
+            }
+        }
+        let body = |c: usize, y: &mut [f64]| self.with_blocks(Into(c, x, y));
         if parallel(y.len()) {
             y.par_chunks_mut(CHUNK)
                 .enumerate()
