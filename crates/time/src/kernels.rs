@@ -1011,14 +1011,16 @@ fn batch_rows(
         run.friction += 1;
     }
     let (gamma_dt, ratio) = (s.gamma_dt, s.ratio);
+    let mut finite = run.finite;
     for k in 0..n {
         an[k] = (vn[k] - v[k]) / gamma_dt - ratio * a[k];
+        // `&`, not `&&`: no branch, so the loop stays vectorized.
+        finite &= rn[k].is_finite() & vn[k].is_finite();
     }
-    let (mut strain, mut kinetic, mut finite) = (run.strain, run.kinetic, run.finite);
+    let (mut strain, mut kinetic) = (run.strain, run.kinetic);
     for k in 0..n {
         strain += rn[k] * ku[k];
         kinetic += m[k] * vn[k] * vn[k];
-        finite &= rn[k].is_finite() && vn[k].is_finite();
     }
     (run.strain, run.kinetic, run.finite) = (strain, kinetic, finite);
 }
@@ -1197,6 +1199,59 @@ mod tests {
                         .build()
                         .unwrap();
                     pool.install(|| check_fused(k, compact, &format!("{name} {threads}")));
+                }
+            }
+        }
+    }
+
+    /// A NaN or infinite r_K or ṙ_K in any row, in either chunk, with K r_K
+    /// handed in or not, clears the sweep's finiteness flag.
+    #[test]
+    fn fused_step_flags_non_finite() {
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes");
+        for name in ["slab-q2-8x2.msh", "slab-q2-64x16.msh"] {
+            let mesh = Mesh::from_file(dir.join(name)).unwrap();
+            let model = Model::new(&mesh, &material, &[]).unwrap();
+            let k = &model.stiffness;
+            let n = k.nrows();
+            let compact = Compact::new(k).unwrap();
+            let mass = vec![1.0; n];
+            let zero = vec![0.0; n];
+            for (row, bad, in_r) in [
+                (0, f64::NAN, true),
+                (n - 1, f64::INFINITY, false),
+                (n / 2 + 1, f64::NEG_INFINITY, true),
+                (n / 3, f64::NAN, false),
+            ] {
+                let mut r_new = x_of(n);
+                let mut v = vec![0.5; n];
+                if in_r {
+                    r_new[row] = bad;
+                } else {
+                    v[row] = bad;
+                }
+                let data = StepData {
+                    load_new: &zero,
+                    load_rows: &[],
+                    mass: &mass,
+                    r_new: &r_new,
+                    v: &v,
+                    a: &zero,
+                    cv: 2.0,
+                    ca: 1.0,
+                    scale: 2.0,
+                    gamma_dt: 0.5,
+                    ratio: 1.0,
+                };
+                let mut ku = vec![0.0; n];
+                compact.spmv(&r_new, &mut ku);
+                for given in [None, Some(&ku[..])] {
+                    let mut p = partials(n);
+                    let (mut vn, mut an) = (vec![0.0; n], vec![0.0; n]);
+                    let (_, sums) =
+                        fused_step(&compact, &data, &[], given, &mut vn, &mut an, &mut p);
+                    assert!(!sums.finite, "{name} row {row} {bad}");
                 }
             }
         }
