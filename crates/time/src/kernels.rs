@@ -83,6 +83,12 @@
 //! then steps in 2.11 instead of 2.51 µs and Q1 708×177 in 1.61 instead
 //! of 1.89 ms (fastest of 3, same session); that is a profile choice for
 //! the workspace (Cargo.toml), not made here.
+//!
+//! Tried and not kept (branch `cd-predictor-fusion`): the sweep writing
+//! the next step's predictor so that a step of the same Δt skips pass A's
+//! sweep (bit-identical, 10 → 7 vector streams) measured no faster, the
+//! sweep being compute-bound at opt-level 2 (Q1 708×177 1.85 vs 1.91 ms,
+//! 1416×354 8.94 vs 9.17 ms, fastest of 2-3, load 0.8-1.3).
 
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
