@@ -439,13 +439,14 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     );
     let extra = if explicit {
         // Bytes the two sweeps must move (kernels.rs): K in its compact
-        // form; vectors: the predictor reads the constant load, 2 loads, r,
-        // ṙ, r̈ and writes R_K, r_K (8); the sweep reads r_K, R_K, R, m, r,
-        // ṙ, r̈ and writes ṙ_K, r̈_K (9). 17 vectors of n f64.
-        let bytes = i.explicit_matrix_bytes() as f64 + 17.0 * 8.0 * n as f64;
+        // form; vectors: the predictor reads r, ṙ, r̈ and writes r_K (4);
+        // the sweep reads r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K (6); the loads
+        // at their rows only (Integrator::explicit_bytes_per_step).
+        let bytes = i.explicit_bytes_per_step() as f64;
         let bw = pool.install(stream_triad);
+        let (dict, blocks) = i.explicit_dictionary().unwrap_or((0, 0));
         format!(
-            "bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
+            "dict_blocks={dict} of_blocks={blocks} bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
             bytes / per_step.0,
             100.0 * bytes / per_step.0 / bw
         )

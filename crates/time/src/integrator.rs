@@ -345,6 +345,9 @@ pub struct Integrator {
     friction: Vec<(usize, f64)>,
     /// Per contact node and component, the entry of `friction`.
     friction_slots: Vec<[Option<usize>; 2]>,
+    /// The constant load and the loads on their nonzero rows (explicit
+    /// runs: pass A forms R_K there only).
+    sparse_loads: kernels::SparseLoads,
 }
 
 impl std::fmt::Debug for Integrator {
@@ -541,6 +544,7 @@ impl Integrator {
             compact: None,
             friction: Vec::new(),
             friction_slots: Vec::new(),
+            sparse_loads: kernels::SparseLoads::new(&[], &[]),
             r,
             v,
             dynamics,
@@ -594,6 +598,8 @@ impl Integrator {
             if this.compact.is_some() {
                 this.dynamics.stiffness = CsrMatrix::zeros(0, 0);
             }
+            let loads: Vec<&[f64]> = this.loads.iter().map(|l| &l.vector[..]).collect();
+            this.sparse_loads = kernels::SparseLoads::new(&this.dynamics.constant_load, &loads);
             if let Some(c) = &this.contact {
                 let mut dofs: Vec<usize> = c.nodes.iter().flat_map(|n| n.dofs).flatten().collect();
                 dofs.sort_unstable();
@@ -844,31 +850,43 @@ impl Integrator {
         for (theta, l) in self.thetas.iter_mut().zip(&self.loads) {
             *theta = l.history.value(t_new);
         }
+        // A non-finite θ made every entry of R_K, hence of ṙ_K, NaN in the
+        // dense pass A; pass A over the load rows needs finite θ (kernels.rs).
+        if self.thetas.iter().any(|t| !t.is_finite()) {
+            return Err(self.non_finite(step_number, t_new));
+        }
         // β = 0: r_K = r + Δt ṙ + ½Δt² r̈ is final (no corrector).
         let c1 = dt;
         let c2 = 0.5 * dt * dt;
-        kernels::load_and_predict(
-            &self.dynamics.constant_load,
-            &self.loads,
+        kernels::predict(
+            &self.sparse_loads,
             &self.thetas,
             &self.r,
             &self.v,
             &self.a,
             c1,
             c2,
+            &self.load,
             &mut self.load_new,
             &mut self.r_new,
+            &mut self.partials,
         );
         let scale = 1.0 / (gamma * dt);
         let closed_form = self.settings.explicit_friction == ExplicitFriction::ClosedForm
             || self.contact.is_none();
         let (strain, sums, iterations) = match &self.compact {
             Some(k) if closed_form => {
+                // One chunk: K r_K first, for the friction and the sweep
+                // (it stays in cache); else the friction's rows alone and
+                // K r_K formed in the sweep.
+                let one_chunk = kernels::chunks(self.r_new.len()) == 1;
+                if one_chunk {
+                    k.spmv(&self.r_new, &mut self.b);
+                }
                 let data = kernels::StepData {
                     load_new: &self.load_new,
-                    load: &self.load,
+                    load_rows: self.sparse_loads.rows(),
                     mass: &self.dynamics.lumped_mass,
-                    r: &self.r,
                     r_new: &self.r_new,
                     v: &self.v,
                     a: &self.a,
@@ -887,7 +905,12 @@ impl Integrator {
                         let (mut p, mut q) = (0.0, 0.0);
                         for c in 0..2 {
                             if let Some(i) = node.dofs[c] {
-                                b[c] = kernels::rhs_entry(&data, i, k.row(i, &self.r_new));
+                                let ku = if one_chunk {
+                                    self.b[i]
+                                } else {
+                                    k.row(i, &self.r_new)
+                                };
+                                b[c] = kernels::rhs_entry(&data, i, ku);
                                 let d = mass[i] * scale;
                                 p += node.tangent[c] * b[c] / d;
                                 q += node.tangent[c] * node.tangent[c] / d;
@@ -908,6 +931,7 @@ impl Integrator {
                     k,
                     &data,
                     &self.friction,
+                    one_chunk.then_some(&self.b[..]),
                     &mut self.v_new,
                     &mut self.tmp,
                     &mut self.partials,
@@ -1395,6 +1419,40 @@ impl Integrator {
             }
             (None, false) => 0,
         }
+    }
+
+    /// Bytes one explicit step moves through memory (closed-form friction,
+    /// `kernels.rs`): K ([`Integrator::explicit_matrix_bytes`]), the free-DOF
+    /// vectors its passes read or write (10 of n f64 for the one sweep, 12
+    /// when it has one chunk and K r_K is stored for the friction, 20 for
+    /// the compact product and passes B and C, 23 with the CSR's product)
+    /// and the loads at their rows; 0 for implicit runs.
+    pub fn explicit_bytes_per_step(&self) -> usize {
+        if !self.explicit {
+            return 0;
+        }
+        let n = self.dynamics.n();
+        let streams = match &self.compact {
+            Some(_) if kernels::chunks(n) == 1 => 12,
+            Some(_) => 10,
+            None => 23,
+        };
+        let streams = if self.compact.is_some()
+            && self.contact.is_some()
+            && self.settings.explicit_friction == ExplicitFriction::Iterate
+        {
+            20
+        } else {
+            streams
+        };
+        self.explicit_matrix_bytes() + 8 * streams * n + self.sparse_loads.bytes()
+    }
+
+    /// (distinct blocks, stored blocks) of K's compact form when its values
+    /// are a dictionary (`kernels.rs`), `None` otherwise.
+    pub fn explicit_dictionary(&self) -> Option<(usize, usize)> {
+        let k = self.compact.as_ref()?;
+        (k.dictionary_len() > 0).then(|| (k.dictionary_len(), k.blocks()))
     }
 
     /// How implicit steps solve their linear systems.

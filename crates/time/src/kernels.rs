@@ -2,68 +2,105 @@
 //! deliverable 2).
 //!
 //! An explicit step is bound by memory traffic, so it makes as few sweeps
-//! over the free-DOF vectors as the data dependencies allow: (A) load and
-//! predictor r_K, then, once r_K exists everywhere, one sweep
-//! ([`fused_step`]) that per row forms K r_K, R̂_K, ṙ_K = R̂_K/(m·scale),
-//! r̈_K, and the strain, kinetic, work and load sums. The nodal friction
-//! needs R̂_K at the contact DOFs before their ṙ_K: those few rows are
-//! evaluated first ([`Compact::row`], [`rhs_entry`]) and their velocities
-//! handed to the sweep. Per entry and per sum this is the arithmetic of the
-//! earlier three passes (kept: [`rhs_and_velocity`], [`accelerate_and_sum`],
-//! used by the iterated friction, which needs R̂_K everywhere), so the
-//! results are bit-identical to them; 17 vector streams per step instead of
-//! 24.
+//! over the free-DOF vectors as the data dependencies allow: (A) the
+//! predictor r_K ([`predict`]), with R_K formed only on the rows where a
+//! load is nonzero ([`SparseLoads`]: tractions act on a boundary; the other
+//! rows of R_K are +0 and stay so) and the work and load sums over those
+//! rows; then, once r_K exists everywhere, one sweep ([`fused_step`]) that
+//! forms K r_K, R̂_K, ṙ_K = R̂_K/(m·scale), r̈_K, and the strain and
+//! kinetic sums. The nodal friction needs R̂_K at the contact DOFs before
+//! their ṙ_K: those few rows are evaluated first ([`Compact::row`],
+//! [`rhs_entry`]; a one-chunk run forms all of K r_K first instead, which
+//! stays in cache) and their velocities handed to the sweep. Per entry and
+//! per sum this is the arithmetic of the earlier three passes (kept:
+//! [`rhs_and_velocity`], [`accelerate_and_sum`], used by the iterated
+//! friction, which needs R̂_K everywhere), so the results are bit-identical
+//! to them (tests below; the verify references differ by 0): 10 vector
+//! streams per step (pass A reads r, ṙ, r̈ and writes r_K; the sweep reads
+//! r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K) instead of 17 with dense loads, 24
+//! for the three passes.
 //!
 //! Work is split into fixed chunks of [`CHUNK`] DOFs whatever the number of
 //! threads, and sums are formed per chunk and added in chunk order, so a
 //! run is bit-identical on one thread and on many. Below [`PARALLEL_MIN`]
 //! chunks the passes run on the calling thread (a rayon dispatch costs
-//! microseconds, more than a pass over the paper's 170 DOFs).
+//! microseconds, more than a pass over the paper's 148 free DOFs). Within
+//! a chunk the sweep forms K r_K for [`BATCH`] rows at a time into a buffer
+//! and then runs the per-row work in loops over the batch (the divisions
+//! of ṙ_K and r̈_K of different rows overlap; the sums stay in row order).
 //!
-//! K·r row by row from [`Compact`] (2×2 blocks with u32 columns, 162 bytes
-//! per Q1 DOF) rather than nalgebra-sparse's CSR (usize columns, 288 bytes
-//! per Q1 DOF) or element by element, chosen by measurement: the
-//! `kernel_lab` test below, Q1 slab of 1,004,298 DOFs, 2026-11-22 02:24,
-//! load average 1.1 on the 2 cores:
+//! K·r row by row from [`Compact`] (2×2 blocks with u32 columns, their
+//! values stored, 36 bytes per block, or indexed into a dictionary of the
+//! distinct blocks, 6 or 8) rather than nalgebra-sparse's CSR (usize
+//! columns, 16 bytes per entry) or element by element, chosen by
+//! measurement: the `kernel_lab` test below, Q1 slab of 1,004,298 DOFs,
+//! 2026-11-22 03:44, load average 1.1 on the 2 cores:
 //!
-//! | one K·x, fastest of 20        | 1 thread | 2 threads |
-//! |-------------------------------|----------|-----------|
-//! | CSR (313 MB)                  | 12.3 ms  |  9.4 ms   |
-//! | compact (183 MB)              | 12.8 ms  |  6.8 ms   |
-//! | element by element (297 MB)   | 13.4 ms  |  —        |
+//! | one K·x, fastest of 20             | 1 thread | 2 threads |
+//! |------------------------------------|----------|-----------|
+//! | CSR (313 MB)                       | 13.8 ms  |  9.2 ms   |
+//! | compact, stored (183 MB)           | 10.9 ms  |  6.0 ms   |
+//! | compact, dictionary (63 MB)        |  8.1 ms  |  4.1 ms   |
+//! | element by element (297 MB)        | 12.3 ms  |  —        |
 //!
 //! | step after the predictor, 30 interleaved rounds | 1 thread: median, min | 2 threads: median, min |
 //! |-------------------------------------------------|-----------------------|------------------------|
-//! | CSR, pass B, pass C                             | 20.2, 17.4 ms         | 15.7, 14.0 ms          |
-//! | compact fused with B, pass C                    | 25.1, 23.1 ms         | 14.3, 12.0 ms          |
-//! | one sweep ([`fused_step`])                      | 22.7, 20.2 ms         | 14.3, 13.0 ms          |
+//! | CSR, pass B, pass C                             | 16.9, 16.6 ms         | 13.6, 13.1 ms          |
+//! | compact fused with B, pass C                    | 18.0, 17.7 ms         |  9.9,  9.7 ms          |
+//! | one sweep ([`fused_step`], batches)             | 13.9, 13.6 ms         |  7.1,  7.0 ms          |
 //!
-//! (A run a minute earlier: 2 threads 18.8/16.2, 18.2/13.6, 18.1/13.3 ms;
-//! the machine is shared.)
+//! (The lab's sweep has no load rows; the first two read dense loads.)
+//! Element by element moves more bytes than the compact rows (512 bytes of
+//! matrix and 32 of connectivity per element, one element per node, and a
+//! scatter that reads and writes y), and threading it deterministically
+//! would need a colouring (scatters of neighbouring elements collide);
+//! rows are independent, so threads never share an output. For Q2 the
+//! element matrices (18×18 per 4 nodes, 324 bytes per DOF) lose more.
 //!
-//! On one thread the products are bound by the adder's latency (a row's sum
-//! is a chain in fixed order), not by memory, and the CSR's simpler loop
-//! wins; on the machine's two threads memory binds and the smaller stream
-//! wins. Element by element moves more bytes than the compact rows (512
-//! bytes of matrix and 32 of connectivity per element, one element per
-//! node, and a scatter that reads and writes y), and threading it
-//! deterministically would need a colouring (scatters of neighbouring
-//! elements collide); rows are independent, so threads never share an
-//! output. For Q2 the element matrices (18×18 per 4 nodes, 324 bytes per
-//! DOF) lose more. The one sweep measured equal to compact·B + C; it is
-//! kept for its 7 fewer vector streams. On one thread the compact K·x
-//! costs about 2.8 ns per 2×2 block whatever the bytes: the gain is in the
-//! two-thread, memory-bound case this machine runs.
+//! The dictionary ([`Compact::new`]: used when it halves the matrix
+//! stream; exact bits, so K·x keeps its bits) on the structured slabs,
+//! measured 2026-11-22: Q1 128×32: 10,024 distinct of 37,338 blocks;
+//! 708×177: 101,880 of 1,130,778 (matrix 41.7 → 13.3 MB); 1416×354:
+//! 211,770 of 4,517,896 (167 → 47 MB, the 6.8 MB dictionary read from
+//! cache). The Q2 slabs have 85% distinct blocks (352×88: 1,685,723 of
+//! 1,986,505; 75% distinct column pairs) but only 168,411 distinct values:
+//! a dictionary of values (a 4-byte index per entry, 20 bytes per block
+//! instead of 36) was tried and made the step slower (gen-q2-352x88, same
+//! session: 5.7 → 8.4 ms; four gathers per block, and the Q2 product is
+//! not memory-bound on this machine), so the Q2 and unstructured meshes
+//! keep their blocks stored.
+//!
+//! Each block costs a fixed set of operations (four products and four
+//! additions in the CSR's order per block, its column's bounds check, the
+//! value loads): the dev profile's opt-level 2 emits them scalar (rustc
+//! runs LLVM's SLP vectorizer at opt-level 3 only), about 1.5 ns per block
+//! on one core in cache (paper mesh: 1,088 blocks, ~1.6 µs of its step).
+//! Two groups (four row sums) in lockstep ([`Compact::groups_into`]);
+//! four were measured no faster (paper mesh 2.64 vs 2.49 µs per step, Q2
+//! equal within the noise): the loop is bound by instructions, not by
+//! the adder's latency. Storing the blocks by columns lets opt-level 3
+//! pair the two rows' operations (mulpd/addpd, same bits): the paper mesh
+//! then steps in 2.11 instead of 2.51 µs and Q1 708×177 in 1.61 instead
+//! of 1.89 ms (fastest of 3, same session); that is a profile choice for
+//! the workspace (Cargo.toml), not made here.
+//!
+//! Tried and not kept (branch `cd-predictor-fusion`): the sweep writing
+//! the next step's predictor so that a step of the same Δt skips pass A's
+//! sweep (bit-identical, 10 → 7 vector streams) measured no faster, the
+//! sweep being compute-bound at opt-level 2 (Q1 708×177 1.85 vs 1.91 ms,
+//! 1416×354 8.94 vs 9.17 ms, fastest of 2-3, load 0.8-1.3).
 
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
-
-use crate::integrator::Load;
 
 /// DOFs per chunk of work.
 pub const CHUNK: usize = 8192;
 /// Chunks from which the passes go parallel.
 pub const PARALLEL_MIN: usize = 2;
+/// Rows per batch of the one-sweep step ([`Compact::chunk_batches`]).
+pub const BATCH: usize = 256;
+/// Groups the product sums in lockstep ([`Compact::groups_into`]).
+const LOCKSTEP: usize = 2;
 
 /// Number of chunks of a vector of length n.
 pub fn chunks(n: usize) -> usize {
@@ -115,48 +152,108 @@ fn total(partials: &[[f64; 5]], k: usize) -> f64 {
     partials.iter().map(|p| p[k]).sum()
 }
 
-/// Pass A: R_K = constant + Σ θ_l load_l into `load_new`, and the
-/// predictor r_K = r + c1 ṙ + c2 r̈ into `r_new`.
+/// The loads on the rows where the constant load or any load vector is
+/// nonzero (bit for bit: a −0 counts) — tractions act on a boundary, so a
+/// few rows. Elsewhere R_K = +0 + Σ θ_l·(+0) = +0 exactly for finite θ_l,
+/// and the step's pass A leaves those rows of R_K untouched.
+#[derive(Clone, Debug)]
+pub struct SparseLoads {
+    /// Rows, ascending.
+    rows: Vec<usize>,
+    /// The constant load on them.
+    constant: Vec<f64>,
+    /// Each load vector on them.
+    loads: Vec<Vec<f64>>,
+}
+
+impl SparseLoads {
+    /// The loads `constant` and `loads` (vectors of one length) on their
+    /// nonzero rows.
+    pub fn new(constant: &[f64], loads: &[&[f64]]) -> SparseLoads {
+        let rows: Vec<usize> = (0..constant.len())
+            .filter(|&i| constant[i].to_bits() != 0 || loads.iter().any(|l| l[i].to_bits() != 0))
+            .collect();
+        SparseLoads {
+            constant: rows.iter().map(|&i| constant[i]).collect(),
+            loads: loads
+                .iter()
+                .map(|l| rows.iter().map(|&i| l[i]).collect())
+                .collect(),
+            rows,
+        }
+    }
+
+    /// The rows, ascending.
+    pub fn rows(&self) -> &[usize] {
+        &self.rows
+    }
+
+    /// Bytes a step moves for them: the row indices and the loads read,
+    /// R_K written, R_{K−1}, r and r_K read at those rows (pass A's sums).
+    pub fn bytes(&self) -> usize {
+        self.rows.len() * (8 + 8 * (1 + self.loads.len()) + 8 * 4)
+    }
+}
+
+/// Pass A: the predictor r_K = r + c1 ṙ + c2 r̈ into `r_new` (every row),
+/// R_K = constant + Σ θ_l load_l into `load_new` at the loads' rows only
+/// (its other rows must hold +0: [`SparseLoads`]), and per chunk the sums
+/// work = Σ ½(R_K + R_{K−1})(r_K − r_{K−1}) and r_K·R_K over those rows
+/// into `partials[c][0]` and `[2]`. Every θ_l must be finite.
+///
+/// The per-entry arithmetic and per-chunk order of [`accelerate_and_sum`]'s
+/// sums: a row off the loads adds ½(+0)(r_K − r) = ±0, and a sum that
+/// starts at +0 is never −0 (x + (−x) = +0), so s ± 0 = s and leaving those
+/// rows out gives the same bits (for finite r_K − r; a non-finite r_K
+/// fails the step either way).
 #[allow(clippy::too_many_arguments)]
-pub fn load_and_predict(
-    constant: &[f64],
-    loads: &[Load],
+pub fn predict(
+    sparse: &SparseLoads,
     thetas: &[f64],
     r: &[f64],
     v: &[f64],
     a: &[f64],
     c1: f64,
     c2: f64,
+    load: &[f64],
     load_new: &mut [f64],
     r_new: &mut [f64],
+    partials: &mut Partials,
 ) {
-    let body = |c: usize, l: &mut [f64], rn: &mut [f64]| {
-        let range = c * CHUNK..c * CHUNK + l.len();
-        l.copy_from_slice(&constant[range.clone()]);
-        for (load, theta) in loads.iter().zip(thetas) {
-            if *theta != 0.0 {
-                for (o, f) in l.iter_mut().zip(&load.vector[range.clone()]) {
-                    *o += theta * f;
-                }
-            }
-        }
+    debug_assert!(thetas.iter().all(|t| t.is_finite()));
+    let body = |c: usize, rn: &mut [f64]| {
+        let range = c * CHUNK..c * CHUNK + rn.len();
         let (r, v, a) = (&r[range.clone()], &v[range.clone()], &a[range]);
         for i in 0..rn.len() {
             rn[i] = r[i] + c1 * v[i] + c2 * a[i];
         }
     };
     if parallel(r.len()) {
-        load_new
+        r_new
             .par_chunks_mut(CHUNK)
-            .zip(r_new.par_chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(c, (l, rn))| body(c, l, rn));
+            .for_each(|(c, rn)| body(c, rn));
     } else {
-        load_new
+        r_new
             .chunks_mut(CHUNK)
-            .zip(r_new.chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(c, (l, rn))| body(c, l, rn));
+            .for_each(|(c, rn)| body(c, rn));
+    }
+    for p in partials.iter_mut() {
+        p[0] = 0.0;
+        p[2] = 0.0;
+    }
+    for (k, &i) in sparse.rows.iter().enumerate() {
+        let mut l = sparse.constant[k];
+        for (load, theta) in sparse.loads.iter().zip(thetas) {
+            if *theta != 0.0 {
+                l += theta * load[k];
+            }
+        }
+        load_new[i] = l;
+        let p = &mut partials[i / CHUNK];
+        p[0] += 0.5 * (l + load[i]) * (r_new[i] - r[i]);
+        p[2] += r_new[i] * l;
     }
 }
 
@@ -283,11 +380,13 @@ pub fn accelerate_and_sum(
 /// K in the compact form the explicit step streams (built once per run):
 /// rows grouped in pairs of consecutive free DOFs with the same column
 /// pattern (the x and y DOF of one node; plane elasticity couples nodes by
-/// 2×2 blocks), each pair storing its row in 2-column blocks, 4 values and
-/// one u32 column index per block. A Q1 node's two rows then cost 9 blocks
-/// of 36 bytes, 162 bytes per DOF instead of 288 for nalgebra-sparse's CSR
+/// 2×2 blocks), each pair storing its row in 2-column blocks, 4 values (or
+/// their index in a dictionary of distinct blocks, [`Values`]) and one u32
+/// column index per block. A Q1 node's two rows then cost 9 blocks of 36
+/// bytes, 162 bytes per DOF instead of 288 for nalgebra-sparse's CSR
 /// (usize column index and value per entry); with the row pointers (4 bytes
-/// per pair) the matrix stream is 0.57× the CSR's.
+/// per pair) the matrix stream is 0.57× the CSR's, and with a dictionary
+/// of 2-byte (4-byte) indices 0.12× (0.16×) plus the dictionary.
 ///
 /// Rows that have no partner (a node with one DOF constrained, or a pair
 /// straddling a [`CHUNK`] boundary, so that threads never share a group)
@@ -308,17 +407,185 @@ pub struct Compact {
     group_blocks: Vec<u32>,
     /// First column of each block.
     cols: Vec<u32>,
-    /// [row 0 · col 0, row 0 · col 1, row 1 · col 0, row 1 · col 1].
-    vals: Vec<[f64; 4]>,
+    /// The blocks' values, stored or by dictionary.
+    values: Values,
     /// Groups of chunk c: chunk_groups[c]..chunk_groups[c + 1].
     chunk_groups: Vec<u32>,
+}
+
+/// The values of the blocks, [row 0 · col 0, row 1 · col 0, row 0 · col 1,
+/// row 1 · col 1] each (by columns): stored per block, or as an index per block into a
+/// dictionary of the distinct blocks (bit for bit: no tolerance, so a
+/// block read from the dictionary has the bits of the stored one).
+#[derive(Clone, Debug)]
+enum Values {
+    /// 32 bytes per block.
+    Stored(Vec<[f64; 4]>),
+    /// 2 bytes per block and the dictionary (≤ 65,536 distinct blocks).
+    Dict16 { ids: Vec<u16>, dict: Vec<[f64; 4]> },
+    /// 4 bytes per block and the dictionary.
+    Dict32 { ids: Vec<u32>, dict: Vec<[f64; 4]> },
+}
+
+/// Which form [`Compact::with_form`] builds (the step uses `Auto`; the
+/// tests and the lab force the others).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(not(test), allow(dead_code))]
+pub enum Form {
+    /// The dictionary when it cuts the matrix stream by ≥ 2× (see
+    /// [`Compact::new`]).
+    Auto,
+    /// Values stored per block.
+    Stored,
+    /// The dictionary whatever it saves.
+    Dictionary,
+}
+
+/// Block values as the kernels read them: a slice of per-block entries
+/// (`ids`) and how an entry gives its block.
+trait Blocks: Sync {
+    type Id: Sync;
+    fn ids(&self) -> &[Self::Id];
+    fn value(&self, id: &Self::Id) -> [f64; 4];
+}
+
+struct StoredBlocks<'a>(&'a [[f64; 4]]);
+
+impl Blocks for StoredBlocks<'_> {
+    type Id = [f64; 4];
+    #[inline(always)]
+    fn ids(&self) -> &[[f64; 4]] {
+        self.0
+    }
+    #[inline(always)]
+    fn value(&self, id: &[f64; 4]) -> [f64; 4] {
+        *id
+    }
+}
+
+struct DictBlocks<'a, I> {
+    ids: &'a [I],
+    dict: &'a [[f64; 4]],
+}
+
+impl<I: Copy + Into<u32> + Sync> Blocks for DictBlocks<'_, I> {
+    type Id = I;
+    #[inline(always)]
+    fn ids(&self) -> &[I] {
+        self.ids
+    }
+    #[inline(always)]
+    fn value(&self, id: &I) -> [f64; 4] {
+        let k: u32 = (*id).into();
+        self.dict[k as usize]
+    }
+}
+
+/// A kernel over the block values in whichever form they are
+/// ([`Compact::with_blocks`]: one match per call, the loops monomorphic).
+trait Kernel<R> {
+    fn run<B: Blocks>(self, k: &Compact, b: &B) -> R;
+}
+
+/// One 2×2 block's contribution to a group's two sums, each in the CSR's
+/// order (column c, then c + 1). The block is stored by columns, so that
+/// the two rows' operations on one column are a pair of adjacent lanes
+/// (the compiler's 2-wide vector operations).
+#[inline(always)]
+fn block(col: u32, v: [f64; 4], x: &[f64], s: &mut [f64; 2]) {
+    let c = col as usize;
+    let xs = &x[c..c + 2];
+    let (x0, x1) = (xs[0], xs[1]);
+    s[0] += v[0] * x0;
+    s[1] += v[1] * x0;
+    s[0] += v[2] * x1;
+    s[1] += v[3] * x1;
+}
+
+impl Values {
+    fn bytes(&self) -> usize {
+        match self {
+            Values::Stored(v) => 32 * v.len(),
+            Values::Dict16 { ids, dict } => 2 * ids.len() + 32 * dict.len(),
+            Values::Dict32 { ids, dict } => 4 * ids.len() + 32 * dict.len(),
+        }
+    }
+}
+
+/// The dictionary of distinct blocks (equal bits, in order of first
+/// appearance) and each block's index into it; `None` as soon as it would
+/// hold more than `max` blocks.
+fn dictionary(blocks: &[[f64; 4]], max: usize) -> Option<Values> {
+    let mut index: std::collections::HashMap<[u64; 4], u32, BlockHash> =
+        std::collections::HashMap::with_capacity_and_hasher(max.min(blocks.len()) / 4, BlockHash);
+    let mut dict = Vec::new();
+    let mut ids = Vec::with_capacity(blocks.len());
+    for b in blocks {
+        let next = dict.len() as u32;
+        let id = *index.entry(b.map(f64::to_bits)).or_insert(next);
+        if id == next {
+            if dict.len() == max {
+                return None;
+            }
+            dict.push(*b);
+        }
+        ids.push(id);
+    }
+    dict.shrink_to_fit();
+    Some(if dict.len() <= 1 << 16 {
+        Values::Dict16 {
+            ids: ids.iter().map(|&k| k as u16).collect(),
+            dict,
+        }
+    } else {
+        Values::Dict32 { ids, dict }
+    })
+}
+
+/// A multiply-xor hash of a block's bits (SipHash, the default, made the
+/// dictionary of a 1M-DOF Q2 matrix take seconds; no adversary here).
+#[derive(Clone, Copy, Default)]
+struct BlockHash;
+
+impl std::hash::BuildHasher for BlockHash {
+    type Hasher = BlockHasher;
+    fn build_hasher(&self) -> BlockHasher {
+        BlockHasher(0)
+    }
+}
+
+struct BlockHasher(u64);
+
+impl std::hash::Hasher for BlockHasher {
+    fn finish(&self) -> u64 {
+        self.0 ^ (self.0 >> 29)
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for c in bytes.chunks(8) {
+            let mut w = [0u8; 8];
+            w[..c.len()].copy_from_slice(c);
+            self.write_u64(u64::from_le_bytes(w));
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(23) ^ x).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
 }
 
 impl Compact {
     /// The compact form of a square CSR matrix with sorted columns, or
     /// `None` when it does not apply (fewer than 2 rows, more than u32
-    /// indices can address).
+    /// indices can address). The block values go into a dictionary when
+    /// that cuts the bytes the SpMV streams from the matrix by ≥ 2×
+    /// (structured meshes: few distinct blocks), else they are stored per
+    /// block (unstructured meshes: nearly every block distinct, and a
+    /// dictionary would add an index per block and a scattered read).
     pub fn new(a: &CsrMatrix<f64>) -> Option<Compact> {
+        Compact::with_form(a, Form::Auto)
+    }
+
+    /// [`Compact::new`] with the form of the values chosen by the caller.
+    pub fn with_form(a: &CsrMatrix<f64>, form: Form) -> Option<Compact> {
         let n = a.nrows();
         let offsets = a.row_offsets();
         let cols = a.col_indices();
@@ -368,7 +635,7 @@ impl Compact {
                         block_vals.push([0.0; 4]);
                     }
                     debug_assert_eq!(block_cols[next], s);
-                    block_vals[next][2 * k + (c - s as usize)] = vals[p];
+                    block_vals[next][2 * (c - s as usize) + k] = vals[p];
                 }
             }
             if block_cols.len() >= u32::MAX as usize {
@@ -387,119 +654,225 @@ impl Compact {
         }
         block_cols.shrink_to_fit();
         block_vals.shrink_to_fit();
-        Some(Compact {
+        let mut compact = Compact {
             group_rows,
             group_blocks,
             cols: block_cols,
-            vals: block_vals,
+            values: Values::Stored(Vec::new()),
             chunk_groups,
-        })
+        };
+        compact.values = match form {
+            Form::Stored => Values::Stored(block_vals),
+            Form::Dictionary => dictionary(&block_vals, usize::MAX).expect("no limit"),
+            Form::Auto => {
+                // The largest dictionary that can halve the stream (with
+                // 2-byte indices, the least it can cost per block); the
+                // build stops there, so a mesh with nearly all blocks
+                // distinct pays for a fraction of it.
+                let blocks = block_vals.len();
+                let stored = compact.bytes_with(32 * blocks);
+                let max = (stored / 2).saturating_sub(compact.bytes_with(2 * blocks)) / 32;
+                match dictionary(&block_vals, max) {
+                    Some(values) if 2 * compact.bytes_with(values.bytes()) <= stored => values,
+                    _ => Values::Stored(block_vals),
+                }
+            }
+        };
+        Some(compact)
     }
 
-    /// Bytes the SpMV streams from the matrix.
+    /// Bytes the SpMV streams from the matrix: block columns, group
+    /// offsets and the values (a dictionary counted once: it stays in
+    /// cache over a step).
     pub fn bytes(&self) -> usize {
-        36 * self.cols.len() + 4 * (self.group_rows.len() + self.group_blocks.len())
+        self.bytes_with(self.values.bytes())
+    }
+
+    fn bytes_with(&self, values: usize) -> usize {
+        4 * (self.cols.len() + self.group_rows.len() + self.group_blocks.len()) + values
+    }
+
+    /// Distinct blocks in the dictionary (0 when the values are stored).
+    pub fn dictionary_len(&self) -> usize {
+        match &self.values {
+            Values::Stored(_) => 0,
+            Values::Dict16 { dict, .. } | Values::Dict32 { dict, .. } => dict.len(),
+        }
+    }
+
+    /// Stored blocks.
+    pub fn blocks(&self) -> usize {
+        self.cols.len()
+    }
+
+    /// Runs `k` with the block values in their form.
+    #[inline(always)]
+    fn with_blocks<R>(&self, k: impl Kernel<R>) -> R {
+        match &self.values {
+            Values::Stored(v) => k.run(self, &StoredBlocks(v)),
+            Values::Dict16 { ids, dict } => k.run(self, &DictBlocks { ids, dict }),
+            Values::Dict32 { ids, dict } => k.run(self, &DictBlocks { ids, dict }),
+        }
     }
 
     /// The sums of group g's rows (the second is 0 for a single row).
-    #[inline]
-    fn group_sums(&self, g: usize, x: &[f64]) -> (f64, f64) {
+    #[inline(always)]
+    fn group_sums_in<B: Blocks>(&self, b: &B, g: usize, x: &[f64]) -> [f64; 2] {
         let blocks = self.group_blocks[g] as usize..self.group_blocks[g + 1] as usize;
-        let (mut s0, mut s1) = (0.0, 0.0);
-        for (&col, v) in self.cols[blocks.clone()].iter().zip(&self.vals[blocks]) {
-            let c = col as usize;
-            let xs = &x[c..c + 2];
-            s0 += v[0] * xs[0];
-            s0 += v[1] * xs[1];
-            s1 += v[2] * xs[0];
-            s1 += v[3] * xs[1];
+        let mut s = [0.0; 2];
+        for (&col, v) in self.cols[blocks.clone()].iter().zip(&b.ids()[blocks]) {
+            block(col, b.value(v), x, &mut s);
         }
-        (s0, s1)
+        s
     }
 
     /// (K x)_i alone, with the bits the passes give it.
     pub fn row(&self, i: usize, x: &[f64]) -> f64 {
-        let g = self.group_rows.partition_point(|&r| r as usize <= i) - 1;
-        let (s0, s1) = self.group_sums(g, x);
-        if i == self.group_rows[g] as usize {
-            s0
-        } else {
-            s1
+        struct Row<'x>(usize, &'x [f64]);
+        impl Kernel<f64> for Row<'_> {
+            fn run<B: Blocks>(self, k: &Compact, b: &B) -> f64 {
+                let Row(i, x) = self;
+                let g = k.group_rows.partition_point(|&r| r as usize <= i) - 1;
+                let s = k.group_sums_in(b, g, x);
+                if i == k.group_rows[g] as usize {
+                    s[0]
+                } else {
+                    s[1]
+                }
+            }
         }
+        self.with_blocks(Row(i, x))
     }
 
     /// Calls `f(row, (K x)_row)` for every row of chunk `c`, in row order.
-    ///
-    /// Two groups are summed in lockstep: a row's sum is a chain of
-    /// dependent additions in a fixed order (the CSR's, for the bits), so
-    /// one group alone leaves the core waiting on the adder's latency; two
-    /// give it four independent chains, each still in its own order.
     #[inline]
     fn chunk_rows(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, f64)) {
-        let (g0, g1) = (
-            self.chunk_groups[c] as usize,
-            self.chunk_groups[c + 1] as usize,
-        );
-        #[inline(always)]
-        fn block(col: u32, v: &[f64; 4], x: &[f64], s: &mut [f64; 2]) {
-            let c = col as usize;
-            let xs = &x[c..c + 2];
-            s[0] += v[0] * xs[0];
-            s[0] += v[1] * xs[1];
-            s[1] += v[2] * xs[0];
-            s[1] += v[3] * xs[1];
-        }
-        let mut emit = |g: usize, s: [f64; 2]| {
-            let r0 = self.group_rows[g] as usize;
-            f(r0, s[0]);
-            if self.group_rows[g + 1] as usize - r0 == 2 {
-                f(r0 + 1, s[1]);
+        self.chunk_batches(c, x, |r0, ku| {
+            for (k, &s) in ku.iter().enumerate() {
+                f(r0 + k, s);
             }
-        };
+        });
+    }
+
+    /// Calls `f(first row, K x on the batch's rows)` for consecutive
+    /// batches of at most [`BATCH`] rows covering chunk `c`, in order: the
+    /// caller's per-row work then runs in loops over a batch held in L1
+    /// (the divisions of ṙ_K and r̈_K pipelined) instead of once per row
+    /// inside the product's loop.
+    #[inline]
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64])) {
+        struct Batches<'x, F>(usize, &'x [f64], F);
+        impl<F: FnMut(usize, &[f64])> Kernel<()> for Batches<'_, F> {
+            #[inline(always)]
+            fn run<B: Blocks>(self, k: &Compact, b: &B) {
+                let Batches(c, x, mut f) = self;
+                let (g0, g1) = (k.chunk_groups[c] as usize, k.chunk_groups[c + 1] as usize);
+                let mut buf = [0.0; BATCH];
+                let mut g = g0;
+                while g < g1 {
+                    let gb = (g + BATCH / 2).min(g1);
+                    let (ra, rb) = (k.group_rows[g] as usize, k.group_rows[gb] as usize);
+                    let out = &mut buf[..rb - ra];
+                    k.groups_into(b, g, gb, x, out);
+                    f(ra, out);
+                    g = gb;
+                }
+            }
+        }
+        self.with_blocks(Batches(c, x, f))
+    }
+
+    /// K x on the rows of groups g0..g1 into `out` (from the first row of
+    /// g0 on), with the values in form `B`.
+    ///
+    /// [`LOCKSTEP`] groups are summed in lockstep: a row's sum is a chain
+    /// of dependent additions in a fixed order (the CSR's, for the bits),
+    /// so one group alone leaves the core waiting on the adder's latency;
+    /// G groups give it 2G independent chains, each still in its own order.
+    #[inline(always)]
+    fn groups_into<B: Blocks>(&self, b: &B, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
+        let base = self.group_rows[g0] as usize;
         let mut g = g0;
-        while g + 1 < g1 {
-            let (a0, a1) = (
-                self.group_blocks[g] as usize,
-                self.group_blocks[g + 1] as usize,
-            );
-            let b1 = self.group_blocks[g + 2] as usize;
-            let (mut sa, mut sb) = ([0.0; 2], [0.0; 2]);
-            let (ca, va) = (&self.cols[a0..a1], &self.vals[a0..a1]);
-            let (cb, vb) = (&self.cols[a1..b1], &self.vals[a1..b1]);
-            let common = ca.len().min(cb.len());
-            for (((ca, va), cb), vb) in ca[..common]
-                .iter()
-                .zip(&va[..common])
-                .zip(&cb[..common])
-                .zip(&vb[..common])
-            {
-                block(*ca, va, x, &mut sa);
-                block(*cb, vb, x, &mut sb);
-            }
-            for (c, v) in ca[common..].iter().zip(&va[common..]) {
-                block(*c, v, x, &mut sa);
-            }
-            for (c, v) in cb[common..].iter().zip(&vb[common..]) {
-                block(*c, v, x, &mut sb);
-            }
-            emit(g, sa);
-            emit(g + 1, sb);
-            g += 2;
+        while g + LOCKSTEP <= g1 {
+            self.lockstep::<LOCKSTEP, B>(b, g, x, out, base);
+            g += LOCKSTEP;
         }
-        if g < g1 {
-            let (s0, s1) = self.group_sums(g, x);
-            emit(g, [s0, s1]);
+        while g < g1 {
+            self.lockstep::<1, B>(b, g, x, out, base);
+            g += 1;
         }
     }
 
-    /// y = K x (the same bits as [`spmv`] on the CSR); the step uses the
-    /// fused [`spmv_rhs_and_velocity`].
-    #[cfg(test)]
+    /// Groups g..g + G in lockstep over their common length, then the
+    /// rest of each.
+    #[inline(always)]
+    fn lockstep<const G: usize, B: Blocks>(
+        &self,
+        b: &B,
+        g: usize,
+        x: &[f64],
+        out: &mut [f64],
+        base: usize,
+    ) {
+        let mut at: [usize; G] = std::array::from_fn(|q| self.group_blocks[g + q] as usize);
+        let end: [usize; G] = std::array::from_fn(|q| self.group_blocks[g + q + 1] as usize);
+        let mut s = [[0.0; 2]; G];
+        self.common(b, x, &mut at, &end, &mut s);
+        if G > 1 {
+            for q in 0..G {
+                let mut one = [s[q]];
+                self.common(b, x, &mut [at[q]], &[end[q]], &mut one);
+                s[q] = one[0];
+            }
+        }
+        for (q, s) in s.iter().enumerate() {
+            let r0 = self.group_rows[g + q] as usize;
+            out[r0 - base] = s[0];
+            if self.group_rows[g + q + 1] as usize - r0 == 2 {
+                out[r0 + 1 - base] = s[1];
+            }
+        }
+    }
+
+    /// The blocks at[q]..at[q] + len of G groups in lockstep, len their
+    /// least remaining length; advances `at`.
+    #[inline(always)]
+    fn common<const G: usize, B: Blocks>(
+        &self,
+        b: &B,
+        x: &[f64],
+        at: &mut [usize; G],
+        end: &[usize; G],
+        s: &mut [[f64; 2]; G],
+    ) {
+        let ids = b.ids();
+        let len = (0..G).map(|q| end[q] - at[q]).min().unwrap_or(0);
+        let cols: [&[u32]; G] = std::array::from_fn(|q| &self.cols[at[q]..at[q] + len]);
+        let vals: [&[B::Id]; G] = std::array::from_fn(|q| &ids[at[q]..at[q] + len]);
+        let mut acc = *s;
+        for j in 0..len {
+            for q in 0..G {
+                block(cols[q][j], b.value(&vals[q][j]), x, &mut acc[q]);
+            }
+        }
+        *s = acc;
+        for a in at.iter_mut() {
+            *a += len;
+        }
+    }
+
+    /// y = K x (the same bits as [`spmv`] on the CSR).
     pub fn spmv(&self, x: &[f64], y: &mut [f64]) {
-        let body = |c: usize, y: &mut [f64]| {
-            let start = c * CHUNK;
-            self.chunk_rows(c, x, |i, s| y[i - start] = s);
-        };
+        struct Into<'x, 'y>(usize, &'x [f64], &'y mut [f64]);
+        impl Kernel<()> for Into<'_, '_> {
+            #[inline(always)]
+            fn run<B: Blocks>(self, k: &Compact, b: &B) {
+                let Into(c, x, y) = self;
+                let (g0, g1) = (k.chunk_groups[c] as usize, k.chunk_groups[c + 1] as usize);
+                k.groups_into(b, g0, g1, x, y);
+            }
+        }
+        let body = |c: usize, y: &mut [f64]| self.with_blocks(Into(c, x, y));
         if parallel(y.len()) {
             y.par_chunks_mut(CHUNK)
                 .enumerate()
@@ -560,14 +933,12 @@ pub fn spmv_rhs_and_velocity(
 
 /// The vectors and coefficients of one explicit step for [`fused_step`].
 pub struct StepData<'a> {
-    /// R_K.
+    /// R_K (+0 off `load_rows`).
     pub load_new: &'a [f64],
-    /// R_{K−1}.
-    pub load: &'a [f64],
+    /// The rows where R_K may be nonzero ([`SparseLoads::rows`]).
+    pub load_rows: &'a [usize],
     /// Lumped mass.
     pub mass: &'a [f64],
-    /// r_{K−1}.
-    pub r: &'a [f64],
     /// r_K (the predictor, final for β = 0).
     pub r_new: &'a [f64],
     /// ṙ_{K−1}.
@@ -592,50 +963,120 @@ pub fn rhs_entry(s: &StepData, i: usize, ku: f64) -> f64 {
     s.load_new[i] - ku + s.mass[i] * (s.cv * s.v[i] + s.ca * s.a[i])
 }
 
+/// The sweep's running sums over a chunk, in row order.
+struct Running {
+    strain: f64,
+    kinetic: f64,
+    finite: bool,
+    /// Next entries of `load_rows` and `friction`.
+    load: usize,
+    friction: usize,
+}
+
+/// The sweep's per-row work on rows r0..r0 + ku.len() given their K r_K:
+/// ṙ_K = R̂_K/(m·scale) (with R_K = +0 first, the literal, then again at
+/// the load rows with their R_K: [`rhs_entry`]'s operations either way),
+/// the friction's velocities at the contact DOFs, r̈_K, and the strain and
+/// kinetic sums in row order. Loops over the batch rather than one pass
+/// per row: the first two have no dependence between rows, so their
+/// divisions overlap.
+#[inline(always)]
+fn batch_rows(
+    s: &StepData,
+    friction: &[(usize, f64)],
+    r0: usize,
+    ku: &[f64],
+    vn: &mut [f64],
+    an: &mut [f64],
+    run: &mut Running,
+) {
+    let n = ku.len();
+    let rows = r0..r0 + n;
+    let (m, v, a) = (
+        &s.mass[rows.clone()],
+        &s.v[rows.clone()],
+        &s.a[rows.clone()],
+    );
+    let rn = &s.r_new[rows];
+    let (vn, an) = (&mut vn[..n], &mut an[..n]);
+    let (cv, ca, scale) = (s.cv, s.ca, s.scale);
+    for k in 0..n {
+        let zero = 0.0;
+        let bi = zero - ku[k] + m[k] * (cv * v[k] + ca * a[k]);
+        vn[k] = bi / (m[k] * scale);
+    }
+    while run.load < s.load_rows.len() && s.load_rows[run.load] < r0 + n {
+        let i = s.load_rows[run.load];
+        let k = i - r0;
+        vn[k] = rhs_entry(s, i, ku[k]) / (m[k] * scale);
+        run.load += 1;
+    }
+    while run.friction < friction.len() && friction[run.friction].0 < r0 + n {
+        let (i, vi) = friction[run.friction];
+        vn[i - r0] = vi;
+        run.friction += 1;
+    }
+    let (gamma_dt, ratio) = (s.gamma_dt, s.ratio);
+    let mut finite = run.finite;
+    for k in 0..n {
+        an[k] = (vn[k] - v[k]) / gamma_dt - ratio * a[k];
+        // `&`, not `&&`: no branch, so the loop stays vectorized.
+        finite &= rn[k].is_finite() & vn[k].is_finite();
+    }
+    let (mut strain, mut kinetic) = (run.strain, run.kinetic);
+    for k in 0..n {
+        strain += rn[k] * ku[k];
+        kinetic += m[k] * vn[k] * vn[k];
+    }
+    (run.strain, run.kinetic, run.finite) = (strain, kinetic, finite);
+}
+
 /// Passes B and C and the SpMV in one sweep: per row, K r_K, R̂_K,
 /// ṙ_K = R̂_K/(m·scale) — or, at the contact DOFs, the velocity the nodal
 /// friction gave (`friction`, (DOF, ṙ_K) sorted by DOF, computed before
 /// from [`Compact::row`] and [`rhs_entry`]) — then r̈_K and the sums. Per
 /// entry the arithmetic of [`rhs_and_velocity`] and [`accelerate_and_sum`],
-/// per chunk the sums in row order: the same bits as the three passes, with
-/// 17 vector streams per step (with pass A) instead of 24, and R̂_K never
+/// per chunk the sums in row order: the same bits as the three passes.
+/// The work and load sums are pass A's ([`predict`], over the load rows,
+/// in `partials[c][0]` and `[2]`), so the sweep reads neither R_{K−1} nor
+/// r_{K−1}: with pass A, 10 vector streams per step (pass A reads r, ṙ,
+/// r̈ and writes r_K; the sweep reads r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K)
+/// instead of 24 for the three passes over dense loads, and R̂_K never
 /// stored.
+///
+/// `ku`: K r_K when the caller has it (the one-chunk step computes it
+/// first for the friction, [`Compact::spmv`]); else the sweep forms it.
 pub fn fused_step(
     k: &Compact,
     s: &StepData,
     friction: &[(usize, f64)],
+    ku: Option<&[f64]>,
     v_new: &mut [f64],
     a_new: &mut [f64],
     partials: &mut Partials,
 ) -> (f64, Sums) {
     let body = |c: usize, vn: &mut [f64], an: &mut [f64], partial: &mut [f64; 5]| {
         let start = c * CHUNK;
-        let mut next = friction.partition_point(|f| f.0 < start);
-        let (mut strain, mut work, mut kinetic, mut load_dot) = (0.0, 0.0, 0.0, 0.0);
-        let mut finite = true;
-        k.chunk_rows(c, s.r_new, |i, ku| {
-            let rn = s.r_new[i];
-            strain += rn * ku;
-            let bi = rhs_entry(s, i, ku);
-            let mut vi = bi / (s.mass[i] * s.scale);
-            if next < friction.len() && friction[next].0 == i {
-                vi = friction[next].1;
-                next += 1;
+        let mut run = Running {
+            strain: 0.0,
+            kinetic: 0.0,
+            finite: true,
+            load: s.load_rows.partition_point(|&i| i < start),
+            friction: friction.partition_point(|f| f.0 < start),
+        };
+        match ku {
+            Some(ku) => {
+                let ku = &ku[start..start + vn.len()];
+                batch_rows(s, friction, start, ku, vn, an, &mut run);
             }
-            vn[i - start] = vi;
-            an[i - start] = (vi - s.v[i]) / s.gamma_dt - s.ratio * s.a[i];
-            work += 0.5 * (s.load_new[i] + s.load[i]) * (rn - s.r[i]);
-            kinetic += s.mass[i] * vi * vi;
-            load_dot += rn * s.load_new[i];
-            finite &= rn.is_finite() && vi.is_finite();
-        });
-        *partial = [
-            work,
-            kinetic,
-            load_dot,
-            if finite { 0.0 } else { 1.0 },
-            strain,
-        ];
+            None => k.chunk_batches(c, s.r_new, |r0, ku| {
+                let (vn, an) = (&mut vn[r0 - start..], &mut an[r0 - start..]);
+                batch_rows(s, friction, r0, ku, vn, an, &mut run);
+            }),
+        }
+        partial[1] = run.kinetic;
+        partial[3] = if run.finite { 0.0 } else { 1.0 };
+        partial[4] = run.strain;
     };
     if parallel(v_new.len()) {
         v_new
@@ -701,27 +1142,43 @@ mod tests {
                 let model = Model::new(&mesh, &material, conditions).unwrap();
                 for k in [&model.stiffness, &model.mass] {
                     let n = k.nrows();
-                    let compact = Compact::new(k).expect("applies");
                     let x = x_of(n);
-                    let (mut y0, mut y1) = (vec![0.0; n], vec![1.0; n]);
+                    let mut y0 = vec![0.0; n];
                     spmv(k, &x, &mut y0);
-                    compact.spmv(&x, &mut y1);
-                    for i in 0..n {
-                        assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "{name} row {i}");
+                    for form in [Form::Stored, Form::Dictionary, Form::Auto] {
+                        let compact = Compact::with_form(k, form).expect("applies");
+                        let mut y1 = vec![1.0; n];
+                        compact.spmv(&x, &mut y1);
+                        for i in 0..n {
+                            assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "{name} {form:?} row {i}");
+                            assert_eq!(
+                                y0[i].to_bits(),
+                                compact.row(i, &x).to_bits(),
+                                "{name} {form:?} row {i} alone"
+                            );
+                        }
+                        // A Q1 / Q2 node's two rows are one pair (the blocks
+                        // are at most 4/3 of the CSR's entries, the padding
+                        // is only at constrained nodes and chunk seams).
+                        assert!(3 * compact.cols.len() <= k.nnz(), "{name}");
+                        let dict = compact.dictionary_len();
+                        match form {
+                            Form::Stored => assert_eq!(dict, 0),
+                            Form::Dictionary => assert!(dict > 0 && dict <= compact.blocks()),
+                            Form::Auto => {}
+                        }
                     }
-                    // A Q1 / Q2 node's two rows are one pair (the blocks
-                    // are at most 4/3 of the CSR's entries, the padding
-                    // is only at constrained nodes and chunk seams).
-                    assert!(3 * compact.cols.len() <= k.nnz(), "{name}");
                 }
             }
         }
     }
 
-    /// The one-sweep step (friction velocities handed in) has the bits of
-    /// the CSR SpMV and passes B and C with the friction written between
-    /// them, as the step did before the sweep: on a model of several
-    /// chunks, serial and on two threads.
+    /// The one-sweep step (friction velocities handed in, loads over their
+    /// rows) has the bits of the CSR SpMV and the dense passes A, B and C
+    /// with the friction written between B and C, as the step did before
+    /// the sweep: on a model of several chunks and on the paper's mesh (one
+    /// chunk, K r_K handed in and formed in the sweep), both value forms,
+    /// serial and on two threads.
     #[test]
     fn fused_step_has_the_bits_of_the_passes() {
         let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
@@ -730,22 +1187,150 @@ mod tests {
             Dirichlet::new("left", 0, 0.0),
         ];
         let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes");
-        let mesh = Mesh::from_file(dir.join("slab-q2-64x16.msh")).unwrap();
-        let model = Model::new(&mesh, &material, &supports).unwrap();
-        let k = &model.stiffness;
+        for (name, several) in [("slab-q2-64x16.msh", true), ("slab-q2-8x2.msh", false)] {
+            let mesh = Mesh::from_file(dir.join(name)).unwrap();
+            let model = Model::new(&mesh, &material, &supports).unwrap();
+            let k = &model.stiffness;
+            let n = k.nrows();
+            assert_eq!(chunks(n) >= 2, several, "{name}: {n} DOFs");
+            let forms = [
+                Compact::with_form(k, Form::Stored).unwrap(),
+                Compact::with_form(k, Form::Dictionary).unwrap(),
+            ];
+            assert!(forms[1].dictionary_len() > 0);
+            for threads in [1, 2] {
+                for compact in &forms {
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .unwrap();
+                    pool.install(|| check_fused(k, compact, &format!("{name} {threads}")));
+                }
+            }
+        }
+    }
+
+    /// A NaN or infinite r_K or ṙ_K in any row, in either chunk, with K r_K
+    /// handed in or not, clears the sweep's finiteness flag.
+    #[test]
+    fn fused_step_flags_non_finite() {
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes");
+        for name in ["slab-q2-8x2.msh", "slab-q2-64x16.msh"] {
+            let mesh = Mesh::from_file(dir.join(name)).unwrap();
+            let model = Model::new(&mesh, &material, &[]).unwrap();
+            let k = &model.stiffness;
+            let n = k.nrows();
+            let compact = Compact::new(k).unwrap();
+            let mass = vec![1.0; n];
+            let zero = vec![0.0; n];
+            for (row, bad, in_r) in [
+                (0, f64::NAN, true),
+                (n - 1, f64::INFINITY, false),
+                (n / 2 + 1, f64::NEG_INFINITY, true),
+                (n / 3, f64::NAN, false),
+            ] {
+                let mut r_new = x_of(n);
+                let mut v = vec![0.5; n];
+                if in_r {
+                    r_new[row] = bad;
+                } else {
+                    v[row] = bad;
+                }
+                let data = StepData {
+                    load_new: &zero,
+                    load_rows: &[],
+                    mass: &mass,
+                    r_new: &r_new,
+                    v: &v,
+                    a: &zero,
+                    cv: 2.0,
+                    ca: 1.0,
+                    scale: 2.0,
+                    gamma_dt: 0.5,
+                    ratio: 1.0,
+                };
+                let mut ku = vec![0.0; n];
+                compact.spmv(&r_new, &mut ku);
+                for given in [None, Some(&ku[..])] {
+                    let mut p = partials(n);
+                    let (mut vn, mut an) = (vec![0.0; n], vec![0.0; n]);
+                    let (_, sums) =
+                        fused_step(&compact, &data, &[], given, &mut vn, &mut an, &mut p);
+                    assert!(!sums.finite, "{name} row {row} {bad}");
+                }
+            }
+        }
+    }
+
+    /// See [`fused_step_has_the_bits_of_the_passes`].
+    fn check_fused(k: &CsrMatrix<f64>, compact: &Compact, name: &str) {
         let n = k.nrows();
-        assert!(chunks(n) >= 2, "{n} DOFs: one chunk");
-        let compact = Compact::new(k).unwrap();
         let vec =
             |shift: f64| -> Vec<f64> { x_of(n).iter().map(|x| x * shift + 0.1 * shift).collect() };
-        let (r, r_new, v, a) = (vec(1.0), vec(1.1), vec(-0.7), vec(3.0));
-        let (load, load_new) = (vec(0.3), vec(0.31));
+        let (r, v, a) = (vec(1.0), vec(-0.7), vec(3.0));
         let mass: Vec<f64> = x_of(n).iter().map(|x| 1.0 + x.abs()).collect();
+        // Loads on a few rows (both sides of chunk seams, a −0 entry, a row
+        // where two loads cancel), +0 elsewhere.
+        let mut constant = vec![0.0; n];
+        let mut l1 = vec![0.0; n];
+        let mut l2 = vec![0.0; n];
+        for i in (0..n).filter(|i| i % 61 == 5 || i % CHUNK == 0 || i % CHUNK == CHUNK - 1) {
+            l1[i] = 0.3 + 1e-3 * i as f64;
+        }
+        for i in (0..n).filter(|i| i % 89 == 7) {
+            l2[i] = -0.2 * (1.0 + (i % 5) as f64);
+            if i % 3 == 0 {
+                l1[i] = -l2[i];
+            }
+        }
+        constant[n / 2] = 0.25;
+        constant[n / 3] = -0.0;
+        let sparse = SparseLoads::new(&constant, &[&l1, &l2]);
+        assert!(sparse.rows().len() < n / 8 && sparse.rows().contains(&(n / 3)));
+        let (c1, c2) = (1e-3, 0.5e-6);
+        // The dense pass A of before, at θ = (0.7, 1.3) (step K) and at
+        // θ = (0.9, 0) (step K − 1).
+        let dense = |thetas: [f64; 2]| -> Vec<f64> {
+            let mut l = constant.clone();
+            for (load, theta) in [&l1, &l2].iter().zip(thetas) {
+                if theta != 0.0 {
+                    for (o, f) in l.iter_mut().zip(load.iter()) {
+                        *o += theta * f;
+                    }
+                }
+            }
+            l
+        };
+        let (load, load_new0) = (dense([0.9, 0.0]), dense([0.7, 1.3]));
+        let r_new0: Vec<f64> = (0..n).map(|i| r[i] + c1 * v[i] + c2 * a[i]).collect();
+        let (mut load_new, mut r_new) = (vec![0.0; n], vec![7.0; n]);
+        let mut p1 = partials(n);
+        predict(
+            &sparse,
+            &[0.7, 1.3],
+            &r,
+            &v,
+            &a,
+            c1,
+            c2,
+            &load,
+            &mut load_new,
+            &mut r_new,
+            &mut p1,
+        );
+        for i in 0..n {
+            assert_eq!(
+                load_new0[i].to_bits(),
+                load_new[i].to_bits(),
+                "{name}: R_K {i}"
+            );
+            assert_eq!(r_new0[i].to_bits(), r_new[i].to_bits(), "{name}: r_K {i}");
+        }
         let data = StepData {
             load_new: &load_new,
-            load: &load,
+            load_rows: sparse.rows(),
             mass: &mass,
-            r: &r,
             r_new: &r_new,
             v: &v,
             a: &a,
@@ -755,62 +1340,59 @@ mod tests {
             gamma_dt: 0.5 * 1e-3,
             ratio: 1.0,
         };
-        // "Friction" at DOFs on both sides of chunk seams.
+        // "Friction" at DOFs on both sides of chunk seams and at load rows.
         let friction: Vec<(usize, f64)> = (0..n)
-            .filter(|i| i % 97 == 0 || i % CHUNK == 0 || i % CHUNK == CHUNK - 1)
+            .filter(|i| i % 97 == 0 || i % CHUNK == 0 || i % CHUNK == CHUNK - 1 || i % 61 == 5)
             .map(|i| (i, -0.25 * i as f64))
             .collect();
-        for threads in [1, 2] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
-                let mut p0 = partials(n);
-                let (mut b, mut vn0, mut an0) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-                spmv(k, &r_new, &mut b);
-                let strain0 = rhs_and_velocity(
-                    &load_new, &mass, &r_new, &v, &a, data.cv, data.ca, data.scale, &mut b,
-                    &mut vn0, &mut p0,
-                );
-                for &(i, vi) in &friction {
-                    vn0[i] = vi;
-                }
-                let sums0 = accelerate_and_sum(
-                    &mass,
-                    &load,
-                    &load_new,
-                    &r,
-                    &r_new,
-                    &v,
-                    &vn0,
-                    &a,
-                    data.gamma_dt,
-                    data.ratio,
-                    &mut an0,
-                    &mut p0,
-                );
-                let mut p1 = partials(n);
-                let (mut vn1, mut an1) = (vec![0.0; n], vec![0.0; n]);
-                let (strain1, sums1) =
-                    fused_step(&compact, &data, &friction, &mut vn1, &mut an1, &mut p1);
-                assert_eq!(strain0.to_bits(), strain1.to_bits(), "{threads}: strain");
-                for (x, y) in [
-                    (sums0.work, sums1.work),
-                    (sums0.kinetic, sums1.kinetic),
-                    (sums0.load_dot, sums1.load_dot),
-                ] {
-                    assert_eq!(x.to_bits(), y.to_bits(), "{threads}: sums");
-                }
-                assert!(sums0.finite && sums1.finite);
-                for i in 0..n {
-                    assert_eq!(vn0[i].to_bits(), vn1[i].to_bits(), "{threads}: ṙ row {i}");
-                    assert_eq!(an0[i].to_bits(), an1[i].to_bits(), "{threads}: r̈ row {i}");
-                    // What the friction pre-pass reads.
-                    let bi = rhs_entry(&data, i, compact.row(i, &r_new));
-                    assert_eq!(b[i].to_bits(), bi.to_bits(), "{threads}: R̂ row {i}");
-                }
-            });
+        let mut p0 = partials(n);
+        let (mut b, mut vn0, mut an0) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        spmv(k, &r_new, &mut b);
+        let ku = b.clone();
+        let strain0 = rhs_and_velocity(
+            &load_new, &mass, &r_new, &v, &a, data.cv, data.ca, data.scale, &mut b, &mut vn0,
+            &mut p0,
+        );
+        for &(i, vi) in &friction {
+            vn0[i] = vi;
+        }
+        let sums0 = accelerate_and_sum(
+            &mass,
+            &load,
+            &load_new,
+            &r,
+            &r_new,
+            &v,
+            &vn0,
+            &a,
+            data.gamma_dt,
+            data.ratio,
+            &mut an0,
+            &mut p0,
+        );
+        assert!(sums0.work != 0.0 && sums0.load_dot != 0.0);
+        for given in [None, Some(&ku[..])] {
+            let mut p = p1.clone();
+            let (mut vn1, mut an1) = (vec![0.0; n], vec![0.0; n]);
+            let (strain1, sums1) =
+                fused_step(compact, &data, &friction, given, &mut vn1, &mut an1, &mut p);
+            let name = format!("{name} K r_K given: {}", given.is_some());
+            assert_eq!(strain0.to_bits(), strain1.to_bits(), "{name}: strain");
+            for (x, y) in [
+                (sums0.work, sums1.work),
+                (sums0.kinetic, sums1.kinetic),
+                (sums0.load_dot, sums1.load_dot),
+            ] {
+                assert_eq!(x.to_bits(), y.to_bits(), "{name}: sums");
+            }
+            assert!(sums0.finite && sums1.finite);
+            for i in 0..n {
+                assert_eq!(vn0[i].to_bits(), vn1[i].to_bits(), "{name}: ṙ row {i}");
+                assert_eq!(an0[i].to_bits(), an1[i].to_bits(), "{name}: r̈ row {i}");
+                // What the friction pre-pass reads.
+                let bi = rhs_entry(&data, i, compact.row(i, &r_new));
+                assert_eq!(b[i].to_bits(), bi.to_bits(), "{name}: R̂ row {i}");
+            }
         }
     }
 
@@ -840,7 +1422,13 @@ mod tests {
                     let (i, j) = (free[2 * p + a], free[2 * q + b]);
                     if i != usize::MAX && j != usize::MAX {
                         let v = if q == p + 1 && a == b {
-                            0.0
+                            // Explicit zeros of both signs: distinct bits,
+                            // distinct dictionary entries.
+                            if p % 2 == 0 {
+                                0.0
+                            } else {
+                                -0.0
+                            }
                         } else {
                             ((i * 31 + j * 17) % 101) as f64 - 50.0
                         };
@@ -850,17 +1438,20 @@ mod tests {
             }
         }
         let k = CsrMatrix::from(&coo);
-        let compact = Compact::new(&k).unwrap();
-        let pairs = (0..compact.group_rows.len() - 1)
-            .filter(|&g| compact.group_rows[g + 1] - compact.group_rows[g] == 2)
-            .count();
-        assert!(pairs > n / 2 - 100, "{pairs} pairs of {n} rows");
         let x = x_of(n);
-        let (mut y0, mut y1) = (vec![0.0; n], vec![1.0; n]);
+        let mut y0 = vec![0.0; n];
         spmv(&k, &x, &mut y0);
-        compact.spmv(&x, &mut y1);
-        for i in 0..n {
-            assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "row {i}");
+        for form in [Form::Stored, Form::Dictionary] {
+            let compact = Compact::with_form(&k, form).unwrap();
+            let pairs = (0..compact.group_rows.len() - 1)
+                .filter(|&g| compact.group_rows[g + 1] - compact.group_rows[g] == 2)
+                .count();
+            assert!(pairs > n / 2 - 100, "{pairs} pairs of {n} rows");
+            let mut y1 = vec![1.0; n];
+            compact.spmv(&x, &mut y1);
+            for i in 0..n {
+                assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "{form:?} row {i}");
+            }
         }
     }
 
@@ -932,6 +1523,7 @@ mod tests {
         let k = &model.stiffness;
         let n = k.nrows();
         let compact = Compact::new(k).unwrap();
+        let stored = Compact::with_form(k, Form::Stored).unwrap();
         // Element matrices (64 values) and free DOFs (u32::MAX = fixed).
         let basis = CellBasis::full(CellKind::Quad4);
         let d = material.elasticity();
@@ -1022,21 +1614,30 @@ mod tests {
                 );
                 let t = time(&mut || compact.spmv(&x, &mut y1));
                 println!(
-                    "  {threads} thread(s) compact 2×2 : {:.3} ms, {:.0} MB, {:.1} GB/s",
+                    "  {threads} thread(s) compact 2×2 : {:.3} ms, {:.0} MB, {:.1} GB/s ({} distinct blocks)",
                     1e3 * t,
                     compact_bytes / 1e6,
-                    compact_bytes / t / 1e9
+                    compact_bytes / t / 1e9,
+                    compact.dictionary_len()
+                );
+                let t = time(&mut || stored.spmv(&x, &mut y1));
+                let stored_bytes = stored.bytes() as f64 + vectors;
+                println!(
+                    "  {threads} thread(s) stored 2×2  : {:.3} ms, {:.0} MB, {:.1} GB/s",
+                    1e3 * t,
+                    stored_bytes / 1e6,
+                    stored_bytes / t / 1e9
                 );
                 // The step's passes after the predictor, three ways, on
                 // distinct vectors as in a step.
                 let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
                 let (ln, l, m, r, rn, v, a) =
                     (w(1.0), w(1.1), w(1.2), w(1.3), w(1.4), w(1.5), w(1.6));
+                // (The sweep with no load rows: pass A does the loads'.)
                 let data = StepData {
                     load_new: &ln,
-                    load: &l,
+                    load_rows: &[],
                     mass: &m,
-                    r: &r,
                     r_new: &rn,
                     v: &v,
                     a: &a,
@@ -1068,7 +1669,7 @@ mod tests {
                     );
                     t[1].push(s.elapsed().as_secs_f64());
                     let s = Instant::now();
-                    fused_step(&compact, &data, &[], &mut vn, &mut an, &mut p);
+                    fused_step(&compact, &data, &[], None, &mut vn, &mut an, &mut p);
                     t[2].push(s.elapsed().as_secs_f64());
                 }
                 for (name, t) in ["CSR, B, C", "compact·B, C", "one sweep"]
