@@ -81,8 +81,10 @@
 //! the adder's latency. Storing the blocks by columns lets opt-level 3
 //! pair the two rows' operations (mulpd/addpd, same bits): the paper mesh
 //! then steps in 2.11 instead of 2.51 µs and Q1 708×177 in 1.61 instead
-//! of 1.89 ms (fastest of 3, same session); that is a profile choice for
-//! the workspace (Cargo.toml), not made here.
+//! of 1.89 ms (fastest of 3, same session), but the 1M-DOF Q1 and the
+//! Q2 352×88 rungs measured no faster (11.2 vs 13.3 ms, 4.9 vs 5.4 ms, one
+//! or two runs, load 1.3-1.5); that is a profile choice for the workspace
+//! (Cargo.toml), not made here.
 //!
 //! Tried and not kept (branch `cd-predictor-fusion`): the sweep writing
 //! the next step's predictor so that a step of the same Δt skips pass A's
