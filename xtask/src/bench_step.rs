@@ -9,7 +9,9 @@
 //!
 //! Runs `crates/time/examples/bench_step.rs`, which times each rung in its
 //! own process (so its peak RSS is the rung's), prints one row per rung and
-//! writes target/bench/step.csv. Figures are printed, not asserted.
+//! writes target/bench/step.csv; a full run (no --quick, no --max-dofs)
+//! with the peer also copies it to docs/bench-step.csv, the table the
+//! README quotes. Figures are printed, not asserted.
 //!
 //!     cargo xtask bench step [--quick] [--max-dofs N] [--no-peer]
 
@@ -69,6 +71,14 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     if !status.success() {
         return Err(format!("the step bench failed ({status})"));
     }
-    println!("table: {}", root.join("target/bench/step.csv").display());
+    let table = root.join("target/bench/step.csv");
+    println!("table: {}", table.display());
+    let full = peer && !pass.iter().any(|a| a == "--quick" || a == "--max-dofs");
+    if full {
+        let docs = root.join("docs/bench-step.csv");
+        std::fs::copy(&table, &docs)
+            .map_err(|e| format!("cannot copy {} to {}: {e}", table.display(), docs.display()))?;
+        println!("copied to {} (quoted by the README)", docs.display());
+    }
     Ok(())
 }
