@@ -41,7 +41,7 @@ pub use material::{Hypothesis, Material};
 pub use model::Model;
 pub use solver::{csc_view, SolverError, SparseCholesky};
 pub use statics::{gauss_point_stresses, nodal_stresses, static_solve, GaussPointStress};
-pub use supernodal::Supernodal;
+pub use supernodal::{ContactOperator, Supernodal};
 
 /// The physical group `name` of `mesh`, wanted for `purpose`.
 pub(crate) fn find_group<'m>(

@@ -26,6 +26,35 @@
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use rayon::prelude::*;
 
+/// P A⁻¹ Pᵀ and W = L⁻¹ Perm Pᵀ for the rows of P given to
+/// [`Supernodal::schur_complement`]: S dense (column-major p × p), W by
+/// columns on the permuted indices. Each column of W is nonzero only on the
+/// paths from its DOFs to the root, so W is a fraction of the reach's part
+/// of L, and p = Wᵀy, the correction W f replace the two solves restricted
+/// to the reach.
+#[derive(Clone, Debug, Default)]
+pub struct ContactOperator {
+    /// S = P A⁻¹ Pᵀ, column-major.
+    pub s: Vec<f64>,
+    w_ptr: Vec<usize>,
+    w_idx: Vec<u32>,
+    w_val: Vec<f64>,
+}
+
+impl ContactOperator {
+    /// Stored values of W.
+    pub fn w_len(&self) -> usize {
+        self.w_val.len()
+    }
+}
+
+/// W's products go to the thread pool from this many values (the same
+/// arithmetic either way; below it a dispatch costs more than the pass).
+const PATHS_PARALLEL_MIN: usize = 1 << 16;
+
+/// One column of W: (reach-local index, value) on its paths.
+type PathColumn = Vec<(u32, f64)>;
+
 /// Columns solved together by [`Supernodal::schur_complement`].
 const GROUP: usize = 8;
 
@@ -87,6 +116,7 @@ pub struct Supernodal {
     /// (u32::MAX outside the reach).
     reach_list: Vec<u32>,
     reach_local: Vec<u32>,
+    reach_global: Vec<u32>,
     reach_cols: usize,
     /// The permuted vector, the reach solution, the reach correction.
     xp: Vec<f64>,
@@ -178,6 +208,7 @@ impl Supernodal {
             reach_len: 0,
             reach_list: Vec::new(),
             reach_local: Vec::new(),
+            reach_global: Vec::new(),
             reach_cols: 0,
             xp: vec![0.0; n],
             xr: vec![0.0; n],
@@ -347,14 +378,19 @@ impl Supernodal {
         self.reach_len = (0..ns).filter(|&s| marked[s]).map(|s| self.len(s)).sum();
         self.reach_list = (0..ns).filter(|&s| marked[s]).map(|s| s as u32).collect();
         self.reach_local = vec![u32::MAX; self.n];
+        self.reach_global.clear();
         let mut next = 0u32;
         for &s in &self.reach_list {
             for c in self.begin[s as usize]..self.begin[s as usize + 1] {
                 self.reach_local[c] = next;
+                self.reach_global.push(c as u32);
                 next += 1;
             }
         }
         self.reach_cols = next as usize;
+        // `finish_step_paths` keeps two sums on the reach in `w`.
+        let len = self.n.max(2 * self.reach_cols);
+        self.w.resize(len, 0.0);
     }
 
     /// G = P A⁻¹ Pᵀ (column-major, p × p) for the p sparse rows of P given
@@ -367,10 +403,10 @@ impl Supernodal {
     /// values are read once per group and the inner loops run over the
     /// group), groups in parallel; a column's arithmetic is the same on any
     /// thread.
-    pub fn schur_complement(&self, l: &[f64], rows: &[Vec<(usize, f64)>]) -> Vec<f64> {
+    pub fn schur_complement(&self, l: &[f64], rows: &[Vec<(usize, f64)>]) -> ContactOperator {
         let p = rows.len();
         let groups: Vec<usize> = (0..p).step_by(GROUP).collect();
-        let columns: Vec<Vec<f64>> = groups
+        let columns: Vec<(Vec<f64>, Vec<PathColumn>)> = groups
             .par_iter()
             .map_init(
                 || {
@@ -390,6 +426,18 @@ impl Supernodal {
                     for &s in &self.reach_list {
                         self.group_forward(l, s as usize, x, tmp);
                     }
+                    // W's columns, L⁻¹Pᵀe_j: nonzero only on the paths
+                    // from the row's DOFs to the root.
+                    let w: Vec<PathColumn> = (0..width)
+                        .map(|c| {
+                            (0..self.reach_cols)
+                                .filter_map(|li| {
+                                    let v = x[li * GROUP + c];
+                                    (v != 0.0).then_some((li as u32, v))
+                                })
+                                .collect()
+                        })
+                        .collect();
                     for &s in self.reach_list.iter().rev() {
                         self.group_backward(l, s as usize, x, tmp);
                     }
@@ -402,11 +450,92 @@ impl Supernodal {
                                 .sum();
                         }
                     }
-                    g
+                    (g, w)
                 },
             )
             .collect();
-        columns.concat()
+        let mut op = ContactOperator {
+            s: Vec::with_capacity(p * p),
+            w_ptr: vec![0],
+            w_idx: Vec::new(),
+            w_val: Vec::new(),
+        };
+        for (g, w) in columns {
+            op.s.extend(g);
+            for col in w {
+                for (i, v) in col {
+                    op.w_idx.push(i);
+                    op.w_val.push(v);
+                }
+                op.w_ptr.push(op.w_idx.len());
+            }
+        }
+        op
+    }
+
+    /// The step's start with a [`ContactOperator`]: the forward solve
+    /// y = L⁻¹(Perm b) into the internal vector and p_j = W_jᵀ y = (P A⁻¹ b)_j
+    /// (one pass over W instead of a back solve over the reach; the rows
+    /// in parallel, each its own sum).
+    pub fn begin_step_paths(&mut self, l: &[f64], op: &ContactOperator, b: &[f64], p: &mut [f64]) {
+        let mut xp = std::mem::take(&mut self.xp);
+        permute_in(&self.fwd, b, &mut xp);
+        self.forward(l, false, &mut xp);
+        let mut yr = std::mem::take(&mut self.xr);
+        for (y, &g) in yr.iter_mut().zip(&self.reach_global) {
+            *y = xp[g as usize];
+        }
+        let yr_ref = &yr;
+        let row = |(j, pj): (usize, &mut f64)| {
+            let (a, e) = (op.w_ptr[j], op.w_ptr[j + 1]);
+            *pj = op.w_idx[a..e]
+                .iter()
+                .zip(&op.w_val[a..e])
+                .map(|(&i, v)| v * yr_ref[i as usize])
+                .sum();
+        };
+        if op.w_len() >= PATHS_PARALLEL_MIN {
+            p.par_iter_mut().enumerate().with_min_len(8).for_each(row);
+        } else {
+            p.iter_mut().enumerate().for_each(row);
+        }
+        self.xr = yr;
+        self.xp = xp;
+    }
+
+    /// The step's end: x = A⁻¹(b − Pᵀf) = Perm⁻¹ L⁻ᵀ(y − W f). W f in two
+    /// halves of its columns at once, each into its own sums on the reach,
+    /// added in a fixed order (the same bits on one thread and on two).
+    pub fn finish_step_paths(&mut self, l: &[f64], op: &ContactOperator, f: &[f64], x: &mut [f64]) {
+        let mut xp = std::mem::take(&mut self.xp);
+        let half = f.len() / 2;
+        let mut acc = std::mem::take(&mut self.w);
+        let (a0, a1) = acc[..2 * self.reach_cols].split_at_mut(self.reach_cols);
+        let scatter = |cols: std::ops::Range<usize>, acc: &mut [f64]| {
+            acc.fill(0.0);
+            for j in cols {
+                let fj = f[j];
+                if fj != 0.0 {
+                    let (a, e) = (op.w_ptr[j], op.w_ptr[j + 1]);
+                    for (&i, v) in op.w_idx[a..e].iter().zip(&op.w_val[a..e]) {
+                        acc[i as usize] += v * fj;
+                    }
+                }
+            }
+        };
+        if op.w_len() >= PATHS_PARALLEL_MIN {
+            rayon::join(|| scatter(0..half, a0), || scatter(half..f.len(), a1));
+        } else {
+            scatter(0..half, a0);
+            scatter(half..f.len(), a1);
+        }
+        for ((&g, s0), s1) in self.reach_global.iter().zip(a0.iter()).zip(a1.iter()) {
+            xp[g as usize] -= s0 + s1;
+        }
+        self.w = acc;
+        self.backward(l, false, &mut xp);
+        permute_out(&self.fwd, &xp, x);
+        self.xp = xp;
     }
 
     /// [`Supernodal::forward`]'s step for GROUP interleaved columns on the
@@ -553,22 +682,23 @@ impl Supernodal {
     /// Finishes the step: x = A⁻¹(b − c) with c nonzero only at DOFs given
     /// to [`Supernodal::set_reach`], as (permuted index, value).
     pub fn finish_step(&mut self, l: &[f64], c: &[(usize, f64)], x: &mut [f64]) {
-        let mut w = std::mem::take(&mut self.w);
+        let mut buffer = std::mem::take(&mut self.w);
+        let w = &mut buffer[..self.n];
         w.fill(0.0);
         for &(i, v) in c {
             w[i] += v;
         }
         // L⁻¹c is zero outside the reach, so L⁻¹(b − c) = L⁻¹b − L⁻¹c
         // changes only the reach's columns.
-        self.forward(l, true, &mut w);
+        self.forward(l, true, w);
         let mut xp = std::mem::take(&mut self.xp);
-        for (y, wi) in xp.iter_mut().zip(&w) {
+        for (y, wi) in xp.iter_mut().zip(w.iter()) {
             *y -= wi;
         }
         self.backward(l, false, &mut xp);
         permute_out(&self.fwd, &xp, x);
         self.xp = xp;
-        self.w = w;
+        self.w = buffer;
     }
 
     /// The forward solve L y = x over the plan's supernodes, in place.
@@ -961,11 +1091,31 @@ mod tests {
                 let c: Vec<(usize, f64)> = dofs.iter().map(|&d| (perm[d], 0.5)).collect();
                 let mut y = vec![0.0; n];
                 sn.finish_step(&f.l, &c, &mut y);
-                (x, at, y)
+                // The step through W: p, then the corrected solution.
+                let rows: Vec<Vec<(usize, f64)>> =
+                    dofs.iter().map(|&d| vec![(perm[d], 1.0)]).collect();
+                let op = sn.schur_complement(&f.l, &rows);
+                let mut p = vec![0.0; rows.len()];
+                sn.begin_step_paths(&f.l, &op, &b, &mut p);
+                let mut z = vec![0.0; n];
+                sn.finish_step_paths(&f.l, &op, &vec![0.5; rows.len()], &mut z);
+                (x, at, y, (op.s, p, z))
             })
         };
-        let (x1, at1, y1) = run(1);
-        let (x2, at2, y2) = run(2);
+        let (x1, at1, y1, w1) = run(1);
+        let (x2, at2, y2, w2) = run(2);
+        assert!(
+            residual(&a, &w1.2, &{
+                let mut bc = b.clone();
+                for &d in &dofs {
+                    bc[d] -= 0.5;
+                }
+                bc
+            }) < 1e-12
+        );
+        for (k, &d) in dofs.iter().enumerate() {
+            assert!((w1.1[k] - x1[d]).abs() <= 1e-12 * x1[d].abs().max(1.0));
+        }
         assert!(residual(&a, &x1, &b) < 1e-12);
         for (k, &d) in dofs.iter().enumerate() {
             assert!((at1[k] - x1[d]).abs() <= 1e-12 * x1[d].abs().max(1.0));
@@ -979,6 +1129,9 @@ mod tests {
         assert_eq!(bits(&x1), bits(&x2));
         assert_eq!(bits(&at1), bits(&at2));
         assert_eq!(bits(&y1), bits(&y2));
+        assert_eq!(bits(&w1.0), bits(&w2.0), "S");
+        assert_eq!(bits(&w1.1), bits(&w2.1), "p through W");
+        assert_eq!(bits(&w1.2), bits(&w2.2), "x through W");
     }
 
     /// G = P A⁻¹ Pᵀ on the reach equals P applied to full solves.
@@ -1005,8 +1158,33 @@ mod tests {
             .iter()
             .map(|r| r.iter().map(|&(d, v)| (perm[d], v)).collect())
             .collect();
-        let g = sn.schur_complement(&f.l, &permuted);
+        let op = sn.schur_complement(&f.l, &permuted);
+        let g = &op.s;
         let p = rows.len();
+        // The step through W: p = P A⁻¹ b, then x = A⁻¹(b − Pᵀf).
+        let b = rhs(n);
+        let mut pv = vec![0.0; p];
+        sn.begin_step_paths(&f.l, &op, &b, &mut pv);
+        let mut full = b.clone();
+        faer_solve(&f, &mut full);
+        for (j, row) in rows.iter().enumerate() {
+            let want: f64 = row.iter().map(|&(d, v)| v * full[d]).sum();
+            assert!(
+                (pv[j] - want).abs() <= 1e-12 * want.abs().max(1.0),
+                "p[{j}]"
+            );
+        }
+        let fv: Vec<f64> = (0..p).map(|j| 0.3 * j as f64 - 1.0).collect();
+        let mut x = vec![0.0; n];
+        sn.finish_step_paths(&f.l, &op, &fv, &mut x);
+        let mut bc = b.clone();
+        for (row, fj) in rows.iter().zip(&fv) {
+            for &(d, v) in row {
+                bc[d] -= v * fj;
+            }
+        }
+        assert!(residual(&a, &x, &bc) < 1e-12);
+        assert!(op.w_len() < sn.reach_cols * p, "W is sparse");
         for j in 0..p {
             let mut x = vec![0.0; n];
             for &(d, v) in &rows[j] {
@@ -1066,6 +1244,24 @@ mod tests {
                 sn.begin_step(&f.l, &b);
                 sn.finish_step(&f.l, &c, &mut x);
             });
+            let rows: Vec<Vec<(usize, f64)>> = dofs.iter().map(|&d| vec![(perm[d], 1.0)]).collect();
+            let t_op = std::time::Instant::now();
+            let op = sn.schur_complement(&f.l, &rows);
+            let t_op = t_op.elapsed().as_secs_f64();
+            let mut pv = vec![0.0; rows.len()];
+            let fv = vec![1.0; rows.len()];
+            let t_paths = time(&mut || {
+                sn.begin_step_paths(&f.l, &op, &b, &mut pv);
+                sn.finish_step_paths(&f.l, &op, &fv, &mut x);
+            });
+            println!(
+                "  W: {} values ({:.1}% of L, reach {:.1}%), S and W built in {:.2} s; step through W {:.2} ms",
+                op.w_len(),
+                100.0 * op.w_len() as f64 / f.l.len() as f64,
+                100.0 * sn.reach_len() as f64 / f.l.len() as f64,
+                t_op,
+                t_paths * 1e3
+            );
             println!(
                 "{kind:?} n={n} L={} ({:.0} MB) supernodes={} split={} reach {:.1}% of L: faer {:.2} ms, ours {:.2} ms, split step {:.2} ms",
                 f.l.len(),

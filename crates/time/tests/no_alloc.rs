@@ -86,11 +86,12 @@ fn steps_allocate_nothing() {
         });
         assert_eq!(n, 0, "{mesh}: {n} allocations in 200 explicit steps");
     }
-    // Implicit, Schur path (both corrections), with the step reduction:
+    // Implicit, Schur path (each correction), with the step reduction:
     // warm up until the normal and the reduced Δt have their factors.
     for solver in [
         ImplicitSolver::SchurStoredZ,
         ImplicitSolver::SchurSecondSolve,
+        ImplicitSolver::SchurPaths,
     ] {
         let s = paper_slab("slab-q2-8x2.msh", 1e-4, History::Step);
         let mut settings = Settings::new(

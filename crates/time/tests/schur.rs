@@ -55,12 +55,13 @@ fn build(
 }
 
 /// One integrator per Schur variant, in the order Schur, SchurStoredZ,
-/// SchurSecondSolve.
+/// SchurSecondSolve, SchurPaths.
 fn schur_variants(s: &Slab, scheme: Scheme, reduction: Option<StickReduction>) -> Vec<Integrator> {
     [
         ImplicitSolver::Schur,
         ImplicitSolver::SchurStoredZ,
         ImplicitSolver::SchurSecondSolve,
+        ImplicitSolver::SchurPaths,
     ]
     .into_iter()
     .map(|solver| build(s, scheme, reduction, solver))
