@@ -453,10 +453,12 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     } else {
         let solve = solve.expect("timed above");
         format!(
-            "solve={solve:.4e} step_over_solve={:.2} factor_len={} factorizations={}",
+            "solve={solve:.4e} step_over_solve={:.2} factor_len={} factorizations={} w_len={} reach_len={}",
             per_step.0 / solve,
             i.factor_len(),
-            i.factorizations()
+            i.factorizations(),
+            i.paths_len().0,
+            i.paths_len().1
         )
     };
     println!(

@@ -1407,6 +1407,13 @@ impl Integrator {
         self.schur.as_ref().map_or(0, |op| op.factor_len())
     }
 
+    /// Implicit runs with friction: (values of W = L⁻¹Pᵀ the step uses, 0
+    /// when it solves on the reach instead; values of the factor on the
+    /// contact DOFs' paths to the root). For the cost figures.
+    pub fn paths_len(&self) -> (usize, usize) {
+        self.schur.as_ref().map_or((0, 0), |op| op.paths_len())
+    }
+
     /// Bytes of K one explicit step streams (its compact form, see
     /// `kernels.rs`; the CSR's values, column indices and row offsets when
     /// the compact form does not apply); 0 for implicit runs.

@@ -265,6 +265,17 @@ impl SchurOperator {
         self.symbolic.len_val()
     }
 
+    /// (values of W the current Δt's step uses, 0 if it goes otherwise;
+    /// values of L on the contact DOFs' paths to the root).
+    pub fn paths_len(&self) -> (usize, usize) {
+        let w = self
+            .entries
+            .get(self.current)
+            .and_then(|e| e.paths.as_ref())
+            .map_or(0, |op| op.w_len());
+        (w, self.sn.reach_len())
+    }
+
     /// Makes the factor of A₀ = c_k K + c_m M for this Δt current: from the
     /// cache, or factorized (with S and Z) once.
     pub fn set_dt(
