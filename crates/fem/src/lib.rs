@@ -39,7 +39,7 @@ pub use loads::{
 };
 pub use material::{Hypothesis, Material};
 pub use model::Model;
-pub use solver::{csc_view, SolverError, SparseCholesky};
+pub use solver::{analyze_symbolic, csc_view, SolverError, SparseCholesky};
 pub use statics::{gauss_point_stresses, nodal_stresses, static_solve, GaussPointStress};
 pub use supernodal::{ContactOperator, Supernodal};
 

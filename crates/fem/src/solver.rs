@@ -99,6 +99,24 @@ fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
     csc_view(a, a.values())
 }
 
+/// The symbolic analysis of `a`'s pattern (AMD ordering), always
+/// supernodal so that [`Supernodal`] solves on its layout.
+///
+/// # Errors
+/// [`SolverError::Analysis`] if faer fails.
+pub fn analyze_symbolic(a: &CsrMatrix<f64>) -> Result<SymbolicCholesky<usize>, SolverError> {
+    factorize_symbolic_cholesky(
+        as_csc(a).symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Amd,
+        CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| SolverError::Analysis(format!("{e:?}")))
+}
+
 impl SparseCholesky {
     /// Computes the fill-reducing ordering (AMD) and the symbolic factor of
     /// `a`'s pattern. Values are not read.
@@ -112,16 +130,7 @@ impl SparseCholesky {
                 cols: a.ncols(),
             });
         }
-        let symbolic = factorize_symbolic_cholesky(
-            as_csc(a).symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| SolverError::Analysis(format!("{e:?}")))?;
+        let symbolic = analyze_symbolic(a)?;
         let factor_scratch = MemBuffer::new(
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
         );

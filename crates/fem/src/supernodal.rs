@@ -538,15 +538,25 @@ impl Supernodal {
         self.xp = xp;
     }
 
+    /// Supernode s: its first column, its number of columns, its pattern
+    /// and its block of L.
+    #[inline]
+    fn supernode<'a>(&'a self, l: &'a [f64], s: usize) -> (usize, usize, &'a [u32], &'a [f64]) {
+        let c0 = self.begin[s];
+        (
+            c0,
+            self.begin[s + 1] - c0,
+            &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]],
+            &l[self.val_ptr[s]..self.val_ptr[s + 1]],
+        )
+    }
+
     /// [`Supernodal::forward`]'s step for GROUP interleaved columns on the
     /// reach's local numbering (x[local·GROUP + c]).
     fn group_forward(&self, l: &[f64], s: usize, x: &mut [f64], tmp: &mut [f64]) {
-        let (c0, c1) = (self.begin[s], self.begin[s + 1]);
-        let k = c1 - c0;
-        let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
+        let (c0, k, pattern, block) = self.supernode(l, s);
         let m = pattern.len();
         let ld = k + m;
-        let block = &l[self.val_ptr[s]..self.val_ptr[s + 1]];
         let lo = self.reach_local[c0] as usize * GROUP;
         let xs = &mut x[lo..lo + k * GROUP];
         for j in 0..k {
@@ -588,12 +598,9 @@ impl Supernodal {
 
     /// [`Supernodal::backward`]'s step for GROUP interleaved columns.
     fn group_backward(&self, l: &[f64], s: usize, x: &mut [f64], tmp: &mut [f64]) {
-        let (c0, c1) = (self.begin[s], self.begin[s + 1]);
-        let k = c1 - c0;
-        let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
+        let (c0, k, pattern, block) = self.supernode(l, s);
         let m = pattern.len();
         let ld = k + m;
-        let block = &l[self.val_ptr[s]..self.val_ptr[s + 1]];
         let tmp = &mut tmp[..m * GROUP];
         for (t, &r) in tmp.chunks_exact_mut(GROUP).zip(pattern) {
             let at = self.reach_local[r as usize] as usize * GROUP;
@@ -923,10 +930,7 @@ mod tests {
     use crate::testing::rectangle;
     use crate::{Hypothesis, Material, Model};
     use faer::dyn_stack::{MemBuffer, MemStack};
-    use faer::sparse::linalg::cholesky::{
-        factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymmetricOrdering,
-    };
-    use faer::sparse::linalg::SupernodalThreshold;
+    use faer::sparse::linalg::cholesky::LltRef;
     use faer::sparse::SparseColMatRef;
     use faer::{Conj, MatMut, Par, Side, Spec};
     use nalgebra_sparse::CsrMatrix;
@@ -950,16 +954,7 @@ mod tests {
     }
 
     fn factor(a: &CsrMatrix<f64>) -> Factor {
-        let symbolic = factorize_symbolic_cholesky(
-            as_csc(a).symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let symbolic = crate::analyze_symbolic(a).unwrap();
         let mut l = vec![0.0; symbolic.len_val()];
         let mut scratch = MemBuffer::new(
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),

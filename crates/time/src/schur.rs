@@ -35,15 +35,11 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{LltError, LltParams};
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
-    SymmetricOrdering,
-};
-use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::{Conj, MatMut, MatRef, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{ContactNode, ContactSurface, SlipState, StepSystem};
-use stickslip_fem::{csc_view, ContactOperator, SolverError};
+use stickslip_fem::{analyze_symbolic, csc_view, ContactOperator, SolverError};
 
 use stickslip_fem::Supernodal;
 
@@ -166,17 +162,7 @@ impl SchurOperator {
                 cols: stiffness.ncols(),
             });
         }
-        let symbolic = factorize_symbolic_cholesky(
-            csc_view(stiffness, stiffness.values()).symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            // Supernodal whatever the size: `supernodal.rs` solves on its layout.
-            CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| SolverError::Analysis(format!("{e:?}")))?;
+        let symbolic = analyze_symbolic(stiffness)?;
         let mut sn = Supernodal::new(&symbolic).ok_or_else(|| {
             SolverError::Analysis("faer returned a factor layout this solver does not know".into())
         })?;
