@@ -234,8 +234,7 @@ fn test(root: &Path, rest: &[String]) -> Result<(), String> {
     // The quick verification table (closed forms, rates, the paper, the
     // references): the README's promise of what the test command checks.
     println!("$ cargo xtask verify --quick");
-    verify::verify(root, &["--quick".to_string()])
-        .map_err(|e| format!("verify --quick: {e}"))?;
+    verify::verify(root, &["--quick".to_string()]).map_err(|e| format!("verify --quick: {e}"))?;
     Ok(())
 }
 
