@@ -84,7 +84,7 @@
 //! of 1.89 ms (fastest of 3, same session), but the 1M-DOF Q1 and the
 //! Q2 352×88 rungs measured no faster (11.2 vs 13.3 ms, 4.9 vs 5.4 ms, one
 //! or two runs, load 1.3-1.5); that is a profile choice for the workspace
-//! (Cargo.toml), not made here.
+//! (Cargo.toml): it now compiles stickslip-time at opt-level 3.
 //!
 //! Tried and not kept (branch `cd-predictor-fusion`): the sweep writing
 //! the next step's predictor so that a step of the same Δt skips pass A's
@@ -114,6 +114,62 @@ fn parallel(n: usize) -> bool {
     chunks(n) >= PARALLEL_MIN && rayon::current_num_threads() > 1
 }
 
+/// Runs `body(c, chunk)` over the CHUNK-sized chunks of `y`, on the pool
+/// when [`parallel`]: the chunks and each one's arithmetic are the same
+/// either way.
+fn each_chunk(y: &mut [f64], body: impl Fn(usize, &mut [f64]) + Sync) {
+    if parallel(y.len()) {
+        y.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, y)| body(c, y));
+    } else {
+        y.chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, y)| body(c, y));
+    }
+}
+
+/// [`each_chunk`] with the chunk's partial sums.
+fn each_chunk_summed(
+    y: &mut [f64],
+    partials: &mut Partials,
+    body: impl Fn(usize, &mut [f64], &mut [f64; 5]) + Sync,
+) {
+    if parallel(y.len()) {
+        y.par_chunks_mut(CHUNK)
+            .zip(partials.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (y, p))| body(c, y, p));
+    } else {
+        y.chunks_mut(CHUNK)
+            .zip(partials.iter_mut())
+            .enumerate()
+            .for_each(|(c, (y, p))| body(c, y, p));
+    }
+}
+
+/// [`each_chunk_summed`] over the same chunks of two vectors.
+fn each_chunk_pair(
+    y: &mut [f64],
+    z: &mut [f64],
+    partials: &mut Partials,
+    body: impl Fn(usize, &mut [f64], &mut [f64], &mut [f64; 5]) + Sync,
+) {
+    if parallel(y.len()) {
+        y.par_chunks_mut(CHUNK)
+            .zip(z.par_chunks_mut(CHUNK))
+            .zip(partials.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, ((y, z), p))| body(c, y, z, p));
+    } else {
+        y.chunks_mut(CHUNK)
+            .zip(z.chunks_mut(CHUNK))
+            .zip(partials.iter_mut())
+            .enumerate()
+            .for_each(|(c, ((y, z), p))| body(c, y, z, p));
+    }
+}
+
 /// y = A x, rows in parallel chunks (each y_i is one row's sum in storage
 /// order, so the threading never changes a bit).
 pub fn spmv(a: &CsrMatrix<f64>, x: &[f64], y: &mut [f64]) {
@@ -131,15 +187,7 @@ pub fn spmv(a: &CsrMatrix<f64>, x: &[f64], y: &mut [f64]) {
             *yi = s;
         }
     };
-    if parallel(y.len()) {
-        y.par_chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(c, y)| body(c, y));
-    } else {
-        y.chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(c, y)| body(c, y));
-    }
+    each_chunk(y, body);
 }
 
 /// Per-chunk partial sums, added in chunk order.
@@ -230,17 +278,7 @@ pub fn predict(
             rn[i] = r[i] + c1 * v[i] + c2 * a[i];
         }
     };
-    if parallel(r.len()) {
-        r_new
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(c, rn)| body(c, rn));
-    } else {
-        r_new
-            .chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(c, rn)| body(c, rn));
-    }
+    each_chunk(r_new, body);
     for p in partials.iter_mut() {
         p[0] = 0.0;
         p[2] = 0.0;
@@ -294,19 +332,7 @@ pub fn rhs_and_velocity(
         }
         partial[0] = strain;
     };
-    if parallel(r_new.len()) {
-        b.par_chunks_mut(CHUNK)
-            .zip(v_new.par_chunks_mut(CHUNK))
-            .zip(partials.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, ((b, vn), p))| body(c, b, vn, p));
-    } else {
-        b.chunks_mut(CHUNK)
-            .zip(v_new.chunks_mut(CHUNK))
-            .zip(partials.iter_mut())
-            .enumerate()
-            .for_each(|(c, ((b, vn), p))| body(c, b, vn, p));
-    }
+    each_chunk_pair(b, v_new, partials, body);
     0.5 * total(partials, 0)
 }
 
@@ -358,19 +384,7 @@ pub fn accelerate_and_sum(
         }
         partial[..4].copy_from_slice(&[work, kinetic, load_dot, if finite { 0.0 } else { 1.0 }]);
     };
-    if parallel(r.len()) {
-        a_new
-            .par_chunks_mut(CHUNK)
-            .zip(partials.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, (an, p))| body(c, an, p));
-    } else {
-        a_new
-            .chunks_mut(CHUNK)
-            .zip(partials.iter_mut())
-            .enumerate()
-            .for_each(|(c, (an, p))| body(c, an, p));
-    }
+    each_chunk_summed(a_new, partials, body);
     Sums {
         work: total(partials, 0),
         kinetic: 0.5 * total(partials, 1),
@@ -875,15 +889,7 @@ impl Compact {
             }
         }
         let body = |c: usize, y: &mut [f64]| self.with_blocks(Into(c, x, y));
-        if parallel(y.len()) {
-            y.par_chunks_mut(CHUNK)
-                .enumerate()
-                .for_each(|(c, y)| body(c, y));
-        } else {
-            y.chunks_mut(CHUNK)
-                .enumerate()
-                .for_each(|(c, y)| body(c, y));
-        }
+        each_chunk(y, body);
     }
 }
 
@@ -917,19 +923,7 @@ pub fn spmv_rhs_and_velocity(
         });
         partial[0] = strain;
     };
-    if parallel(r_new.len()) {
-        b.par_chunks_mut(CHUNK)
-            .zip(v_new.par_chunks_mut(CHUNK))
-            .zip(partials.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, ((b, vn), p))| body(c, b, vn, p));
-    } else {
-        b.chunks_mut(CHUNK)
-            .zip(v_new.chunks_mut(CHUNK))
-            .zip(partials.iter_mut())
-            .enumerate()
-            .for_each(|(c, ((b, vn), p))| body(c, b, vn, p));
-    }
+    each_chunk_pair(b, v_new, partials, body);
     0.5 * total(partials, 0)
 }
 
@@ -1080,21 +1074,7 @@ pub fn fused_step(
         partial[3] = if run.finite { 0.0 } else { 1.0 };
         partial[4] = run.strain;
     };
-    if parallel(v_new.len()) {
-        v_new
-            .par_chunks_mut(CHUNK)
-            .zip(a_new.par_chunks_mut(CHUNK))
-            .zip(partials.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, ((vn, an), p))| body(c, vn, an, p));
-    } else {
-        v_new
-            .chunks_mut(CHUNK)
-            .zip(a_new.chunks_mut(CHUNK))
-            .zip(partials.iter_mut())
-            .enumerate()
-            .for_each(|(c, ((vn, an), p))| body(c, vn, an, p));
-    }
+    each_chunk_pair(v_new, a_new, partials, body);
     (
         0.5 * total(partials, 4),
         Sums {
