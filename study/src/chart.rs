@@ -17,7 +17,7 @@ use std::path::Path;
 use stickslip_mesh::Mesh;
 
 use crate::plot::{self, Marker, Panel, Series, COLORS};
-use crate::run::{relative_l2, sample, timed_run, Method, Trace};
+use crate::run::{label, relative_l2, sample, timed_run, Method, Trace};
 use crate::slab::{self, read_mesh, LoadKind};
 
 /// End time of every run (the paper's plots end at 0.5).
@@ -488,7 +488,7 @@ pub fn panels(rows: &[Row], loads: &[LoadKind]) -> Vec<Panel> {
                         .collect();
                     all.extend(pts.iter().copied());
                     series.push(Series {
-                        label: format!("{} Q{order}", method.label()),
+                        label: format!("{} Q{order}", label(*method)),
                         color: COLORS[mi],
                         marker: marker(*method),
                         filled: order == 2,
@@ -504,7 +504,7 @@ pub fn panels(rows: &[Row], loads: &[LoadKind]) -> Vec<Panel> {
                     .map(|r| (r.time(), r.errors.as_array()[k]))
                     .collect();
                 series.push(Series {
-                    label: format!("ε ladder, {}", method.label()),
+                    label: format!("ε ladder, {}", label(method)),
                     color: COLORS[5],
                     marker: marker(method),
                     filled: false,

@@ -4,15 +4,12 @@
 use std::time::Instant;
 
 use stickslip_mesh::Mesh;
-use stickslip_time::{Scheme, Settings, StickReduction};
+use stickslip_time::{Scheme, Settings};
 
 use crate::slab::{self, LoadKind, Slab};
 
 /// Remark 4.3 as the paper did it: Δt = 1e-7 for 10 steps after sticking.
-pub const REDUCTION: StickReduction = StickReduction {
-    dt: 1e-7,
-    steps: 10,
-};
+pub use stickslip_time::scenes::PAPER_REDUCTION as REDUCTION;
 /// Newmark β = ¼, γ = ½ (trapezoidal rule).
 pub const TRAPEZOIDAL: Scheme = Scheme::Newmark {
     beta: 0.25,
@@ -24,60 +21,15 @@ pub const DAMPED: Scheme = Scheme::Newmark {
     gamma: 0.6,
 };
 
-/// The time-stepping methods the studies compare.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    /// Central difference, lumped mass, closed-form nodal friction.
-    CentralDifference,
-    /// Newmark ¼/½, consistent mass.
-    Trapezoidal,
-    /// Newmark ¼/½ with the step reduction of Remark 4.3.
-    TrapezoidalReduced,
-    /// Newmark 0.3025/0.6.
-    Damped,
-}
+pub use stickslip_time::scenes::Method;
 
-impl Method {
-    /// All of them, in table order.
-    pub const ALL: [Method; 4] = [
-        Method::CentralDifference,
-        Method::Trapezoidal,
-        Method::TrapezoidalReduced,
-        Method::Damped,
-    ];
-
-    /// Short name for tables and legends.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::CentralDifference => "cd",
-            Method::Trapezoidal => "nm-0.25-0.5",
-            Method::TrapezoidalReduced => "nm-0.25-0.5-reduced",
-            Method::Damped => "nm-0.3025-0.6",
-        }
-    }
-
-    /// Longer name for legends.
-    pub fn label(self) -> &'static str {
-        match self {
-            Method::CentralDifference => "central difference",
-            Method::Trapezoidal => "Newmark ¼,½",
-            Method::TrapezoidalReduced => "Newmark ¼,½ + reduction",
-            Method::Damped => "Newmark 0.3025,0.6",
-        }
-    }
-
-    /// The time crate's settings for this method.
-    pub fn settings(self, dt: f64, t_end: f64) -> Settings {
-        match self {
-            Method::CentralDifference => Settings::new(Scheme::CentralDifference, dt, t_end),
-            Method::Trapezoidal => Settings::new(TRAPEZOIDAL, dt, t_end),
-            Method::TrapezoidalReduced => {
-                let mut s = Settings::new(TRAPEZOIDAL, dt, t_end);
-                s.stick_reduction = Some(REDUCTION);
-                s
-            }
-            Method::Damped => Settings::new(DAMPED, dt, t_end),
-        }
+/// Longer name of a method for legends.
+pub fn label(method: Method) -> &'static str {
+    match method {
+        Method::CentralDifference => "central difference",
+        Method::Trapezoidal => "Newmark ¼,½",
+        Method::TrapezoidalReduced => "Newmark ¼,½ + reduction",
+        Method::Damped => "Newmark 0.3025,0.6",
     }
 }
 

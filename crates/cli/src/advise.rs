@@ -236,64 +236,25 @@ pub fn continue_errors(measured: &[f64], ratios: &[f64], max_order: f64) -> (Vec
     (e, p)
 }
 
-/// The time-stepping methods the advisor chooses from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    /// Central difference, lumped mass.
-    CentralDifference,
-    /// Newmark ¼/½ (trapezoidal), consistent mass.
-    Trapezoidal,
-    /// Newmark ¼/½ with the step reduction of Remark 4.3.
-    TrapezoidalReduced,
-    /// Newmark 0.3025/0.6 (numerical damping).
-    Damped,
-}
+pub use stickslip_time::scenes::Method;
 
-impl Method {
-    /// All of them.
-    pub const ALL: [Method; 4] = [
-        Method::CentralDifference,
-        Method::Trapezoidal,
-        Method::TrapezoidalReduced,
-        Method::Damped,
-    ];
-
-    /// Short name (as in docs/work-precision.csv).
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::CentralDifference => "cd",
-            Method::Trapezoidal => "nm-0.25-0.5",
-            Method::TrapezoidalReduced => "nm-0.25-0.5-reduced",
-            Method::Damped => "nm-0.3025-0.6",
+/// Longer name of a method for the report.
+pub fn label(method: Method) -> &'static str {
+    match method {
+        Method::CentralDifference => "central difference",
+        Method::Trapezoidal => "Newmark beta 1/4, gamma 1/2",
+        Method::TrapezoidalReduced => {
+            "Newmark beta 1/4, gamma 1/2 with step reduction (Remark 4.3)"
         }
-    }
-
-    /// Longer name for the report.
-    pub fn label(self) -> &'static str {
-        match self {
-            Method::CentralDifference => "central difference",
-            Method::Trapezoidal => "Newmark beta 1/4, gamma 1/2",
-            Method::TrapezoidalReduced => {
-                "Newmark beta 1/4, gamma 1/2 with step reduction (Remark 4.3)"
-            }
-            Method::Damped => "Newmark beta 0.3025, gamma 0.6",
-        }
-    }
-
-    fn newmark(self) -> Option<(f64, f64)> {
-        match self {
-            Method::CentralDifference => None,
-            Method::Trapezoidal | Method::TrapezoidalReduced => Some((0.25, 0.5)),
-            Method::Damped => Some((0.3025, 0.6)),
-        }
+        Method::Damped => "Newmark beta 0.3025, gamma 0.6",
     }
 }
 
 /// The paper's Remark 4.3 (Δt = 1e-7 for 10 steps after sticking), used
 /// when the case gives no `time.stick_reduction` of its own.
 pub const PAPER_REDUCTION: StickReduction = StickReduction {
-    dt: 1e-7,
-    steps: 10,
+    dt: stickslip_time::scenes::PAPER_REDUCTION.dt,
+    steps: stickslip_time::scenes::PAPER_REDUCTION.steps,
 };
 
 /// Central-difference Δt as fractions of Δt_crit (as in the chart).
@@ -1377,7 +1338,7 @@ fn describe(c: &Candidate, ladder: &[LadderMesh]) -> String {
         c.order,
         c.mesh,
         c.dofs,
-        c.method.label(),
+        label(c.method),
         c.dt,
         c.eps
     )
