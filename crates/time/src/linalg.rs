@@ -31,6 +31,8 @@ fn row_dot(vals: &[f64], cols: &[usize], x: &[f64]) -> f64 {
 }
 
 /// y = A x, rows in chunks on the thread pool when there are several.
+/// (`kernels::spmv` keeps one chain per row instead: the explicit step's
+/// compact K must reproduce its bits.)
 pub fn spmv(a: &CsrMatrix<f64>, x: &[f64], y: &mut [f64]) {
     let offsets = a.row_offsets();
     let cols = a.col_indices();
