@@ -22,6 +22,7 @@ mod implicit;
 mod integrator;
 mod kernels;
 pub mod linalg;
+mod memory;
 pub mod scenes;
 mod schur;
 pub mod stability;

@@ -343,6 +343,8 @@ impl SchurOperator {
         entry.last_used = self.clock;
         self.current = slot;
         self.build_schur(slot);
+        // The factorization's workspace and S's scratch are freed.
+        crate::memory::release_free_memory();
         Ok(())
     }
 
