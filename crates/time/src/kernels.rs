@@ -760,16 +760,6 @@ impl Compact {
         self.with_blocks(Row(i, x))
     }
 
-    /// Calls `f(row, (K x)_row)` for every row of chunk `c`, in row order.
-    #[inline]
-    fn chunk_rows(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, f64)) {
-        self.chunk_batches(c, x, |r0, ku| {
-            for (k, &s) in ku.iter().enumerate() {
-                f(r0 + k, s);
-            }
-        });
-    }
-
     /// Calls `f(first row, K x on the batch's rows)` for consecutive
     /// batches of at most [`BATCH`] rows covering chunk `c`, in order: the
     /// caller's per-row work then runs in loops over a batch held in L1
@@ -893,13 +883,264 @@ impl Compact {
     }
 }
 
+/// The product the step's sweeps run over: K x by rows, in batches of a
+/// chunk ([`Compact`], the assembled K; [`Classes`], matrix-free). Each row's
+/// value must not depend on the batches or chunks it is computed in, so
+/// that a run is bit-identical on one thread and on many.
+pub trait RowProduct: Sync {
+    /// Calls `f(first row, K x on the batch's rows)` for consecutive
+    /// batches of at most [`BATCH`] rows covering chunk `c`, in order.
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64]));
+    /// (K x)_i alone, with the bits the batches give it.
+    fn row(&self, i: usize, x: &[f64]) -> f64;
+    /// y = K x.
+    fn spmv(&self, x: &[f64], y: &mut [f64]);
+    /// Bytes one K x streams from the operator's data.
+    fn bytes(&self) -> usize;
+}
+
+impl RowProduct for Compact {
+    #[inline]
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64])) {
+        Compact::chunk_batches(self, c, x, f)
+    }
+    fn row(&self, i: usize, x: &[f64]) -> f64 {
+        Compact::row(self, i, x)
+    }
+    fn spmv(&self, x: &[f64], y: &mut [f64]) {
+        Compact::spmv(self, x, y)
+    }
+    fn bytes(&self) -> usize {
+        Compact::bytes(self)
+    }
+}
+
+/// K as the explicit step reads it: the compact form of the assembled K,
+/// or matrix-free by element classes when the mesh has them
+/// ([`Classes`]: measured faster on the structured Q2 slabs; the module
+/// documentation gives the figures).
+#[derive(Clone, Debug)]
+pub enum Product {
+    /// [`Compact`].
+    Compact(Compact),
+    /// [`Classes`].
+    Classes(Classes),
+}
+
+impl RowProduct for Product {
+    #[inline]
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64])) {
+        match self {
+            Product::Compact(k) => RowProduct::chunk_batches(k, c, x, f),
+            Product::Classes(k) => k.chunk_batches(c, x, f),
+        }
+    }
+    fn row(&self, i: usize, x: &[f64]) -> f64 {
+        match self {
+            Product::Compact(k) => k.row(i, x),
+            Product::Classes(k) => k.row(i, x),
+        }
+    }
+    fn spmv(&self, x: &[f64], y: &mut [f64]) {
+        match self {
+            Product::Compact(k) => k.spmv(x, y),
+            Product::Classes(k) => k.spmv(x, y),
+        }
+    }
+    fn bytes(&self) -> usize {
+        match self {
+            Product::Compact(k) => k.bytes(),
+            Product::Classes(k) => RowProduct::bytes(k),
+        }
+    }
+}
+
+/// Independent sums per row of a node ([`Classes`]): a node's rows are
+/// chains of dependent additions, LANES of them per row hide the adder's
+/// latency (the columns taken in turn).
+const LANES: usize = 4;
+
+/// K x matrix-free from element classes ([`ElementClasses`]: one element
+/// matrix per class of cells alike to the coordinates' rounding), node by
+/// node: a node's two rows are the sum over its cells e of the node's rows
+/// of K_e times x_e (fixed DOFs read as 0). Each row is a function of x
+/// alone (its node's cells in ascending order, the columns in [`LANES`]
+/// sums added in a fixed order), whatever the batch or thread computing it.
+/// Not the bits of the assembled K's product: within 1e-12 of
+/// max_i Σ_j |K_ij x_j| (tests below).
+#[derive(Clone, Debug)]
+pub struct Classes {
+    ec: stickslip_fem::ElementClasses,
+}
+
+impl Classes {
+    /// The operator of `ec` (Q1 or Q2 cells).
+    pub fn new(ec: stickslip_fem::ElementClasses) -> Option<Classes> {
+        matches!(ec.nodes_per_cell(), 4 | 9).then_some(Classes { ec })
+    }
+
+    /// The element classes.
+    pub fn classes(&self) -> &stickslip_fem::ElementClasses {
+        &self.ec
+    }
+
+    /// K x on rows r0..r0 + out.len() into `out` (a few rows: a small
+    /// cache).
+    #[inline]
+    fn rows_into(&self, r0: usize, x: &[f64], out: &mut [f64]) {
+        match self.ec.nodes_per_cell() {
+            4 => self.rows_nd::<8, 16>(r0, x, out, &mut Gathered::new()),
+            9 => self.rows_nd::<18, 16>(r0, x, out, &mut Gathered::new()),
+            _ => unreachable!("Classes::new admits Q1 and Q2"),
+        }
+    }
+
+    /// [`RowProduct::chunk_batches`] with the cells' x_e gathered once per
+    /// chunk ([`Gathered`]).
+    #[inline(always)]
+    fn batches_nd<const ND: usize>(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, &[f64])) {
+        let n = self.ec.n_free();
+        let (start, end) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
+        let mut buf = [0.0; BATCH];
+        let mut cache = Gathered::<ND>::new();
+        let mut r0 = start;
+        while r0 < end {
+            let r1 = (r0 + BATCH).min(end);
+            let out = &mut buf[..r1 - r0];
+            self.rows_nd::<ND, SLOTS>(r0, x, out, &mut cache);
+            f(r0, out);
+            r0 = r1;
+        }
+    }
+
+    #[inline(always)]
+    fn rows_nd<const ND: usize, const S: usize>(
+        &self,
+        r0: usize,
+        x: &[f64],
+        out: &mut [f64],
+        cache: &mut Gathered<ND, S>,
+    ) {
+        let ec = &self.ec;
+        let group_rows = ec.group_rows();
+        let mask = ec.group_mask();
+        let r1 = r0 + out.len();
+        let mut g = group_rows.partition_point(|&r| r as usize <= r0) - 1;
+        while g + 1 < group_rows.len() && (group_rows[g] as usize) < r1 {
+            let s = self.node_sums::<ND, S>(g, x, cache);
+            let mut r = group_rows[g] as usize;
+            for (comp, s) in s.iter().enumerate() {
+                if mask[g] >> comp & 1 == 1 {
+                    if (r0..r1).contains(&r) {
+                        out[r - r0] = *s;
+                    }
+                    r += 1;
+                }
+            }
+            g += 1;
+        }
+    }
+
+    /// The sums of group g's two rows (a fixed component's too, unused).
+    #[inline(always)]
+    fn node_sums<const ND: usize, const S: usize>(
+        &self,
+        g: usize,
+        x: &[f64],
+        cache: &mut Gathered<ND, S>,
+    ) -> [f64; 2] {
+        use stickslip_fem::classes::{HAS_FIXED, LOCAL_BITS};
+        let ec = &self.ec;
+        let (gc, nc) = (ec.group_cells(), ec.node_cells());
+        let (classes, matrices) = (ec.cell_class(), ec.matrices());
+        let n = ND / 2;
+        let mut acc = [[0.0; 2]; LANES];
+        for &p in &nc[gc[g] as usize..gc[g + 1] as usize] {
+            let e = (p >> LOCAL_BITS) as usize;
+            let a = (p & ((1 << LOCAL_BITS) - 1)) as usize;
+            let k = (classes[e] & !HAS_FIXED) as usize;
+            let m: &[[f64; 2]; ND] = matrices[(k * n + a) * ND..][..ND].try_into().unwrap();
+            let xe = cache.get(ec.cell_dofs(), e, x);
+            for j in 0..ND {
+                let q = j % LANES;
+                acc[q][0] += m[j][0] * xe[j];
+                acc[q][1] += m[j][1] * xe[j];
+            }
+        }
+        std::array::from_fn(|r| (acc[0][r] + acc[1][r]) + (acc[2][r] + acc[3][r]))
+    }
+}
+
+/// Slots of [`Gathered`] (a power of 2).
+const SLOTS: usize = 256;
+
+/// A direct-mapped cache of cells' x_e (slot: cell mod [`SLOTS`]): a cell
+/// serves up to 9 nodes, most of them in one chunk, so its x_e is gathered
+/// about once per chunk instead of once per node. A copy of x's entries (0
+/// at fixed DOFs), so the sums do not depend on what was cached.
+struct Gathered<const ND: usize, const S: usize = SLOTS> {
+    tags: [u32; S],
+    xe: [[f64; ND]; S],
+}
+
+impl<const ND: usize, const S: usize> Gathered<ND, S> {
+    fn new() -> Self {
+        Gathered {
+            tags: [u32::MAX; S],
+            xe: [[0.0; ND]; S],
+        }
+    }
+
+    /// x_e of cell e.
+    #[inline(always)]
+    fn get(&mut self, dofs: &[u32], e: usize, x: &[f64]) -> &[f64; ND] {
+        let slot = e % S;
+        if self.tags[slot] != e as u32 {
+            let d: &[u32; ND] = dofs[e * ND..][..ND].try_into().unwrap();
+            // A fixed DOF (u32::MAX) is out of range: 0.
+            self.xe[slot] = std::array::from_fn(|j| x.get(d[j] as usize).copied().unwrap_or(0.0));
+            self.tags[slot] = e as u32;
+        }
+        &self.xe[slot]
+    }
+}
+
+impl RowProduct for Classes {
+    #[inline]
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64])) {
+        match self.ec.nodes_per_cell() {
+            4 => self.batches_nd::<8>(c, x, f),
+            9 => self.batches_nd::<18>(c, x, f),
+            _ => unreachable!("Classes::new admits Q1 and Q2"),
+        }
+    }
+
+    fn row(&self, i: usize, x: &[f64]) -> f64 {
+        let mut out = [0.0];
+        self.rows_into(i, x, &mut out);
+        out[0]
+    }
+
+    fn spmv(&self, x: &[f64], y: &mut [f64]) {
+        each_chunk(y, |c, y| {
+            self.chunk_batches(c, x, |r0, ku| {
+                y[r0 - c * CHUNK..][..ku.len()].copy_from_slice(ku);
+            })
+        });
+    }
+
+    fn bytes(&self) -> usize {
+        self.ec.bytes()
+    }
+}
+
 /// The SpMV fused with pass B ([`rhs_and_velocity`]): each row's K r_K is
 /// used as soon as it is summed, so K r_K is never written and read back
 /// (two vector passes fewer). The same arithmetic per entry and the same
 /// order of the strain sum, hence the same bits.
 #[allow(clippy::too_many_arguments)]
-pub fn spmv_rhs_and_velocity(
-    k: &Compact,
+pub fn spmv_rhs_and_velocity<K: RowProduct>(
+    k: &K,
     load_new: &[f64],
     mass: &[f64],
     r_new: &[f64],
@@ -915,11 +1156,14 @@ pub fn spmv_rhs_and_velocity(
     let body = |c: usize, b: &mut [f64], vn: &mut [f64], partial: &mut [f64; 5]| {
         let start = c * CHUNK;
         let mut strain = 0.0;
-        k.chunk_rows(c, r_new, |i, ku| {
-            strain += r_new[i] * ku;
-            let bi = load_new[i] - ku + mass[i] * (cv * v[i] + ca * a[i]);
-            b[i - start] = bi;
-            vn[i - start] = bi / (mass[i] * scale);
+        k.chunk_batches(c, r_new, |r0, kus| {
+            for (j, &ku) in kus.iter().enumerate() {
+                let i = r0 + j;
+                strain += r_new[i] * ku;
+                let bi = load_new[i] - ku + mass[i] * (cv * v[i] + ca * a[i]);
+                b[i - start] = bi;
+                vn[i - start] = bi / (mass[i] * scale);
+            }
         });
         partial[0] = strain;
     };
@@ -1042,8 +1286,8 @@ fn batch_rows(
 ///
 /// `ku`: K r_K when the caller has it (the one-chunk step computes it
 /// first for the friction, [`Compact::spmv`]); else the sweep forms it.
-pub fn fused_step(
-    k: &Compact,
+pub fn fused_step<K: RowProduct>(
+    k: &K,
     s: &StepData,
     friction: &[(usize, f64)],
     ku: Option<&[f64]>,
@@ -1675,6 +1919,169 @@ mod tests {
                     );
                 }
             });
+        }
+    }
+
+    /// Class lab: K·x matrix-free by element classes ([`Classes`]) against
+    /// [`Compact`] (the form the step picks, [`Compact::new`]) on the bench's
+    /// structured slabs (`testing::rectangle`, the coordinates of
+    /// bench_step's `structured_slab`) with the slab's supports: one K·x and
+    /// the whole explicit step (pass A and the sweep, no loads or friction),
+    /// the variants interleaved, fastest and median of 20, on 1 and 2
+    /// threads; checks the matrix-free rows against the CSR's to 1e-12 of
+    /// max_i Σ_j |K_ij x_j|. `STICKSLIP_LAB_MESHES` = comma-separated
+    /// `q1-NXxNY` / `q2-NXxNY` (default the three rungs below).
+    ///
+    ///     cargo test --profile dev -p stickslip-time --lib class_lab -- --ignored --nocapture
+    #[test]
+    #[ignore = "timing; run by hand (see the doc comment)"]
+    fn class_lab() {
+        use std::time::Instant;
+        use stickslip_fem::testing::rectangle;
+        use stickslip_fem::ElementClasses;
+        use stickslip_mesh::CellKind;
+
+        let meshes = std::env::var("STICKSLIP_LAB_MESHES")
+            .unwrap_or_else(|_| "q1-1416x354,q2-352x88,q2-708x177".into());
+        println!(
+            "class lab, load: {:?}",
+            std::fs::read_to_string("/proc/loadavg")
+                .unwrap_or_default()
+                .trim()
+        );
+        for name in meshes.split(',') {
+            let (order, size) = name.split_once('-').unwrap();
+            let (nx, ny) = size.split_once('x').unwrap();
+            let kind = if order == "q2" {
+                CellKind::Quad9
+            } else {
+                CellKind::Quad4
+            };
+            let mesh = rectangle(
+                kind,
+                nx.parse().unwrap(),
+                ny.parse().unwrap(),
+                [0.0, 0.0],
+                [8.0, 1.0],
+            );
+            let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+            let supports = [
+                Dirichlet::new("top", 1, 0.0),
+                Dirichlet::new("left", 0, 0.0),
+            ];
+            let model = Model::new(&mesh, &material, &supports).unwrap();
+            let k = &model.stiffness;
+            let n = k.nrows();
+            let t0 = Instant::now();
+            let compact = Compact::new(k).unwrap();
+            let t_compact = t0.elapsed().as_secs_f64();
+            let t0 = Instant::now();
+            let ec =
+                ElementClasses::with_limit(&mesh, &material, &model.dofs, 1).expect("one class");
+            let classes = Classes::new(ec).unwrap();
+            let t_classes = t0.elapsed().as_secs_f64();
+            let x = x_of(n);
+            let (mut y0, mut y1) = (vec![0.0; n], vec![0.0; n]);
+            spmv(k, &x, &mut y0);
+            classes.spmv(&x, &mut y1);
+            let abs = {
+                let (o, c, v) = (k.row_offsets(), k.col_indices(), k.values());
+                (0..n)
+                    .map(|i| {
+                        (o[i]..o[i + 1])
+                            .map(|p| (v[p] * x[c[p]]).abs())
+                            .sum::<f64>()
+                    })
+                    .fold(0.0_f64, f64::max)
+            };
+            let diff = y0
+                .iter()
+                .zip(&y1)
+                .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+            println!(
+                "{name}: n = {n}, {} classes, compact {:.0} MB ({} distinct blocks, built in {:.2} s), classes {:.1} MB (built in {:.2} s), |Δ| = {:.2e} of max Σ|K x| = {:.2e} ({:.1e})",
+                classes.classes().classes(),
+                compact.bytes() as f64 / 1e6,
+                compact.dictionary_len(),
+                t_compact,
+                classes.bytes() as f64 / 1e6,
+                t_classes,
+                diff,
+                abs,
+                diff / abs
+            );
+            assert!(diff <= 1e-12 * abs);
+            let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
+            let (r, m, v, a) = (w(1.3), w(1.2), w(1.5), w(1.6));
+            let (zero, mut ln, mut rn) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            let sparse = SparseLoads::new(&zero, &[]);
+            for threads in [1, 2] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                pool.install(|| {
+                    let mut p = partials(n);
+                    let (mut vn, mut an) = (vec![0.0; n], vec![0.0; n]);
+                    let mut t: [Vec<f64>; 4] = Default::default();
+                    for _ in 0..20 {
+                        let s = Instant::now();
+                        compact.spmv(&x, &mut y0);
+                        t[0].push(s.elapsed().as_secs_f64());
+                        let s = Instant::now();
+                        classes.spmv(&x, &mut y1);
+                        t[1].push(s.elapsed().as_secs_f64());
+                        let mut step = |q: usize, use_classes: bool| {
+                            let s = Instant::now();
+                            predict(
+                                &sparse,
+                                &[],
+                                &r,
+                                &v,
+                                &a,
+                                1e-3,
+                                0.5e-6,
+                                &zero,
+                                &mut ln,
+                                &mut rn,
+                                &mut p,
+                            );
+                            let data = StepData {
+                                load_new: &ln,
+                                load_rows: &[],
+                                mass: &m,
+                                r_new: &rn,
+                                v: &v,
+                                a: &a,
+                                cv: 2e3,
+                                ca: 1.0,
+                                scale: 2e3,
+                                gamma_dt: 5e-4,
+                                ratio: 1.0,
+                            };
+                            if use_classes {
+                                fused_step(&classes, &data, &[], None, &mut vn, &mut an, &mut p);
+                            } else {
+                                fused_step(&compact, &data, &[], None, &mut vn, &mut an, &mut p);
+                            }
+                            t[q].push(s.elapsed().as_secs_f64());
+                        };
+                        step(2, false);
+                        step(3, true);
+                    }
+                    for (label, t) in ["K·x compact", "K·x classes", "step compact", "step classes"]
+                        .iter()
+                        .zip(&mut t)
+                    {
+                        t.sort_by(f64::total_cmp);
+                        println!(
+                            "  {threads} thread(s) {label:13}: fastest {:.3} ms, median {:.3} ms",
+                            1e3 * t[0],
+                            1e3 * t[10]
+                        );
+                    }
+                });
+            }
         }
     }
 }
