@@ -1681,6 +1681,189 @@ mod tests {
         }
     }
 
+    /// The tolerance of the matrix-free product: row-wise within 1e-12 of
+    /// max_i Σ_j |K_ij x_j| (the class matrices come from cells alike to
+    /// the coordinates' rounding, and the sums run in another order).
+    fn check_classes(k: &CsrMatrix<f64>, op: &Classes, x: &[f64], name: &str) {
+        let n = k.nrows();
+        let (o, c, v) = (k.row_offsets(), k.col_indices(), k.values());
+        let scale = (0..n)
+            .map(|i| {
+                (o[i]..o[i + 1])
+                    .map(|p| (v[p] * x[c[p]]).abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0_f64, f64::max);
+        assert!(scale > 0.0);
+        let mut y0 = vec![0.0; n];
+        spmv(k, x, &mut y0);
+        let mut y1 = vec![f64::NAN; n];
+        op.spmv(x, &mut y1);
+        for i in 0..n {
+            assert!(
+                (y0[i] - y1[i]).abs() <= 1e-12 * scale,
+                "{name} row {i}: {} vs {} (scale {scale:e})",
+                y0[i],
+                y1[i]
+            );
+        }
+        // A row alone and the batches of a chunk give the same bits.
+        for i in (0..n).step_by(97).chain([0, n - 1]) {
+            assert_eq!(
+                op.row(i, x).to_bits(),
+                y1[i].to_bits(),
+                "{name} row {i} alone"
+            );
+        }
+        for c in 0..chunks(n) {
+            op.chunk_batches(c, x, |r0, ku| {
+                for (j, v) in ku.iter().enumerate() {
+                    assert_eq!(v.to_bits(), y1[r0 + j].to_bits(), "{name} chunk {c}");
+                }
+            });
+        }
+    }
+
+    /// Matrix-free K·x by element classes against the CSR's on structured
+    /// Q1 and Q2 rectangles (several chunks) with and without Dirichlet
+    /// DOFs (the slab's supports, single-DOF nodes, and a corner held in
+    /// both components), and on meshes without classes: the committed
+    /// unstructured ones and a perturbed rectangle, where
+    /// [`ElementClasses::new`] declines and a class per cell is still right.
+    #[test]
+    fn classes_spmv_matches_the_csr() {
+        use stickslip_fem::testing::{add_point_group, map_nodes, rectangle};
+        use stickslip_fem::ElementClasses;
+        use stickslip_mesh::CellKind;
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let supports = [
+            Dirichlet::new("top", 1, 0.0),
+            Dirichlet::new("left", 0, 0.0),
+            Dirichlet::new("corner", 1, 0.0),
+            Dirichlet::new("corner", 0, 0.0),
+        ];
+        for (kind, nx, ny) in [(CellKind::Quad9, 96, 24), (CellKind::Quad4, 192, 48)] {
+            let mut mesh = rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
+            let corner = mesh.nodes.iter().position(|p| p[0] == 8.0 && p[1] == 0.0);
+            add_point_group(&mut mesh, "corner", &[corner.unwrap()]);
+            for conditions in [&supports[..], &[]] {
+                let model = Model::new(&mesh, &material, conditions).unwrap();
+                let k = &model.stiffness;
+                let n = k.nrows();
+                assert!(chunks(n) >= 3, "{n}");
+                let ec = ElementClasses::new(&mesh, &material, &model.dofs);
+                // Q1 declines (the dictionary is faster), Q2 has one class.
+                assert_eq!(ec.is_some(), kind == CellKind::Quad9);
+                let ec = ElementClasses::with_limit(&mesh, &material, &model.dofs, 64).unwrap();
+                assert_eq!(ec.classes(), 1);
+                let op = Classes::new(ec).unwrap();
+                let x = x_of(n);
+                check_classes(k, &op, &x, &format!("{kind:?} {}", conditions.len()));
+            }
+        }
+        // No classes: every cell its own (or nearly).
+        let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes");
+        let mut perturbed = rectangle(CellKind::Quad9, 24, 6, [0.0, 0.0], [8.0, 1.0]);
+        map_nodes(&mut perturbed, |p| {
+            [
+                p[0] + 1e-3 * (7.0 * p[1] + 3.0 * p[0]).sin(),
+                p[1] + 1e-3 * (5.0 * p[0]).cos(),
+            ]
+        });
+        let meshes = [
+            ("perturbed", perturbed),
+            (
+                "unstructured q1",
+                Mesh::from_file(dir.join("slab-unstructured-q1.msh")).unwrap(),
+            ),
+            (
+                "unstructured q2",
+                Mesh::from_file(dir.join("slab-unstructured-q2.msh")).unwrap(),
+            ),
+        ];
+        let supports = [
+            Dirichlet::new("left", 0, 0.0),
+            Dirichlet::new("left", 1, 0.0),
+        ];
+        for (name, mesh) in meshes {
+            let model = Model::new(&mesh, &material, &supports).unwrap();
+            assert!(
+                ElementClasses::new(&mesh, &material, &model.dofs).is_none(),
+                "{name}"
+            );
+            let ec = ElementClasses::with_limit(&mesh, &material, &model.dofs, usize::MAX).unwrap();
+            assert!(
+                2 * ec.classes() > mesh.n_cells(),
+                "{name}: {} classes",
+                ec.classes()
+            );
+            let op = Classes::new(ec).unwrap();
+            let k = &model.stiffness;
+            check_classes(k, &op, &x_of(k.nrows()), name);
+        }
+    }
+
+    /// The matrix-free product and the one-sweep step on it have the same
+    /// bits on one thread and on two (rows are independent of the chunks'
+    /// assignment to threads).
+    #[test]
+    fn classes_one_thread_and_two_give_the_same_bits() {
+        use stickslip_fem::testing::rectangle;
+        use stickslip_fem::ElementClasses;
+        use stickslip_mesh::CellKind;
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let mesh = rectangle(CellKind::Quad9, 96, 24, [0.0, 0.0], [8.0, 1.0]);
+        let supports = [
+            Dirichlet::new("top", 1, 0.0),
+            Dirichlet::new("left", 0, 0.0),
+        ];
+        let model = Model::new(&mesh, &material, &supports).unwrap();
+        let n = model.dofs.n_free();
+        let op = Classes::new(ElementClasses::new(&mesh, &material, &model.dofs).unwrap()).unwrap();
+        let x = x_of(n);
+        let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
+        let (m, v, a) = (w(1.2), w(1.5), w(1.6));
+        let mass: Vec<f64> = m.iter().map(|m| 1.0 + m.abs()).collect();
+        let zero = vec![0.0; n];
+        let friction: Vec<(usize, f64)> = (0..n).step_by(301).map(|i| (i, 0.5)).collect();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut y = vec![0.0; n];
+                op.spmv(&x, &mut y);
+                let data = StepData {
+                    load_new: &zero,
+                    load_rows: &[],
+                    mass: &mass,
+                    r_new: &x,
+                    v: &v,
+                    a: &a,
+                    cv: 2e3,
+                    ca: 1.0,
+                    scale: 2e3,
+                    gamma_dt: 5e-4,
+                    ratio: 1.0,
+                };
+                let mut p = partials(n);
+                let (mut vn, mut an) = (vec![0.0; n], vec![0.0; n]);
+                let (strain, sums) =
+                    fused_step(&op, &data, &friction, None, &mut vn, &mut an, &mut p);
+                (y, vn, an, strain, sums.kinetic)
+            })
+        };
+        let one = run(1);
+        let two = run(2);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&one.0), bits(&two.0));
+        assert_eq!(bits(&one.1), bits(&two.1));
+        assert_eq!(bits(&one.2), bits(&two.2));
+        assert_eq!(one.3.to_bits(), two.3.to_bits());
+        assert_eq!(one.4.to_bits(), two.4.to_bits());
+    }
+
     /// Kernel lab (issue 7: "K·r by CSR SpMV or element by element, choose
     /// by measurement"): K·x on a structured Q1 slab (default 1416 × 354
     /// cells, 1,004,298 free DOFs; `STICKSLIP_LAB_NY` sets ny, nx = 4 ny)
