@@ -1435,8 +1435,10 @@ impl Integrator {
     }
 
     /// Bytes of K one explicit step streams (its compact form, see
-    /// `kernels.rs`; the CSR's values, column indices and row offsets when
-    /// the compact form does not apply); 0 for implicit runs.
+    /// `kernels.rs`, or with element classes their cells' DOFs and classes,
+    /// the nodes' cell lists and the class matrices once; the CSR's values,
+    /// column indices and row offsets when neither applies); 0 for implicit
+    /// runs.
     pub fn explicit_matrix_bytes(&self) -> usize {
         match (&self.compact, self.explicit) {
             (Some(k), _) => k.bytes(),

@@ -91,6 +91,42 @@
 //! sweep (bit-identical, 10 → 7 vector streams) measured no faster, the
 //! sweep being compute-bound at opt-level 2 (Q1 708×177 1.85 vs 1.91 ms,
 //! 1416×354 8.94 vs 9.17 ms, fastest of 2-3, load 0.8-1.3).
+//!
+//! Matrix-free by element classes ([`Classes`], branch `cd-matrix-free`):
+//! on the structured slabs every cell is a translate of the others up to
+//! the rounding of its coordinates, so one element matrix serves all
+//! ([`stickslip_fem::ElementClasses`]: cells alike when their relative
+//! node coordinates agree within 8 ε max |x|, the coordinates' own
+//! rounding), and K·x is summed node by node over each node's cells (rows
+//! independent: the same bits on any number of threads; not the CSR's
+//! bits, within 1e-12 of max_i Σ_j |K_ij x_j|, measured 5e-14 to 1.5e-13).
+//! The `class_lab` test below, 2026-11-22 06:08, load average 1.2 on the 2
+//! cores, fastest (median) of 20 interleaved rounds, the step being pass A
+//! and the sweep without loads or friction:
+//!
+//! | mesh (free DOFs)         | threads | K·x compact   | K·x classes   | step compact  | step classes  |
+//! |--------------------------|---------|---------------|---------------|---------------|---------------|
+//! | Q1 1416×354 (1,004,298)  | 1       | 7.38 (8.18)   | 11.88 (11.95) | 12.75 (13.50) | 15.59 (15.75) |
+//! |                          | 2       | 3.99 (4.54)   |  6.01 (6.23)  |  6.88 (7.59)  |  8.01 (8.33)  |
+//! | Q2 352×88 (248,688)      | 1       | 6.35 (6.66)   |  3.40 (3.49)  |  7.36 (7.93)  |  4.23 (4.42)  |
+//! |                          | 2       | 3.23 (3.42)   |  1.75 (1.83)  |  3.97 (4.20)  |  2.14 (2.32)  |
+//! | Q2 708×177 (1,004,298)   | 1       | 23.87 (24.44) | 13.44 (13.52) | 29.73 (30.29) | 17.30 (17.42) |
+//! |                          | 2       | 12.54 (12.89) |  6.79 (6.86)  | 15.91 (16.45) |  9.14 (9.29)  |
+//!
+//! (ms.) Q2 steps 1.7-1.9× faster, so the explicit step uses the classes
+//! when the caller attaches them (`Dynamics::element_classes`); Q1 keeps
+//! the compact form, its dictionary needing 9 blocks (36 products) per
+//! node against 4 cells of 8 columns (64), and
+//! [`stickslip_fem::ElementClasses::new`] declines Q1 meshes. The
+//! matrix-free data is 4.6 MB (Q2 249k) and 18.6 MB (Q2 1M) against 73 and
+//! 293 MB of stored blocks. Tried and not kept: each cell's K_e x_e formed
+//! once per chunk into a per-thread cache and the nodes summing its
+//! entries (fewer loads per product, but cells recomputed in every chunk
+//! they touch): Q2 708×177 K·x 11.9 vs 10.0 ms for the node sums (2
+//! threads, fastest of 20, same session, load 1.1-1.5); and gathering x_e
+//! per node and cell instead of through the chunk's cache of gathered
+//! cells ([`Gathered`]): Q2 352×88 K·x 4.8 vs 3.6 ms on 1 thread (fastest
+//! of 20, two sessions minutes apart, load 1.0-1.4).
 
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
