@@ -322,8 +322,9 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     let (model, contact, loads) = problem(&mesh);
     let explicit = scheme == "cd";
     // The explicit step forms K·x from element classes where the mesh has
-    // them (structured Q2: kernels.rs), else streams the assembled K.
-    let classes = if explicit {
+    // them (structured Q2: kernels.rs), else streams the assembled K
+    // (always with STICKSLIP_NO_CLASSES set: the comparison).
+    let classes = if explicit && std::env::var_os("STICKSLIP_NO_CLASSES").is_none() {
         ElementClasses::new(&mesh, &slab_material(), &model.dofs)
     } else {
         None
