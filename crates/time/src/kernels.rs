@@ -1020,13 +1020,13 @@ impl Classes {
         &self.ec
     }
 
-    /// K x on rows r0..r0 + out.len() into `out` (a few rows: a small
-    /// cache).
+    /// K x on rows r0..r0 + out.len() into `out` (a row or two, for the
+    /// friction: a one-slot cache, nothing to clear).
     #[inline]
     fn rows_into(&self, r0: usize, x: &[f64], out: &mut [f64]) {
         match self.ec.nodes_per_cell() {
-            4 => self.rows_nd::<8, 16>(r0, x, out, &mut Gathered::new()),
-            9 => self.rows_nd::<18, 16>(r0, x, out, &mut Gathered::new()),
+            4 => self.rows_nd::<8, 1>(r0, x, out, &mut Gathered::new()),
+            9 => self.rows_nd::<18, 1>(r0, x, out, &mut Gathered::new()),
             _ => unreachable!("Classes::new admits Q1 and Q2"),
         }
     }
