@@ -23,7 +23,8 @@ fn run(s: &Slab, classes: bool, threads: usize, steps: usize) -> Integrator {
             .unwrap();
         let dt = 0.9 * probe.dt_crit().unwrap();
         let ec = classes.then(|| {
-            ElementClasses::new(&s.mesh, &material, &s.model.dofs).expect("structured Q2 slab")
+            ElementClasses::with_limit(&s.mesh, &material, &s.model.dofs, 64)
+                .expect("structured Q2 slab")
         });
         let dynamics = Dynamics::from_model(&s.model).with_element_classes(ec);
         let settings = Settings::new(Scheme::CentralDifference, dt, 0.5);
