@@ -128,7 +128,17 @@
 //! threads, fastest of 20, same session, load 1.1-1.5); and gathering x_e
 //! per node and cell instead of through the chunk's cache of gathered
 //! cells ([`Gathered`]): Q2 352×88 K·x 4.8 vs 3.6 ms on 1 thread (fastest
-//! of 20, two sessions minutes apart, load 1.0-1.4).
+//! of 20, two sessions minutes apart, load 1.0-1.4). Measured no faster
+//! (1 thread, fastest of 20, load 0.7-1.2, against 13.2-13.4 ms for Q2
+//! 708×177 and 3.4-3.5 ms for 352×88 in the sessions around): x_e held
+//! twice and both operands 16-byte aligned, so that a column is one load,
+//! one mulpd with a memory operand and one addpd (checked in the
+//! assembly): 14.0-14.2 and 3.5 ms; a per-thread cache wide enough for
+//! all of a chunk's cells (each gathered once per chunk, not once per
+//! grid row): 13.7 and 3.2 ms; 2 or 6 partial sums per row instead of 4:
+//! within 5%. The kernel is then neither bound by its instruction count
+//! nor by the gathers; on this machine it runs at about 2 cycles per
+//! column of a node's two rows.
 
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
