@@ -15,8 +15,8 @@ use std::time::Instant;
 use anyhow::Context;
 use stickslip_contact::{ContactSurface, IterationOptions};
 use stickslip_fem::{
-    body_force_load, traction_load, Dirichlet, Hypothesis as FemHypothesis, Material, Model,
-    Traction,
+    body_force_load, traction_load, Dirichlet, ElementClasses, Hypothesis as FemHypothesis,
+    Material, Model, Traction,
 };
 use stickslip_mesh::Mesh;
 use stickslip_time::{
@@ -312,15 +312,24 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
         explicit_friction: ExplicitFriction::ClosedForm,
         initial_velocity: None,
     };
-    let integrator = Integrator::new(Dynamics::from_model(&model), contact, loads, settings)
-        .map_err(|e| {
-            let key = match e {
-                TimeError::Unstable { .. } => "time.dt",
-                TimeError::Static(_) => "dirichlet.0.group",
-                _ => "time.scheme",
-            };
-            input(format!("{}[time]: {e}", case.at(key)))
-        })?;
+    // The explicit step forms K·x from element classes where the mesh has
+    // them (structured Q2 meshes; stickslip-time's kernels.rs), else it
+    // streams the assembled K.
+    let classes = match (scheme, &material) {
+        (Scheme::CentralDifference, Some(material)) => {
+            ElementClasses::new(&mesh, material, &model.dofs)
+        }
+        _ => None,
+    };
+    let dynamics = Dynamics::from_model(&model).with_element_classes(classes);
+    let integrator = Integrator::new(dynamics, contact, loads, settings).map_err(|e| {
+        let key = match e {
+            TimeError::Unstable { .. } => "time.dt",
+            TimeError::Static(_) => "dirichlet.0.group",
+            _ => "time.scheme",
+        };
+        input(format!("{}[time]: {e}", case.at(key)))
+    })?;
     Ok(Prepared {
         mesh,
         model,

@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{
-    traction_load, Dirichlet, Hypothesis, Material, Model, SparseCholesky, Traction,
+    traction_load, Dirichlet, ElementClasses, Hypothesis, Material, Model, SparseCholesky, Traction,
 };
 use stickslip_mesh::{CellKind, Edge, Group, Mesh, SourceInfo};
 use stickslip_time::stability::critical_step;
@@ -137,9 +137,14 @@ fn structured_slab(nx: usize, ny: usize, q2: bool) -> Mesh {
     }
 }
 
+/// The paper's slab material (BENCHMARK.md).
+fn slab_material() -> Material {
+    Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap()
+}
+
 /// The paper's slab problem (BENCHMARK.md) on `mesh`.
 fn problem(mesh: &Mesh) -> (Model, ContactSurface, Vec<Load>) {
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let material = slab_material();
     let conditions = vec![
         Dirichlet::new("support", 1, 0.0),
         Dirichlet::new("left", 0, 0.0),
@@ -315,11 +320,19 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     let t_setup = Instant::now();
     let mesh = mesh_named(name);
     let (model, contact, loads) = problem(&mesh);
+    let explicit = scheme == "cd";
+    // The explicit step forms K·x from element classes where the mesh has
+    // them (structured Q2: kernels.rs), else streams the assembled K
+    // (always with STICKSLIP_NO_CLASSES set: the comparison).
+    let classes = if explicit && std::env::var_os("STICKSLIP_NO_CLASSES").is_none() {
+        ElementClasses::new(&mesh, &slab_material(), &model.dofs)
+    } else {
+        None
+    };
     drop(mesh);
     let n = model.dofs.n_free();
     let nnz = model.stiffness.nnz();
     let n_c = contact.len();
-    let explicit = scheme == "cd";
     let newmark_dt = 5e-3;
     // Long enough on small meshes for nodes to slip (the friction branches
     // are then part of the check); a few steps on large ones.
@@ -353,7 +366,7 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         dump_problem(dir, &model, &contact, &loads, scheme, dt, check_steps);
     }
     // The model's matrices move into the integrator: one copy of K and M.
-    let dynamics = Dynamics::from_model_owned(model);
+    let dynamics = Dynamics::from_model_owned(model).with_element_classes(classes);
     let settings = if explicit {
         Settings::new(Scheme::CentralDifference, dt, 1e9)
     } else {
@@ -445,8 +458,9 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         let bytes = i.explicit_bytes_per_step() as f64;
         let bw = pool.install(stream_triad);
         let (dict, blocks) = i.explicit_dictionary().unwrap_or((0, 0));
+        let classes = i.explicit_classes().unwrap_or(0);
         format!(
-            "dict_blocks={dict} of_blocks={blocks} bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
+            "dict_blocks={dict} of_blocks={blocks} element_classes={classes} bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
             bytes / per_step.0,
             100.0 * bytes / per_step.0 / bw
         )

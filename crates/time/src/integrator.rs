@@ -2,11 +2,11 @@
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{iterate, ContactSurface, IterationFailure, IterationOptions, SlipState};
-use stickslip_fem::{Model, SolverError, SparseCholesky};
+use stickslip_fem::{ElementClasses, Model, SolverError, SparseCholesky};
 
 use crate::history::History;
 use crate::implicit::{DiagonalStep, ImplicitOperator, ImplicitStep};
-use crate::kernels;
+use crate::kernels::{self, RowProduct};
 use crate::linalg::{
     self, dot, load_minus_k_plus_m, quadratic_form, row_chunks, same_pattern, spmv, two_forms,
     PairBlocks,
@@ -27,6 +27,11 @@ pub struct Dynamics {
     pub lumped_mass: Vec<f64>,
     /// A load acting at all times, also before t = 0.
     pub constant_load: Vec<f64>,
+    /// K's cells in classes of alike geometry ([`ElementClasses`], from the
+    /// mesh): when present the explicit step forms K·x from them, matrix-free,
+    /// instead of streaming the assembled K (`kernels::Classes`). Not the
+    /// assembled K's bits (within 1e-12 of the row's Σ|K_ij x_j|).
+    pub element_classes: Option<ElementClasses>,
 }
 
 impl Dynamics {
@@ -37,6 +42,7 @@ impl Dynamics {
             consistent_mass: model.mass.clone(),
             lumped_mass: model.lumped_mass.clone(),
             constant_load: model.dirichlet_load.clone(),
+            element_classes: None,
         }
     }
 
@@ -49,7 +55,15 @@ impl Dynamics {
             consistent_mass: model.mass,
             lumped_mass: model.lumped_mass,
             constant_load: model.dirichlet_load,
+            element_classes: None,
         }
+    }
+
+    /// With the element classes of the model's mesh (see
+    /// [`Dynamics::element_classes`]; `None` leaves the assembled K).
+    pub fn with_element_classes(mut self, classes: Option<ElementClasses>) -> Dynamics {
+        self.element_classes = classes;
+        self
     }
 
     /// Number of free DOFs.
@@ -341,9 +355,9 @@ pub struct Integrator {
     thetas: Vec<f64>,
     /// Per-chunk partial sums of the explicit passes.
     partials: kernels::Partials,
-    /// K in the explicit step's compact form (`kernels::Compact`); the CSR
-    /// K is then no longer held.
-    compact: Option<kernels::Compact>,
+    /// K as the explicit step reads it (`kernels::Product`: the compact
+    /// form or the element classes); the CSR K is then no longer held.
+    compact: Option<kernels::Product>,
     /// (DOF, ṙ_K) at the contact DOFs, sorted by DOF: the closed-form
     /// friction's velocities handed to `kernels::fused_step`.
     friction: Vec<(usize, f64)>,
@@ -611,7 +625,13 @@ impl Integrator {
             // From here on the explicit step reads K only through the
             // compact form: 0.57× the CSR's bytes per step, and the CSR's
             // memory returned.
-            this.compact = kernels::Compact::new(&this.dynamics.stiffness);
+            this.compact = match this.dynamics.element_classes.take() {
+                Some(ec) => kernels::Classes::new(ec).map(kernels::Product::Classes),
+                None => None,
+            }
+            .or_else(|| {
+                kernels::Compact::new(&this.dynamics.stiffness).map(kernels::Product::Compact)
+            });
             if this.compact.is_some() {
                 this.dynamics.stiffness = CsrMatrix::zeros(0, 0);
             }
@@ -1442,8 +1462,10 @@ impl Integrator {
     }
 
     /// Bytes of K one explicit step streams (its compact form, see
-    /// `kernels.rs`; the CSR's values, column indices and row offsets when
-    /// the compact form does not apply); 0 for implicit runs.
+    /// `kernels.rs`, or with element classes their cells' DOFs and classes,
+    /// the nodes' cell lists and the class matrices once; the CSR's values,
+    /// column indices and row offsets when neither applies); 0 for implicit
+    /// runs.
     pub fn explicit_matrix_bytes(&self) -> usize {
         match (&self.compact, self.explicit) {
             (Some(k), _) => k.bytes(),
@@ -1485,8 +1507,19 @@ impl Integrator {
     /// (distinct blocks, stored blocks) of K's compact form when its values
     /// are a dictionary (`kernels.rs`), `None` otherwise.
     pub fn explicit_dictionary(&self) -> Option<(usize, usize)> {
-        let k = self.compact.as_ref()?;
+        let Some(kernels::Product::Compact(k)) = &self.compact else {
+            return None;
+        };
         (k.dictionary_len() > 0).then(|| (k.dictionary_len(), k.blocks()))
+    }
+
+    /// Classes of K's cells when the explicit step forms K·x from element
+    /// classes (`kernels::Classes`), `None` otherwise.
+    pub fn explicit_classes(&self) -> Option<usize> {
+        match &self.compact {
+            Some(kernels::Product::Classes(k)) => Some(k.classes().classes()),
+            _ => None,
+        }
     }
 
     /// How implicit steps solve their linear systems.

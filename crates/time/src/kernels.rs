@@ -91,6 +91,54 @@
 //! sweep (bit-identical, 10 → 7 vector streams) measured no faster, the
 //! sweep being compute-bound at opt-level 2 (Q1 708×177 1.85 vs 1.91 ms,
 //! 1416×354 8.94 vs 9.17 ms, fastest of 2-3, load 0.8-1.3).
+//!
+//! Matrix-free by element classes ([`Classes`], branch `cd-matrix-free`):
+//! on the structured slabs every cell is a translate of the others up to
+//! the rounding of its coordinates, so one element matrix serves all
+//! ([`stickslip_fem::ElementClasses`]: cells alike when their relative
+//! node coordinates agree within 8 ε max |x|, the coordinates' own
+//! rounding), and K·x is summed node by node over each node's cells (rows
+//! independent: the same bits on any number of threads; not the CSR's
+//! bits, within 1e-12 of max_i Σ_j |K_ij x_j|, measured 5e-14 to 1.5e-13).
+//! The `class_lab` test below, 2026-11-22 06:08, load average 1.2 on the 2
+//! cores, fastest (median) of 20 interleaved rounds, the step being pass A
+//! and the sweep without loads or friction:
+//!
+//! | mesh (free DOFs)         | threads | K·x compact   | K·x classes   | step compact  | step classes  |
+//! |--------------------------|---------|---------------|---------------|---------------|---------------|
+//! | Q1 1416×354 (1,004,298)  | 1       | 7.38 (8.18)   | 11.88 (11.95) | 12.75 (13.50) | 15.59 (15.75) |
+//! |                          | 2       | 3.99 (4.54)   |  6.01 (6.23)  |  6.88 (7.59)  |  8.01 (8.33)  |
+//! | Q2 352×88 (248,688)      | 1       | 6.35 (6.66)   |  3.40 (3.49)  |  7.36 (7.93)  |  4.23 (4.42)  |
+//! |                          | 2       | 3.23 (3.42)   |  1.75 (1.83)  |  3.97 (4.20)  |  2.14 (2.32)  |
+//! | Q2 708×177 (1,004,298)   | 1       | 23.87 (24.44) | 13.44 (13.52) | 29.73 (30.29) | 17.30 (17.42) |
+//! |                          | 2       | 12.54 (12.89) |  6.79 (6.86)  | 15.91 (16.45) |  9.14 (9.29)  |
+//!
+//! (ms.) Q2 steps 1.7-1.9× faster, so the explicit step uses the classes
+//! when the caller attaches them (`Dynamics::element_classes`); Q1 keeps
+//! the compact form, its dictionary needing 9 blocks (36 products) per
+//! node against 4 cells of 8 columns (64), and
+//! [`stickslip_fem::ElementClasses::new`] declines Q1 meshes, and Q2 meshes
+//! below [`stickslip_fem::classes::MIN_FREE_DOFS`] (their stored blocks
+//! stay in cache and stream faster: 8,352 DOFs 117 vs 142 µs per step). The
+//! matrix-free data is 4.6 MB (Q2 249k) and 18.6 MB (Q2 1M) against 73 and
+//! 293 MB of stored blocks. Tried and not kept: each cell's K_e x_e formed
+//! once per chunk into a per-thread cache and the nodes summing its
+//! entries (fewer loads per product, but cells recomputed in every chunk
+//! they touch): Q2 708×177 K·x 11.9 vs 10.0 ms for the node sums (2
+//! threads, fastest of 20, same session, load 1.1-1.5); and gathering x_e
+//! per node and cell instead of through the chunk's cache of gathered
+//! cells ([`Gathered`]): Q2 352×88 K·x 4.8 vs 3.6 ms on 1 thread (fastest
+//! of 20, two sessions minutes apart, load 1.0-1.4). Measured no faster
+//! (1 thread, fastest of 20, load 0.7-1.2, against 13.2-13.4 ms for Q2
+//! 708×177 and 3.4-3.5 ms for 352×88 in the sessions around): x_e held
+//! twice and both operands 16-byte aligned, so that a column is one load,
+//! one mulpd with a memory operand and one addpd (checked in the
+//! assembly): 14.0-14.2 and 3.5 ms; a per-thread cache wide enough for
+//! all of a chunk's cells (each gathered once per chunk, not once per
+//! grid row): 13.7 and 3.2 ms; 2 or 6 partial sums per row instead of 4:
+//! within 5%. The kernel is then neither bound by its instruction count
+//! nor by the gathers; on this machine it runs at about 2 cycles per
+//! column of a node's two rows.
 
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
@@ -760,16 +808,6 @@ impl Compact {
         self.with_blocks(Row(i, x))
     }
 
-    /// Calls `f(row, (K x)_row)` for every row of chunk `c`, in row order.
-    #[inline]
-    fn chunk_rows(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, f64)) {
-        self.chunk_batches(c, x, |r0, ku| {
-            for (k, &s) in ku.iter().enumerate() {
-                f(r0 + k, s);
-            }
-        });
-    }
-
     /// Calls `f(first row, K x on the batch's rows)` for consecutive
     /// batches of at most [`BATCH`] rows covering chunk `c`, in order: the
     /// caller's per-row work then runs in loops over a batch held in L1
@@ -893,13 +931,264 @@ impl Compact {
     }
 }
 
+/// The product the step's sweeps run over: K x by rows, in batches of a
+/// chunk ([`Compact`], the assembled K; [`Classes`], matrix-free). Each row's
+/// value must not depend on the batches or chunks it is computed in, so
+/// that a run is bit-identical on one thread and on many.
+pub trait RowProduct: Sync {
+    /// Calls `f(first row, K x on the batch's rows)` for consecutive
+    /// batches of at most [`BATCH`] rows covering chunk `c`, in order.
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64]));
+    /// (K x)_i alone, with the bits the batches give it.
+    fn row(&self, i: usize, x: &[f64]) -> f64;
+    /// y = K x.
+    fn spmv(&self, x: &[f64], y: &mut [f64]);
+    /// Bytes one K x streams from the operator's data.
+    fn bytes(&self) -> usize;
+}
+
+impl RowProduct for Compact {
+    #[inline]
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64])) {
+        Compact::chunk_batches(self, c, x, f)
+    }
+    fn row(&self, i: usize, x: &[f64]) -> f64 {
+        Compact::row(self, i, x)
+    }
+    fn spmv(&self, x: &[f64], y: &mut [f64]) {
+        Compact::spmv(self, x, y)
+    }
+    fn bytes(&self) -> usize {
+        Compact::bytes(self)
+    }
+}
+
+/// K as the explicit step reads it: the compact form of the assembled K,
+/// or matrix-free by element classes when the mesh has them
+/// ([`Classes`]: measured faster on the structured Q2 slabs; the module
+/// documentation gives the figures).
+#[derive(Clone, Debug)]
+pub enum Product {
+    /// [`Compact`].
+    Compact(Compact),
+    /// [`Classes`].
+    Classes(Classes),
+}
+
+impl RowProduct for Product {
+    #[inline]
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64])) {
+        match self {
+            Product::Compact(k) => RowProduct::chunk_batches(k, c, x, f),
+            Product::Classes(k) => k.chunk_batches(c, x, f),
+        }
+    }
+    fn row(&self, i: usize, x: &[f64]) -> f64 {
+        match self {
+            Product::Compact(k) => k.row(i, x),
+            Product::Classes(k) => k.row(i, x),
+        }
+    }
+    fn spmv(&self, x: &[f64], y: &mut [f64]) {
+        match self {
+            Product::Compact(k) => k.spmv(x, y),
+            Product::Classes(k) => k.spmv(x, y),
+        }
+    }
+    fn bytes(&self) -> usize {
+        match self {
+            Product::Compact(k) => k.bytes(),
+            Product::Classes(k) => RowProduct::bytes(k),
+        }
+    }
+}
+
+/// Independent sums per row of a node ([`Classes`]): a node's rows are
+/// chains of dependent additions, LANES of them per row hide the adder's
+/// latency (the columns taken in turn).
+const LANES: usize = 4;
+
+/// K x matrix-free from element classes ([`ElementClasses`]: one element
+/// matrix per class of cells alike to the coordinates' rounding), node by
+/// node: a node's two rows are the sum over its cells e of the node's rows
+/// of K_e times x_e (fixed DOFs read as 0). Each row is a function of x
+/// alone (its node's cells in ascending order, the columns in [`LANES`]
+/// sums added in a fixed order), whatever the batch or thread computing it.
+/// Not the bits of the assembled K's product: within 1e-12 of
+/// max_i Σ_j |K_ij x_j| (tests below).
+#[derive(Clone, Debug)]
+pub struct Classes {
+    ec: stickslip_fem::ElementClasses,
+}
+
+impl Classes {
+    /// The operator of `ec` (Q1 or Q2 cells).
+    pub fn new(ec: stickslip_fem::ElementClasses) -> Option<Classes> {
+        matches!(ec.nodes_per_cell(), 4 | 9).then_some(Classes { ec })
+    }
+
+    /// The element classes.
+    pub fn classes(&self) -> &stickslip_fem::ElementClasses {
+        &self.ec
+    }
+
+    /// K x on rows r0..r0 + out.len() into `out` (a row or two, for the
+    /// friction: a one-slot cache, nothing to clear).
+    #[inline]
+    fn rows_into(&self, r0: usize, x: &[f64], out: &mut [f64]) {
+        match self.ec.nodes_per_cell() {
+            4 => self.rows_nd::<8, 1>(r0, x, out, &mut Gathered::new()),
+            9 => self.rows_nd::<18, 1>(r0, x, out, &mut Gathered::new()),
+            _ => unreachable!("Classes::new admits Q1 and Q2"),
+        }
+    }
+
+    /// [`RowProduct::chunk_batches`] with the cells' x_e gathered once per
+    /// chunk ([`Gathered`]).
+    #[inline(always)]
+    fn batches_nd<const ND: usize>(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, &[f64])) {
+        let n = self.ec.n_free();
+        let (start, end) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
+        let mut buf = [0.0; BATCH];
+        let mut cache = Gathered::<ND>::new();
+        let mut r0 = start;
+        while r0 < end {
+            let r1 = (r0 + BATCH).min(end);
+            let out = &mut buf[..r1 - r0];
+            self.rows_nd::<ND, SLOTS>(r0, x, out, &mut cache);
+            f(r0, out);
+            r0 = r1;
+        }
+    }
+
+    #[inline(always)]
+    fn rows_nd<const ND: usize, const S: usize>(
+        &self,
+        r0: usize,
+        x: &[f64],
+        out: &mut [f64],
+        cache: &mut Gathered<ND, S>,
+    ) {
+        let ec = &self.ec;
+        let group_rows = ec.group_rows();
+        let mask = ec.group_mask();
+        let r1 = r0 + out.len();
+        let mut g = group_rows.partition_point(|&r| r as usize <= r0) - 1;
+        while g + 1 < group_rows.len() && (group_rows[g] as usize) < r1 {
+            let s = self.node_sums::<ND, S>(g, x, cache);
+            let mut r = group_rows[g] as usize;
+            for (comp, s) in s.iter().enumerate() {
+                if mask[g] >> comp & 1 == 1 {
+                    if (r0..r1).contains(&r) {
+                        out[r - r0] = *s;
+                    }
+                    r += 1;
+                }
+            }
+            g += 1;
+        }
+    }
+
+    /// The sums of group g's two rows (a fixed component's too, unused).
+    #[inline(always)]
+    fn node_sums<const ND: usize, const S: usize>(
+        &self,
+        g: usize,
+        x: &[f64],
+        cache: &mut Gathered<ND, S>,
+    ) -> [f64; 2] {
+        use stickslip_fem::classes::{HAS_FIXED, LOCAL_BITS};
+        let ec = &self.ec;
+        let (gc, nc) = (ec.group_cells(), ec.node_cells());
+        let (classes, matrices) = (ec.cell_class(), ec.matrices());
+        let n = ND / 2;
+        let mut acc = [[0.0; 2]; LANES];
+        for &p in &nc[gc[g] as usize..gc[g + 1] as usize] {
+            let e = (p >> LOCAL_BITS) as usize;
+            let a = (p & ((1 << LOCAL_BITS) - 1)) as usize;
+            let k = (classes[e] & !HAS_FIXED) as usize;
+            let m: &[[f64; 2]; ND] = matrices[(k * n + a) * ND..][..ND].try_into().unwrap();
+            let xe = cache.get(ec.cell_dofs(), e, x);
+            for j in 0..ND {
+                let q = j % LANES;
+                acc[q][0] += m[j][0] * xe[j];
+                acc[q][1] += m[j][1] * xe[j];
+            }
+        }
+        std::array::from_fn(|r| (acc[0][r] + acc[1][r]) + (acc[2][r] + acc[3][r]))
+    }
+}
+
+/// Slots of [`Gathered`] (a power of 2).
+const SLOTS: usize = 256;
+
+/// A direct-mapped cache of cells' x_e (slot: cell mod [`SLOTS`]): a cell
+/// serves up to 9 nodes, most of them in one chunk, so its x_e is gathered
+/// about once per chunk instead of once per node. A copy of x's entries (0
+/// at fixed DOFs), so the sums do not depend on what was cached.
+struct Gathered<const ND: usize, const S: usize = SLOTS> {
+    tags: [u32; S],
+    xe: [[f64; ND]; S],
+}
+
+impl<const ND: usize, const S: usize> Gathered<ND, S> {
+    fn new() -> Self {
+        Gathered {
+            tags: [u32::MAX; S],
+            xe: [[0.0; ND]; S],
+        }
+    }
+
+    /// x_e of cell e.
+    #[inline(always)]
+    fn get(&mut self, dofs: &[u32], e: usize, x: &[f64]) -> &[f64; ND] {
+        let slot = e % S;
+        if self.tags[slot] != e as u32 {
+            let d: &[u32; ND] = dofs[e * ND..][..ND].try_into().unwrap();
+            // A fixed DOF (u32::MAX) is out of range: 0.
+            self.xe[slot] = std::array::from_fn(|j| x.get(d[j] as usize).copied().unwrap_or(0.0));
+            self.tags[slot] = e as u32;
+        }
+        &self.xe[slot]
+    }
+}
+
+impl RowProduct for Classes {
+    #[inline]
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64])) {
+        match self.ec.nodes_per_cell() {
+            4 => self.batches_nd::<8>(c, x, f),
+            9 => self.batches_nd::<18>(c, x, f),
+            _ => unreachable!("Classes::new admits Q1 and Q2"),
+        }
+    }
+
+    fn row(&self, i: usize, x: &[f64]) -> f64 {
+        let mut out = [0.0];
+        self.rows_into(i, x, &mut out);
+        out[0]
+    }
+
+    fn spmv(&self, x: &[f64], y: &mut [f64]) {
+        each_chunk(y, |c, y| {
+            self.chunk_batches(c, x, |r0, ku| {
+                y[r0 - c * CHUNK..][..ku.len()].copy_from_slice(ku);
+            })
+        });
+    }
+
+    fn bytes(&self) -> usize {
+        self.ec.bytes()
+    }
+}
+
 /// The SpMV fused with pass B ([`rhs_and_velocity`]): each row's K r_K is
 /// used as soon as it is summed, so K r_K is never written and read back
 /// (two vector passes fewer). The same arithmetic per entry and the same
 /// order of the strain sum, hence the same bits.
 #[allow(clippy::too_many_arguments)]
-pub fn spmv_rhs_and_velocity(
-    k: &Compact,
+pub fn spmv_rhs_and_velocity<K: RowProduct>(
+    k: &K,
     load_new: &[f64],
     mass: &[f64],
     r_new: &[f64],
@@ -915,11 +1204,14 @@ pub fn spmv_rhs_and_velocity(
     let body = |c: usize, b: &mut [f64], vn: &mut [f64], partial: &mut [f64; 5]| {
         let start = c * CHUNK;
         let mut strain = 0.0;
-        k.chunk_rows(c, r_new, |i, ku| {
-            strain += r_new[i] * ku;
-            let bi = load_new[i] - ku + mass[i] * (cv * v[i] + ca * a[i]);
-            b[i - start] = bi;
-            vn[i - start] = bi / (mass[i] * scale);
+        k.chunk_batches(c, r_new, |r0, kus| {
+            for (j, &ku) in kus.iter().enumerate() {
+                let i = r0 + j;
+                strain += r_new[i] * ku;
+                let bi = load_new[i] - ku + mass[i] * (cv * v[i] + ca * a[i]);
+                b[i - start] = bi;
+                vn[i - start] = bi / (mass[i] * scale);
+            }
         });
         partial[0] = strain;
     };
@@ -1042,8 +1334,8 @@ fn batch_rows(
 ///
 /// `ku`: K r_K when the caller has it (the one-chunk step computes it
 /// first for the friction, [`Compact::spmv`]); else the sweep forms it.
-pub fn fused_step(
-    k: &Compact,
+pub fn fused_step<K: RowProduct>(
+    k: &K,
     s: &StepData,
     friction: &[(usize, f64)],
     ku: Option<&[f64]>,
@@ -1437,6 +1729,200 @@ mod tests {
         }
     }
 
+    /// The tolerance of the matrix-free product: row-wise within 1e-12 of
+    /// max_i Σ_j |K_ij x_j| (the class matrices come from cells alike to
+    /// the coordinates' rounding, and the sums run in another order).
+    fn check_classes(k: &CsrMatrix<f64>, op: &Classes, x: &[f64], name: &str) {
+        let n = k.nrows();
+        let (o, c, v) = (k.row_offsets(), k.col_indices(), k.values());
+        let scale = (0..n)
+            .map(|i| {
+                (o[i]..o[i + 1])
+                    .map(|p| (v[p] * x[c[p]]).abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0_f64, f64::max);
+        assert!(scale > 0.0);
+        let mut y0 = vec![0.0; n];
+        spmv(k, x, &mut y0);
+        let mut y1 = vec![f64::NAN; n];
+        op.spmv(x, &mut y1);
+        for i in 0..n {
+            assert!(
+                (y0[i] - y1[i]).abs() <= 1e-12 * scale,
+                "{name} row {i}: {} vs {} (scale {scale:e})",
+                y0[i],
+                y1[i]
+            );
+        }
+        // A row alone and the batches of a chunk give the same bits.
+        for i in (0..n).step_by(97).chain([0, n - 1]) {
+            assert_eq!(
+                op.row(i, x).to_bits(),
+                y1[i].to_bits(),
+                "{name} row {i} alone"
+            );
+        }
+        for c in 0..chunks(n) {
+            op.chunk_batches(c, x, |r0, ku| {
+                for (j, v) in ku.iter().enumerate() {
+                    assert_eq!(v.to_bits(), y1[r0 + j].to_bits(), "{name} chunk {c}");
+                }
+            });
+        }
+    }
+
+    /// Matrix-free K·x by element classes against the CSR's on structured
+    /// Q1 and Q2 rectangles (several chunks) with and without Dirichlet
+    /// DOFs (the slab's supports, single-DOF nodes, and a corner held in
+    /// both components), and on meshes without classes: the committed
+    /// unstructured ones and a perturbed rectangle, where
+    /// [`ElementClasses::new`] declines and a class per cell is still right.
+    #[test]
+    fn classes_spmv_matches_the_csr() {
+        use stickslip_fem::testing::{add_point_group, map_nodes, rectangle};
+        use stickslip_fem::ElementClasses;
+        use stickslip_mesh::CellKind;
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let supports = [
+            Dirichlet::new("top", 1, 0.0),
+            Dirichlet::new("left", 0, 0.0),
+            Dirichlet::new("corner", 1, 0.0),
+            Dirichlet::new("corner", 0, 0.0),
+        ];
+        for (kind, nx, ny) in [(CellKind::Quad9, 96, 24), (CellKind::Quad4, 192, 48)] {
+            let mut mesh = rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
+            let corner = mesh.nodes.iter().position(|p| p[0] == 8.0 && p[1] == 0.0);
+            add_point_group(&mut mesh, "corner", &[corner.unwrap()]);
+            for conditions in [&supports[..], &[]] {
+                let model = Model::new(&mesh, &material, conditions).unwrap();
+                let k = &model.stiffness;
+                let n = k.nrows();
+                assert!(chunks(n) >= 3, "{n}");
+                // Declined: Q1 (the dictionary is faster) and fewer than
+                // MIN_FREE_DOFS (K stays in cache).
+                assert!(ElementClasses::new(&mesh, &material, &model.dofs).is_none());
+                let ec = ElementClasses::with_limit(&mesh, &material, &model.dofs, 64).unwrap();
+                assert_eq!(ec.classes(), 1);
+                let op = Classes::new(ec).unwrap();
+                let x = x_of(n);
+                check_classes(k, &op, &x, &format!("{kind:?} {}", conditions.len()));
+            }
+        }
+        // Accepted: a structured Q2 slab above MIN_FREE_DOFS (the DOF map
+        // alone; one class, one matrix).
+        let big = rectangle(CellKind::Quad9, 252, 63, [0.0, 0.0], [8.0, 1.0]);
+        let dofs = stickslip_fem::DofMap::new(&big, &[Dirichlet::new("top", 1, 0.0)]).unwrap();
+        assert!(dofs.n_free() >= stickslip_fem::classes::MIN_FREE_DOFS);
+        let ec = ElementClasses::new(&big, &material, &dofs).expect("classes pay");
+        assert_eq!(ec.classes(), 1);
+        // No classes: every cell its own (or nearly).
+        let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes");
+        let mut perturbed = rectangle(CellKind::Quad9, 24, 6, [0.0, 0.0], [8.0, 1.0]);
+        map_nodes(&mut perturbed, |p| {
+            [
+                p[0] + 1e-3 * (7.0 * p[1] + 3.0 * p[0]).sin(),
+                p[1] + 1e-3 * (5.0 * p[0]).cos(),
+            ]
+        });
+        let meshes = [
+            ("perturbed", perturbed),
+            (
+                "unstructured q1",
+                Mesh::from_file(dir.join("slab-unstructured-q1.msh")).unwrap(),
+            ),
+            (
+                "unstructured q2",
+                Mesh::from_file(dir.join("slab-unstructured-q2.msh")).unwrap(),
+            ),
+        ];
+        let supports = [
+            Dirichlet::new("left", 0, 0.0),
+            Dirichlet::new("left", 1, 0.0),
+        ];
+        for (name, mesh) in meshes {
+            let model = Model::new(&mesh, &material, &supports).unwrap();
+            // Declined by the class count alone (MAX_CLASSES), whatever
+            // the size.
+            let limit = stickslip_fem::classes::MAX_CLASSES;
+            assert!(
+                ElementClasses::with_limit(&mesh, &material, &model.dofs, limit).is_none(),
+                "{name}"
+            );
+            let ec = ElementClasses::with_limit(&mesh, &material, &model.dofs, usize::MAX).unwrap();
+            assert!(
+                2 * ec.classes() > mesh.n_cells(),
+                "{name}: {} classes",
+                ec.classes()
+            );
+            let op = Classes::new(ec).unwrap();
+            let k = &model.stiffness;
+            check_classes(k, &op, &x_of(k.nrows()), name);
+        }
+    }
+
+    /// The matrix-free product and the one-sweep step on it have the same
+    /// bits on one thread and on two (rows are independent of the chunks'
+    /// assignment to threads).
+    #[test]
+    fn classes_one_thread_and_two_give_the_same_bits() {
+        use stickslip_fem::testing::rectangle;
+        use stickslip_fem::ElementClasses;
+        use stickslip_mesh::CellKind;
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let mesh = rectangle(CellKind::Quad9, 96, 24, [0.0, 0.0], [8.0, 1.0]);
+        let supports = [
+            Dirichlet::new("top", 1, 0.0),
+            Dirichlet::new("left", 0, 0.0),
+        ];
+        let model = Model::new(&mesh, &material, &supports).unwrap();
+        let n = model.dofs.n_free();
+        let ec = ElementClasses::with_limit(&mesh, &material, &model.dofs, 64).unwrap();
+        let op = Classes::new(ec).unwrap();
+        let x = x_of(n);
+        let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
+        let (m, v, a) = (w(1.2), w(1.5), w(1.6));
+        let mass: Vec<f64> = m.iter().map(|m| 1.0 + m.abs()).collect();
+        let zero = vec![0.0; n];
+        let friction: Vec<(usize, f64)> = (0..n).step_by(301).map(|i| (i, 0.5)).collect();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut y = vec![0.0; n];
+                op.spmv(&x, &mut y);
+                let data = StepData {
+                    load_new: &zero,
+                    load_rows: &[],
+                    mass: &mass,
+                    r_new: &x,
+                    v: &v,
+                    a: &a,
+                    cv: 2e3,
+                    ca: 1.0,
+                    scale: 2e3,
+                    gamma_dt: 5e-4,
+                    ratio: 1.0,
+                };
+                let mut p = partials(n);
+                let (mut vn, mut an) = (vec![0.0; n], vec![0.0; n]);
+                let (strain, sums) =
+                    fused_step(&op, &data, &friction, None, &mut vn, &mut an, &mut p);
+                (y, vn, an, strain, sums.kinetic)
+            })
+        };
+        let one = run(1);
+        let two = run(2);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&one.0), bits(&two.0));
+        assert_eq!(bits(&one.1), bits(&two.1));
+        assert_eq!(bits(&one.2), bits(&two.2));
+        assert_eq!(one.3.to_bits(), two.3.to_bits());
+        assert_eq!(one.4.to_bits(), two.4.to_bits());
+    }
+
     /// Kernel lab (issue 7: "K·r by CSR SpMV or element by element, choose
     /// by measurement"): K·x on a structured Q1 slab (default 1416 × 354
     /// cells, 1,004,298 free DOFs; `STICKSLIP_LAB_NY` sets ny, nx = 4 ny)
@@ -1675,6 +2161,169 @@ mod tests {
                     );
                 }
             });
+        }
+    }
+
+    /// Class lab: K·x matrix-free by element classes ([`Classes`]) against
+    /// [`Compact`] (the form the step picks, [`Compact::new`]) on the bench's
+    /// structured slabs (`testing::rectangle`, the coordinates of
+    /// bench_step's `structured_slab`) with the slab's supports: one K·x and
+    /// the whole explicit step (pass A and the sweep, no loads or friction),
+    /// the variants interleaved, fastest and median of 20, on 1 and 2
+    /// threads; checks the matrix-free rows against the CSR's to 1e-12 of
+    /// max_i Σ_j |K_ij x_j|. `STICKSLIP_LAB_MESHES` = comma-separated
+    /// `q1-NXxNY` / `q2-NXxNY` (default the three rungs below).
+    ///
+    ///     cargo test --profile dev -p stickslip-time --lib class_lab -- --ignored --nocapture
+    #[test]
+    #[ignore = "timing; run by hand (see the doc comment)"]
+    fn class_lab() {
+        use std::time::Instant;
+        use stickslip_fem::testing::rectangle;
+        use stickslip_fem::ElementClasses;
+        use stickslip_mesh::CellKind;
+
+        let meshes = std::env::var("STICKSLIP_LAB_MESHES")
+            .unwrap_or_else(|_| "q1-1416x354,q2-352x88,q2-708x177".into());
+        println!(
+            "class lab, load: {:?}",
+            std::fs::read_to_string("/proc/loadavg")
+                .unwrap_or_default()
+                .trim()
+        );
+        for name in meshes.split(',') {
+            let (order, size) = name.split_once('-').unwrap();
+            let (nx, ny) = size.split_once('x').unwrap();
+            let kind = if order == "q2" {
+                CellKind::Quad9
+            } else {
+                CellKind::Quad4
+            };
+            let mesh = rectangle(
+                kind,
+                nx.parse().unwrap(),
+                ny.parse().unwrap(),
+                [0.0, 0.0],
+                [8.0, 1.0],
+            );
+            let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+            let supports = [
+                Dirichlet::new("top", 1, 0.0),
+                Dirichlet::new("left", 0, 0.0),
+            ];
+            let model = Model::new(&mesh, &material, &supports).unwrap();
+            let k = &model.stiffness;
+            let n = k.nrows();
+            let t0 = Instant::now();
+            let compact = Compact::new(k).unwrap();
+            let t_compact = t0.elapsed().as_secs_f64();
+            let t0 = Instant::now();
+            let ec =
+                ElementClasses::with_limit(&mesh, &material, &model.dofs, 1).expect("one class");
+            let classes = Classes::new(ec).unwrap();
+            let t_classes = t0.elapsed().as_secs_f64();
+            let x = x_of(n);
+            let (mut y0, mut y1) = (vec![0.0; n], vec![0.0; n]);
+            spmv(k, &x, &mut y0);
+            classes.spmv(&x, &mut y1);
+            let abs = {
+                let (o, c, v) = (k.row_offsets(), k.col_indices(), k.values());
+                (0..n)
+                    .map(|i| {
+                        (o[i]..o[i + 1])
+                            .map(|p| (v[p] * x[c[p]]).abs())
+                            .sum::<f64>()
+                    })
+                    .fold(0.0_f64, f64::max)
+            };
+            let diff = y0
+                .iter()
+                .zip(&y1)
+                .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+            println!(
+                "{name}: n = {n}, {} classes, compact {:.0} MB ({} distinct blocks, built in {:.2} s), classes {:.1} MB (built in {:.2} s), |Δ| = {:.2e} of max Σ|K x| = {:.2e} ({:.1e})",
+                classes.classes().classes(),
+                compact.bytes() as f64 / 1e6,
+                compact.dictionary_len(),
+                t_compact,
+                classes.bytes() as f64 / 1e6,
+                t_classes,
+                diff,
+                abs,
+                diff / abs
+            );
+            assert!(diff <= 1e-12 * abs);
+            let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
+            let (r, m, v, a) = (w(1.3), w(1.2), w(1.5), w(1.6));
+            let (zero, mut ln, mut rn) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            let sparse = SparseLoads::new(&zero, &[]);
+            for threads in [1, 2] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                pool.install(|| {
+                    let mut p = partials(n);
+                    let (mut vn, mut an) = (vec![0.0; n], vec![0.0; n]);
+                    let mut t: [Vec<f64>; 4] = Default::default();
+                    for _ in 0..20 {
+                        let s = Instant::now();
+                        compact.spmv(&x, &mut y0);
+                        t[0].push(s.elapsed().as_secs_f64());
+                        let s = Instant::now();
+                        classes.spmv(&x, &mut y1);
+                        t[1].push(s.elapsed().as_secs_f64());
+                        let mut step = |q: usize, use_classes: bool| {
+                            let s = Instant::now();
+                            predict(
+                                &sparse,
+                                &[],
+                                &r,
+                                &v,
+                                &a,
+                                1e-3,
+                                0.5e-6,
+                                &zero,
+                                &mut ln,
+                                &mut rn,
+                                &mut p,
+                            );
+                            let data = StepData {
+                                load_new: &ln,
+                                load_rows: &[],
+                                mass: &m,
+                                r_new: &rn,
+                                v: &v,
+                                a: &a,
+                                cv: 2e3,
+                                ca: 1.0,
+                                scale: 2e3,
+                                gamma_dt: 5e-4,
+                                ratio: 1.0,
+                            };
+                            if use_classes {
+                                fused_step(&classes, &data, &[], None, &mut vn, &mut an, &mut p);
+                            } else {
+                                fused_step(&compact, &data, &[], None, &mut vn, &mut an, &mut p);
+                            }
+                            t[q].push(s.elapsed().as_secs_f64());
+                        };
+                        step(2, false);
+                        step(3, true);
+                    }
+                    for (label, t) in ["K·x compact", "K·x classes", "step compact", "step classes"]
+                        .iter()
+                        .zip(&mut t)
+                    {
+                        t.sort_by(f64::total_cmp);
+                        println!(
+                            "  {threads} thread(s) {label:13}: fastest {:.3} ms, median {:.3} ms",
+                            1e3 * t[0],
+                            1e3 * t[10]
+                        );
+                    }
+                });
+            }
         }
     }
 }

@@ -372,6 +372,7 @@ pub mod sdof {
             consistent_mass: scalar(1.0),
             lumped_mass: vec![1.0],
             constant_load: vec![0.0],
+            element_classes: None,
         };
         let node = ContactNode {
             node: 0,

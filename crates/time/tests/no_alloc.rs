@@ -9,7 +9,11 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use common::*;
-use stickslip_time::{History, ImplicitSolver, Integrator, Scheme, Settings, StickReduction};
+use stickslip_fem::{ElementClasses, Hypothesis, Material};
+use stickslip_time::scenes::{E, NU};
+use stickslip_time::{
+    Dynamics, History, ImplicitSolver, Integrator, Scheme, Settings, StickReduction,
+};
 
 struct Counting;
 
@@ -85,6 +89,31 @@ fn steps_allocate_nothing() {
             count(&mut i, 200)
         });
         assert_eq!(n, 0, "{mesh}: {n} allocations in 200 explicit steps");
+    }
+    // Explicit with K·x matrix-free by element classes (a structured Q2
+    // mesh of > 8192 DOFs).
+    {
+        let s = paper_slab("slab-q2-64x16.msh", 1e-4, History::Step);
+        let material = Material::new(E, NU, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let classes = ElementClasses::with_limit(&s.mesh, &material, &s.model.dofs, 64);
+        assert!(classes.is_some());
+        let probe = s
+            .integrator(Settings::new(Scheme::CentralDifference, 1e-9, 1.0))
+            .unwrap();
+        let settings = Settings::new(
+            Scheme::CentralDifference,
+            0.5 * probe.dt_crit().unwrap(),
+            1e3,
+        );
+        let dynamics = Dynamics::from_model(&s.model).with_element_classes(classes);
+        let mut i =
+            Integrator::new(dynamics, s.contact.clone(), s.loads.clone(), settings).unwrap();
+        assert!(i.explicit_classes().is_some());
+        let n = pool.install(|| {
+            count(&mut i, 100);
+            count(&mut i, 200)
+        });
+        assert_eq!(n, 0, "classes: {n} allocations in 200 explicit steps");
     }
     // Implicit, Schur path (each correction), with the step reduction:
     // warm up until the normal and the reduced Δt have their factors.
