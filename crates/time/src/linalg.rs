@@ -139,7 +139,18 @@ pub fn two_forms(
         }
         (s, t)
     };
-    let chunks = row_chunks(x.len());
+    pair_sums(x.len(), partials, chunk)
+}
+
+/// Two sums over the row chunks of a length-n vector: `chunk(c)` per
+/// chunk into `partials` (2·[`row_chunks`] long), on the pool when there
+/// are several, the chunks' sums added in order (the same bits either way).
+fn pair_sums(
+    n: usize,
+    partials: &mut [f64],
+    chunk: impl Fn(usize) -> (f64, f64) + Sync,
+) -> (f64, f64) {
+    let chunks = row_chunks(n);
     let partials = &mut partials[..2 * chunks];
     if chunks > 1 {
         partials
@@ -368,19 +379,7 @@ impl PairBlocks {
             }
             (s, t)
         };
-        let chunks = row_chunks(n);
-        let partials = &mut partials[..2 * chunks];
-        if chunks > 1 {
-            partials
-                .par_chunks_mut(2)
-                .enumerate()
-                .for_each(|(c, p)| (p[0], p[1]) = chunk(c));
-            let s = partials.iter().step_by(2).sum();
-            let t = partials.iter().skip(1).step_by(2).sum();
-            (s, t)
-        } else {
-            chunk(0)
-        }
+        pair_sums(n, partials, chunk)
     }
 }
 
