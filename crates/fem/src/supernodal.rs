@@ -927,7 +927,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::rectangle;
+    use crate::testing::{on_threads, plain_spmv, rectangle};
     use crate::{Hypothesis, Material, Model};
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::sparse::linalg::cholesky::LltRef;
@@ -987,14 +987,8 @@ mod tests {
     fn residual(a: &CsrMatrix<f64>, x: &[f64], b: &[f64]) -> f64 {
         let mut worst: f64 = 0.0;
         let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for (i, row) in a.row_iter().enumerate() {
-            let ax: f64 = row
-                .col_indices()
-                .iter()
-                .zip(row.values())
-                .map(|(&j, v)| v * x[j])
-                .sum();
-            worst = worst.max((ax - b[i]).abs() / scale);
+        for (ax, bi) in plain_spmv(a, x).iter().zip(b) {
+            worst = worst.max((ax - bi).abs() / scale);
         }
         worst
     }
@@ -1070,11 +1064,7 @@ mod tests {
         let b = rhs(n);
         let dofs: Vec<usize> = (0..=40).map(|i| 2 * i).collect();
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
+            on_threads(threads, || {
                 let mut sn = Supernodal::with_split_min(&f.symbolic, 0).unwrap();
                 assert!(sn.is_split(), "the tree splits");
                 sn.set_reach(&dofs);

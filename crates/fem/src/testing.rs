@@ -3,8 +3,35 @@
 //! four sides as named line groups, optionally distorted or curved by a map
 //! of the nodes; and the manufactured static solution ([`manufactured`])
 //! whose errors the fem convergence test and `cargo xtask verify` measure.
+//! Also two helpers the workspace's tests share: [`on_threads`] and the
+//! reference product [`plain_spmv`].
 
+use nalgebra_sparse::CsrMatrix;
 use stickslip_mesh::{CellKind, Edge, Group, Mesh, SourceInfo};
+
+/// Runs `f` on a rayon pool of `threads` threads (the thread-independence
+/// tests run the same work on 1 and on 2).
+pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
+        .install(f)
+}
+
+/// A x as plain row sums in storage order: the reference the tests hold the
+/// optimized products and the solves' residuals against.
+pub fn plain_spmv(a: &CsrMatrix<f64>, x: &[f64]) -> Vec<f64> {
+    a.row_iter()
+        .map(|r| {
+            r.col_indices()
+                .iter()
+                .zip(r.values())
+                .map(|(&j, v)| v * x[j])
+                .sum()
+        })
+        .collect()
+}
 
 /// A rectangle `[x0, x0 + lx] × [y0, y0 + ly]` of `nx × ny` cells of `kind`.
 /// Groups: lines "bottom", "right", "top", "left" (tags 1-4, edges oriented

@@ -1,8 +1,7 @@
 //! Assembled operators: rigid-body modes, mass totals, HRZ ratios, shared
 //! pattern, `combine`, and thread-count independence.
 
-use nalgebra_sparse::CsrMatrix;
-use stickslip_fem::testing::{map_nodes, rectangle};
+use stickslip_fem::testing::{map_nodes, on_threads, plain_spmv, rectangle};
 use stickslip_fem::{Hypothesis, Material, Model};
 use stickslip_mesh::{CellKind, Mesh};
 
@@ -23,18 +22,6 @@ fn distorted(kind: CellKind, nx: usize, ny: usize) -> Mesh {
         ]
     });
     m
-}
-
-fn spmv(a: &CsrMatrix<f64>, x: &[f64]) -> Vec<f64> {
-    a.row_iter()
-        .map(|r| {
-            r.col_indices()
-                .iter()
-                .zip(r.values())
-                .map(|(&j, v)| v * x[j])
-                .sum()
-        })
-        .collect()
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -59,7 +46,7 @@ fn stiffness_annihilates_the_three_rigid_body_motions() {
         ];
         for (m, motion) in motions.iter().enumerate() {
             let r: Vec<f64> = mesh.nodes.iter().flat_map(|&p| motion(p)).collect();
-            let kr = spmv(&model.stiffness, &r);
+            let kr = plain_spmv(&model.stiffness, &r);
             let rel = norm(&kr) / (k_norm * norm(&r));
             assert!(
                 rel < 1e-10,
@@ -90,7 +77,7 @@ fn consistent_and_lumped_mass_sum_to_rho_area_per_direction() {
                 .flat_map(|_| [(dir == 0) as u8 as f64, (dir == 1) as u8 as f64])
                 .collect();
             let other: Vec<f64> = e.iter().map(|v| 1.0 - v).collect();
-            let me = spmv(&model.mass, &e);
+            let me = plain_spmv(&model.mass, &e);
             let total: f64 = me.iter().zip(&e).map(|(a, b)| a * b).sum();
             let cross: f64 = me.iter().zip(&other).map(|(a, b)| a * b).sum();
             assert!(
@@ -177,13 +164,7 @@ fn assembly_is_bitwise_identical_for_any_thread_count() {
         stickslip_fem::Dirichlet::new("left", 0, 0.01),
         stickslip_fem::Dirichlet::new("bottom", 1, 0.0),
     ];
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| Model::new(&mesh, &mat, &bcs).unwrap())
-    };
+    let run = |threads: usize| on_threads(threads, || Model::new(&mesh, &mat, &bcs).unwrap());
     let one = run(1);
     let many = run(4);
     assert_eq!(one.stiffness.values(), many.stiffness.values());

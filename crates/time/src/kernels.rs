@@ -1382,6 +1382,7 @@ pub fn fused_step<K: RowProduct>(
 mod tests {
     use super::*;
     use nalgebra_sparse::{CooMatrix, CsrMatrix};
+    use stickslip_fem::testing::on_threads;
     use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
     use stickslip_mesh::Mesh;
 
@@ -1474,11 +1475,9 @@ mod tests {
             assert!(forms[1].dictionary_len() > 0);
             for threads in [1, 2] {
                 for compact in &forms {
-                    let pool = rayon::ThreadPoolBuilder::new()
-                        .num_threads(threads)
-                        .build()
-                        .unwrap();
-                    pool.install(|| check_fused(k, compact, &format!("{name} {threads}")));
+                    on_threads(threads, || {
+                        check_fused(k, compact, &format!("{name} {threads}"))
+                    });
                 }
             }
         }
@@ -1886,11 +1885,7 @@ mod tests {
         let zero = vec![0.0; n];
         let friction: Vec<(usize, f64)> = (0..n).step_by(301).map(|i| (i, 0.5)).collect();
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
+            on_threads(threads, || {
                 let mut y = vec![0.0; n];
                 op.spmv(&x, &mut y);
                 let data = StepData {
@@ -2068,11 +2063,7 @@ mod tests {
                 .trim()
         );
         for threads in [1, 2] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
+            on_threads(threads, || {
                 let t = time(&mut || spmv(k, &x, &mut y0));
                 println!(
                     "  {threads} thread(s) CSR usize   : {:.3} ms, {:.0} MB, {:.1} GB/s",
@@ -2258,11 +2249,7 @@ mod tests {
             let (zero, mut ln, mut rn) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
             let sparse = SparseLoads::new(&zero, &[]);
             for threads in [1, 2] {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
-                pool.install(|| {
+                on_threads(threads, || {
                     let mut p = partials(n);
                     let (mut vn, mut an) = (vec![0.0; n], vec![0.0; n]);
                     let mut t: [Vec<f64>; 4] = Default::default();

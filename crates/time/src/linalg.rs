@@ -387,6 +387,7 @@ impl PairBlocks {
 mod tests {
     use super::*;
     use nalgebra_sparse::CooMatrix;
+    use stickslip_fem::testing::{on_threads, plain_spmv};
 
     /// A banded symmetric pattern over `n` rows (rows of 5-11 entries, so
     /// the four-way split and the remainder both occur) and two value sets.
@@ -417,11 +418,7 @@ mod tests {
             assert!(same_pattern(&k, &m));
             let (x, y, l) = (vector(n, 1), vector(n, 2), vector(n, 3));
             let run = |threads: usize| {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
-                pool.install(|| {
+                on_threads(threads, || {
                     let mut partials = vec![0.0; 2 * row_chunks(n)];
                     let (mut kx, mut my, mut fused) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
                     spmv(&k, &x, &mut kx);
@@ -443,14 +440,8 @@ mod tests {
             assert_eq!(bits(&one.0), bits(&two.0), "n = {n}: threads");
             assert_eq!(one.3 .0.to_bits(), two.3 .0.to_bits(), "n = {n}: threads");
             // And the product is right: against a plain row loop to 1e-13.
-            for (i, row) in k.row_iter().enumerate() {
-                let plain: f64 = row
-                    .col_indices()
-                    .iter()
-                    .zip(row.values())
-                    .map(|(&j, v)| v * x[j])
-                    .sum();
-                assert!((plain - one.4[i]).abs() <= 1e-13 * plain.abs().max(1.0));
+            for (plain, kx) in plain_spmv(&k, &x).iter().zip(&one.4) {
+                assert!((plain - kx).abs() <= 1e-13 * plain.abs().max(1.0));
             }
         }
     }
@@ -488,11 +479,7 @@ mod tests {
                 let blocks = PairBlocks::new(&k, &m).expect("shared pattern");
                 let (x, y, l) = (vector(n, 4), vector(n, 5), vector(n, 6));
                 let run = |threads: usize| {
-                    let pool = rayon::ThreadPoolBuilder::new()
-                        .num_threads(threads)
-                        .build()
-                        .unwrap();
-                    pool.install(|| {
+                    on_threads(threads, || {
                         let mut out = vec![0.0; n];
                         let mut partials = vec![0.0; 2 * row_chunks(n)];
                         blocks.load_minus_k_plus_m(&l, &x, &y, &mut out);

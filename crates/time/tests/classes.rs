@@ -7,17 +7,14 @@
 
 mod common;
 use common::*;
+use stickslip_fem::testing::on_threads;
 use stickslip_fem::{ElementClasses, Hypothesis, Material};
 use stickslip_time::scenes::{E, NU};
 use stickslip_time::{Dynamics, History, Integrator, Scheme, Settings};
 
 fn run(s: &Slab, classes: bool, threads: usize, steps: usize) -> Integrator {
     let material = Material::new(E, NU, 1.0, Hypothesis::PlaneStrain).unwrap();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| {
+    on_threads(threads, || {
         let probe = s
             .integrator(Settings::new(Scheme::CentralDifference, 1e-9, 0.5))
             .unwrap();

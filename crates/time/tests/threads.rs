@@ -4,14 +4,11 @@
 
 mod common;
 use common::*;
+use stickslip_fem::testing::on_threads;
 use stickslip_time::{History, Integrator, Scheme, Settings};
 
 fn run(s: &Slab, threads: usize, steps: usize) -> Integrator {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| {
+    on_threads(threads, || {
         assert_eq!(rayon::current_num_threads(), threads);
         let probe = s
             .integrator(Settings::new(Scheme::CentralDifference, 1e-9, 0.5))
