@@ -348,7 +348,7 @@ pub struct Integrator {
     /// products with both run as one pass.
     shared_pattern: bool,
     /// K and the consistent M as 2×2 blocks (`linalg::PairBlocks`), for
-    /// the implicit step's two products per step.
+    /// the implicit step's two products per step; small systems only.
     pair_blocks: Option<PairBlocks>,
     forces_new: Vec<f64>,
     /// θ_l(t) of each load for the step being taken.
@@ -357,7 +357,7 @@ pub struct Integrator {
     partials: kernels::Partials,
     /// K as the explicit step reads it (`kernels::Product`: the compact
     /// form or the element classes); the CSR K is then no longer held.
-    compact: Option<kernels::Product>,
+    product: Option<kernels::Product>,
     /// (DOF, ṙ_K) at the contact DOFs, sorted by DOF: the closed-form
     /// friction's velocities handed to `kernels::fused_step`.
     friction: Vec<(usize, f64)>,
@@ -572,7 +572,7 @@ impl Integrator {
             forces_new: vec![0.0; n_c],
             thetas: vec![0.0; loads.len()],
             partials: kernels::partials(n),
-            compact: None,
+            product: None,
             friction: Vec::new(),
             friction_slots: Vec::new(),
             sparse_loads: kernels::SparseLoads::new(&[], &[]),
@@ -622,17 +622,19 @@ impl Integrator {
             balance: 0.0,
         };
         if this.explicit {
-            // From here on the explicit step reads K only through the
-            // compact form: 0.57× the CSR's bytes per step, and the CSR's
-            // memory returned.
-            this.compact = match this.dynamics.element_classes.take() {
-                Some(ec) => kernels::Classes::new(ec).map(kernels::Product::Classes),
-                None => None,
-            }
-            .or_else(|| {
-                kernels::Compact::new(&this.dynamics.stiffness).map(kernels::Product::Compact)
-            });
-            if this.compact.is_some() {
+            // From here on the explicit step reads K only through its
+            // element classes or its compact form (0.57× the CSR's bytes per
+            // step), and the CSR's memory is returned.
+            this.product = this
+                .dynamics
+                .element_classes
+                .take()
+                .and_then(kernels::Classes::new)
+                .map(kernels::Product::Classes)
+                .or_else(|| {
+                    kernels::Compact::new(&this.dynamics.stiffness).map(kernels::Product::Compact)
+                });
+            if this.product.is_some() {
                 this.dynamics.stiffness = CsrMatrix::zeros(0, 0);
             }
             let loads: Vec<&[f64]> = this.loads.iter().map(|l| &l.vector[..]).collect();
@@ -921,7 +923,7 @@ impl Integrator {
         let scale = 1.0 / (gamma * dt);
         let closed_form = self.settings.explicit_friction == ExplicitFriction::ClosedForm
             || self.contact.is_none();
-        let (strain, sums, iterations) = match &self.compact {
+        let (strain, sums, iterations) = match &self.product {
             Some(k) if closed_form => {
                 // One chunk: K r_K first, for the friction and the sweep
                 // (it stays in cache); else the friction's rows alone and
@@ -990,7 +992,7 @@ impl Integrator {
                 (strain, sums, 1)
             }
             _ => {
-                let strain = if let Some(k) = &self.compact {
+                let strain = if let Some(k) = &self.product {
                     kernels::spmv_rhs_and_velocity(
                         k,
                         &self.load_new,
@@ -1467,7 +1469,7 @@ impl Integrator {
     /// column indices and row offsets when neither applies); 0 for implicit
     /// runs.
     pub fn explicit_matrix_bytes(&self) -> usize {
-        match (&self.compact, self.explicit) {
+        match (&self.product, self.explicit) {
             (Some(k), _) => k.bytes(),
             (None, true) => {
                 let k = &self.dynamics.stiffness;
@@ -1488,12 +1490,12 @@ impl Integrator {
             return 0;
         }
         let n = self.dynamics.n();
-        let streams = match &self.compact {
+        let streams = match &self.product {
             Some(_) if kernels::chunks(n) == 1 => 12,
             Some(_) => 10,
             None => 23,
         };
-        let streams = if self.compact.is_some()
+        let streams = if self.product.is_some()
             && self.contact.is_some()
             && self.settings.explicit_friction == ExplicitFriction::Iterate
         {
@@ -1507,7 +1509,7 @@ impl Integrator {
     /// (distinct blocks, stored blocks) of K's compact form when its values
     /// are a dictionary (`kernels.rs`), `None` otherwise.
     pub fn explicit_dictionary(&self) -> Option<(usize, usize)> {
-        let Some(kernels::Product::Compact(k)) = &self.compact else {
+        let Some(kernels::Product::Compact(k)) = &self.product else {
             return None;
         };
         (k.dictionary_len() > 0).then(|| (k.dictionary_len(), k.blocks()))
@@ -1516,7 +1518,7 @@ impl Integrator {
     /// Classes of K's cells when the explicit step forms K·x from element
     /// classes (`kernels::Classes`), `None` otherwise.
     pub fn explicit_classes(&self) -> Option<usize> {
-        match &self.compact {
+        match &self.product {
             Some(kernels::Product::Classes(k)) => Some(k.classes().classes()),
             _ => None,
         }
