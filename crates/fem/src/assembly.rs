@@ -23,33 +23,42 @@ const NO_POSITION: usize = usize::MAX;
 /// small enough that the chunk's buffers (≈ 8 KB per Q2 element) stay modest.
 const CHUNK: usize = 1024;
 
+/// Node → its places in the connectivity, by counting: node p's entries
+/// are `entries[offsets[p]..offsets[p + 1]]`, each an index k into
+/// `mesh.cells` (cell k / nodes per cell, local node k % nodes per cell),
+/// ascending.
+pub(crate) fn node_entries(mesh: &Mesh) -> (Vec<usize>, Vec<usize>) {
+    let n_nodes = mesh.nodes.len();
+    let mut offsets = vec![0usize; n_nodes + 1];
+    for &v in &mesh.cells {
+        offsets[v + 1] += 1;
+    }
+    for i in 0..n_nodes {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut fill = offsets.clone();
+    let mut entries = vec![0usize; mesh.cells.len()];
+    for (k, &v) in mesh.cells.iter().enumerate() {
+        entries[fill[v]] = k;
+        fill[v] += 1;
+    }
+    (offsets, entries)
+}
+
 /// Node-to-node adjacency (two nodes are adjacent when they share a cell),
 /// as CSR offsets and sorted neighbour lists including the node itself.
 pub fn node_adjacency(mesh: &Mesh) -> (Vec<usize>, Vec<usize>) {
     let n_nodes = mesh.nodes.len();
     let npc = mesh.kind.nodes_per_cell();
-    // Node → cells, by counting.
-    let mut cell_offsets = vec![0usize; n_nodes + 1];
-    for &v in &mesh.cells {
-        cell_offsets[v + 1] += 1;
-    }
-    for i in 0..n_nodes {
-        cell_offsets[i + 1] += cell_offsets[i];
-    }
-    let mut fill = cell_offsets.clone();
-    let mut node_cells = vec![0usize; mesh.cells.len()];
-    for (k, &v) in mesh.cells.iter().enumerate() {
-        node_cells[fill[v]] = k / npc;
-        fill[v] += 1;
-    }
+    let (cell_offsets, entries) = node_entries(mesh);
     let mut offsets = Vec::with_capacity(n_nodes + 1);
     offsets.push(0);
     let mut neighbours = Vec::with_capacity(n_nodes * if npc == 9 { 16 } else { 9 });
     let mut marker = vec![usize::MAX; n_nodes];
     for p in 0..n_nodes {
         let start = neighbours.len();
-        for &c in &node_cells[cell_offsets[p]..cell_offsets[p + 1]] {
-            for &q in mesh.cell(c) {
+        for &k in &entries[cell_offsets[p]..cell_offsets[p + 1]] {
+            for &q in mesh.cell(k / npc) {
                 if marker[q] != p {
                     marker[q] = p;
                     neighbours.push(q);

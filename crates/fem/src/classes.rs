@@ -25,6 +25,7 @@ use std::collections::HashMap;
 
 use stickslip_mesh::Mesh;
 
+use crate::assembly::node_entries;
 use crate::dofs::DofMap;
 use crate::element::CellBasis;
 use crate::material::Material;
@@ -193,19 +194,11 @@ impl ElementClasses {
         }
         // Node → (cell, local index), cells ascending.
         let n_nodes = mesh.nodes.len();
-        let mut offsets = vec![0u32; n_nodes + 1];
-        for &v in &mesh.cells {
-            offsets[v + 1] += 1;
-        }
-        for v in 0..n_nodes {
-            offsets[v + 1] += offsets[v];
-        }
-        let mut fill = offsets.clone();
-        let mut adjacency = vec![0u32; mesh.cells.len()];
-        for (k, &v) in mesh.cells.iter().enumerate() {
-            adjacency[fill[v] as usize] = ((k / n) as u32) << LOCAL_BITS | (k % n) as u32;
-            fill[v] += 1;
-        }
+        let (offsets, entries) = node_entries(mesh);
+        let adjacency: Vec<u32> = entries
+            .iter()
+            .map(|&k| ((k / n) as u32) << LOCAL_BITS | (k % n) as u32)
+            .collect();
         // Groups: the nodes with a free DOF, in free-DOF order (free DOFs
         // are numbered by node, then component).
         let mut group_rows = Vec::new();
@@ -220,7 +213,7 @@ impl ElementClasses {
             let first = dofs.free(v, 0).or(dofs.free(v, 1)).expect("a free DOF");
             group_rows.push(first as u32);
             group_mask.push(mask);
-            node_cells.extend_from_slice(&adjacency[offsets[v] as usize..offsets[v + 1] as usize]);
+            node_cells.extend_from_slice(&adjacency[offsets[v]..offsets[v + 1]]);
             group_cells.push(node_cells.len() as u32);
         }
         group_rows.push(n_free as u32);
