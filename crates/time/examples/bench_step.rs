@@ -459,8 +459,9 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         let bw = pool.install(stream_triad);
         let (dict, blocks) = i.explicit_dictionary().unwrap_or((0, 0));
         let classes = i.explicit_classes().unwrap_or(0);
+        let stencils = i.explicit_stencils().unwrap_or(0);
         format!(
-            "dict_blocks={dict} of_blocks={blocks} element_classes={classes} bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
+            "dict_blocks={dict} of_blocks={blocks} element_classes={classes} stencil_types={stencils} bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1}",
             bytes / per_step.0,
             100.0 * bytes / per_step.0 / bw
         )

@@ -143,6 +143,8 @@
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
 
+pub use crate::stencils::Stencils;
+
 /// DOFs per chunk of work.
 pub const CHUNK: usize = 8192;
 /// Chunks from which the passes go parallel.
@@ -165,7 +167,7 @@ fn parallel(n: usize) -> bool {
 /// Runs `body(c, chunk)` over the CHUNK-sized chunks of `y`, on the pool
 /// when [`parallel`]: the chunks and each one's arithmetic are the same
 /// either way.
-fn each_chunk(y: &mut [f64], body: impl Fn(usize, &mut [f64]) + Sync) {
+pub(crate) fn each_chunk(y: &mut [f64], body: impl Fn(usize, &mut [f64]) + Sync) {
     if parallel(y.len()) {
         y.par_chunks_mut(CHUNK)
             .enumerate()
@@ -556,7 +558,7 @@ trait Kernel<R> {
 /// the two rows' operations on one column are a pair of adjacent lanes
 /// (the compiler's 2-wide vector operations).
 #[inline(always)]
-fn block(col: u32, v: [f64; 4], x: &[f64], s: &mut [f64; 2]) {
+pub(crate) fn block(col: u32, v: [f64; 4], x: &[f64], s: &mut [f64; 2]) {
     let c = col as usize;
     let xs = &x[c..c + 2];
     let (x0, x1) = (xs[0], xs[1]);
@@ -636,6 +638,97 @@ impl std::hash::Hasher for BlockHasher {
     }
 }
 
+/// The row groups of a square CSR matrix with sorted columns (the rows of
+/// [`Compact`] and [`crate::stencils::Stencils`]): a node's two rows when
+/// they have the same columns and no chunk seam divides them, else one row.
+/// Calls `visit(first row, end row, block columns, block values)` for each
+/// group in order, its 2×2 blocks in ascending column order (a block's
+/// first column is the pair start of its columns: a single DOF is padded
+/// into the block before it, the padding +0; values by columns, as
+/// [`block`] reads them), and returns the groups' first rows, then n.
+pub(crate) fn row_groups(
+    a: &CsrMatrix<f64>,
+    mut visit: impl FnMut(usize, usize, &[u32], &[[f64; 4]]),
+) -> Vec<u32> {
+    let n = a.nrows();
+    let offsets = a.row_offsets();
+    let cols = a.col_indices();
+    let vals = a.values();
+    let row = |i: usize| &cols[offsets[i]..offsets[i + 1]];
+    // Pair start of each DOF: i for the first of a node's pair of rows
+    // (same columns), i − 1 for the second; a single DOF is padded into the
+    // block before it. The pairs are the matrix's, whatever the chunks, so
+    // a node's blocks are the same wherever the chunk seams fall (a seam
+    // through a pair only makes its rows two groups).
+    let mut start = vec![0u32; n];
+    let mut pair = vec![false; n];
+    let mut i = 0;
+    while i < n {
+        if i + 1 < n && row(i) == row(i + 1) {
+            start[i] = i as u32;
+            start[i + 1] = i as u32;
+            pair[i] = true;
+            i += 2;
+        } else {
+            start[i] = i.saturating_sub(1) as u32;
+            i += 1;
+        }
+    }
+    let mut group_rows = Vec::with_capacity(n / 2 + 2);
+    let mut i = 0;
+    while i < n {
+        group_rows.push(i as u32);
+        i += if pair[i] && (i + 1) % CHUNK != 0 {
+            2
+        } else {
+            1
+        };
+    }
+    group_rows.push(n as u32);
+    let (mut block_cols, mut block_vals): (Vec<u32>, Vec<[f64; 4]>) = (Vec::new(), Vec::new());
+    for g in 0..group_rows.len() - 1 {
+        let (r0, r1) = (group_rows[g] as usize, group_rows[g + 1] as usize);
+        block_cols.clear();
+        block_vals.clear();
+        for (k, r) in (r0..r1).enumerate() {
+            let mut next = 0;
+            for p in offsets[r]..offsets[r + 1] {
+                let c = cols[p];
+                let s = start[c];
+                // Both rows of a pair have the same columns, so the
+                // second row finds the blocks the first one made.
+                while next < block_cols.len() && block_cols[next] < s {
+                    next += 1;
+                }
+                if next == block_cols.len() {
+                    debug_assert_eq!(k, 0);
+                    block_cols.push(s);
+                    block_vals.push([0.0; 4]);
+                }
+                debug_assert_eq!(block_cols[next], s);
+                block_vals[next][2 * (c - s as usize) + k] = vals[p];
+            }
+        }
+        visit(r0, r1, &block_cols, &block_vals);
+    }
+    group_rows
+}
+
+/// The first group of each chunk of n rows, then the number of groups.
+pub(crate) fn chunk_groups(group_rows: &[u32], n: usize) -> Vec<u32> {
+    let groups = group_rows.len() - 1;
+    let mut chunk_groups = Vec::with_capacity(chunks(n) + 1);
+    for (g, &r) in group_rows.iter().enumerate() {
+        while chunk_groups.len() * CHUNK <= r as usize && chunk_groups.len() <= chunks(n) {
+            chunk_groups.push(g as u32);
+        }
+    }
+    while chunk_groups.len() <= chunks(n) {
+        chunk_groups.push(groups as u32);
+    }
+    chunk_groups
+}
+
 impl Compact {
     /// The compact form of a square CSR matrix with sorted columns, or
     /// `None` when it does not apply (fewer than 2 rows, more than u32
@@ -651,71 +744,22 @@ impl Compact {
     /// [`Compact::new`] with the form of the values chosen by the caller.
     pub fn with_form(a: &CsrMatrix<f64>, form: Form) -> Option<Compact> {
         let n = a.nrows();
-        let offsets = a.row_offsets();
-        let cols = a.col_indices();
-        let vals = a.values();
         if n < 2 || a.ncols() != n || n >= u32::MAX as usize || a.nnz() >= u32::MAX as usize {
             return None;
         }
-        let row = |i: usize| &cols[offsets[i]..offsets[i + 1]];
-        // Pair start of each DOF: i for the first of a pair, i − 1 for the
-        // second; a single DOF is padded into the block before it.
-        let mut start = vec![0u32; n];
-        let mut group_rows = Vec::with_capacity(n / 2 + 2);
-        let mut i = 0;
-        while i < n {
-            group_rows.push(i as u32);
-            if i + 1 < n && (i + 1) % CHUNK != 0 && row(i) == row(i + 1) {
-                start[i] = i as u32;
-                start[i + 1] = i as u32;
-                i += 2;
-            } else {
-                start[i] = i.saturating_sub(1) as u32;
-                i += 1;
-            }
-        }
-        group_rows.push(n as u32);
-        let groups = group_rows.len() - 1;
-        let mut group_blocks = Vec::with_capacity(groups + 1);
+        let mut group_blocks = Vec::with_capacity(n / 2 + 2);
         let mut block_cols: Vec<u32> = Vec::with_capacity(a.nnz() / 2);
         let mut block_vals: Vec<[f64; 4]> = Vec::with_capacity(a.nnz() / 2);
         group_blocks.push(0u32);
-        for g in 0..groups {
-            let (r0, r1) = (group_rows[g] as usize, group_rows[g + 1] as usize);
-            let first = block_cols.len();
-            for (k, r) in (r0..r1).enumerate() {
-                let mut next = first;
-                for p in offsets[r]..offsets[r + 1] {
-                    let c = cols[p];
-                    let s = start[c];
-                    // Both rows of a pair have the same columns, so the
-                    // second row finds the blocks the first one made.
-                    while next < block_cols.len() && block_cols[next] < s {
-                        next += 1;
-                    }
-                    if next == block_cols.len() {
-                        debug_assert_eq!(k, 0);
-                        block_cols.push(s);
-                        block_vals.push([0.0; 4]);
-                    }
-                    debug_assert_eq!(block_cols[next], s);
-                    block_vals[next][2 * (c - s as usize) + k] = vals[p];
-                }
-            }
-            if block_cols.len() >= u32::MAX as usize {
-                return None;
-            }
-            group_blocks.push(block_cols.len() as u32);
+        let group_rows = row_groups(a, |_, _, c, v| {
+            block_cols.extend_from_slice(c);
+            block_vals.extend_from_slice(v);
+            group_blocks.push(block_cols.len().min(u32::MAX as usize) as u32);
+        });
+        if block_cols.len() >= u32::MAX as usize {
+            return None;
         }
-        let mut chunk_groups = Vec::with_capacity(chunks(n) + 1);
-        for (g, &r) in group_rows.iter().enumerate() {
-            while chunk_groups.len() * CHUNK <= r as usize && chunk_groups.len() <= chunks(n) {
-                chunk_groups.push(g as u32);
-            }
-        }
-        while chunk_groups.len() <= chunks(n) {
-            chunk_groups.push(groups as u32);
-        }
+        let chunk_groups = chunk_groups(&group_rows, n);
         block_cols.shrink_to_fit();
         block_vals.shrink_to_fit();
         let mut compact = Compact {
@@ -973,6 +1017,8 @@ pub enum Product {
     Compact(Compact),
     /// [`Classes`].
     Classes(Classes),
+    /// [`Stencils`].
+    Stencils(Stencils),
 }
 
 impl RowProduct for Product {
@@ -981,24 +1027,28 @@ impl RowProduct for Product {
         match self {
             Product::Compact(k) => RowProduct::chunk_batches(k, c, x, f),
             Product::Classes(k) => k.chunk_batches(c, x, f),
+            Product::Stencils(k) => k.chunk_batches(c, x, f),
         }
     }
     fn row(&self, i: usize, x: &[f64]) -> f64 {
         match self {
             Product::Compact(k) => k.row(i, x),
             Product::Classes(k) => k.row(i, x),
+            Product::Stencils(k) => k.row(i, x),
         }
     }
     fn spmv(&self, x: &[f64], y: &mut [f64]) {
         match self {
             Product::Compact(k) => k.spmv(x, y),
             Product::Classes(k) => k.spmv(x, y),
+            Product::Stencils(k) => k.spmv(x, y),
         }
     }
     fn bytes(&self) -> usize {
         match self {
             Product::Compact(k) => k.bytes(),
             Product::Classes(k) => RowProduct::bytes(k),
+            Product::Stencils(k) => k.bytes(),
         }
     }
 }
@@ -2213,6 +2263,15 @@ mod tests {
                 ElementClasses::with_limit(&mesh, &material, &model.dofs, 1).expect("one class");
             let classes = Classes::new(ec).unwrap();
             let t_classes = t0.elapsed().as_secs_f64();
+            let t0 = Instant::now();
+            let stencils = Stencils::new(k).expect("structured");
+            let t_stencils = t0.elapsed().as_secs_f64();
+            println!(
+                "{name}: {} stencil types, {:.2} MB, built in {:.2} s",
+                stencils.types(),
+                RowProduct::bytes(&stencils) as f64 / 1e6,
+                t_stencils
+            );
             let x = x_of(n);
             let (mut y0, mut y1) = (vec![0.0; n], vec![0.0; n]);
             spmv(k, &x, &mut y0);
@@ -2252,7 +2311,7 @@ mod tests {
                 on_threads(threads, || {
                     let mut p = partials(n);
                     let (mut vn, mut an) = (vec![0.0; n], vec![0.0; n]);
-                    let mut t: [Vec<f64>; 4] = Default::default();
+                    let mut t: [Vec<f64>; 6] = Default::default();
                     for _ in 0..20 {
                         let s = Instant::now();
                         compact.spmv(&x, &mut y0);
@@ -2260,7 +2319,10 @@ mod tests {
                         let s = Instant::now();
                         classes.spmv(&x, &mut y1);
                         t[1].push(s.elapsed().as_secs_f64());
-                        let mut step = |q: usize, use_classes: bool| {
+                        let s = Instant::now();
+                        stencils.spmv(&x, &mut y1);
+                        t[4].push(s.elapsed().as_secs_f64());
+                        let mut step = |q: usize, use_classes: u8| {
                             let s = Instant::now();
                             predict(
                                 &sparse,
@@ -2288,19 +2350,39 @@ mod tests {
                                 gamma_dt: 5e-4,
                                 ratio: 1.0,
                             };
-                            if use_classes {
-                                fused_step(&classes, &data, &[], None, &mut vn, &mut an, &mut p);
-                            } else {
-                                fused_step(&compact, &data, &[], None, &mut vn, &mut an, &mut p);
-                            }
+                            match use_classes {
+                                1 => {
+                                    fused_step(&classes, &data, &[], None, &mut vn, &mut an, &mut p)
+                                }
+                                2 => fused_step(
+                                    &stencils,
+                                    &data,
+                                    &[],
+                                    None,
+                                    &mut vn,
+                                    &mut an,
+                                    &mut p,
+                                ),
+                                _ => {
+                                    fused_step(&compact, &data, &[], None, &mut vn, &mut an, &mut p)
+                                }
+                            };
                             t[q].push(s.elapsed().as_secs_f64());
                         };
-                        step(2, false);
-                        step(3, true);
+                        step(2, 0);
+                        step(3, 1);
+                        step(5, 2);
                     }
-                    for (label, t) in ["K·x compact", "K·x classes", "step compact", "step classes"]
-                        .iter()
-                        .zip(&mut t)
+                    for (label, t) in [
+                        "K·x compact",
+                        "K·x classes",
+                        "step compact",
+                        "step classes",
+                        "K·x stencils",
+                        "step stencils",
+                    ]
+                    .iter()
+                    .zip(&mut t)
                     {
                         t.sort_by(f64::total_cmp);
                         println!(

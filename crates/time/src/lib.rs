@@ -26,6 +26,7 @@ mod memory;
 pub mod scenes;
 mod schur;
 pub mod stability;
+mod stencils;
 
 pub use history::History;
 pub use integrator::{

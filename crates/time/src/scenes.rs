@@ -373,6 +373,7 @@ pub mod sdof {
             lumped_mass: vec![1.0],
             constant_load: vec![0.0],
             element_classes: None,
+            stencils: true,
         };
         let node = ContactNode {
             node: 0,

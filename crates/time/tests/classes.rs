@@ -1,9 +1,10 @@
 //! The explicit step with K·x matrix-free by element classes
-//! (`Dynamics::element_classes`) follows the run on the assembled K: the
-//! products differ in the last bits (class matrices from cells alike to the
-//! coordinates' rounding, another summation order), so the states agree to
-//! 1e-10 relative, not bit for bit; and the run is bit-identical on one
-//! thread and on two.
+//! (`Dynamics::element_classes`) or by stencil types (`Dynamics::stencils`)
+//! follows the run on the assembled K: the products differ in the last
+//! bits (class matrices from cells alike to the coordinates' rounding,
+//! another summation order; stencils alike to 1e-12 of max |K_ij| sharing
+//! one copy), so the states agree to 1e-10 relative, not bit for bit; and
+//! the run is bit-identical on one thread and on two.
 
 mod common;
 use common::*;
@@ -12,22 +13,33 @@ use stickslip_fem::{ElementClasses, Hypothesis, Material};
 use stickslip_time::scenes::{E, NU};
 use stickslip_time::{Dynamics, History, Integrator, Scheme, Settings};
 
-fn run(s: &Slab, classes: bool, threads: usize, steps: usize) -> Integrator {
+/// K·x by: the assembled K, element classes, stencil types.
+#[derive(Clone, Copy, PartialEq)]
+enum By {
+    Assembled,
+    Classes,
+    Stencils,
+}
+
+fn run(s: &Slab, by: By, threads: usize, steps: usize) -> Integrator {
     let material = Material::new(E, NU, 1.0, Hypothesis::PlaneStrain).unwrap();
     on_threads(threads, || {
         let probe = s
             .integrator(Settings::new(Scheme::CentralDifference, 1e-9, 0.5))
             .unwrap();
         let dt = 0.9 * probe.dt_crit().unwrap();
-        let ec = classes.then(|| {
+        let ec = (by == By::Classes).then(|| {
             ElementClasses::with_limit(&s.mesh, &material, &s.model.dofs, 64)
                 .expect("structured Q2 slab")
         });
-        let dynamics = Dynamics::from_model(&s.model).with_element_classes(ec);
+        let dynamics = Dynamics::from_model(&s.model)
+            .with_element_classes(ec)
+            .with_stencils(by == By::Stencils);
         let settings = Settings::new(Scheme::CentralDifference, dt, 0.5);
         let mut i =
             Integrator::new(dynamics, s.contact.clone(), s.loads.clone(), settings).unwrap();
-        assert_eq!(i.explicit_classes().is_some(), classes);
+        assert_eq!(i.explicit_classes().is_some(), by == By::Classes);
+        assert_eq!(i.explicit_stencils().is_some(), by == By::Stencils);
         for _ in 0..steps {
             i.step().unwrap();
         }
@@ -45,14 +57,15 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
 }
 
-#[test]
-fn classes_follow_the_assembled_run() {
+/// The run by `by` within 1e-10 of the assembled one, and the same bits
+/// on one thread and two.
+fn follows_the_assembled_run(mesh: &str, by: By) {
     // > 8192 free DOFs: several chunks, the friction's rows formed alone.
-    let s = paper_slab("slab-q2-64x16.msh", 1e-4, History::Step);
+    let s = paper_slab(mesh, 1e-4, History::Step);
     assert!(s.model.dofs.n_free() > 8192);
     let steps = 400;
-    let plain = run(&s, false, 2, steps);
-    let with = run(&s, true, 2, steps);
+    let plain = run(&s, By::Assembled, 2, steps);
+    let with = run(&s, by, 2, steps);
     for (name, a, b) in [
         ("r", plain.displacement(), with.displacement()),
         ("ṙ", plain.velocity(), with.velocity()),
@@ -73,9 +86,20 @@ fn classes_follow_the_assembled_run() {
     }
     assert!(with.classes().iter().any(|c| !c.is_stuck()) || e1.dissipated > 0.0);
     // Bit-identical on one thread and two.
-    let one = run(&s, true, 1, steps);
+    let one = run(&s, by, 1, steps);
     assert_eq!(one.displacement(), with.displacement());
     assert_eq!(one.velocity(), with.velocity());
     assert_eq!(one.acceleration(), with.acceleration());
     assert_eq!(one.energy(), with.energy());
+}
+
+#[test]
+fn classes_follow_the_assembled_run() {
+    // Gmsh's numbering (boundary nodes first): no stencil types, classes.
+    follows_the_assembled_run("slab-q2-64x16.msh", By::Classes);
+}
+
+#[test]
+fn stencils_follow_the_assembled_run() {
+    follows_the_assembled_run("slab-q1-128x32.msh", By::Stencils);
 }
