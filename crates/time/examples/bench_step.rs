@@ -25,117 +25,9 @@ use stickslip_contact::ContactSurface;
 use stickslip_fem::{
     traction_load, Dirichlet, ElementClasses, Hypothesis, Material, Model, SparseCholesky, Traction,
 };
-use stickslip_mesh::{CellKind, Edge, Group, Mesh, SourceInfo};
+use stickslip_mesh::Mesh;
 use stickslip_time::stability::critical_step;
 use stickslip_time::{Dynamics, History, Integrator, Load, Scheme, Settings};
-
-/// The structured slab [0, 8] × [0, 1] with nx × ny Q1 or Q2 cells and the
-/// groups of cases/meshes/README.md (edges oriented with the cell on the
-/// left, counter-clockwise cells).
-fn structured_slab(nx: usize, ny: usize, q2: bool) -> Mesh {
-    let q = if q2 { 2 } else { 1 };
-    let (gx, gy) = (q * nx + 1, q * ny + 1);
-    let id = |i: usize, j: usize| j * gx + i;
-    let mut nodes = Vec::with_capacity(gx * gy);
-    for j in 0..gy {
-        for i in 0..gx {
-            nodes.push([8.0 * i as f64 / (gx - 1) as f64, j as f64 / (gy - 1) as f64]);
-        }
-    }
-    let per = if q2 { 9 } else { 4 };
-    let mut cells = Vec::with_capacity(nx * ny * per);
-    for cy in 0..ny {
-        for cx in 0..nx {
-            let (i, j) = (q * cx, q * cy);
-            cells.extend([id(i, j), id(i + q, j), id(i + q, j + q), id(i, j + q)]);
-            if q2 {
-                cells.extend([
-                    id(i + 1, j),
-                    id(i + 2, j + 1),
-                    id(i + 1, j + 2),
-                    id(i, j + 1),
-                    id(i + 1, j + 1),
-                ]);
-            }
-        }
-    }
-    let cell = |cx: usize, cy: usize| cy * nx + cx;
-    let mid = |i: usize, j: usize| if q2 { Some(id(i, j)) } else { None };
-    let line = |name: &str, tag: i32, edges: Vec<Edge>| {
-        let mut ns: Vec<usize> = edges
-            .iter()
-            .flat_map(|e| e.nodes.into_iter().chain(e.mid))
-            .collect();
-        ns.sort_unstable();
-        ns.dedup();
-        Group {
-            name: name.into(),
-            tag,
-            dim: 1,
-            elements: edges.len(),
-            edges,
-            cells: vec![],
-            points: vec![],
-            nodes: ns,
-        }
-    };
-    let top = gy - 1;
-    let right = gx - 1;
-    let contact = (0..nx)
-        .map(|cx| Edge {
-            nodes: [id(q * cx, 0), id(q * cx + q, 0)],
-            mid: mid(q * cx + 1, 0),
-            cell: cell(cx, 0),
-        })
-        .collect();
-    let load = (0..ny)
-        .map(|cy| Edge {
-            nodes: [id(right, q * cy), id(right, q * cy + q)],
-            mid: mid(right, q * cy + 1),
-            cell: cell(nx - 1, cy),
-        })
-        .collect();
-    let support = (0..nx)
-        .map(|cx| Edge {
-            nodes: [id(q * cx + q, top), id(q * cx, top)],
-            mid: mid(q * cx + 1, top),
-            cell: cell(cx, ny - 1),
-        })
-        .collect();
-    let left = (0..ny)
-        .map(|cy| Edge {
-            nodes: [id(0, q * cy + q), id(0, q * cy)],
-            mid: mid(0, q * cy + 1),
-            cell: cell(0, cy),
-        })
-        .collect();
-    let n_cells = nx * ny;
-    let groups = vec![
-        line("contact", 1, contact),
-        line("load", 2, load),
-        line("support", 3, support),
-        line("left", 4, left),
-        Group {
-            name: "body".into(),
-            tag: 10,
-            dim: 2,
-            edges: vec![],
-            cells: (0..n_cells).collect(),
-            points: vec![],
-            nodes: (0..nodes.len()).collect(),
-            elements: n_cells,
-        },
-    ];
-    Mesh {
-        node_tags: (1..=nodes.len() as u64).collect(),
-        nodes,
-        kind: if q2 { CellKind::Quad9 } else { CellKind::Quad4 },
-        cells,
-        cell_tags: (1..=n_cells as u64).collect(),
-        groups,
-        source: SourceInfo::default(),
-    }
-}
 
 /// The paper's slab material (BENCHMARK.md).
 fn slab_material() -> Material {
@@ -180,7 +72,11 @@ fn mesh_named(name: &str) -> Mesh {
     if let Some(rest) = name.strip_prefix("gen-") {
         let (order, size) = rest.split_once('-').expect("gen-qK-NXxNY");
         let (nx, ny) = size.split_once('x').expect("NXxNY");
-        return structured_slab(nx.parse().unwrap(), ny.parse().unwrap(), order == "q2");
+        return stickslip_time::scenes::structured_slab(
+            nx.parse().unwrap(),
+            ny.parse().unwrap(),
+            order == "q2",
+        );
     }
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../cases/meshes")
@@ -433,8 +329,8 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     // What the run must hold: the matrices it streams or factorizes, the
     // factor, and the integrator's free-DOF vectors (r, ṙ, r̈, R and their
     // new values, b, two scratch, the lumped mass, the constant load, the
-    // bench's two loads: 14 of n f64).
-    let vectors = 14.0 * 8.0 * n as f64;
+    // bench's two loads: 14 of n f64; explicit: the next predictor, 15).
+    let vectors = if explicit { 15.0 } else { 14.0 } * 8.0 * n as f64;
     let csr = 16.0 * nnz as f64 + 8.0 * (n + 1) as f64;
     let (matrix, factor) = if explicit {
         (i.explicit_matrix_bytes() as f64, 0.0)
@@ -451,10 +347,10 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         peak / need
     );
     let extra = if explicit {
-        // Bytes the two sweeps must move (kernels.rs): K in its compact
-        // form; vectors: the predictor reads r, ṙ, r̈ and writes r_K (4);
-        // the sweep reads r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K (6); the loads
-        // at their rows only (Integrator::explicit_bytes_per_step).
+        // Bytes a step must move (kernels.rs): K as the step reads it;
+        // vectors: the sweep reads r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K and
+        // the next step's predictor (7); the loads at their rows only
+        // (Integrator::explicit_bytes_per_step).
         let bytes = i.explicit_bytes_per_step() as f64;
         let bw = pool.install(stream_triad);
         let (dict, blocks) = i.explicit_dictionary().unwrap_or((0, 0));

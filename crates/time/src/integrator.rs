@@ -363,11 +363,20 @@ pub struct Integrator {
     /// K and the consistent M as 2×2 blocks (`linalg::PairBlocks`), for
     /// the implicit step's two products per step; small systems only.
     pair_blocks: Option<PairBlocks>,
+    /// K and the consistent M by stencil types for the implicit step's
+    /// products, on large structured meshes (`Dynamics::stencils`).
+    implicit_products: Option<ImplicitProducts>,
     forces_new: Vec<f64>,
     /// θ_l(t) of each load for the step being taken.
     thetas: Vec<f64>,
     /// Per-chunk partial sums of the explicit passes.
     partials: kernels::Partials,
+    /// The next explicit step's predictor, written by the sweep
+    /// (`kernels::fused_step`), swapped into `r_new` after the step.
+    r_next: Vec<f64>,
+    /// The Δt `r_new` holds the predictor for (set by a completed sweep;
+    /// a step of another Δt, a restore or a failed step forms it anew).
+    predicted: Option<f64>,
     /// K as the explicit step reads it (`kernels::Product`: the compact
     /// form or the element classes); the CSR K is then no longer held.
     product: Option<kernels::Product>,
@@ -379,6 +388,32 @@ pub struct Integrator {
     /// The constant load and the loads on their nonzero rows (explicit
     /// runs: pass A forms R_K there only).
     sparse_loads: kernels::SparseLoads,
+}
+
+/// K and M by stencil types for the implicit step (see
+/// `Integrator::implicit_products`), and a vector for their products.
+#[derive(Clone, Debug)]
+struct ImplicitProducts {
+    k: kernels::Stencils,
+    /// The consistent M's; `None` with the lumped mass.
+    m: Option<kernels::Stencils>,
+    scratch: Vec<f64>,
+}
+
+impl ImplicitProducts {
+    /// Both products by stencil types, or `None` where either declines.
+    fn new(k: &CsrMatrix<f64>, mass_kind: MassKind, m: &CsrMatrix<f64>) -> Option<Self> {
+        let ks = kernels::Stencils::new(k)?;
+        let ms = match mass_kind {
+            MassKind::Consistent => Some(kernels::Stencils::new(m)?),
+            MassKind::Lumped => None,
+        };
+        Some(ImplicitProducts {
+            k: ks,
+            m: ms,
+            scratch: vec![0.0; k.nrows()],
+        })
+    }
 }
 
 impl std::fmt::Debug for Integrator {
@@ -550,6 +585,15 @@ impl Integrator {
         } else {
             None
         };
+        // Larger systems read K and M from memory four times a step (R̂'s
+        // two products, the energies' two forms): by stencil types where
+        // the mesh has them, 8 bytes per node pair instead of 24 per entry
+        // (Q2 249k: 380 MB a step of the CSRs' values and columns).
+        let implicit_products = if !explicit && pair_blocks.is_none() && dynamics.stencils {
+            ImplicitProducts::new(&dynamics.stiffness, mass_kind, &mass_matrix)
+        } else {
+            None
+        };
         let mut this = Integrator {
             beta,
             gamma,
@@ -582,9 +626,12 @@ impl Integrator {
             row_partials: vec![0.0; 2 * row_chunks(n)],
             shared_pattern,
             pair_blocks,
+            implicit_products,
             forces_new: vec![0.0; n_c],
             thetas: vec![0.0; loads.len()],
             partials: kernels::partials(n),
+            r_next: Vec::new(),
+            predicted: None,
             product: None,
             friction: Vec::new(),
             friction_slots: Vec::new(),
@@ -655,6 +702,7 @@ impl Integrator {
                 });
             if this.product.is_some() {
                 this.dynamics.stiffness = CsrMatrix::zeros(0, 0);
+                this.r_next = vec![0.0; n];
             }
             let loads: Vec<&[f64]> = this.loads.iter().map(|l| &l.vector[..]).collect();
             this.sparse_loads = kernels::SparseLoads::new(&this.dynamics.constant_load, &loads);
@@ -697,6 +745,23 @@ impl Integrator {
     /// (½ṙᵀMṙ, ½rᵀKr) of the current state; one pass over K and M when
     /// they share their pattern.
     fn kinetic_and_strain(&mut self) -> (f64, f64) {
+        if let Some(p) = &mut self.implicit_products {
+            p.k.spmv(&self.r, &mut p.scratch);
+            let rkr = dot(&self.r, &p.scratch);
+            let vmv = match &p.m {
+                Some(m) => {
+                    m.spmv(&self.v, &mut p.scratch);
+                    dot(&self.v, &p.scratch)
+                }
+                None => self
+                    .v
+                    .iter()
+                    .zip(&self.dynamics.lumped_mass)
+                    .map(|(v, m)| m * v * v)
+                    .sum(),
+            };
+            return (0.5 * vmv, 0.5 * rkr);
+        }
         if let Some(blocks) = &self.pair_blocks {
             let (rkr, vmv) = blocks.two_forms(&self.r, &self.v, &mut self.row_partials);
             return (0.5 * vmv, 0.5 * rkr);
@@ -779,10 +844,27 @@ impl Integrator {
         for i in 0..n {
             self.tmp[i] = cv * self.v[i] + ca * self.a[i];
         }
-        if self.mass_kind != MassKind::Consistent || !self.shared_pattern {
+        if let Some(p) = &mut self.implicit_products {
+            p.k.spmv(&self.r_new, &mut self.b);
+            match &p.m {
+                Some(m) => {
+                    m.spmv(&self.tmp, &mut p.scratch);
+                    for i in 0..n {
+                        self.b[i] = self.load_new[i] - self.b[i] + p.scratch[i];
+                    }
+                }
+                None => {
+                    for i in 0..n {
+                        self.b[i] = self.load_new[i] - self.b[i]
+                            + self.dynamics.lumped_mass[i] * self.tmp[i];
+                    }
+                }
+            }
+        } else if self.mass_kind != MassKind::Consistent || !self.shared_pattern {
             spmv(&self.dynamics.stiffness, &self.r_new, &mut self.b);
         }
         match self.mass_kind {
+            _ if self.implicit_products.is_some() => {}
             MassKind::Consistent if self.pair_blocks.is_some() => {
                 let blocks = self.pair_blocks.as_ref().expect("checked");
                 blocks.load_minus_k_plus_m(&self.load_new, &self.r_new, &self.tmp, &mut self.b);
@@ -918,6 +1000,8 @@ impl Integrator {
         for (theta, l) in self.thetas.iter_mut().zip(&self.loads) {
             *theta = l.history.value(t_new);
         }
+        // The last sweep's predictor, if it was formed for this Δt.
+        let predicted = self.predicted.take().map(f64::to_bits) == Some(dt.to_bits());
         // A non-finite θ made every entry of R_K, hence of ṙ_K, NaN in the
         // dense pass A; pass A over the load rows needs finite θ (kernels.rs).
         if self.thetas.iter().any(|t| !t.is_finite()) {
@@ -937,9 +1021,11 @@ impl Integrator {
             &self.load,
             &mut self.load_new,
             &mut self.r_new,
+            !predicted,
             &mut self.partials,
         );
         let scale = 1.0 / (gamma * dt);
+        let mut swept = false;
         let closed_form = self.settings.explicit_friction == ExplicitFriction::ClosedForm
             || self.contact.is_none();
         let (strain, sums, iterations) = match &self.product {
@@ -963,6 +1049,9 @@ impl Integrator {
                     scale,
                     gamma_dt: gamma * dt,
                     ratio: (1.0 - gamma) / gamma,
+                    // The next step's predictor for a step of the same Δt:
+                    // pass A's c1 and c2 above.
+                    next: (c1, c2),
                 };
                 if let Some(contact) = &self.contact {
                     // The nodal friction first, from R̂_K at the contact DOFs
@@ -1002,8 +1091,10 @@ impl Integrator {
                     one_chunk.then_some(&self.b[..]),
                     &mut self.v_new,
                     &mut self.tmp,
+                    &mut self.r_next,
                     &mut self.partials,
                 );
+                swept = true;
                 self.scratch_classes.copy_from_slice(&self.classes);
                 if let Some(contact) = &self.contact {
                     contact.classify(&self.v_new, &mut self.scratch_classes);
@@ -1100,6 +1191,11 @@ impl Integrator {
         let (dissipated, stick_events) = self.friction_ledger(dt);
         std::mem::swap(&mut self.a, &mut self.tmp);
         self.commit(t_new, step_number, iterations);
+        if swept {
+            // r_new held r_K, now in r; the sweep's predictor takes its place.
+            std::mem::swap(&mut self.r_new, &mut self.r_next);
+            self.predicted = Some(dt);
+        }
         Ok(self.close_step(
             [sums.kinetic, strain, sums.work, dissipated, sums.load_dot],
             dt,
@@ -1366,6 +1462,8 @@ impl Integrator {
         self.initial_mechanical = c.initial_mechanical;
         self.reduced_remaining = usize::try_from(c.reduced_remaining).unwrap_or(usize::MAX);
         self.total_iterations = c.total_iterations;
+        // The state changed under the sweep's predictor: form it anew.
+        self.predicted = None;
         if let Some(op) = self.implicit.as_mut() {
             op.factorizations = c.factorizations;
         }
@@ -1498,20 +1596,22 @@ impl Integrator {
         }
     }
 
-    /// Bytes one explicit step moves through memory (closed-form friction,
-    /// `kernels.rs`): K ([`Integrator::explicit_matrix_bytes`]), the free-DOF
-    /// vectors its passes read or write (10 of n f64 for the one sweep, 12
-    /// when it has one chunk and K r_K is stored for the friction, 20 for
-    /// the compact product and passes B and C, 23 with the CSR's product)
-    /// and the loads at their rows; 0 for implicit runs.
+    /// Bytes one explicit step of the run's Δt moves through memory
+    /// (closed-form friction, `kernels.rs`): K
+    /// ([`Integrator::explicit_matrix_bytes`]), the free-DOF vectors its
+    /// passes read or write (7 of n f64 for the one sweep, whose previous
+    /// run formed the predictor; 9 when it has one chunk and K r_K is
+    /// stored for the friction; 20 for the compact product and passes B
+    /// and C, 23 with the CSR's product) and the loads at their rows; 0 for
+    /// implicit runs.
     pub fn explicit_bytes_per_step(&self) -> usize {
         if !self.explicit {
             return 0;
         }
         let n = self.dynamics.n();
         let streams = match &self.product {
-            Some(_) if kernels::chunks(n) == 1 => 12,
-            Some(_) => 10,
+            Some(_) if kernels::chunks(n) == 1 => 9,
+            Some(_) => 7,
             None => 23,
         };
         let streams = if self.product.is_some()

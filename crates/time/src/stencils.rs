@@ -56,6 +56,9 @@ pub struct Stencils {
     values: Vec<[f64; 4]>,
     /// Groups of chunk c: chunk_groups[c]..chunk_groups[c + 1].
     chunk_groups: Vec<u32>,
+    /// The CPU has AVX (checked at run time): runs of four node pairs of
+    /// one type are summed 4 doubles wide ([`avx::quad`]), the same bits.
+    avx: bool,
 }
 
 impl Stencils {
@@ -142,6 +145,7 @@ impl Stencils {
             offsets,
             values,
             chunk_groups,
+            avx: avx::available(),
         })
     }
 
@@ -195,7 +199,39 @@ impl Stencils {
         let mut g = g0;
         while g < g1 {
             let t = self.types[g];
-            if g + LOCKSTEP <= g1 && self.types[g + 1..g + LOCKSTEP].iter().all(|&u| u == t) {
+            let alike = |k: usize| g + k <= g1 && self.types[g + 1..g + k].iter().all(|&u| u == t);
+            let ty = |t: u32| {
+                let b = self.type_blocks[t as usize] as usize
+                    ..self.type_blocks[t as usize + 1] as usize;
+                (&self.offsets[b.clone()], &self.values[b])
+            };
+            let pairs = |k: usize| self.group_rows[g + k] == self.group_rows[g] + 2 * k as u32;
+            if self.avx && alike(4) && pairs(4) {
+                // Four node pairs of one type on consecutive rows (Q1).
+                let (o, v) = ty(t);
+                let sums = avx::run(o, v, avx::Rows::Consecutive(self.group_rows[g] as usize), x);
+                for (q, s) in sums.into_iter().enumerate() {
+                    put(g + q, s);
+                }
+                g += 4;
+            } else if self.avx
+                && g + 8 <= g1
+                && pairs(8)
+                && (2..8).all(|k| self.types[g + k] == self.types[g + k % 2])
+            {
+                // Eight node pairs of two types in turn (a Q2 node row:
+                // vertex and edge nodes, or edge and centre nodes).
+                let r = self.group_rows[g] as usize;
+                for (p, t) in [(0, t), (1, self.types[g + 1])] {
+                    let (o, v) = ty(t);
+                    let rows = std::array::from_fn(|q| r + 2 * p + 4 * q);
+                    let sums = avx::run(o, v, avx::Rows::Any(rows), x);
+                    for (q, s) in sums.into_iter().enumerate() {
+                        put(g + p + 2 * q, s);
+                    }
+                }
+                g += 8;
+            } else if alike(LOCKSTEP) {
                 for (q, s) in self.lockstep::<LOCKSTEP>(g, x).into_iter().enumerate() {
                     put(g + q, s);
                 }
@@ -205,6 +241,116 @@ impl Stencils {
                 g += 1;
             }
         }
+    }
+}
+
+/// The 4-wide sums of four node pairs of one type.
+mod avx {
+    /// The first rows of the four pairs.
+    #[derive(Clone, Copy)]
+    pub enum Rows {
+        /// r, r + 2, r + 4, r + 6.
+        Consecutive(usize),
+        /// Anywhere.
+        Any([usize; 4]),
+    }
+
+    /// Whether this CPU runs [`quad`].
+    pub fn available() -> bool {
+        #[cfg(target_arch = "x86_64")]
+        {
+            std::arch::is_x86_feature_detected!("avx")
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            false
+        }
+    }
+
+    /// [`quad`] on a CPU where [`available`] said yes.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub fn run(offsets: &[i32], values: &[[f64; 4]], rows: Rows, x: &[f64]) -> [[f64; 2]; 4] {
+        #[cfg(target_arch = "x86_64")]
+        {
+            // SAFETY: callers hold `Stencils::avx`, set from `available()`.
+            unsafe {
+                match rows {
+                    Rows::Consecutive(r) => quad::<true>(offsets, values, [r; 4], x),
+                    Rows::Any(rows) => quad::<false>(offsets, values, rows, x),
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let _ = (offsets, values, rows, x);
+            unreachable!("AVX is x86_64 only")
+        }
+    }
+
+    /// The sums of four node pairs of one type (blocks at `offsets` with
+    /// `values`) at `rows` (`CONSECUTIVE`: rows[0] + 2q), each row's
+    /// products added in `kernels::block`'s order (column c, then c + 1),
+    /// multiplications and additions separate (no fused multiply-add): the
+    /// bits of the scalar sums. Two pairs per 4-wide register; consecutive
+    /// pairs read x[c..c + 4] in one load.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[allow(unsafe_code)]
+    fn quad<const CONSECUTIVE: bool>(
+        offsets: &[i32],
+        values: &[[f64; 4]],
+        rows: [usize; 4],
+        x: &[f64],
+    ) -> [[f64; 2]; 4] {
+        use std::arch::x86_64::*;
+        let mut s = [_mm256_setzero_pd(); 2];
+        for (&o, v) in offsets.iter().zip(values) {
+            let o = o as isize;
+            // [x_c, x_c+1] of pairs 2h and 2h + 1.
+            let xs: [__m256d; 2] = std::array::from_fn(|h| {
+                if CONSECUTIVE {
+                    let c = (rows[0] as isize + o) as usize + 4 * h;
+                    let xs: &[f64; 4] = x[c..c + 4].try_into().expect("4 columns");
+                    // SAFETY: xs holds 4 doubles; unaligned load.
+                    unsafe { _mm256_loadu_pd(xs.as_ptr()) }
+                } else {
+                    let col = |q: usize| (rows[q] as isize + o) as usize;
+                    let (c0, c1) = (col(2 * h), col(2 * h + 1));
+                    let (a, b): (&[f64; 2], &[f64; 2]) = (
+                        x[c0..c0 + 2].try_into().expect("2 columns"),
+                        x[c1..c1 + 2].try_into().expect("2 columns"),
+                    );
+                    // SAFETY: a and b hold 2 doubles each; unaligned loads.
+                    unsafe {
+                        _mm256_insertf128_pd(
+                            _mm256_castpd128_pd256(_mm_loadu_pd(a.as_ptr())),
+                            _mm_loadu_pd(b.as_ptr()),
+                            1,
+                        )
+                    }
+                }
+            });
+            // [v0, v1, v0, v1] and [v2, v3, v2, v3]: rows 0 and 1 of the
+            // block's first and second column, for two pairs.
+            let c0 = _mm256_setr_pd(v[0], v[1], v[0], v[1]);
+            let c1 = _mm256_setr_pd(v[2], v[3], v[2], v[3]);
+            for h in 0..2 {
+                let lo = _mm256_unpacklo_pd(xs[h], xs[h]);
+                s[h] = _mm256_add_pd(s[h], _mm256_mul_pd(c0, lo));
+            }
+            for h in 0..2 {
+                let hi = _mm256_unpackhi_pd(xs[h], xs[h]);
+                s[h] = _mm256_add_pd(s[h], _mm256_mul_pd(c1, hi));
+            }
+        }
+        let mut out = [0.0; 8];
+        // SAFETY: out holds 8 doubles.
+        unsafe {
+            _mm256_storeu_pd(out.as_mut_ptr(), s[0]);
+            _mm256_storeu_pd(out.as_mut_ptr().add(4), s[1]);
+        }
+        std::array::from_fn(|q| [out[2 * q], out[2 * q + 1]])
     }
 }
 
