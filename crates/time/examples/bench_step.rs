@@ -213,6 +213,9 @@ fn stream_triad() -> f64 {
 /// One rung: prints a RESULT line. With `dump`, first writes the problem
 /// and the state after a few steps for bench/peer.py.
 fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option<PathBuf>) {
+    // The process before any of the run's data: code, libraries, the
+    // runtime (~4.5 MB), which the run's own figure leaves out.
+    let rss_base = status_bytes("VmRSS:");
     let t_setup = Instant::now();
     let mesh = mesh_named(name);
     let (model, contact, loads) = problem(&mesh);
@@ -341,9 +344,10 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     };
     let need = matrix + factor + vectors;
     let memory = format!(
-        "peak_rss={peak:.0} peak_run={peak_run:.0} rss_start={rss_start:.0} matrix_bytes={matrix:.0} \
-         factor_bytes={factor:.0} vector_bytes={vectors:.0} peak_run_over_need={:.3} peak_over_need={:.3}",
+        "peak_rss={peak:.0} peak_run={peak_run:.0} rss_start={rss_start:.0} rss_base={rss_base:.0} matrix_bytes={matrix:.0} \
+         factor_bytes={factor:.0} vector_bytes={vectors:.0} peak_run_over_need={:.3} run_own_over_need={:.3} peak_over_need={:.3}",
         peak_run / need,
+        (peak_run - rss_base) / need,
         peak / need
     );
     let extra = if explicit {

@@ -56,10 +56,25 @@ pub struct Stencils {
     values: Vec<[f64; 4]>,
     /// Groups of chunk c: chunk_groups[c]..chunk_groups[c + 1].
     chunk_groups: Vec<u32>,
-    /// The CPU has AVX (checked at run time): runs of four node pairs of
-    /// one type are summed 4 doubles wide ([`avx::quad`]), the same bits.
+    /// Units: two consecutive node pairs (rows r..r + 4, types A and B)
+    /// read as one 4-row stencil, for the 4-wide sums ([`avx::units`]):
+    /// each group's unit with the next group, or [`NO_UNIT`].
+    unit_of: Vec<u32>,
+    /// Blocks of unit u: unit_blocks[u]..unit_blocks[u + 1].
+    unit_blocks: Vec<u32>,
+    /// The union of A's and B's block offsets, ascending.
+    unit_offsets: Vec<i32>,
+    /// Per unit block, the first and the second columns' values of rows
+    /// [A 0, A 1, B 0, B 1]; +0 where A or B has no block at the offset
+    /// (s + 0·x = s: the bits of the pair's own blocks).
+    unit_values: Vec<[[f64; 4]; 2]>,
+    /// The CPU has AVX (checked at run time): runs of two alike units are
+    /// summed 4 doubles wide ([`avx::units`]), the same bits.
     avx: bool,
 }
+
+/// [`Stencils::unit_of`] of a group that starts no unit.
+const NO_UNIT: u32 = u32::MAX;
 
 impl Stencils {
     /// The stencil types of a square CSR matrix with sorted columns at
@@ -138,15 +153,71 @@ impl Stencils {
         }
         let chunk_groups = kernels::chunk_groups(&group_rows, n);
         types.shrink_to_fit();
-        Some(Stencils {
+        let mut stencils = Stencils {
             group_rows,
             types,
             type_blocks,
             offsets,
             values,
             chunk_groups,
+            unit_of: Vec::new(),
+            unit_blocks: vec![0],
+            unit_offsets: Vec::new(),
+            unit_values: Vec::new(),
             avx: avx::available(),
-        })
+        };
+        if stencils.avx {
+            stencils.build_units();
+        }
+        Some(stencils)
+    }
+
+    /// The units of consecutive node pairs (see [`Stencils::unit_of`]).
+    fn build_units(&mut self) {
+        let groups = self.types.len();
+        let mut index: HashMap<(u32, u32), u32> = HashMap::new();
+        self.unit_of = vec![NO_UNIT; groups];
+        for g in 0..groups.saturating_sub(1) {
+            let r = self.group_rows[g];
+            if self.group_rows[g + 1] != r + 2 || self.group_rows[g + 2] != r + 4 {
+                continue;
+            }
+            let key = (self.types[g], self.types[g + 1]);
+            let next = (self.unit_blocks.len() - 1) as u32;
+            let u = *index.entry(key).or_insert(next);
+            if u == next {
+                let block = |t: u32| {
+                    let b = self.type_blocks[t as usize] as usize
+                        ..self.type_blocks[t as usize + 1] as usize;
+                    (&self.offsets[b.clone()], &self.values[b])
+                };
+                let ((oa, va), (ob, vb)) = (block(key.0), block(key.1));
+                let (mut i, mut j) = (0, 0);
+                while i < oa.len() || j < ob.len() {
+                    let o = match (oa.get(i), ob.get(j)) {
+                        (Some(&a), Some(&b)) => a.min(b),
+                        (Some(&a), None) => a,
+                        (None, Some(&b)) => b,
+                        (None, None) => unreachable!(),
+                    };
+                    let mut a = [0.0; 4];
+                    let mut b = [0.0; 4];
+                    if oa.get(i) == Some(&o) {
+                        a = va[i];
+                        i += 1;
+                    }
+                    if ob.get(j) == Some(&o) {
+                        b = vb[j];
+                        j += 1;
+                    }
+                    self.unit_offsets.push(o);
+                    self.unit_values
+                        .push([[a[0], a[1], b[0], b[1]], [a[2], a[3], b[2], b[3]]]);
+                }
+                self.unit_blocks.push(self.unit_offsets.len() as u32);
+            }
+            self.unit_of[g] = u;
+        }
     }
 
     /// Distinct stencils.
@@ -157,32 +228,27 @@ impl Stencils {
     /// The sums of group g's rows (the second is 0 for a single row).
     #[inline(always)]
     fn group_sums(&self, g: usize, x: &[f64]) -> [f64; 2] {
-        let t = self.types[g] as usize;
-        let r0 = self.group_rows[g] as isize;
-        let b = self.type_blocks[t] as usize..self.type_blocks[t + 1] as usize;
-        let mut s = [0.0; 2];
-        for (&o, v) in self.offsets[b.clone()].iter().zip(&self.values[b]) {
-            kernels::block((r0 + o as isize) as u32, *v, x, &mut s);
-        }
-        s
+        self.lockstep::<1>(g, x)[0]
     }
 
-    /// G groups of one type in lockstep: 2G independent chains of
-    /// additions (one chain alone waits on the adder's latency), each row's
-    /// order unchanged, the type's blocks loaded once for all.
+    /// G groups of one type in lockstep, the type's blocks loaded once
+    /// for all. Each row in two partial sums, the blocks' first columns'
+    /// terms and their second columns', added at the end ([`split_block`]):
+    /// 4G independent chains of additions (one chain per row would wait on
+    /// the adder's latency); the order every kernel here keeps.
     #[inline(always)]
     fn lockstep<const G: usize>(&self, g: usize, x: &[f64]) -> [[f64; 2]; G] {
         let t = self.types[g] as usize;
         let r: [isize; G] = std::array::from_fn(|q| self.group_rows[g + q] as isize);
         let b = self.type_blocks[t] as usize..self.type_blocks[t + 1] as usize;
-        let mut s = [[0.0; 2]; G];
+        let mut s = [[[0.0; 2]; 2]; G];
         for (&o, v) in self.offsets[b.clone()].iter().zip(&self.values[b]) {
             let o = o as isize;
             for q in 0..G {
-                kernels::block((r[q] + o) as u32, *v, x, &mut s[q]);
+                split_block((r[q] + o) as usize, v, x, &mut s[q]);
             }
         }
-        s
+        s.map(|[lo, hi]| [lo[0] + hi[0], lo[1] + hi[1]])
     }
 
     /// K x on the rows of groups g0..g1 into `out` (from g0's first row).
@@ -200,37 +266,26 @@ impl Stencils {
         while g < g1 {
             let t = self.types[g];
             let alike = |k: usize| g + k <= g1 && self.types[g + 1..g + k].iter().all(|&u| u == t);
-            let ty = |t: u32| {
-                let b = self.type_blocks[t as usize] as usize
-                    ..self.type_blocks[t as usize + 1] as usize;
-                (&self.offsets[b.clone()], &self.values[b])
+            let u = self.unit_of.get(g).copied().unwrap_or(NO_UNIT);
+            let b = if u != NO_UNIT && g + 4 <= g1 && self.unit_of[g + 2] == u {
+                self.unit_blocks[u as usize] as usize..self.unit_blocks[u as usize + 1] as usize
+            } else {
+                0..0
             };
-            let pairs = |k: usize| self.group_rows[g + k] == self.group_rows[g] + 2 * k as u32;
-            if self.avx && alike(4) && pairs(4) {
-                // Four node pairs of one type on consecutive rows (Q1).
-                let (o, v) = ty(t);
-                let sums = avx::run(o, v, avx::Rows::Consecutive(self.group_rows[g] as usize), x);
+            let r = self.group_rows[g] as usize;
+            // The padded lanes read x too: in range near the first and
+            // last rows?
+            let inside = !b.is_empty()
+                && r as isize + self.unit_offsets[b.start] as isize >= 0
+                && r as isize + self.unit_offsets[b.end - 1] as isize + 8 <= x.len() as isize;
+            if inside {
+                // Two alike units on consecutive rows: four node pairs of
+                // one type (Q1) or of two types in turn (a Q2 node row).
+                let sums = avx::units(&self.unit_offsets[b.clone()], &self.unit_values[b], r, x);
                 for (q, s) in sums.into_iter().enumerate() {
                     put(g + q, s);
                 }
                 g += 4;
-            } else if self.avx
-                && g + 8 <= g1
-                && pairs(8)
-                && (2..8).all(|k| self.types[g + k] == self.types[g + k % 2])
-            {
-                // Eight node pairs of two types in turn (a Q2 node row:
-                // vertex and edge nodes, or edge and centre nodes).
-                let r = self.group_rows[g] as usize;
-                for (p, t) in [(0, t), (1, self.types[g + 1])] {
-                    let (o, v) = ty(t);
-                    let rows = std::array::from_fn(|q| r + 2 * p + 4 * q);
-                    let sums = avx::run(o, v, avx::Rows::Any(rows), x);
-                    for (q, s) in sums.into_iter().enumerate() {
-                        put(g + p + 2 * q, s);
-                    }
-                }
-                g += 8;
             } else if alike(LOCKSTEP) {
                 for (q, s) in self.lockstep::<LOCKSTEP>(g, x).into_iter().enumerate() {
                     put(g + q, s);
@@ -244,18 +299,20 @@ impl Stencils {
     }
 }
 
-/// The 4-wide sums of four node pairs of one type.
-mod avx {
-    /// The first rows of the four pairs.
-    #[derive(Clone, Copy)]
-    pub enum Rows {
-        /// r, r + 2, r + 4, r + 6.
-        Consecutive(usize),
-        /// Anywhere.
-        Any([usize; 4]),
-    }
+/// One 2×2 block (by columns) at column c into a pair's partial sums:
+/// s[0] the first column's terms of rows 0 and 1, s[1] the second's.
+#[inline(always)]
+fn split_block(c: usize, v: &[f64; 4], x: &[f64], s: &mut [[f64; 2]; 2]) {
+    let xs = &x[c..c + 2];
+    s[0][0] += v[0] * xs[0];
+    s[0][1] += v[1] * xs[0];
+    s[1][0] += v[2] * xs[1];
+    s[1][1] += v[3] * xs[1];
+}
 
-    /// Whether this CPU runs [`quad`].
+/// The 4-wide sums of two units of consecutive node pairs.
+mod avx {
+    /// Whether this CPU runs [`units`].
     pub fn available() -> bool {
         #[cfg(target_arch = "x86_64")]
         {
@@ -267,83 +324,57 @@ mod avx {
         }
     }
 
-    /// [`quad`] on a CPU where [`available`] said yes.
+    /// The sums of the node pairs at rows r, r + 2 (one unit: blocks at
+    /// `offsets` with `values`) and r + 4, r + 6 (the same unit), each
+    /// row's products in the scalar kernel's two partial sums
+    /// (`split_block`), multiplications and additions separate (no fused
+    /// multiply-add): the bits of the scalar sums. Call only where
+    /// [`available`] said yes (`Stencils::unit_of` is empty otherwise).
     #[inline(always)]
     #[allow(unsafe_code)]
-    pub fn run(offsets: &[i32], values: &[[f64; 4]], rows: Rows, x: &[f64]) -> [[f64; 2]; 4] {
+    pub fn units(offsets: &[i32], values: &[[[f64; 4]; 2]], r: usize, x: &[f64]) -> [[f64; 2]; 4] {
         #[cfg(target_arch = "x86_64")]
         {
-            // SAFETY: callers hold `Stencils::avx`, set from `available()`.
-            unsafe {
-                match rows {
-                    Rows::Consecutive(r) => quad::<true>(offsets, values, [r; 4], x),
-                    Rows::Any(rows) => quad::<false>(offsets, values, rows, x),
-                }
-            }
+            // SAFETY: units exist only where `available()` said yes
+            // (`Stencils::build_units`).
+            unsafe { units_avx(offsets, values, r, x) }
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            let _ = (offsets, values, rows, x);
+            let _ = (offsets, values, r, x);
             unreachable!("AVX is x86_64 only")
         }
     }
 
-    /// The sums of four node pairs of one type (blocks at `offsets` with
-    /// `values`) at `rows` (`CONSECUTIVE`: rows[0] + 2q), each row's
-    /// products added in `kernels::block`'s order (column c, then c + 1),
-    /// multiplications and additions separate (no fused multiply-add): the
-    /// bits of the scalar sums. Two pairs per 4-wide register; consecutive
-    /// pairs read x[c..c + 4] in one load.
+    /// [`units`]: a unit's four rows in one 4-wide register each for the
+    /// first and the second columns' terms, x[c..c + 4] in one load.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     #[allow(unsafe_code)]
-    fn quad<const CONSECUTIVE: bool>(
-        offsets: &[i32],
-        values: &[[f64; 4]],
-        rows: [usize; 4],
-        x: &[f64],
-    ) -> [[f64; 2]; 4] {
+    fn units_avx(offsets: &[i32], values: &[[[f64; 4]; 2]], r: usize, x: &[f64]) -> [[f64; 2]; 4] {
         use std::arch::x86_64::*;
-        let mut s = [_mm256_setzero_pd(); 2];
+        let mut lo = [_mm256_setzero_pd(); 2];
+        let mut hi = [_mm256_setzero_pd(); 2];
         for (&o, v) in offsets.iter().zip(values) {
-            let o = o as isize;
-            // [x_c, x_c+1] of pairs 2h and 2h + 1.
-            let xs: [__m256d; 2] = std::array::from_fn(|h| {
-                if CONSECUTIVE {
-                    let c = (rows[0] as isize + o) as usize + 4 * h;
-                    let xs: &[f64; 4] = x[c..c + 4].try_into().expect("4 columns");
-                    // SAFETY: xs holds 4 doubles; unaligned load.
-                    unsafe { _mm256_loadu_pd(xs.as_ptr()) }
-                } else {
-                    let col = |q: usize| (rows[q] as isize + o) as usize;
-                    let (c0, c1) = (col(2 * h), col(2 * h + 1));
-                    let (a, b): (&[f64; 2], &[f64; 2]) = (
-                        x[c0..c0 + 2].try_into().expect("2 columns"),
-                        x[c1..c1 + 2].try_into().expect("2 columns"),
-                    );
-                    // SAFETY: a and b hold 2 doubles each; unaligned loads.
-                    unsafe {
-                        _mm256_insertf128_pd(
-                            _mm256_castpd128_pd256(_mm_loadu_pd(a.as_ptr())),
-                            _mm_loadu_pd(b.as_ptr()),
-                            1,
-                        )
-                    }
-                }
-            });
-            // [v0, v1, v0, v1] and [v2, v3, v2, v3]: rows 0 and 1 of the
-            // block's first and second column, for two pairs.
-            let c0 = _mm256_setr_pd(v[0], v[1], v[0], v[1]);
-            let c1 = _mm256_setr_pd(v[2], v[3], v[2], v[3]);
-            for h in 0..2 {
-                let lo = _mm256_unpacklo_pd(xs[h], xs[h]);
-                s[h] = _mm256_add_pd(s[h], _mm256_mul_pd(c0, lo));
-            }
-            for h in 0..2 {
-                let hi = _mm256_unpackhi_pd(xs[h], xs[h]);
-                s[h] = _mm256_add_pd(s[h], _mm256_mul_pd(c1, hi));
+            let c = (r as isize + o as isize) as usize;
+            let xs: &[f64; 8] = x[c..c + 8].try_into().expect("8 columns");
+            // SAFETY: xs and v hold 8 doubles each; unaligned loads.
+            let (xa, xb, c0, c1) = unsafe {
+                (
+                    _mm256_loadu_pd(xs.as_ptr()),
+                    _mm256_loadu_pd(xs.as_ptr().add(4)),
+                    _mm256_loadu_pd(v[0].as_ptr()),
+                    _mm256_loadu_pd(v[1].as_ptr()),
+                )
+            };
+            for (h, xh) in [xa, xb].into_iter().enumerate() {
+                let x0 = _mm256_unpacklo_pd(xh, xh);
+                lo[h] = _mm256_add_pd(lo[h], _mm256_mul_pd(c0, x0));
+                let x1 = _mm256_unpackhi_pd(xh, xh);
+                hi[h] = _mm256_add_pd(hi[h], _mm256_mul_pd(c1, x1));
             }
         }
+        let s = [_mm256_add_pd(lo[0], hi[0]), _mm256_add_pd(lo[1], hi[1])];
         let mut out = [0.0; 8];
         // SAFETY: out holds 8 doubles.
         unsafe {
@@ -395,8 +426,9 @@ impl RowProduct for Stencils {
 
     fn bytes(&self) -> usize {
         4 * (self.group_rows.len() + self.types.len() + self.chunk_groups.len())
-            + 4 * self.type_blocks.len()
+            + 4 * (self.type_blocks.len() + self.unit_of.len() + self.unit_blocks.len())
             + 36 * self.values.len()
+            + 68 * self.unit_values.len()
     }
 }
 
@@ -468,8 +500,9 @@ mod tests {
     /// committed Gmsh Q1 slab, boundary nodes numbered first): few types,
     /// products within the tolerance of the CSR's, the same bits on 1 and
     /// 2 threads, by batches and row by row, for K and M; with tolerance 0
-    /// (equal bits only) the product is the CSR's to the last bit (the
-    /// blocks' order and padding are the compact form's).
+    /// (equal bits only) the product has, to the last bit, each row's own
+    /// blocks ([`kernels::row_groups`], as the compact form reads them)
+    /// summed in the order of [`split_block`].
     #[test]
     fn stencil_types_on_the_slabs() {
         use stickslip_fem::testing::rectangle;
@@ -494,12 +527,23 @@ mod tests {
                 // first: more of them), one inside.
                 let groups = s.types.len();
                 assert!(6 * s.types() <= groups, "{name}: {} types", s.types());
+                // The 4-wide path ran (the bits against the row-by-row
+                // sums in `check`).
+                assert!(!avx::available() || s.unit_of.iter().any(|&u| u != NO_UNIT));
                 check(k, &s, name);
                 let exact = Stencils::build(k, 0.0, usize::MAX).unwrap();
                 assert!(exact.types() > s.types(), "{name}");
                 let x = x_of(k.nrows());
                 let (mut y0, mut y1) = (vec![0.0; k.nrows()], vec![0.0; k.nrows()]);
-                spmv(k, &x, &mut y0);
+                kernels::row_groups(k, |r0, r1, cols, vals| {
+                    let mut s = [[0.0; 2]; 2];
+                    for (&c, v) in cols.iter().zip(vals) {
+                        split_block(c as usize, v, &x, &mut s);
+                    }
+                    for (k, y) in y0[r0..r1].iter_mut().enumerate() {
+                        *y = s[0][k] + s[1][k];
+                    }
+                });
                 exact.spmv(&x, &mut y1);
                 for i in 0..k.nrows() {
                     assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "{name} row {i} exact");
