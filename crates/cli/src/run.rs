@@ -312,9 +312,11 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
         explicit_friction: ExplicitFriction::ClosedForm,
         initial_velocity: None,
     };
-    // The explicit step forms K·x from element classes where the mesh has
-    // them (structured Q2 meshes; stickslip-time's kernels.rs), else it
-    // streams the assembled K.
+    // The explicit step forms K·x by stencil types where the mesh's
+    // numbering repeats its node rows (structured meshes numbered row by
+    // row), else from element classes where the mesh has them (structured
+    // Q2 meshes), else from a compact copy of the assembled K
+    // (stickslip-time's kernels.rs picks).
     let classes = match (scheme, &material) {
         (Scheme::CentralDifference, Some(material)) => {
             ElementClasses::new(&mesh, material, &model.dofs)

@@ -265,7 +265,11 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         dump_problem(dir, &model, &contact, &loads, scheme, dt, check_steps);
     }
     // The model's matrices move into the integrator: one copy of K and M.
-    let dynamics = Dynamics::from_model_owned(model).with_element_classes(classes);
+    // STICKSLIP_NO_STENCILS set: K (and M) as the mesh allows without
+    // stencil types (the comparison).
+    let dynamics = Dynamics::from_model_owned(model)
+        .with_element_classes(classes)
+        .with_stencils(std::env::var_os("STICKSLIP_NO_STENCILS").is_none());
     let settings = if explicit {
         Settings::new(Scheme::CentralDifference, dt, 1e9)
     } else {

@@ -15,10 +15,14 @@
 //! per sum this is the arithmetic of the earlier three passes (kept:
 //! [`rhs_and_velocity`], [`accelerate_and_sum`], used by the iterated
 //! friction, which needs R̂_K everywhere), so the results are bit-identical
-//! to them (tests below; the verify references differ by 0): 10 vector
-//! streams per step (pass A reads r, ṙ, r̈ and writes r_K; the sweep reads
-//! r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K) instead of 17 with dense loads, 24
-//! for the three passes.
+//! to them (tests below; the verify references differ by 0). The sweep
+//! also writes the next step's predictor r_K + Δt ṙ_K + ½Δt² r̈_K, with
+//! pass A's operations, and a next step of the same Δt skips pass A's
+//! dense sweep (tests/explicit_predictor.rs: bit-identical to runs that
+//! form every predictor anew, across Remark 4.3's Δt changes). Vector
+//! streams per step: 7 (the sweep reads r_K, m, ṙ, r̈ and writes ṙ_K,
+//! r̈_K, r_{K+1}); 10 with pass A (which reads r, ṙ, r̈ and writes r_K),
+//! 17 with dense loads, 24 for the three passes.
 //!
 //! Work is split into fixed chunks of [`CHUNK`] DOFs whatever the number of
 //! threads, and sums are formed per chunk and added in chunk order, so a
@@ -86,11 +90,21 @@
 //! or two runs, load 1.3-1.5); that is a profile choice for the workspace
 //! (Cargo.toml): it now compiles stickslip-time at opt-level 3.
 //!
-//! Tried and not kept (branch `cd-predictor-fusion`): the sweep writing
-//! the next step's predictor so that a step of the same Δt skips pass A's
-//! sweep (bit-identical, 10 → 7 vector streams) measured no faster, the
-//! sweep being compute-bound at opt-level 2 (Q1 708×177 1.85 vs 1.91 ms,
-//! 1416×354 8.94 vs 9.17 ms, fastest of 2-3, load 0.8-1.3).
+//! The predictor from the sweep (branch `cd-predictor-fusion`) first
+//! measured no faster, the sweep then being compute-bound (Q1 1416×354
+//! 8.94 vs 9.17 ms); with K·x by stencil types the vectors are the stream,
+//! and it is kept: same session, bench step, Q1 708×177 1.11 → 0.95 ms,
+//! Q2 352×88 1.66 → 1.45 ms.
+//!
+//! K·x by stencil types ([`Stencils`], `stencils.rs`), preferred to all
+//! below where it applies: structured meshes numbered row by row, whose
+//! node rows share a few stencils up to the coordinates' rounding (Q1
+//! 1416×354: 2,845 types for 502k node pairs; the product streams 8 bytes
+//! per node pair, and runs of alike pairs are summed 4 wide with AVX);
+//! within 1e-12 of max |K_ij| per block of the assembled K, not its bits.
+//! `class_lab` (below), 2 threads, fastest of 20, 09:08-09:16: K·x Q1 1M
+//! 4.44 (compact dictionary) → 1.40-1.55 ms; Q2 249k 1.74 (classes) →
+//! 0.70-0.73 ms; Q2 1M 6.77 (classes) → 2.9 ms.
 //!
 //! Matrix-free by element classes ([`Classes`], branch `cd-matrix-free`):
 //! on the structured slabs every cell is a translate of the others up to
