@@ -1485,15 +1485,25 @@ pub fn fused_step<K: RowProduct>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use nalgebra_sparse::{CooMatrix, CsrMatrix};
     use stickslip_fem::testing::on_threads;
     use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
     use stickslip_mesh::Mesh;
 
+    /// The labs' sweep: no friction, K r_K formed in the sweep.
+    fn lab_sweep<K: RowProduct>(
+        k: &K,
+        data: &StepData,
+        [vn, an, rx]: [&mut [f64]; 3],
+        p: &mut Partials,
+    ) {
+        fused_step(k, data, &[], None, vn, an, rx, p);
+    }
+
     /// A deterministic, non-repeating x with entries of both signs.
-    fn x_of(n: usize) -> Vec<f64> {
+    pub(crate) fn x_of(n: usize) -> Vec<f64> {
         (0..n)
             .map(|i| ((i as f64 * 0.618_033_988_75).fract() - 0.5) * (1.0 + i as f64 * 1e-3))
             .collect()
@@ -2253,16 +2263,7 @@ mod tests {
                     );
                     t[1].push(s.elapsed().as_secs_f64());
                     let s = Instant::now();
-                    fused_step(
-                        &compact,
-                        &data,
-                        &[],
-                        None,
-                        &mut vn,
-                        &mut an,
-                        &mut rx,
-                        &mut p,
-                    );
+                    lab_sweep(&compact, &data, [&mut vn, &mut an, &mut rx], &mut p);
                     t[2].push(s.elapsed().as_secs_f64());
                 }
                 for (name, t) in ["CSR, B, C", "compact·B, C", "one sweep"]
@@ -2438,36 +2439,15 @@ mod tests {
                                 next: (1e-3, 0.5e-6),
                             };
                             match use_classes {
-                                1 => fused_step(
-                                    &classes,
-                                    &data,
-                                    &[],
-                                    None,
-                                    &mut vn,
-                                    &mut an,
-                                    &mut rx,
-                                    &mut p,
-                                ),
-                                2 => fused_step(
-                                    &stencils,
-                                    &data,
-                                    &[],
-                                    None,
-                                    &mut vn,
-                                    &mut an,
-                                    &mut rx,
-                                    &mut p,
-                                ),
-                                _ => fused_step(
-                                    &compact,
-                                    &data,
-                                    &[],
-                                    None,
-                                    &mut vn,
-                                    &mut an,
-                                    &mut rx,
-                                    &mut p,
-                                ),
+                                1 => {
+                                    lab_sweep(&classes, &data, [&mut vn, &mut an, &mut rx], &mut p)
+                                }
+                                2 => {
+                                    lab_sweep(&stencils, &data, [&mut vn, &mut an, &mut rx], &mut p)
+                                }
+                                _ => {
+                                    lab_sweep(&compact, &data, [&mut vn, &mut an, &mut rx], &mut p)
+                                }
                             };
                             t[q].push(s.elapsed().as_secs_f64());
                         };

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use stickslip_contact::{ContactError, ContactSurface};
 use stickslip_fem::{traction_load, Dirichlet, FemError, Hypothesis, Material, Model, Traction};
-use stickslip_mesh::{CellKind, Edge, Group, Mesh, MeshError, SourceInfo};
+use stickslip_mesh::{CellKind, Mesh, MeshError};
 
 use crate::{Dynamics, History, Integrator, Load, Scheme, Settings, StickReduction, TimeError};
 
@@ -475,110 +475,22 @@ impl Method {
 }
 
 /// The structured slab [0, 8] × [0, 1] with nx × ny Q1 or Q2 cells and the
-/// groups of cases/meshes/README.md (edges oriented with the cell on the
-/// left, counter-clockwise cells), its nodes numbered row by row (the step
-/// bench's ladder; K's node rows then share stencils).
+/// groups of cases/meshes/README.md (`stickslip_fem::testing::rectangle`,
+/// its edges renamed: contact below, load on the right, support on top),
+/// its nodes numbered row by row (the step bench's ladder; K's node rows
+/// then share stencils).
 pub fn structured_slab(nx: usize, ny: usize, q2: bool) -> Mesh {
-    let q = if q2 { 2 } else { 1 };
-    let (gx, gy) = (q * nx + 1, q * ny + 1);
-    let id = |i: usize, j: usize| j * gx + i;
-    let mut nodes = Vec::with_capacity(gx * gy);
-    for j in 0..gy {
-        for i in 0..gx {
-            nodes.push([8.0 * i as f64 / (gx - 1) as f64, j as f64 / (gy - 1) as f64]);
-        }
+    let kind = if q2 { CellKind::Quad9 } else { CellKind::Quad4 };
+    let mut mesh = stickslip_fem::testing::rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
+    for g in &mut mesh.groups {
+        let (name, tag) = match g.name.as_str() {
+            "bottom" => ("contact", 1),
+            "right" => ("load", 2),
+            "top" => ("support", 3),
+            "left" => ("left", 4),
+            _ => ("body", 10),
+        };
+        (g.name, g.tag) = (name.into(), tag);
     }
-    let per = if q2 { 9 } else { 4 };
-    let mut cells = Vec::with_capacity(nx * ny * per);
-    for cy in 0..ny {
-        for cx in 0..nx {
-            let (i, j) = (q * cx, q * cy);
-            cells.extend([id(i, j), id(i + q, j), id(i + q, j + q), id(i, j + q)]);
-            if q2 {
-                cells.extend([
-                    id(i + 1, j),
-                    id(i + 2, j + 1),
-                    id(i + 1, j + 2),
-                    id(i, j + 1),
-                    id(i + 1, j + 1),
-                ]);
-            }
-        }
-    }
-    let cell = |cx: usize, cy: usize| cy * nx + cx;
-    let mid = |i: usize, j: usize| if q2 { Some(id(i, j)) } else { None };
-    let line = |name: &str, tag: i32, edges: Vec<Edge>| {
-        let mut ns: Vec<usize> = edges
-            .iter()
-            .flat_map(|e| e.nodes.into_iter().chain(e.mid))
-            .collect();
-        ns.sort_unstable();
-        ns.dedup();
-        Group {
-            name: name.into(),
-            tag,
-            dim: 1,
-            elements: edges.len(),
-            edges,
-            cells: vec![],
-            points: vec![],
-            nodes: ns,
-        }
-    };
-    let top = gy - 1;
-    let right = gx - 1;
-    let contact = (0..nx)
-        .map(|cx| Edge {
-            nodes: [id(q * cx, 0), id(q * cx + q, 0)],
-            mid: mid(q * cx + 1, 0),
-            cell: cell(cx, 0),
-        })
-        .collect();
-    let load = (0..ny)
-        .map(|cy| Edge {
-            nodes: [id(right, q * cy), id(right, q * cy + q)],
-            mid: mid(right, q * cy + 1),
-            cell: cell(nx - 1, cy),
-        })
-        .collect();
-    let support = (0..nx)
-        .map(|cx| Edge {
-            nodes: [id(q * cx + q, top), id(q * cx, top)],
-            mid: mid(q * cx + 1, top),
-            cell: cell(cx, ny - 1),
-        })
-        .collect();
-    let left = (0..ny)
-        .map(|cy| Edge {
-            nodes: [id(0, q * cy + q), id(0, q * cy)],
-            mid: mid(0, q * cy + 1),
-            cell: cell(0, cy),
-        })
-        .collect();
-    let n_cells = nx * ny;
-    let groups = vec![
-        line("contact", 1, contact),
-        line("load", 2, load),
-        line("support", 3, support),
-        line("left", 4, left),
-        Group {
-            name: "body".into(),
-            tag: 10,
-            dim: 2,
-            edges: vec![],
-            cells: (0..n_cells).collect(),
-            points: vec![],
-            nodes: (0..nodes.len()).collect(),
-            elements: n_cells,
-        },
-    ];
-    Mesh {
-        node_tags: (1..=nodes.len() as u64).collect(),
-        nodes,
-        kind: if q2 { CellKind::Quad9 } else { CellKind::Quad4 },
-        cells,
-        cell_tags: (1..=n_cells as u64).collect(),
-        groups,
-        source: SourceInfo::default(),
-    }
+    mesh
 }

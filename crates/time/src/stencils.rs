@@ -436,15 +436,10 @@ impl RowProduct for Stencils {
 mod tests {
     use super::*;
     use crate::kernels::spmv;
+    use crate::kernels::tests::x_of;
     use stickslip_fem::testing::on_threads;
     use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
     use stickslip_mesh::Mesh;
-
-    fn x_of(n: usize) -> Vec<f64> {
-        (0..n)
-            .map(|i| ((i as f64 * 0.618_033_988_75).fract() - 0.5) * (1.0 + i as f64 * 1e-3))
-            .collect()
-    }
 
     /// Every row within TOLERANCE · max|K| · Σ_j |x_j| (its columns) of the
     /// CSR's product, and the rows alone and on two threads the same bits.
