@@ -1047,7 +1047,6 @@ impl Integrator {
                     cv: 1.0 / (gamma * dt),
                     ca: 1.0 / gamma - 1.0,
                     scale,
-                    gamma_dt: gamma * dt,
                     ratio: (1.0 - gamma) / gamma,
                     // The next step's predictor for a step of the same Δt:
                     // pass A's c1 and c2 above.
@@ -1177,7 +1176,7 @@ impl Integrator {
                     &self.v,
                     &self.v_new,
                     &self.a,
-                    gamma * dt,
+                    scale,
                     ratio,
                     &mut self.tmp,
                     &mut self.partials,

@@ -438,7 +438,8 @@ pub struct Sums {
     pub finite: bool,
 }
 
-/// Pass C: r̈_K = (ṙ_K − ṙ)/(γΔt) − (1−γ)/γ r̈ into `a_new`, and the sums.
+/// Pass C: r̈_K = (ṙ_K − ṙ)·scale − (1−γ)/γ r̈ into `a_new` (scale =
+/// 1/(γΔt): a product, not a division per row), and the sums.
 #[allow(clippy::too_many_arguments)]
 pub fn accelerate_and_sum(
     mass: &[f64],
@@ -449,7 +450,7 @@ pub fn accelerate_and_sum(
     v: &[f64],
     v_new: &[f64],
     a: &[f64],
-    gamma_dt: f64,
+    scale: f64,
     ratio: f64,
     a_new: &mut [f64],
     partials: &mut Partials,
@@ -466,7 +467,7 @@ pub fn accelerate_and_sum(
         let (mut work, mut kinetic, mut load_dot) = (0.0, 0.0, 0.0);
         let mut finite = true;
         for i in 0..an.len() {
-            an[i] = (vn[i] - v[i]) / gamma_dt - ratio * a[i];
+            an[i] = (vn[i] - v[i]) * scale - ratio * a[i];
             work += 0.5 * (ln[i] + l[i]) * (rn[i] - r[i]);
             kinetic += m[i] * vn[i] * vn[i];
             load_dot += rn[i] * ln[i];
@@ -1327,11 +1328,9 @@ pub struct StepData<'a> {
     pub cv: f64,
     /// See `cv`.
     pub ca: f64,
-    /// 1/(γΔt): ṙ_K = b/(m·scale).
+    /// 1/(γΔt): ṙ_K = b/(m·scale), r̈_K = (ṙ_K − ṙ)·scale − ratio·r̈.
     pub scale: f64,
-    /// γΔt and (1−γ)/γ of the acceleration update.
-    pub gamma_dt: f64,
-    /// See `gamma_dt`.
+    /// (1−γ)/γ.
     pub ratio: f64,
     /// The next step's predictor coefficients c1, c2 for a step of the
     /// same Δt ([`predict`]'s): the sweep writes r_K + c1 ṙ_K + c2 r̈_K.
@@ -1399,11 +1398,11 @@ fn batch_rows(
         vn[i - r0] = vi;
         run.friction += 1;
     }
-    let (gamma_dt, ratio) = (s.gamma_dt, s.ratio);
+    let ratio = s.ratio;
     let (c1, c2) = s.next;
     let mut finite = run.finite;
     for k in 0..n {
-        let ak = (vn[k] - v[k]) / gamma_dt - ratio * a[k];
+        let ak = (vn[k] - v[k]) * s.scale - ratio * a[k];
         an[k] = ak;
         r_next[k] = rn[k] + c1 * vn[k] + c2 * ak;
         // `&`, not `&&`: no branch, so the loop stays vectorized.
@@ -1636,7 +1635,6 @@ pub(crate) mod tests {
                     cv: 2.0,
                     ca: 1.0,
                     scale: 2.0,
-                    gamma_dt: 0.5,
                     ratio: 1.0,
                     next: (1e-3, 0.5e-6),
                 };
@@ -1736,7 +1734,6 @@ pub(crate) mod tests {
             cv: 1.0 / (0.5 * 1e-3),
             ca: 1.0,
             scale: 1.0 / (0.5 * 1e-3),
-            gamma_dt: 0.5 * 1e-3,
             ratio: 1.0,
             next: (c1, c2),
         };
@@ -1757,17 +1754,7 @@ pub(crate) mod tests {
             vn0[i] = vi;
         }
         let sums0 = accelerate_and_sum(
-            &mass,
-            &load,
-            &load_new,
-            &r,
-            &r_new,
-            &v,
-            &vn0,
-            &a,
-            data.gamma_dt,
-            data.ratio,
-            &mut an0,
+            &mass, &load, &load_new, &r, &r_new, &v, &vn0, &a, data.scale, data.ratio, &mut an0,
             &mut p0,
         );
         assert!(sums0.work != 0.0 && sums0.load_dot != 0.0);
@@ -2029,7 +2016,6 @@ pub(crate) mod tests {
                     cv: 2e3,
                     ca: 1.0,
                     scale: 2e3,
-                    gamma_dt: 5e-4,
                     ratio: 1.0,
                     next: (1e-3, 0.5e-6),
                 };
@@ -2236,7 +2222,6 @@ pub(crate) mod tests {
                     cv: 2e3,
                     ca: 1.0,
                     scale: 2e3,
-                    gamma_dt: 5e-4,
                     ratio: 1.0,
                     next: (1e-3, 0.5e-6),
                 };
@@ -2251,7 +2236,7 @@ pub(crate) mod tests {
                     spmv(k, &rn, &mut b);
                     rhs_and_velocity(&ln, &m, &rn, &v, &a, 2e3, 1.0, 2e3, &mut b, &mut vn, &mut p);
                     accelerate_and_sum(
-                        &m, &l, &ln, &r, &rn, &v, &vn, &a, 5e-4, 1.0, &mut an, &mut p,
+                        &m, &l, &ln, &r, &rn, &v, &vn, &a, 2e3, 1.0, &mut an, &mut p,
                     );
                     t[0].push(s.elapsed().as_secs_f64());
                     let s = Instant::now();
@@ -2259,7 +2244,7 @@ pub(crate) mod tests {
                         &compact, &ln, &m, &rn, &v, &a, 2e3, 1.0, 2e3, &mut b, &mut vn, &mut p,
                     );
                     accelerate_and_sum(
-                        &m, &l, &ln, &r, &rn, &v, &vn, &a, 5e-4, 1.0, &mut an, &mut p,
+                        &m, &l, &ln, &r, &rn, &v, &vn, &a, 2e3, 1.0, &mut an, &mut p,
                     );
                     t[1].push(s.elapsed().as_secs_f64());
                     let s = Instant::now();
@@ -2434,7 +2419,6 @@ pub(crate) mod tests {
                                 cv: 2e3,
                                 ca: 1.0,
                                 scale: 2e3,
-                                gamma_dt: 5e-4,
                                 ratio: 1.0,
                                 next: (1e-3, 0.5e-6),
                             };
