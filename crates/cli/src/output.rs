@@ -90,6 +90,9 @@ pub struct Summary {
     pub dt_crit: Option<f64>,
     /// Why the run stopped early, if it did (root attribute `failure`).
     pub failure: Option<String>,
+    /// How the steps formed their products with K
+    /// (`Integrator::stiffness_product`).
+    pub stiffness_product: String,
 }
 
 /// Growing datasets, one row per output step.
@@ -804,6 +807,10 @@ impl ResultsWriter {
         if let Some(d) = summary.dt_crit {
             put_scalar(&solver, "dt_crit", d)?;
         }
+        if solver.attr("stiffness_product").is_ok() {
+            solver.delete_attr("stiffness_product")?;
+        }
+        string_attr(&solver, "stiffness_product", &summary.stiffness_product)?;
         if self.file.attr("failure").is_ok() {
             self.file.delete_attr("failure")?;
         }
@@ -934,6 +941,7 @@ pub(crate) mod tests {
                     factorizations: 2,
                     dt_crit: Some(0.25),
                     failure: (!c).then(|| "iteration cap hit at step 3".to_string()),
+                    stiffness_product: "stencil types".into(),
                 },
             )
             .unwrap();
@@ -1094,6 +1102,15 @@ pub(crate) mod tests {
         assert_eq!(
             solver.attr("steps").unwrap().read_scalar::<u64>().unwrap(),
             30
+        );
+        assert_eq!(
+            solver
+                .attr("stiffness_product")
+                .unwrap()
+                .read_scalar::<VarLenUnicode>()
+                .unwrap()
+                .as_str(),
+            "stencil types"
         );
         assert_eq!(
             solver

@@ -759,6 +759,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         factorizations: integrator.factorizations(),
         dt_crit: integrator.dt_crit(),
         failure: reason.clone(),
+        stiffness_product: integrator.stiffness_product().into(),
     };
     let rows = writer.rows();
     writer.finish(complete, &summary)?;
@@ -773,7 +774,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     };
     if !quiet {
         eprintln!(
-            "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations) in {:.3} s",
+            "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations, K by {}) in {:.3} s",
             match status {
                 "complete" => "done:",
                 "interrupted" => "interrupted:",
@@ -783,6 +784,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             integrator.time(),
             integrator.total_iterations(),
             integrator.factorizations(),
+            summary.stiffness_product,
             summary.wall_time_s
         );
         eprintln!(
@@ -805,6 +807,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             "wall_time_s": summary.wall_time_s,
             "iterations": integrator.total_iterations(),
             "factorizations": integrator.factorizations(),
+            "stiffness_product": summary.stiffness_product,
             "dt": case.time.dt,
             "dt_crit": integrator.dt_crit(),
             "energy": {

@@ -1651,6 +1651,21 @@ impl Integrator {
         }
     }
 
+    /// How the step forms its products with K (and M): "stencil types",
+    /// "element classes", "compact blocks", "2x2 blocks" or "assembled
+    /// CSR" (the first two within 1e-12 of the assembled K's products, not
+    /// their bits).
+    pub fn stiffness_product(&self) -> &'static str {
+        match (&self.product, self.explicit) {
+            (Some(kernels::Product::Stencils(_)), _) => "stencil types",
+            (Some(kernels::Product::Classes(_)), _) => "element classes",
+            (Some(kernels::Product::Compact(_)), _) => "compact blocks",
+            (None, false) if self.implicit_products.is_some() => "stencil types",
+            (None, false) if self.pair_blocks.is_some() => "2x2 blocks",
+            (None, _) => "assembled CSR",
+        }
+    }
+
     /// How implicit steps solve their linear systems.
     pub fn implicit_solver(&self) -> ImplicitSolver {
         self.solver
