@@ -377,12 +377,21 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     let steps = (case.time.t_end / case.time.dt).ceil();
     if i.is_explicit() {
         println!(
-            "solver      explicit: no linear system; friction solved node by node in closed form"
+            "solver      explicit: no linear system; friction solved node by node in closed form; K·x by {}",
+            i.stiffness_product()
+        );
+    } else if i.implicit_solver() == stickslip_time::ImplicitSolver::Direct {
+        println!(
+            "solver      implicit Newmark: sparse Cholesky (faer, AMD) of A₀ + C, analysed once, refactorized when dt or the stuck set changes; nnz(K) = {}; K·x by {}",
+            p.model.stiffness.nnz(),
+            i.stiffness_product()
         );
     } else {
+        let n_c = i.contact().map_or(0, |c| c.len());
         println!(
-            "solver      implicit Newmark: sparse Cholesky (faer, AMD), analysed once, refactorized when dt or the stuck set changes; nnz(K) = {}",
-            p.model.stiffness.nnz()
+            "solver      implicit Newmark: sparse Cholesky (faer, AMD) of A₀, analysed once, factorized once per distinct dt; friction on the {n_c} contact unknowns by the Schur complement; nnz(K) = {}; K·x by {}",
+            p.model.stiffness.nnz(),
+            i.stiffness_product()
         );
     }
     println!(
