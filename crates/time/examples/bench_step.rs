@@ -214,7 +214,7 @@ fn stream_triad() -> f64 {
 /// and the state after a few steps for bench/peer.py.
 fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option<PathBuf>) {
     // The process before any of the run's data: code, libraries, the
-    // runtime (~4.5 MB), which the run's own figure leaves out.
+    // runtime (about 3 MB), which the run's own figure leaves out.
     let rss_base = status_bytes("VmRSS:");
     let t_setup = Instant::now();
     let mesh = mesh_named(name);

@@ -416,6 +416,11 @@ impl ImplicitProducts {
     }
 }
 
+/// xᵀ M_L x with the lumped mass m.
+fn lumped_form(m: &[f64], x: &[f64]) -> f64 {
+    x.iter().zip(m).map(|(v, m)| m * v * v).sum()
+}
+
 impl std::fmt::Debug for Integrator {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Integrator")
@@ -753,12 +758,7 @@ impl Integrator {
                     m.spmv(&self.v, &mut p.scratch);
                     dot(&self.v, &p.scratch)
                 }
-                None => self
-                    .v
-                    .iter()
-                    .zip(&self.dynamics.lumped_mass)
-                    .map(|(v, m)| m * v * v)
-                    .sum(),
+                None => lumped_form(&self.dynamics.lumped_mass, &self.v),
             };
             return (0.5 * vmv, 0.5 * rkr);
         }
@@ -786,11 +786,7 @@ impl Integrator {
 
     fn mass_product(&mut self, x: &[f64]) -> f64 {
         match self.mass_kind {
-            MassKind::Lumped => x
-                .iter()
-                .zip(&self.dynamics.lumped_mass)
-                .map(|(v, m)| m * v * v)
-                .sum(),
+            MassKind::Lumped => lumped_form(&self.dynamics.lumped_mass, x),
             MassKind::Consistent => quadratic_form(&self.mass_matrix, x, &mut self.row_partials),
         }
     }
@@ -844,27 +840,20 @@ impl Integrator {
         for i in 0..n {
             self.tmp[i] = cv * self.v[i] + ca * self.a[i];
         }
-        if let Some(p) = &mut self.implicit_products {
+        if let Some(p) = &self.implicit_products {
             p.k.spmv(&self.r_new, &mut self.b);
-            match &p.m {
-                Some(m) => {
-                    m.spmv(&self.tmp, &mut p.scratch);
-                    for i in 0..n {
-                        self.b[i] = self.load_new[i] - self.b[i] + p.scratch[i];
-                    }
-                }
-                None => {
-                    for i in 0..n {
-                        self.b[i] = self.load_new[i] - self.b[i]
-                            + self.dynamics.lumped_mass[i] * self.tmp[i];
-                    }
-                }
-            }
         } else if self.mass_kind != MassKind::Consistent || !self.shared_pattern {
             spmv(&self.dynamics.stiffness, &self.r_new, &mut self.b);
         }
         match self.mass_kind {
-            _ if self.implicit_products.is_some() => {}
+            MassKind::Consistent if self.implicit_products.is_some() => {
+                let p = self.implicit_products.as_mut().expect("checked");
+                let m = p.m.as_ref().expect("consistent mass: M's stencils");
+                m.spmv(&self.tmp, &mut p.scratch);
+                for i in 0..n {
+                    self.b[i] = self.load_new[i] - self.b[i] + p.scratch[i];
+                }
+            }
             MassKind::Consistent if self.pair_blocks.is_some() => {
                 let blocks = self.pair_blocks.as_ref().expect("checked");
                 blocks.load_minus_k_plus_m(&self.load_new, &self.r_new, &self.tmp, &mut self.b);

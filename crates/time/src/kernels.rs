@@ -755,6 +755,32 @@ pub(crate) fn row_groups(
     group_rows
 }
 
+/// Calls `f(first row, K x on the batch's rows)` for consecutive batches
+/// of at most [`BATCH`] rows (BATCH / 2 groups) covering chunk `c`, in
+/// order, the sums of groups g..gb from `sums(g, gb, out)` into a buffer
+/// held in L1 (the row groups of [`Compact`] and
+/// [`crate::stencils::Stencils`]).
+#[inline(always)]
+pub(crate) fn group_batches(
+    chunk_groups: &[u32],
+    group_rows: &[u32],
+    c: usize,
+    mut sums: impl FnMut(usize, usize, &mut [f64]),
+    mut f: impl FnMut(usize, &[f64]),
+) {
+    let (g0, g1) = (chunk_groups[c] as usize, chunk_groups[c + 1] as usize);
+    let mut buf = [0.0; BATCH];
+    let mut g = g0;
+    while g < g1 {
+        let gb = (g + BATCH / 2).min(g1);
+        let (ra, rb) = (group_rows[g] as usize, group_rows[gb] as usize);
+        let out = &mut buf[..rb - ra];
+        sums(g, gb, out);
+        f(ra, out);
+        g = gb;
+    }
+}
+
 /// The first group of each chunk of n rows, then the number of groups.
 pub(crate) fn chunk_groups(group_rows: &[u32], n: usize) -> Vec<u32> {
     let groups = group_rows.len() - 1;
@@ -904,18 +930,9 @@ impl Compact {
         impl<F: FnMut(usize, &[f64])> Kernel<()> for Batches<'_, F> {
             #[inline(always)]
             fn run<B: Blocks>(self, k: &Compact, b: &B) {
-                let Batches(c, x, mut f) = self;
-                let (g0, g1) = (k.chunk_groups[c] as usize, k.chunk_groups[c + 1] as usize);
-                let mut buf = [0.0; BATCH];
-                let mut g = g0;
-                while g < g1 {
-                    let gb = (g + BATCH / 2).min(g1);
-                    let (ra, rb) = (k.group_rows[g] as usize, k.group_rows[gb] as usize);
-                    let out = &mut buf[..rb - ra];
-                    k.groups_into(b, g, gb, x, out);
-                    f(ra, out);
-                    g = gb;
-                }
+                let Batches(c, x, f) = self;
+                let sums = |g: usize, gb: usize, out: &mut [f64]| k.groups_into(b, g, gb, x, out);
+                group_batches(&k.chunk_groups, &k.group_rows, c, sums, f);
             }
         }
         self.with_blocks(Batches(c, x, f))

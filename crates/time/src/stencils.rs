@@ -25,7 +25,7 @@ use std::collections::HashMap;
 
 use nalgebra_sparse::CsrMatrix;
 
-use crate::kernels::{self, RowProduct, BATCH};
+use crate::kernels::{self, RowProduct};
 
 /// Block values within this fraction of max |K_ij| of a type's are the
 /// type's (measured: the Q1 and Q2 slabs' stencils spread by up to ~1e-13
@@ -176,22 +176,18 @@ impl Stencils {
     fn build_units(&mut self) {
         let groups = self.types.len();
         let mut index: HashMap<(u32, u32), u32> = HashMap::new();
-        self.unit_of = vec![NO_UNIT; groups];
+        let mut unit_of = vec![NO_UNIT; groups];
+        let (mut blocks, mut offsets, mut values) = (vec![0u32], Vec::new(), Vec::new());
         for g in 0..groups.saturating_sub(1) {
             let r = self.group_rows[g];
             if self.group_rows[g + 1] != r + 2 || self.group_rows[g + 2] != r + 4 {
                 continue;
             }
             let key = (self.types[g], self.types[g + 1]);
-            let next = (self.unit_blocks.len() - 1) as u32;
+            let next = (blocks.len() - 1) as u32;
             let u = *index.entry(key).or_insert(next);
             if u == next {
-                let block = |t: u32| {
-                    let b = self.type_blocks[t as usize] as usize
-                        ..self.type_blocks[t as usize + 1] as usize;
-                    (&self.offsets[b.clone()], &self.values[b])
-                };
-                let ((oa, va), (ob, vb)) = (block(key.0), block(key.1));
+                let ((oa, va), (ob, vb)) = (self.stencil(key.0), self.stencil(key.1));
                 let (mut i, mut j) = (0, 0);
                 while i < oa.len() || j < ob.len() {
                     let o = match (oa.get(i), ob.get(j)) {
@@ -210,14 +206,22 @@ impl Stencils {
                         b = vb[j];
                         j += 1;
                     }
-                    self.unit_offsets.push(o);
-                    self.unit_values
-                        .push([[a[0], a[1], b[0], b[1]], [a[2], a[3], b[2], b[3]]]);
+                    offsets.push(o);
+                    values.push([[a[0], a[1], b[0], b[1]], [a[2], a[3], b[2], b[3]]]);
                 }
-                self.unit_blocks.push(self.unit_offsets.len() as u32);
+                blocks.push(offsets.len() as u32);
             }
-            self.unit_of[g] = u;
+            unit_of[g] = u;
         }
+        (self.unit_of, self.unit_blocks) = (unit_of, blocks);
+        (self.unit_offsets, self.unit_values) = (offsets, values);
+    }
+
+    /// Type t's blocks: offsets and values.
+    #[inline(always)]
+    fn stencil(&self, t: u32) -> (&[i32], &[[f64; 4]]) {
+        let b = self.type_blocks[t as usize] as usize..self.type_blocks[t as usize + 1] as usize;
+        (&self.offsets[b.clone()], &self.values[b])
     }
 
     /// Distinct stencils.
@@ -238,17 +242,33 @@ impl Stencils {
     /// the adder's latency); the order every kernel here keeps.
     #[inline(always)]
     fn lockstep<const G: usize>(&self, g: usize, x: &[f64]) -> [[f64; 2]; G] {
-        let t = self.types[g] as usize;
         let r: [isize; G] = std::array::from_fn(|q| self.group_rows[g + q] as isize);
-        let b = self.type_blocks[t] as usize..self.type_blocks[t + 1] as usize;
+        let (offsets, values) = self.stencil(self.types[g]);
         let mut s = [[[0.0; 2]; 2]; G];
-        for (&o, v) in self.offsets[b.clone()].iter().zip(&self.values[b]) {
+        for (&o, v) in offsets.iter().zip(values) {
             let o = o as isize;
             for q in 0..G {
                 split_block((r[q] + o) as usize, v, x, &mut s[q]);
             }
         }
         s.map(|[lo, hi]| [lo[0] + hi[0], lo[1] + hi[1]])
+    }
+
+    /// The blocks of the unit that groups g..g + 4 (below g1) form twice,
+    /// when they do and its padded lanes read inside x (of length n; near
+    /// the first and last rows they may not); `None` otherwise.
+    #[inline(always)]
+    fn unit_run(&self, g: usize, g1: usize, n: usize) -> Option<std::ops::Range<usize>> {
+        let u = *self.unit_of.get(g)?;
+        if u == NO_UNIT || g + 4 > g1 || self.unit_of[g + 2] != u {
+            return None;
+        }
+        let b = self.unit_blocks[u as usize] as usize..self.unit_blocks[u as usize + 1] as usize;
+        let r = self.group_rows[g] as isize;
+        let inside = !b.is_empty()
+            && r + self.unit_offsets[b.start] as isize >= 0
+            && r + self.unit_offsets[b.end - 1] as isize + 8 <= n as isize;
+        inside.then_some(b)
     }
 
     /// K x on the rows of groups g0..g1 into `out` (from g0's first row).
@@ -266,21 +286,10 @@ impl Stencils {
         while g < g1 {
             let t = self.types[g];
             let alike = |k: usize| g + k <= g1 && self.types[g + 1..g + k].iter().all(|&u| u == t);
-            let u = self.unit_of.get(g).copied().unwrap_or(NO_UNIT);
-            let b = if u != NO_UNIT && g + 4 <= g1 && self.unit_of[g + 2] == u {
-                self.unit_blocks[u as usize] as usize..self.unit_blocks[u as usize + 1] as usize
-            } else {
-                0..0
-            };
-            let r = self.group_rows[g] as usize;
-            // The padded lanes read x too: in range near the first and
-            // last rows?
-            let inside = !b.is_empty()
-                && r as isize + self.unit_offsets[b.start] as isize >= 0
-                && r as isize + self.unit_offsets[b.end - 1] as isize + 8 <= x.len() as isize;
-            if inside {
+            if let Some(b) = self.unit_run(g, g1, x.len()) {
                 // Two alike units on consecutive rows: four node pairs of
                 // one type (Q1) or of two types in turn (a Q2 node row).
+                let r = self.group_rows[g] as usize;
                 let sums = avx::units(&self.unit_offsets[b.clone()], &self.unit_values[b], r, x);
                 for (q, s) in sums.into_iter().enumerate() {
                     put(g + q, s);
@@ -387,21 +396,9 @@ mod avx {
 
 impl RowProduct for Stencils {
     #[inline]
-    fn chunk_batches(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, &[f64])) {
-        let (g0, g1) = (
-            self.chunk_groups[c] as usize,
-            self.chunk_groups[c + 1] as usize,
-        );
-        let mut buf = [0.0; BATCH];
-        let mut g = g0;
-        while g < g1 {
-            let gb = (g + BATCH / 2).min(g1);
-            let (ra, rb) = (self.group_rows[g] as usize, self.group_rows[gb] as usize);
-            let out = &mut buf[..rb - ra];
-            self.groups_into(g, gb, x, out);
-            f(ra, out);
-            g = gb;
-        }
+    fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64])) {
+        let sums = |g: usize, gb: usize, out: &mut [f64]| self.groups_into(g, gb, x, out);
+        kernels::group_batches(&self.chunk_groups, &self.group_rows, c, sums, f);
     }
 
     fn row(&self, i: usize, x: &[f64]) -> f64 {
