@@ -2478,4 +2478,127 @@ pub(crate) mod tests {
             }
         }
     }
+
+    /// Where the explicit step's time goes on a large structured mesh: K·x
+    /// by stencil types alone, the sweep's vector work alone (K r_K handed
+    /// in: 8 streams, no product) and the one sweep; 2 threads, median
+    /// (fastest) of 20 interleaved rounds, ms. Run by hand:
+    ///
+    ///     cargo test --release -p stickslip-time --lib sweep_lab -- --ignored --nocapture
+    ///
+    /// (STICKSLIP_LAB_MESHES, default q1-1416x354,q2-708x177.) Measured
+    /// 2026-11-24 04:20-04:35, release, this 2-core machine:
+    ///
+    /// | mesh (free DOFs)       | K·x         | vectors     | sweep       |
+    /// |------------------------|-------------|-------------|-------------|
+    /// | Q1 354×88 (62,746)     | 0.108-0.150 | 0.053-0.065 | 0.224-0.237 |
+    /// | Q1 708×177 (251,517)   | 0.617       | 0.426       | 1.163       |
+    /// | Q1 1416×354 (1,004,298)| 1.92-2.47   | 1.72-2.79   | 4.24-4.87   |
+    /// | Q2 708×177 (1,004,298) | 3.86        | 2.64        | 6.52        |
+    ///
+    /// The sweep costs about the sum of its parts (in cache too, at 62k
+    /// DOFs), so the product's arithmetic and the vectors' memory traffic
+    /// do not overlap; the vector part alone moves its 8 streams at
+    /// 23-37 GB/s, near the STREAM triad. Prefetching the next batch's
+    /// m, ṙ, r̈ (and its three output rows) while the batch's K r_K is
+    /// formed, one to four batches ahead, measured no faster (Q1 1M sweep
+    /// 4.28-5.57 with against 4.62-5.29 ms without) and was not kept. A
+    /// standalone loop of the sweep's 7 streams with its division and no
+    /// product runs at 80-85% of the triad (2.0 ms at 1M rows): 50% of
+    /// STREAM for the whole step needs the product hidden under the
+    /// traffic, or about half its arithmetic.
+    #[test]
+    #[ignore = "timing; run by hand (see the doc comment)"]
+    fn sweep_lab() {
+        use std::time::Instant;
+        use stickslip_fem::testing::rectangle;
+        use stickslip_mesh::CellKind;
+
+        let meshes = std::env::var("STICKSLIP_LAB_MESHES")
+            .unwrap_or_else(|_| "q1-1416x354,q2-708x177".into());
+        for name in meshes.split(',') {
+            let (order, size) = name.split_once('-').unwrap();
+            let (nx, ny) = size.split_once('x').unwrap();
+            let kind = if order == "q2" {
+                CellKind::Quad9
+            } else {
+                CellKind::Quad4
+            };
+            let mesh = rectangle(
+                kind,
+                nx.parse().unwrap(),
+                ny.parse().unwrap(),
+                [0.0, 0.0],
+                [8.0, 1.0],
+            );
+            let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+            let supports = [
+                Dirichlet::new("top", 1, 0.0),
+                Dirichlet::new("left", 0, 0.0),
+            ];
+            let model = Model::new(&mesh, &material, &supports).unwrap();
+            drop(mesh);
+            let n = model.stiffness.nrows();
+            let stencils = Stencils::new(&model.stiffness).expect("structured");
+            drop(model);
+            let x = x_of(n);
+            let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
+            let (rn, m, v, a) = (w(1.3), w(1.2), w(1.5), w(1.6));
+            let zero = vec![0.0; n];
+            let mut ku = vec![0.0; n];
+            let data = StepData {
+                load_new: &zero,
+                load_rows: &[],
+                mass: &m,
+                r_new: &rn,
+                v: &v,
+                a: &a,
+                cv: 2e3,
+                ca: 1.0,
+                scale: 2e3,
+                ratio: 1.0,
+                next: (1e-3, 0.5e-6),
+            };
+            let labels = ["K·x", "vectors (K·x given)", "sweep"];
+            let mut t: [Vec<f64>; 3] = Default::default();
+            on_threads(2, || {
+                let mut p = partials(n);
+                let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+                for _ in 0..20 {
+                    let s = Instant::now();
+                    stencils.spmv(&rn, &mut ku);
+                    t[0].push(s.elapsed().as_secs_f64());
+                    // K r_K handed in runs the vector work on the calling
+                    // thread in one chunk: split it over the pool as the
+                    // sweep is.
+                    let s = Instant::now();
+                    each_chunk_triple([&mut vn, &mut an, &mut rx], &mut p, |c, [vn, an, rx], _| {
+                        let start = c * CHUNK;
+                        let mut run = Running {
+                            strain: 0.0,
+                            kinetic: 0.0,
+                            finite: true,
+                            load: 0,
+                            friction: 0,
+                        };
+                        let ku = &ku[start..start + vn.len()];
+                        batch_rows(&data, &[], start, ku, vn, an, rx, &mut run);
+                    });
+                    t[1].push(s.elapsed().as_secs_f64());
+                    let s = Instant::now();
+                    lab_sweep(&stencils, &data, [&mut vn, &mut an, &mut rx], &mut p);
+                    t[2].push(s.elapsed().as_secs_f64());
+                }
+            });
+            println!("{name}: n = {n}, {} stencil types", stencils.types());
+            for (label, t) in labels.iter().zip(&mut t) {
+                t.sort_by(f64::total_cmp);
+                println!(
+                    "  {label:<22} {:7.3} ({:.3}) ms",
+                    1e3 * t[t.len() / 2],
+                    1e3 * t[0]
+                );
+            }
+        }
+    }
 }
