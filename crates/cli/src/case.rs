@@ -262,9 +262,8 @@ pub struct OutputSection {
     pub flush_every: usize,
     /// ... and at least every this many seconds (default 5).
     pub flush_seconds: f64,
-    /// Deflate level of the growing datasets, 0 (none) to 9 (default 4).
-    /// Deflate costs about 85 ms per record on 100k nodes, no compression
-    /// 1.4 ms (output.rs, `write_speed`).
+    /// Deflate level of the growing datasets, 0 (none, the default) to 9
+    /// (output.rs, `DEFLATE_LEVEL`: deflate costs more than the run).
     pub compression: u8,
 }
 
@@ -1217,12 +1216,16 @@ fn convert(
             format!("output.flush_seconds = {flush_seconds} must be > 0 (seconds between flushes; default 5)"),
         );
     }
-    let compression = raw.output.compression.as_ref().map_or(4, |e| *e.get_ref());
+    let compression = raw
+        .output
+        .compression
+        .as_ref()
+        .map_or(u64::from(crate::output::DEFLATE_LEVEL), |e| *e.get_ref());
     if let Some(e) = &raw.output.compression {
         check(
             compression <= 9,
             e.span(),
-            format!("output.compression = {compression} must be 0 (none) to 9 (deflate level; default 4)"),
+            format!("output.compression = {compression} must be 0 (none) to 9 (deflate level; default 0)"),
         );
     }
     let out_file = match &raw.output.file {

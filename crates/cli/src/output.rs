@@ -2,8 +2,10 @@
 //!
 //! The file is created with the mesh and the contact surface, then grows by
 //! one row per output step in every time-dependent dataset (unlimited first
-//! dimension, chunked along time, shuffle + deflate unless `compression` is
-//! 0). It is flushed every [`ResultsWriter::flush_every_steps`] appends or
+//! dimension, chunked along time; shuffle + deflate when `compression` is
+//! 1-9, none by default). Rows are kept in memory up to the end of a chunk
+//! along time and written as one block per dataset ([`Pending`]), and
+//! always before a flush. It is flushed every [`ResultsWriter::flush_every_steps`] appends or
 //! [`ResultsWriter::flush_every_secs`] seconds (or when the run says so,
 //! with a checkpoint), so a run that stops early leaves a readable file with
 //! `complete = false`; [`ResultsWriter::finish`] writes the solver summary
@@ -115,14 +117,94 @@ struct ContactSeries {
     state: Dataset,
 }
 
+/// Rows appended since the last write into the datasets, row after row.
+///
+/// Writing each row as it comes costs about 30 HDF5 calls a row (a resize
+/// and a hyperslab write per dataset), which on small meshes is most of a
+/// run: the paper's slab, 501 rows, 0.12-0.13 s a run of which the steps
+/// are about 1 ms (2026-11-24). Rows are kept here and written one block
+/// per dataset when the row count reaches the end of a chunk along time
+/// (so a chunk is compressed once, whole), and before every flush,
+/// checkpoint and the end of the run, so a flushed file holds every row
+/// appended before the flush. At most one chunk of rows per dataset
+/// (≤ 1 MiB each, [`chunk_rows`]).
+#[derive(Debug, Default)]
+struct Pending {
+    rows: usize,
+    time: Vec<f64>,
+    displacement: Vec<f64>,
+    velocity: Vec<f64>,
+    acceleration: Vec<f64>,
+    friction_stress: Vec<f64>,
+    slip_velocity: Vec<f64>,
+    state: Vec<i8>,
+    energy: [Vec<f64>; 6],
+    dt: Vec<f64>,
+    iterations: Vec<u32>,
+}
+
+impl Pending {
+    fn push(&mut self, rec: &Record) {
+        self.rows += 1;
+        self.time.push(rec.t);
+        self.displacement.extend_from_slice(rec.displacement);
+        self.velocity.extend_from_slice(rec.velocity);
+        self.acceleration.extend_from_slice(rec.acceleration);
+        self.friction_stress.extend_from_slice(rec.friction_stress);
+        self.slip_velocity.extend_from_slice(rec.slip_velocity);
+        self.state.extend_from_slice(rec.state);
+        let e = [
+            rec.kinetic,
+            rec.strain,
+            rec.external_work,
+            rec.dissipated,
+            rec.total,
+            rec.balance,
+        ];
+        for (series, v) in self.energy.iter_mut().zip(e) {
+            series.push(v);
+        }
+        self.dt.push(rec.dt);
+        self.iterations.push(rec.iterations);
+    }
+
+    /// Empties the buffers, keeping their capacity.
+    fn clear(&mut self) {
+        self.rows = 0;
+        for v in [
+            &mut self.time,
+            &mut self.displacement,
+            &mut self.velocity,
+            &mut self.acceleration,
+            &mut self.friction_stress,
+            &mut self.slip_velocity,
+            &mut self.dt,
+        ]
+        .into_iter()
+        .chain(&mut self.energy)
+        {
+            v.clear();
+        }
+        self.state.clear();
+        self.iterations.clear();
+    }
+}
+
 /// Writes one results file as a run goes.
 #[derive(Debug)]
 pub struct ResultsWriter {
-    file: File,
+    // Fields drop in this order: the datasets close before the file.
     series: Series,
+    file: File,
     n_nodes: usize,
     n_c: usize,
+    /// Rows appended, written or still in `pending`.
     rows: usize,
+    /// Appended rows not yet in the datasets.
+    pending: Pending,
+    /// Rows per chunk of the vector fields along time: `pending` is
+    /// written when the row count reaches a multiple of it.
+    block_rows: usize,
     since_flush: usize,
     last_flush: Instant,
     /// Flush after this many appends (default 100).
@@ -189,12 +271,16 @@ fn scalar_attr<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<
     Ok(())
 }
 
-/// Deflate level of the growing datasets (after shuffle: HDF5 refuses
-/// shuffle after a compression filter, DEPENDENCIES.md §1a). Measured with
-/// the ignored test `write_speed` (100k nodes, 3 vector fields): levels 1
-/// and 4 both cost about 85 ms per record (57 MB/s, file 0.70 of raw), no
-/// compression 1.4 ms per record.
-const DEFLATE_LEVEL: u8 = 4;
+/// Deflate level of the growing datasets by default: none. Deflate (after
+/// shuffle: HDF5 refuses shuffle after a compression filter,
+/// DEPENDENCIES.md §1a) is slower than everything else a run does on the
+/// meshes measured, for files 0.7-0.85 of raw: the ignored test
+/// `write_speed` (100k nodes, 3 vector fields), levels 1 and 4 about 85 ms
+/// per record (57 MB/s), none 1.4 ms; `cargo xtask bench output`
+/// (2026-11-24): the paper's case 0.10 s a run at level 4 against 0.03 s
+/// with none, a 4,257-node Newmark run 0.75-0.82 s against 0.29-0.36 s.
+/// `output.compression = 1..9` turns it on.
+pub const DEFLATE_LEVEL: u8 = 0;
 
 /// Names of the `/energy` series, in [`Record`] order.
 const ENERGY_NAMES: [&str; 6] = [
@@ -243,6 +329,14 @@ fn series_3d(g: &Group, name: &str, n: usize, level: u8) -> Result<Dataset> {
         .chunk((rows, n, 2))
         .shape((0.., n, 2))
         .create(name)?)
+}
+
+/// Rows per chunk along time of a growing dataset (1 if it has no chunks).
+fn block_rows(d: &Dataset) -> usize {
+    d.chunk()
+        .and_then(|c| c.first().copied())
+        .unwrap_or(1)
+        .max(1)
 }
 
 /// Writes `v` into the 1-D dataset `name` of `g`, creating it (contiguous,
@@ -490,12 +584,15 @@ impl ResultsWriter {
             iterations: series_1d::<u32>(&solver, "iterations", level)?,
         };
         file.flush()?;
+        let block_rows = block_rows(&series.displacement);
         Ok(ResultsWriter {
             file,
             series,
             n_nodes,
             n_c,
             rows: 0,
+            pending: Pending::default(),
+            block_rows,
             since_flush: 0,
             last_flush: Instant::now(),
             flush_every_steps: 100,
@@ -592,12 +689,15 @@ impl ResultsWriter {
             file.delete_attr("failure")?;
         }
         file.flush()?;
+        let block_rows = block_rows(&series.displacement);
         Ok(ResultsWriter {
             file,
             series,
             n_nodes,
             n_c,
             rows,
+            pending: Pending::default(),
+            block_rows,
             since_flush: 0,
             last_flush: Instant::now(),
             flush_every_steps: 100,
@@ -643,6 +743,7 @@ impl ResultsWriter {
     /// # Errors
     /// HDF5 errors, or a state whose lengths changed since the last checkpoint.
     pub fn write_checkpoint(&mut self, cp: &Checkpoint, extra: &CheckpointExtra) -> Result<()> {
+        self.write_pending()?;
         let (cg, slot) = if self.file.link_exists("checkpoint") {
             let cg = self.file.group("checkpoint")?;
             let current: u8 = get_scalar(&cg, "slot")?;
@@ -706,13 +807,68 @@ impl ResultsWriter {
     /// # Errors
     /// HDF5 errors.
     pub fn flush(&mut self) -> Result<()> {
+        self.write_pending()?;
         self.file.flush()?;
         self.since_flush = 0;
         self.last_flush = Instant::now();
         Ok(())
     }
 
-    /// Appends one output step to every dataset.
+    /// Writes the rows in [`Pending`] into the datasets: one resize and one
+    /// hyperslab write per dataset.
+    ///
+    /// # Errors
+    /// HDF5 errors.
+    fn write_pending(&mut self) -> Result<()> {
+        let p = &self.pending;
+        let m = p.rows;
+        if m == 0 {
+            return Ok(());
+        }
+        let (n, n_c) = (self.n_nodes, self.n_c);
+        let (k0, k1) = (self.rows - m, self.rows);
+        let s = &self.series;
+        for (ds, v) in [(&s.time, &p.time), (&s.dt, &p.dt)]
+            .into_iter()
+            .chain(s.energy.iter().zip(&p.energy))
+        {
+            ds.resize(k1)?;
+            ds.write_slice(ArrayView1::from(&v[..]), s![k0..k1])?;
+        }
+        s.iterations.resize(k1)?;
+        s.iterations
+            .write_slice(ArrayView1::from(&p.iterations[..]), s![k0..k1])?;
+        for (ds, v) in [
+            (&s.displacement, &p.displacement),
+            (&s.velocity, &p.velocity),
+            (&s.acceleration, &p.acceleration),
+        ] {
+            ds.resize((k1, n, 2))?;
+            ds.write_slice(
+                ndarray::ArrayView3::from_shape((m, n, 2), &v[..])?,
+                s![k0..k1, .., ..],
+            )?;
+        }
+        if let Some(c) = &s.contact {
+            for (ds, v) in [
+                (&c.friction_stress, &p.friction_stress),
+                (&c.slip_velocity, &p.slip_velocity),
+            ] {
+                ds.resize((k1, n_c))?;
+                ds.write_slice(ArrayView2::from_shape((m, n_c), &v[..])?, s![k0..k1, ..])?;
+            }
+            c.state.resize((k1, n_c))?;
+            c.state.write_slice(
+                ArrayView2::from_shape((m, n_c), &p.state[..])?,
+                s![k0..k1, ..],
+            )?;
+        }
+        self.pending.clear();
+        Ok(())
+    }
+
+    /// Appends one output step to every dataset (written with its block:
+    /// [`Pending`]).
     ///
     /// # Errors
     /// HDF5 errors, or slices whose lengths do not match the header.
@@ -739,51 +895,11 @@ impl ResultsWriter {
                 "record {k}: {name} has {len} values, expected {n_c} contact nodes"
             );
         }
-        let s = &self.series;
-        let one = |ds: &Dataset, v: &f64| -> Result<()> {
-            ds.resize(k + 1)?;
-            ds.write_slice(ArrayView1::from(std::slice::from_ref(v)), s![k..k + 1])?;
-            Ok(())
-        };
-        one(&s.time, &rec.t)?;
-        for (ds, v) in [
-            (&s.displacement, rec.displacement),
-            (&s.velocity, rec.velocity),
-            (&s.acceleration, rec.acceleration),
-        ] {
-            ds.resize((k + 1, n, 2))?;
-            ds.write_slice(ArrayView2::from_shape((n, 2), v)?, s![k, .., ..])?;
-        }
-        if let Some(c) = &s.contact {
-            c.friction_stress.resize((k + 1, n_c))?;
-            c.friction_stress
-                .write_slice(ArrayView1::from(rec.friction_stress), s![k, ..])?;
-            c.slip_velocity.resize((k + 1, n_c))?;
-            c.slip_velocity
-                .write_slice(ArrayView1::from(rec.slip_velocity), s![k, ..])?;
-            c.state.resize((k + 1, n_c))?;
-            c.state
-                .write_slice(ArrayView1::from(rec.state), s![k, ..])?;
-        }
-        let e = [
-            rec.kinetic,
-            rec.strain,
-            rec.external_work,
-            rec.dissipated,
-            rec.total,
-            rec.balance,
-        ];
-        for (ds, v) in s.energy.iter().zip(&e) {
-            one(ds, v)?;
-        }
-        one(&s.dt, &rec.dt)?;
-        s.iterations.resize(k + 1)?;
-        s.iterations.write_slice(
-            ArrayView1::from(std::slice::from_ref(&rec.iterations)),
-            s![k..k + 1],
-        )?;
-
+        self.pending.push(rec);
         self.rows += 1;
+        if self.rows % self.block_rows == 0 {
+            self.write_pending()?;
+        }
         if self.auto_flush {
             self.since_flush += 1;
             if self.flush_due() {
@@ -799,7 +915,8 @@ impl ResultsWriter {
     ///
     /// # Errors
     /// HDF5 errors.
-    pub fn finish(self, complete: bool, summary: &Summary) -> Result<()> {
+    pub fn finish(mut self, complete: bool, summary: &Summary) -> Result<()> {
+        self.write_pending()?;
         let solver = self.file.group("solver")?;
         put_scalar(&solver, "wall_time_s", summary.wall_time_s)?;
         put_scalar(&solver, "steps", summary.steps)?;
@@ -818,10 +935,18 @@ impl ResultsWriter {
             string_attr(&self.file, "failure", f)?;
         }
         self.file.attr("complete")?.write_scalar(&complete)?;
+        // On disk now; dropping the writer closes the datasets, then the file.
         self.file.flush()?;
-        drop(self.series);
-        self.file.close()?;
         Ok(())
+    }
+}
+
+impl Drop for ResultsWriter {
+    /// A writer dropped without [`ResultsWriter::finish`] (a run that
+    /// errors out) still writes the rows appended to it; the file then
+    /// says `complete = false`.
+    fn drop(&mut self) {
+        let _ = self.write_pending();
     }
 }
 
@@ -900,7 +1025,9 @@ pub(crate) mod tests {
             contact_nodes: &[0, 1, 2],
             contact_s: &[0.0, 1.0, 2.0],
         };
-        let mut w = ResultsWriter::create(path, &header).unwrap();
+        // Compressed, so that the filters' path is the one read back (the
+        // default is none: `default_output_is_unfiltered`).
+        let mut w = ResultsWriter::create_with(path, &header, 4).unwrap();
         let mut d = vec![0.0; 12];
         let mut v = vec![0.0; 12];
         let mut a = vec![0.0; 12];
@@ -945,6 +1072,22 @@ pub(crate) mod tests {
                 },
             )
             .unwrap();
+        }
+    }
+
+    /// A header for `mesh` with no case text, with the tiny mesh's contact
+    /// line (nodes 0, 1, 2) or none.
+    fn test_header(mesh: &Mesh, contact: bool) -> Header<'_> {
+        let (nodes, s): (&[usize], &[f64]) = if contact {
+            (&[0, 1, 2], &[0.0, 1.0, 2.0])
+        } else {
+            (&[], &[])
+        };
+        Header {
+            case_source: "",
+            mesh,
+            contact_nodes: nodes,
+            contact_s: s,
         }
     }
 
@@ -1149,6 +1292,108 @@ pub(crate) mod tests {
         std::fs::remove_file(&path).ok();
     }
 
+    /// Rows go to the datasets in blocks (a chunk's worth, 16 rows for this
+    /// mesh, and at every flush): every row appended is in the file, in
+    /// order, across chunk ends, flushes between them and a writer dropped
+    /// without finish.
+    #[test]
+    fn buffered_rows_all_reach_the_file() {
+        let _guard = h5_lock();
+        let path = scratch("blocks");
+        let mesh = tiny_mesh();
+        let header = test_header(&mesh, true);
+        let rows = 41;
+        {
+            let mut w = ResultsWriter::create(&path, &header).unwrap();
+            assert_eq!(w.block_rows, 16);
+            w.flush_every_steps = 7;
+            w.flush_every_secs = f64::INFINITY;
+            for k in 0..rows {
+                let d: Vec<f64> = (0..12).map(|i| u(k, i)).collect();
+                let fs = [k as f64, -(k as f64), 0.5];
+                let st: [i8; 3] = [(k % 3) as i8 - 1, 0, 1];
+                w.append(&Record {
+                    t: k as f64,
+                    displacement: &d,
+                    velocity: &d,
+                    acceleration: &d,
+                    friction_stress: &fs,
+                    slip_velocity: &fs,
+                    state: &st,
+                    kinetic: k as f64,
+                    strain: 0.0,
+                    external_work: 0.0,
+                    dissipated: 0.0,
+                    total: 0.0,
+                    balance: 0.0,
+                    dt: 0.5,
+                    iterations: k as u32,
+                })
+                .unwrap();
+                if k == 20 {
+                    // Flushed rows are readable while the writer goes on.
+                    let f = File::open(&path).unwrap();
+                    assert_eq!(f.dataset("time").unwrap().shape(), vec![21]);
+                }
+            }
+            // Dropped here after 41 rows, the last flush at 35.
+        }
+        let f = File::open(&path).unwrap();
+        let time = f.dataset("time").unwrap().read_1d::<f64>().unwrap();
+        assert_eq!(
+            time.to_vec(),
+            (0..rows).map(|k| k as f64).collect::<Vec<_>>()
+        );
+        let d = f
+            .dataset("displacement")
+            .unwrap()
+            .read_dyn::<f64>()
+            .unwrap();
+        assert_eq!(d.shape(), [rows, 6, 2]);
+        for k in 0..rows {
+            for i in 0..12 {
+                assert_eq!(d[[k, i / 2, i % 2]], u(k, i), "row {k}, value {i}");
+            }
+        }
+        let st = f.dataset("contact/state").unwrap().read_2d::<i8>().unwrap();
+        let fs = f
+            .dataset("contact/friction_stress")
+            .unwrap()
+            .read_2d::<f64>()
+            .unwrap();
+        let it = f
+            .dataset("solver/iterations")
+            .unwrap()
+            .read_1d::<u32>()
+            .unwrap();
+        for k in 0..rows {
+            assert_eq!(st[[k, 0]], (k % 3) as i8 - 1, "row {k}");
+            assert_eq!(fs[[k, 1]], -(k as f64), "row {k}");
+            assert_eq!(it[k], k as u32, "row {k}");
+        }
+        assert!(!f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
+        drop(f);
+        std::fs::remove_file(&path).ok();
+    }
+
+    /// The default writes no filter (deflate costs more than the run on the
+    /// meshes measured: [`DEFLATE_LEVEL`]).
+    #[test]
+    fn default_output_is_unfiltered() {
+        let _guard = h5_lock();
+        let path = scratch("unfiltered");
+        let mesh = tiny_mesh();
+        let header = test_header(&mesh, false);
+        let w = ResultsWriter::create(&path, &header).unwrap();
+        w.finish(true, &Summary::default()).unwrap();
+        let f = File::open(&path).unwrap();
+        let d = f.dataset("displacement").unwrap();
+        assert_eq!(d.chunk().unwrap()[1..], [6, 2]);
+        assert!(d.filters().is_empty(), "{:?}", d.filters());
+        drop(f);
+        std::fs::remove_file(&path).ok();
+    }
+
     #[test]
     fn unfinished_file_is_readable_and_incomplete() {
         let _guard = h5_lock();
@@ -1179,12 +1424,7 @@ pub(crate) mod tests {
         let _guard = h5_lock();
         let path = scratch("lengths");
         let mesh = tiny_mesh();
-        let header = Header {
-            case_source: "",
-            mesh: &mesh,
-            contact_nodes: &[],
-            contact_s: &[],
-        };
+        let header = test_header(&mesh, false);
         let mut w = ResultsWriter::create(&path, &header).unwrap();
         let z = vec![0.0; 12];
         let mut rec = Record {
@@ -1229,12 +1469,7 @@ pub(crate) mod tests {
         let _guard = h5_lock();
         let path = scratch("midrun");
         let mesh = tiny_mesh();
-        let header = Header {
-            case_source: "",
-            mesh: &mesh,
-            contact_nodes: &[],
-            contact_s: &[],
-        };
+        let header = test_header(&mesh, false);
         let mut w = ResultsWriter::create(&path, &header).unwrap();
         w.flush_every_steps = 2;
         w.flush_every_secs = f64::INFINITY;
@@ -1291,12 +1526,7 @@ pub(crate) mod tests {
         mesh.nodes = (0..n).map(|i| [(i % nx) as f64, (i / nx) as f64]).collect();
         mesh.node_tags = (1..=n as u64).collect();
         let path = scratch("speed");
-        let header = Header {
-            case_source: "",
-            mesh: &mesh,
-            contact_nodes: &[],
-            contact_s: &[],
-        };
+        let header = test_header(&mesh, false);
         let mut w = ResultsWriter::create(&path, &header).unwrap();
         let mut d: Vec<f64> = (0..2 * n).map(|i| (i as f64 * 1e-3).sin()).collect();
         let steps = 50;
