@@ -9,6 +9,7 @@ use std::process::{Command, ExitCode};
 
 mod bench_fem;
 mod bench_mesh;
+mod bench_output;
 mod bench_step;
 mod meshes;
 mod python;
@@ -40,6 +41,8 @@ usage: cargo xtask <command> [args]
                     the STREAM bandwidth and one forward+back solve
   bench fem         assembly and Cholesky on the Q2 slab ladder against
                     scikit-fem and scipy's splu (--refine 8,16,32,64 --no-peer)
+  bench output      wall time of whole runs (paper slab, a 4k-node slab) with
+                    their results written uncompressed, deflated, or not at all
 ";
 
 fn main() -> ExitCode {
@@ -65,8 +68,9 @@ fn main() -> ExitCode {
             Some((what, more)) if what == "mesh" => bench_mesh::run(&root, more),
             Some((what, more)) if what == "fem" => bench_fem::run(&root, more),
             Some((what, more)) if what == "step" => bench_step::run(&root, more),
+            Some((what, more)) if what == "output" => bench_output::run(&root, more),
             _ => Err(format!(
-                "cargo xtask bench: say what to benchmark (mesh, fem, step)\n{USAGE}"
+                "cargo xtask bench: say what to benchmark (mesh, fem, step, output)\n{USAGE}"
             )),
         },
         "help" | "--help" | "-h" => {
@@ -114,7 +118,7 @@ fn describe(cmd: &Command) -> String {
     s
 }
 
-fn cargo() -> Command {
+pub(crate) fn cargo() -> Command {
     Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
 }
 
@@ -131,7 +135,7 @@ fn hdf5_present() -> bool {
 
 /// Installs libhdf5-dev (and h5py/numpy for the tests' Python checks)
 /// when missing, saying so.
-fn setup(python_too: bool) -> Result<(), String> {
+pub(crate) fn setup(python_too: bool) -> Result<(), String> {
     if hdf5_present() {
         eprintln!("setup: HDF5 development files found");
     } else {
