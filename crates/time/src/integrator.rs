@@ -12,7 +12,7 @@ use crate::linalg::{
     PairBlocks,
 };
 use crate::schur::{ImplicitSolver, SchurOperator};
-use crate::stability::critical_step;
+use crate::stability::{critical_step, critical_step_with};
 
 /// The semi-discrete system on free DOFs: K, M (consistent, with K's
 /// sparsity pattern), the HRZ lumped mass, and loads that never change
@@ -508,10 +508,36 @@ impl Integrator {
         // A scene without friction nodes runs no friction code.
         let contact = contact.filter(|c| !c.is_empty());
         let explicit = beta == 0.0 && mass_kind == MassKind::Lumped;
-        let dt_crit = if explicit {
-            Some(critical_step(&dynamics.stiffness, &dynamics.lumped_mass))
+        // The explicit step reads K only through its stencil types
+        // (structured numbering), its element classes (structured Q2 cells)
+        // or its compact form (0.57× the CSR's bytes per step), the fastest
+        // that applies (kernels.rs); built first, so that the critical
+        // step's Lanczos runs on it too (its ~300 products were most of an
+        // explicit run's setup on large meshes).
+        let product = if explicit {
+            let classes = dynamics.element_classes.take();
+            (dynamics.stencils)
+                .then(|| kernels::Stencils::new(&dynamics.stiffness))
+                .flatten()
+                .map(kernels::Product::Stencils)
+                .or_else(|| {
+                    classes
+                        .and_then(kernels::Classes::new)
+                        .map(kernels::Product::Classes)
+                })
+                .or_else(|| {
+                    kernels::Compact::new(&dynamics.stiffness).map(kernels::Product::Compact)
+                })
         } else {
             None
+        };
+        let dt_crit = match (&product, explicit) {
+            (Some(k), _) => Some(critical_step_with(
+                |x, y| k.spmv(x, y),
+                &dynamics.lumped_mass,
+            )),
+            (None, true) => Some(critical_step(&dynamics.stiffness, &dynamics.lumped_mass)),
+            (None, false) => None,
         };
         if let Some(crit) = dt_crit {
             if settings.dt > crit && !settings.allow_unstable {
@@ -688,23 +714,8 @@ impl Integrator {
         };
         if this.explicit {
             // From here on the explicit step reads K only through its
-            // stencil types (structured numbering), its element classes
-            // (structured Q2 cells) or its compact form (0.57× the CSR's
-            // bytes per step), the fastest that applies (kernels.rs), and
-            // the CSR's memory is returned.
-            let classes = this.dynamics.element_classes.take();
-            this.product = (this.dynamics.stencils)
-                .then(|| kernels::Stencils::new(&this.dynamics.stiffness))
-                .flatten()
-                .map(kernels::Product::Stencils)
-                .or_else(|| {
-                    classes
-                        .and_then(kernels::Classes::new)
-                        .map(kernels::Product::Classes)
-                })
-                .or_else(|| {
-                    kernels::Compact::new(&this.dynamics.stiffness).map(kernels::Product::Compact)
-                });
+            // product (built above), and the CSR's memory is returned.
+            this.product = product;
             if this.product.is_some() {
                 this.dynamics.stiffness = CsrMatrix::zeros(0, 0);
                 this.r_next = vec![0.0; n];

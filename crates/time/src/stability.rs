@@ -2,6 +2,7 @@
 //! with ω_max² the largest eigenvalue of M_L⁻¹K.
 
 use nalgebra_sparse::CsrMatrix;
+use rayon::prelude::*;
 
 use crate::linalg::{dot, spmv};
 
@@ -18,6 +19,26 @@ pub fn largest_eigenvalue(
     lumped_mass: &[f64],
     max_steps: usize,
 ) -> f64 {
+    largest_eigenvalue_with(|x, y| spmv(stiffness, x, y), lumped_mass, max_steps)
+}
+
+/// Entries per chunk of the Lanczos vector passes: the chunks and the
+/// order their partial sums are added in do not depend on the threads.
+const CHUNK: usize = 8192;
+
+/// [`largest_eigenvalue`] with y = K x formed by `product` (the explicit
+/// step's own K·x: `Integrator::new`).
+///
+/// A step is the product and three passes over the vectors, threaded by
+/// fixed chunks with their sums added in chunk order (the same bits on any
+/// number of threads): with x = M^{-1/2} q and y = K x, α = yᵀx; w =
+/// M^{-1/2} y − α q − β q_prev and β² = wᵀw; then q_prev, q ← q, w/β and the
+/// next x. (α = yᵀx is qᵀM^{-1/2} K M^{-1/2} q, one pass before w exists.)
+pub fn largest_eigenvalue_with(
+    mut product: impl FnMut(&[f64], &mut [f64]),
+    lumped_mass: &[f64],
+    max_steps: usize,
+) -> f64 {
     let n = lumped_mass.len();
     if n == 0 {
         return 0.0;
@@ -28,27 +49,33 @@ pub fn largest_eigenvalue(
         .map(|i| 1.0 + ((i as f64) * 0.618_033_988_75).fract())
         .collect();
     let norm = dot(&q, &q).sqrt();
-    q.iter_mut().for_each(|x| *x /= norm);
+    q.iter_mut().for_each(|v| *v /= norm);
+    let mut x: Vec<f64> = q.iter().zip(&scale).map(|(q, s)| q * s).collect();
     let mut q_prev = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    let mut tmp = vec![0.0; n];
+    let mut y = vec![0.0; n];
+    let mut partials = vec![0.0; n.div_ceil(CHUNK)];
     let (mut alphas, mut betas) = (Vec::new(), Vec::new());
     let mut beta_prev = 0.0;
     let mut last = 0.0;
     for step in 0..max_steps.min(n) {
-        for i in 0..n {
-            tmp[i] = q[i] * scale[i];
-        }
-        spmv(stiffness, &tmp, &mut w);
-        for i in 0..n {
-            w[i] *= scale[i];
-        }
-        let alpha = dot(&w, &q);
-        for i in 0..n {
-            w[i] -= alpha * q[i] + beta_prev * q_prev[i];
-        }
+        product(&x, &mut y);
+        let alpha = chunked_sum(&mut partials, |c, p| {
+            let r = c * CHUNK..((c + 1) * CHUNK).min(n);
+            *p = dot(&y[r.clone()], &x[r]);
+        });
+        // y becomes w in place.
+        let beta = chunk_pairs(&mut y, &mut q_prev, &mut partials, |c, w, qp, p| {
+            let r = c * CHUNK..c * CHUNK + w.len();
+            let (q, s) = (&q[r.clone()], &scale[r]);
+            let mut sum = 0.0;
+            for i in 0..w.len() {
+                w[i] = w[i] * s[i] - (alpha * q[i] + beta_prev * qp[i]);
+                sum += w[i] * w[i];
+            }
+            *p = sum;
+        })
+        .sqrt();
         alphas.push(alpha);
-        let beta = dot(&w, &w).sqrt();
         if step % 5 == 4 || beta <= 1e-14 * alpha.abs() || step + 1 == max_steps.min(n) {
             let top = tridiagonal_max_eigenvalue(&alphas, &betas);
             if beta <= 1e-14 * alpha.abs() || (top - last).abs() <= 1e-12 * top.abs() {
@@ -57,13 +84,49 @@ pub fn largest_eigenvalue(
             last = top;
         }
         betas.push(beta);
-        for i in 0..n {
-            q_prev[i] = q[i];
-            q[i] = w[i] / beta;
-        }
+        // q_prev ← q, q ← w/β, x ← M^{-1/2} q.
+        std::mem::swap(&mut q_prev, &mut q);
+        let (w, s) = (&y, &scale);
+        q.par_chunks_mut(CHUNK)
+            .zip(x.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (q, x))| {
+                let r = c * CHUNK..c * CHUNK + q.len();
+                let (w, s) = (&w[r.clone()], &s[r]);
+                for i in 0..q.len() {
+                    q[i] = w[i] / beta;
+                    x[i] = q[i] * s[i];
+                }
+            });
         beta_prev = beta;
     }
     tridiagonal_max_eigenvalue(&alphas, &betas[..alphas.len().saturating_sub(1)])
+}
+
+/// Σ over chunks of `f(chunk, &mut partial)`, the partials added in chunk
+/// order.
+fn chunked_sum(partials: &mut [f64], f: impl Fn(usize, &mut f64) + Sync) -> f64 {
+    partials
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(c, p)| f(c, p));
+    partials.iter().sum()
+}
+
+/// `f(chunk, a's chunk, b's chunk, &mut partial)` over the same chunks of
+/// `a` and `b`, the partials added in chunk order.
+fn chunk_pairs(
+    a: &mut [f64],
+    b: &mut [f64],
+    partials: &mut [f64],
+    f: impl Fn(usize, &mut [f64], &mut [f64], &mut f64) + Sync,
+) -> f64 {
+    a.par_chunks_mut(CHUNK)
+        .zip(b.par_chunks_mut(CHUNK))
+        .zip(partials.par_iter_mut())
+        .enumerate()
+        .for_each(|(c, ((a, b), p))| f(c, a, b, p));
+    partials.iter().sum()
 }
 
 /// Largest eigenvalue of the symmetric tridiagonal matrix with diagonal `a`
@@ -109,7 +172,12 @@ fn tridiagonal_max_eigenvalue(a: &[f64], b: &[f64]) -> f64 {
 
 /// Δt_crit = 2/ω_max for central difference with the lumped mass.
 pub fn critical_step(stiffness: &CsrMatrix<f64>, lumped_mass: &[f64]) -> f64 {
-    let lambda = largest_eigenvalue(stiffness, lumped_mass, 300);
+    critical_step_with(|x, y| spmv(stiffness, x, y), lumped_mass)
+}
+
+/// [`critical_step`] with y = K x formed by `product`.
+pub fn critical_step_with(product: impl FnMut(&[f64], &mut [f64]), lumped_mass: &[f64]) -> f64 {
+    let lambda = largest_eigenvalue_with(product, lumped_mass, 300);
     if lambda > 0.0 {
         2.0 / lambda.sqrt()
     } else {
@@ -155,5 +223,47 @@ mod tests {
         let m4 = vec![4.0; n];
         let ratio = critical_step(&k, &m4) / critical_step(&k, &m);
         assert!((ratio - 2.0).abs() < 1e-6, "ratio {ratio}");
+    }
+
+    /// The Lanczos passes are threaded by fixed chunks: the same bits on one
+    /// thread and on two (a system of several chunks); and the estimate on
+    /// the explicit step's products (stencil types, compact blocks: within
+    /// 1e-12 of K·x) agrees with the one on the CSR to 1e-12 relative
+    /// (measured 2e-16 to 2e-14 on the slabs of 251k to 1M DOFs).
+    #[test]
+    fn threads_and_products_keep_the_estimate() {
+        use crate::kernels::RowProduct;
+        use stickslip_fem::testing::{on_threads, rectangle};
+        use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
+        use stickslip_mesh::CellKind;
+
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let supports = [
+            Dirichlet::new("top", 1, 0.0),
+            Dirichlet::new("left", 0, 0.0),
+        ];
+        for (kind, nx) in [(CellKind::Quad4, 192), (CellKind::Quad9, 96)] {
+            let mesh = rectangle(kind, nx, nx / 4, [0.0, 0.0], [8.0, 1.0]);
+            let model = Model::new(&mesh, &material, &supports).unwrap();
+            let (k, m) = (&model.stiffness, &model.lumped_mass);
+            assert!(m.len() > 2 * CHUNK, "{kind:?}: {} DOFs", m.len());
+            let one = on_threads(1, || critical_step(k, m));
+            let two = on_threads(2, || critical_step(k, m));
+            assert_eq!(one.to_bits(), two.to_bits(), "{kind:?}");
+            let stencils = crate::kernels::Stencils::new(k).expect("structured");
+            let compact = crate::kernels::Compact::new(k).expect("square");
+            for (name, dt) in [
+                (
+                    "stencils",
+                    critical_step_with(|x, y| RowProduct::spmv(&stencils, x, y), m),
+                ),
+                ("compact", critical_step_with(|x, y| compact.spmv(x, y), m)),
+            ] {
+                assert!(
+                    (dt - one).abs() <= 1e-12 * one,
+                    "{kind:?} {name}: {dt:e} against {one:e}"
+                );
+            }
+        }
     }
 }
