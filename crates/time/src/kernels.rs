@@ -1508,6 +1508,34 @@ pub(crate) mod tests {
     use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
     use stickslip_mesh::Mesh;
 
+    /// The labs' slab, named "q1-NXxNY" or "q2-NXxNY": 8 × 1, rollers on
+    /// top, held in x at the left.
+    fn lab_slab(name: &str) -> (Mesh, Material, Model) {
+        use stickslip_fem::testing::rectangle;
+        use stickslip_mesh::CellKind;
+        let (order, size) = name.split_once('-').expect("q1-NXxNY or q2-NXxNY");
+        let (nx, ny) = size.split_once('x').expect("NXxNY");
+        let kind = if order == "q2" {
+            CellKind::Quad9
+        } else {
+            CellKind::Quad4
+        };
+        let mesh = rectangle(
+            kind,
+            nx.parse().unwrap(),
+            ny.parse().unwrap(),
+            [0.0, 0.0],
+            [8.0, 1.0],
+        );
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let supports = [
+            Dirichlet::new("top", 1, 0.0),
+            Dirichlet::new("left", 0, 0.0),
+        ];
+        let model = Model::new(&mesh, &material, &supports).unwrap();
+        (mesh, material, model)
+    }
+
     /// The labs' sweep: no friction, K r_K formed in the sweep.
     fn lab_sweep<K: RowProduct>(
         k: &K,
@@ -2307,9 +2335,7 @@ pub(crate) mod tests {
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn class_lab() {
         use std::time::Instant;
-        use stickslip_fem::testing::rectangle;
         use stickslip_fem::ElementClasses;
-        use stickslip_mesh::CellKind;
 
         let meshes = std::env::var("STICKSLIP_LAB_MESHES")
             .unwrap_or_else(|_| "q1-1416x354,q2-352x88,q2-708x177".into());
@@ -2320,26 +2346,7 @@ pub(crate) mod tests {
                 .trim()
         );
         for name in meshes.split(',') {
-            let (order, size) = name.split_once('-').unwrap();
-            let (nx, ny) = size.split_once('x').unwrap();
-            let kind = if order == "q2" {
-                CellKind::Quad9
-            } else {
-                CellKind::Quad4
-            };
-            let mesh = rectangle(
-                kind,
-                nx.parse().unwrap(),
-                ny.parse().unwrap(),
-                [0.0, 0.0],
-                [8.0, 1.0],
-            );
-            let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
-            let supports = [
-                Dirichlet::new("top", 1, 0.0),
-                Dirichlet::new("left", 0, 0.0),
-            ];
-            let model = Model::new(&mesh, &material, &supports).unwrap();
+            let (mesh, material, model) = lab_slab(name);
             let k = &model.stiffness;
             let n = k.nrows();
             let t0 = Instant::now();
@@ -2511,33 +2518,11 @@ pub(crate) mod tests {
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn sweep_lab() {
         use std::time::Instant;
-        use stickslip_fem::testing::rectangle;
-        use stickslip_mesh::CellKind;
 
         let meshes = std::env::var("STICKSLIP_LAB_MESHES")
             .unwrap_or_else(|_| "q1-1416x354,q2-708x177".into());
         for name in meshes.split(',') {
-            let (order, size) = name.split_once('-').unwrap();
-            let (nx, ny) = size.split_once('x').unwrap();
-            let kind = if order == "q2" {
-                CellKind::Quad9
-            } else {
-                CellKind::Quad4
-            };
-            let mesh = rectangle(
-                kind,
-                nx.parse().unwrap(),
-                ny.parse().unwrap(),
-                [0.0, 0.0],
-                [8.0, 1.0],
-            );
-            let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
-            let supports = [
-                Dirichlet::new("top", 1, 0.0),
-                Dirichlet::new("left", 0, 0.0),
-            ];
-            let model = Model::new(&mesh, &material, &supports).unwrap();
-            drop(mesh);
+            let (_, _, model) = lab_slab(name);
             let n = model.stiffness.nrows();
             let stencils = Stencils::new(&model.stiffness).expect("structured");
             drop(model);
