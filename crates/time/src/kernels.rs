@@ -194,7 +194,7 @@ pub(crate) fn each_chunk(y: &mut [f64], body: impl Fn(usize, &mut [f64]) + Sync)
 }
 
 /// [`each_chunk`] with the chunk's partial sums.
-fn each_chunk_summed(
+pub(crate) fn each_chunk_summed(
     y: &mut [f64],
     partials: &mut Partials,
     body: impl Fn(usize, &mut [f64], &mut [f64; 5]) + Sync,
@@ -213,7 +213,7 @@ fn each_chunk_summed(
 }
 
 /// [`each_chunk_summed`] over the same chunks of two vectors.
-fn each_chunk_pair(
+pub(crate) fn each_chunk_pair(
     y: &mut [f64],
     z: &mut [f64],
     partials: &mut Partials,
@@ -285,7 +285,7 @@ pub fn partials(n: usize) -> Partials {
     vec![[0.0; 5]; chunks(n)]
 }
 
-fn total(partials: &[[f64; 5]], k: usize) -> f64 {
+pub(crate) fn total(partials: &[[f64; 5]], k: usize) -> f64 {
     partials.iter().map(|p| p[k]).sum()
 }
 

@@ -2,8 +2,8 @@
 //! with ω_max² the largest eigenvalue of M_L⁻¹K.
 
 use nalgebra_sparse::CsrMatrix;
-use rayon::prelude::*;
 
+use crate::kernels::{each_chunk_pair, each_chunk_summed, partials, total, CHUNK};
 use crate::linalg::{dot, spmv};
 
 /// Largest eigenvalue of M⁻¹K for a diagonal (lumped) mass, by Lanczos on
@@ -22,16 +22,12 @@ pub fn largest_eigenvalue(
     largest_eigenvalue_with(|x, y| spmv(stiffness, x, y), lumped_mass, max_steps)
 }
 
-/// Entries per chunk of the Lanczos vector passes: the chunks and the
-/// order their partial sums are added in do not depend on the threads.
-const CHUNK: usize = 8192;
-
 /// [`largest_eigenvalue`] with y = K x formed by `product` (the explicit
 /// step's own K·x: `Integrator::new`).
 ///
 /// A step is the product and three passes over the vectors, threaded by
-/// fixed chunks with their sums added in chunk order (the same bits on any
-/// number of threads): with x = M^{-1/2} q and y = K x, α = yᵀx; w =
+/// the explicit step's fixed chunks with their sums added in chunk order
+/// (`kernels::each_chunk_summed`: the same bits on any number of threads): with x = M^{-1/2} q and y = K x, α = yᵀx; w =
 /// M^{-1/2} y − α q − β q_prev and β² = wᵀw; then q_prev, q ← q, w/β and the
 /// next x. (α = yᵀx is qᵀM^{-1/2} K M^{-1/2} q, one pass before w exists.)
 pub fn largest_eigenvalue_with(
@@ -53,28 +49,28 @@ pub fn largest_eigenvalue_with(
     let mut x: Vec<f64> = q.iter().zip(&scale).map(|(q, s)| q * s).collect();
     let mut q_prev = vec![0.0; n];
     let mut y = vec![0.0; n];
-    let mut partials = vec![0.0; n.div_ceil(CHUNK)];
+    let mut partials = partials(n);
     let (mut alphas, mut betas) = (Vec::new(), Vec::new());
     let mut beta_prev = 0.0;
     let mut last = 0.0;
     for step in 0..max_steps.min(n) {
         product(&x, &mut y);
-        let alpha = chunked_sum(&mut partials, |c, p| {
-            let r = c * CHUNK..((c + 1) * CHUNK).min(n);
-            *p = dot(&y[r.clone()], &x[r]);
+        each_chunk_summed(&mut y, &mut partials, |c, y, p| {
+            p[0] = dot(y, &x[c * CHUNK..c * CHUNK + y.len()]);
         });
+        let alpha = total(&partials, 0);
         // y becomes w in place.
-        let beta = chunk_pairs(&mut y, &mut q_prev, &mut partials, |c, w, qp, p| {
+        each_chunk_summed(&mut y, &mut partials, |c, w, p| {
             let r = c * CHUNK..c * CHUNK + w.len();
-            let (q, s) = (&q[r.clone()], &scale[r]);
+            let (q, qp, s) = (&q[r.clone()], &q_prev[r.clone()], &scale[r]);
             let mut sum = 0.0;
             for i in 0..w.len() {
                 w[i] = w[i] * s[i] - (alpha * q[i] + beta_prev * qp[i]);
                 sum += w[i] * w[i];
             }
-            *p = sum;
-        })
-        .sqrt();
+            p[0] = sum;
+        });
+        let beta = total(&partials, 0).sqrt();
         alphas.push(alpha);
         if step % 5 == 4 || beta <= 1e-14 * alpha.abs() || step + 1 == max_steps.min(n) {
             let top = tridiagonal_max_eigenvalue(&alphas, &betas);
@@ -87,46 +83,17 @@ pub fn largest_eigenvalue_with(
         // q_prev ← q, q ← w/β, x ← M^{-1/2} q.
         std::mem::swap(&mut q_prev, &mut q);
         let (w, s) = (&y, &scale);
-        q.par_chunks_mut(CHUNK)
-            .zip(x.par_chunks_mut(CHUNK))
-            .enumerate()
-            .for_each(|(c, (q, x))| {
-                let r = c * CHUNK..c * CHUNK + q.len();
-                let (w, s) = (&w[r.clone()], &s[r]);
-                for i in 0..q.len() {
-                    q[i] = w[i] / beta;
-                    x[i] = q[i] * s[i];
-                }
-            });
+        each_chunk_pair(&mut q, &mut x, &mut partials, |c, q, x, _| {
+            let r = c * CHUNK..c * CHUNK + q.len();
+            let (w, s) = (&w[r.clone()], &s[r]);
+            for i in 0..q.len() {
+                q[i] = w[i] / beta;
+                x[i] = q[i] * s[i];
+            }
+        });
         beta_prev = beta;
     }
     tridiagonal_max_eigenvalue(&alphas, &betas[..alphas.len().saturating_sub(1)])
-}
-
-/// Σ over chunks of `f(chunk, &mut partial)`, the partials added in chunk
-/// order.
-fn chunked_sum(partials: &mut [f64], f: impl Fn(usize, &mut f64) + Sync) -> f64 {
-    partials
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(c, p)| f(c, p));
-    partials.iter().sum()
-}
-
-/// `f(chunk, a's chunk, b's chunk, &mut partial)` over the same chunks of
-/// `a` and `b`, the partials added in chunk order.
-fn chunk_pairs(
-    a: &mut [f64],
-    b: &mut [f64],
-    partials: &mut [f64],
-    f: impl Fn(usize, &mut [f64], &mut [f64], &mut f64) + Sync,
-) -> f64 {
-    a.par_chunks_mut(CHUNK)
-        .zip(b.par_chunks_mut(CHUNK))
-        .zip(partials.par_iter_mut())
-        .enumerate()
-        .for_each(|(c, ((a, b), p))| f(c, a, b, p));
-    partials.iter().sum()
 }
 
 /// Largest eigenvalue of the symmetric tridiagonal matrix with diagonal `a`
