@@ -1510,7 +1510,7 @@ pub(crate) mod tests {
 
     /// The labs' slab, named "q1-NXxNY" or "q2-NXxNY": 8 × 1, rollers on
     /// top, held in x at the left.
-    fn lab_slab(name: &str) -> (Mesh, Material, Model) {
+    pub(crate) fn lab_slab(name: &str) -> (Mesh, Material, Model) {
         use stickslip_fem::testing::rectangle;
         use stickslip_mesh::CellKind;
         let (order, size) = name.split_once('-').expect("q1-NXxNY or q2-NXxNY");
@@ -1534,6 +1534,30 @@ pub(crate) mod tests {
         ];
         let model = Model::new(&mesh, &material, &supports).unwrap();
         (mesh, material, model)
+    }
+
+    /// A step's data with the labs' coefficients (Δt = 1e-3, γ = ½, no
+    /// load rows).
+    fn lab_data<'a>(
+        load_new: &'a [f64],
+        mass: &'a [f64],
+        r_new: &'a [f64],
+        v: &'a [f64],
+        a: &'a [f64],
+    ) -> StepData<'a> {
+        StepData {
+            load_new,
+            load_rows: &[],
+            mass,
+            r_new,
+            v,
+            a,
+            cv: 2e3,
+            ca: 1.0,
+            scale: 2e3,
+            ratio: 1.0,
+            next: (1e-3, 0.5e-6),
+        }
     }
 
     /// The labs' sweep: no friction, K r_K formed in the sweep.
@@ -2051,19 +2075,7 @@ pub(crate) mod tests {
             on_threads(threads, || {
                 let mut y = vec![0.0; n];
                 op.spmv(&x, &mut y);
-                let data = StepData {
-                    load_new: &zero,
-                    load_rows: &[],
-                    mass: &mass,
-                    r_new: &x,
-                    v: &v,
-                    a: &a,
-                    cv: 2e3,
-                    ca: 1.0,
-                    scale: 2e3,
-                    ratio: 1.0,
-                    next: (1e-3, 0.5e-6),
-                };
+                let data = lab_data(&zero, &mass, &x, &v, &a);
                 let mut p = partials(n);
                 let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
                 let (strain, sums) = fused_step(
@@ -2257,19 +2269,7 @@ pub(crate) mod tests {
                 let (ln, l, m, r, rn, v, a) =
                     (w(1.0), w(1.1), w(1.2), w(1.3), w(1.4), w(1.5), w(1.6));
                 // (The sweep with no load rows: pass A does the loads'.)
-                let data = StepData {
-                    load_new: &ln,
-                    load_rows: &[],
-                    mass: &m,
-                    r_new: &rn,
-                    v: &v,
-                    a: &a,
-                    cv: 2e3,
-                    ca: 1.0,
-                    scale: 2e3,
-                    ratio: 1.0,
-                    next: (1e-3, 0.5e-6),
-                };
+                let data = lab_data(&ln, &m, &rn, &v, &a);
                 let mut p = partials(n);
                 let (mut b, mut vn, mut an) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
                 let mut rx = vec![0.0; n];
@@ -2433,19 +2433,7 @@ pub(crate) mod tests {
                                 false,
                                 &mut p,
                             );
-                            let data = StepData {
-                                load_new: &ln,
-                                load_rows: &[],
-                                mass: &m,
-                                r_new: &rn,
-                                v: &v,
-                                a: &a,
-                                cv: 2e3,
-                                ca: 1.0,
-                                scale: 2e3,
-                                ratio: 1.0,
-                                next: (1e-3, 0.5e-6),
-                            };
+                            let data = lab_data(&ln, &m, &rn, &v, &a);
                             match use_classes {
                                 1 => {
                                     lab_sweep(&classes, &data, [&mut vn, &mut an, &mut rx], &mut p)
@@ -2531,19 +2519,7 @@ pub(crate) mod tests {
             let (rn, m, v, a) = (w(1.3), w(1.2), w(1.5), w(1.6));
             let zero = vec![0.0; n];
             let mut ku = vec![0.0; n];
-            let data = StepData {
-                load_new: &zero,
-                load_rows: &[],
-                mass: &m,
-                r_new: &rn,
-                v: &v,
-                a: &a,
-                cv: 2e3,
-                ca: 1.0,
-                scale: 2e3,
-                ratio: 1.0,
-                next: (1e-3, 0.5e-6),
-            };
+            let data = lab_data(&zero, &m, &rn, &v, &a);
             let labels = ["K·x", "vectors (K·x given)", "sweep"];
             let mut t: [Vec<f64>; 3] = Default::default();
             on_threads(2, || {

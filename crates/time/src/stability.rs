@@ -199,27 +199,20 @@ mod tests {
     /// (measured 2e-16 to 2e-14 on the slabs of 251k to 1M DOFs).
     #[test]
     fn threads_and_products_keep_the_estimate() {
+        use crate::kernels::tests::lab_slab;
         use crate::kernels::RowProduct;
-        use stickslip_fem::testing::{on_threads, rectangle};
-        use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
-        use stickslip_mesh::CellKind;
+        use stickslip_fem::testing::on_threads;
 
-        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
-        let supports = [
-            Dirichlet::new("top", 1, 0.0),
-            Dirichlet::new("left", 0, 0.0),
-        ];
-        for (kind, nx) in [(CellKind::Quad4, 192), (CellKind::Quad9, 96)] {
-            let mesh = rectangle(kind, nx, nx / 4, [0.0, 0.0], [8.0, 1.0]);
-            let model = Model::new(&mesh, &material, &supports).unwrap();
+        for name in ["q1-192x48", "q2-96x24"] {
+            let (_, _, model) = lab_slab(name);
             let (k, m) = (&model.stiffness, &model.lumped_mass);
-            assert!(m.len() > 2 * CHUNK, "{kind:?}: {} DOFs", m.len());
+            assert!(m.len() > 2 * CHUNK, "{name}: {} DOFs", m.len());
             let one = on_threads(1, || critical_step(k, m));
             let two = on_threads(2, || critical_step(k, m));
-            assert_eq!(one.to_bits(), two.to_bits(), "{kind:?}");
+            assert_eq!(one.to_bits(), two.to_bits(), "{name}");
             let stencils = crate::kernels::Stencils::new(k).expect("structured");
             let compact = crate::kernels::Compact::new(k).expect("square");
-            for (name, dt) in [
+            for (product, dt) in [
                 (
                     "stencils",
                     critical_step_with(|x, y| RowProduct::spmv(&stencils, x, y), m),
@@ -228,7 +221,7 @@ mod tests {
             ] {
                 assert!(
                     (dt - one).abs() <= 1e-12 * one,
-                    "{kind:?} {name}: {dt:e} against {one:e}"
+                    "{name} {product}: {dt:e} against {one:e}"
                 );
             }
         }
