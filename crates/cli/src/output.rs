@@ -130,7 +130,7 @@ struct ContactSeries {
 /// (≤ 1 MiB each, [`chunk_rows`]).
 #[derive(Debug, Default)]
 struct Pending {
-    rows: usize,
+    /// One entry a row: its length is the number of rows.
     time: Vec<f64>,
     displacement: Vec<f64>,
     velocity: Vec<f64>,
@@ -144,8 +144,11 @@ struct Pending {
 }
 
 impl Pending {
+    fn rows(&self) -> usize {
+        self.time.len()
+    }
+
     fn push(&mut self, rec: &Record) {
-        self.rows += 1;
         self.time.push(rec.t);
         self.displacement.extend_from_slice(rec.displacement);
         self.velocity.extend_from_slice(rec.velocity);
@@ -170,7 +173,6 @@ impl Pending {
 
     /// Empties the buffers, keeping their capacity.
     fn clear(&mut self) {
-        self.rows = 0;
         for v in [
             &mut self.time,
             &mut self.displacement,
@@ -277,8 +279,9 @@ fn scalar_attr<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<
 /// meshes measured, for files 0.7-0.85 of raw: the ignored test
 /// `write_speed` (100k nodes, 3 vector fields), levels 1 and 4 about 85 ms
 /// per record (57 MB/s), none 1.4 ms; `cargo xtask bench output`
-/// (2026-11-24): the paper's case 0.10 s a run at level 4 against 0.03 s
-/// with none, a 4,257-node Newmark run 0.75-0.82 s against 0.29-0.36 s.
+/// (docs/bench-output.csv, 2026-11-24): the paper's case 0.108 s a run at
+/// level 4 against 0.038 s with none, a 4,257-node Newmark run 0.91 s
+/// against 0.42 s.
 /// `output.compression = 1..9` turns it on.
 pub const DEFLATE_LEVEL: u8 = 0;
 
@@ -821,7 +824,7 @@ impl ResultsWriter {
     /// HDF5 errors.
     fn write_pending(&mut self) -> Result<()> {
         let p = &self.pending;
-        let m = p.rows;
+        let m = p.rows();
         if m == 0 {
             return Ok(());
         }
