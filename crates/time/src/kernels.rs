@@ -164,7 +164,14 @@ pub const CHUNK: usize = 8192;
 /// Chunks from which the passes go parallel.
 pub const PARALLEL_MIN: usize = 2;
 /// Rows per batch of the one-sweep step ([`Compact::chunk_batches`]).
-pub const BATCH: usize = 256;
+/// Small enough that the product's arithmetic and the vectors' memory
+/// streams of neighbouring batches overlap in the core: `sweep_lab`,
+/// 2026-11-24, 2 threads, median of 20, 1M DOFs, Q1 (Q2): 256 rows
+/// 3.85 (4.84) ms, 128 about the same, 64 2.66-2.75 (3.93-4.07), 48 2.71
+/// (3.81), 32 2.72-2.96 (3.88-4.08), 16 3.19 (4.31). The paper mesh's
+/// step, one batch of 148 rows before, measured no slower (1.87 vs 1.92
+/// µs).
+pub const BATCH: usize = 64;
 /// Groups the product sums in lockstep ([`Compact::groups_into`]).
 const LOCKSTEP: usize = 2;
 
@@ -1374,9 +1381,10 @@ struct Running {
 /// ṙ_K = R̂_K/(m·scale) (with R_K = +0 first, the literal, then again at
 /// the load rows with their R_K: [`rhs_entry`]'s operations either way),
 /// the friction's velocities at the contact DOFs, r̈_K, and the strain and
-/// kinetic sums in row order. Loops over the batch rather than one pass
-/// per row: the first two have no dependence between rows, so their
-/// divisions overlap.
+/// kinetic sums in row order. Loops over at most [`BATCH`] rows at a time
+/// rather than one pass per row: the first two have no dependence between
+/// rows, so their divisions overlap. ṙ_K is formed in a buffer held in L1
+/// and the three outputs are written once.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn batch_rows(
@@ -1389,48 +1397,111 @@ fn batch_rows(
     r_next: &mut [f64],
     run: &mut Running,
 ) {
-    let n = ku.len();
-    let rows = r0..r0 + n;
-    let (m, v, a) = (
-        &s.mass[rows.clone()],
-        &s.v[rows.clone()],
-        &s.a[rows.clone()],
-    );
-    let rn = &s.r_new[rows];
-    let (vn, an, r_next) = (&mut vn[..n], &mut an[..n], &mut r_next[..n]);
-    let (cv, ca, scale) = (s.cv, s.ca, s.scale);
-    for k in 0..n {
-        let zero = 0.0;
-        let bi = zero - ku[k] + m[k] * (cv * v[k] + ca * a[k]);
-        vn[k] = bi / (m[k] * scale);
+    let mut vb = [0.0; BATCH];
+    let mut o = 0;
+    while o < ku.len() {
+        let n = (ku.len() - o).min(BATCH);
+        let (b0, rows) = (r0 + o, r0 + o..r0 + o + n);
+        let (m, v, a) = (
+            &s.mass[rows.clone()],
+            &s.v[rows.clone()],
+            &s.a[rows.clone()],
+        );
+        let (rn, ku) = (&s.r_new[rows], &ku[o..o + n]);
+        let (vn, an, r_next) = (&mut vn[o..o + n], &mut an[o..o + n], &mut r_next[o..o + n]);
+        let vb = &mut vb[..n];
+        let (cv, ca, scale) = (s.cv, s.ca, s.scale);
+        for k in 0..n {
+            let zero = 0.0;
+            let bi = zero - ku[k] + m[k] * (cv * v[k] + ca * a[k]);
+            vb[k] = bi / (m[k] * scale);
+        }
+        while run.load < s.load_rows.len() && s.load_rows[run.load] < b0 + n {
+            let i = s.load_rows[run.load];
+            let k = i - b0;
+            vb[k] = rhs_entry(s, i, ku[k]) / (m[k] * scale);
+            run.load += 1;
+        }
+        while run.friction < friction.len() && friction[run.friction].0 < b0 + n {
+            let (i, vi) = friction[run.friction];
+            vb[i - b0] = vi;
+            run.friction += 1;
+        }
+        let ratio = s.ratio;
+        let (c1, c2) = s.next;
+        let mut finite = run.finite;
+        for k in 0..n {
+            let ak = (vb[k] - v[k]) * s.scale - ratio * a[k];
+            vn[k] = vb[k];
+            an[k] = ak;
+            r_next[k] = rn[k] + c1 * vb[k] + c2 * ak;
+            // `&`, not `&&`: no branch, so the loop stays vectorized.
+            finite &= rn[k].is_finite() & vb[k].is_finite();
+        }
+        let (mut strain, mut kinetic) = (run.strain, run.kinetic);
+        for k in 0..n {
+            strain += rn[k] * ku[k];
+            kinetic += m[k] * vb[k] * vb[k];
+        }
+        (run.strain, run.kinetic, run.finite) = (strain, kinetic, finite);
+        o += n;
     }
-    while run.load < s.load_rows.len() && s.load_rows[run.load] < r0 + n {
-        let i = s.load_rows[run.load];
-        let k = i - r0;
-        vn[k] = rhs_entry(s, i, ku[k]) / (m[k] * scale);
-        run.load += 1;
+}
+
+/// [`batch_rows`] compiled for AVX: the same IEEE operations (no fused
+/// multiply-add) 4 wide, so the same bits; the divisions of ṙ_K, which
+/// bound the loop, run twice as many per cycle as SSE2's on the machine
+/// measured. Call only where [`avx`] said yes.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[allow(clippy::too_many_arguments)]
+fn batch_rows_avx(
+    s: &StepData,
+    friction: &[(usize, f64)],
+    r0: usize,
+    ku: &[f64],
+    vn: &mut [f64],
+    an: &mut [f64],
+    r_next: &mut [f64],
+    run: &mut Running,
+) {
+    batch_rows(s, friction, r0, ku, vn, an, r_next, run)
+}
+
+/// [`batch_rows`], by [`batch_rows_avx`] where `avx` (the CPU has AVX).
+#[inline(always)]
+#[allow(clippy::too_many_arguments, unsafe_code)]
+fn batch_rows_on(
+    avx: bool,
+    s: &StepData,
+    friction: &[(usize, f64)],
+    r0: usize,
+    ku: &[f64],
+    vn: &mut [f64],
+    an: &mut [f64],
+    r_next: &mut [f64],
+    run: &mut Running,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if avx {
+        // SAFETY: `avx` is `avx()`'s answer for this CPU.
+        unsafe { batch_rows_avx(s, friction, r0, ku, vn, an, r_next, run) };
+        return;
     }
-    while run.friction < friction.len() && friction[run.friction].0 < r0 + n {
-        let (i, vi) = friction[run.friction];
-        vn[i - r0] = vi;
-        run.friction += 1;
+    let _ = avx;
+    batch_rows(s, friction, r0, ku, vn, an, r_next, run)
+}
+
+/// Whether this CPU has AVX (checked once; cached by std).
+pub(crate) fn avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx")
     }
-    let ratio = s.ratio;
-    let (c1, c2) = s.next;
-    let mut finite = run.finite;
-    for k in 0..n {
-        let ak = (vn[k] - v[k]) * s.scale - ratio * a[k];
-        an[k] = ak;
-        r_next[k] = rn[k] + c1 * vn[k] + c2 * ak;
-        // `&`, not `&&`: no branch, so the loop stays vectorized.
-        finite &= rn[k].is_finite() & vn[k].is_finite();
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
     }
-    let (mut strain, mut kinetic) = (run.strain, run.kinetic);
-    for k in 0..n {
-        strain += rn[k] * ku[k];
-        kinetic += m[k] * vn[k] * vn[k];
-    }
-    (run.strain, run.kinetic, run.finite) = (strain, kinetic, finite);
 }
 
 /// Passes B and C and the SpMV in one sweep: per row, K r_K, R̂_K,
@@ -1464,6 +1535,20 @@ pub fn fused_step<K: RowProduct>(
     r_next: &mut [f64],
     partials: &mut Partials,
 ) -> (f64, Sums) {
+    let out = [v_new, a_new, r_next];
+    sweep(avx(), k, s, friction, ku, out, partials)
+}
+
+/// [`fused_step`], its per-row work compiled for AVX where `avx`.
+pub(crate) fn sweep<K: RowProduct>(
+    avx: bool,
+    k: &K,
+    s: &StepData,
+    friction: &[(usize, f64)],
+    ku: Option<&[f64]>,
+    out: [&mut [f64]; 3],
+    partials: &mut Partials,
+) -> (f64, Sums) {
     let body = |c: usize, [vn, an, rx]: [&mut [f64]; 3], partial: &mut [f64; 5]| {
         let start = c * CHUNK;
         let mut run = Running {
@@ -1476,19 +1561,19 @@ pub fn fused_step<K: RowProduct>(
         match ku {
             Some(ku) => {
                 let ku = &ku[start..start + vn.len()];
-                batch_rows(s, friction, start, ku, vn, an, rx, &mut run);
+                batch_rows_on(avx, s, friction, start, ku, vn, an, rx, &mut run);
             }
             None => k.chunk_batches(c, s.r_new, |r0, ku| {
                 let o = r0 - start;
                 let (vn, an, rx) = (&mut vn[o..], &mut an[o..], &mut rx[o..]);
-                batch_rows(s, friction, r0, ku, vn, an, rx, &mut run);
+                batch_rows_on(avx, s, friction, r0, ku, vn, an, rx, &mut run);
             }),
         }
         partial[1] = run.kinetic;
         partial[3] = if run.finite { 0.0 } else { 1.0 };
         partial[4] = run.strain;
     };
-    each_chunk_triple([v_new, a_new, r_next], partials, body);
+    each_chunk_triple(out, partials, body);
     (
         0.5 * total(partials, 4),
         Sums {
@@ -1827,13 +1912,18 @@ pub(crate) mod tests {
             &mut p0,
         );
         assert!(sums0.work != 0.0 && sums0.load_dot != 0.0);
-        for given in [None, Some(&ku[..])] {
+        // Both builds of the per-row work (SSE2 and, where the CPU has it,
+        // AVX), with K r_K formed in the sweep and handed in.
+        let builds = [false, avx()];
+        for (given, avx) in [None, Some(&ku[..])]
+            .into_iter()
+            .flat_map(|g| builds.map(|b| (g, b)))
+        {
             let mut p = p1.clone();
             let (mut vn1, mut an1, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            let (strain1, sums1) = fused_step(
-                compact, &data, &friction, given, &mut vn1, &mut an1, &mut rx, &mut p,
-            );
-            let name = format!("{name} K r_K given: {}", given.is_some());
+            let out = [&mut vn1[..], &mut an1[..], &mut rx[..]];
+            let (strain1, sums1) = sweep(avx, compact, &data, &friction, given, out, &mut p);
+            let name = format!("{name} K r_K given: {}, AVX: {avx}", given.is_some());
             assert_eq!(strain0.to_bits(), strain1.to_bits(), "{name}: strain");
             for (x, y) in [
                 (sums0.work, sums1.work),
@@ -2520,8 +2610,14 @@ pub(crate) mod tests {
             let zero = vec![0.0; n];
             let mut ku = vec![0.0; n];
             let data = lab_data(&zero, &m, &rn, &v, &a);
-            let labels = ["K·x", "vectors (K·x given)", "sweep"];
-            let mut t: [Vec<f64>; 3] = Default::default();
+            let labels = [
+                "K·x",
+                "vectors (K·x given)",
+                "sweep",
+                "sweep, SSE2",
+                "sweep, AVX",
+            ];
+            let mut t: [Vec<f64>; 5] = Default::default();
             on_threads(2, || {
                 let mut p = partials(n);
                 let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
@@ -2549,6 +2645,28 @@ pub(crate) mod tests {
                     let s = Instant::now();
                     lab_sweep(&stencils, &data, [&mut vn, &mut an, &mut rx], &mut p);
                     t[2].push(s.elapsed().as_secs_f64());
+                    let s = Instant::now();
+                    sweep(
+                        false,
+                        &stencils,
+                        &data,
+                        &[],
+                        None,
+                        [&mut vn, &mut an, &mut rx],
+                        &mut p,
+                    );
+                    t[3].push(s.elapsed().as_secs_f64());
+                    let s = Instant::now();
+                    sweep(
+                        true,
+                        &stencils,
+                        &data,
+                        &[],
+                        None,
+                        [&mut vn, &mut an, &mut rx],
+                        &mut p,
+                    );
+                    t[4].push(s.elapsed().as_secs_f64());
                 }
             });
             println!("{name}: n = {n}, {} stencil types", stencils.types());

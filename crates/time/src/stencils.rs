@@ -64,9 +64,12 @@ pub struct Stencils {
     unit_blocks: Vec<u32>,
     /// The union of A's and B's block offsets, ascending.
     unit_offsets: Vec<i32>,
-    /// Per unit block, the first and the second columns' values of rows
-    /// [A 0, A 1, B 0, B 1]; +0 where A or B has no block at the offset
-    /// (s + 0·x = s: the bits of the pair's own blocks).
+    /// Per unit block, the values of rows [A 0, A 1, B 0, B 1] that
+    /// multiply [x_c, x_c+1, x_c+2, x_c+3] (each row's diagonal term: the
+    /// blocks' first column for row 0, the second for row 1) and those
+    /// that multiply the pairs swapped, [x_c+1, x_c, x_c+3, x_c+2] (the
+    /// other column); +0 where A or B has no block at the offset (s + 0·x
+    /// = s: the bits of the pair's own blocks).
     unit_values: Vec<[[f64; 4]; 2]>,
     /// The CPU has AVX (checked at run time): runs of two alike units are
     /// summed 4 doubles wide ([`avx::units`]), the same bits.
@@ -207,7 +210,8 @@ impl Stencils {
                         j += 1;
                     }
                     offsets.push(o);
-                    values.push([[a[0], a[1], b[0], b[1]], [a[2], a[3], b[2], b[3]]]);
+                    // Blocks by columns: [K00, K10, K01, K11].
+                    values.push([[a[0], a[3], b[0], b[3]], [a[2], a[1], b[2], b[1]]]);
                 }
                 blocks.push(offsets.len() as u32);
             }
@@ -271,11 +275,18 @@ impl Stencils {
         inside.then_some(b)
     }
 
+    /// Whether groups g..g + 4 (below g1) are two units `u` again (their
+    /// rows follow the previous four's).
+    #[inline(always)]
+    fn unit_run_continues(&self, g: usize, g1: usize, u: u32) -> bool {
+        g + 4 <= g1 && self.unit_of[g] == u && self.unit_of[g + 2] == u
+    }
+
     /// K x on the rows of groups g0..g1 into `out` (from g0's first row).
     #[inline(always)]
     fn groups_into(&self, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
         let base = self.group_rows[g0] as usize;
-        let mut put = |g: usize, s: [f64; 2]| {
+        let put = |out: &mut [f64], g: usize, s: [f64; 2]| {
             let (r0, r1) = (self.group_rows[g] as usize, self.group_rows[g + 1] as usize);
             out[r0 - base] = s[0];
             if r1 - r0 == 2 {
@@ -288,20 +299,29 @@ impl Stencils {
             let alike = |k: usize| g + k <= g1 && self.types[g + 1..g + k].iter().all(|&u| u == t);
             if let Some(b) = self.unit_run(g, g1, x.len()) {
                 // Two alike units on consecutive rows: four node pairs of
-                // one type (Q1) or of two types in turn (a Q2 node row).
+                // one type (Q1) or of two types in turn (a Q2 node row),
+                // and as many more fours after them as hold the same unit
+                // (their 8 rows each follow on: `build_units`).
+                let u = self.unit_of[g];
                 let r = self.group_rows[g] as usize;
-                let sums = avx::units(&self.unit_offsets[b.clone()], &self.unit_values[b], r, x);
-                for (q, s) in sums.into_iter().enumerate() {
-                    put(g + q, s);
+                let last = self.unit_offsets[b.end - 1] as isize;
+                let mut count = 1;
+                while self.unit_run_continues(g + 4 * count, g1, u)
+                    && (r + 8 * (count + 1)) as isize + last <= x.len() as isize
+                {
+                    count += 1;
                 }
-                g += 4;
+                let run = &mut out[r - base..r - base + 8 * count];
+                let (o, v) = (&self.unit_offsets[b.clone()], &self.unit_values[b]);
+                avx::units(o, v, r, x, run);
+                g += 4 * count;
             } else if alike(LOCKSTEP) {
                 for (q, s) in self.lockstep::<LOCKSTEP>(g, x).into_iter().enumerate() {
-                    put(g + q, s);
+                    put(out, g + q, s);
                 }
                 g += LOCKSTEP;
             } else {
-                put(g, self.group_sums(g, x));
+                put(out, g, self.group_sums(g, x));
                 g += 1;
             }
         }
@@ -333,64 +353,68 @@ mod avx {
         }
     }
 
-    /// The sums of the node pairs at rows r, r + 2 (one unit: blocks at
+    /// The sums of rows r..r + out.len() (a multiple of 8) into `out`:
+    /// per 8 rows, the node pairs at rows r, r + 2 (one unit: blocks at
     /// `offsets` with `values`) and r + 4, r + 6 (the same unit), each
-    /// row's products in the scalar kernel's two partial sums
-    /// (`split_block`), multiplications and additions separate (no fused
-    /// multiply-add): the bits of the scalar sums. Call only where
-    /// [`available`] said yes (`Stencils::unit_of` is empty otherwise).
+    /// row's products in two partial sums, its diagonal terms and its
+    /// other column's, added at the end: per row the scalar kernel's two
+    /// partial sums (`split_block`: first and second columns' terms) in
+    /// the same order, and a + b = b + a, so the same bits.
+    /// Multiplications and additions separate (no fused multiply-add).
+    /// Call only where [`available`] said yes (`Stencils::unit_of` is
+    /// empty otherwise).
     #[inline(always)]
     #[allow(unsafe_code)]
-    pub fn units(offsets: &[i32], values: &[[[f64; 4]; 2]], r: usize, x: &[f64]) -> [[f64; 2]; 4] {
+    pub fn units(offsets: &[i32], values: &[[[f64; 4]; 2]], r: usize, x: &[f64], out: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
         {
             // SAFETY: units exist only where `available()` said yes
             // (`Stencils::build_units`).
-            unsafe { units_avx(offsets, values, r, x) }
+            unsafe { units_avx(offsets, values, r, x, out) }
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            let _ = (offsets, values, r, x);
+            let _ = (offsets, values, r, x, out);
             unreachable!("AVX is x86_64 only")
         }
     }
 
     /// [`units`]: a unit's four rows in one 4-wide register each for the
-    /// first and the second columns' terms, x[c..c + 4] in one load.
+    /// diagonal and the other terms, x[c..c + 4] in one load and its pairs
+    /// swapped in one shuffle.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     #[allow(unsafe_code)]
-    fn units_avx(offsets: &[i32], values: &[[[f64; 4]; 2]], r: usize, x: &[f64]) -> [[f64; 2]; 4] {
+    fn units_avx(offsets: &[i32], values: &[[[f64; 4]; 2]], r: usize, x: &[f64], out: &mut [f64]) {
         use std::arch::x86_64::*;
-        let mut lo = [_mm256_setzero_pd(); 2];
-        let mut hi = [_mm256_setzero_pd(); 2];
-        for (&o, v) in offsets.iter().zip(values) {
-            let c = (r as isize + o as isize) as usize;
-            let xs: &[f64; 8] = x[c..c + 8].try_into().expect("8 columns");
-            // SAFETY: xs and v hold 8 doubles each; unaligned loads.
-            let (xa, xb, c0, c1) = unsafe {
-                (
-                    _mm256_loadu_pd(xs.as_ptr()),
-                    _mm256_loadu_pd(xs.as_ptr().add(4)),
-                    _mm256_loadu_pd(v[0].as_ptr()),
-                    _mm256_loadu_pd(v[1].as_ptr()),
-                )
-            };
-            for (h, xh) in [xa, xb].into_iter().enumerate() {
-                let x0 = _mm256_unpacklo_pd(xh, xh);
-                lo[h] = _mm256_add_pd(lo[h], _mm256_mul_pd(c0, x0));
-                let x1 = _mm256_unpackhi_pd(xh, xh);
-                hi[h] = _mm256_add_pd(hi[h], _mm256_mul_pd(c1, x1));
+        for (j, out) in out.chunks_exact_mut(8).enumerate() {
+            let rj = (r + 8 * j) as isize;
+            let mut d = [_mm256_setzero_pd(); 2];
+            let mut o = [_mm256_setzero_pd(); 2];
+            for (&off, v) in offsets.iter().zip(values) {
+                let c = (rj + off as isize) as usize;
+                let xs: &[f64; 8] = x[c..c + 8].try_into().expect("8 columns");
+                // SAFETY: xs and v hold 8 doubles each; unaligned loads.
+                let (xa, xb, vd, vo) = unsafe {
+                    (
+                        _mm256_loadu_pd(xs.as_ptr()),
+                        _mm256_loadu_pd(xs.as_ptr().add(4)),
+                        _mm256_loadu_pd(v[0].as_ptr()),
+                        _mm256_loadu_pd(v[1].as_ptr()),
+                    )
+                };
+                for (h, xh) in [xa, xb].into_iter().enumerate() {
+                    d[h] = _mm256_add_pd(d[h], _mm256_mul_pd(vd, xh));
+                    let swapped = _mm256_permute_pd::<0b0101>(xh);
+                    o[h] = _mm256_add_pd(o[h], _mm256_mul_pd(vo, swapped));
+                }
+            }
+            // SAFETY: out holds 8 doubles.
+            unsafe {
+                _mm256_storeu_pd(out.as_mut_ptr(), _mm256_add_pd(d[0], o[0]));
+                _mm256_storeu_pd(out.as_mut_ptr().add(4), _mm256_add_pd(d[1], o[1]));
             }
         }
-        let s = [_mm256_add_pd(lo[0], hi[0]), _mm256_add_pd(lo[1], hi[1])];
-        let mut out = [0.0; 8];
-        // SAFETY: out holds 8 doubles.
-        unsafe {
-            _mm256_storeu_pd(out.as_mut_ptr(), s[0]);
-            _mm256_storeu_pd(out.as_mut_ptr().add(4), s[1]);
-        }
-        std::array::from_fn(|q| [out[2 * q], out[2 * q + 1]])
     }
 }
 
