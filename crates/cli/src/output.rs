@@ -900,7 +900,7 @@ impl ResultsWriter {
         }
         self.pending.push(rec);
         self.rows += 1;
-        if self.rows % self.block_rows == 0 {
+        if self.rows.is_multiple_of(self.block_rows) {
             self.write_pending()?;
         }
         if self.auto_flush {
