@@ -31,7 +31,8 @@
 //! microseconds, more than a pass over the paper's 148 free DOFs). Within
 //! a chunk the sweep forms K r_K for [`BATCH`] rows at a time into a buffer
 //! and then runs the per-row work in loops over the batch (the divisions
-//! of ṙ_K and r̈_K of different rows overlap; the sums stay in row order).
+//! of ṙ_K and r̈_K of different rows overlap; the strain and kinetic sums
+//! go in four lanes by row, [`Lanes`]).
 //!
 //! K·r row by row from [`Compact`] (2×2 blocks with u32 columns, their
 //! values stored, 36 bytes per block, or indexed into a dictionary of the
@@ -418,16 +419,16 @@ pub fn rhs_and_velocity(
             &mass[range.clone()],
             &r_new[range.clone()],
         );
-        let (v, a) = (&v[range.clone()], &a[range]);
-        let mut strain = 0.0;
+        let (v, a) = (&v[range.clone()], &a[range.clone()]);
+        let mut strain = Lanes::default();
+        strain.add_rows(range.start, b.len(), |i| rn[i] * b[i]);
         for i in 0..b.len() {
             let ku = b[i];
-            strain += rn[i] * ku;
             let bi = l[i] - ku + m[i] * (cv * v[i] + ca * a[i]);
             b[i] = bi;
             vn[i] = bi / (m[i] * scale);
         }
-        partial[0] = strain;
+        partial[0] = strain.total();
     };
     each_chunk_pair(b, v_new, partials, body);
     0.5 * total(partials, 0)
@@ -470,16 +471,18 @@ pub fn accelerate_and_sum(
             &load_new[range.clone()],
         );
         let (r, rn, v) = (&r[range.clone()], &r_new[range.clone()], &v[range.clone()]);
-        let (vn, a) = (&v_new[range.clone()], &a[range]);
-        let (mut work, mut kinetic, mut load_dot) = (0.0, 0.0, 0.0);
+        let (vn, a) = (&v_new[range.clone()], &a[range.clone()]);
+        let (mut work, mut load_dot) = (0.0, 0.0);
+        let mut kinetic = Lanes::default();
+        kinetic.add_rows(range.start, an.len(), |i| m[i] * vn[i] * vn[i]);
         let mut finite = true;
         for i in 0..an.len() {
             an[i] = (vn[i] - v[i]) * scale - ratio * a[i];
             work += 0.5 * (ln[i] + l[i]) * (rn[i] - r[i]);
-            kinetic += m[i] * vn[i] * vn[i];
             load_dot += rn[i] * ln[i];
             finite &= rn[i].is_finite() && vn[i].is_finite();
         }
+        let kinetic = kinetic.total();
         partial[..4].copy_from_slice(&[work, kinetic, load_dot, if finite { 0.0 } else { 1.0 }]);
     };
     each_chunk_summed(a_new, partials, body);
@@ -1367,10 +1370,46 @@ pub fn rhs_entry(s: &StepData, i: usize, ku: f64) -> f64 {
     s.load_new[i] - ku + s.mass[i] * (s.cv * s.v[i] + s.ca * s.a[i])
 }
 
-/// The sweep's running sums over a chunk, in row order.
+/// A sum over rows in four lanes, row i in lane i mod 4, added
+/// (l0 + l1) + (l2 + l3) at the end: four chains of additions instead of
+/// one (a chain per row costs the adder's latency, 3 cycles, which the
+/// sweep paid per row: `sweep_lab` 1M Q1 2.62 → 2.42 ms, fastest of 20,
+/// one run each, 2026-11-24; later A/B runs drowned in the host's noise),
+/// in an order fixed by the rows whatever batch or thread adds them.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Lanes([f64; 4]);
+
+impl Lanes {
+    /// Adds term(k) for rows i0 + k, k < n.
+    #[inline(always)]
+    pub(crate) fn add_rows(&mut self, i0: usize, n: usize, term: impl Fn(usize) -> f64) {
+        let mut k = 0;
+        while k < n && !(i0 + k).is_multiple_of(4) {
+            self.0[(i0 + k) % 4] += term(k);
+            k += 1;
+        }
+        while k + 4 <= n {
+            for l in 0..4 {
+                self.0[l] += term(k + l);
+            }
+            k += 4;
+        }
+        while k < n {
+            self.0[(i0 + k) % 4] += term(k);
+            k += 1;
+        }
+    }
+
+    /// The sum.
+    pub(crate) fn total(self) -> f64 {
+        (self.0[0] + self.0[1]) + (self.0[2] + self.0[3])
+    }
+}
+
+/// The sweep's running sums over a chunk ([`Lanes`]).
 struct Running {
-    strain: f64,
-    kinetic: f64,
+    strain: Lanes,
+    kinetic: Lanes,
     finite: bool,
     /// Next entries of `load_rows` and `friction`.
     load: usize,
@@ -1381,7 +1420,7 @@ struct Running {
 /// ṙ_K = R̂_K/(m·scale) (with R_K = +0 first, the literal, then again at
 /// the load rows with their R_K: [`rhs_entry`]'s operations either way),
 /// the friction's velocities at the contact DOFs, r̈_K, and the strain and
-/// kinetic sums in row order. Loops over at most [`BATCH`] rows at a time
+/// kinetic sums ([`Lanes`]). Loops over at most [`BATCH`] rows at a time
 /// rather than one pass per row: the first two have no dependence between
 /// rows, so their divisions overlap. ṙ_K is formed in a buffer held in L1
 /// and the three outputs are written once.
@@ -1438,12 +1477,9 @@ fn batch_rows(
             // `&`, not `&&`: no branch, so the loop stays vectorized.
             finite &= rn[k].is_finite() & vb[k].is_finite();
         }
-        let (mut strain, mut kinetic) = (run.strain, run.kinetic);
-        for k in 0..n {
-            strain += rn[k] * ku[k];
-            kinetic += m[k] * vb[k] * vb[k];
-        }
-        (run.strain, run.kinetic, run.finite) = (strain, kinetic, finite);
+        run.strain.add_rows(b0, n, |k| rn[k] * ku[k]);
+        run.kinetic.add_rows(b0, n, |k| m[k] * vb[k] * vb[k]);
+        run.finite = finite;
         o += n;
     }
 }
@@ -1509,7 +1545,7 @@ pub(crate) fn avx() -> bool {
 /// friction gave (`friction`, (DOF, ṙ_K) sorted by DOF, computed before
 /// from [`Compact::row`] and [`rhs_entry`]) — then r̈_K and the sums. Per
 /// entry the arithmetic of [`rhs_and_velocity`] and [`accelerate_and_sum`],
-/// per chunk the sums in row order: the same bits as the three passes.
+/// per chunk the sums in the same order: the same bits as the three passes.
 /// The work and load sums are pass A's ([`predict`], over the load rows,
 /// in `partials[c][0]` and `[2]`), so the sweep reads neither R_{K−1} nor
 /// r_{K−1}: with pass A, 10 vector streams per step (pass A reads r, ṙ,
@@ -1552,8 +1588,8 @@ pub(crate) fn sweep<K: RowProduct>(
     let body = |c: usize, [vn, an, rx]: [&mut [f64]; 3], partial: &mut [f64; 5]| {
         let start = c * CHUNK;
         let mut run = Running {
-            strain: 0.0,
-            kinetic: 0.0,
+            strain: Lanes::default(),
+            kinetic: Lanes::default(),
             finite: true,
             load: s.load_rows.partition_point(|&i| i < start),
             friction: friction.partition_point(|f| f.0 < start),
@@ -1569,9 +1605,9 @@ pub(crate) fn sweep<K: RowProduct>(
                 batch_rows_on(avx, s, friction, r0, ku, vn, an, rx, &mut run);
             }),
         }
-        partial[1] = run.kinetic;
+        partial[1] = run.kinetic.total();
         partial[3] = if run.finite { 0.0 } else { 1.0 };
-        partial[4] = run.strain;
+        partial[4] = run.strain.total();
     };
     each_chunk_triple(out, partials, body);
     (
@@ -2632,8 +2668,8 @@ pub(crate) mod tests {
                     each_chunk_triple([&mut vn, &mut an, &mut rx], &mut p, |c, [vn, an, rx], _| {
                         let start = c * CHUNK;
                         let mut run = Running {
-                            strain: 0.0,
-                            kinetic: 0.0,
+                            strain: Lanes::default(),
+                            kinetic: Lanes::default(),
                             finite: true,
                             load: 0,
                             friction: 0,
