@@ -13,12 +13,12 @@
 //! of the few types from L1. Runs of alike node pairs are summed 4 doubles
 //! wide (AVX) or, where the CPU has AVX-512, 8 wide: `sweep_lab`,
 //! 2026-11-24, 1M DOFs, K·x Q1 1.2 → 0.95-1.0 ms, Q2 1.9 → 1.7 ms (2
-//! threads, median of 20, two runs each). Rows are independent and each is summed in its
-//! type's block order whatever batch or thread computes it: the same bits
-//! on any number of threads. Not the bits of the assembled K's product:
-//! within [`TOLERANCE`] · max |K_ij| · Σ_j |x_j| over the row's columns of
-//! it (tests below); the classes of `stickslip_fem::ElementClasses` make the
-//! same trade on Q2 meshes.
+//! threads, median of 20, two runs each). Rows are independent and each
+//! is summed in its type's block order whatever batch or thread computes
+//! it: the same bits on any number of threads. Not the bits of the
+//! assembled K's product: within [`TOLERANCE`] · max |K_ij| · Σ_j |x_j|
+//! over the row's columns of it (tests below); the classes of
+//! `stickslip_fem::ElementClasses` make the same trade on Q2 meshes.
 //!
 //! Declined ([`Stencils::new`] returns `None`) when the types would not
 //! shrink the matrix: unstructured meshes, where nearly every group is its
@@ -348,17 +348,8 @@ fn split_block(c: usize, v: &[f64; 4], x: &[f64], s: &mut [[f64; 2]; 2]) {
 
 /// The 4-wide sums of two units of consecutive node pairs.
 mod avx {
-    /// Whether this CPU runs [`units`].
-    pub fn available() -> bool {
-        #[cfg(target_arch = "x86_64")]
-        {
-            std::arch::is_x86_feature_detected!("avx")
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            false
-        }
-    }
+    /// Whether this CPU runs [`units`] (it has AVX).
+    pub(super) use crate::kernels::avx as available;
 
     /// Whether this CPU has AVX-512 (foundation) for `units(true, ..)`.
     pub fn available_512() -> bool {
