@@ -1431,11 +1431,10 @@ fn batch_rows(
     friction: &[(usize, f64)],
     r0: usize,
     ku: &[f64],
-    vn: &mut [f64],
-    an: &mut [f64],
-    r_next: &mut [f64],
+    out: [&mut [f64]; 3],
     run: &mut Running,
 ) {
+    let [vn, an, r_next] = out;
     let mut vb = [0.0; BATCH];
     let mut o = 0;
     while o < ku.len() {
@@ -1485,9 +1484,11 @@ fn batch_rows(
 }
 
 /// [`batch_rows`] compiled for AVX: the same IEEE operations (no fused
-/// multiply-add) 4 wide, so the same bits; the divisions of ṙ_K, which
-/// bound the loop, run twice as many per cycle as SSE2's on the machine
-/// measured. Call only where [`avx`] said yes.
+/// multiply-add), in 4-wide registers where the compiler vectorizes, so
+/// the same bits: `sweep_lab`'s "sweep, SSE2" against "sweep, AVX", 1M
+/// DOFs, 2026-11-24, medians of 20 in three runs: Q1 3.06 / 2.86, 3.03 /
+/// 2.79, 2.97 / 2.90 ms; Q2 3.90 / 3.86, 3.92 / 3.83, 4.80 / 4.76 ms.
+/// Call only where [`avx`] said yes.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 #[allow(clippy::too_many_arguments)]
@@ -1496,12 +1497,10 @@ fn batch_rows_avx(
     friction: &[(usize, f64)],
     r0: usize,
     ku: &[f64],
-    vn: &mut [f64],
-    an: &mut [f64],
-    r_next: &mut [f64],
+    out: [&mut [f64]; 3],
     run: &mut Running,
 ) {
-    batch_rows(s, friction, r0, ku, vn, an, r_next, run)
+    batch_rows(s, friction, r0, ku, out, run)
 }
 
 /// [`batch_rows`], by [`batch_rows_avx`] where `avx` (the CPU has AVX).
@@ -1513,19 +1512,17 @@ fn batch_rows_on(
     friction: &[(usize, f64)],
     r0: usize,
     ku: &[f64],
-    vn: &mut [f64],
-    an: &mut [f64],
-    r_next: &mut [f64],
+    out: [&mut [f64]; 3],
     run: &mut Running,
 ) {
     #[cfg(target_arch = "x86_64")]
     if avx {
         // SAFETY: `avx` is `avx()`'s answer for this CPU.
-        unsafe { batch_rows_avx(s, friction, r0, ku, vn, an, r_next, run) };
+        unsafe { batch_rows_avx(s, friction, r0, ku, out, run) };
         return;
     }
     let _ = avx;
-    batch_rows(s, friction, r0, ku, vn, an, r_next, run)
+    batch_rows(s, friction, r0, ku, out, run)
 }
 
 /// Whether this CPU has AVX (checked once; cached by std).
@@ -1597,12 +1594,12 @@ pub(crate) fn sweep<K: RowProduct>(
         match ku {
             Some(ku) => {
                 let ku = &ku[start..start + vn.len()];
-                batch_rows_on(avx, s, friction, start, ku, vn, an, rx, &mut run);
+                batch_rows_on(avx, s, friction, start, ku, [vn, an, rx], &mut run);
             }
             None => k.chunk_batches(c, s.r_new, |r0, ku| {
                 let o = r0 - start;
                 let (vn, an, rx) = (&mut vn[o..], &mut an[o..], &mut rx[o..]);
-                batch_rows_on(avx, s, friction, r0, ku, vn, an, rx, &mut run);
+                batch_rows_on(avx, s, friction, r0, ku, [vn, an, rx], &mut run);
             }),
         }
         partial[1] = run.kinetic.total();
@@ -2675,34 +2672,19 @@ pub(crate) mod tests {
                             friction: 0,
                         };
                         let ku = &ku[start..start + vn.len()];
-                        batch_rows(&data, &[], start, ku, vn, an, rx, &mut run);
+                        batch_rows(&data, &[], start, ku, [vn, an, rx], &mut run);
                     });
                     t[1].push(s.elapsed().as_secs_f64());
                     let s = Instant::now();
                     lab_sweep(&stencils, &data, [&mut vn, &mut an, &mut rx], &mut p);
                     t[2].push(s.elapsed().as_secs_f64());
-                    let s = Instant::now();
-                    sweep(
-                        false,
-                        &stencils,
-                        &data,
-                        &[],
-                        None,
-                        [&mut vn, &mut an, &mut rx],
-                        &mut p,
-                    );
-                    t[3].push(s.elapsed().as_secs_f64());
-                    let s = Instant::now();
-                    sweep(
-                        true,
-                        &stencils,
-                        &data,
-                        &[],
-                        None,
-                        [&mut vn, &mut an, &mut rx],
-                        &mut p,
-                    );
-                    t[4].push(s.elapsed().as_secs_f64());
+                    // Both builds of the per-row work (batch_rows_avx).
+                    for (slot, avx) in [(3, false), (4, avx())] {
+                        let s = Instant::now();
+                        let out = [&mut vn[..], &mut an[..], &mut rx[..]];
+                        sweep(avx, &stencils, &data, &[], None, out, &mut p);
+                        t[slot].push(s.elapsed().as_secs_f64());
+                    }
                 }
             });
             println!("{name}: n = {n}, {} stencil types", stencils.types());
