@@ -1420,10 +1420,9 @@ struct Running {
 /// ṙ_K = R̂_K/(m·scale) (with R_K = +0 first, the literal, then again at
 /// the load rows with their R_K: [`rhs_entry`]'s operations either way),
 /// the friction's velocities at the contact DOFs, r̈_K, and the strain and
-/// kinetic sums ([`Lanes`]). Loops over at most [`BATCH`] rows at a time
-/// rather than one pass per row: the first two have no dependence between
-/// rows, so their divisions overlap. ṙ_K is formed in a buffer held in L1
-/// and the three outputs are written once.
+/// kinetic sums ([`Lanes`]). Loops over the batch rather than one pass
+/// per row: the first two have no dependence between rows, so their
+/// divisions overlap.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn batch_rows(
@@ -1435,52 +1434,45 @@ fn batch_rows(
     run: &mut Running,
 ) {
     let [vn, an, r_next] = out;
-    let mut vb = [0.0; BATCH];
-    let mut o = 0;
-    while o < ku.len() {
-        let n = (ku.len() - o).min(BATCH);
-        let (b0, rows) = (r0 + o, r0 + o..r0 + o + n);
-        let (m, v, a) = (
-            &s.mass[rows.clone()],
-            &s.v[rows.clone()],
-            &s.a[rows.clone()],
-        );
-        let (rn, ku) = (&s.r_new[rows], &ku[o..o + n]);
-        let (vn, an, r_next) = (&mut vn[o..o + n], &mut an[o..o + n], &mut r_next[o..o + n]);
-        let vb = &mut vb[..n];
-        let (cv, ca, scale) = (s.cv, s.ca, s.scale);
-        for k in 0..n {
-            let zero = 0.0;
-            let bi = zero - ku[k] + m[k] * (cv * v[k] + ca * a[k]);
-            vb[k] = bi / (m[k] * scale);
-        }
-        while run.load < s.load_rows.len() && s.load_rows[run.load] < b0 + n {
-            let i = s.load_rows[run.load];
-            let k = i - b0;
-            vb[k] = rhs_entry(s, i, ku[k]) / (m[k] * scale);
-            run.load += 1;
-        }
-        while run.friction < friction.len() && friction[run.friction].0 < b0 + n {
-            let (i, vi) = friction[run.friction];
-            vb[i - b0] = vi;
-            run.friction += 1;
-        }
-        let ratio = s.ratio;
-        let (c1, c2) = s.next;
-        let mut finite = run.finite;
-        for k in 0..n {
-            let ak = (vb[k] - v[k]) * s.scale - ratio * a[k];
-            vn[k] = vb[k];
-            an[k] = ak;
-            r_next[k] = rn[k] + c1 * vb[k] + c2 * ak;
-            // `&`, not `&&`: no branch, so the loop stays vectorized.
-            finite &= rn[k].is_finite() & vb[k].is_finite();
-        }
-        run.strain.add_rows(b0, n, |k| rn[k] * ku[k]);
-        run.kinetic.add_rows(b0, n, |k| m[k] * vb[k] * vb[k]);
-        run.finite = finite;
-        o += n;
+    let n = ku.len();
+    let rows = r0..r0 + n;
+    let (m, v, a) = (
+        &s.mass[rows.clone()],
+        &s.v[rows.clone()],
+        &s.a[rows.clone()],
+    );
+    let rn = &s.r_new[rows];
+    let (vn, an, r_next) = (&mut vn[..n], &mut an[..n], &mut r_next[..n]);
+    let (cv, ca, scale) = (s.cv, s.ca, s.scale);
+    for k in 0..n {
+        let zero = 0.0;
+        let bi = zero - ku[k] + m[k] * (cv * v[k] + ca * a[k]);
+        vn[k] = bi / (m[k] * scale);
     }
+    while run.load < s.load_rows.len() && s.load_rows[run.load] < r0 + n {
+        let i = s.load_rows[run.load];
+        let k = i - r0;
+        vn[k] = rhs_entry(s, i, ku[k]) / (m[k] * scale);
+        run.load += 1;
+    }
+    while run.friction < friction.len() && friction[run.friction].0 < r0 + n {
+        let (i, vi) = friction[run.friction];
+        vn[i - r0] = vi;
+        run.friction += 1;
+    }
+    let ratio = s.ratio;
+    let (c1, c2) = s.next;
+    let mut finite = run.finite;
+    for k in 0..n {
+        let ak = (vn[k] - v[k]) * s.scale - ratio * a[k];
+        an[k] = ak;
+        r_next[k] = rn[k] + c1 * vn[k] + c2 * ak;
+        // `&`, not `&&`: no branch, so the loop stays vectorized.
+        finite &= rn[k].is_finite() & vn[k].is_finite();
+    }
+    run.strain.add_rows(r0, n, |k| rn[k] * ku[k]);
+    run.kinetic.add_rows(r0, n, |k| m[k] * vn[k] * vn[k]);
+    run.finite = finite;
 }
 
 /// [`batch_rows`] compiled for AVX: the same IEEE operations (no fused
