@@ -2591,32 +2591,33 @@ pub(crate) mod tests {
 
     /// Where the explicit step's time goes on a large structured mesh: K·x
     /// by stencil types alone, the sweep's vector work alone (K r_K handed
-    /// in: 8 streams, no product) and the one sweep; 2 threads, median
-    /// (fastest) of 20 interleaved rounds, ms. Run by hand:
+    /// in: 8 streams, no product) and the one sweep, with the per-row work
+    /// built for SSE2 and as `fused_step` runs it (AVX where the CPU has
+    /// it); 2 threads, median (fastest) of 20 interleaved rounds, ms. Run
+    /// by hand:
     ///
     ///     cargo test --release -p stickslip-time --lib sweep_lab -- --ignored --nocapture
     ///
     /// (STICKSLIP_LAB_MESHES, default q1-1416x354,q2-708x177.) Measured
-    /// 2026-11-24 04:20-04:35, release, this 2-core machine:
+    /// 2026-11-24 06:05, release, this 2-core machine (AVX-512 stencil
+    /// sums, 64-row batches):
     ///
-    /// | mesh (free DOFs)       | K·x         | vectors     | sweep       |
-    /// |------------------------|-------------|-------------|-------------|
-    /// | Q1 354×88 (62,746)     | 0.108-0.150 | 0.053-0.065 | 0.224-0.237 |
-    /// | Q1 708×177 (251,517)   | 0.617       | 0.426       | 1.163       |
-    /// | Q1 1416×354 (1,004,298)| 1.92-2.47   | 1.72-2.79   | 4.24-4.87   |
-    /// | Q2 708×177 (1,004,298) | 3.86        | 2.64        | 6.52        |
+    /// | mesh (free DOFs)        | K·x         | vectors     | sweep, SSE2 | sweep       |
+    /// |-------------------------|-------------|-------------|-------------|-------------|
+    /// | Q1 708×177 (251,517)    | 0.197       | 0.278       | 0.552       | 0.474       |
+    /// | Q1 1416×354 (1,004,298) | 0.964       | 1.926       | 2.325       | 2.178       |
+    /// | Q2 708×177 (1,004,298)  | 1.688       | 2.065       | 3.242       | 3.244       |
     ///
-    /// The sweep costs about the sum of its parts (in cache too, at 62k
-    /// DOFs), so the product's arithmetic and the vectors' memory traffic
-    /// do not overlap; the vector part alone moves its 8 streams at
-    /// 23-37 GB/s, near the STREAM triad. Prefetching the next batch's
-    /// m, ṙ, r̈ (and its three output rows) while the batch's K r_K is
-    /// formed, one to four batches ahead, measured no faster (Q1 1M sweep
-    /// 4.28-5.57 with against 4.62-5.29 ms without) and was not kept. A
-    /// standalone loop of the sweep's 7 streams with its division and no
-    /// product runs at 80-85% of the triad (2.0 ms at 1M rows): 50% of
-    /// STREAM for the whole step needs the product hidden under the
-    /// traffic, or about half its arithmetic.
+    /// At 1M DOFs the sweep now costs less than its parts: the product's
+    /// arithmetic of one batch overlaps the vectors' traffic of the next
+    /// ([`BATCH`]). Before (04:20-04:35, 256-row batches, 4-wide sums) it
+    /// cost about their sum: Q1 1M K·x 1.92-2.47, vectors 1.72-2.79, sweep
+    /// 4.24-4.87; Q2 1M 3.86, 2.64, 6.52. Tried then and not kept:
+    /// prefetching the next batch's m, ṙ, r̈ (and its three output rows)
+    /// one to four batches ahead (Q1 1M sweep 4.28-5.57 with against
+    /// 4.62-5.29 ms without); and since, non-temporal stores for the three
+    /// outputs (no faster: 3.85 against 4.08 ms at 256-row batches, 2.66
+    /// against 3.32 at 64).
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn sweep_lab() {
@@ -2635,14 +2636,8 @@ pub(crate) mod tests {
             let zero = vec![0.0; n];
             let mut ku = vec![0.0; n];
             let data = lab_data(&zero, &m, &rn, &v, &a);
-            let labels = [
-                "K·x",
-                "vectors (K·x given)",
-                "sweep",
-                "sweep, SSE2",
-                "sweep, AVX",
-            ];
-            let mut t: [Vec<f64>; 5] = Default::default();
+            let labels = ["K·x", "vectors (K·x given)", "sweep, SSE2", "sweep"];
+            let mut t: [Vec<f64>; 4] = Default::default();
             on_threads(2, || {
                 let mut p = partials(n);
                 let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
@@ -2667,11 +2662,9 @@ pub(crate) mod tests {
                         batch_rows(&data, &[], start, ku, [vn, an, rx], &mut run);
                     });
                     t[1].push(s.elapsed().as_secs_f64());
-                    let s = Instant::now();
-                    lab_sweep(&stencils, &data, [&mut vn, &mut an, &mut rx], &mut p);
-                    t[2].push(s.elapsed().as_secs_f64());
-                    // Both builds of the per-row work (batch_rows_avx).
-                    for (slot, avx) in [(3, false), (4, avx())] {
+                    // Both builds of the per-row work (batch_rows_avx; the
+                    // second is fused_step's, AVX where the CPU has it).
+                    for (slot, avx) in [(2, false), (3, avx())] {
                         let s = Instant::now();
                         let out = [&mut vn[..], &mut an[..], &mut rx[..]];
                         sweep(avx, &stencils, &data, &[], None, out, &mut p);
