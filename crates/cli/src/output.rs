@@ -5,11 +5,12 @@
 //! dimension, chunked along time; shuffle + deflate when `compression` is
 //! 1-9, none by default). Rows are kept in memory up to the end of a chunk
 //! along time and written as one block per dataset ([`Pending`]), and
-//! always before a flush. It is flushed every [`ResultsWriter::flush_every_steps`] appends or
+//! always before a flush. It is flushed every
+//! [`ResultsWriter::flush_every_steps`] appends or
 //! [`ResultsWriter::flush_every_secs`] seconds (or when the run says so,
-//! with a checkpoint), so a run that stops early leaves a readable file with
-//! `complete = false`; [`ResultsWriter::finish`] writes the solver summary
-//! and sets `complete`.
+//! with a checkpoint), so a run that stops early leaves a readable file
+//! with `complete = false`; [`ResultsWriter::finish`] writes the solver
+//! summary and sets `complete`.
 //!
 //! `/checkpoint` holds the integrator's full state at the last flush
 //! ([`ResultsWriter::write_checkpoint`]: the `stickslip_time::Checkpoint`

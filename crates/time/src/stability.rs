@@ -27,9 +27,10 @@ pub fn largest_eigenvalue(
 ///
 /// A step is the product and three passes over the vectors, threaded by
 /// the explicit step's fixed chunks with their sums added in chunk order
-/// (`kernels::each_chunk_summed`: the same bits on any number of threads): with x = M^{-1/2} q and y = K x, α = yᵀx; w =
-/// M^{-1/2} y − α q − β q_prev and β² = wᵀw; then q_prev, q ← q, w/β and the
-/// next x. (α = yᵀx is qᵀM^{-1/2} K M^{-1/2} q, one pass before w exists.)
+/// (`kernels::each_chunk_summed`: the same bits on any number of
+/// threads): with x = M^{-1/2} q and y = K x, α = yᵀx; w = M^{-1/2} y −
+/// α q − β q_prev and β² = wᵀw; then q_prev, q ← q, w/β and the next x.
+/// (α = yᵀx is qᵀM^{-1/2} K M^{-1/2} q, one pass before w exists.)
 pub fn largest_eigenvalue_with(
     mut product: impl FnMut(&[f64], &mut [f64]),
     lumped_mass: &[f64],
