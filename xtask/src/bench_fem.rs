@@ -51,12 +51,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                     })
                     .collect::<Result<_, _>>()?;
             }
-            "--splu-max-dofs" => {
-                let v = it.next().ok_or("--splu-max-dofs needs a number")?;
-                splu_max = v
-                    .parse()
-                    .map_err(|_| format!("--splu-max-dofs {v}: not an integer"))?;
-            }
+            "--splu-max-dofs" => splu_max = crate::integer_arg(a, "a number", &mut it)?,
             "--q1" => q1 = true,
             "--no-peer" => peer = false,
             "-h" | "--help" => {

@@ -45,13 +45,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
-            "--rounds" => {
-                let v = it.next().ok_or("--rounds needs a number")?;
-                rounds = v
-                    .parse::<usize>()
-                    .map_err(|_| format!("--rounds {v}: not an integer"))?
-                    .max(1);
-            }
+            "--rounds" => rounds = crate::integer_arg::<usize>(a, "a number", &mut it)?.max(1),
             "-h" | "--help" => {
                 println!("cargo xtask bench output [--rounds N]");
                 return Ok(());

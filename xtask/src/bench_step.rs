@@ -36,11 +36,8 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
             "--quick" => pass.push(a.clone()),
             "--no-peer" => peer = false,
             "--max-dofs" => {
-                let v = it.next().ok_or("--max-dofs needs a number of DOFs")?;
-                v.parse::<u64>()
-                    .map_err(|_| format!("--max-dofs {v}: not an integer"))?;
-                pass.push(a.clone());
-                pass.push(v.clone());
+                let v: u64 = crate::integer_arg(a, "a number of DOFs", &mut it)?;
+                pass.extend([a.clone(), v.to_string()]);
             }
             "-h" | "--help" => {
                 println!("cargo xtask bench step [--quick] [--max-dofs N] [--no-peer]");

@@ -96,6 +96,18 @@ fn project_root() -> PathBuf {
         .to_path_buf()
 }
 
+/// The integer after the flag `flag` of a bench command: "{flag} needs
+/// {what}" when it is missing, "{flag} {v}: not an integer" when it is not
+/// one.
+pub fn integer_arg<T: std::str::FromStr>(
+    flag: &str,
+    what: &str,
+    it: &mut std::slice::Iter<String>,
+) -> Result<T, String> {
+    let v = it.next().ok_or_else(|| format!("{flag} needs {what}"))?;
+    v.parse().map_err(|_| format!("{flag} {v}: not an integer"))
+}
+
 /// Runs a command, echoing it, and fails with its exit status.
 pub fn run(cmd: &mut Command) -> Result<(), String> {
     eprintln!("$ {}", describe(cmd));
