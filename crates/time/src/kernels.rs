@@ -76,8 +76,8 @@
 //! keep their blocks stored.
 //!
 //! Each block costs a fixed set of operations (four products and four
-//! additions in the CSR's order per block, its column's bounds check, the
-//! value loads): the dev profile's opt-level 2 emits them scalar (rustc
+//! additions, its column's bounds check, the value loads; then in the
+//! CSR's order): the dev profile's opt-level 2 emits them scalar (rustc
 //! runs LLVM's SLP vectorizer at opt-level 3 only), about 1.5 ns per block
 //! on one core in cache (paper mesh: 1,088 blocks, ~1.6 µs of its step).
 //! Two groups (four row sums) in lockstep ([`Compact::groups_into`]);
@@ -173,8 +173,6 @@ pub const PARALLEL_MIN: usize = 2;
 /// step, one batch of 148 rows before, measured no slower (1.87 vs 1.92
 /// µs).
 pub const BATCH: usize = 64;
-/// Groups the product sums in lockstep ([`Compact::groups_into`]).
-const LOCKSTEP: usize = 2;
 
 /// Number of chunks of a vector of length n.
 pub fn chunks(n: usize) -> usize {
@@ -511,11 +509,17 @@ pub fn accelerate_and_sum(
 /// constrained is padded with a zero in the block starting one column
 /// earlier (or at column 0): every block reads x[c], x[c+1] in bounds.
 ///
-/// Summation order is the CSR's: each row adds its stored entries in
-/// ascending column order, the padding zeros interleaved. s + 0·x = s
-/// exactly for finite x and s ≠ −0 (a sum started at +0 is never −0), so
-/// K·r is bit-identical to [`spmv`] on the CSR (tests in this module).
-/// (A non-finite r makes the step fail on the finiteness check either way.)
+/// Each group has an even number of blocks (a zero block at its last
+/// column pads an odd count), stored two to a 64-byte line ([`Lines`]).
+/// The summation order is [`group_sums`]': eight partial sums per row
+/// (block number mod 4 × column of the block), so that 8-wide registers
+/// hold two blocks and a row is not one long chain of dependent additions
+/// (the paper mesh's K·x, `small_lab`: 1.11 µs in the CSR's order with
+/// two groups in lockstep, 0.62 µs now). Padding zeros are exact: s + 0·x
+/// = s for finite x and s ≠ −0 (a sum started at +0 is never −0). (A
+/// non-finite r makes the step fail on the finiteness check either way.)
+/// The CSR's [`spmv`] sums each row in column order: other bits, within
+/// rounding.
 #[derive(Clone, Debug)]
 pub struct Compact {
     /// First row of each group (1 or 2 rows), then n.
@@ -528,6 +532,10 @@ pub struct Compact {
     values: Values,
     /// Groups of chunk c: chunk_groups[c]..chunk_groups[c + 1].
     chunk_groups: Vec<u32>,
+    /// How wide the sums run (the same bits at every width).
+    wide: Wide,
+    /// Rows (and columns): every block's columns are below it.
+    n: usize,
 }
 
 /// The values of the blocks, [row 0 · col 0, row 1 · col 0, row 0 · col 1,
@@ -536,12 +544,48 @@ pub struct Compact {
 /// block read from the dictionary has the bits of the stored one).
 #[derive(Clone, Debug)]
 enum Values {
-    /// 32 bytes per block.
-    Stored(Vec<[f64; 4]>),
+    /// 32 bytes per block, the pairs of blocks on 64-byte lines.
+    Stored(Lines),
     /// 2 bytes per block and the dictionary (≤ 65,536 distinct blocks).
     Dict16 { ids: Vec<u16>, dict: Vec<[f64; 4]> },
     /// 4 bytes per block and the dictionary.
     Dict32 { ids: Vec<u32>, dict: Vec<[f64; 4]> },
+}
+
+/// Blocks stored two to a 64-byte-aligned line: with every group an even
+/// number of blocks, each of [`avx512_groups`]' 8-double loads is one line
+/// (the paper mesh's K·x took 1.04 µs with its blocks at 48 bytes past a
+/// line, 0.72 at 16).
+#[derive(Clone, Debug)]
+pub(crate) struct Lines {
+    lines: Vec<Line>,
+    blocks: usize,
+}
+
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Line([[f64; 4]; 2]);
+
+impl Lines {
+    fn new(blocks: &[[f64; 4]]) -> Lines {
+        let lines = blocks
+            .chunks(2)
+            .map(|p| Line([p[0], p.get(1).copied().unwrap_or([0.0; 4])]))
+            .collect();
+        Lines {
+            lines,
+            blocks: blocks.len(),
+        }
+    }
+
+    fn as_blocks(&self) -> &[[f64; 4]] {
+        // SAFETY: Line is repr(C) of two [f64; 4] (64 bytes, no padding),
+        // so `lines` holds 2·lines.len() ≥ `blocks` consecutive blocks.
+        #[allow(unsafe_code)]
+        unsafe {
+            std::slice::from_raw_parts(self.lines.as_ptr().cast(), self.blocks)
+        }
+    }
 }
 
 /// Which form [`Compact::with_form`] builds (the step uses `Auto`; the
@@ -563,7 +607,10 @@ pub enum Form {
 trait Blocks: Sync {
     type Id: Sync;
     fn ids(&self) -> &[Self::Id];
-    fn value(&self, id: &Self::Id) -> [f64; 4];
+    fn value<'s>(&'s self, id: &'s Self::Id) -> &'s [f64; 4];
+    /// The 8 values of two consecutive blocks (`ids` holds 2) when they
+    /// are adjacent in memory.
+    fn pair(&self, ids: &[Self::Id]) -> Option<*const f64>;
 }
 
 struct StoredBlocks<'a>(&'a [[f64; 4]]);
@@ -575,8 +622,13 @@ impl Blocks for StoredBlocks<'_> {
         self.0
     }
     #[inline(always)]
-    fn value(&self, id: &[f64; 4]) -> [f64; 4] {
-        *id
+    fn value<'s>(&'s self, id: &'s [f64; 4]) -> &'s [f64; 4] {
+        id
+    }
+    #[inline(always)]
+    fn pair(&self, ids: &[[f64; 4]]) -> Option<*const f64> {
+        let two: &[[f64; 4]; 2] = ids.try_into().ok()?;
+        Some(two.as_ptr().cast())
     }
 }
 
@@ -592,9 +644,13 @@ impl<I: Copy + Into<u32> + Sync> Blocks for DictBlocks<'_, I> {
         self.ids
     }
     #[inline(always)]
-    fn value(&self, id: &I) -> [f64; 4] {
+    fn value<'s>(&'s self, id: &'s I) -> &'s [f64; 4] {
         let k: u32 = (*id).into();
-        self.dict[k as usize]
+        &self.dict[k as usize]
+    }
+    #[inline(always)]
+    fn pair(&self, _: &[I]) -> Option<*const f64> {
+        None
     }
 }
 
@@ -604,25 +660,70 @@ trait Kernel<R> {
     fn run<B: Blocks>(self, k: &Compact, b: &B) -> R;
 }
 
-/// One 2×2 block's contribution to a group's two sums, each in the CSR's
-/// order (column c, then c + 1). The block is stored by columns, so that
-/// the two rows' operations on one column are a pair of adjacent lanes
-/// (the compiler's 2-wide vector operations).
+/// One 2×2 block's products added to four partial sums, laid out as the
+/// block is stored (by columns): [row 0 · column c, row 1 · column c,
+/// row 0 · column c + 1, row 1 · column c + 1]: one 4-wide operation per
+/// block ([`avx_groups`]).
 #[inline(always)]
-pub(crate) fn block(col: u32, v: [f64; 4], x: &[f64], s: &mut [f64; 2]) {
+pub(crate) fn block(col: u32, v: &[f64; 4], x: &[f64], s: &mut [f64; 4]) {
     let c = col as usize;
     let xs = &x[c..c + 2];
-    let (x0, x1) = (xs[0], xs[1]);
-    s[0] += v[0] * x0;
-    s[1] += v[1] * x0;
-    s[0] += v[2] * x1;
-    s[1] += v[3] * x1;
+    s[0] += v[0] * xs[0];
+    s[1] += v[1] * xs[0];
+    s[2] += v[2] * xs[1];
+    s[3] += v[3] * xs[1];
+}
+
+/// A group's two row sums from its blocks' products ([`block`]), in the
+/// order [`Compact`] defines: four partial sums per lane, one per block
+/// number mod 4 over the whole quads of blocks, each in storage order;
+/// then even = s₀ + s₂ and odd = s₁ + s₃ lane by lane, the last pair of
+/// blocks (a group's count is even, [`Lines`]) added to even and odd;
+/// then even + odd lane by lane, and per row its first column's terms +
+/// its second's. Chosen for 8-wide registers (two blocks each, two
+/// registers per group, [`avx512_groups`]): a row's sum is eight short
+/// chains of dependent additions instead of the CSR's one long chain.
+#[inline(always)]
+pub(crate) fn group_sums<'v>(
+    cols: &[u32],
+    vals: impl ExactSizeIterator<Item = &'v [f64; 4]>,
+    x: &[f64],
+) -> [f64; 2] {
+    let quads = cols.len() & !3;
+    let mut s = [[0.0; 4]; 4];
+    let (mut even, mut odd) = ([0.0; 4], [0.0; 4]);
+    for (j, (&c, v)) in cols.iter().zip(vals).enumerate() {
+        if j < quads {
+            block(c, v, x, &mut s[j % 4]);
+        } else {
+            if j == quads {
+                even = std::array::from_fn(|l| s[0][l] + s[2][l]);
+                odd = std::array::from_fn(|l| s[1][l] + s[3][l]);
+            }
+            block(
+                c,
+                v,
+                x,
+                if (j - quads).is_multiple_of(2) {
+                    &mut even
+                } else {
+                    &mut odd
+                },
+            );
+        }
+    }
+    if quads == cols.len() {
+        even = std::array::from_fn(|l| s[0][l] + s[2][l]);
+        odd = std::array::from_fn(|l| s[1][l] + s[3][l]);
+    }
+    let t: [f64; 4] = std::array::from_fn(|l| even[l] + odd[l]);
+    [t[0] + t[2], t[1] + t[3]]
 }
 
 impl Values {
     fn bytes(&self) -> usize {
         match self {
-            Values::Stored(v) => 32 * v.len(),
+            Values::Stored(v) => 32 * v.blocks,
             Values::Dict16 { ids, dict } => 2 * ids.len() + 32 * dict.len(),
             Values::Dict32 { ids, dict } => 4 * ids.len() + 32 * dict.len(),
         }
@@ -831,6 +932,12 @@ impl Compact {
         let group_rows = row_groups(a, |_, _, c, v| {
             block_cols.extend_from_slice(c);
             block_vals.extend_from_slice(v);
+            // An even number of blocks per group: a zero block at the last
+            // column (its terms +0·x leave the odd sums' bits, [`Lines`]).
+            if let (true, Some(&last)) = (c.len() % 2 == 1, c.last()) {
+                block_cols.push(last);
+                block_vals.push([0.0; 4]);
+            }
             group_blocks.push(block_cols.len().min(u32::MAX as usize) as u32);
         });
         if block_cols.len() >= u32::MAX as usize {
@@ -843,11 +950,15 @@ impl Compact {
             group_rows,
             group_blocks,
             cols: block_cols,
-            values: Values::Stored(Vec::new()),
+            values: Values::Stored(Lines::new(&[])),
             chunk_groups,
+            wide: Wide::best(),
+            n,
         };
+        // avx*_groups read x[c], x[c + 1] unchecked.
+        assert!(compact.cols.iter().all(|&c| (c as usize) + 1 < n));
         compact.values = match form {
-            Form::Stored => Values::Stored(block_vals),
+            Form::Stored => Values::Stored(Lines::new(&block_vals)),
             Form::Dictionary => dictionary(&block_vals, usize::MAX).expect("no limit"),
             Form::Auto => {
                 // The largest dictionary that can halve the stream (with
@@ -859,7 +970,7 @@ impl Compact {
                 let max = (stored / 2).saturating_sub(compact.bytes_with(2 * blocks)) / 32;
                 match dictionary(&block_vals, max) {
                     Some(values) if 2 * compact.bytes_with(values.bytes()) <= stored => values,
-                    _ => Values::Stored(block_vals),
+                    _ => Values::Stored(Lines::new(&block_vals)),
                 }
             }
         };
@@ -894,7 +1005,7 @@ impl Compact {
     #[inline(always)]
     fn with_blocks<R>(&self, k: impl Kernel<R>) -> R {
         match &self.values {
-            Values::Stored(v) => k.run(self, &StoredBlocks(v)),
+            Values::Stored(v) => k.run(self, &StoredBlocks(v.as_blocks())),
             Values::Dict16 { ids, dict } => k.run(self, &DictBlocks { ids, dict }),
             Values::Dict32 { ids, dict } => k.run(self, &DictBlocks { ids, dict }),
         }
@@ -904,11 +1015,8 @@ impl Compact {
     #[inline(always)]
     fn group_sums_in<B: Blocks>(&self, b: &B, g: usize, x: &[f64]) -> [f64; 2] {
         let blocks = self.group_blocks[g] as usize..self.group_blocks[g + 1] as usize;
-        let mut s = [0.0; 2];
-        for (&col, v) in self.cols[blocks.clone()].iter().zip(&b.ids()[blocks]) {
-            block(col, b.value(v), x, &mut s);
-        }
-        s
+        let ids = &b.ids()[blocks.clone()];
+        group_sums(&self.cols[blocks], ids.iter().map(|i| b.value(i)), x)
     }
 
     /// (K x)_i alone, with the bits the passes give it.
@@ -949,85 +1057,30 @@ impl Compact {
     }
 
     /// K x on the rows of groups g0..g1 into `out` (from the first row of
-    /// g0 on), with the values in form `B`.
-    ///
-    /// [`LOCKSTEP`] groups are summed in lockstep: a row's sum is a chain
-    /// of dependent additions in a fixed order (the CSR's, for the bits),
-    /// so one group alone leaves the core waiting on the adder's latency;
-    /// G groups give it 2G independent chains, each still in its own order.
+    /// g0 on), with the values in form `B`: 8 or 4 wide where the CPU
+    /// can ([`avx512_groups`], [`avx_groups`]), the same bits.
     #[inline(always)]
+    #[allow(unsafe_code)]
     fn groups_into<B: Blocks>(&self, b: &B, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        match self.wide {
+            // SAFETY: `wide` says what the CPU has (Compact::with_form).
+            Wide::Avx512 => return unsafe { avx512_groups(self, b, g0, g1, x, out) },
+            Wide::Avx => return unsafe { avx_groups(self, b, g0, g1, x, out) },
+            Wide::No => {}
+        }
         let base = self.group_rows[g0] as usize;
-        let mut g = g0;
-        while g + LOCKSTEP <= g1 {
-            self.lockstep::<LOCKSTEP, B>(b, g, x, out, base);
-            g += LOCKSTEP;
-        }
-        while g < g1 {
-            self.lockstep::<1, B>(b, g, x, out, base);
-            g += 1;
-        }
-    }
-
-    /// Groups g..g + G in lockstep over their common length, then the
-    /// rest of each.
-    #[inline(always)]
-    fn lockstep<const G: usize, B: Blocks>(
-        &self,
-        b: &B,
-        g: usize,
-        x: &[f64],
-        out: &mut [f64],
-        base: usize,
-    ) {
-        let mut at: [usize; G] = std::array::from_fn(|q| self.group_blocks[g + q] as usize);
-        let end: [usize; G] = std::array::from_fn(|q| self.group_blocks[g + q + 1] as usize);
-        let mut s = [[0.0; 2]; G];
-        self.common(b, x, &mut at, &end, &mut s);
-        if G > 1 {
-            for q in 0..G {
-                let mut one = [s[q]];
-                self.common(b, x, &mut [at[q]], &[end[q]], &mut one);
-                s[q] = one[0];
-            }
-        }
-        for (q, s) in s.iter().enumerate() {
-            let r0 = self.group_rows[g + q] as usize;
+        for g in g0..g1 {
+            let s = self.group_sums_in(b, g, x);
+            let r0 = self.group_rows[g] as usize;
             out[r0 - base] = s[0];
-            if self.group_rows[g + q + 1] as usize - r0 == 2 {
+            if self.group_rows[g + 1] as usize - r0 == 2 {
                 out[r0 + 1 - base] = s[1];
             }
         }
     }
 
-    /// The blocks at[q]..at[q] + len of G groups in lockstep, len their
-    /// least remaining length; advances `at`.
-    #[inline(always)]
-    fn common<const G: usize, B: Blocks>(
-        &self,
-        b: &B,
-        x: &[f64],
-        at: &mut [usize; G],
-        end: &[usize; G],
-        s: &mut [[f64; 2]; G],
-    ) {
-        let ids = b.ids();
-        let len = (0..G).map(|q| end[q] - at[q]).min().unwrap_or(0);
-        let cols: [&[u32]; G] = std::array::from_fn(|q| &self.cols[at[q]..at[q] + len]);
-        let vals: [&[B::Id]; G] = std::array::from_fn(|q| &ids[at[q]..at[q] + len]);
-        let mut acc = *s;
-        for j in 0..len {
-            for q in 0..G {
-                block(cols[q][j], b.value(&vals[q][j]), x, &mut acc[q]);
-            }
-        }
-        *s = acc;
-        for a in at.iter_mut() {
-            *a += len;
-        }
-    }
-
-    /// y = K x (the same bits as [`spmv`] on the CSR).
+    /// y = K x.
     pub fn spmv(&self, x: &[f64], y: &mut [f64]) {
         struct Into<'x, 'y>(usize, &'x [f64], &'y mut [f64]);
         impl Kernel<()> for Into<'_, '_> {
@@ -1040,6 +1093,194 @@ impl Compact {
         }
         let body = |c: usize, y: &mut [f64]| self.with_blocks(Into(c, x, y));
         each_chunk(y, body);
+    }
+}
+
+/// The widest sums a CPU runs for [`Compact`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Wide {
+    /// Scalar ([`block`], the compiler's 2-wide operations).
+    No,
+    /// [`avx_groups`].
+    Avx,
+    /// [`avx512_groups`].
+    Avx512,
+}
+
+impl Wide {
+    /// The widest this CPU has.
+    pub(crate) fn best() -> Wide {
+        if avx() && avx512() {
+            Wide::Avx512
+        } else if avx() {
+            Wide::Avx
+        } else {
+            Wide::No
+        }
+    }
+}
+
+/// A group's row sums ([`group_sums`]) from its even and odd partial sums,
+/// each 4 wide, into `out` at the group's rows.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn store_group(
+    k: &Compact,
+    g: usize,
+    base: usize,
+    even: std::arch::x86_64::__m256d,
+    odd: std::arch::x86_64::__m256d,
+    out: &mut [f64],
+) {
+    use std::arch::x86_64::*;
+    let t = _mm256_add_pd(even, odd);
+    let rows = _mm_add_pd(_mm256_castpd256_pd128(t), _mm256_extractf128_pd::<1>(t));
+    let r0 = k.group_rows[g] as usize - base;
+    if k.group_rows[g + 1] as usize - base - r0 == 2 {
+        let o: &mut [f64; 2] = (&mut out[r0..r0 + 2]).try_into().expect("2 rows");
+        // SAFETY: o holds 2 doubles; unaligned store.
+        #[allow(unsafe_code)]
+        unsafe {
+            _mm_storeu_pd(o.as_mut_ptr(), rows)
+        };
+    } else {
+        out[r0] = _mm_cvtsd_f64(rows);
+    }
+}
+
+/// x[c], x[c + 1], x[c], x[c + 1]: one 16-byte broadcast.
+///
+/// # Safety
+/// x[c + 1] must be readable from `xp`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[allow(unsafe_code)]
+unsafe fn pair_twice(xp: *const f64, c: u32) -> std::arch::x86_64::__m256d {
+    use std::arch::x86_64::*;
+    // SAFETY: the caller's; an unaligned read (the broadcast's reference
+    // wants 16-byte alignment, x has 8).
+    unsafe { _mm256_broadcast_pd(&(xp.add(c as usize) as *const __m128d).read_unaligned()) }
+}
+
+/// One block's products added to `acc` ([`block`] 4 wide): x[c], x[c + 1]
+/// spread to [x[c], x[c], x[c + 1], x[c + 1]] by an in-lane shuffle.
+///
+/// # Safety
+/// x[c + 1] must be readable from `xp`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[allow(unsafe_code)]
+unsafe fn block4(
+    xp: *const f64,
+    c: u32,
+    v: &[f64; 4],
+    acc: std::arch::x86_64::__m256d,
+) -> std::arch::x86_64::__m256d {
+    use std::arch::x86_64::*;
+    // SAFETY: the caller's; v holds 4 doubles (unaligned load).
+    let (xv, vv) = unsafe { (pair_twice(xp, c), _mm256_loadu_pd(v.as_ptr())) };
+    _mm256_add_pd(acc, _mm256_mul_pd(vv, _mm256_permute_pd::<0b1100>(xv)))
+}
+
+/// [`Compact::groups_into`] 4 wide: per group four registers of
+/// [`block`]'s partial sums, one per block number mod 4 ([`group_sums`]'s
+/// order). Per lane the scalar kernel's operations in its order
+/// (multiplications and additions separate, no fused multiply-add), so
+/// the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[allow(unsafe_code)]
+fn avx_groups<B: Blocks>(k: &Compact, b: &B, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
+    use std::arch::x86_64::*;
+    let base = k.group_rows[g0] as usize;
+    let ids = b.ids();
+    // Every block's columns c, c + 1 are below n (Compact::with_form):
+    // with x this long, the reads need no check per block.
+    let xp = x[..k.n].as_ptr();
+    for g in g0..g1 {
+        let blocks = k.group_blocks[g] as usize..k.group_blocks[g + 1] as usize;
+        let (cols, ids) = (&k.cols[blocks.clone()], &ids[blocks]);
+        let mut s = [_mm256_setzero_pd(); 4];
+        let quads = cols.len() & !3;
+        for (c, i) in cols[..quads]
+            .chunks_exact(4)
+            .zip(ids[..quads].chunks_exact(4))
+        {
+            for q in 0..4 {
+                // SAFETY: c[q] + 1 < n = x's length (above).
+                s[q] = unsafe { block4(xp, c[q], b.value(&i[q]), s[q]) };
+            }
+        }
+        let (mut even, mut odd) = (_mm256_add_pd(s[0], s[2]), _mm256_add_pd(s[1], s[3]));
+        for (j, (&c, i)) in cols[quads..].iter().zip(&ids[quads..]).enumerate() {
+            let acc = if j % 2 == 0 { &mut even } else { &mut odd };
+            // SAFETY: as above.
+            *acc = unsafe { block4(xp, c, b.value(i), *acc) };
+        }
+        store_group(k, g, base, even, odd, out);
+    }
+}
+
+/// [`Compact::groups_into`] 8 wide: two blocks to a register (the even
+/// one's partial sums in the low half, the odd one's in the high), two
+/// registers per group (blocks 4m, 4m + 1 and 4m + 2, 4m + 3): lane by
+/// lane [`avx_groups`]'s operations, so the same bits, in half the
+/// instructions. Where the values are stored, the two blocks are one
+/// 64-byte line ([`Lines`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[allow(unsafe_code)]
+fn avx512_groups<B: Blocks>(k: &Compact, b: &B, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
+    use std::arch::x86_64::*;
+    let base = k.group_rows[g0] as usize;
+    let ids = b.ids();
+    // As in avx_groups: x[c], x[c + 1] in bounds for every block.
+    let xp = x[..k.n].as_ptr();
+    let two = |c: &[u32], i: &[B::Id], acc: __m512d| -> __m512d {
+        // SAFETY: c[0] + 1, c[1] + 1 < n = x's length (above); two blocks
+        // of 4 doubles, as one 8-double load where they are adjacent.
+        unsafe {
+            let xv = _mm512_insertf64x4::<1>(
+                _mm512_castpd256_pd512(pair_twice(xp, c[0])),
+                pair_twice(xp, c[1]),
+            );
+            let v = match b.pair(i) {
+                Some(p) => _mm512_loadu_pd(p),
+                None => _mm512_insertf64x4::<1>(
+                    _mm512_castpd256_pd512(_mm256_loadu_pd(b.value(&i[0]).as_ptr())),
+                    _mm256_loadu_pd(b.value(&i[1]).as_ptr()),
+                ),
+            };
+            let xv = _mm512_permute_pd::<0b1100_1100>(xv);
+            _mm512_add_pd(acc, _mm512_mul_pd(v, xv))
+        }
+    };
+    for g in g0..g1 {
+        let blocks = k.group_blocks[g] as usize..k.group_blocks[g + 1] as usize;
+        let (cols, ids) = (&k.cols[blocks.clone()], &ids[blocks]);
+        let (mut lo, mut hi) = (_mm512_setzero_pd(), _mm512_setzero_pd());
+        let quads = cols.len() & !3;
+        for (c, i) in cols[..quads]
+            .chunks_exact(4)
+            .zip(ids[..quads].chunks_exact(4))
+        {
+            lo = two(&c[..2], &i[..2], lo);
+            hi = two(&c[2..], &i[2..], hi);
+        }
+        let mut acc = _mm512_add_pd(lo, hi);
+        let pairs = cols.len() & !1;
+        if pairs > quads {
+            acc = two(&cols[quads..pairs], &ids[quads..pairs], acc);
+        }
+        let (mut even, odd) = (
+            _mm512_castpd512_pd256(acc),
+            _mm512_extractf64x4_pd::<1>(acc),
+        );
+        if pairs < cols.len() {
+            // SAFETY: as above.
+            even = unsafe { block4(xp, cols[pairs], b.value(&ids[pairs]), even) };
+        }
+        store_group(k, g, base, even, odd, out);
     }
 }
 
@@ -1529,6 +1770,18 @@ pub(crate) fn avx() -> bool {
     }
 }
 
+/// Whether this CPU has AVX-512 (foundation).
+pub(crate) fn avx512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512f")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// Passes B and C and the SpMV in one sweep: per row, K r_K, R̂_K,
 /// ṙ_K = R̂_K/(m·scale) — or, at the contact DOFs, the velocity the nodal
 /// friction gave (`friction`, (DOF, ṙ_K) sorted by DOF, computed before
@@ -1687,12 +1940,87 @@ pub(crate) mod tests {
             .collect()
     }
 
-    /// The compact K·x has the CSR's bits (the claim of [`Compact`]: same
-    /// summation order, padding zeros exact), on the committed meshes with
-    /// the slab's supports (single-DOF nodes on two edges) and on a free
-    /// model (every node a full pair).
+    /// K x in [`Compact`]'s order ([`group_sums`]) from the CSR alone:
+    /// each row's blocks are the pair starts of its columns (a node's two
+    /// rows have the same columns; a DOF without a partner starts its
+    /// block one column early, column 0 at itself), their count rounded up
+    /// to even; an entry of block j in column half h goes to partial sum
+    /// (j mod 4, h) while j is in the whole quads, then to even (j even) or
+    /// odd; y = Σ_h (even_h + odd_h).
+    pub(crate) fn compact_order_spmv(k: &CsrMatrix<f64>, x: &[f64]) -> Vec<f64> {
+        let n = k.nrows();
+        let (off, cols, vals) = (k.row_offsets(), k.col_indices(), k.values());
+        let row = |i: usize| &cols[off[i]..off[i + 1]];
+        let mut start = vec![0; n];
+        let mut i = 0;
+        while i < n {
+            if i + 1 < n && row(i) == row(i + 1) {
+                (start[i], start[i + 1]) = (i, i);
+                i += 2;
+            } else {
+                start[i] = i.saturating_sub(1);
+                i += 1;
+            }
+        }
+        (0..n)
+            .map(|i| {
+                let mut blocks: Vec<usize> = row(i).iter().map(|&c| start[c]).collect();
+                blocks.dedup();
+                let quads = (blocks.len() + blocks.len() % 2) & !3;
+                let mut p = [[0.0; 2]; 4];
+                let (mut even, mut odd) = ([0.0; 2], [0.0; 2]);
+                let mut formed = false;
+                for e in off[i]..off[i + 1] {
+                    let c = cols[e];
+                    let j = blocks.binary_search(&start[c]).expect("a block");
+                    let h = c - start[c];
+                    if j < quads {
+                        p[j % 4][h] += vals[e] * x[c];
+                        continue;
+                    }
+                    if !formed {
+                        even = [p[0][0] + p[2][0], p[0][1] + p[2][1]];
+                        odd = [p[1][0] + p[3][0], p[1][1] + p[3][1]];
+                        formed = true;
+                    }
+                    let sums = if (j - quads).is_multiple_of(2) {
+                        &mut even
+                    } else {
+                        &mut odd
+                    };
+                    sums[h] += vals[e] * x[c];
+                }
+                if !formed {
+                    even = [p[0][0] + p[2][0], p[0][1] + p[2][1]];
+                    odd = [p[1][0] + p[3][0], p[1][1] + p[3][1]];
+                }
+                (even[0] + odd[0]) + (even[1] + odd[1])
+            })
+            .collect()
+    }
+
+    /// [`Compact`] at every width this CPU runs.
+    pub(crate) fn widths(compact: &Compact) -> Vec<Compact> {
+        [Wide::No, Wide::Avx, Wide::Avx512]
+            .into_iter()
+            .filter(|&w| match w {
+                Wide::No => true,
+                Wide::Avx => avx(),
+                Wide::Avx512 => avx() && avx512(),
+            })
+            .map(|wide| Compact {
+                wide,
+                ..compact.clone()
+            })
+            .collect()
+    }
+
+    /// The compact K·x sums in the order [`Compact`] defines (padding
+    /// zeros exact) at every width, on the committed meshes with the
+    /// slab's supports (single-DOF nodes on two edges) and on a free model
+    /// (every node a full pair).
     #[test]
-    fn compact_spmv_has_the_csr_bits() {
+    fn compact_spmv_has_the_bits_of_its_order() {
         let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
         let supports = [
             Dirichlet::new("support", 1, 0.0),
@@ -1712,14 +2040,22 @@ pub(crate) mod tests {
                 for k in [&model.stiffness, &model.mass] {
                     let n = k.nrows();
                     let x = x_of(n);
-                    let mut y0 = vec![0.0; n];
-                    spmv(k, &x, &mut y0);
+                    let y0 = compact_order_spmv(k, &x);
                     for form in [Form::Stored, Form::Dictionary, Form::Auto] {
                         let compact = Compact::with_form(k, form).expect("applies");
-                        let mut y1 = vec![1.0; n];
-                        compact.spmv(&x, &mut y1);
+                        for compact in widths(&compact) {
+                            let mut y1 = vec![1.0; n];
+                            compact.spmv(&x, &mut y1);
+                            let w = compact.wide;
+                            for i in 0..n {
+                                assert_eq!(
+                                    y0[i].to_bits(),
+                                    y1[i].to_bits(),
+                                    "{name} {form:?} {w:?} row {i}"
+                                );
+                            }
+                        }
                         for i in 0..n {
-                            assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "{name} {form:?} row {i}");
                             assert_eq!(
                                 y0[i].to_bits(),
                                 compact.row(i, &x).to_bits(),
@@ -1922,8 +2258,8 @@ pub(crate) mod tests {
             .map(|i| (i, -0.25 * i as f64))
             .collect();
         let mut p0 = partials(n);
-        let (mut b, mut vn0, mut an0) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        spmv(k, &r_new, &mut b);
+        let (mut vn0, mut an0) = (vec![0.0; n], vec![0.0; n]);
+        let mut b = compact_order_spmv(k, &r_new);
         let ku = b.clone();
         let strain0 = rhs_and_velocity(
             &load_new, &mass, &r_new, &v, &a, data.cv, data.ca, data.scale, &mut b, &mut vn0,
@@ -2014,18 +2350,20 @@ pub(crate) mod tests {
         }
         let k = CsrMatrix::from(&coo);
         let x = x_of(n);
-        let mut y0 = vec![0.0; n];
-        spmv(&k, &x, &mut y0);
+        let y0 = compact_order_spmv(&k, &x);
         for form in [Form::Stored, Form::Dictionary] {
             let compact = Compact::with_form(&k, form).unwrap();
             let pairs = (0..compact.group_rows.len() - 1)
                 .filter(|&g| compact.group_rows[g + 1] - compact.group_rows[g] == 2)
                 .count();
             assert!(pairs > n / 2 - 100, "{pairs} pairs of {n} rows");
-            let mut y1 = vec![1.0; n];
-            compact.spmv(&x, &mut y1);
-            for i in 0..n {
-                assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "{form:?} row {i}");
+            for compact in widths(&compact) {
+                let mut y1 = vec![1.0; n];
+                compact.spmv(&x, &mut y1);
+                for i in 0..n {
+                    let w = compact.wide;
+                    assert_eq!(y0[i].to_bits(), y1[i].to_bits(), "{form:?} {w:?} row {i}");
+                }
             }
         }
     }
@@ -2681,6 +3019,54 @@ pub(crate) mod tests {
                     1e3 * t[0]
                 );
             }
+        }
+    }
+
+    /// K·x on a small mesh (one chunk, in cache: the per-step overhead
+    /// the paper mesh's step is made of), CSR against [`Compact`] at each
+    /// width, medians of 30 rounds of 20,000 products. `STICKSLIP_LAB_MESH`
+    /// picks the slab (default q2-8x2, the paper's 148 free DOFs):
+    ///
+    ///     cargo test --release -p stickslip-time --lib small_lab -- --ignored --nocapture
+    ///
+    /// 2026-11-24: CSR 2.28 µs; compact scalar, AVX, AVX-512 in
+    /// [`group_sums`]' order with 64-byte lines: see the commit; the
+    /// CSR's order (two groups in lockstep, 2×2-wide) had 1.11 µs.
+    #[test]
+    #[ignore = "timing; run by hand (see the doc comment)"]
+    fn small_lab() {
+        use std::time::Instant;
+        let name = std::env::var("STICKSLIP_LAB_MESH").unwrap_or_else(|_| "q2-8x2".into());
+        let (_, _, model) = lab_slab(&name);
+        let k = &model.stiffness;
+        let n = k.nrows();
+        let compact = Compact::new(k).expect("applies");
+        let x = x_of(n);
+        let mut y = vec![0.0; n];
+        let reps = 20_000;
+        let time = |f: &mut dyn FnMut()| -> f64 {
+            let mut t: Vec<f64> = (0..30)
+                .map(|_| {
+                    let s = Instant::now();
+                    for _ in 0..reps {
+                        f();
+                    }
+                    s.elapsed().as_secs_f64() / reps as f64
+                })
+                .collect();
+            t.sort_by(f64::total_cmp);
+            t[t.len() / 2]
+        };
+        println!(
+            "{name}: n = {n}, nnz = {}, blocks = {}",
+            k.nnz(),
+            compact.blocks()
+        );
+        let csr = time(&mut || spmv(k, std::hint::black_box(&x), &mut y));
+        println!("  CSR            {:.3} µs", 1e6 * csr);
+        for c in widths(&compact) {
+            let t = time(&mut || c.spmv(std::hint::black_box(&x), &mut y));
+            println!("  compact {:<6} {:.3} µs", format!("{:?}", c.wide), 1e6 * t);
         }
     }
 }

@@ -352,16 +352,7 @@ mod avx {
     pub(super) use crate::kernels::avx as available;
 
     /// Whether this CPU has AVX-512 (foundation) for `units(true, ..)`.
-    pub fn available_512() -> bool {
-        #[cfg(target_arch = "x86_64")]
-        {
-            std::arch::is_x86_feature_detected!("avx512f")
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            false
-        }
-    }
+    pub(super) use crate::kernels::avx512 as available_512;
 
     /// The sums of rows r..r + out.len() (a multiple of 8) into `out`:
     /// per 8 rows, the node pairs at rows r, r + 2 (one unit: blocks at
