@@ -80,10 +80,10 @@
 //! CSR's order): the dev profile's opt-level 2 emits them scalar (rustc
 //! runs LLVM's SLP vectorizer at opt-level 3 only), about 1.5 ns per block
 //! on one core in cache (paper mesh: 1,088 blocks, ~1.6 µs of its step).
-//! Two groups (four row sums) in lockstep ([`Compact::groups_into`]);
-//! four were measured no faster (paper mesh 2.64 vs 2.49 µs per step, Q2
-//! equal within the noise): the loop is bound by instructions, not by
-//! the adder's latency. Storing the blocks by columns lets opt-level 3
+//! Two groups (four row sums) in lockstep, in the CSR's order; four
+//! were measured no faster (paper mesh 2.64 vs 2.49 µs per step, Q2
+//! equal within the noise). (Since 2026-11-24 each row is summed in
+//! eight partial sums, 4 or 8 wide: [`Compact`].) Storing the blocks by columns lets opt-level 3
 //! pair the two rows' operations (mulpd/addpd, same bits): the paper mesh
 //! then steps in 2.11 instead of 2.51 µs and Q1 708×177 in 1.61 instead
 //! of 1.89 ms (fastest of 3, same session), but the 1M-DOF Q1 and the
@@ -3029,9 +3029,11 @@ pub(crate) mod tests {
     ///
     ///     cargo test --release -p stickslip-time --lib small_lab -- --ignored --nocapture
     ///
-    /// 2026-11-24: CSR 2.28 µs; compact scalar, AVX, AVX-512 in
-    /// [`group_sums`]' order with 64-byte lines: see the commit; the
-    /// CSR's order (two groups in lockstep, 2×2-wide) had 1.11 µs.
+    /// 2026-11-24, paper mesh: CSR 2.30 µs; compact in [`group_sums`]'
+    /// order on 64-byte lines: scalar (SSE2 build) 1.86, AVX 0.63,
+    /// AVX-512 0.64 µs (the compact in the CSR's order, two groups in
+    /// lockstep, 2-wide, had 1.11 µs); Q2 64×16 (8,352 DOFs, two chunks):
+    /// CSR 208, AVX 67, AVX-512 61 µs.
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn small_lab() {
