@@ -686,35 +686,18 @@ pub(crate) fn block(col: u32, v: &[f64; 4], x: &[f64], s: &mut [f64; 4]) {
 #[inline(always)]
 pub(crate) fn group_sums<'v>(
     cols: &[u32],
-    vals: impl ExactSizeIterator<Item = &'v [f64; 4]>,
+    mut vals: impl ExactSizeIterator<Item = &'v [f64; 4]>,
     x: &[f64],
 ) -> [f64; 2] {
     let quads = cols.len() & !3;
     let mut s = [[0.0; 4]; 4];
-    let (mut even, mut odd) = ([0.0; 4], [0.0; 4]);
-    for (j, (&c, v)) in cols.iter().zip(vals).enumerate() {
-        if j < quads {
-            block(c, v, x, &mut s[j % 4]);
-        } else {
-            if j == quads {
-                even = std::array::from_fn(|l| s[0][l] + s[2][l]);
-                odd = std::array::from_fn(|l| s[1][l] + s[3][l]);
-            }
-            block(
-                c,
-                v,
-                x,
-                if (j - quads).is_multiple_of(2) {
-                    &mut even
-                } else {
-                    &mut odd
-                },
-            );
-        }
+    for (j, (&c, v)) in cols[..quads].iter().zip(vals.by_ref()).enumerate() {
+        block(c, v, x, &mut s[j % 4]);
     }
-    if quads == cols.len() {
-        even = std::array::from_fn(|l| s[0][l] + s[2][l]);
-        odd = std::array::from_fn(|l| s[1][l] + s[3][l]);
+    let mut even: [f64; 4] = std::array::from_fn(|l| s[0][l] + s[2][l]);
+    let mut odd: [f64; 4] = std::array::from_fn(|l| s[1][l] + s[3][l]);
+    for (j, (&c, v)) in cols[quads..].iter().zip(vals).enumerate() {
+        block(c, v, x, if j % 2 == 0 { &mut even } else { &mut odd });
     }
     let t: [f64; 4] = std::array::from_fn(|l| even[l] + odd[l]);
     [t[0] + t[2], t[1] + t[3]]
