@@ -538,6 +538,27 @@ impl Supernodal {
         self.xp = xp;
     }
 
+    /// The permutation: x_perm[i] = x[fwd[i]].
+    pub fn forward_permutation(&self) -> &[u32] {
+        &self.fwd
+    }
+
+    /// Supernode s's number of columns and pattern length.
+    pub fn block_shape(&self, s: usize) -> (usize, usize) {
+        (
+            self.begin[s + 1] - self.begin[s],
+            self.row_ptr[s + 1] - self.row_ptr[s],
+        )
+    }
+
+    /// Supernode s of the factor with values `l`, for solvers built on
+    /// this layout: its first (permuted) column, its number of columns k,
+    /// its pattern (the m permuted rows below its diagonal block) and its
+    /// block of L, column-major (k + m) × k.
+    pub fn block<'a>(&'a self, l: &'a [f64], s: usize) -> (usize, usize, &'a [u32], &'a [f64]) {
+        self.supernode(l, s)
+    }
+
     /// Supernode s: its first column, its number of columns, its pattern
     /// and its block of L.
     #[inline]

@@ -1566,8 +1566,8 @@ impl Integrator {
     }
 
     /// Values stored per factor of A₀ (Schur path; 0 otherwise): with 8
-    /// bytes each, the memory of one Δt's factor and the data one
-    /// forward+back solve reads twice.
+    /// bytes each, the memory of one Δt's factor (with its inverted blocks
+    /// on small meshes, `small_solve.rs`).
     pub fn factor_len(&self) -> usize {
         self.schur.as_ref().map_or(0, |op| op.factor_len())
     }

@@ -25,6 +25,7 @@ pub mod linalg;
 mod memory;
 pub mod scenes;
 mod schur;
+mod small_solve;
 pub mod stability;
 mod stencils;
 

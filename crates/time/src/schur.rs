@@ -43,6 +43,8 @@ use stickslip_fem::{analyze_symbolic, csc_view, ContactOperator, SolverError};
 
 use stickslip_fem::Supernodal;
 
+use crate::small_solve::BlockInverse;
+
 /// Right-hand sides solved together when building Z and S: one pass over
 /// the factor serves the whole block.
 /// (16: the pool's two blocks in flight hold what one block of 32 did.)
@@ -97,6 +99,9 @@ struct Entry {
     /// W = L⁻¹Pᵀ on its paths (`Supernodal::schur_complement`), when the
     /// step goes through it rather than through solves on the reach.
     paths: Option<ContactOperator>,
+    /// The solve by inverted supernode blocks, for small factors
+    /// (`small_solve.rs`).
+    small: Option<BlockInverse>,
     /// Distinguishes entries for the dense factor's cache.
     id: u64,
     last_used: u64,
@@ -246,9 +251,15 @@ impl SchurOperator {
         })
     }
 
-    /// Numeric factors of L kept (for memory figures).
+    /// Values held per Δt for the solves (for memory figures): L's, and
+    /// the inverted blocks' where the factor is small.
     pub fn factor_len(&self) -> usize {
-        self.symbolic.len_val()
+        let small = self
+            .entries
+            .get(self.current)
+            .and_then(|e| e.small.as_ref())
+            .map_or(0, BlockInverse::len);
+        self.symbolic.len_val() + small
     }
 
     /// (values of W the current Δt's step uses, 0 if it goes otherwise;
@@ -300,6 +311,7 @@ impl SchurOperator {
                 s: Vec::new(),
                 z: Vec::new(),
                 paths: None,
+                small: None,
                 id: 0,
                 last_used: 0,
             });
@@ -342,6 +354,8 @@ impl SchurOperator {
         self.next_id += 1;
         entry.last_used = self.clock;
         self.current = slot;
+        entry.small =
+            BlockInverse::worth_it(&self.sn).then(|| BlockInverse::new(&self.sn, &entry.l_values));
         self.build_schur(slot);
         // The factorization's workspace and S's scratch are freed.
         crate::memory::release_free_memory();
@@ -450,8 +464,11 @@ impl SchurOperator {
     }
 
     fn solve(&mut self, x: &mut [f64]) {
-        let entry = &self.entries[self.current];
-        self.sn.solve(&entry.l_values, x);
+        let entry = &mut self.entries[self.current];
+        match &mut entry.small {
+            Some(small) => small.solve(x),
+            None => self.sn.solve(&entry.l_values, x),
+        }
     }
 
     /// v = A₀⁻¹ b without friction.

@@ -1,0 +1,569 @@
+//! Solves with a small factor through inverted supernode blocks (issue 7:
+//! the paper mesh's Newmark step).
+//!
+//! On small meshes the supernodal solve (`supernodal.rs` in `fem`) is bound
+//! by latency, not by its 2·|L| multiplications: within a supernode each
+//! column's division and update wait for the previous column's, and its
+//! loops run a handful of times each. The paper's mesh (148 DOFs, a factor
+//! of 3,462 values in 16 supernodes of 4-18 columns) took 4.5 µs a solve,
+//! about 16,000 cycles.
+//!
+//! Here each supernode's triangle is inverted once per factorization,
+//! T = L_kk⁻¹, and F = [T; −L_b T] ((k + m) × k, L_b the m rows below the
+//! triangle) is stored column-major, and so is Fᵀ, both on 64-byte lines
+//! (columns padded with zeros to a multiple of 8). Then
+//!
+//! * the forward step of a supernode is one dense product: [y; δ] = F x_s,
+//!   x_s ← y, x_pattern += δ (L_kk y = x_s, δ = −L_b y);
+//! * its back step is one product with Fᵀ: x_s ← Tᵀ x_s − (L_b T)ᵀ
+//!   x_pattern = Fᵀ [x_s; x_pattern] (the pattern rows already final).
+//!
+//! Nothing inside a supernode waits on anything else, and both products
+//! are sums of columns scaled by one entry each ([`Wide::product`]), 8
+//! wide. The price is memory: 2.3× the factor on the slabs (whole
+//! triangles, both layouts, padding), so the step uses it only for small
+//! factors ([`MAX_VALUES`]). The arithmetic per lane is fixed, so the bits
+//! do not depend on the CPU's width; they are not the supernodal solve's
+//! bits (T is an explicit inverse), which is why the tests compare with
+//! the matrix and with that solve to a tolerance.
+
+use stickslip_fem::Supernodal;
+
+/// Factors up to this many values of F and Fᵀ together (2 MB) are solved
+/// by inverted blocks. `block_inverse_lab` (2026-11-24), one solve against
+/// the supernodal loops: 3.4× faster on the paper's Q2 8×2 mesh (170
+/// DOFs), 2.8× at 350 and 594 DOFs, 2.2× (Q1 48×12, 0.9 MB) and 2.1× (Q2
+/// 32×8, 1.9 MB); still 1.8× at 8.5k DOFs (9 MB), but there F and Fᵀ take
+/// 2.3× the factor's memory, which the large meshes cannot spare.
+const MAX_VALUES: usize = 1 << 18;
+
+/// Eight doubles on one 64-byte line.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
+struct Line([f64; 8]);
+
+/// One supernode: its first permuted column, k columns, m pattern rows,
+/// the offset of its pattern, and F (lines per column, offset) and Fᵀ
+/// (likewise).
+#[derive(Clone, Copy, Debug)]
+struct Block {
+    c0: usize,
+    k: usize,
+    m: usize,
+    pattern: usize,
+    f_lines: usize,
+    f_at: usize,
+    g_lines: usize,
+    g_at: usize,
+}
+
+impl Block {
+    /// Lines of F (k columns of k + m rows) and of Fᵀ (k + m columns of k
+    /// rows), rows padded to 8.
+    fn lines(k: usize, m: usize) -> (usize, usize) {
+        ((k + m).div_ceil(8), k.div_ceil(8))
+    }
+}
+
+/// A factor's solve through inverted supernode blocks.
+#[derive(Clone, Debug)]
+pub(crate) struct BlockInverse {
+    data: Data,
+    /// The permuted vector, a block's product and a block's gathered x.
+    xp: Vec<f64>,
+    out: Vec<f64>,
+    z: Vec<f64>,
+    wide: Wide,
+}
+
+/// The blocks.
+#[derive(Clone, Debug)]
+struct Data {
+    /// x_perm[i] = x[fwd[i]].
+    fwd: Vec<u32>,
+    blocks: Vec<Block>,
+    pattern: Vec<u32>,
+    /// F of every block (column-major), then Fᵀ of every block.
+    values: Vec<Line>,
+}
+
+/// The solve's width: scalar, or AVX-512 with the same bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Wide {
+    No,
+    Avx512,
+}
+
+impl BlockInverse {
+    /// Values of F and Fᵀ for `sn`'s layout.
+    pub fn values_for(sn: &Supernodal) -> usize {
+        (0..sn.supernodes())
+            .map(|s| {
+                let (k, m) = sn.block_shape(s);
+                let (f, g) = Block::lines(k, m);
+                8 * (f * k + g * (k + m))
+            })
+            .sum()
+    }
+
+    /// True when `sn`'s factors are small enough for the inverted blocks
+    /// (at most [`MAX_VALUES`]).
+    pub fn worth_it(sn: &Supernodal) -> bool {
+        Self::values_for(sn) <= MAX_VALUES
+    }
+
+    /// The inverted blocks of the factor with values `l` on `sn`'s layout
+    /// (a factor of an SPD matrix: positive diagonal).
+    pub fn new(sn: &Supernodal, l: &[f64]) -> BlockInverse {
+        let mut blocks = Vec::with_capacity(sn.supernodes());
+        let mut pattern_all = Vec::new();
+        let mut f_values: Vec<Line> = Vec::with_capacity(Self::values_for(sn) / 8);
+        let mut g_values: Vec<Line> = Vec::new();
+        let (mut max_out, mut max_z) = (0, 0);
+        let mut t = Vec::new();
+        let mut f = Vec::new();
+        let to_lines = |v: &[f64], into: &mut Vec<Line>| {
+            into.extend(v.chunks_exact(8).map(|c| {
+                let mut line = Line::default();
+                line.0.copy_from_slice(c);
+                line
+            }))
+        };
+        for s in 0..sn.supernodes() {
+            let (c0, k, pattern, block) = sn.block(l, s);
+            let m = pattern.len();
+            let ld = k + m;
+            let (f_lines, g_lines) = Block::lines(k, m);
+            max_out = max_out.max(8 * f_lines.max(g_lines));
+            max_z = max_z.max(ld);
+            // T = L_kk⁻¹, column-major k × k, by forward substitution on
+            // the unit vectors.
+            t.clear();
+            t.resize(k * k, 0.0);
+            for j in 0..k {
+                t[j * k + j] = 1.0 / block[j * ld + j];
+                for i in j + 1..k {
+                    let mut sum = 0.0;
+                    for p in j..i {
+                        sum += block[p * ld + i] * t[j * k + p];
+                    }
+                    t[j * k + i] = -sum / block[i * ld + i];
+                }
+            }
+            // F = [T; −L_b T], column-major, columns padded to f_lines·8.
+            let rows = 8 * f_lines;
+            f.clear();
+            f.resize(rows * k, 0.0);
+            for j in 0..k {
+                let col = &mut f[j * rows..(j + 1) * rows];
+                col[..k].copy_from_slice(&t[j * k..(j + 1) * k]);
+                for r in 0..m {
+                    let mut sum = 0.0;
+                    for p in j..k {
+                        sum += block[p * ld + k + r] * t[j * k + p];
+                    }
+                    col[k + r] = -sum;
+                }
+            }
+            let f_at = f_values.len();
+            to_lines(&f, &mut f_values);
+            // Fᵀ, column-major (k + m columns of k rows, padded).
+            let g_at = g_values.len();
+            let mut g = vec![0.0; 8 * g_lines * ld];
+            for i in 0..ld {
+                for j in 0..k {
+                    g[i * 8 * g_lines + j] = f[j * rows + i];
+                }
+            }
+            to_lines(&g, &mut g_values);
+            blocks.push(Block {
+                c0,
+                k,
+                m,
+                pattern: pattern_all.len(),
+                f_lines,
+                f_at,
+                g_lines,
+                g_at,
+            });
+            pattern_all.extend_from_slice(pattern);
+        }
+        let g_base = f_values.len();
+        for b in &mut blocks {
+            b.g_at += g_base;
+        }
+        f_values.extend(g_values);
+        let n = sn.forward_permutation().len();
+        BlockInverse {
+            data: Data {
+                fwd: sn.forward_permutation().to_vec(),
+                blocks,
+                pattern: pattern_all,
+                values: f_values,
+            },
+            xp: vec![0.0; n],
+            out: vec![0.0; max_out],
+            z: vec![0.0; max_z],
+            wide: if crate::kernels::avx512() {
+                Wide::Avx512
+            } else {
+                Wide::No
+            },
+        }
+    }
+
+    /// Values held (F and Fᵀ; for the memory figures).
+    pub fn len(&self) -> usize {
+        8 * self.data.values.len()
+    }
+
+    /// x ← A⁻¹x.
+    #[allow(unsafe_code)]
+    pub fn solve(&mut self, x: &mut [f64]) {
+        let d = &self.data;
+        let (xp, out, z) = (&mut self.xp, &mut self.out, &mut self.z);
+        d.permute_in(x, xp);
+        for blk in &d.blocks {
+            // [y; δ] = F x_s; x_s ← y, x_pattern += δ.
+            let (c0, k) = (blk.c0, blk.k);
+            let out = &mut out[..8 * blk.f_lines];
+            self.wide
+                .product(d.f(blk), &xp[c0..c0 + k], blk.f_lines, out);
+            xp[c0..c0 + k].copy_from_slice(&out[..k]);
+            for (&r, v) in d.pattern(blk).iter().zip(&out[k..]) {
+                xp[r as usize] += v;
+            }
+        }
+        for blk in d.blocks.iter().rev() {
+            // x_s ← Fᵀ [x_s; x_pattern].
+            let (c0, k) = (blk.c0, blk.k);
+            let z = &mut z[..k + blk.m];
+            z[..k].copy_from_slice(&xp[c0..c0 + k]);
+            for (zi, &r) in z[k..].iter_mut().zip(d.pattern(blk)) {
+                *zi = xp[r as usize];
+            }
+            let out = &mut out[..8 * blk.g_lines];
+            self.wide.product(d.g(blk), z, blk.g_lines, out);
+            xp[c0..c0 + k].copy_from_slice(&out[..k]);
+        }
+        d.permute_out(xp, x);
+    }
+
+    /// Solves as [`BlockInverse::solve`] on the given width (tests).
+    #[cfg(test)]
+    fn solve_on(&mut self, wide: Wide, x: &mut [f64]) {
+        let best = self.wide;
+        self.wide = wide;
+        self.solve(x);
+        self.wide = best;
+    }
+}
+
+impl Data {
+    fn f(&self, blk: &Block) -> &[Line] {
+        &self.values[blk.f_at..blk.f_at + blk.f_lines * blk.k]
+    }
+
+    fn g(&self, blk: &Block) -> &[Line] {
+        &self.values[blk.g_at..blk.g_at + blk.g_lines * (blk.k + blk.m)]
+    }
+
+    fn pattern(&self, blk: &Block) -> &[u32] {
+        &self.pattern[blk.pattern..blk.pattern + blk.m]
+    }
+
+    fn permute_in(&self, x: &[f64], xp: &mut [f64]) {
+        for (y, &f) in xp.iter_mut().zip(&self.fwd) {
+            *y = x[f as usize];
+        }
+    }
+
+    fn permute_out(&self, xp: &[f64], x: &mut [f64]) {
+        for (y, &f) in xp.iter().zip(&self.fwd) {
+            x[f as usize] = *y;
+        }
+    }
+}
+
+impl Wide {
+    /// out = A v for A column-major on `lines` lines per column (v.len()
+    /// columns): per lane the terms of the even columns summed in order,
+    /// those of the odd columns likewise, then even + odd. Lines in
+    /// groups of up to four, held in registers across the columns.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    fn product(self, a: &[Line], v: &[f64], lines: usize, out: &mut [f64]) {
+        let mut g = 0;
+        while g < lines {
+            macro_rules! group {
+                ($n:literal) => {{
+                    #[cfg(target_arch = "x86_64")]
+                    if self == Wide::Avx512 {
+                        // SAFETY: Avx512 only where the CPU has it (new).
+                        unsafe { group_avx512::<$n>(a, v, lines, g, out) };
+                        g += $n;
+                        continue;
+                    }
+                    group_product::<$n>(a, v, lines, g, out);
+                    g += $n;
+                }};
+            }
+            match lines - g {
+                1 => group!(1),
+                2 => group!(2),
+                3 => group!(3),
+                _ => group!(4),
+            }
+        }
+    }
+}
+
+/// Lines g..g + G of A v into out (see [`Wide::product`]).
+#[inline(always)]
+fn group_product<const G: usize>(a: &[Line], v: &[f64], lines: usize, g: usize, out: &mut [f64]) {
+    let mut even = [[0.0f64; 8]; G];
+    let mut odd = [[0.0f64; 8]; G];
+    let pairs = a.chunks_exact(2 * lines);
+    let last = pairs.remainder();
+    let vj = v.chunks_exact(2);
+    let v_last = vj.remainder();
+    for (pair, ab) in vj.zip(pairs) {
+        let (p, q): (&[Line; G], &[Line; G]) = (
+            ab[g..g + G].try_into().expect("G lines"),
+            ab[lines + g..lines + g + G].try_into().expect("G lines"),
+        );
+        for c in 0..G {
+            for l in 0..8 {
+                even[c][l] += p[c].0[l] * pair[0];
+                odd[c][l] += q[c].0[l] * pair[1];
+            }
+        }
+    }
+    if let [v_last] = v_last {
+        let p: &[Line; G] = last[g..g + G].try_into().expect("G lines");
+        for c in 0..G {
+            for l in 0..8 {
+                even[c][l] += p[c].0[l] * v_last;
+            }
+        }
+    }
+    for c in 0..G {
+        for l in 0..8 {
+            out[8 * (g + c) + l] = even[c][l] + odd[c][l];
+        }
+    }
+}
+
+/// [`group_product`] with AVX-512: one register per line and sum, lane by
+/// lane the same operations in the same order (multiplications and
+/// additions separate), so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline]
+#[allow(unsafe_code)]
+fn group_avx512<const G: usize>(a: &[Line], v: &[f64], lines: usize, g: usize, out: &mut [f64]) {
+    use std::arch::x86_64::*;
+    // SAFETY: lines are 64-byte aligned 8-double arrays.
+    let load = |line: &Line| unsafe { _mm512_load_pd(line.0.as_ptr()) };
+    let mut even = [_mm512_setzero_pd(); G];
+    let mut odd = [_mm512_setzero_pd(); G];
+    let pairs = a.chunks_exact(2 * lines);
+    let last = pairs.remainder();
+    let vj = v.chunks_exact(2);
+    let v_last = vj.remainder();
+    for (pair, ab) in vj.zip(pairs) {
+        let (p, q): (&[Line; G], &[Line; G]) = (
+            ab[g..g + G].try_into().expect("G lines"),
+            ab[lines + g..lines + g + G].try_into().expect("G lines"),
+        );
+        let (x0, x1) = (_mm512_set1_pd(pair[0]), _mm512_set1_pd(pair[1]));
+        for c in 0..G {
+            even[c] = _mm512_add_pd(even[c], _mm512_mul_pd(load(&p[c]), x0));
+            odd[c] = _mm512_add_pd(odd[c], _mm512_mul_pd(load(&q[c]), x1));
+        }
+    }
+    if let [v_last] = v_last {
+        let p: &[Line; G] = last[g..g + G].try_into().expect("G lines");
+        let x0 = _mm512_set1_pd(*v_last);
+        for c in 0..G {
+            even[c] = _mm512_add_pd(even[c], _mm512_mul_pd(load(&p[c]), x0));
+        }
+    }
+    let out = &mut out[8 * g..8 * (g + G)];
+    for c in 0..G {
+        // SAFETY: out holds 8·G doubles from 8·g (the slice above).
+        unsafe { _mm512_storeu_pd(out[8 * c..].as_mut_ptr(), _mm512_add_pd(even[c], odd[c])) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::{Par, Side, Spec};
+    use nalgebra_sparse::CsrMatrix;
+    use stickslip_fem::testing::{plain_spmv, rectangle};
+    use stickslip_fem::{analyze_symbolic, csc_view, Hypothesis, Material, Model};
+    use stickslip_mesh::CellKind;
+
+    /// A₀ of the paper's Newmark step on a slab without every `drop`-th
+    /// DOF (as if held; supernodes of odd width), with its factor.
+    fn factored(
+        kind: CellKind,
+        nx: usize,
+        ny: usize,
+        drop: usize,
+    ) -> (CsrMatrix<f64>, Supernodal, Vec<f64>) {
+        let mesh = rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let model = Model::new(&mesh, &material, &[]).unwrap();
+        let full = model.combined(0.5e-3, 1.0 / 0.5e-3);
+        let kept: Vec<usize> = (0..full.nrows())
+            .filter(|i| drop == usize::MAX || i % drop != 1)
+            .collect();
+        let mut index = vec![usize::MAX; full.nrows()];
+        for (new, &old) in kept.iter().enumerate() {
+            index[old] = new;
+        }
+        let mut coo = nalgebra_sparse::CooMatrix::new(kept.len(), kept.len());
+        for (i, j, v) in full.triplet_iter() {
+            if index[i] != usize::MAX && index[j] != usize::MAX {
+                coo.push(index[i], index[j], *v);
+            }
+        }
+        let a = CsrMatrix::from(&coo);
+        let symbolic = analyze_symbolic(&a).unwrap();
+        let mut l = vec![0.0; symbolic.len_val()];
+        let mut scratch = MemBuffer::new(
+            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+        );
+        symbolic
+            .factorize_numeric_llt(
+                &mut l,
+                csc_view(&a, a.values()),
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut scratch),
+                Spec::default(),
+            )
+            .unwrap();
+        let sn = Supernodal::new(&symbolic).unwrap();
+        (a, sn, l)
+    }
+
+    fn rhs(n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| ((i * 7919) % 1000) as f64 / 500.0 - 1.0)
+            .collect()
+    }
+
+    fn widths() -> Vec<Wide> {
+        let mut w = vec![Wide::No];
+        if crate::kernels::avx512() {
+            w.push(Wide::Avx512);
+        }
+        w
+    }
+
+    /// A x = b to rounding (the residual against the matrix, relative to
+    /// b), the same bits on every width, and the same x as the supernodal
+    /// solve to 1e-12; Q1 and Q2, supernodes of odd width (DOFs dropped)
+    /// and of more than 32 rows (more than one group of lines).
+    #[test]
+    fn solves_the_system_on_every_width() {
+        let (mut odd, mut long) = (false, false);
+        for (kind, nx, ny, drop) in [
+            (CellKind::Quad9, 8, 2, usize::MAX),
+            (CellKind::Quad9, 8, 2, 7),
+            (CellKind::Quad4, 24, 6, 5),
+            (CellKind::Quad9, 32, 8, usize::MAX),
+        ] {
+            let (a, mut sn, l) = factored(kind, nx, ny, drop);
+            let n = a.nrows();
+            let mut inv = BlockInverse::new(&sn, &l);
+            odd |= inv.data.blocks.iter().any(|b| b.k % 2 == 1);
+            long |= inv.data.blocks.iter().any(|b| b.f_lines > 4);
+            let b = rhs(n);
+            let mut reference = b.clone();
+            sn.solve(&l, &mut reference);
+            let mut first: Option<Vec<f64>> = None;
+            for w in widths() {
+                let mut x = b.clone();
+                inv.solve_on(w, &mut x);
+                let ax = plain_spmv(&a, &x);
+                let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let worst = ax
+                    .iter()
+                    .zip(&b)
+                    .map(|(p, q)| (p - q).abs() / scale)
+                    .fold(0.0, f64::max);
+                assert!(worst < 1e-13, "{kind:?} {w:?}: residual {worst:e}");
+                let xs = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for (p, q) in x.iter().zip(&reference) {
+                    assert!((p - q).abs() <= 1e-12 * xs, "{kind:?} {w:?}: {p} vs {q}");
+                }
+                match &first {
+                    None => first = Some(x),
+                    Some(f) => assert!(
+                        f.iter().zip(&x).all(|(p, q)| p.to_bits() == q.to_bits()),
+                        "{kind:?}: {w:?} differs from the scalar bits"
+                    ),
+                }
+            }
+        }
+        assert!(
+            odd && long,
+            "a supernode of odd width and one of more than 4 lines"
+        );
+    }
+
+    /// Timing lab (run by hand): one solve by the supernodal loops and by
+    /// the inverted blocks, per mesh, with F's size.
+    ///
+    ///     cargo test --release -p stickslip-time --lib block_inverse_lab -- --ignored --nocapture
+    #[test]
+    #[ignore = "timing lab, run by hand"]
+    fn block_inverse_lab() {
+        for (kind, nx, ny) in [
+            (CellKind::Quad9, 8, 2),
+            (CellKind::Quad4, 24, 6),
+            (CellKind::Quad9, 16, 4),
+            (CellKind::Quad4, 48, 12),
+            (CellKind::Quad9, 32, 8),
+            (CellKind::Quad4, 96, 24),
+            (CellKind::Quad9, 64, 16),
+        ] {
+            let (a, mut sn, l) = factored(kind, nx, ny, usize::MAX);
+            let n = a.nrows();
+            let mut inv = BlockInverse::new(&sn, &l);
+            let b = rhs(n);
+            let mut x = b.clone();
+            let reps = (20_000_000 / l.len()).max(10);
+            let mut time = |f: &mut dyn FnMut(&mut [f64])| {
+                let mut t = Vec::new();
+                for _ in 0..7 {
+                    let s = std::time::Instant::now();
+                    for _ in 0..reps {
+                        x.copy_from_slice(&b);
+                        f(&mut x);
+                    }
+                    t.push(s.elapsed().as_secs_f64() / reps as f64);
+                }
+                t.sort_by(f64::total_cmp);
+                t[3]
+            };
+            let t_sn = time(&mut |x| sn.solve(&l, x));
+            let t_inv = time(&mut |x| inv.solve(x));
+            println!(
+                "{kind:?} {nx}x{ny}: n={n} L={} F={} ({:.0} KB): supernodal {:.2} us, inverted blocks {:.2} us ({:.2}x)",
+                l.len(),
+                inv.len(),
+                inv.len() as f64 * 8e-3,
+                t_sn * 1e6,
+                t_inv * 1e6,
+                t_sn / t_inv
+            );
+        }
+    }
+}
