@@ -3053,5 +3053,15 @@ pub(crate) mod tests {
             let t = time(&mut || c.spmv(std::hint::black_box(&x), &mut y));
             println!("  compact {:<6} {:.3} µs", format!("{:?}", c.wide), 1e6 * t);
         }
+        // Newmark's two passes over K and M (linalg.rs).
+        let pairs = crate::linalg::PairBlocks::new(k, &model.mass).expect("shared pattern");
+        let l = x_of(n);
+        let mut partials = vec![0.0; 2 * crate::linalg::row_chunks(n)];
+        let t = time(&mut || pairs.load_minus_k_plus_m(&l, std::hint::black_box(&x), &x, &mut y));
+        println!("  pair blocks: l − K x + M y {:.3} µs", 1e6 * t);
+        let t = time(&mut || {
+            std::hint::black_box(pairs.two_forms(std::hint::black_box(&x), &x, &mut partials));
+        });
+        println!("  pair blocks: xᵀK x, yᵀM y  {:.3} µs", 1e6 * t);
     }
 }

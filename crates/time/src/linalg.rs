@@ -241,7 +241,12 @@ pub const PAIR_BLOCKS_MAX_BYTES: usize = 8 << 20;
 /// row its first column's terms + its second's. So the bits depend on the
 /// pattern alone, not on threads or the CPU's width. The paper mesh's
 /// Newmark step (bench_step, three runs each, 2026-11-24): 10.7-10.9 µs
-/// with 2-wide sums of each column in turn, 9.4-9.6 µs 8 wide.
+/// with 2-wide sums of each column in turn, 9.4-9.6 µs 8 wide; with the
+/// whole pass (its loop over pairs, the rows' sums and the pass's own
+/// arithmetic) in one AVX-512 function rather than a call per pair,
+/// 6.3-6.9 → 5.4-5.7 µs (four runs each, against the build before, the
+/// small solve in both). Each pass is now about 1.0 µs (`small_lab`),
+/// about 3.6 cycles a block: K's and M's 57 KB do not fit the 32 KB L1.
 #[derive(Clone, Debug)]
 pub struct PairBlocks {
     n: usize,
@@ -322,15 +327,45 @@ impl PairBlocks {
         4 * (self.starts.len() + self.cols.len()) + 64 * self.vals.len()
     }
 
-    /// ((K x) on rows 2p, 2p + 1; (M y) on the same rows).
+    /// One pass over `pairs`: with FORMS, returns (Σ x_i (K x)_i, Σ y_i
+    /// (M y)_i) over their rows, each sum row by row in order; without,
+    /// writes l_i − (K x)_i + (M y)_i into `out` (its row 0 is the first
+    /// pair's first row).
     #[inline(always)]
     #[allow(unsafe_code)]
-    fn pair(&self, p: usize, x: &[f64], y: &[f64]) -> ([f64; 2], [f64; 2]) {
+    fn pass<const FORMS: bool>(
+        &self,
+        pairs: std::ops::Range<usize>,
+        x: &[f64],
+        y: &[f64],
+        l: &[f64],
+        out: &mut [f64],
+    ) -> (f64, f64) {
         #[cfg(target_arch = "x86_64")]
         if self.wide {
             // SAFETY: `wide` only where the CPU has AVX-512 (new).
-            return unsafe { self.pair_avx512(p, x, y) };
+            return unsafe { self.pass_avx512::<FORMS>(pairs, x, y, l, out) };
         }
+        let (n, first) = (self.n, pairs.start);
+        let (mut s, mut t) = (0.0, 0.0);
+        for p in pairs {
+            let (kx, my) = self.pair(p, x, y);
+            let i = 2 * p;
+            for r in 0..2.min(n - i) {
+                if FORMS {
+                    s += x[i + r] * kx[r];
+                    t += y[i + r] * my[r];
+                } else {
+                    out[i - 2 * first + r] = l[i + r] - kx[r] + my[r];
+                }
+            }
+        }
+        (s, t)
+    }
+
+    /// ((K x) on rows 2p, 2p + 1; (M y) on the same rows), scalar.
+    #[inline(always)]
+    fn pair(&self, p: usize, x: &[f64], y: &[f64]) -> ([f64; 2], [f64; 2]) {
         let blocks = self.starts[p] as usize..self.starts[p + 1] as usize;
         let (cols, vals) = (&self.cols[blocks.clone()], &self.vals[blocks]);
         // One length for both vectors: one bounds check covers both reads.
@@ -354,65 +389,106 @@ impl PairBlocks {
         ([t[0] + t[2], t[1] + t[3]], [t[4] + t[6], t[5] + t[7]])
     }
 
-    /// [`PairBlocks::pair`] 8 wide: a block's values against x_c, x_c+1,
+    /// [`PairBlocks::pass`] 8 wide: a block's values against x_c, x_c+1,
     /// y_c, y_c+1 spread by two 16-byte broadcasts and one in-lane
     /// shuffle; per lane the scalar operations in their order
-    /// (multiplications and additions separate), so the same bits.
+    /// (multiplications and additions separate), then the rows' sums and
+    /// the pass's own arithmetic on two lanes, so the same bits.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
     #[allow(unsafe_code)]
-    fn pair_avx512(&self, p: usize, x: &[f64], y: &[f64]) -> ([f64; 2], [f64; 2]) {
+    fn pass_avx512<const FORMS: bool>(
+        &self,
+        pairs: std::ops::Range<usize>,
+        x: &[f64],
+        y: &[f64],
+        l: &[f64],
+        out: &mut [f64],
+    ) -> (f64, f64) {
         use std::arch::x86_64::*;
-        let blocks = self.starts[p] as usize..self.starts[p + 1] as usize;
-        let (cols, vals) = (&self.cols[blocks.clone()], &self.vals[blocks]);
+        let (n, first) = (self.n, pairs.start);
         // Every block's c + 1 < n (new): with x and y this long the reads
         // need no check per block.
-        let (xp, yp) = (x[..self.n].as_ptr(), y[..self.n].as_ptr());
+        let (xp, yp) = (x[..n].as_ptr(), y[..n].as_ptr());
+        // [x_c, x_c, x_c+1, x_c+1, y_c, y_c, y_c+1, y_c+1] from the two
+        // pairs in one two-source permutation.
+        let spread = _mm512_set_epi64(9, 9, 8, 8, 1, 1, 0, 0);
         let add = |c: u32, v: &Line, acc: __m512d| -> __m512d {
             // SAFETY: c + 1 < n (above): two doubles read unaligned from
-            // each vector (the broadcast's reference wants 16-byte
-            // alignment); a line is 8 doubles, 64-byte aligned.
+            // each vector; a line is 8 doubles, 64-byte aligned.
             unsafe {
                 let c = c as usize;
                 let xv = (xp.add(c) as *const __m128d).read_unaligned();
                 let yv = (yp.add(c) as *const __m128d).read_unaligned();
-                let z = _mm512_insertf64x4::<1>(
-                    _mm512_castpd256_pd512(_mm256_broadcast_pd(&xv)),
-                    _mm256_broadcast_pd(&yv),
+                let z = _mm512_permutex2var_pd(
+                    _mm512_castpd128_pd512(xv),
+                    spread,
+                    _mm512_castpd128_pd512(yv),
                 );
-                let z = _mm512_permute_pd::<0b1100_1100>(z);
                 _mm512_add_pd(acc, _mm512_mul_pd(_mm512_load_pd(v.0.as_ptr()), z))
             }
         };
-        let (mut even, mut odd) = (_mm512_setzero_pd(), _mm512_setzero_pd());
-        let split = cols.len() & !1;
-        for (c, v) in cols[..split]
-            .chunks_exact(2)
-            .zip(vals[..split].chunks_exact(2))
-        {
-            even = add(c[0], &v[0], even);
-            odd = add(c[1], &v[1], odd);
+        let two = |v: &[f64]| -> __m128d {
+            // SAFETY: v holds two doubles.
+            unsafe { _mm_loadu_pd(v[..2].as_ptr()) }
+        };
+        let lanes =
+            |v: __m128d| -> [f64; 2] { [_mm_cvtsd_f64(v), _mm_cvtsd_f64(_mm_unpackhi_pd(v, v))] };
+        let (mut s, mut t) = (0.0, 0.0);
+        for p in pairs {
+            let blocks = self.starts[p] as usize..self.starts[p + 1] as usize;
+            let (cols, vals) = (&self.cols[blocks.clone()], &self.vals[blocks]);
+            let (mut even, mut odd) = (_mm512_setzero_pd(), _mm512_setzero_pd());
+            let split = cols.len() & !1;
+            for (c, v) in cols[..split]
+                .chunks_exact(2)
+                .zip(vals[..split].chunks_exact(2))
+            {
+                even = add(c[0], &v[0], even);
+                odd = add(c[1], &v[1], odd);
+            }
+            if split < cols.len() {
+                even = add(cols[split], &vals[split], even);
+            }
+            // Lanes [K: (r0, c0), (r1, c0), (r0, c1), (r1, c1), then M]:
+            // each row's first column + its second, in lanes 0, 1 (K) and
+            // 4, 5 (M).
+            let sum = _mm512_add_pd(even, odd);
+            let rows = _mm512_add_pd(sum, _mm512_permutex_pd::<0b01_00_11_10>(sum));
+            let kx = _mm512_castpd512_pd128(rows);
+            let my = _mm256_castpd256_pd128(_mm512_extractf64x4_pd::<1>(rows));
+            let i = 2 * p;
+            if i + 1 < n {
+                if FORMS {
+                    let (px, py) = (
+                        lanes(_mm_mul_pd(two(&x[i..]), kx)),
+                        lanes(_mm_mul_pd(two(&y[i..]), my)),
+                    );
+                    s = s + px[0] + px[1];
+                    t = t + py[0] + py[1];
+                } else {
+                    let o = _mm_add_pd(_mm_sub_pd(two(&l[i..]), kx), my);
+                    // SAFETY: rows i, i + 1 of out exist (i + 1 < n).
+                    unsafe { _mm_storeu_pd(out[i - 2 * first..][..2].as_mut_ptr(), o) };
+                }
+            } else {
+                let (kx, my) = (_mm_cvtsd_f64(kx), _mm_cvtsd_f64(my));
+                if FORMS {
+                    s += x[i] * kx;
+                    t += y[i] * my;
+                } else {
+                    out[i - 2 * first] = l[i] - kx + my;
+                }
+            }
         }
-        if split < cols.len() {
-            even = add(cols[split], &vals[split], even);
-        }
-        let mut t = [0.0; 8];
-        // SAFETY: t holds 8 doubles; unaligned store.
-        unsafe { _mm512_storeu_pd(t.as_mut_ptr(), _mm512_add_pd(even, odd)) };
-        Self::rows(t)
+        (s, t)
     }
 
     /// out_i = l_i − (K x)_i + (M y)_i, rows in chunks on the pool.
     pub fn load_minus_k_plus_m(&self, l: &[f64], x: &[f64], y: &[f64], out: &mut [f64]) {
         let body = |c: usize, out: &mut [f64]| {
-            let first = c * ROWS;
-            for (q, o) in out.chunks_mut(2).enumerate() {
-                let i = first + 2 * q;
-                let (kx, my) = self.pair(i / 2, x, y);
-                for (r, o) in o.iter_mut().enumerate() {
-                    *o = l[i + r] - kx[r] + my[r];
-                }
-            }
+            let first = c * ROWS / 2;
+            self.pass::<false>(first..first + out.len().div_ceil(2), x, y, l, out);
         };
         if out.len() > ROWS {
             out.par_chunks_mut(ROWS)
@@ -429,15 +505,7 @@ impl PairBlocks {
         let n = self.n;
         let chunk = |c: usize| -> (f64, f64) {
             let rows = c * ROWS..((c + 1) * ROWS).min(n);
-            let (mut s, mut t) = (0.0, 0.0);
-            for i in rows.step_by(2) {
-                let (kx, my) = self.pair(i / 2, x, y);
-                for r in 0..2.min(n - i) {
-                    s += x[i + r] * kx[r];
-                    t += y[i + r] * my[r];
-                }
-            }
-            (s, t)
+            self.pass::<true>(rows.start / 2..rows.end.div_ceil(2), x, y, &[], &mut [])
         };
         pair_sums(n, partials, chunk)
     }
