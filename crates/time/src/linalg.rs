@@ -256,6 +256,10 @@ pub struct PairBlocks {
     cols: Vec<u32>,
     /// [K by columns: (r0, c0), (r1, c0), (r0, c1), (r1, c1); then M].
     vals: Vec<Line>,
+    /// Where K and M are symmetric and n even: the index of pair p's
+    /// diagonal block (its blocks before it lie below the diagonal, those
+    /// after above), for the quadratic forms on the upper half.
+    upper: Vec<u32>,
     /// The sums run 8 wide ([`PairBlocks::pair_avx512`]; the same bits).
     wide: bool,
 }
@@ -311,20 +315,38 @@ impl PairBlocks {
             }
             starts.push(bcols.len() as u32);
         }
-        // pair_avx512 reads x[c], x[c + 1] unchecked.
+        // pass_avx512 reads x[c], x[c + 1] unchecked.
         assert!(bcols.iter().all(|&c| (c as usize) + 1 < n));
+        let symmetric = |a: &CsrMatrix<f64>| {
+            a.triplet_iter()
+                .all(|(i, j, v)| csr_index(a, j, i).map(|e| a.values()[e]) == Some(*v))
+        };
+        let upper = if n.is_multiple_of(2) && symmetric(k) && symmetric(m) {
+            (0..n / 2)
+                .map(|p| {
+                    let blocks = starts[p] as usize..starts[p + 1] as usize;
+                    let d = bcols[blocks.clone()]
+                        .iter()
+                        .position(|&c| c as usize == 2 * p);
+                    (blocks.start + d.expect("a symmetric pattern holds the diagonal")) as u32
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         Some(PairBlocks {
             n,
             starts,
             cols: bcols,
             vals,
+            upper,
             wide: crate::kernels::avx512(),
         })
     }
 
     /// Bytes held (and streamed per product).
     pub fn bytes(&self) -> usize {
-        4 * (self.starts.len() + self.cols.len()) + 64 * self.vals.len()
+        4 * (self.starts.len() + self.cols.len() + self.upper.len()) + 64 * self.vals.len()
     }
 
     /// One pass over `pairs`: with FORMS, returns (Σ x_i (K x)_i, Σ y_i
@@ -333,7 +355,7 @@ impl PairBlocks {
     /// pair's first row).
     #[inline(always)]
     #[allow(unsafe_code)]
-    fn pass<const FORMS: bool>(
+    fn pass<const FORMS: bool, const UPPER: bool>(
         &self,
         pairs: std::ops::Range<usize>,
         x: &[f64],
@@ -344,12 +366,12 @@ impl PairBlocks {
         #[cfg(target_arch = "x86_64")]
         if self.wide {
             // SAFETY: `wide` only where the CPU has AVX-512 (new).
-            return unsafe { self.pass_avx512::<FORMS>(pairs, x, y, l, out) };
+            return unsafe { self.pass_avx512::<FORMS, UPPER>(pairs, x, y, l, out) };
         }
         let (n, first) = (self.n, pairs.start);
         let (mut s, mut t) = (0.0, 0.0);
         for p in pairs {
-            let (kx, my) = self.pair(p, x, y);
+            let (kx, my) = self.pair::<UPPER>(p, x, y);
             let i = 2 * p;
             for r in 0..2.min(n - i) {
                 if FORMS {
@@ -365,21 +387,38 @@ impl PairBlocks {
 
     /// ((K x) on rows 2p, 2p + 1; (M y) on the same rows), scalar.
     #[inline(always)]
-    fn pair(&self, p: usize, x: &[f64], y: &[f64]) -> ([f64; 2], [f64; 2]) {
-        let blocks = self.starts[p] as usize..self.starts[p + 1] as usize;
+    /// With UPPER, the pair's upper half (see [`PairBlocks::two_forms`]).
+    fn pair<const UPPER: bool>(&self, p: usize, x: &[f64], y: &[f64]) -> ([f64; 2], [f64; 2]) {
+        let start = if UPPER { self.upper[p] } else { self.starts[p] };
+        let blocks = start as usize..self.starts[p + 1] as usize;
         let (cols, vals) = (&self.cols[blocks.clone()], &self.vals[blocks]);
         // One length for both vectors: one bounds check covers both reads.
         let (x, y) = (&x[..self.n], &y[..self.n]);
-        let mut acc = [[0.0; 8]; 2];
-        for (j, (&c, Line(v))) in cols.iter().zip(vals).enumerate() {
+        let product = |c: u32, v: &[f64; 8]| -> [f64; 8] {
             let c = c as usize;
             let (xs, ys) = (&x[c..c + 2], &y[c..c + 2]);
             let z = [xs[0], xs[0], xs[1], xs[1], ys[0], ys[0], ys[1], ys[1]];
+            std::array::from_fn(|l| v[l] * z[l])
+        };
+        let skip = usize::from(UPPER);
+        let mut acc = [[0.0; 8]; 2];
+        for (j, (&c, Line(v))) in cols[skip..].iter().zip(&vals[skip..]).enumerate() {
+            let t = product(c, v);
             for l in 0..8 {
-                acc[j % 2][l] += v[l] * z[l];
+                acc[j % 2][l] += t[l];
             }
         }
-        Self::rows(std::array::from_fn(|l| acc[0][l] + acc[1][l]))
+        if UPPER {
+            let mut d = [0.0; 8];
+            for (d, t) in d.iter_mut().zip(product(cols[0], &vals[0].0)) {
+                *d += t;
+            }
+            Self::rows(std::array::from_fn(|l| {
+                d[l] + 2.0 * (acc[0][l] + acc[1][l])
+            }))
+        } else {
+            Self::rows(std::array::from_fn(|l| acc[0][l] + acc[1][l]))
+        }
     }
 
     /// The pair's two rows of K x and M y from the lanes' sums (even +
@@ -389,15 +428,15 @@ impl PairBlocks {
         ([t[0] + t[2], t[1] + t[3]], [t[4] + t[6], t[5] + t[7]])
     }
 
-    /// [`PairBlocks::pass`] 8 wide: a block's values against x_c, x_c+1,
-    /// y_c, y_c+1 spread by two 16-byte broadcasts and one in-lane
-    /// shuffle; per lane the scalar operations in their order
+    /// [`PairBlocks::pass`] 8 wide: a block's values against x_c, x_c,
+    /// x_c+1, x_c+1, y_c, y_c, y_c+1, y_c+1 (one two-source permutation
+    /// of the two pairs); per lane the scalar operations in their order
     /// (multiplications and additions separate), then the rows' sums and
     /// the pass's own arithmetic on two lanes, so the same bits.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
     #[allow(unsafe_code)]
-    fn pass_avx512<const FORMS: bool>(
+    fn pass_avx512<const FORMS: bool, const UPPER: bool>(
         &self,
         pairs: std::ops::Range<usize>,
         x: &[f64],
@@ -436,8 +475,12 @@ impl PairBlocks {
             |v: __m128d| -> [f64; 2] { [_mm_cvtsd_f64(v), _mm_cvtsd_f64(_mm_unpackhi_pd(v, v))] };
         let (mut s, mut t) = (0.0, 0.0);
         for p in pairs {
-            let blocks = self.starts[p] as usize..self.starts[p + 1] as usize;
+            let start = if UPPER { self.upper[p] } else { self.starts[p] };
+            let blocks = start as usize..self.starts[p + 1] as usize;
             let (cols, vals) = (&self.cols[blocks.clone()], &self.vals[blocks]);
+            let diagonal = UPPER.then(|| add(cols[0], &vals[0], _mm512_setzero_pd()));
+            let skip = usize::from(UPPER);
+            let (cols, vals) = (&cols[skip..], &vals[skip..]);
             let (mut even, mut odd) = (_mm512_setzero_pd(), _mm512_setzero_pd());
             let split = cols.len() & !1;
             for (c, v) in cols[..split]
@@ -453,7 +496,10 @@ impl PairBlocks {
             // Lanes [K: (r0, c0), (r1, c0), (r0, c1), (r1, c1), then M]:
             // each row's first column + its second, in lanes 0, 1 (K) and
             // 4, 5 (M).
-            let sum = _mm512_add_pd(even, odd);
+            let mut sum = _mm512_add_pd(even, odd);
+            if let Some(d) = diagonal {
+                sum = _mm512_add_pd(d, _mm512_mul_pd(_mm512_set1_pd(2.0), sum));
+            }
             let rows = _mm512_add_pd(sum, _mm512_permutex_pd::<0b01_00_11_10>(sum));
             let kx = _mm512_castpd512_pd128(rows);
             let my = _mm256_castpd256_pd128(_mm512_extractf64x4_pd::<1>(rows));
@@ -488,7 +534,7 @@ impl PairBlocks {
     pub fn load_minus_k_plus_m(&self, l: &[f64], x: &[f64], y: &[f64], out: &mut [f64]) {
         let body = |c: usize, out: &mut [f64]| {
             let first = c * ROWS / 2;
-            self.pass::<false>(first..first + out.len().div_ceil(2), x, y, l, out);
+            self.pass::<false, false>(first..first + out.len().div_ceil(2), x, y, l, out);
         };
         if out.len() > ROWS {
             out.par_chunks_mut(ROWS)
@@ -501,11 +547,22 @@ impl PairBlocks {
 
     /// (xᵀK x, yᵀM y), per chunk of rows into `partials` (2·[`row_chunks`]
     /// long), the chunks' sums added in order.
+    ///
+    /// Where K and M are symmetric (bit for bit) and n even, each pair's
+    /// rows take their diagonal block once and the blocks right of it
+    /// twice (x_Iᵀ(D_I x_I + 2 Σ_{J>I} B_IJ x_J)), so the pass reads half
+    /// the blocks: per lane the diagonal block's product + 2·(even + odd
+    /// sums of the others), then the rows' sums as in the products.
     pub fn two_forms(&self, x: &[f64], y: &[f64], partials: &mut [f64]) -> (f64, f64) {
         let n = self.n;
         let chunk = |c: usize| -> (f64, f64) {
             let rows = c * ROWS..((c + 1) * ROWS).min(n);
-            self.pass::<true>(rows.start / 2..rows.end.div_ceil(2), x, y, &[], &mut [])
+            let pairs = rows.start / 2..rows.end.div_ceil(2);
+            if self.upper.is_empty() {
+                self.pass::<true, false>(pairs, x, y, &[], &mut [])
+            } else {
+                self.pass::<true, true>(pairs, x, y, &[], &mut [])
+            }
         };
         pair_sums(n, partials, chunk)
     }
@@ -599,12 +656,15 @@ mod tests {
     }
 
     /// The block products equal plain row sums to rounding, on one thread
-    /// and on two with the same bits.
+    /// and on two with the same bits, scalar and 8 wide; the forms too, on
+    /// the upper half (symmetric, n even) and on whole rows.
     #[test]
     fn pair_blocks_agree_with_the_csr_products() {
         for n in [2, 3, 37, 38, 2 * ROWS + 1, 3 * ROWS + 10] {
-            for (k, m) in [pair(n), ragged(n)] {
+            for (symmetric, (k, m)) in [(false, pair(n)), (true, ragged(n))] {
                 let blocks = PairBlocks::new(&k, &m).expect("shared pattern");
+                // The forms on the upper half where K and M are symmetric.
+                assert_eq!(!blocks.upper.is_empty(), symmetric && n % 2 == 0, "n = {n}");
                 let (x, y, l) = (vector(n, 4), vector(n, 5), vector(n, 6));
                 let run = |threads: usize| {
                     on_threads(threads, || {
