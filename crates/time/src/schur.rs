@@ -43,7 +43,7 @@ use stickslip_fem::{analyze_symbolic, csc_view, ContactOperator, SolverError};
 
 use stickslip_fem::Supernodal;
 
-use crate::small_solve::BlockInverse;
+use crate::small_solve::{minus_columns, BlockInverse};
 
 /// Right-hand sides solved together when building Z and S: one pass over
 /// the factor serves the whole block.
@@ -532,15 +532,8 @@ impl SchurOperator {
             }
             self.sn.finish_step(&entry.l_values, &self.correction, v);
         } else {
-            // Column by column: a stuck node with f = 0 costs nothing.
-            for (j, &f) in self.f.iter().enumerate() {
-                if f != 0.0 {
-                    let z = &entry.z[j * n..(j + 1) * n];
-                    for (vi, zi) in v.iter_mut().zip(z) {
-                        *vi -= f * zi;
-                    }
-                }
-            }
+            // A node with f = 0 costs nothing.
+            minus_columns(&mut v[..n], &entry.z, &self.f);
         }
     }
 
