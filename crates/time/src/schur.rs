@@ -36,7 +36,7 @@
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{LltError, LltParams};
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
-use faer::{Conj, MatMut, MatRef, Par, Side, Spec};
+use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{ContactNode, ContactSurface, SlipState, StepSystem};
 use stickslip_fem::{analyze_symbolic, csc_view, ContactOperator, SolverError};
@@ -215,13 +215,6 @@ impl SchurOperator {
                     n_c,
                     Par::Seq,
                     Default::default(),
-                )
-                .and(
-                    faer::linalg::cholesky::llt::solve::solve_in_place_scratch::<f64>(
-                        n_c,
-                        1,
-                        Par::Seq,
-                    ),
                 ),
             ),
         };
@@ -601,13 +594,25 @@ impl SchurOperator {
                 }
                 y[a] = d.w[a] * r;
             }
-            faer::linalg::cholesky::llt::solve::solve_in_place_with_conj(
-                MatRef::from_column_major_slice(&d.l[..m * m], m, m),
-                Conj::No,
-                MatMut::from_column_major_slice_mut(y, m, 1),
-                Par::Seq,
-                MemStack::new(&mut d.scratch),
-            );
+            // L Lᵀ y = rhs by plain loops: at n_s ≤ n_c (16 on the paper
+            // mesh) faer's dispatch cost more than the 2·n_s² operations.
+            let l = &d.l[..m * m];
+            for j in 0..m {
+                let col = &l[j * m..(j + 1) * m];
+                let yj = y[j] / col[j];
+                y[j] = yj;
+                for (yi, lij) in y[j + 1..].iter_mut().zip(&col[j + 1..]) {
+                    *yi -= lij * yj;
+                }
+            }
+            for j in (0..m).rev() {
+                let col = &l[j * m..(j + 1) * m];
+                let mut sum = y[j];
+                for (yi, lij) in y[j + 1..].iter().zip(&col[j + 1..]) {
+                    sum -= lij * yi;
+                }
+                y[j] = sum / col[j];
+            }
             for (a, &ja) in d.index.iter().enumerate() {
                 self.f[ja] = d.w[a] * y[a];
             }
