@@ -543,6 +543,16 @@ impl Supernodal {
         &self.fwd
     }
 
+    /// Supernode s's first (permuted) column.
+    pub fn first_column(&self, s: usize) -> usize {
+        self.begin[s]
+    }
+
+    /// Supernode s's pattern: the permuted rows below its diagonal block.
+    pub fn pattern(&self, s: usize) -> &[u32] {
+        &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]]
+    }
+
     /// Supernode s's number of columns and pattern length.
     pub fn block_shape(&self, s: usize) -> (usize, usize) {
         (

@@ -8,17 +8,19 @@
 //! of 3,462 values in 16 supernodes of 4-18 columns) took 4.5 µs a solve,
 //! about 16,000 cycles.
 //!
-//! Here each supernode's triangle is inverted once per factorization,
+//! Here the supernodes are taken in panels of consecutive ones (up to
+//! [`PANEL`] columns, their columns of L made dense), and each panel's
+//! triangle is inverted once per factorization,
 //! T = L_kk⁻¹, and F = [T; −L_b T] ((k + m) × k, L_b the m rows below the
 //! triangle) is stored column-major, and so is Fᵀ, both on 64-byte lines
 //! (columns padded with zeros to a multiple of 8). Then
 //!
-//! * the forward step of a supernode is one dense product: [y; δ] = F x_s,
+//! * the forward step of a panel is one dense product: [y; δ] = F x_s,
 //!   x_s ← y, x_pattern += δ (L_kk y = x_s, δ = −L_b y);
 //! * its back step is one product with Fᵀ: x_s ← Tᵀ x_s − (L_b T)ᵀ
 //!   x_pattern = Fᵀ [x_s; x_pattern] (the pattern rows already final).
 //!
-//! Nothing inside a supernode waits on anything else, and both products
+//! Nothing inside a panel waits on anything else, and both products
 //! are sums of columns scaled by one entry each ([`Wide::product`]), 8
 //! wide. The price is memory: 2.3× the factor on the slabs (whole
 //! triangles, both layouts, padding), so the step uses it only for small
@@ -88,6 +90,56 @@ struct Data {
     values: Vec<Line>,
 }
 
+/// Consecutive supernodes merged into one block while its columns stay
+/// at most this many: fewer blocks mean fewer passes of the per-block work
+/// (index moves, loop set-up), at the price of the zeros the merged
+/// triangle and pattern hold, and the time follows the values stored
+/// (about 0.14 ns a value). `block_inverse_lab`, 2026-11-24, one solve,
+/// panels of ≤ 0 (none) / 8 / 24 / 32 columns: Q2 8×2 1.39 / 1.36 / 1.51
+/// / 1.72 µs; Q1 24×6 3.72 / 3.35 / 3.97 / 4.41 µs; Q2 16×4 7.12 / 6.44 /
+/// 7.39 / 7.79 µs; Q1 48×12 18.6 / 18.0 / 22.4 / 25.5 µs.
+const PANEL: usize = 8;
+
+/// Consecutive supernodes solved as one block: columns c0..c0 + k, the
+/// rows below them with a nonzero in any of their columns.
+struct Panel {
+    supernodes: std::ops::Range<usize>,
+    c0: usize,
+    k: usize,
+    pattern: Vec<u32>,
+}
+
+/// `sn`'s supernodes merged greedily in order into panels of at most
+/// `kmax` columns (a wider supernode is a panel of its own).
+fn panels(sn: &Supernodal, kmax: usize) -> Vec<Panel> {
+    let mut out: Vec<Panel> = Vec::new();
+    let mut s = 0;
+    while s < sn.supernodes() {
+        let (k0, _) = sn.block_shape(s);
+        let mut e = s + 1;
+        let mut k = k0;
+        while e < sn.supernodes() && k + sn.block_shape(e).0 <= kmax {
+            k += sn.block_shape(e).0;
+            e += 1;
+        }
+        let c0 = sn.first_column(s);
+        let mut pattern: Vec<u32> = (s..e)
+            .flat_map(|q| sn.pattern(q).iter().copied())
+            .filter(|&r| r as usize >= c0 + k)
+            .collect();
+        pattern.sort_unstable();
+        pattern.dedup();
+        out.push(Panel {
+            supernodes: s..e,
+            c0,
+            k,
+            pattern,
+        });
+        s = e;
+    }
+    out
+}
+
 /// The solve's width: scalar, or AVX-512 with the same bits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Wide {
@@ -98,9 +150,10 @@ enum Wide {
 impl BlockInverse {
     /// Values of F and Fᵀ for `sn`'s layout.
     pub fn values_for(sn: &Supernodal) -> usize {
-        (0..sn.supernodes())
-            .map(|s| {
-                let (k, m) = sn.block_shape(s);
+        panels(sn, PANEL)
+            .iter()
+            .map(|p| {
+                let (k, m) = (p.k, p.pattern.len());
                 let (f, g) = Block::lines(k, m);
                 8 * (f * k + g * (k + m))
             })
@@ -116,13 +169,20 @@ impl BlockInverse {
     /// The inverted blocks of the factor with values `l` on `sn`'s layout
     /// (a factor of an SPD matrix: positive diagonal).
     pub fn new(sn: &Supernodal, l: &[f64]) -> BlockInverse {
-        let mut blocks = Vec::with_capacity(sn.supernodes());
+        Self::with_panel(sn, l, PANEL)
+    }
+
+    /// [`BlockInverse::new`] with panels of up to `kmax` columns.
+    fn with_panel(sn: &Supernodal, l: &[f64], kmax: usize) -> BlockInverse {
+        let panels = panels(sn, kmax);
+        let mut blocks = Vec::with_capacity(panels.len());
         let mut index = Vec::new();
-        let mut f_values: Vec<Line> = Vec::with_capacity(Self::values_for(sn) / 8);
+        let mut f_values: Vec<Line> = Vec::new();
         let mut g_values: Vec<Line> = Vec::new();
         let (mut max_out, mut max_z) = (0, 0);
         let mut t = Vec::new();
         let mut f = Vec::new();
+        let mut block = Vec::new();
         let to_lines = |v: &[f64], into: &mut Vec<Line>| {
             into.extend(v.chunks_exact(8).map(|c| {
                 let mut line = Line::default();
@@ -130,10 +190,39 @@ impl BlockInverse {
                 line
             }))
         };
-        for s in 0..sn.supernodes() {
-            let (c0, k, pattern, block) = sn.block(l, s);
+        let mut local = vec![u32::MAX; sn.forward_permutation().len()];
+        for panel in &panels {
+            let (c0, k, pattern) = (panel.c0, panel.k, &panel.pattern[..]);
             let m = pattern.len();
             let ld = k + m;
+            // The panel's columns of L, dense (k + m) × k column-major:
+            // rows c0..c0 + k, then the pattern.
+            for (i, &r) in pattern.iter().enumerate() {
+                local[r as usize] = (k + i) as u32;
+            }
+            block.clear();
+            block.resize(ld * k, 0.0);
+            for s in panel.supernodes.clone() {
+                let (a, ks, sp, values) = sn.block(l, s);
+                let lds = ks + sp.len();
+                for j in 0..ks {
+                    let col = &mut block[(a - c0 + j) * ld..(a - c0 + j + 1) * ld];
+                    let src = &values[j * lds..(j + 1) * lds];
+                    // Its triangle's rows j.., then its pattern rows.
+                    for i in j..ks {
+                        col[a - c0 + i] = src[i];
+                    }
+                    for (&r, v) in sp.iter().zip(&src[ks..]) {
+                        let r = r as usize;
+                        let at = if r < c0 + k {
+                            r - c0
+                        } else {
+                            local[r] as usize
+                        };
+                        col[at] = *v;
+                    }
+                }
+            }
             let (f_lines, g_lines) = Block::lines(k, m);
             max_out = max_out.max(8 * f_lines.max(g_lines));
             max_z = max_z.max(ld);
@@ -543,11 +632,12 @@ mod tests {
 
     /// A x = b to rounding (the residual against the matrix, relative to
     /// b), the same bits on every width, and the same x as the supernodal
-    /// solve to 1e-12; Q1 and Q2, supernodes of odd width (DOFs dropped)
-    /// and of more than 32 rows (more than one group of lines).
+    /// solve to 1e-12; Q1 and Q2, blocks of odd width (DOFs dropped), of
+    /// more than 32 rows (more than one group of lines) and of several
+    /// supernodes ([`PANEL`]).
     #[test]
     fn solves_the_system_on_every_width() {
-        let (mut odd, mut long) = (false, false);
+        let (mut odd, mut long, mut merged) = (false, false, false);
         for (kind, nx, ny, drop) in [
             (CellKind::Quad9, 8, 2, usize::MAX),
             (CellKind::Quad9, 8, 2, 7),
@@ -559,6 +649,7 @@ mod tests {
             let mut inv = BlockInverse::new(&sn, &l);
             odd |= inv.data.blocks.iter().any(|b| b.k % 2 == 1);
             long |= inv.data.blocks.iter().any(|b| b.f_lines > 4);
+            merged |= inv.data.blocks.len() < sn.supernodes();
             let b = rhs(n);
             let mut reference = b.clone();
             sn.solve(&l, &mut reference);
@@ -588,13 +679,14 @@ mod tests {
             }
         }
         assert!(
-            odd && long,
-            "a supernode of odd width and one of more than 4 lines"
+            odd && long && merged,
+            "a block of odd width, one of more than 4 lines, one of several supernodes"
         );
     }
 
     /// Timing lab (run by hand): one solve by the supernodal loops and by
-    /// the inverted blocks, per mesh, with F's size.
+    /// the inverted blocks, per mesh, with F's size, and by panels of
+    /// other widths ([`PANEL`]).
     ///
     ///     cargo test --release -p stickslip-time --lib block_inverse_lab -- --ignored --nocapture
     #[test]
@@ -630,6 +722,16 @@ mod tests {
             };
             let t_sn = time(&mut |x| sn.solve(&l, x));
             let t_inv = time(&mut |x| inv.solve(x));
+            for kmax in [0, 8, 24, 32] {
+                let mut other = BlockInverse::with_panel(&sn, &l, kmax);
+                let t = time(&mut |x| other.solve(x));
+                println!(
+                    "    panels of ≤ {kmax} columns: {} blocks, {} values, {:.2} us",
+                    other.data.blocks.len(),
+                    other.len(),
+                    t * 1e6
+                );
+            }
             println!(
                 "{kind:?} {nx}x{ny}: n={n} L={} F={} ({:.0} KB): supernodal {:.2} us, inverted blocks {:.2} us ({:.2}x)",
                 l.len(),
