@@ -118,6 +118,11 @@ struct DenseFactor {
     w: Vec<f64>,
     /// The factor, column-major n_s × n_s in the first n_s² values.
     l: Vec<f64>,
+    /// 1 / the factor's diagonal (the solves multiply: a division's
+    /// latency per column was most of their chains).
+    inv_diag: Vec<f64>,
+    /// The nodes with f ≠ 0 at this solve (slipping).
+    slip: Vec<usize>,
     scratch: MemBuffer,
 }
 
@@ -210,6 +215,8 @@ impl SchurOperator {
             index: Vec::with_capacity(n_c),
             w: Vec::with_capacity(n_c),
             l: vec![0.0; n_c * n_c],
+            inv_diag: Vec::with_capacity(n_c),
+            slip: Vec::with_capacity(n_c),
             scratch: MemBuffer::new(
                 faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(
                     n_c,
@@ -578,6 +585,8 @@ impl SchurOperator {
                     return Err(SolverError::NotPositiveDefinite { pivot: index, n: m });
                 }
             }
+            d.inv_diag.clear();
+            d.inv_diag.extend((0..m).map(|j| 1.0 / d.l[j * m + j]));
             d.entry_id = entry.id;
             d.valid = true;
         }
@@ -585,12 +594,12 @@ impl SchurOperator {
         if m > 0 {
             // y = (I + W S_ss W)⁻¹ W (p_s − S_s· F); f_s = W y.
             let y = &mut u[..m];
+            d.slip.clear();
+            d.slip.extend((0..n_c).filter(|&j| self.f[j] != 0.0));
             for (a, &ja) in d.index.iter().enumerate() {
                 let mut r = self.p[ja];
-                for (j, f) in self.f.iter().enumerate() {
-                    if *f != 0.0 {
-                        r -= s[j * n_c + ja] * f;
-                    }
+                for &j in &d.slip {
+                    r -= s[j * n_c + ja] * self.f[j];
                 }
                 y[a] = d.w[a] * r;
             }
@@ -599,7 +608,7 @@ impl SchurOperator {
             let l = &d.l[..m * m];
             for j in 0..m {
                 let col = &l[j * m..(j + 1) * m];
-                let yj = y[j] / col[j];
+                let yj = y[j] * d.inv_diag[j];
                 y[j] = yj;
                 for (yi, lij) in y[j + 1..].iter_mut().zip(&col[j + 1..]) {
                     *yi -= lij * yj;
@@ -611,7 +620,7 @@ impl SchurOperator {
                 for (yi, lij) in y[j + 1..].iter().zip(&col[j + 1..]) {
                     sum -= lij * yi;
                 }
-                y[j] = sum / col[j];
+                y[j] = sum * d.inv_diag[j];
             }
             for (a, &ja) in d.index.iter().enumerate() {
                 self.f[ja] = d.w[a] * y[a];
