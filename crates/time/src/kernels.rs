@@ -1607,21 +1607,25 @@ impl Lanes {
     /// Adds term(k) for rows i0 + k, k < n.
     #[inline(always)]
     pub(crate) fn add_rows(&mut self, i0: usize, n: usize, term: impl Fn(usize) -> f64) {
+        // A local copy: summed through `self` the lanes stayed in memory,
+        // a store and a reload per row (the paper mesh's sweep).
+        let mut lanes = self.0;
         let mut k = 0;
         while k < n && !(i0 + k).is_multiple_of(4) {
-            self.0[(i0 + k) % 4] += term(k);
+            lanes[(i0 + k) % 4] += term(k);
             k += 1;
         }
         while k + 4 <= n {
             for l in 0..4 {
-                self.0[l] += term(k + l);
+                lanes[l] += term(k + l);
             }
             k += 4;
         }
         while k < n {
-            self.0[(i0 + k) % 4] += term(k);
+            lanes[(i0 + k) % 4] += term(k);
             k += 1;
         }
+        self.0 = lanes;
     }
 
     /// The sum.
