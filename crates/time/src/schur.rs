@@ -19,7 +19,9 @@
 //!
 //! The solves are this crate's own loops over faer's supernodal factor
 //! (`supernodal.rs`: 2.7× faster than faer's one-column solve at 250k DOFs,
-//! the tree split between two threads). Without a stored Z the step's two
+//! the tree split between two threads), and on small factors the inverted
+//! blocks of `small_solve.rs` (the paper mesh: 3.6× faster than those
+//! loops). Without a stored Z the step's two
 //! solves share their work: v₀ is only needed at the contact DOFs before
 //! the iteration, and A₀⁻¹(b − Pᵀf) differs from A₀⁻¹b only on the paths
 //! from the contact DOFs to the root, so a step is one forward solve, a
