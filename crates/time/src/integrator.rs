@@ -11,6 +11,7 @@ use crate::linalg::{
     self, dot, load_minus_k_plus_m, quadratic_form, row_chunks, same_pattern, spmv, two_forms,
     PairBlocks,
 };
+use crate::nodal::NodalFriction;
 use crate::schur::{ImplicitSolver, SchurOperator};
 use crate::stability::{critical_step, critical_step_with};
 
@@ -385,6 +386,8 @@ pub struct Integrator {
     friction: Vec<(usize, f64)>,
     /// Per contact node and component, the entry of `friction`.
     friction_slots: Vec<[Option<usize>; 2]>,
+    /// The closed-form nodal friction's constants for the last Δt.
+    nodal: NodalFriction,
     /// The constant load and the loads on their nonzero rows (explicit
     /// runs: pass A forms R_K there only).
     sparse_loads: kernels::SparseLoads,
@@ -666,6 +669,7 @@ impl Integrator {
             product: None,
             friction: Vec::new(),
             friction_slots: Vec::new(),
+            nodal: NodalFriction::default(),
             sparse_loads: kernels::SparseLoads::new(&[], &[]),
             r,
             v,
@@ -899,11 +903,8 @@ impl Integrator {
         }
 
         self.scratch_classes.copy_from_slice(&self.classes);
-        let iterations = if self.explicit {
-            self.explicit_velocity(dt, step_number, t_new)?
-        } else {
-            self.implicit_velocity(dt, step_number, t_new)?
-        };
+        // (The explicit scheme took `explicit_step` above.)
+        let iterations = self.implicit_velocity(dt, step_number, t_new)?;
 
         // Corrector, with the finiteness check (a flag, not a branch per
         // entry).
@@ -1066,33 +1067,21 @@ impl Integrator {
                 if let Some(contact) = &self.contact {
                     // The nodal friction first, from R̂_K at the contact DOFs
                     // (the same bits as the sweep's), then one sweep.
-                    let mass = &self.dynamics.lumped_mass;
-                    for (node, slots) in contact.nodes.iter().zip(&self.friction_slots) {
-                        let mut b = [0.0; 2];
-                        let (mut p, mut q) = (0.0, 0.0);
-                        for c in 0..2 {
-                            if let Some(i) = node.dofs[c] {
-                                let ku = if one_chunk {
-                                    self.b[i]
-                                } else {
-                                    k.row(i, &self.r_new)
-                                };
-                                b[c] = kernels::rhs_entry(&data, i, ku);
-                                let d = mass[i] * scale;
-                                p += node.tangent[c] * b[c] / d;
-                                q += node.tangent[c] * node.tangent[c] / d;
+                    self.nodal
+                        .prepare(contact, &self.dynamics.lumped_mass, scale);
+                    let (ku, r_new) = (&self.b, &self.r_new);
+                    let (friction, slots) = (&mut self.friction, &self.friction_slots);
+                    self.nodal.velocities(
+                        |i| {
+                            let ku = if one_chunk { ku[i] } else { k.row(i, r_new) };
+                            kernels::rhs_entry(&data, i, ku)
+                        },
+                        |j, c, _, v| {
+                            if let Some(slot) = slots[j][c] {
+                                friction[slot].1 = v;
                             }
-                        }
-                        let wg = node.force_scale();
-                        let vt = contact.law.solve_nodal(p, wg * q);
-                        let phi = contact.law.phi(vt);
-                        for c in 0..2 {
-                            if let (Some(i), Some(slot)) = (node.dofs[c], slots[c]) {
-                                self.friction[slot].1 =
-                                    (b[c] - wg * phi * node.tangent[c]) / (mass[i] * scale);
-                            }
-                        }
-                    }
+                        },
+                    );
                 }
                 let (strain, sums) = kernels::fused_step(
                     k,
@@ -1148,27 +1137,10 @@ impl Integrator {
                     None => 1,
                     Some(contact) => match self.settings.explicit_friction {
                         ExplicitFriction::ClosedForm => {
-                            let mass = &self.dynamics.lumped_mass;
-                            for node in &contact.nodes {
-                                // As in explicit_velocity, d = m·scale inline.
-                                let (mut p, mut q) = (0.0, 0.0);
-                                for c in 0..2 {
-                                    if let Some(i) = node.dofs[c] {
-                                        let d = mass[i] * scale;
-                                        p += node.tangent[c] * self.b[i] / d;
-                                        q += node.tangent[c] * node.tangent[c] / d;
-                                    }
-                                }
-                                let wg = node.force_scale();
-                                let vt = contact.law.solve_nodal(p, wg * q);
-                                let phi = contact.law.phi(vt);
-                                for c in 0..2 {
-                                    if let Some(i) = node.dofs[c] {
-                                        self.v_new[i] = (self.b[i] - wg * phi * node.tangent[c])
-                                            / (mass[i] * scale);
-                                    }
-                                }
-                            }
+                            self.nodal
+                                .prepare(contact, &self.dynamics.lumped_mass, scale);
+                            let (b, v_new) = (&self.b, &mut self.v_new);
+                            self.nodal.velocities(|i| b[i], |_, _, i, v| v_new[i] = v);
                             contact.classify(&self.v_new, &mut self.scratch_classes);
                             1
                         }
@@ -1214,7 +1186,9 @@ impl Integrator {
         ))
     }
 
-    /// Explicit step: d = M_L/(γΔt), friction node by node.
+    /// Explicit step with the friction iterated (`ExplicitFriction::Iterate`,
+    /// the reference for the closed form): d = M_L/(γΔt), then §5's
+    /// iteration on the diagonal system.
     fn explicit_velocity(&mut self, dt: f64, step: u64, t: f64) -> Result<usize, TimeError> {
         let scale = 1.0 / (self.gamma * dt);
         for (d, m) in self.diagonal.iter_mut().zip(&self.dynamics.lumped_mass) {
@@ -1226,57 +1200,29 @@ impl Integrator {
         let Some(contact) = &self.contact else {
             return Ok(1);
         };
-        match self.settings.explicit_friction {
-            ExplicitFriction::ClosedForm => {
-                // Per node: with t = τ·ṙ, t + w g q φ_ε(t) = p where
-                // p = τᵀD⁻¹b, q = τᵀD⁻¹τ; then ṙ = D⁻¹(b − w g φ_ε(t) τ).
-                for node in &contact.nodes {
-                    let (mut p, mut q) = (0.0, 0.0);
-                    for c in 0..2 {
-                        if let Some(i) = node.dofs[c] {
-                            p += node.tangent[c] * self.b[i] / self.diagonal[i];
-                            q += node.tangent[c] * node.tangent[c] / self.diagonal[i];
-                        }
-                    }
-                    let wg = node.force_scale();
-                    let vt = contact.law.solve_nodal(p, wg * q);
-                    let phi = contact.law.phi(vt);
-                    for c in 0..2 {
-                        if let Some(i) = node.dofs[c] {
-                            self.v_new[i] =
-                                (self.b[i] - wg * phi * node.tangent[c]) / self.diagonal[i];
-                        }
-                    }
-                }
-                contact.classify(&self.v_new, &mut self.scratch_classes);
-                Ok(1)
-            }
-            ExplicitFriction::Iterate => {
-                let mut system = DiagonalStep {
-                    diagonal: &self.diagonal,
-                    b: &self.b,
-                };
-                match iterate(
-                    contact,
-                    &mut system,
-                    &mut self.scratch_classes,
-                    &mut self.iter_scratch,
-                    &mut self.v_new,
-                    self.settings.iteration,
-                ) {
-                    Ok(report) => Ok(report.iterations),
-                    Err(IterationFailure::Cap {
-                        iterations,
-                        changing,
-                    }) => Err(TimeError::IterationCap {
-                        step,
-                        t,
-                        iterations,
-                        changing,
-                    }),
-                    Err(IterationFailure::Solve(never)) => match never {},
-                }
-            }
+        let mut system = DiagonalStep {
+            diagonal: &self.diagonal,
+            b: &self.b,
+        };
+        match iterate(
+            contact,
+            &mut system,
+            &mut self.scratch_classes,
+            &mut self.iter_scratch,
+            &mut self.v_new,
+            self.settings.iteration,
+        ) {
+            Ok(report) => Ok(report.iterations),
+            Err(IterationFailure::Cap {
+                iterations,
+                changing,
+            }) => Err(TimeError::IterationCap {
+                step,
+                t,
+                iterations,
+                changing,
+            }),
+            Err(IterationFailure::Solve(never)) => match never {},
         }
     }
 

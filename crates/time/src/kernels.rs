@@ -3057,6 +3057,16 @@ pub(crate) mod tests {
             let t = time(&mut || c.spmv(std::hint::black_box(&x), &mut y));
             println!("  compact {:<6} {:.3} µs", format!("{:?}", c.wide), 1e6 * t);
         }
+        let dict = Compact::with_form(k, Form::Dictionary).expect("applies");
+        println!(
+            "  dictionary: {} distinct of {} blocks",
+            dict.dictionary_len(),
+            dict.blocks()
+        );
+        for c in widths(&dict) {
+            let t = time(&mut || c.spmv(std::hint::black_box(&x), &mut y));
+            println!("  dict    {:<6} {:.3} µs", format!("{:?}", c.wide), 1e6 * t);
+        }
         // Newmark's two passes over K and M (linalg.rs).
         let pairs = crate::linalg::PairBlocks::new(k, &model.mass).expect("shared pattern");
         let l = x_of(n);

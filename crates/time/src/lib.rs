@@ -23,6 +23,7 @@ mod integrator;
 mod kernels;
 pub mod linalg;
 mod memory;
+mod nodal;
 pub mod scenes;
 mod schur;
 mod small_solve;

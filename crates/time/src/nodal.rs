@@ -1,0 +1,119 @@
+//! The explicit step's closed-form nodal friction (METHOD.md §4, the
+//! central-difference scheme) with its constants formed once per Δt.
+//!
+//! Per contact node J, with D = M_L/(γΔt) (diagonal) and τ its tangent,
+//! t = τ·ṙ_K solves t + c φ_ε(t) = p, p = τᵀD⁻¹b, c = w_J g_J τᵀD⁻¹τ, and
+//! then ṙ_K = D⁻¹(b − w_J g_J φ_ε(t) τ) at the node's DOFs. Everything but
+//! b is fixed while Δt is: D⁻¹, τ/d, w g τ/d, c and the stuck factor
+//! 1/(1 + c/ε) are formed here once per Δt, so that a step does no division
+//! at all (before, nine per node: the paper mesh's explicit step took 1.394
+//! µs with them, 1.275 µs without, medians of ten alternating bench_step
+//! runs, 2026-11-24). Products by reciprocals round differently from the
+//! quotients, within rounding; the test against the iterated friction
+//! (`tests/paper.rs`) holds the two to 1e-12.
+
+use stickslip_contact::ContactSurface;
+
+/// The constants of one contact node for one Δt.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    /// Free DOFs of the node (`None` = fixed).
+    dofs: [Option<usize>; 2],
+    /// τ_c/d_c (p = Σ a_c b_c).
+    a: [f64; 2],
+    /// 1/d_c.
+    inv_d: [f64; 2],
+    /// w g τ_c/d_c.
+    w: [f64; 2],
+    /// c = w g τᵀD⁻¹τ.
+    c: f64,
+    /// 1/(1 + c/ε): the stuck root is p times this.
+    stuck: f64,
+}
+
+/// The closed-form nodal friction of the explicit step.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct NodalFriction {
+    /// The bits of 1/(γΔt) the constants are for (None: not formed).
+    scale: Option<u64>,
+    eps: f64,
+    inv_eps: f64,
+    nodes: Vec<Node>,
+}
+
+impl NodalFriction {
+    /// Forms the constants for D = `mass`·`scale` unless they are formed
+    /// for this scale already.
+    pub(crate) fn prepare(&mut self, contact: &ContactSurface, mass: &[f64], scale: f64) {
+        if self.scale == Some(scale.to_bits()) && self.nodes.len() == contact.nodes.len() {
+            return;
+        }
+        let eps = contact.law.eps;
+        self.eps = eps;
+        self.inv_eps = 1.0 / eps;
+        self.nodes.clear();
+        for node in &contact.nodes {
+            let wg = node.force_scale();
+            let (mut a, mut inv_d, mut w, mut q) = ([0.0; 2], [0.0; 2], [0.0; 2], 0.0);
+            for c in 0..2 {
+                if let Some(i) = node.dofs[c] {
+                    inv_d[c] = 1.0 / (mass[i] * scale);
+                    a[c] = node.tangent[c] * inv_d[c];
+                    w[c] = wg * a[c];
+                    q += node.tangent[c] * a[c];
+                }
+            }
+            let c = wg * q;
+            self.nodes.push(Node {
+                dofs: node.dofs,
+                a,
+                inv_d,
+                w,
+                c,
+                stuck: 1.0 / (1.0 + c / eps),
+            });
+        }
+        self.scale = Some(scale.to_bits());
+    }
+
+    /// Calls `out(node, component, dof, ṙ_K)` for every free DOF of every
+    /// contact node, given `b(dof)` = R̂_K there. [`NodalFriction::prepare`]
+    /// first.
+    #[inline]
+    pub(crate) fn velocities(
+        &self,
+        mut b: impl FnMut(usize) -> f64,
+        mut out: impl FnMut(usize, usize, usize, f64),
+    ) {
+        let (eps, inv_eps) = (self.eps, self.inv_eps);
+        for (j, node) in self.nodes.iter().enumerate() {
+            let mut bj = [0.0; 2];
+            let mut p = 0.0;
+            for c in 0..2 {
+                if let Some(i) = node.dofs[c] {
+                    bj[c] = b(i);
+                    p += node.a[c] * bj[c];
+                }
+            }
+            // FrictionLaw::solve_nodal and ::phi with the stored factors.
+            let stuck = p * node.stuck;
+            let t = if stuck.abs() <= eps {
+                stuck
+            } else {
+                p - node.c * p.signum()
+            };
+            let phi = if t > eps {
+                1.0
+            } else if t < -eps {
+                -1.0
+            } else {
+                t * inv_eps
+            };
+            for c in 0..2 {
+                if let Some(i) = node.dofs[c] {
+                    out(j, c, i, bj[c] * node.inv_d[c] - phi * node.w[c]);
+                }
+            }
+        }
+    }
+}
