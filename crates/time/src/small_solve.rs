@@ -285,6 +285,8 @@ impl BlockInverse {
         }
         f_values.extend(g_values);
         let n = sn.forward_permutation().len();
+        // `solve` moves values through the indices unchecked.
+        assert!(index.iter().all(|&r| (r as usize) < n));
         BlockInverse {
             data: Data {
                 fwd: sn.forward_permutation().to_vec(),
@@ -324,11 +326,14 @@ impl BlockInverse {
             self.wide
                 .product(d.f(blk), &xp[c0..c0 + k], blk.f_lines, out);
             let (cols, pattern) = d.index(blk).split_at(k);
+            // SAFETY (here and below): every index is below n = xp.len()
+            // (asserted in `with_panel`): the checks were a compare and a
+            // branch per value moved, in loops of nothing but moves.
             for (&c, v) in cols.iter().zip(&out[..k]) {
-                xp[c as usize] = *v;
+                unsafe { *xp.get_unchecked_mut(c as usize) = *v };
             }
             for (&r, v) in pattern.iter().zip(&out[k..]) {
-                xp[r as usize] += v;
+                unsafe { *xp.get_unchecked_mut(r as usize) += v };
             }
         }
         for blk in d.blocks.iter().rev() {
@@ -337,12 +342,12 @@ impl BlockInverse {
             let index = d.index(blk);
             let z = &mut z[..index.len()];
             for (zi, &r) in z.iter_mut().zip(index) {
-                *zi = xp[r as usize];
+                *zi = unsafe { *xp.get_unchecked(r as usize) };
             }
             let out = &mut out[..8 * blk.g_lines];
             self.wide.product(d.g(blk), z, blk.g_lines, out);
             for (&c, v) in index[..k].iter().zip(&out[..k]) {
-                xp[c as usize] = *v;
+                unsafe { *xp.get_unchecked_mut(c as usize) = *v };
             }
         }
         d.permute_out(xp, x);
