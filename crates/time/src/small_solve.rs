@@ -24,19 +24,22 @@
 //! are sums of columns scaled by one entry each ([`Wide::product`]), 8
 //! wide. The price is memory: 2.3× the factor on the slabs (whole
 //! triangles, both layouts, padding), so the step uses it only for small
-//! factors ([`MAX_VALUES`]). The arithmetic per lane is fixed, so the bits
+//! factors ([`MAX_VALUES`]); beyond half the L2 ([`TRANSPOSED_MAX_VALUES`])
+//! only F is stored (1.15× the factor) and the back step takes dot
+//! products with its columns ([`Wide::dots`]). The arithmetic per lane is fixed, so the bits
 //! do not depend on the CPU's width; they are not the supernodal solve's
 //! bits (T is an explicit inverse), which is why the tests compare with
 //! the matrix and with that solve to a tolerance.
 
 use stickslip_fem::Supernodal;
 
-/// Factors up to this many values of F and Fᵀ together (2 MB) are solved
-/// by inverted blocks. `block_inverse_lab` (2026-11-24), one solve against
-/// the supernodal loops: 3.4× faster on the paper's Q2 8×2 mesh (170
-/// DOFs), 2.8× at 350 and 594 DOFs, 2.2× (Q1 48×12, 0.9 MB) and 2.1× (Q2
-/// 32×8, 1.9 MB); still 1.8× at 8.5k DOFs (9 MB), but there F and Fᵀ take
-/// 2.3× the factor's memory, which the large meshes cannot spare.
+/// Factors up to this many values stored (2 MB; F and Fᵀ, or F alone
+/// beyond [`TRANSPOSED_MAX_VALUES`]) are solved by inverted blocks.
+/// `block_inverse_lab` (2026-11-24), one solve against the supernodal
+/// loops: 3.8× faster on the paper's Q2 8×2 mesh (170 DOFs), 3.2-3.3× at
+/// 350 and 594 DOFs, 2.9× (Q1 48×12) and 2.6× (Q2 32×8, 0.9 MB of F
+/// alone); still 2.3× at 8.5k DOFs (4.5 MB of F alone), but that is 1.15×
+/// the factor's memory again, which the large meshes cannot spare.
 const MAX_VALUES: usize = 1 << 18;
 
 /// Eight doubles on one 64-byte line.
@@ -75,6 +78,8 @@ pub(crate) struct BlockInverse {
     xp: Vec<f64>,
     out: Vec<f64>,
     z: Vec<f64>,
+    /// A block's gathered x on lines (the back step by dot products).
+    lines: Vec<Line>,
     wide: Wide,
 }
 
@@ -86,9 +91,24 @@ struct Data {
     blocks: Vec<Block>,
     /// Per block its columns c0..c0 + k, then its pattern.
     index: Vec<u32>,
-    /// F of every block (column-major), then Fᵀ of every block.
+    /// F of every block (column-major), then Fᵀ of every block where
+    /// `transposed`.
     values: Vec<Line>,
+    /// Fᵀ is stored and the back step is its products (small factors);
+    /// else the back step takes dot products with F's columns.
+    transposed: bool,
 }
+
+/// Factors whose F and Fᵀ together hold at most this many values (512 KB,
+/// half the 1 MB L2) store both; larger ones store F alone and run the back
+/// step as dot products with its columns, each summed by a three-round
+/// reduction across lanes. On small factors that reduction sits on the
+/// chain from block to block, where beyond the L2 half the values read
+/// cost more: `block_inverse_lab`, 2026-11-24, one run, F and Fᵀ / F
+/// alone: Q2 8×2 1.34 / 1.41 µs, Q1 24×6 3.28 / 3.64, Q2 16×4 (343 KB of
+/// both) 6.07 / 6.75; Q1 48×12 (0.9 MB) 17.2 / 16.1, Q2 32×8 (1.9 MB)
+/// 36.4 / 33.9, Q2 64×16 (9.3 MB) 204 / 182 µs.
+const TRANSPOSED_MAX_VALUES: usize = 1 << 16;
 
 /// Consecutive supernodes merged into one block while its columns stay
 /// at most this many: fewer blocks mean fewer passes of the per-block work
@@ -148,16 +168,24 @@ enum Wide {
 }
 
 impl BlockInverse {
-    /// Values of F and Fᵀ for `sn`'s layout.
+    /// Values of F and of Fᵀ on `panels`.
+    fn counts(panels: &[Panel]) -> (usize, usize) {
+        panels.iter().fold((0, 0), |(f_sum, g_sum), p| {
+            let (k, m) = (p.k, p.pattern.len());
+            let (f, g) = Block::lines(k, m);
+            (f_sum + 8 * f * k, g_sum + 8 * g * (k + m))
+        })
+    }
+
+    /// Values stored for `sn`'s layout: F and Fᵀ up to
+    /// [`TRANSPOSED_MAX_VALUES`] of both, else F.
     pub fn values_for(sn: &Supernodal) -> usize {
-        panels(sn, PANEL)
-            .iter()
-            .map(|p| {
-                let (k, m) = (p.k, p.pattern.len());
-                let (f, g) = Block::lines(k, m);
-                8 * (f * k + g * (k + m))
-            })
-            .sum()
+        let (f, g) = Self::counts(&panels(sn, PANEL));
+        if f + g <= TRANSPOSED_MAX_VALUES {
+            f + g
+        } else {
+            f
+        }
     }
 
     /// True when `sn`'s factors are small enough for the inverted blocks
@@ -169,17 +197,28 @@ impl BlockInverse {
     /// The inverted blocks of the factor with values `l` on `sn`'s layout
     /// (a factor of an SPD matrix: positive diagonal).
     pub fn new(sn: &Supernodal, l: &[f64]) -> BlockInverse {
-        Self::with_panel(sn, l, PANEL)
+        Self::with_panel(sn, l, PANEL, None)
     }
 
-    /// [`BlockInverse::new`] with panels of up to `kmax` columns.
-    fn with_panel(sn: &Supernodal, l: &[f64], kmax: usize) -> BlockInverse {
+    /// [`BlockInverse::new`] with panels of up to `kmax` columns, and Fᵀ
+    /// stored or not as `transposed` says (None: by
+    /// [`TRANSPOSED_MAX_VALUES`]).
+    fn with_panel(
+        sn: &Supernodal,
+        l: &[f64],
+        kmax: usize,
+        transposed: Option<bool>,
+    ) -> BlockInverse {
         let panels = panels(sn, kmax);
+        let transposed = transposed.unwrap_or_else(|| {
+            let (f, g) = Self::counts(&panels);
+            f + g <= TRANSPOSED_MAX_VALUES
+        });
         let mut blocks = Vec::with_capacity(panels.len());
         let mut index = Vec::new();
         let mut f_values: Vec<Line> = Vec::new();
         let mut g_values: Vec<Line> = Vec::new();
-        let (mut max_out, mut max_z) = (0, 0);
+        let (mut max_out, mut max_z, mut max_lines) = (0, 0, 0);
         let mut t = Vec::new();
         let mut f = Vec::new();
         let mut block = Vec::new();
@@ -226,6 +265,7 @@ impl BlockInverse {
             let (f_lines, g_lines) = Block::lines(k, m);
             max_out = max_out.max(8 * f_lines.max(g_lines));
             max_z = max_z.max(ld);
+            max_lines = max_lines.max(f_lines);
             // T = L_kk⁻¹, column-major k × k, by forward substitution on
             // the unit vectors.
             t.clear();
@@ -259,13 +299,15 @@ impl BlockInverse {
             to_lines(&f, &mut f_values);
             // Fᵀ, column-major (k + m columns of k rows, padded).
             let g_at = g_values.len();
-            let mut g = vec![0.0; 8 * g_lines * ld];
-            for i in 0..ld {
-                for j in 0..k {
-                    g[i * 8 * g_lines + j] = f[j * rows + i];
+            if transposed {
+                let mut g = vec![0.0; 8 * g_lines * ld];
+                for i in 0..ld {
+                    for j in 0..k {
+                        g[i * 8 * g_lines + j] = f[j * rows + i];
+                    }
                 }
+                to_lines(&g, &mut g_values);
             }
-            to_lines(&g, &mut g_values);
             blocks.push(Block {
                 c0,
                 k,
@@ -293,10 +335,12 @@ impl BlockInverse {
                 blocks,
                 index,
                 values: f_values,
+                transposed,
             },
             xp: vec![0.0; n],
             out: vec![0.0; max_out],
             z: vec![0.0; max_z],
+            lines: vec![Line::default(); max_lines],
             wide: if crate::kernels::avx512() {
                 Wide::Avx512
             } else {
@@ -314,7 +358,7 @@ impl BlockInverse {
     #[allow(unsafe_code)]
     pub fn solve(&mut self, x: &mut [f64]) {
         let d = &self.data;
-        let (xp, out, z) = (&mut self.xp, &mut self.out, &mut self.z);
+        let (xp, out, z, lines) = (&mut self.xp, &mut self.out, &mut self.z, &mut self.lines);
         d.permute_in(x, xp);
         // The block's columns go through their indices like its pattern
         // rows: copies of a few doubles by `copy_from_slice` were calls to
@@ -340,12 +384,28 @@ impl BlockInverse {
             // x_s ← Fᵀ [x_s; x_pattern].
             let k = blk.k;
             let index = d.index(blk);
-            let z = &mut z[..index.len()];
-            for (zi, &r) in z.iter_mut().zip(index) {
-                *zi = unsafe { *xp.get_unchecked(r as usize) };
-            }
-            let out = &mut out[..8 * blk.g_lines];
-            self.wide.product(d.g(blk), z, blk.g_lines, out);
+            let out = if d.transposed {
+                // By columns of the stored Fᵀ.
+                let z = &mut z[..index.len()];
+                for (zi, &r) in z.iter_mut().zip(index) {
+                    *zi = unsafe { *xp.get_unchecked(r as usize) };
+                }
+                let out = &mut out[..8 * blk.g_lines];
+                self.wide.product(d.g(blk), z, blk.g_lines, out);
+                out
+            } else {
+                // As dot products with F's columns (F alone stored).
+                let z = &mut lines[..blk.f_lines];
+                for (line, rows) in z.iter_mut().zip(index.chunks(8)) {
+                    line.0 = [0.0; 8];
+                    for (zi, &r) in line.0.iter_mut().zip(rows) {
+                        *zi = unsafe { *xp.get_unchecked(r as usize) };
+                    }
+                }
+                let out = &mut out[..k];
+                self.wide.dots(d.f(blk), z, blk.f_lines, k, out);
+                out
+            };
             for (&c, v) in index[..k].iter().zip(&out[..k]) {
                 unsafe { *xp.get_unchecked_mut(c as usize) = *v };
             }
@@ -421,6 +481,94 @@ impl Wide {
             }
         }
     }
+}
+
+impl Wide {
+    /// out[j] = Σ_r A[r, j] z[r] for the `k` columns of A (column-major on
+    /// `lines` lines per column, z on as many lines, zero where A's
+    /// columns are padded): per column, lane l sums the terms of rows
+    /// 8q + l in order of q, then the lanes pairwise, ((l0 + l1) + (l2 +
+    /// l3)) + ((l4 + l5) + (l6 + l7)). Columns in groups of eight.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    fn dots(self, a: &[Line], z: &[Line], lines: usize, k: usize, out: &mut [f64]) {
+        let mut j = 0;
+        while j < k {
+            let cols = (k - j).min(8);
+            #[cfg(target_arch = "x86_64")]
+            if self == Wide::Avx512 {
+                // SAFETY: Avx512 only where the CPU has it (new).
+                unsafe { dots_avx512(&a[j * lines..(j + cols) * lines], z, lines, &mut out[j..]) };
+                j += cols;
+                continue;
+            }
+            dots_scalar(&a[j * lines..(j + cols) * lines], z, lines, &mut out[j..]);
+            j += cols;
+        }
+    }
+}
+
+/// [`Wide::dots`] for up to eight columns (a.len() / lines of them).
+fn dots_scalar(a: &[Line], z: &[Line], lines: usize, out: &mut [f64]) {
+    for (col, o) in a.chunks_exact(lines).zip(out.iter_mut()) {
+        let mut acc = [0.0f64; 8];
+        for (line, zq) in col.iter().zip(z) {
+            for l in 0..8 {
+                acc[l] += line.0[l] * zq.0[l];
+            }
+        }
+        *o = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+    }
+}
+
+/// [`dots_scalar`] with AVX-512: a register per column, the lanes summed
+/// by three rounds of pairing across the eight registers, lane by lane
+/// the same operations, so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[allow(unsafe_code)]
+fn dots_avx512(a: &[Line], z: &[Line], lines: usize, out: &mut [f64]) {
+    use std::arch::x86_64::*;
+    // SAFETY: lines are 64-byte aligned 8-double arrays.
+    let load = |line: &Line| unsafe { _mm512_load_pd(line.0.as_ptr()) };
+    let cols = a.len() / lines;
+    let mut acc = [_mm512_setzero_pd(); 8];
+    for q in 0..lines {
+        let zq = load(&z[q]);
+        for c in 0..8 {
+            if c < cols {
+                acc[c] = _mm512_add_pd(acc[c], _mm512_mul_pd(load(&a[c * lines + q]), zq));
+            }
+        }
+    }
+    // Round 1: [c0 (l0+l1), c1 (l0+l1), c0 (l2+l3), c1 (l2+l3), ...].
+    let pair =
+        |x: __m512d, y: __m512d| _mm512_add_pd(_mm512_unpacklo_pd(x, y), _mm512_unpackhi_pd(x, y));
+    let (t01, t23, t45, t67) = (
+        pair(acc[0], acc[1]),
+        pair(acc[2], acc[3]),
+        pair(acc[4], acc[5]),
+        pair(acc[6], acc[7]),
+    );
+    // Round 2: 128-bit lanes 0, 2 of both plus lanes 1, 3 of both:
+    // [c0 (0..3), c1 (0..3), c2 (0..3), c3 (0..3), c0 (4..7), c1 (4..7), ...].
+    let quad = |x: __m512d, y: __m512d| {
+        _mm512_add_pd(
+            _mm512_shuffle_f64x2::<0b10_00_10_00>(x, y),
+            _mm512_shuffle_f64x2::<0b11_01_11_01>(x, y),
+        )
+    };
+    let (u0, u1) = (quad(t01, t23), quad(t45, t67));
+    // Round 3: the low halves (rows 0..3) plus the high halves (rows 4..7):
+    // [c0, c1, c2, c3, c4, c5, c6, c7].
+    let total = _mm512_add_pd(
+        _mm512_shuffle_f64x2::<0b10_00_10_00>(u0, u1),
+        _mm512_shuffle_f64x2::<0b11_01_11_01>(u0, u1),
+    );
+    let mut sums = [0.0f64; 8];
+    // SAFETY: sums holds 8 doubles.
+    unsafe { _mm512_storeu_pd(sums.as_mut_ptr(), total) };
+    out[..cols].copy_from_slice(&sums[..cols]);
 }
 
 /// Lines g..g + G of A v into out (see [`Wide::product`]).
@@ -643,6 +791,7 @@ mod tests {
     #[test]
     fn solves_the_system_on_every_width() {
         let (mut odd, mut long, mut merged) = (false, false, false);
+        let (mut transposed, mut dots) = (false, false);
         for (kind, nx, ny, drop) in [
             (CellKind::Quad9, 8, 2, usize::MAX),
             (CellKind::Quad9, 8, 2, 7),
@@ -655,6 +804,8 @@ mod tests {
             odd |= inv.data.blocks.iter().any(|b| b.k % 2 == 1);
             long |= inv.data.blocks.iter().any(|b| b.f_lines > 4);
             merged |= inv.data.blocks.len() < sn.supernodes();
+            transposed |= inv.data.transposed;
+            dots |= !inv.data.transposed;
             let b = rhs(n);
             let mut reference = b.clone();
             sn.solve(&l, &mut reference);
@@ -687,11 +838,16 @@ mod tests {
             odd && long && merged,
             "a block of odd width, one of more than 4 lines, one of several supernodes"
         );
+        assert!(
+            transposed && dots,
+            "a factor with Fᵀ stored and one without"
+        );
     }
 
     /// Timing lab (run by hand): one solve by the supernodal loops and by
-    /// the inverted blocks, per mesh, with F's size, and by panels of
-    /// other widths ([`PANEL`]).
+    /// the inverted blocks, per mesh, with F's size, with Fᵀ stored and
+    /// without ([`TRANSPOSED_MAX_VALUES`]), and by panels of other widths
+    /// ([`PANEL`]).
     ///
     ///     cargo test --release -p stickslip-time --lib block_inverse_lab -- --ignored --nocapture
     #[test]
@@ -727,8 +883,18 @@ mod tests {
             };
             let t_sn = time(&mut |x| sn.solve(&l, x));
             let t_inv = time(&mut |x| inv.solve(x));
+            for stored in [true, false] {
+                let mut other = BlockInverse::with_panel(&sn, &l, PANEL, Some(stored));
+                let t = time(&mut |x| other.solve(x));
+                println!(
+                    "    {}: {} values, {:.2} us",
+                    if stored { "F and Fᵀ" } else { "F alone " },
+                    other.len(),
+                    t * 1e6
+                );
+            }
             for kmax in [0, 8, 24, 32] {
-                let mut other = BlockInverse::with_panel(&sn, &l, kmax);
+                let mut other = BlockInverse::with_panel(&sn, &l, kmax, None);
                 let t = time(&mut |x| other.solve(x));
                 println!(
                     "    panels of ≤ {kmax} columns: {} blocks, {} values, {:.2} us",
