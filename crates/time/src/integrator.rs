@@ -393,6 +393,28 @@ pub struct Integrator {
     sparse_loads: kernels::SparseLoads,
 }
 
+/// The stick/slip iteration's failure as the step's error: the cap, or
+/// the failed solve as `solve` maps it.
+fn iteration_error<E>(
+    failure: IterationFailure<E>,
+    step: u64,
+    t: f64,
+    solve: impl FnOnce(E) -> TimeError,
+) -> TimeError {
+    match failure {
+        IterationFailure::Cap {
+            iterations,
+            changing,
+        } => TimeError::IterationCap {
+            step,
+            t,
+            iterations,
+            changing,
+        },
+        IterationFailure::Solve(e) => solve(e),
+    }
+}
+
 /// K and M by stencil types for the implicit step (see
 /// `Integrator::implicit_products`), and a vector for their products.
 #[derive(Clone, Debug)]
@@ -1219,16 +1241,7 @@ impl Integrator {
             self.settings.iteration,
         ) {
             Ok(report) => Ok(report.iterations),
-            Err(IterationFailure::Cap {
-                iterations,
-                changing,
-            }) => Err(TimeError::IterationCap {
-                step,
-                t,
-                iterations,
-                changing,
-            }),
-            Err(IterationFailure::Solve(never)) => match never {},
+            Err(failure) => Err(iteration_error(failure, step, t, |never| match never {})),
         }
     }
 
@@ -1271,16 +1284,9 @@ impl Integrator {
                 op.finish(&mut self.v_new);
                 Ok(report.iterations)
             }
-            Err(IterationFailure::Cap {
-                iterations,
-                changing,
-            }) => Err(TimeError::IterationCap {
-                step,
-                t,
-                iterations,
-                changing,
-            }),
-            Err(IterationFailure::Solve(source)) => Err(TimeError::Solve { step, t, source }),
+            Err(failure) => Err(iteration_error(failure, step, t, |source| {
+                TimeError::Solve { step, t, source }
+            })),
         }
     }
 
@@ -1319,16 +1325,9 @@ impl Integrator {
         );
         match result {
             Ok(report) => Ok(report.iterations),
-            Err(IterationFailure::Cap {
-                iterations,
-                changing,
-            }) => Err(TimeError::IterationCap {
-                step,
-                t,
-                iterations,
-                changing,
-            }),
-            Err(IterationFailure::Solve(source)) => Err(TimeError::Solve { step, t, source }),
+            Err(failure) => Err(iteration_error(failure, step, t, |source| {
+                TimeError::Solve { step, t, source }
+            })),
         }
     }
 
