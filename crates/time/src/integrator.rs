@@ -949,8 +949,9 @@ impl Integrator {
         }
 
         // Energy ledger, before the state is overwritten: the work and
-        // r_K·R_K in four lanes each (one chain of additions per sum took
-        // a tenth of the paper mesh's Newmark step).
+        // r_K·R_K in four lanes each, not one chain of additions per sum
+        // (with the fused loop above: the paper mesh's Newmark step 4.18
+        // → 4.05 µs, medians of ten alternating runs).
         let (mut work, mut load_dot) = (Lanes::default(), Lanes::default());
         {
             let n = self.r_new.len();
