@@ -117,3 +117,82 @@ impl NodalFriction {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stickslip_contact::{ContactNode, SlipState};
+
+    /// The stored-constant form against FrictionLaw's own closed form
+    /// (quotients, solve_nodal, phi) to rounding, on stuck and slipping
+    /// nodes of both signs, a node with a fixed component and tilted
+    /// tangents; and the constants formed anew when Δt changes.
+    #[test]
+    fn velocities_match_the_laws_closed_form() {
+        let (eps, n) = (1e-3, 8);
+        let tilt = (0.6f64, 0.8f64);
+        let node = |j: usize, dofs: [Option<usize>; 2], tangent: [f64; 2]| ContactNode {
+            node: j,
+            dofs,
+            weight: 0.5 + 0.1 * j as f64,
+            tangent,
+            s: j as f64,
+            bound: 2.0 + j as f64,
+        };
+        let nodes = vec![
+            node(0, [Some(0), Some(1)], [1.0, 0.0]),
+            node(1, [Some(2), None], [1.0, 0.0]),
+            node(2, [Some(3), Some(4)], [tilt.0, tilt.1]),
+            node(3, [Some(5), Some(6)], [-tilt.1, tilt.0]),
+        ];
+        let contact = ContactSurface::from_nodes("bottom", nodes, eps).unwrap();
+        let mass: Vec<f64> = (0..n).map(|i| 0.25 + 0.05 * i as f64).collect();
+        let mut nodal = NodalFriction::default();
+        let (mut stuck, mut slip_pos, mut slip_neg) = (0, 0, 0);
+        for dt in [1e-3, 5e-4, 1e-3] {
+            let scale = 1.0 / (0.5 * dt);
+            nodal.prepare(&contact, &mass, scale);
+            // R̂ from tiny (stuck) to large of either sign (slipping).
+            for amp in [1e-9, 1e-6, 1e-3, 1.0, -1.0, 30.0, -30.0] {
+                let b: Vec<f64> = (0..n).map(|i| amp * (1.0 + 0.3 * i as f64)).collect();
+                let mut got = vec![f64::NAN; n];
+                nodal.velocities(|i| b[i], |_, _, i, v| got[i] = v);
+                for node in &contact.nodes {
+                    let (mut p, mut q) = (0.0, 0.0);
+                    for c in 0..2 {
+                        if let Some(i) = node.dofs[c] {
+                            let d = mass[i] * scale;
+                            p += node.tangent[c] * b[i] / d;
+                            q += node.tangent[c] * node.tangent[c] / d;
+                        }
+                    }
+                    let wg = node.force_scale();
+                    let t = contact.law.solve_nodal(p, wg * q);
+                    match contact.law.classify(t) {
+                        SlipState::Stuck => stuck += 1,
+                        SlipState::SlipPositive => slip_pos += 1,
+                        SlipState::SlipNegative => slip_neg += 1,
+                    }
+                    let phi = contact.law.phi(t);
+                    for c in 0..2 {
+                        if let Some(i) = node.dofs[c] {
+                            let want = (b[i] - wg * phi * node.tangent[c]) / (mass[i] * scale);
+                            let tol = 1e-14 * (b[i].abs() + wg) / (mass[i] * scale);
+                            assert!(
+                                (got[i] - want).abs() <= tol,
+                                "dt {dt}, amp {amp}, dof {i}: {} vs {want}",
+                                got[i]
+                            );
+                        }
+                    }
+                }
+                // DOFs of no contact node are left alone.
+                assert!(got[7].is_nan());
+            }
+        }
+        assert!(
+            stuck > 0 && slip_pos > 0 && slip_neg > 0,
+            "{stuck} {slip_pos} {slip_neg}"
+        );
+    }
+}
