@@ -177,11 +177,17 @@ impl BlockInverse {
         })
     }
 
+    /// Whether Fᵀ is stored beside F for these counts of their values
+    /// ([`TRANSPOSED_MAX_VALUES`]).
+    fn keeps_transposed((f, g): (usize, usize)) -> bool {
+        f + g <= TRANSPOSED_MAX_VALUES
+    }
+
     /// Values stored for `sn`'s layout: F and Fᵀ up to
     /// [`TRANSPOSED_MAX_VALUES`] of both, else F.
     pub fn values_for(sn: &Supernodal) -> usize {
         let (f, g) = Self::counts(&panels(sn, PANEL));
-        if f + g <= TRANSPOSED_MAX_VALUES {
+        if Self::keeps_transposed((f, g)) {
             f + g
         } else {
             f
@@ -210,10 +216,8 @@ impl BlockInverse {
         transposed: Option<bool>,
     ) -> BlockInverse {
         let panels = panels(sn, kmax);
-        let transposed = transposed.unwrap_or_else(|| {
-            let (f, g) = Self::counts(&panels);
-            f + g <= TRANSPOSED_MAX_VALUES
-        });
+        let transposed =
+            transposed.unwrap_or_else(|| Self::keeps_transposed(Self::counts(&panels)));
         let mut blocks = Vec::with_capacity(panels.len());
         let mut index = Vec::new();
         let mut f_values: Vec<Line> = Vec::new();
