@@ -551,6 +551,9 @@ impl Integrator {
                         .map(kernels::Product::Classes)
                 })
                 .or_else(|| {
+                    crate::sliced::Sliced::small(&dynamics.stiffness).map(kernels::Product::Sliced)
+                })
+                .or_else(|| {
                     kernels::Compact::new(&dynamics.stiffness).map(kernels::Product::Compact)
                 })
         } else {
@@ -1623,6 +1626,7 @@ impl Integrator {
             (Some(kernels::Product::Stencils(_)), _) => "stencil types",
             (Some(kernels::Product::Classes(_)), _) => "element classes",
             (Some(kernels::Product::Compact(_)), _) => "compact blocks",
+            (Some(kernels::Product::Sliced(_)), _) => "sliced rows",
             (None, false) if self.implicit_products.is_some() => "stencil types",
             (None, false) if self.pair_blocks.is_some() => "2x2 blocks",
             (None, _) => "assembled CSR",

@@ -34,6 +34,15 @@
 //! of ṙ_K and r̈_K of different rows overlap; the strain and kinetic sums
 //! go in four lanes by row, [`Lanes`]).
 //!
+//! On small systems (one chunk; at most 128 KB of padded slices, at least
+//! half filled) K·r comes from [`Sliced`] instead (`sliced.rs`: slices of
+//! eight rows, a column of a slice one 64-byte line, no gathers of x pairs
+//! and no reduction across lanes): `sliced_lab`, the paper-sized Q2 8×2
+//! slab, one K·x 0.63 → 0.47 µs; the paper mesh's explicit step (bench
+//! step, ten alternating runs, 2026-11-24) 1.41 → 1.12 µs median, 1.27 →
+//! 1.06 µs fastest, which also counts the one-chunk sweep's dense R_K
+//! ([`batch_rows`]).
+//!
 //! K·r row by row from [`Compact`] (2×2 blocks with u32 columns, their
 //! values stored, 36 bytes per block, or indexed into a dictionary of the
 //! distinct blocks, 6 or 8) rather than nalgebra-sparse's CSR (usize
@@ -155,6 +164,7 @@
 //! nor by the gathers; on this machine it runs at about 2 cycles per
 //! column of a node's two rows.
 
+use crate::sliced::Sliced;
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
 
@@ -1283,6 +1293,34 @@ pub trait RowProduct: Sync {
     fn bytes(&self) -> usize;
 }
 
+impl RowProduct for Sliced {
+    /// Row by row ([`Sliced::row`], the bits of [`Sliced::spmv`]): the
+    /// sweep reads K r_K formed whole when there is one chunk, which is
+    /// where [`Sliced`] is used; this serves the iterated friction's passes.
+    fn chunk_batches(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, &[f64])) {
+        let (start, end) = (c * CHUNK, ((c + 1) * CHUNK).min(self.n()));
+        let mut buf = [0.0; BATCH];
+        let mut r0 = start;
+        while r0 < end {
+            let r1 = (r0 + BATCH).min(end);
+            for (o, i) in buf.iter_mut().zip(r0..r1) {
+                *o = self.row(i, x);
+            }
+            f(r0, &buf[..r1 - r0]);
+            r0 = r1;
+        }
+    }
+    fn row(&self, i: usize, x: &[f64]) -> f64 {
+        Sliced::row(self, i, x)
+    }
+    fn spmv(&self, x: &[f64], y: &mut [f64]) {
+        Sliced::spmv(self, x, y)
+    }
+    fn bytes(&self) -> usize {
+        Sliced::bytes(self)
+    }
+}
+
 impl RowProduct for Compact {
     #[inline]
     fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64])) {
@@ -1300,6 +1338,8 @@ impl RowProduct for Compact {
 }
 
 /// K as the explicit step reads it: the compact form of the assembled K,
+/// its slices of eight rows on small systems ([`Sliced`]), by stencil
+/// types on structured numberings ([`Stencils`]),
 /// or matrix-free by element classes when the mesh has them
 /// ([`Classes`]: measured faster on the structured Q2 slabs; the module
 /// documentation gives the figures).
@@ -1311,6 +1351,8 @@ pub enum Product {
     Classes(Classes),
     /// [`Stencils`].
     Stencils(Stencils),
+    /// [`Sliced`]: small systems (one chunk).
+    Sliced(Sliced),
 }
 
 impl RowProduct for Product {
@@ -1320,6 +1362,7 @@ impl RowProduct for Product {
             Product::Compact(k) => RowProduct::chunk_batches(k, c, x, f),
             Product::Classes(k) => k.chunk_batches(c, x, f),
             Product::Stencils(k) => k.chunk_batches(c, x, f),
+            Product::Sliced(k) => RowProduct::chunk_batches(k, c, x, f),
         }
     }
     fn row(&self, i: usize, x: &[f64]) -> f64 {
@@ -1327,6 +1370,7 @@ impl RowProduct for Product {
             Product::Compact(k) => k.row(i, x),
             Product::Classes(k) => k.row(i, x),
             Product::Stencils(k) => k.row(i, x),
+            Product::Sliced(k) => k.row(i, x),
         }
     }
     fn spmv(&self, x: &[f64], y: &mut [f64]) {
@@ -1334,6 +1378,7 @@ impl RowProduct for Product {
             Product::Compact(k) => k.spmv(x, y),
             Product::Classes(k) => k.spmv(x, y),
             Product::Stencils(k) => k.spmv(x, y),
+            Product::Sliced(k) => k.spmv(x, y),
         }
     }
     fn bytes(&self) -> usize {
@@ -1341,6 +1386,7 @@ impl RowProduct for Product {
             Product::Compact(k) => k.bytes(),
             Product::Classes(k) => RowProduct::bytes(k),
             Product::Stencils(k) => k.bytes(),
+            Product::Sliced(k) => k.bytes(),
         }
     }
 }
@@ -1672,12 +1718,25 @@ fn batch_rows(
     let rn = &s.r_new[rows];
     let (vn, an, r_next) = (&mut vn[..n], &mut an[..n], &mut r_next[..n]);
     let (cv, ca, scale) = (s.cv, s.ca, s.scale);
-    for k in 0..n {
-        let zero = 0.0;
-        let bi = zero - ku[k] + m[k] * (cv * v[k] + ca * a[k]);
-        vn[k] = bi / (m[k] * scale);
+    if s.load_new.len() <= CHUNK {
+        // One chunk: the vectors are in cache, so R_K is read densely (+0
+        // off the load rows, where +0 − K r_K has the bits of the other
+        // branch's 0 − K r_K) instead of a scalar pass over the load rows
+        // with a division each.
+        let l = &s.load_new[r0..r0 + n];
+        for k in 0..n {
+            let bi = l[k] - ku[k] + m[k] * (cv * v[k] + ca * a[k]);
+            vn[k] = bi / (m[k] * scale);
+        }
+    } else {
+        for k in 0..n {
+            let zero = 0.0;
+            let bi = zero - ku[k] + m[k] * (cv * v[k] + ca * a[k]);
+            vn[k] = bi / (m[k] * scale);
+        }
     }
-    while run.load < s.load_rows.len() && s.load_rows[run.load] < r0 + n {
+    while s.load_new.len() > CHUNK && run.load < s.load_rows.len() && s.load_rows[run.load] < r0 + n
+    {
         let i = s.load_rows[run.load];
         let k = i - r0;
         vn[k] = rhs_entry(s, i, ku[k]) / (m[k] * scale);

@@ -26,6 +26,7 @@ mod memory;
 mod nodal;
 pub mod scenes;
 mod schur;
+mod sliced;
 mod small_solve;
 pub mod stability;
 mod stencils;
