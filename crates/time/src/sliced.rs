@@ -318,7 +318,7 @@ mod tests {
             ragged |= s
                 .starts
                 .windows(2)
-                .any(|w| (w[1] - w[0]) as usize % SUMS != 0);
+                .any(|w| !((w[1] - w[0]) as usize).is_multiple_of(SUMS));
             #[cfg(target_arch = "x86_64")]
             if crate::kernels::avx512() {
                 let mut z = vec![f64::NAN; n];
