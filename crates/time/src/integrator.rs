@@ -1126,10 +1126,6 @@ impl Integrator {
                     &mut self.partials,
                 );
                 swept = true;
-                self.scratch_classes.copy_from_slice(&self.classes);
-                if let Some(contact) = &self.contact {
-                    contact.classify(&self.v_new, &mut self.scratch_classes);
-                }
                 (strain, sums, 1)
             }
             _ => {
@@ -1202,7 +1198,20 @@ impl Integrator {
         if !sums.finite {
             return Err(self.non_finite(step_number, t_new));
         }
-        let (dissipated, stick_events) = self.friction_ledger(dt);
+        let (dissipated, stick_events) = match (&self.contact, swept) {
+            // The closed-form friction's nodes: classes, forces and the
+            // ledger in one pass (`NodalFriction::ledger`).
+            (Some(_), true) => self.nodal.ledger(
+                &self.v_new,
+                &self.v,
+                dt,
+                &self.classes,
+                &mut self.scratch_classes,
+                &self.forces,
+                &mut self.forces_new,
+            ),
+            _ => self.friction_ledger(dt),
+        };
         std::mem::swap(&mut self.a, &mut self.tmp);
         self.commit(t_new, step_number, iterations);
         if swept {
