@@ -348,6 +348,10 @@ impl SparseLoads {
     }
 }
 
+/// Up to this many loads [`predict`] picks those with θ ≠ 0 once per step
+/// (beyond, θ is tested per row).
+const ACTIVE_LOADS: usize = 8;
+
 /// Pass A: the predictor r_K = r + c1 ṙ + c2 r̈ into `r_new` (every row),
 /// R_K = constant + Σ θ_l load_l into `load_new` at the loads' rows only
 /// (its other rows must hold +0: [`SparseLoads`]), and per chunk the sums
@@ -394,11 +398,31 @@ pub fn predict(
     // memory each addition waited for the last one's store (the paper
     // mesh's predict, about 8% of its explicit step, was mostly that).
     let (mut chunk, mut work, mut dot) = (0, 0.0, 0.0);
-    for (k, &i) in sparse.rows.iter().enumerate() {
-        let mut l = sparse.constant[k];
-        for (load, theta) in sparse.loads.iter().zip(thetas) {
-            if *theta != 0.0 {
+    // The loads with θ ≠ 0 (their order kept), picked once, not per row.
+    let mut active = [(0.0, &[][..]); ACTIVE_LOADS];
+    let few = sparse.loads.len() <= ACTIVE_LOADS;
+    let mut n_active = 0;
+    if few {
+        for (load, &theta) in sparse.loads.iter().zip(thetas) {
+            if theta != 0.0 {
+                active[n_active] = (theta, &load[..sparse.rows.len()]);
+                n_active += 1;
+            }
+        }
+    }
+    let active = &active[..n_active];
+    let (rows, constant) = (&sparse.rows[..], &sparse.constant[..sparse.rows.len()]);
+    for (k, &i) in rows.iter().enumerate() {
+        let mut l = constant[k];
+        if few {
+            for &(theta, load) in active {
                 l += theta * load[k];
+            }
+        } else {
+            for (load, theta) in sparse.loads.iter().zip(thetas) {
+                if *theta != 0.0 {
+                    l += theta * load[k];
+                }
             }
         }
         load_new[i] = l;
@@ -2292,6 +2316,80 @@ pub(crate) mod tests {
                     assert!(!sums.finite, "{name} row {row} {bad}");
                 }
             }
+        }
+    }
+
+    /// `predict`'s R_K and sums with loads past [`ACTIVE_LOADS`] (θ tested
+    /// per row) and within it (the active ones picked once), some θ = 0:
+    /// the bits of the dense sum in the loads' order either way.
+    #[test]
+    fn predict_with_few_and_many_loads() {
+        let n = 40;
+        for count in [3, ACTIVE_LOADS, ACTIVE_LOADS + 3] {
+            let loads: Vec<Vec<f64>> = (0..count)
+                .map(|l| {
+                    (0..n)
+                        .map(|i| {
+                            if (i + l) % 7 == 0 {
+                                0.1 + 0.37 * l as f64 - 1e-3 * i as f64
+                            } else {
+                                0.0
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            let constant: Vec<f64> = (0..n)
+                .map(|i| if i % 11 == 3 { 0.5 } else { 0.0 })
+                .collect();
+            let refs: Vec<&[f64]> = loads.iter().map(|l| &l[..]).collect();
+            let sparse = SparseLoads::new(&constant, &refs);
+            let thetas: Vec<f64> = (0..count)
+                .map(|l| if l % 3 == 1 { 0.0 } else { 0.3 + l as f64 })
+                .collect();
+            let mut want = constant.clone();
+            for (load, &theta) in loads.iter().zip(&thetas) {
+                if theta != 0.0 {
+                    for (o, f) in want.iter_mut().zip(load) {
+                        *o += theta * f;
+                    }
+                }
+            }
+            let (r, v, a) = (x_of(n), vec![0.5; n], vec![-0.25; n]);
+            let old = vec![0.125; n];
+            let (mut load_new, mut r_new) = (vec![0.0; n], vec![0.0; n]);
+            let mut p = partials(n);
+            predict(
+                &sparse,
+                &thetas,
+                &r,
+                &v,
+                &a,
+                1e-3,
+                5e-7,
+                &old,
+                &mut load_new,
+                &mut r_new,
+                true,
+                &mut p,
+            );
+            let (mut work, mut dot) = (0.0, 0.0);
+            for &i in sparse.rows() {
+                work += 0.5 * (want[i] + old[i]) * (r_new[i] - r[i]);
+                dot += r_new[i] * want[i];
+            }
+            for i in 0..n {
+                assert_eq!(
+                    load_new[i].to_bits(),
+                    want[i].to_bits(),
+                    "{count} loads, row {i}"
+                );
+            }
+            assert_eq!(
+                (p[0][0].to_bits(), p[0][2].to_bits()),
+                (work.to_bits(), dot.to_bits()),
+                "{count} loads"
+            );
         }
     }
 
