@@ -2108,6 +2108,22 @@ pub(crate) mod tests {
     }
 
     /// A deterministic, non-repeating x with entries of both signs.
+    /// The labs' timing: the median over 30 rounds of `reps` calls of `f`,
+    /// seconds a call.
+    pub(crate) fn median_time(reps: usize, f: &mut dyn FnMut()) -> f64 {
+        let mut t: Vec<f64> = (0..30)
+            .map(|_| {
+                let s = std::time::Instant::now();
+                for _ in 0..reps {
+                    f();
+                }
+                s.elapsed().as_secs_f64() / reps as f64
+            })
+            .collect();
+        t.sort_by(f64::total_cmp);
+        t[t.len() / 2]
+    }
+
     pub(crate) fn x_of(n: usize) -> Vec<f64> {
         (0..n)
             .map(|i| ((i as f64 * 0.618_033_988_75).fract() - 0.5) * (1.0 + i as f64 * 1e-3))
@@ -3285,7 +3301,6 @@ pub(crate) mod tests {
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn small_lab() {
-        use std::time::Instant;
         let name = std::env::var("STICKSLIP_LAB_MESH").unwrap_or_else(|_| "q2-8x2".into());
         let (_, _, model) = lab_slab(&name);
         let k = &model.stiffness;
@@ -3293,20 +3308,7 @@ pub(crate) mod tests {
         let compact = Compact::new(k).expect("applies");
         let x = x_of(n);
         let mut y = vec![0.0; n];
-        let reps = 20_000;
-        let time = |f: &mut dyn FnMut()| -> f64 {
-            let mut t: Vec<f64> = (0..30)
-                .map(|_| {
-                    let s = Instant::now();
-                    for _ in 0..reps {
-                        f();
-                    }
-                    s.elapsed().as_secs_f64() / reps as f64
-                })
-                .collect();
-            t.sort_by(f64::total_cmp);
-            t[t.len() / 2]
-        };
+        let time = |f: &mut dyn FnMut()| median_time(20_000, f);
         println!(
             "{name}: n = {n}, nnz = {}, blocks = {}",
             k.nnz(),

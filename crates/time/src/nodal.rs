@@ -180,6 +180,18 @@ mod tests {
     use super::*;
     use stickslip_contact::{ContactNode, SlipState};
 
+    /// A test contact node: weight and bound vary with j.
+    fn node(j: usize, dofs: [Option<usize>; 2], tangent: [f64; 2]) -> ContactNode {
+        ContactNode {
+            node: j,
+            dofs,
+            weight: 0.5 + 0.1 * j as f64,
+            tangent,
+            s: j as f64,
+            bound: 2.0 + j as f64,
+        }
+    }
+
     /// `ledger` against the surface's own passes, bit for bit: the classes
     /// (`classify`), the forces (`nodal_forces`) and the dissipation and
     /// slip → stick events as `Integrator::friction_ledger` sums them, on
@@ -188,14 +200,6 @@ mod tests {
     #[test]
     fn ledger_matches_the_surfaces_passes() {
         let eps = 1e-3;
-        let node = |j: usize, dofs: [Option<usize>; 2], tangent: [f64; 2]| ContactNode {
-            node: j,
-            dofs,
-            weight: 0.5 + 0.1 * j as f64,
-            tangent,
-            s: j as f64,
-            bound: 2.0 + j as f64,
-        };
         let nodes = vec![
             node(0, [Some(0), Some(1)], [1.0, 0.0]),
             node(1, [Some(2), None], [1.0, 0.0]),
@@ -276,14 +280,6 @@ mod tests {
     fn velocities_match_the_laws_closed_form() {
         let (eps, n) = (1e-3, 8);
         let tilt = (0.6f64, 0.8f64);
-        let node = |j: usize, dofs: [Option<usize>; 2], tangent: [f64; 2]| ContactNode {
-            node: j,
-            dofs,
-            weight: 0.5 + 0.1 * j as f64,
-            tangent,
-            s: j as f64,
-            bound: 2.0 + j as f64,
-        };
         let nodes = vec![
             node(0, [Some(0), Some(1)], [1.0, 0.0]),
             node(1, [Some(2), None], [1.0, 0.0]),

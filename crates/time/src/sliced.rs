@@ -285,7 +285,7 @@ impl Sliced {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernels::tests::{lab_slab, x_of};
+    use crate::kernels::tests::{lab_slab, median_time, x_of};
 
     /// Each row of the product is the row of K times x to rounding, the
     /// scalar and AVX-512 paths give the same bits, and `row` gives the
@@ -346,7 +346,6 @@ mod tests {
     #[test]
     #[ignore = "timing lab, run by hand"]
     fn sliced_lab() {
-        use std::time::Instant;
         for name in [
             "q2-8x2",
             "q2-12x2",
@@ -364,20 +363,7 @@ mod tests {
             let c = crate::kernels::Compact::new(k).expect("applies");
             let x = x_of(n);
             let mut y = vec![0.0; n];
-            let reps = 20_000;
-            let time = |f: &mut dyn FnMut()| -> f64 {
-                let mut t: Vec<f64> = (0..30)
-                    .map(|_| {
-                        let s = Instant::now();
-                        for _ in 0..reps {
-                            f();
-                        }
-                        s.elapsed().as_secs_f64() / reps as f64
-                    })
-                    .collect();
-                t.sort_by(f64::total_cmp);
-                t[t.len() / 2]
-            };
+            let time = |f: &mut dyn FnMut()| median_time(20_000, f);
             let tc = time(&mut || c.spmv(std::hint::black_box(&x), &mut y));
             let ts = time(&mut || s.spmv(std::hint::black_box(&x), &mut y));
             println!(
