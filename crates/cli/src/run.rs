@@ -386,6 +386,13 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
             p.model.stiffness.nnz(),
             i.stiffness_product()
         );
+    } else if i.implicit_solver() == stickslip_time::ImplicitSolver::Modal {
+        let n_c = i.contact().map_or(0, |c| c.len());
+        println!(
+            "solver      implicit Newmark in the {n} modes of (K, M) (dense eigensolver once; up to {} DOFs): A₀ diagonal, no K·x per step; friction on the {n_c} contact unknowns by the Schur complement",
+            stickslip_time::MODAL_MAX_DOFS,
+            n = p.model.stiffness.nrows(),
+        );
     } else {
         let n_c = i.contact().map_or(0, |c| c.len());
         println!(

@@ -11,6 +11,7 @@ use crate::linalg::{
     self, dot, load_minus_k_plus_m, quadratic_form, row_chunks, same_pattern, spmv, two_forms,
     PairBlocks,
 };
+use crate::modal::{self, ModalState, Modes, MODAL_MAX_DOFS};
 use crate::nodal::NodalFriction;
 use crate::schur::{ImplicitSolver, SchurOperator};
 use crate::stability::{critical_step, critical_step_with};
@@ -310,6 +311,11 @@ pub struct Checkpoint {
     pub total_iterations: u64,
     /// Numeric factorizations so far.
     pub factorizations: u64,
+    /// The modal step's own state (`modal.rs`), for a bit-identical
+    /// continuation: q, q̇, q̈ (n each) and the contact nodes' tangential
+    /// velocities; empty from other solvers (a modal run then projects the
+    /// physical state).
+    pub modal: Vec<f64>,
 }
 
 /// Integrates from the initial state to `t_end`, one step per call.
@@ -332,6 +338,9 @@ pub struct Integrator {
     solver: ImplicitSolver,
     /// Nodal tangential velocities of the Schur path's iteration.
     nodal_velocity: Vec<f64>,
+    /// The modal step (`modal.rs`): `r`, `v`, `a`, `load`, `load_new`
+    /// and the step's vectors then hold modal coordinates.
+    modal: Option<ModalState>,
     // State at the current time.
     t: f64,
     steps: u64,
@@ -664,6 +673,7 @@ impl Integrator {
             schur,
             solver: ImplicitSolver::Schur,
             nodal_velocity: vec![0.0; n_c],
+            modal: None,
             t: 0.0,
             steps: 0,
             a: vec![0.0; n],
@@ -741,6 +751,10 @@ impl Integrator {
             total: kinetic + strain - dot(&this.r, &this.load),
             balance: 0.0,
         };
+        if !this.explicit && n <= MODAL_MAX_DOFS {
+            this.enter_modal()?;
+            this.solver = ImplicitSolver::Modal;
+        }
         if this.explicit {
             // From here on the explicit step reads K only through its
             // product (built above), and the CSR's memory is returned.
@@ -775,15 +789,68 @@ impl Integrator {
         } else {
             &mut self.load
         };
-        out.copy_from_slice(&self.dynamics.constant_load);
-        for l in &self.loads {
+        // The modal step's loads are Φᵀ of the physical ones.
+        let modal = self.modal.as_ref();
+        out.copy_from_slice(modal.map_or(&self.dynamics.constant_load, |m| &m.constant_load));
+        for (k, l) in self.loads.iter().enumerate() {
+            let vector = modal.map_or(&l.vector, |m| &m.loads[k]);
             let theta = l.history.value(t);
             if theta != 0.0 {
-                for (o, f) in out.iter_mut().zip(&l.vector) {
+                for (o, f) in out.iter_mut().zip(vector) {
                     *o += theta * f;
                 }
             }
         }
+    }
+
+    /// Moves the state into the modes of (K, M) (`modal.rs`): the modes,
+    /// the loads' and the state's modal coordinates, the Schur operator's
+    /// modal mode.
+    fn enter_modal(&mut self) -> Result<(), TimeError> {
+        let modes = Modes::new(&self.dynamics.stiffness, &self.mass_matrix)
+            .map_err(|m| TimeError::Static(SolverError::Analysis(m)))?;
+        let nodes = self.contact.as_ref().map_or(&[][..], |c| &c.nodes[..]);
+        let mut m = ModalState::new(modes, nodes);
+        m.constant_load = vec![0.0; self.r.len()];
+        m.modes
+            .project(&self.dynamics.constant_load, &mut m.constant_load);
+        m.loads = self
+            .loads
+            .iter()
+            .map(|l| {
+                let mut out = vec![0.0; self.r.len()];
+                m.modes.project(&l.vector, &mut out);
+                out
+            })
+            .collect();
+        if let Some(c) = &self.contact {
+            for (o, node) in m.contact_v.iter_mut().zip(&c.nodes) {
+                *o = node.tangential(&self.v);
+            }
+        }
+        if let Some(op) = self.schur.as_mut() {
+            op.set_modal(m.rows.clone(), m.modes.lambda().to_vec());
+        }
+        // q = ΦᵀM r, likewise q̇ and q̈.
+        for x in [&mut self.r, &mut self.v, &mut self.a] {
+            spmv(&self.mass_matrix, x, &mut self.tmp);
+            m.modes.project(&self.tmp, x);
+        }
+        self.modal = Some(m);
+        self.load_at(self.t, false);
+        Ok(())
+    }
+
+    /// Back from the modes to the physical state (another solver chosen).
+    fn leave_modal(&mut self) {
+        let Some(m) = self.modal.take() else {
+            return;
+        };
+        for x in [&mut self.r, &mut self.v, &mut self.a] {
+            m.modes.expand(x, &mut self.tmp);
+            x.copy_from_slice(&self.tmp);
+        }
+        self.load_at(self.t, false);
     }
 
     /// xᵀ M x with the scheme's mass.
@@ -875,6 +942,17 @@ impl Integrator {
         let c2 = 0.5 * dt * dt * (1.0 - 2.0 * beta / gamma);
         let cv = 1.0 / (gamma * dt);
         let ca = 1.0 / gamma - 1.0;
+        if let Some(m) = &self.modal {
+            // In the modes K = Λ and M = I (`modal.rs`): one pass.
+            modal::predict(
+                [c1, c2, cv, ca],
+                [m.modes.lambda(), &self.r, &self.v, &self.a, &self.load_new],
+                [&mut self.r_new, &mut self.tmp, &mut self.b],
+            );
+            self.scratch_classes.copy_from_slice(&self.classes);
+            let iterations = self.implicit_velocity(dt, step_number, t_new)?;
+            return self.implicit_close(dt, cv, t_new, step_number, iterations);
+        }
         for (((rn, t), r), (v, a)) in self
             .r_new
             .iter_mut()
@@ -885,6 +963,17 @@ impl Integrator {
             *rn = r + c1 * v + c2 * a;
             *t = cv * v + ca * a;
         }
+        self.rhs(n);
+
+        self.scratch_classes.copy_from_slice(&self.classes);
+        // (The explicit scheme took `explicit_step` above.)
+        let iterations = self.implicit_velocity(dt, step_number, t_new)?;
+        self.implicit_close(dt, cv, t_new, step_number, iterations)
+    }
+
+    /// R̂ = R_K − K r_pred + M tmp into `b` from the predictor in `r_new`
+    /// and M's vector in `tmp`, by the products the system has.
+    fn rhs(&mut self, n: usize) {
         if let Some(p) = &self.implicit_products {
             p.k.spmv(&self.r_new, &mut self.b);
         } else if self.mass_kind != MassKind::Consistent || !self.shared_pattern {
@@ -926,16 +1015,54 @@ impl Integrator {
                 }
             }
         }
+    }
 
-        self.scratch_classes.copy_from_slice(&self.classes);
-        // (The explicit scheme took `explicit_step` above.)
-        let iterations = self.implicit_velocity(dt, step_number, t_new)?;
-
+    /// The implicit step after its velocity: corrector, ledger, commit,
+    /// energy.
+    fn implicit_close(
+        &mut self,
+        dt: f64,
+        cv: f64,
+        t_new: f64,
+        step_number: u64,
+        iterations: usize,
+    ) -> Result<StepInfo, TimeError> {
+        let (beta, gamma) = (self.beta, self.gamma);
         // Corrector, with the finiteness check (a flag, not a branch per
         // entry), and r̈_K (into `tmp`, free since the bracket: the state
         // stays whole if the step fails).
         let c3 = beta / gamma * dt;
         let ka = (1.0 - gamma) / gamma;
+        if let Some(m) = &self.modal {
+            // In the modes: the corrector, the ledger's sums and the
+            // energies in one pass (`modal::close`).
+            let (finite, [work, load_dot, vv, rkr]) = modal::close(
+                [c3, cv, ka],
+                [
+                    m.modes.lambda(),
+                    &self.r,
+                    &self.v,
+                    &self.a,
+                    &self.v_new,
+                    &self.load,
+                    &self.load_new,
+                ],
+                &mut self.r_new,
+                &mut self.tmp,
+            );
+            if !finite {
+                return Err(self.non_finite(step_number, t_new));
+            }
+            let (dissipated, stick_events) = self.friction_ledger(dt);
+            std::mem::swap(&mut self.a, &mut self.tmp);
+            self.commit(t_new, step_number, iterations);
+            return Ok(self.close_step(
+                [0.5 * vv, 0.5 * rkr, work, dissipated, load_dot],
+                dt,
+                iterations,
+                stick_events,
+            ));
+        }
         let mut finite = true;
         for ((r, v_new), (a_new, (v, a))) in self
             .r_new
@@ -987,6 +1114,10 @@ impl Integrator {
         std::mem::swap(&mut self.load, &mut self.load_new);
         std::mem::swap(&mut self.forces, &mut self.forces_new);
         self.classes.copy_from_slice(&self.scratch_classes);
+        if let Some(m) = &mut self.modal {
+            std::mem::swap(&mut m.contact_v, &mut m.contact_v_new);
+            m.invalidate();
+        }
         self.t = if t_new >= self.settings.t_end * (1.0 - 1e-14) {
             self.settings.t_end
         } else {
@@ -1349,12 +1480,21 @@ impl Integrator {
     /// Everything needed to continue this run bit-identically
     /// ([`Integrator::restore`] on a fresh integrator of the same case).
     pub fn checkpoint(&self) -> Checkpoint {
+        let modal = match &self.modal {
+            Some(m) => [&self.r, &self.v, &self.a, &m.contact_v]
+                .into_iter()
+                .flatten()
+                .copied()
+                .collect(),
+            None => Vec::new(),
+        };
         Checkpoint {
             t: self.t,
             steps: self.steps,
-            displacement: self.r.clone(),
-            velocity: self.v.clone(),
-            acceleration: self.a.clone(),
+            displacement: self.displacement().to_vec(),
+            velocity: self.velocity().to_vec(),
+            acceleration: self.acceleration().to_vec(),
+            modal,
             classes: self.classes.iter().map(|c| c.code()).collect(),
             forces: self.forces.clone(),
             energy: self.energy,
@@ -1399,6 +1539,14 @@ impl Integrator {
                 ));
             }
         }
+        if self.modal.is_some() && !c.modal.is_empty() && c.modal.len() != 3 * n + n_c {
+            return bad(format!(
+                "modal has {} entries, the model {} (3 × {n} modal coordinates and {n_c} \
+                 contact velocities): restart from a checkpoint of the same case",
+                c.modal.len(),
+                3 * n + n_c
+            ));
+        }
         if !(c.t.is_finite() && c.t >= 0.0) {
             return bad(format!("t = {} is not a time ≥ 0", c.t));
         }
@@ -1408,6 +1556,7 @@ impl Integrator {
             .chain(&c.velocity)
             .chain(&c.acceleration)
             .chain(&c.forces)
+            .chain(&c.modal)
             .all(|x| x.is_finite());
         if !finite {
             return bad("the state holds NaN or infinity".into());
@@ -1430,6 +1579,30 @@ impl Integrator {
         self.r.copy_from_slice(&c.displacement);
         self.v.copy_from_slice(&c.velocity);
         self.a.copy_from_slice(&c.acceleration);
+        if let Some(m) = &mut self.modal {
+            m.invalidate();
+            if c.modal.len() == 3 * n + n_c {
+                // The modal run's own coordinates: bit-identical.
+                let (q, rest) = c.modal.split_at(n);
+                let (qd, rest) = rest.split_at(n);
+                let (qdd, u) = rest.split_at(n);
+                self.r.copy_from_slice(q);
+                self.v.copy_from_slice(qd);
+                self.a.copy_from_slice(qdd);
+                m.contact_v.copy_from_slice(u);
+            } else {
+                // Another solver's checkpoint: q = ΦᵀM r, likewise q̇, q̈.
+                if let Some(contact) = &self.contact {
+                    for (o, node) in m.contact_v.iter_mut().zip(&contact.nodes) {
+                        *o = node.tangential(&self.v);
+                    }
+                }
+                for x in [&mut self.r, &mut self.v, &mut self.a] {
+                    spmv(&self.mass_matrix, x, &mut self.tmp);
+                    m.modes.project(&self.tmp, x);
+                }
+            }
+        }
         self.classes.copy_from_slice(&classes);
         self.forces.copy_from_slice(&c.forces);
         self.energy = c.energy;
@@ -1476,16 +1649,32 @@ impl Integrator {
         let Some(c) = &self.contact else {
             return (0.0, 0);
         };
-        c.nodal_forces(&self.v_new, &mut self.forces_new);
         let mut dissipated = 0.0;
-        for ((node, f_new), f_old) in c.nodes.iter().zip(&self.forces_new).zip(&self.forces) {
-            let mut increment = 0.0;
-            for k in 0..2 {
-                if let Some(i) = node.dofs[k] {
-                    increment += node.tangent[k] * (0.5 * dt * (self.v_new[i] + self.v[i]));
-                }
+        if let Some(m) = &mut self.modal {
+            // The nodes' tangential velocities are the iteration's (u = p
+            // − S f at convergence), not formed from q̇.
+            m.contact_v_new.copy_from_slice(&self.nodal_velocity);
+            for (((node, f_new), f_old), (u_new, u)) in c
+                .nodes
+                .iter()
+                .zip(self.forces_new.iter_mut())
+                .zip(&self.forces)
+                .zip(m.contact_v_new.iter().zip(&m.contact_v))
+            {
+                *f_new = node.force_scale() * c.law.phi(*u_new);
+                dissipated += 0.5 * (*f_new + f_old) * (0.5 * dt * (u_new + u));
             }
-            dissipated += 0.5 * (f_new + f_old) * increment;
+        } else {
+            c.nodal_forces(&self.v_new, &mut self.forces_new);
+            for ((node, f_new), f_old) in c.nodes.iter().zip(&self.forces_new).zip(&self.forces) {
+                let mut increment = 0.0;
+                for k in 0..2 {
+                    if let Some(i) = node.dofs[k] {
+                        increment += node.tangent[k] * (0.5 * dt * (self.v_new[i] + self.v[i]));
+                    }
+                }
+                dissipated += 0.5 * (f_new + f_old) * increment;
+            }
         }
         let stick_events = self
             .scratch_classes
@@ -1512,14 +1701,23 @@ impl Integrator {
     }
     /// Displacement r on free DOFs.
     pub fn displacement(&self) -> &[f64] {
+        if let Some(m) = &self.modal {
+            return m.physical(0, &self.r);
+        }
         &self.r
     }
     /// Velocity ṙ on free DOFs.
     pub fn velocity(&self) -> &[f64] {
+        if let Some(m) = &self.modal {
+            return m.physical(1, &self.v);
+        }
         &self.v
     }
     /// Acceleration r̈ on free DOFs.
     pub fn acceleration(&self) -> &[f64] {
+        if let Some(m) = &self.modal {
+            return m.physical(2, &self.a);
+        }
         &self.a
     }
     /// Stick/slip class of each contact node.
@@ -1544,7 +1742,8 @@ impl Integrator {
     /// bytes each, the memory of one Δt's factor (with its inverted blocks
     /// on small meshes, `small_solve.rs`).
     pub fn factor_len(&self) -> usize {
-        self.schur.as_ref().map_or(0, |op| op.factor_len())
+        self.modal.as_ref().map_or(0, |m| m.modes.len())
+            + self.schur.as_ref().map_or(0, |op| op.factor_len())
     }
 
     /// Implicit runs with friction: (values of W = L⁻¹Pᵀ the step uses, 0
@@ -1636,6 +1835,7 @@ impl Integrator {
             (Some(kernels::Product::Classes(_)), _) => "element classes",
             (Some(kernels::Product::Compact(_)), _) => "compact blocks",
             (Some(kernels::Product::Sliced(_)), _) => "sliced rows",
+            (None, false) if self.modal.is_some() => "modes",
             (None, false) if self.implicit_products.is_some() => "stencil types",
             (None, false) if self.pair_blocks.is_some() => "2x2 blocks",
             (None, _) => "assembled CSR",
@@ -1659,6 +1859,7 @@ impl Integrator {
             return Ok(());
         }
         let count = self.factorizations();
+        self.leave_modal();
         self.implicit = None;
         self.schur = None;
         if solver == ImplicitSolver::Direct {
@@ -1674,6 +1875,9 @@ impl Integrator {
             self.schur = Some(op);
         }
         self.solver = solver;
+        if solver == ImplicitSolver::Modal {
+            self.enter_modal()?;
+        }
         Ok(())
     }
     /// Stick/slip iterations (linear solves) summed over all steps.
@@ -1695,14 +1899,26 @@ impl Integrator {
     /// Friction stress σ_T = −g φ_ε(v_T) at each contact node.
     pub fn friction_stress(&self, out: &mut [f64]) {
         if let Some(c) = &self.contact {
-            c.friction_stress(&self.v, out);
+            match &self.modal {
+                Some(m) => {
+                    for ((s, node), u) in out.iter_mut().zip(&c.nodes).zip(&m.contact_v) {
+                        *s = -node.bound * c.law.phi(*u);
+                    }
+                }
+                None => c.friction_stress(&self.v, out),
+            }
         }
     }
     /// Tangential (slip) velocity at each contact node.
     pub fn slip_velocity(&self, out: &mut [f64]) {
         if let Some(c) = &self.contact {
-            for (o, n) in out.iter_mut().zip(&c.nodes) {
-                *o = n.tangential(&self.v);
+            match &self.modal {
+                Some(m) => out[..m.contact_v.len()].copy_from_slice(&m.contact_v),
+                None => {
+                    for (o, n) in out.iter_mut().zip(&c.nodes) {
+                        *o = n.tangential(&self.v);
+                    }
+                }
             }
         }
     }

@@ -15,7 +15,10 @@
 //! operator A₀ is analysed once and factorized once per distinct Δt, the
 //! friction handled by a Schur complement on the contact DOFs
 //! ([`ImplicitSolver::Schur`], the default; [`ImplicitSolver::Direct`]
-//! refactorizes A₀ + C per stuck set and is kept as the reference).
+//! refactorizes A₀ + C per stuck set and is kept as the reference). On
+//! systems of up to [`MODAL_MAX_DOFS`] free DOFs the implicit state is held
+//! in the modes of (K, M) instead ([`ImplicitSolver::Modal`]): A₀ is
+//! diagonal there and a step forms no product with K or M.
 
 mod history;
 mod implicit;
@@ -23,6 +26,7 @@ mod integrator;
 mod kernels;
 pub mod linalg;
 mod memory;
+mod modal;
 mod nodal;
 pub mod scenes;
 mod schur;
@@ -36,4 +40,5 @@ pub use integrator::{
     Checkpoint, Dynamics, Energy, ExplicitFriction, Integrator, Load, MassKind, Scheme, Settings,
     StepInfo, StickReduction, TimeError,
 };
+pub use modal::MODAL_MAX_DOFS;
 pub use schur::ImplicitSolver;

@@ -118,6 +118,7 @@ fn steps_allocate_nothing() {
     // Implicit, Schur path (each correction), with the step reduction:
     // warm up until the normal and the reduced Δt have their factors.
     for solver in [
+        ImplicitSolver::Modal,
         ImplicitSolver::SchurStoredZ,
         ImplicitSolver::SchurSecondSolve,
         ImplicitSolver::SchurPaths,

@@ -17,7 +17,9 @@ mod common;
 use std::collections::BTreeSet;
 
 use common::*;
-use stickslip_time::{History, ImplicitSolver, Integrator, Scheme, Settings, StickReduction};
+use stickslip_time::{
+    History, ImplicitSolver, Integrator, Scheme, Settings, StickReduction, MODAL_MAX_DOFS,
+};
 
 fn cases() -> Vec<(&'static str, Scheme, Option<StickReduction>)> {
     let trapezoidal = Scheme::Newmark {
@@ -55,8 +57,11 @@ fn build(
 }
 
 /// One integrator per Schur variant, in the order Schur, SchurStoredZ,
-/// SchurSecondSolve, SchurPaths.
+/// SchurSecondSolve, SchurPaths, and Modal (the Schur complement on the
+/// modes, `modal.rs`) where the system is small enough for its default
+/// ([`MODAL_MAX_DOFS`]: its agreement is measured there).
 fn schur_variants(s: &Slab, scheme: Scheme, reduction: Option<StickReduction>) -> Vec<Integrator> {
+    let modal = (s.model.stiffness.nrows() <= MODAL_MAX_DOFS).then_some(ImplicitSolver::Modal);
     [
         ImplicitSolver::Schur,
         ImplicitSolver::SchurStoredZ,
@@ -64,6 +69,7 @@ fn schur_variants(s: &Slab, scheme: Scheme, reduction: Option<StickReduction>) -
         ImplicitSolver::SchurPaths,
     ]
     .into_iter()
+    .chain(modal)
     .map(|solver| build(s, scheme, reduction, solver))
     .collect()
 }
