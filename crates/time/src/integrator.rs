@@ -949,21 +949,19 @@ impl Integrator {
                 [m.modes.lambda(), &self.r, &self.v, &self.a, &self.load_new],
                 [&mut self.r_new, &mut self.tmp, &mut self.b],
             );
-            self.scratch_classes.copy_from_slice(&self.classes);
-            let iterations = self.implicit_velocity(dt, step_number, t_new)?;
-            return self.implicit_close(dt, cv, t_new, step_number, iterations);
+        } else {
+            for (((rn, t), r), (v, a)) in self
+                .r_new
+                .iter_mut()
+                .zip(self.tmp.iter_mut())
+                .zip(&self.r)
+                .zip(self.v.iter().zip(&self.a))
+            {
+                *rn = r + c1 * v + c2 * a;
+                *t = cv * v + ca * a;
+            }
+            self.rhs(n);
         }
-        for (((rn, t), r), (v, a)) in self
-            .r_new
-            .iter_mut()
-            .zip(self.tmp.iter_mut())
-            .zip(&self.r)
-            .zip(self.v.iter().zip(&self.a))
-        {
-            *rn = r + c1 * v + c2 * a;
-            *t = cv * v + ca * a;
-        }
-        self.rhs(n);
 
         self.scratch_classes.copy_from_slice(&self.classes);
         // (The explicit scheme took `explicit_step` above.)

@@ -314,6 +314,7 @@ fn close_body(
     let (lambda, v, a, v_new) = (&lambda[..n], &v[..n], &a[..n], &v_new[..n]);
     let (l, l_new, r_new, a_new) = (&l[..n], &l_new[..n], &mut r_new[..n], &mut a_new[..n]);
     let mut finite = true;
+    let mut check = [0.0; 8];
     let mut sums = [[0.0; 8]; 4];
     let whole = n / 8 * 8;
     // Rows k0..k0 + 8 in lanes 0..8 (whole groups), then the rest in
@@ -330,17 +331,20 @@ fn close_body(
             let rn0 = s8(r_new);
             let mut rn = [0.0; 8];
             let mut an = [0.0; 8];
-            let mut ok = [true; 8];
             for j in 0..8 {
                 rn[j] = rn0[j] + c3 * vn[j];
-                ok[j] = rn[j].is_finite() & vn[j].is_finite();
+                // x − x is 0 for a finite x, NaN otherwise (IEEE: not
+                // folded to 0): a sum, where a flag per lane kept the loop
+                // from running 8 wide (0·x instead: 1.22 → 1.41 µs a step).
+                #[allow(clippy::eq_op)]
+                let c = (rn[j] - rn[j]) + (vn[j] - vn[j]);
+                check[j] += c;
                 an[j] = (vn[j] - v[j]) * cv - ka * a[j];
                 sums[0][j] += 0.5 * (ln[j] + l[j]) * (rn[j] - r[j]);
                 sums[1][j] += rn[j] * ln[j];
                 sums[2][j] += vn[j] * vn[j];
                 sums[3][j] += lm[j] * rn[j] * rn[j];
             }
-            finite &= ok.iter().all(|&x| x);
             r_new[k0..k0 + 8].copy_from_slice(&rn);
             a_new[k0..k0 + 8].copy_from_slice(&an);
         } else {
@@ -357,6 +361,7 @@ fn close_body(
             }
         }
     }
+    finite &= check.iter().all(|&x| x == 0.0);
     let total = |s: [f64; 8]| ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
     (finite, sums.map(total))
 }
