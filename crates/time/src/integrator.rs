@@ -847,7 +847,7 @@ impl Integrator {
             return;
         };
         for x in [&mut self.r, &mut self.v, &mut self.a] {
-            m.modes.expand(x, &mut self.tmp);
+            m.modes.expand([x], [&mut self.tmp]);
             x.copy_from_slice(&self.tmp);
         }
         self.load_at(self.t, false);
@@ -1700,21 +1700,21 @@ impl Integrator {
     /// Displacement r on free DOFs.
     pub fn displacement(&self) -> &[f64] {
         if let Some(m) = &self.modal {
-            return m.physical(0, &self.r);
+            return m.physical(0, [&self.r, &self.v, &self.a]);
         }
         &self.r
     }
     /// Velocity ṙ on free DOFs.
     pub fn velocity(&self) -> &[f64] {
         if let Some(m) = &self.modal {
-            return m.physical(1, &self.v);
+            return m.physical(1, [&self.r, &self.v, &self.a]);
         }
         &self.v
     }
     /// Acceleration r̈ on free DOFs.
     pub fn acceleration(&self) -> &[f64] {
         if let Some(m) = &self.modal {
-            return m.physical(2, &self.a);
+            return m.physical(2, [&self.r, &self.v, &self.a]);
         }
         &self.a
     }

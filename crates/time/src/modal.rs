@@ -18,8 +18,9 @@
 //! K and M, one triangular solve pair and two quadratic forms. The price is
 //! Φ (n² values, formed once in O(n³)), and the physical state is formed
 //! (r = Φ q, n² operations) only when it is read, so the path is taken for
-//! small systems only ([`MODAL_MAX_DOFS`]). The bits are not the sparse
-//! path's: the Schur-path tests hold it to the direct path to 1e-10.
+//! small systems only ([`MODAL_MAX_DOFS`]). The modes are refined by a
+//! Jacobi sweep ([`refine`]). The bits are not the sparse path's: the
+//! Schur-path tests hold it to the direct path to 1e-10.
 
 use std::cell::{Cell, OnceCell};
 
@@ -32,18 +33,22 @@ use stickslip_contact::ContactNode;
 
 /// Systems up to this many free DOFs take the modal step by default.
 ///
-/// The bound is set by agreement, not by speed (a step costs O(n·n_c)
-/// at any n; Φ's n² values are read only to form the physical state).
-/// One step from the direct path's state (`tests/schur.rs`, ¼,½):
-/// the paper's Q2 8×2 slab (148 DOFs, λ_max/λ_min = 6.9e3) agrees to
-/// 1.0e-12 in ṙ (|ṙ| ≤ 2.6), the Q1 32×8 slab (552 DOFs, 2.6e4) only to
-/// 1.1e-9, beyond the 1e-10, and the same for ε = 1e-4, 1e-2 and 1
-/// (so not the stuck nodes' damping g/ε). The modes themselves differ:
-/// max |(ΦᵀKΦ − Λ)_ij| / min(λ_i, λ_j) is 1.4e-12 at 148 DOFs but 3.6e-9
-/// at 552, where ε·λ_max/λ_min would be 2.5e-12 (ΦᵀMΦ = I to 8e-15 on
-/// both): the dense eigensolver's low modes are the weak part there. A
-/// Jacobi sweep on ΦᵀKΦ (nearly diagonal, so quadratic) would refine them;
-/// it is not built.
+/// Set by the cost of reading the state, not by the step or by agreement.
+/// A step costs O(n·n_c) at any n, but every output (or checkpoint) forms
+/// r, ṙ, r̈ = Φ(q, q̇, q̈), 3n² operations over Φ's n² values. Up to 300
+/// DOFs Φ (≤ 720 KB) stays in the 1 MB L2. Measured (release, 2000 steps,
+/// best of five, reading the state after every step or not; the factor's
+/// Schur step beside):
+///
+/// * the paper's Q2 8×2 slab (148 DOFs): 1.24 µs a step, 4.70 µs when
+///   reading it every step, against 3.9 µs by the factor;
+/// * the Q1 32×8 slab (552 DOFs, Φ 2.4 MB): 5.5 µs, but 59.6 µs when
+///   reading every step, against 30.8 µs.
+///
+/// So with output at every step the paper mesh's modal run is 0.8 µs a
+/// step slower than the factor's, and from every second step faster. The
+/// agreement with the direct path holds on both (1e-12 a step,
+/// `tests/schur.rs`, which runs the modal path on both).
 pub const MODAL_MAX_DOFS: usize = 300;
 
 /// The M-orthonormal modes of (K, M).
@@ -95,6 +100,7 @@ impl Modes {
         let lambda: Vec<f64> = (0..n).map(|i| evd.S()[i]).collect();
         let mut phi = evd.U().to_owned();
         solve_upper_triangular_in_place(l.transpose(), phi.as_mut(), Par::Seq);
+        let (phi, lambda) = refine(stiffness, phi, lambda);
         let phi = (0..n)
             .flat_map(|j| (0..n).map(move |i| (i, j)))
             .map(|(i, j)| phi[(i, j)])
@@ -124,14 +130,17 @@ impl Modes {
         }
     }
 
-    /// out = Φ q (the physical vector of modal coordinates q).
-    pub fn expand(&self, q: &[f64], out: &mut [f64]) {
-        out.fill(0.0);
-        for (qi, col) in q.iter().zip(self.phi.chunks_exact(self.n)) {
-            for (o, p) in out.iter_mut().zip(col) {
-                *o += qi * p;
-            }
+    /// out_k = Φ q_k for K vectors in one pass over Φ (a column read
+    /// once for all of them), 8 wide where the CPU has AVX-512 (the same
+    /// operations per entry, so the same bits).
+    #[allow(unsafe_code)]
+    pub fn expand<const K: usize>(&self, q: [&[f64]; K], out: [&mut [f64]; K]) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::kernels::avx512() {
+            // SAFETY: the CPU has AVX-512 (checked).
+            return unsafe { expand_avx512(self.n, &self.phi, q, out) };
         }
+        expand_body(self.n, &self.phi, q, out);
     }
 
     /// Φ_c = P Φ by rows (node j's row: Σ_d t_d Φ[dof_d, ·]), n_c × n.
@@ -145,6 +154,137 @@ impl Modes {
         }
         rows
     }
+}
+
+/// Jacobi sweeps at most in [`refine`] (one sufficed on the slabs).
+const MAX_SWEEPS: usize = 10;
+
+/// Refines M-orthonormal modes Φ by Jacobi rotations on ΦᵀKΦ (nearly
+/// diagonal: each sweep squares the off-diagonal part), until every
+/// off-diagonal entry is below 1e-15 of the smaller of its two diagonal
+/// ones; rotations keep ΦᵀMΦ = I.
+///
+/// The dense eigensolver's low modes are its weak part: on the Q1 32×8
+/// slab (552 DOFs, λ_max/λ_min = 2.6e4) max |(ΦᵀKΦ − Λ)_ij| / min(λ_i, λ_j)
+/// was 3.6e-9 (1.4e-12 on the paper's 148 DOFs), and a modal step from
+/// the direct path's state differed from it by 1.3e-9 in ṙ, for ε = 1e-4,
+/// 1e-2 and 1 alike. One sweep (24,671 rotations there, 0.1 s) brings that
+/// to 2.0e-12 (9.2e-13 on the paper mesh); a second finds nothing to do.
+fn refine(
+    stiffness: &CsrMatrix<f64>,
+    mut phi: Mat<f64>,
+    mut lambda: Vec<f64>,
+) -> (Mat<f64>, Vec<f64>) {
+    let n = phi.nrows();
+    let mut kphi = Mat::<f64>::zeros(n, n);
+    for (i, row) in stiffness.row_iter().enumerate() {
+        for (&k, v) in row.col_indices().iter().zip(row.values()) {
+            for j in 0..n {
+                kphi[(i, j)] += v * phi[(k, j)];
+            }
+        }
+    }
+    let mut a = phi.transpose() * &kphi;
+    drop(kphi);
+    for _ in 0..MAX_SWEEPS {
+        let mut rotated = 0usize;
+        for p in 0..n {
+            for q in p + 1..n {
+                let apq = 0.5 * (a[(p, q)] + a[(q, p)]);
+                let (app, aqq) = (a[(p, p)], a[(q, q)]);
+                if apq.abs() <= 1e-15 * app.abs().min(aqq.abs()) {
+                    continue;
+                }
+                rotated += 1;
+                let theta = (aqq - app) / (2.0 * apq);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                for k in 0..n {
+                    let (akp, akq) = (a[(k, p)], a[(k, q)]);
+                    a[(k, p)] = c * akp - s * akq;
+                    a[(k, q)] = s * akp + c * akq;
+                }
+                for k in 0..n {
+                    let (apk, aqk) = (a[(p, k)], a[(q, k)]);
+                    a[(p, k)] = c * apk - s * aqk;
+                    a[(q, k)] = s * apk + c * aqk;
+                }
+                for k in 0..n {
+                    let (xp, xq) = (phi[(k, p)], phi[(k, q)]);
+                    phi[(k, p)] = c * xp - s * xq;
+                    phi[(k, q)] = s * xp + c * xq;
+                }
+            }
+        }
+        if rotated == 0 {
+            break;
+        }
+    }
+    for (i, l) in lambda.iter_mut().enumerate() {
+        *l = a[(i, i)];
+    }
+    (phi, lambda)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[allow(unsafe_code)]
+fn expand_avx512<const K: usize>(n: usize, phi: &[f64], q: [&[f64]; K], out: [&mut [f64]; K]) {
+    expand_body(n, phi, q, out);
+}
+
+#[inline(always)]
+fn expand_body<const K: usize>(n: usize, phi: &[f64], q: [&[f64]; K], out: [&mut [f64]; K]) {
+    // Rows in blocks held in registers over all columns (K·32 sums), so a
+    // column's block is loaded once for the K vectors and nothing else is
+    // stored until the block is done: by columns, each pass loaded and
+    // stored the outputs (5.9 µs for three on the paper mesh).
+    let q = q.map(|q| &q[..n]);
+    let mut out = out.map(|o| &mut o[..n]);
+    let mut r0 = 0;
+    while r0 + 32 <= n {
+        let sums = expand_rows::<K, 32>(n, phi, &q, r0);
+        for (o, s) in out.iter_mut().zip(&sums) {
+            o[r0..r0 + 32].copy_from_slice(s);
+        }
+        r0 += 32;
+    }
+    while r0 + 8 <= n {
+        let sums = expand_rows::<K, 8>(n, phi, &q, r0);
+        for (o, s) in out.iter_mut().zip(&sums) {
+            o[r0..r0 + 8].copy_from_slice(s);
+        }
+        r0 += 8;
+    }
+    while r0 < n {
+        let sums = expand_rows::<K, 1>(n, phi, &q, r0);
+        for (o, s) in out.iter_mut().zip(&sums) {
+            o[r0] = s[0];
+        }
+        r0 += 1;
+    }
+}
+
+/// Rows r0..r0 + W of Φ q_k for each k: Σ_i q_k[i] Φ[r, i] in order of i.
+#[inline(always)]
+fn expand_rows<const K: usize, const W: usize>(
+    n: usize,
+    phi: &[f64],
+    q: &[&[f64]; K],
+    r0: usize,
+) -> [[f64; W]; K] {
+    let mut acc = [[0.0; W]; K];
+    for (i, col) in phi.chunks_exact(n).enumerate() {
+        let block: &[f64; W] = col[r0..r0 + W].try_into().expect("W rows");
+        for (a, q) in acc.iter_mut().zip(q) {
+            let qi = q[i];
+            for j in 0..W {
+                a[j] += qi * block[j];
+            }
+        }
+    }
+    acc
 }
 
 /// Σ a_i b_i in four interleaved partial sums.
@@ -177,11 +317,11 @@ pub(crate) struct ModalState {
     pub contact_v_new: Vec<f64>,
     /// Φ_c by rows, for `contact_v`.
     pub rows: Vec<f64>,
-    /// r, ṙ, r̈ formed from q, q̇, q̈ at their first read since the step,
-    /// in buffers kept across steps (`spare`): no allocation after the
-    /// first read.
-    physical: [OnceCell<Vec<f64>>; 3],
-    spare: [Cell<Vec<f64>>; 3],
+    /// r, ṙ, r̈ formed together from q, q̇, q̈ at the first read of any
+    /// since the step (one pass over Φ), in buffers kept across steps
+    /// (`spare`): no allocation after the first read.
+    physical: OnceCell<[Vec<f64>; 3]>,
+    spare: Cell<[Vec<f64>; 3]>,
 }
 
 impl std::fmt::Debug for ModalState {
@@ -204,7 +344,7 @@ impl ModalState {
             contact_v_new: vec![0.0; nodes.len()],
             rows,
             physical: Default::default(),
-            spare: std::array::from_fn(|_| Cell::new(vec![0.0; n])),
+            spare: Cell::new(std::array::from_fn(|_| vec![0.0; n])),
             modes,
         }
     }
@@ -212,22 +352,23 @@ impl ModalState {
     /// Forgets the physical state formed from the last state (the step
     /// changed it), keeping its buffers.
     pub fn invalidate(&mut self) {
-        for (cell, spare) in self.physical.iter_mut().zip(&self.spare) {
-            if let Some(v) = cell.take() {
-                spare.set(v);
-            }
+        if let Some(v) = self.physical.take() {
+            self.spare.set(v);
         }
     }
 
     /// The physical vector `which` (0: r, 1: ṙ, 2: r̈) of the modal
-    /// coordinates `q` (which must be the integrator's current ones).
-    pub fn physical(&self, which: usize, q: &[f64]) -> &[f64] {
-        self.physical[which].get_or_init(|| {
-            let mut out = self.spare[which].take();
-            out.resize(q.len(), 0.0);
-            self.modes.expand(q, &mut out);
+    /// coordinates `q` = [q, q̇, q̈] (the integrator's current ones).
+    pub fn physical(&self, which: usize, q: [&[f64]; 3]) -> &[f64] {
+        &self.physical.get_or_init(|| {
+            let mut out = self.spare.take();
+            for o in out.iter_mut() {
+                o.resize(self.modes.n(), 0.0);
+            }
+            let [r, v, a] = &mut out;
+            self.modes.expand(q, [r, v, a]);
             out
-        })
+        })[which]
     }
 }
 
@@ -422,7 +563,7 @@ mod tests {
         }
         let q: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin()).collect();
         let mut x = vec![0.0; n];
-        modes.expand(&q, &mut x);
+        modes.expand([&q], [&mut x]);
         let mut back = vec![0.0; n];
         modes.project(&apply(&m, &x), &mut back);
         for i in 0..n {
@@ -492,6 +633,42 @@ mod tests {
             bad[n - 1] = f64::NAN;
             let inputs = [&lambda[..], &r, &v, &a, &bad, &l, &ln];
             assert!(!close(c, inputs, &mut fast[0].clone(), &mut vec![0.0; n]).0);
+        }
+    }
+
+    /// Φq for three vectors at once: the dispatched kernel has the scalar
+    /// body's bits, each vector the bits of its own expansion, and the
+    /// plain sum to rounding, for n around the 32- and 8-row blocks.
+    #[test]
+    fn expand_matches_the_plain_product() {
+        for n in [1, 8, 9, 33, 47, 148] {
+            let phi: Vec<f64> = (0..n * n)
+                .map(|i| ((i * 37) % 101) as f64 / 7.0 - 6.0)
+                .collect();
+            let modes = Modes {
+                n,
+                phi: phi.clone(),
+                lambda: vec![1.0; n],
+            };
+            let q: [Vec<f64>; 3] = std::array::from_fn(|k| {
+                (0..n)
+                    .map(|i| ((k + 1) as f64 * i as f64 * 0.3).cos())
+                    .collect()
+            });
+            let [mut a, mut b, mut c] = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+            modes.expand([&q[0], &q[1], &q[2]], [&mut a, &mut b, &mut c]);
+            let [mut a2, mut b2, mut c2] = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+            expand_body(n, &phi, [&q[0], &q[1], &q[2]], [&mut a2, &mut b2, &mut c2]);
+            assert_eq!([&a, &b, &c], [&a2, &b2, &c2], "n = {n}: the body's bits");
+            for (k, out) in [&a, &b, &c].into_iter().enumerate() {
+                let mut one = vec![0.0; n];
+                modes.expand([&q[k]], [&mut one]);
+                assert_eq!(&one, out, "n = {n}: vector {k} alone");
+                for r in 0..n {
+                    let want: f64 = (0..n).map(|i| q[k][i] * phi[i * n + r]).sum();
+                    assert!((out[r] - want).abs() < 1e-10, "n = {n}, row {r}");
+                }
+            }
         }
     }
 
