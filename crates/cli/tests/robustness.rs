@@ -781,34 +781,100 @@ fn restart_in_a_step_reduction_is_bit_identical_newmark() {
     // Newmark 1/4, 1/2 with Remark 4.3's reduction (dt 5e-3 cut to 1e-7 for
     // 10 steps after sticking). The short run ends half a reduced step
     // after a reduced step, so its checkpoint (taken before its shortened
-    // last step) has the reduction counter running.
-    let dir = scratch("restart-nm");
-    let case = paper_case(&dir, "newmark-step-reduced.toml");
-    let full = dir.join("full.h5");
-    ok(&run(&case, &full, &["--set", "time.t_end=0.3"]));
-    let f = hdf5::File::open(&full).unwrap();
-    let t = f.dataset("time").unwrap().read_raw::<f64>().unwrap();
-    let dt = f.dataset("solver/dt").unwrap().read_raw::<f64>().unwrap();
-    drop(f);
-    let k = (1..dt.len() - 3)
-        .find(|&k| dt[k] == 1e-7 && dt[k + 1] == 1e-7 && dt[k + 2] == 1e-7)
-        .expect("a stick event with reduced steps before t = 0.3");
-    let t1 = t[k] + 0.5e-7;
-    let part = dir.join("part.h5");
-    ok(&run(
-        &case,
-        &part,
-        &["--set", &format!("time.t_end={t1:e}")],
-    ));
-    let remaining = checkpoint_attr::<u64>(&part, "reduced_remaining");
-    assert!(remaining > 0, "checkpoint inside a reduction");
-    ok(&restart(&case, &part, &["--set", "time.t_end=0.3"]));
-    assert_same_datasets(&full, &part);
-    // And across a plain restart point (no reduction running).
-    let part2 = dir.join("part2.h5");
-    ok(&run(&case, &part2, &["--set", "time.t_end=0.1"]));
-    ok(&restart(&case, &part2, &["--set", "time.t_end=0.3"]));
-    assert_same_datasets(&full, &part2);
+    // last step) has the reduction counter running. Written every step the
+    // paper mesh's run goes through the factor, every second step through
+    // its modes (`stiffness_product` = "modes"; the checkpoint then
+    // carries the modal state).
+    for (every, product) in [("1", "2x2 blocks"), ("2", "modes")] {
+        let dir = scratch(&format!("restart-nm-{every}"));
+        let case = paper_case(&dir, "newmark-step-reduced.toml");
+        let every = format!("output.every={every}");
+        let full = dir.join("full.h5");
+        ok(&run(
+            &case,
+            &full,
+            &["--set", "time.t_end=0.3", "--set", &every],
+        ));
+        let f = hdf5::File::open(&full).unwrap();
+        let t = f.dataset("time").unwrap().read_raw::<f64>().unwrap();
+        let dt = f.dataset("solver/dt").unwrap().read_raw::<f64>().unwrap();
+        let used: String = f
+            .group("solver")
+            .unwrap()
+            .attr("stiffness_product")
+            .unwrap()
+            .read_scalar::<hdf5::types::VarLenUnicode>()
+            .unwrap()
+            .as_str()
+            .to_string();
+        assert_eq!(used, product, "{every}");
+        drop(f);
+        let k = (1..dt.len() - 3)
+            .find(|&k| dt[k] == 1e-7 && dt[k + 1] == 1e-7 && dt[k + 2] == 1e-7)
+            .expect("a stick event with reduced steps before t = 0.3");
+        let t1 = t[k] + 0.5e-7;
+        let part = dir.join("part.h5");
+        ok(&run(
+            &case,
+            &part,
+            &["--set", &format!("time.t_end={t1:e}"), "--set", &every],
+        ));
+        let remaining = checkpoint_attr::<u64>(&part, "reduced_remaining");
+        assert!(remaining > 0, "{every}: checkpoint inside a reduction");
+        ok(&restart(
+            &case,
+            &part,
+            &["--set", "time.t_end=0.3", "--set", &every],
+        ));
+        assert_same_datasets(&full, &part);
+        // And across a plain restart point (no reduction running), with
+        // the output cadence changed: the stored run's solver continues.
+        let part2 = dir.join("part2.h5");
+        ok(&run(
+            &case,
+            &part2,
+            &["--set", "time.t_end=0.1", "--set", &every],
+        ));
+        let other = if every.ends_with('1') {
+            "output.every=2"
+        } else {
+            "output.every=1"
+        };
+        ok(&restart(
+            &case,
+            &part2,
+            &["--set", "time.t_end=0.3", "--set", other],
+        ));
+        let f = hdf5::File::open(&part2).unwrap();
+        let t2 = f.dataset("time").unwrap().read_raw::<f64>().unwrap();
+        let r2 = f
+            .dataset("displacement")
+            .unwrap()
+            .read_raw::<f64>()
+            .unwrap();
+        drop(f);
+        let f = hdf5::File::open(&full).unwrap();
+        let tf = f.dataset("time").unwrap().read_raw::<f64>().unwrap();
+        let rf = f
+            .dataset("displacement")
+            .unwrap()
+            .read_raw::<f64>()
+            .unwrap();
+        let (last2, lastf) = (t2.len() - 1, tf.len() - 1);
+        assert_eq!(t2[last2].to_bits(), tf[lastf].to_bits(), "{every}: t_end");
+        let row = rf.len() / tf.len();
+        assert_eq!(
+            r2[last2 * row..]
+                .iter()
+                .map(|x| x.to_bits())
+                .collect::<Vec<_>>(),
+            rf[lastf * row..]
+                .iter()
+                .map(|x| x.to_bits())
+                .collect::<Vec<_>>(),
+            "{every}: the last state, bit for bit, after a restart with {other}"
+        );
+    }
 }
 
 #[test]
