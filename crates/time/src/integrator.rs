@@ -170,6 +170,11 @@ pub struct Settings {
     pub explicit_friction: ExplicitFriction,
     /// ṙ₀ (default zero).
     pub initial_velocity: Option<Vec<f64>>,
+    /// How often the caller reads the state (`Some(1)`: after every
+    /// step; `None`: seldom), for the implicit solver's choice: the modal
+    /// step ([`MODAL_MAX_DOFS`]) pays 3n² for each read, so it is the
+    /// default only where reads come every second step or less often.
+    pub reads_every: Option<u64>,
 }
 
 impl Settings {
@@ -185,6 +190,7 @@ impl Settings {
             allow_unstable: false,
             explicit_friction: ExplicitFriction::ClosedForm,
             initial_velocity: None,
+            reads_every: None,
         }
     }
 }
@@ -751,7 +757,8 @@ impl Integrator {
             total: kinetic + strain - dot(&this.r, &this.load),
             balance: 0.0,
         };
-        if !this.explicit && n <= MODAL_MAX_DOFS {
+        if !this.explicit && n <= MODAL_MAX_DOFS && this.settings.reads_every.is_none_or(|k| k >= 2)
+        {
             this.enter_modal()?;
             this.solver = ImplicitSolver::Modal;
         }
