@@ -830,22 +830,28 @@ impl Integrator {
                 out
             })
             .collect();
+        if let Some(op) = self.schur.as_mut() {
+            op.set_modal(m.modes.tangential_rows(nodes), m.modes.lambda().to_vec());
+        }
+        self.modal = Some(m);
+        self.project_state();
+        self.load_at(self.t, false);
+        Ok(())
+    }
+
+    /// The physical r, ṙ, r̈ in `r`, `v`, `a` into the modes: q = ΦᵀM r,
+    /// likewise q̇ and q̈, and the contact nodes' velocities P ṙ.
+    fn project_state(&mut self) {
+        let m = self.modal.as_mut().expect("the modal step");
         if let Some(c) = &self.contact {
             for (o, node) in m.contact_v.iter_mut().zip(&c.nodes) {
                 *o = node.tangential(&self.v);
             }
         }
-        if let Some(op) = self.schur.as_mut() {
-            op.set_modal(m.rows.clone(), m.modes.lambda().to_vec());
-        }
-        // q = ΦᵀM r, likewise q̇ and q̈.
         for x in [&mut self.r, &mut self.v, &mut self.a] {
             spmv(&self.mass_matrix, x, &mut self.tmp);
             m.modes.project(&self.tmp, x);
         }
-        self.modal = Some(m);
-        self.load_at(self.t, false);
-        Ok(())
     }
 
     /// Back from the modes to the physical state (another solver chosen).
@@ -1596,16 +1602,8 @@ impl Integrator {
                 self.a.copy_from_slice(qdd);
                 m.contact_v.copy_from_slice(u);
             } else {
-                // Another solver's checkpoint: q = ΦᵀM r, likewise q̇, q̈.
-                if let Some(contact) = &self.contact {
-                    for (o, node) in m.contact_v.iter_mut().zip(&contact.nodes) {
-                        *o = node.tangential(&self.v);
-                    }
-                }
-                for x in [&mut self.r, &mut self.v, &mut self.a] {
-                    spmv(&self.mass_matrix, x, &mut self.tmp);
-                    m.modes.project(&self.tmp, x);
-                }
+                // Another solver's checkpoint.
+                self.project_state();
             }
         }
         self.classes.copy_from_slice(&classes);

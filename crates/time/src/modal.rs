@@ -315,8 +315,6 @@ pub(crate) struct ModalState {
     /// in the step being taken (P ṙ = Φ_c q̇ at the end of the step).
     pub contact_v: Vec<f64>,
     pub contact_v_new: Vec<f64>,
-    /// Φ_c by rows, for `contact_v`.
-    pub rows: Vec<f64>,
     /// r, ṙ, r̈ formed together from q, q̇, q̈ at the first read of any
     /// since the step (one pass over Φ), in buffers kept across steps
     /// (`spare`): no allocation after the first read.
@@ -336,13 +334,11 @@ impl std::fmt::Debug for ModalState {
 impl ModalState {
     pub fn new(modes: Modes, nodes: &[ContactNode]) -> ModalState {
         let n = modes.n();
-        let rows = modes.tangential_rows(nodes);
         ModalState {
             constant_load: vec![0.0; n],
             loads: Vec::new(),
             contact_v: vec![0.0; nodes.len()],
             contact_v_new: vec![0.0; nodes.len()],
-            rows,
             physical: Default::default(),
             spare: Cell::new(std::array::from_fn(|_| vec![0.0; n])),
             modes,

@@ -372,13 +372,7 @@ impl SchurOperator {
         if self.modal.is_some() {
             let slot = self.free_slot(bits);
             self.build_modal(slot, c_k, c_m);
-            let entry = &mut self.entries[slot];
-            entry.dt_bits = bits;
-            entry.id = self.next_id;
-            entry.last_used = self.clock;
-            self.next_id += 1;
-            self.factorizations += 1;
-            self.current = slot;
+            self.make_current(slot, bits);
             return Ok(());
         }
         // A₀'s values (K and M share one pattern) and the factorization's
@@ -417,18 +411,26 @@ impl SchurOperator {
         }
         drop(factor_scratch);
         drop(a0);
-        self.factorizations += 1;
-        entry.dt_bits = bits;
-        entry.id = self.next_id;
-        self.next_id += 1;
-        entry.last_used = self.clock;
-        self.current = slot;
+        self.make_current(slot, bits);
+        let entry = &mut self.entries[slot];
         entry.small =
             BlockInverse::worth_it(&self.sn).then(|| BlockInverse::new(&self.sn, &entry.l_values));
         self.build_schur(slot);
         // The factorization's workspace and S's scratch are freed.
         crate::memory::release_free_memory();
         Ok(())
+    }
+
+    /// Entry `slot`, formed for Δt `bits`, becomes the current one: a new
+    /// id (for the dense factor's cache) and one more factorization.
+    fn make_current(&mut self, slot: usize, bits: u64) {
+        let entry = &mut self.entries[slot];
+        entry.dt_bits = bits;
+        entry.id = self.next_id;
+        entry.last_used = self.clock;
+        self.next_id += 1;
+        self.factorizations += 1;
+        self.current = slot;
     }
 
     /// A new entry, or the least recently used one's storage once the
