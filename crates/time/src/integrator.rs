@@ -1044,7 +1044,8 @@ impl Integrator {
         // stays whole if the step fails).
         let c3 = beta / gamma * dt;
         let ka = (1.0 - gamma) / gamma;
-        if let Some(m) = &self.modal {
+        // (The work of the step, r_K·R_K and, in the modes, the energies.)
+        let (finite, work, load_dot, forms) = if let Some(m) = &self.modal {
             // In the modes: the corrector, the ledger's sums and the
             // energies in one pass (`modal::close`).
             let (finite, [work, load_dot, vv, rkr]) = modal::close(
@@ -1061,54 +1062,42 @@ impl Integrator {
                 &mut self.r_new,
                 &mut self.tmp,
             );
-            if !finite {
-                return Err(self.non_finite(step_number, t_new));
+            (finite, work, load_dot, Some((0.5 * vv, 0.5 * rkr)))
+        } else {
+            let mut finite = true;
+            for ((r, v_new), (a_new, (v, a))) in self
+                .r_new
+                .iter_mut()
+                .zip(&self.v_new)
+                .zip(self.tmp.iter_mut().zip(self.v.iter().zip(&self.a)))
+            {
+                *r += c3 * v_new;
+                finite &= r.is_finite() & v_new.is_finite();
+                *a_new = (v_new - v) * cv - ka * a;
             }
-            let (dissipated, stick_events) = self.friction_ledger(dt);
-            std::mem::swap(&mut self.a, &mut self.tmp);
-            self.commit(t_new, step_number, iterations);
-            return Ok(self.close_step(
-                [0.5 * vv, 0.5 * rkr, work, dissipated, load_dot],
-                dt,
-                iterations,
-                stick_events,
-            ));
-        }
-        let mut finite = true;
-        for ((r, v_new), (a_new, (v, a))) in self
-            .r_new
-            .iter_mut()
-            .zip(&self.v_new)
-            .zip(self.tmp.iter_mut().zip(self.v.iter().zip(&self.a)))
-        {
-            *r += c3 * v_new;
-            finite &= r.is_finite() & v_new.is_finite();
-            *a_new = (v_new - v) * cv - ka * a;
-        }
-        if !finite {
-            return Err(self.non_finite(step_number, t_new));
-        }
-
-        // Energy ledger, before the state is overwritten: the work and
-        // r_K·R_K in four lanes each, not one chain of additions per sum
-        // (with the fused loop above: the paper mesh's Newmark step 4.18
-        // → 4.05 µs, medians of ten alternating runs).
-        let (mut work, mut load_dot) = (Lanes::default(), Lanes::default());
-        {
+            // Energy ledger, before the state is overwritten: the work and
+            // r_K·R_K in four lanes each, not one chain of additions per
+            // sum (with the fused loop above: the paper mesh's Newmark
+            // step 4.18 → 4.05 µs, medians of ten alternating runs).
+            let (mut work, mut load_dot) = (Lanes::default(), Lanes::default());
             let n = self.r_new.len();
             let (rn, r) = (&self.r_new[..n], &self.r[..n]);
             let (ln, l) = (&self.load_new[..n], &self.load[..n]);
             work.add_rows(0, n, |k| 0.5 * (ln[k] + l[k]) * (rn[k] - r[k]));
             load_dot.add_rows(0, n, |k| rn[k] * ln[k]);
+            (finite, work.total(), load_dot.total(), None)
+        };
+        if !finite {
+            return Err(self.non_finite(step_number, t_new));
         }
-        let (work, load_dot) = (work.total(), load_dot.total());
         let (dissipated, stick_events) = self.friction_ledger(dt);
 
         // Commit the step.
         std::mem::swap(&mut self.a, &mut self.tmp);
         self.commit(t_new, step_number, iterations);
 
-        let (kinetic, strain) = self.kinetic_and_strain();
+        // ½ṙᵀMṙ and ½rᵀKr of the new state, unless the modal pass formed them.
+        let (kinetic, strain) = forms.unwrap_or_else(|| self.kinetic_and_strain());
         Ok(self.close_step(
             [kinetic, strain, work, dissipated, load_dot],
             dt,
