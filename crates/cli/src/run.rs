@@ -378,7 +378,11 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         ),
         None => println!("contact     none (no friction code runs)"),
     }
-    let crit = stickslip_time::stability::critical_step(&p.model.stiffness, &p.model.lumped_mass);
+    // The explicit integrator computed it already (by its own K·x);
+    // Newmark's did not.
+    let crit = i.dt_crit().unwrap_or_else(|| {
+        stickslip_time::stability::critical_step(&p.model.stiffness, &p.model.lumped_mass)
+    });
     println!("dt_crit     {crit:.6e} (central difference, lumped mass: 2/omega_max)");
     let steps = (case.time.t_end / case.time.dt).ceil();
     if i.is_explicit() {
