@@ -7,6 +7,8 @@
     python3 cases/meshes/generate.py --bench-out DIR --nx 1000 --ny 999
         # the ~1M-node Q1 slab of `cargo xtask bench mesh`, written to DIR
         # as MSH 4.1 ASCII and binary (not committed)
+    python3 cases/meshes/generate.py --bench-out DIR --order 2 --nx 352 --ny 88
+        # a Q2 slab as Gmsh numbers and places its nodes (not snapped)
 
 Runs headless. The output is deterministic: one thread, fresh Gmsh state per
 mesh, and on the transfinite slab every node is snapped to its exact grid
@@ -109,17 +111,19 @@ def main():
     ap.add_argument("--bench-out", help="write only the benchmark slab (Q1, MSH 4.1 ASCII + binary) here")
     ap.add_argument("--nx", type=int, default=1000, help="benchmark slab divisions along x")
     ap.add_argument("--ny", type=int, default=999, help="benchmark slab divisions along y")
+    ap.add_argument("--order", type=int, default=1, choices=(1, 2), help="benchmark slab cell order (1: quad4, 2: quad9)")
     args = ap.parse_args()
 
     if args.bench_out:
         os.makedirs(args.bench_out, exist_ok=True)
         # Gmsh's own coordinates, not snapped: this is what a user's file looks like.
-        nodes, cells = make_mesh(SLAB_GEO, 1, {"nx": args.nx, "ny": args.ny}, snap=False)
-        stem = f"slab-q1-{args.nx}x{args.ny}"
+        nodes, cells = make_mesh(SLAB_GEO, args.order, {"nx": args.nx, "ny": args.ny}, snap=False)
+        stem = f"slab-q{args.order}-{args.nx}x{args.ny}"
+        kind = "quad4" if args.order == 1 else "quad9"
         for suffix, binary in (("ascii", False), ("bin", True)):
             path = os.path.join(args.bench_out, f"{stem}-{suffix}.msh")
             write(path, 4.1, binary)
-            print(f"{path}  nodes {nodes}  cells {cells} quad4  bytes {os.path.getsize(path)}")
+            print(f"{path}  nodes {nodes}  cells {cells} {kind}  bytes {os.path.getsize(path)}")
         gmsh.finalize()
         return
 

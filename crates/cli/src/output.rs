@@ -230,6 +230,10 @@ pub struct CheckpointExtra {
     pub wall_time_s: f64,
     /// Largest |energy balance| so far.
     pub max_balance: f64,
+    /// The state's free DOFs are numbered in grid order
+    /// (`stickslip_fem::NodeOrder::Grid`), not the mesh's node order
+    /// (files written before the grid order: false).
+    pub grid_order: bool,
 }
 
 /// A results file's `/checkpoint` and what a restart needs besides.
@@ -468,6 +472,8 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         rows: get_scalar::<u64>(&g, "rows")? as usize,
         wall_time_s: get_scalar(&g, "wall_time_s")?,
         max_balance: get_scalar(&g, "max_balance")?,
+        // Absent in files of versions before the grid order: the mesh's.
+        grid_order: g.attr("grid_order").is_ok() && get_scalar::<u8>(&g, "grid_order")? == 1,
     };
     let time = file.dataset("time")?;
     let n = time.shape().first().copied().unwrap_or(0);
@@ -765,7 +771,8 @@ impl ResultsWriter {
                 &cg,
                 "about",
                 "the integrator's state at the last flush (stickslip run --restart continues from it), \
-                 in the slot named by the attribute slot (0 = a, 1 = b); vectors on the free DOFs; \
+                 in the slot named by the attribute slot (0 = a, 1 = b); vectors on the free DOFs, numbered node by node \
+                 in the mesh's order or, where grid_order = 1, row by row of the structured grid; \
                  rows = output rows that belong to this state",
             )?;
             (cg, 0)
@@ -808,6 +815,7 @@ impl ResultsWriter {
         put_scalar(&g, "rows", extra.rows as u64)?;
         put_scalar(&g, "wall_time_s", extra.wall_time_s)?;
         put_scalar(&g, "max_balance", extra.max_balance)?;
+        put_scalar(&g, "grid_order", u8::from(extra.grid_order))?;
         // The new slot is complete on disk before it becomes the current one.
         self.file.flush()?;
         put_scalar(&cg, "slot", slot)?;

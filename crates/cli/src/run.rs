@@ -16,7 +16,7 @@ use anyhow::Context;
 use stickslip_contact::{ContactSurface, IterationOptions};
 use stickslip_fem::{
     body_force_load, traction_load, Dirichlet, ElementClasses, Hypothesis as FemHypothesis,
-    Material, Model, Traction,
+    Material, Model, NodeOrder, Traction,
 };
 use stickslip_mesh::Mesh;
 use stickslip_time::{
@@ -364,9 +364,13 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         case.mesh.file.display()
     );
     println!(
-        "DOFs        {} free of {}",
+        "DOFs        {} free of {}, numbered {}",
         p.model.dofs.n_free(),
-        2 * p.mesh.nodes.len()
+        2 * p.mesh.nodes.len(),
+        match p.model.dofs.node_order() {
+            NodeOrder::Mesh => "node by node in the mesh file's order",
+            NodeOrder::Grid => "row by row of the structured grid the nodes form",
+        }
     );
     match i.contact() {
         Some(c) => println!(
@@ -577,6 +581,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         state: vec![0; n_c],
     };
     // E₀ for the blow-up test: kinetic + strain at t = 0.
+    let grid_order = model.dofs.node_order() == NodeOrder::Grid;
     let e0 = integrator.energy();
     let mut initial_mechanical = e0.kinetic + e0.strain;
     let (mut writer, wall_before, mut max_balance, mut times) = if options.restart {
@@ -619,6 +624,41 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                 .set_implicit_solver(solver)
                 .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
         }
+        // A state stored in the other node order (a file of a version
+        // before the grid order, or STICKSLIP_DOF_ORDER changed) is read
+        // into this run's numbering; the modal state, whose modes depend
+        // on the numbering, is then formed again from it.
+        let remapped;
+        let n_free = model.dofs.n_free();
+        let lengths_fit = [&cp.displacement, &cp.velocity, &cp.acceleration]
+            .iter()
+            .all(|x| x.len() == n_free);
+        // (Other lengths: `restore` says what is wrong.)
+        let cp = if stored.extra.grid_order != grid_order && lengths_fit {
+            let order = if stored.extra.grid_order {
+                NodeOrder::Grid
+            } else {
+                NodeOrder::Mesh
+            };
+            let theirs = model.dofs.renumbered(&mesh, order).ok_or_else(|| {
+                input(format!(
+                    "--restart {}: its state is numbered by a structured grid, but {} is not one; restart with the mesh the run started from",
+                    out.display(),
+                    case.mesh.file.display()
+                ))
+            })?;
+            let to_ours = |x: &[f64]| model.dofs.from_numbering(&theirs, x);
+            remapped = stickslip_time::Checkpoint {
+                displacement: to_ours(&cp.displacement),
+                velocity: to_ours(&cp.velocity),
+                acceleration: to_ours(&cp.acceleration),
+                modal: Vec::new(),
+                ..cp.clone()
+            };
+            &remapped
+        } else {
+            cp
+        };
         integrator
             .restore(cp)
             .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
@@ -658,6 +698,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         rows,
         wall_time_s: wall_before + started.elapsed().as_secs_f64(),
         max_balance,
+        grid_order,
     };
     let xdmf_path = out.with_extension("xdmf");
     let xdmf = |times: &[f64]| {

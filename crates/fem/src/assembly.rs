@@ -89,14 +89,19 @@ pub fn free_dof_pattern(mesh: &Mesh, dofs: &DofMap) -> SparsityPattern {
     let mut cols = Vec::with_capacity(nnz);
     for r in 0..n_free {
         let node = dofs.full_of_free(r) / 2;
-        // Free indices grow with (node, component), so walking sorted
-        // neighbours yields sorted columns.
+        // In the mesh's node order free indices grow with (node,
+        // component), so walking sorted neighbours yields sorted columns;
+        // in another order the row is sorted after.
+        let start = cols.len();
         for &q in &neighbours[offsets[node]..offsets[node + 1]] {
             for comp in 0..2 {
                 if let Some(c) = dofs.free(q, comp) {
                     cols.push(c);
                 }
             }
+        }
+        if dofs.node_order() != crate::NodeOrder::Mesh {
+            cols[start..].sort_unstable();
         }
         row_offsets.push(cols.len());
     }

@@ -193,7 +193,6 @@ impl ElementClasses {
             }
         }
         // Node → (cell, local index), cells ascending.
-        let n_nodes = mesh.nodes.len();
         let (offsets, entries) = node_entries(mesh);
         let adjacency: Vec<u32> = entries
             .iter()
@@ -205,11 +204,8 @@ impl ElementClasses {
         let mut group_mask = Vec::new();
         let mut group_cells = vec![0u32];
         let mut node_cells = Vec::with_capacity(adjacency.len());
-        for v in 0..n_nodes {
+        for v in dofs.free_nodes() {
             let mask = dofs.free(v, 0).is_some() as u8 | (dofs.free(v, 1).is_some() as u8) << 1;
-            if mask == 0 {
-                continue;
-            }
             let first = dofs.free(v, 0).or(dofs.free(v, 1)).expect("a free DOF");
             group_rows.push(first as u32);
             group_mask.push(mask);

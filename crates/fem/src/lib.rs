@@ -34,7 +34,7 @@ pub mod testing;
 pub use assembly::{free_dof_pattern, node_adjacency};
 pub use boundary::{boundary_quadrature, BoundaryNode};
 pub use classes::ElementClasses;
-pub use dofs::{Dirichlet, DofMap};
+pub use dofs::{Dirichlet, DofMap, NodeOrder};
 pub use error::FemError;
 pub use loads::{
     body_force_load, body_force_load_with, traction_load, traction_load_with, Traction,

@@ -40,7 +40,15 @@ impl Model {
         material: &Material,
         conditions: &[Dirichlet],
     ) -> Result<Model, FemError> {
-        let dofs = DofMap::new(mesh, conditions)?;
+        Model::with_dofs(mesh, material, DofMap::new(mesh, conditions)?)
+    }
+
+    /// [`Model::new`] on a DOF map of `mesh` made already (e.g. one
+    /// [`DofMap::renumbered`] into another node order).
+    ///
+    /// # Errors
+    /// [`FemError::InvertedCell`].
+    pub fn with_dofs(mesh: &Mesh, material: &Material, dofs: DofMap) -> Result<Model, FemError> {
         let pattern = free_dof_pattern(mesh, &dofs);
         let nnz = pattern.nnz();
         let mut k = vec![0.0; nnz];

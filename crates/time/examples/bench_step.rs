@@ -78,10 +78,16 @@ fn mesh_named(name: &str) -> Mesh {
             order == "q2",
         );
     }
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../cases/meshes")
-        .join(format!("{name}.msh"));
-    Mesh::from_file(path).expect("committed mesh reads")
+    // A path to a .msh file (e.g. a Gmsh slab from generate.py
+    // --bench-out), else a committed mesh by name.
+    let path = if name.ends_with(".msh") {
+        PathBuf::from(name)
+    } else {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../cases/meshes")
+            .join(format!("{name}.msh"))
+    };
+    Mesh::from_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

@@ -31,9 +31,16 @@ use nalgebra_sparse::CsrMatrix;
 use crate::kernels::{self, RowProduct};
 
 /// Block values within this fraction of max |K_ij| of a type's are the
-/// type's (measured: the Q1 and Q2 slabs' stencils spread by up to ~1e-13
-/// relative; see `stencil_types_on_the_slabs`).
-pub const TOLERANCE: f64 = 1e-12;
+/// type's. The committed slabs, snapped to their grid, spread by up to
+/// ~1e-13 (`stencil_types_on_the_slabs`); Gmsh's own transfinite nodes
+/// are off their grid lines by up to 1.4e-9 of a cell (Q1 700×175 slab),
+/// and alike node rows of K then differ by up to about 1e-11: at 1e-12
+/// the Q1 slab of 1M DOFs from Gmsh kept 7.4M of 303M groups a step out of
+/// the 8-wide sums and stepped in 4.5 ms, at 1e-10 3.1M (as many as the
+/// generator's slab) and 3.3 ms (bench_step, 2026-11-24). A product within
+/// 1e-10 · max |K_ij| · Σ_j |x_j| of the assembled K's is that of nodes
+/// moved by less than Gmsh's rounding moved them.
+pub const TOLERANCE: f64 = 1e-10;
 
 /// The coarse grid, in tolerances, on which a stencil's values are hashed
 /// (alike stencils land in one bucket unless a value straddles a grid
