@@ -7,15 +7,18 @@
 //! y), which keeps each node's DOFs adjacent (the assembly exploits it).
 //! Bandwidth is left to the Cholesky's fill-reducing ordering (AMD).
 //!
-//! The node order is the mesh's, except on large structured grids
-//! ([`NodeOrder::Grid`]): there the nodes are taken row by row, as a
+//! The node order is the mesh's, except where the nodes form a structured
+//! grid ([`NodeOrder::Grid`]): there they are taken row by row, as a
 //! generator that knows the grid numbers them. Gmsh numbers a transfinite
 //! slab's boundary nodes first, its interior column by column and a Q2
 //! mesh's mid-edge and centre nodes cell by cell, so that node rows of K
 //! do not repeat at fixed column offsets, which is what the explicit
-//! step's fastest products need (`stickslip-time`'s stencil types): on the
-//! Gmsh Q2 slab of 249k DOFs its step took 4.4 ms in Gmsh's order against
-//! 0.9 ms in the grid's.
+//! step's fastest products need (`stickslip-time`'s stencil types).
+//! bench_step, Gmsh's Q2 slabs, explicit step in the file's order against
+//! the grid's, 2026-11-24: 249k DOFs 4.47 against 1.05 ms (medians of
+//! five), 33k DOFs 238 against 191 µs, 8,352 DOFs 80.8 against 65.7 µs
+//! (medians of three); the paper's 85-node mesh 1.004 against 0.962 µs
+//! (medians of five).
 
 use stickslip_mesh::Mesh;
 
@@ -47,18 +50,8 @@ impl Dirichlet {
     }
 }
 
-/// Fewest free DOFs from which a structured grid is numbered in grid order
-/// ([`NodeOrder::Grid`]): above every committed mesh (at most 8,352 free
-/// DOFs), so that their cases and references keep their bits. Smaller
-/// Gmsh grids would gain too (bench_step, Gmsh Q2 slabs, explicit step,
-/// medians of three alternating runs, 2026-11-24: 8,352 DOFs 80.8 µs in
-/// the file's order against 65.7 µs in the grid's; 33k DOFs 238 against
-/// 191 µs); moving the line below them is left for when their references
-/// are regenerated.
-pub const GRID_ORDER_MIN_FREE: usize = 10_000;
-
-/// Environment variable that picks the node order whatever the size:
-/// `mesh` or `grid` (the latter only where the mesh is a grid).
+/// Environment variable that keeps the mesh file's node order: `mesh`
+/// (any other value, or none: the grid's where the nodes form one).
 pub const ORDER_ENV: &str = "STICKSLIP_DOF_ORDER";
 
 /// The order in which nodes receive their free DOF numbers.
@@ -149,12 +142,9 @@ impl DofMap {
             }
         }
         let fixed: Vec<bool> = source.iter().map(|&s| s != usize::MAX).collect();
-        let n_free = fixed.iter().filter(|&&f| !f).count();
         let wanted = match std::env::var(ORDER_ENV).ok().as_deref() {
             Some("mesh") => NodeOrder::Mesh,
-            Some("grid") => NodeOrder::Grid,
-            _ if n_free >= GRID_ORDER_MIN_FREE => NodeOrder::Grid,
-            _ => NodeOrder::Mesh,
+            _ => NodeOrder::Grid,
         };
         let (order, nodes) = match wanted {
             NodeOrder::Grid => match grid_order(&mesh.nodes) {
