@@ -230,10 +230,11 @@ pub struct CheckpointExtra {
     pub wall_time_s: f64,
     /// Largest |energy balance| so far.
     pub max_balance: f64,
-    /// The state's free DOFs are numbered in grid order
-    /// (`stickslip_fem::NodeOrder::Grid`), not the mesh's node order
-    /// (files written before the grid order: false).
-    pub grid_order: bool,
+    /// How the state's free DOFs are numbered
+    /// (`stickslip_fem::NodeOrder::code`: 0 the mesh file's node order,
+    /// 1 grid rows, 2 reverse Cuthill–McKee; files written before the
+    /// node orders: 0).
+    pub node_order: u8,
 }
 
 /// A results file's `/checkpoint` and what a restart needs besides.
@@ -472,8 +473,12 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         rows: get_scalar::<u64>(&g, "rows")? as usize,
         wall_time_s: get_scalar(&g, "wall_time_s")?,
         max_balance: get_scalar(&g, "max_balance")?,
-        // Absent in files of versions before the grid order: the mesh's.
-        grid_order: g.attr("grid_order").is_ok() && get_scalar::<u8>(&g, "grid_order")? == 1,
+        // Absent in files of versions before the node orders: the mesh's.
+        node_order: if g.attr("node_order").is_ok() {
+            get_scalar(&g, "node_order")?
+        } else {
+            0
+        },
     };
     let time = file.dataset("time")?;
     let n = time.shape().first().copied().unwrap_or(0);
@@ -772,7 +777,8 @@ impl ResultsWriter {
                 "about",
                 "the integrator's state at the last flush (stickslip run --restart continues from it), \
                  in the slot named by the attribute slot (0 = a, 1 = b); vectors on the free DOFs, numbered node by node \
-                 in the mesh's order or, where grid_order = 1, row by row of the structured grid; \
+                 in the order the attribute node_order names (0 the mesh file's, 1 the rows of the structured grid, \
+                 2 reverse Cuthill-McKee); \
                  rows = output rows that belong to this state",
             )?;
             (cg, 0)
@@ -815,7 +821,7 @@ impl ResultsWriter {
         put_scalar(&g, "rows", extra.rows as u64)?;
         put_scalar(&g, "wall_time_s", extra.wall_time_s)?;
         put_scalar(&g, "max_balance", extra.max_balance)?;
-        put_scalar(&g, "grid_order", u8::from(extra.grid_order))?;
+        put_scalar(&g, "node_order", extra.node_order)?;
         // The new slot is complete on disk before it becomes the current one.
         self.file.flush()?;
         put_scalar(&cg, "slot", slot)?;

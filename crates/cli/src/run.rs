@@ -370,6 +370,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         match p.model.dofs.node_order() {
             NodeOrder::Mesh => "node by node in the mesh file's order",
             NodeOrder::Grid => "row by row of the structured grid the nodes form",
+            NodeOrder::Bandwidth => "by reverse Cuthill-McKee (a band around the diagonal)",
         }
     );
     match i.contact() {
@@ -581,7 +582,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         state: vec![0; n_c],
     };
     // E₀ for the blow-up test: kinetic + strain at t = 0.
-    let grid_order = model.dofs.node_order() == NodeOrder::Grid;
+    let node_order = model.dofs.node_order();
     let e0 = integrator.energy();
     let mut initial_mechanical = e0.kinetic + e0.strain;
     let (mut writer, wall_before, mut max_balance, mut times) = if options.restart {
@@ -624,8 +625,8 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                 .set_implicit_solver(solver)
                 .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
         }
-        // A state stored in the other node order (a file of a version
-        // before the grid order, or STICKSLIP_DOF_ORDER changed) is read
+        // A state stored in another node order (a file of a version
+        // before the node orders, or STICKSLIP_DOF_ORDER changed) is read
         // into this run's numbering; the modal state, whose modes depend
         // on the numbering, is then formed again from it.
         let remapped;
@@ -634,19 +635,17 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             .iter()
             .all(|x| x.len() == n_free);
         // (Other lengths: `restore` says what is wrong.)
-        let cp = if stored.extra.grid_order != grid_order && lengths_fit {
-            let order = if stored.extra.grid_order {
-                NodeOrder::Grid
-            } else {
-                NodeOrder::Mesh
-            };
-            let theirs = model.dofs.renumbered(&mesh, order).ok_or_else(|| {
-                input(format!(
-                    "--restart {}: its state is numbered by a structured grid, but {} is not one; restart with the mesh the run started from",
-                    out.display(),
-                    case.mesh.file.display()
-                ))
-            })?;
+        let cp = if stored.extra.node_order != node_order.code() && lengths_fit {
+            let theirs = NodeOrder::from_code(stored.extra.node_order)
+                .and_then(|order| model.dofs.renumbered(&mesh, order))
+                .ok_or_else(|| {
+                    input(format!(
+                        "--restart {}: its state's node_order {} does not apply to {} (a newer version's order, or a structured grid's on a mesh that is none); restart with the version and the mesh the run started from",
+                        out.display(),
+                        stored.extra.node_order,
+                        case.mesh.file.display()
+                    ))
+                })?;
             let to_ours = |x: &[f64]| model.dofs.from_numbering(&theirs, x);
             remapped = stickslip_time::Checkpoint {
                 displacement: to_ours(&cp.displacement),
@@ -698,7 +697,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         rows,
         wall_time_s: wall_before + started.elapsed().as_secs_f64(),
         max_balance,
-        grid_order,
+        node_order: node_order.code(),
     };
     let xdmf_path = out.with_extension("xdmf");
     let xdmf = |times: &[f64]| {
