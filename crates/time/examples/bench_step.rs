@@ -79,9 +79,13 @@ fn mesh_named(name: &str) -> Mesh {
         );
     }
     // A path to a .msh file (e.g. a Gmsh slab from generate.py
-    // --bench-out), else a committed mesh by name.
+    // --bench-out); "gmsh-qK-NXxNY[-fileorder]": the Gmsh slab `cargo
+    // xtask bench step` writes into target/bench/gmsh; else a committed
+    // mesh by name.
     let path = if name.ends_with(".msh") {
         PathBuf::from(name)
+    } else if let Some(rest) = name.strip_prefix("gmsh-") {
+        gmsh_file(rest.trim_end_matches("-fileorder"))
     } else {
         PathBuf::from(env!("CARGO_MANIFEST_DIR"))
             .join("../../cases/meshes")
@@ -89,6 +93,20 @@ fn mesh_named(name: &str) -> Mesh {
     };
     Mesh::from_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
+
+/// The Gmsh slab "qK-NXxNY" as `cargo xtask bench step` writes it
+/// (generate.py --bench-out target/bench/gmsh: Gmsh's numbering and
+/// coordinates, not snapped).
+fn gmsh_file(size: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../target/bench/gmsh")
+        .join(format!("slab-{size}-bin.msh"))
+}
+
+/// Gmsh's own Q2 slab of the 249k rung, in the node order the solver
+/// picks (the grid's) and in the file's (`STICKSLIP_DOF_ORDER=mesh`): what
+/// a user's mesh costs, beside the generator's slab.
+const GMSH_RUNGS: [&str; 2] = ["gmsh-q2-352x88", "gmsh-q2-352x88-fileorder"];
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -529,6 +547,18 @@ fn main() {
             ladder.push(("newmark", name, dofs, if quick { 3 } else { 10 }, 5));
         }
     }
+    if gmsh_file("q2-352x88").exists() {
+        for name in GMSH_RUNGS {
+            let dofs = 248_688.0;
+            ladder.push(("cd", name.into(), dofs, if quick { 20 } else { 100 }, 5));
+            ladder.push(("newmark", name.into(), dofs, if quick { 3 } else { 10 }, 5));
+        }
+    } else {
+        eprintln!(
+            "no Gmsh slab at {}: its rungs are left out (cargo xtask bench step writes it)",
+            gmsh_file("q2-352x88").display()
+        );
+    }
     let exe = std::env::current_exe().unwrap();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     let dir = root.join("target/bench");
@@ -554,6 +584,9 @@ fn main() {
         ]);
         if let Some(d) = &peer_dir {
             cmd.arg("--dump").arg(d);
+        }
+        if name.ends_with("-fileorder") {
+            cmd.env("STICKSLIP_DOF_ORDER", "mesh");
         }
         let out = cmd.output().expect("runs itself");
         let text = String::from_utf8_lossy(&out.stdout);
