@@ -1895,6 +1895,18 @@ pub(crate) fn avx512() -> bool {
     }
 }
 
+/// Whether this CPU has fused multiply-add (FMA3).
+pub(crate) fn fma() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// Passes B and C and the SpMV in one sweep: per row, K r_K, R̂_K,
 /// ṙ_K = R̂_K/(m·scale) — or, at the contact DOFs, the velocity the nodal
 /// friction gave (`friction`, (DOF, ṙ_K) sorted by DOF, computed before
@@ -3220,6 +3232,11 @@ pub(crate) mod tests {
     /// 4.62-5.29 ms without); and since, non-temporal stores for the three
     /// outputs (no faster: 3.85 against 4.08 ms at 256-row batches, 2.66
     /// against 3.32 at 64).
+    /// Prefetching again (2026-11-24 22:30, 64-row batches, the whole
+    /// explicit step of the Q2 1M slab, with and without alternating in
+    /// one process, medians of 59 blocks of 10 steps): m, ṙ, r̈ 64 or 128
+    /// rows ahead 0.7% and 2.6% slower, with the three outputs (prefetchw)
+    /// 128, 256 and 512 rows ahead 0.5%, 1.6% and 2.2% slower.
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn sweep_lab() {

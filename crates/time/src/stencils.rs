@@ -11,7 +11,8 @@
 //! first member) and per group only its type, so a product streams 8 bytes
 //! per group (first row, type) instead of the blocks, and reads the blocks
 //! of the few types from L1. Runs of alike node pairs are summed 4 doubles
-//! wide (AVX) or, where the CPU has AVX-512, 8 wide: `sweep_lab`,
+//! wide (AVX) or, where the CPU has AVX-512, 8 wide, each term by a fused
+//! multiply-add where it has FMA (on every path: the same bits): `sweep_lab`,
 //! 2026-11-24, 1M DOFs, K·x Q1 1.2 → 0.95-1.0 ms, Q2 1.9 → 1.7 ms (2
 //! threads, median of 20, two runs each). Rows are independent and each
 //! is summed in its type's block order whatever batch or thread computes
@@ -87,6 +88,10 @@ pub struct Stencils {
     /// The CPU has AVX-512: the runs are summed 8 doubles wide, two
     /// units to a register (the same bits).
     pub(crate) avx512: bool,
+    /// The CPU has AVX and FMA: every term is added by a fused
+    /// multiply-add, on every path (scalar, 4 and 8 wide), so that they
+    /// keep giving the same bits ([`Stencils::groups_into`]).
+    pub(crate) fma: bool,
 }
 
 /// [`Stencils::unit_of`] of a group that starts no unit.
@@ -182,6 +187,7 @@ impl Stencils {
             unit_values: Vec::new(),
             avx: avx::available(),
             avx512: avx::available() && avx::available_512(),
+            fma: avx::available() && kernels::fma(),
         };
         if stencils.avx {
             stencils.build_units();
@@ -249,8 +255,8 @@ impl Stencils {
 
     /// The sums of group g's rows (the second is 0 for a single row).
     #[inline(always)]
-    fn group_sums(&self, g: usize, x: &[f64]) -> [f64; 2] {
-        self.lockstep::<1>(g, x)[0]
+    fn group_sums<const F: bool>(&self, g: usize, x: &[f64]) -> [f64; 2] {
+        self.lockstep::<1, F>(g, x)[0]
     }
 
     /// G groups of one type in lockstep, the type's blocks loaded once
@@ -259,14 +265,14 @@ impl Stencils {
     /// 4G independent chains of additions (one chain per row would wait on
     /// the adder's latency); the order every kernel here keeps.
     #[inline(always)]
-    fn lockstep<const G: usize>(&self, g: usize, x: &[f64]) -> [[f64; 2]; G] {
+    fn lockstep<const G: usize, const F: bool>(&self, g: usize, x: &[f64]) -> [[f64; 2]; G] {
         let r: [isize; G] = std::array::from_fn(|q| self.group_rows[g + q] as isize);
         let (offsets, values) = self.stencil(self.types[g]);
         let mut s = [[[0.0; 2]; 2]; G];
         for (&o, v) in offsets.iter().zip(values) {
             let o = o as isize;
             for q in 0..G {
-                split_block((r[q] + o) as usize, v, x, &mut s[q]);
+                split_block::<F>((r[q] + o) as usize, v, x, &mut s[q]);
             }
         }
         s.map(|[lo, hi]| [lo[0] + hi[0], lo[1] + hi[1]])
@@ -296,9 +302,61 @@ impl Stencils {
         g + 4 <= g1 && self.unit_of[g] == u && self.unit_of[g + 2] == u
     }
 
-    /// K x on the rows of groups g0..g1 into `out` (from g0's first row).
+    /// K x on the rows of groups g0..g1 into `out` (from g0's first row),
+    /// by fused multiply-adds where the CPU has them: half the
+    /// arithmetic instructions of a product and a sum, which bound the
+    /// 8-wide sums of Q2 node rows (`kx_lab`, 2026-11-24, 1M DOFs, 2
+    /// threads, fused and unfused alternating in one process, three runs:
+    /// K·x 0.89-0.95 of the unfused time on Q2, 0.92-0.96 on Q1; about
+    /// 1.45 against 1.6 ms on Q2), and one rounding per term instead of
+    /// two.
     #[inline(always)]
     fn groups_into(&self, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if self.fma {
+            // SAFETY: `fma` only where the CPU has AVX and FMA.
+            #[allow(unsafe_code)]
+            unsafe {
+                self.groups_into_fma(g0, g1, x, out)
+            };
+            return;
+        }
+        self.groups_into_with::<false>(g0, g1, x, out);
+    }
+
+    /// [`Stencils::groups_into`] compiled for FMA: `f64::mul_add` in the
+    /// scalar sums becomes one instruction, the same bits as the vector
+    /// lanes' (both round once).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,fma")]
+    #[allow(unsafe_code)]
+    fn groups_into_fma(&self, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
+        self.groups_into_with::<true>(g0, g1, x, out);
+    }
+
+    /// One group's sums ([`Stencils::group_sums`]) by the same operations
+    /// as [`Stencils::groups_into`]'s.
+    fn sums_of(&self, g: usize, x: &[f64]) -> [f64; 2] {
+        #[cfg(target_arch = "x86_64")]
+        if self.fma {
+            // SAFETY: `fma` only where the CPU has AVX and FMA.
+            #[allow(unsafe_code)]
+            return unsafe { self.sums_fma(g, x) };
+        }
+        self.group_sums::<false>(g, x)
+    }
+
+    /// [`Stencils::sums_of`] compiled for FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,fma")]
+    #[allow(unsafe_code)]
+    fn sums_fma(&self, g: usize, x: &[f64]) -> [f64; 2] {
+        self.group_sums::<true>(g, x)
+    }
+
+    /// [`Stencils::groups_into`], fused (`F`) or not.
+    #[inline(always)]
+    fn groups_into_with<const F: bool>(&self, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
         let base = self.group_rows[g0] as usize;
         let put = |out: &mut [f64], g: usize, s: [f64; 2]| {
             let (r0, r1) = (self.group_rows[g] as usize, self.group_rows[g + 1] as usize);
@@ -327,15 +385,15 @@ impl Stencils {
                 }
                 let run = &mut out[r - base..r - base + 8 * count];
                 let (o, v) = (&self.unit_offsets[b.clone()], &self.unit_values[b]);
-                avx::units(self.avx512, o, v, r, x, run);
+                avx::units::<F>(self.avx512, o, v, r, x, run);
                 g += 4 * count;
             } else if alike(LOCKSTEP) {
-                for (q, s) in self.lockstep::<LOCKSTEP>(g, x).into_iter().enumerate() {
+                for (q, s) in self.lockstep::<LOCKSTEP, F>(g, x).into_iter().enumerate() {
                     put(out, g + q, s);
                 }
                 g += LOCKSTEP;
             } else {
-                put(out, g, self.group_sums(g, x));
+                put(out, g, self.group_sums::<F>(g, x));
                 g += 1;
             }
         }
@@ -343,14 +401,23 @@ impl Stencils {
 }
 
 /// One 2×2 block (by columns) at column c into a pair's partial sums:
-/// s[0] the first column's terms of rows 0 and 1, s[1] the second's.
+/// s[0] the first column's terms of rows 0 and 1, s[1] the second's; by
+/// fused multiply-adds with `F` (call it so only from code compiled for
+/// FMA, where `mul_add` is one instruction, not a library call).
 #[inline(always)]
-fn split_block(c: usize, v: &[f64; 4], x: &[f64], s: &mut [[f64; 2]; 2]) {
+fn split_block<const F: bool>(c: usize, v: &[f64; 4], x: &[f64], s: &mut [[f64; 2]; 2]) {
     let xs = &x[c..c + 2];
-    s[0][0] += v[0] * xs[0];
-    s[0][1] += v[1] * xs[0];
-    s[1][0] += v[2] * xs[1];
-    s[1][1] += v[3] * xs[1];
+    if F {
+        s[0][0] = v[0].mul_add(xs[0], s[0][0]);
+        s[0][1] = v[1].mul_add(xs[0], s[0][1]);
+        s[1][0] = v[2].mul_add(xs[1], s[1][0]);
+        s[1][1] = v[3].mul_add(xs[1], s[1][1]);
+    } else {
+        s[0][0] += v[0] * xs[0];
+        s[0][1] += v[1] * xs[0];
+        s[1][0] += v[2] * xs[1];
+        s[1][1] += v[3] * xs[1];
+    }
 }
 
 /// The 4-wide sums of two units of consecutive node pairs.
@@ -368,13 +435,14 @@ mod avx {
     /// other column's, added at the end: per row the scalar kernel's two
     /// partial sums (`split_block`: first and second columns' terms) in
     /// the same order, and a + b = b + a, so the same bits.
-    /// Multiplications and additions separate (no fused multiply-add).
-    /// Call only where [`available`] said yes (`Stencils::unit_of` is
-    /// empty otherwise), and with `wide` (8 doubles a register: AVX-512)
-    /// only where [`available_512`] did.
+    /// Each term by a fused multiply-add with `F` (the scalar kernel's
+    /// then), else a product and a sum. Call only where [`available`]
+    /// said yes (`Stencils::unit_of` is empty otherwise), with `wide` (8
+    /// doubles a register: AVX-512) only where [`available_512`] did, and
+    /// with `F` only where the CPU has FMA.
     #[inline(always)]
     #[allow(unsafe_code)]
-    pub fn units(
+    pub fn units<const F: bool>(
         wide: bool,
         offsets: &[i32],
         values: &[[[f64; 4]; 2]],
@@ -386,11 +454,12 @@ mod avx {
         {
             // SAFETY: units exist only where `available()` said yes
             // (`Stencils::build_units`), `wide` only where
-            // `available_512()` did.
-            if wide {
-                unsafe { units_avx512(offsets, values, r, x, out) }
-            } else {
-                unsafe { units_avx(offsets, values, r, x, out) }
+            // `available_512()` did, `F` only where the CPU has FMA.
+            match (wide, F) {
+                (true, true) => unsafe { units_avx512_fma(offsets, values, r, x, out) },
+                (true, false) => unsafe { units_avx512(offsets, values, r, x, out) },
+                (false, true) => unsafe { units_avx_fma(offsets, values, r, x, out) },
+                (false, false) => unsafe { units_avx(offsets, values, r, x, out) },
             }
         }
         #[cfg(not(target_arch = "x86_64"))]
@@ -400,12 +469,98 @@ mod avx {
         }
     }
 
-    /// [`units`] 8 wide: the 8 rows of two units in one register each for
-    /// the diagonal and the other terms, two such groups in lockstep.
+    /// [`units`] 8 wide with fused multiply-adds ([`body_512`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,fma")]
+    #[allow(unsafe_code)]
+    fn units_avx512_fma(o: &[i32], v: &[[[f64; 4]; 2]], r: usize, x: &[f64], out: &mut [f64]) {
+        // SAFETY: this function's features are the body's.
+        unsafe { body_512::<true>(o, v, r, x, out) }
+    }
+
+    /// [`units`] 8 wide, products and sums ([`body_512`]).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f")]
     #[allow(unsafe_code)]
-    fn units_avx512(
+    fn units_avx512(o: &[i32], v: &[[[f64; 4]; 2]], r: usize, x: &[f64], out: &mut [f64]) {
+        // SAFETY: this function's features are the body's.
+        unsafe { body_512::<false>(o, v, r, x, out) }
+    }
+
+    /// [`units`] 4 wide with fused multiply-adds ([`body_256`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,fma")]
+    #[allow(unsafe_code)]
+    fn units_avx_fma(o: &[i32], v: &[[[f64; 4]; 2]], r: usize, x: &[f64], out: &mut [f64]) {
+        // SAFETY: this function's features are the body's.
+        unsafe { body_256::<true>(o, v, r, x, out) }
+    }
+
+    /// [`units`] 4 wide, products and sums ([`body_256`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    #[allow(unsafe_code)]
+    fn units_avx(o: &[i32], v: &[[[f64; 4]; 2]], r: usize, x: &[f64], out: &mut [f64]) {
+        // SAFETY: this function's features are the body's.
+        unsafe { body_256::<false>(o, v, r, x, out) }
+    }
+
+    /// acc + a·b, fused with `F`.
+    ///
+    /// # Safety
+    /// The CPU has AVX-512 (and FMA with `F`).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn term_512<const F: bool>(
+        acc: std::arch::x86_64::__m512d,
+        a: std::arch::x86_64::__m512d,
+        b: std::arch::x86_64::__m512d,
+    ) -> std::arch::x86_64::__m512d {
+        use std::arch::x86_64::*;
+        // SAFETY: the caller's.
+        unsafe {
+            if F {
+                _mm512_fmadd_pd(a, b, acc)
+            } else {
+                _mm512_add_pd(acc, _mm512_mul_pd(a, b))
+            }
+        }
+    }
+
+    /// acc + a·b, fused with `F`.
+    ///
+    /// # Safety
+    /// The CPU has AVX (and FMA with `F`).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn term_256<const F: bool>(
+        acc: std::arch::x86_64::__m256d,
+        a: std::arch::x86_64::__m256d,
+        b: std::arch::x86_64::__m256d,
+    ) -> std::arch::x86_64::__m256d {
+        use std::arch::x86_64::*;
+        // SAFETY: the caller's.
+        unsafe {
+            if F {
+                _mm256_fmadd_pd(a, b, acc)
+            } else {
+                _mm256_add_pd(acc, _mm256_mul_pd(a, b))
+            }
+        }
+    }
+
+    /// [`units`] 8 wide: the 8 rows of two units in one register each for
+    /// the diagonal and the other terms, two such groups in lockstep.
+    /// Inlined into the callers above, which give it their features.
+    ///
+    /// # Safety
+    /// The CPU has AVX-512 (and FMA with `F`).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn body_512<const F: bool>(
         offsets: &[i32],
         values: &[[[f64; 4]; 2]],
         r: usize,
@@ -418,10 +573,12 @@ mod avx {
         while j < groups {
             let two = j + 2 <= groups;
             let (r0, r1) = ((r + 8 * j) as isize, (r + 8 * j + 8) as isize);
-            let mut d = [_mm512_setzero_pd(); 2];
-            let mut o = [_mm512_setzero_pd(); 2];
+            // SAFETY (every block below): the caller's features; v and xs
+            // hold 8 doubles (unaligned loads), out 8 (16 with `two`)
+            // from 8 j.
+            let mut d = [unsafe { _mm512_setzero_pd() }; 2];
+            let mut o = d;
             for (&off, v) in offsets.iter().zip(values) {
-                // SAFETY: v holds 8 doubles; unaligned loads.
                 let (vd, vo) = unsafe {
                     (
                         _mm512_broadcast_f64x4(_mm256_loadu_pd(v[0].as_ptr())),
@@ -434,14 +591,14 @@ mod avx {
                     }
                     let c = (rh + off as isize) as usize;
                     let xs: &[f64; 8] = x[c..c + 8].try_into().expect("8 columns");
-                    // SAFETY: xs holds 8 doubles; unaligned load.
-                    let xv = unsafe { _mm512_loadu_pd(xs.as_ptr()) };
-                    d[h] = _mm512_add_pd(d[h], _mm512_mul_pd(vd, xv));
-                    let swapped = _mm512_permute_pd::<0b0101_0101>(xv);
-                    o[h] = _mm512_add_pd(o[h], _mm512_mul_pd(vo, swapped));
+                    unsafe {
+                        let xv = _mm512_loadu_pd(xs.as_ptr());
+                        d[h] = term_512::<F>(d[h], vd, xv);
+                        let swapped = _mm512_permute_pd::<0b0101_0101>(xv);
+                        o[h] = term_512::<F>(o[h], vo, swapped);
+                    }
                 }
             }
-            // SAFETY: out holds 8 (16 with `two`) doubles from 8 j.
             unsafe {
                 _mm512_storeu_pd(out.as_mut_ptr().add(8 * j), _mm512_add_pd(d[0], o[0]));
                 if two {
@@ -452,37 +609,48 @@ mod avx {
         }
     }
 
-    /// [`units`]: a unit's four rows in one 4-wide register each for the
+    /// [`units`] 4 wide: a unit's four rows in one register each for the
     /// diagonal and the other terms, x[c..c + 4] in one load and its pairs
-    /// swapped in one shuffle.
+    /// swapped in one shuffle. Inlined into the callers above.
+    ///
+    /// # Safety
+    /// The CPU has AVX (and FMA with `F`).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
+    #[inline(always)]
     #[allow(unsafe_code)]
-    fn units_avx(offsets: &[i32], values: &[[[f64; 4]; 2]], r: usize, x: &[f64], out: &mut [f64]) {
+    unsafe fn body_256<const F: bool>(
+        offsets: &[i32],
+        values: &[[[f64; 4]; 2]],
+        r: usize,
+        x: &[f64],
+        out: &mut [f64],
+    ) {
         use std::arch::x86_64::*;
         for (j, out) in out.chunks_exact_mut(8).enumerate() {
             let rj = (r + 8 * j) as isize;
-            let mut d = [_mm256_setzero_pd(); 2];
-            let mut o = [_mm256_setzero_pd(); 2];
+            // SAFETY (every block below): the caller's features; xs and v
+            // hold 8 doubles each (unaligned loads), out 8.
+            let mut d = [unsafe { _mm256_setzero_pd() }; 2];
+            let mut o = d;
             for (&off, v) in offsets.iter().zip(values) {
                 let c = (rj + off as isize) as usize;
                 let xs: &[f64; 8] = x[c..c + 8].try_into().expect("8 columns");
-                // SAFETY: xs and v hold 8 doubles each; unaligned loads.
-                let (xa, xb, vd, vo) = unsafe {
-                    (
+                unsafe {
+                    let (xa, xb) = (
                         _mm256_loadu_pd(xs.as_ptr()),
                         _mm256_loadu_pd(xs.as_ptr().add(4)),
+                    );
+                    let (vd, vo) = (
                         _mm256_loadu_pd(v[0].as_ptr()),
                         _mm256_loadu_pd(v[1].as_ptr()),
-                    )
-                };
-                for (h, xh) in [xa, xb].into_iter().enumerate() {
-                    d[h] = _mm256_add_pd(d[h], _mm256_mul_pd(vd, xh));
-                    let swapped = _mm256_permute_pd::<0b0101>(xh);
-                    o[h] = _mm256_add_pd(o[h], _mm256_mul_pd(vo, swapped));
+                    );
+                    for (h, xh) in [xa, xb].into_iter().enumerate() {
+                        d[h] = term_256::<F>(d[h], vd, xh);
+                        let swapped = _mm256_permute_pd::<0b0101>(xh);
+                        o[h] = term_256::<F>(o[h], vo, swapped);
+                    }
                 }
             }
-            // SAFETY: out holds 8 doubles.
             unsafe {
                 _mm256_storeu_pd(out.as_mut_ptr(), _mm256_add_pd(d[0], o[0]));
                 _mm256_storeu_pd(out.as_mut_ptr().add(4), _mm256_add_pd(d[1], o[1]));
@@ -500,7 +668,7 @@ impl RowProduct for Stencils {
 
     fn row(&self, i: usize, x: &[f64]) -> f64 {
         let g = self.group_rows.partition_point(|&r| r as usize <= i) - 1;
-        let s = self.group_sums(g, x);
+        let s = self.sums_of(g, x);
         if i == self.group_rows[g] as usize {
             s[0]
         } else {
@@ -620,13 +788,24 @@ mod tests {
                 // sums in `check`).
                 assert!(!avx::available() || s.unit_of.iter().any(|&u| u != NO_UNIT));
                 check(k, &s, name);
-                // The 4-wide sums too where the CPU would take 8.
+                // The 4-wide sums too where the CPU would take 8, and
+                // products and sums where it would fuse them.
                 if s.avx512 {
                     let narrow = Stencils {
                         avx512: false,
                         ..s.clone()
                     };
                     check(k, &narrow, &format!("{name}, 4 wide"));
+                }
+                if s.fma {
+                    for avx512 in [s.avx512, false] {
+                        let unfused = Stencils {
+                            avx512,
+                            fma: false,
+                            ..s.clone()
+                        };
+                        check(k, &unfused, &format!("{name}, unfused, AVX-512 {avx512}"));
+                    }
                 }
                 let exact = Stencils::build(k, 0.0, usize::MAX).unwrap();
                 assert!(exact.types() > s.types(), "{name}");
@@ -635,7 +814,11 @@ mod tests {
                 kernels::row_groups(k, |r0, r1, cols, vals| {
                     let mut s = [[0.0; 2]; 2];
                     for (&c, v) in cols.iter().zip(vals) {
-                        split_block(c as usize, v, &x, &mut s);
+                        if exact.fma {
+                            split_block::<true>(c as usize, v, &x, &mut s);
+                        } else {
+                            split_block::<false>(c as usize, v, &x, &mut s);
+                        }
                     }
                     for (k, y) in y0[r0..r1].iter_mut().enumerate() {
                         *y = s[0][k] + s[1][k];
@@ -657,6 +840,60 @@ mod tests {
             let mesh = Mesh::from_file(dir.join(name)).unwrap();
             let model = slab_model(&mesh, "support");
             assert!(Stencils::new(&model.stiffness).is_none(), "{name}");
+        }
+    }
+}
+
+/// K·x by stencil types, fused multiply-adds against products and sums,
+/// on the bench's 1M-DOF slabs, alternating in one process (the host's
+/// other work falls on both alike):
+///
+///     cargo test --release -p stickslip-time --lib kx_lab -- --ignored --nocapture
+#[cfg(test)]
+mod lab {
+    use super::*;
+    use crate::kernels::tests::x_of;
+    use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
+
+    #[test]
+    #[ignore = "a measurement: prints times, asserts nothing"]
+    fn kx_lab() {
+        for (nx, ny, q2) in [(1416, 354, false), (708, 177, true)] {
+            let mesh = crate::scenes::structured_slab(nx, ny, q2);
+            let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+            let supports = [
+                Dirichlet::new("support", 1, 0.0),
+                Dirichlet::new("left", 0, 0.0),
+            ];
+            let model = Model::new(&mesh, &material, &supports).unwrap();
+            let fused = Stencils::new(&model.stiffness).unwrap();
+            let unfused = Stencils {
+                fma: false,
+                ..fused.clone()
+            };
+            let x = x_of(model.stiffness.nrows());
+            let mut y = vec![0.0; x.len()];
+            let mut times = [Vec::new(), Vec::new()];
+            for round in 0..400 {
+                let s = [&unfused, &fused][round % 2];
+                let t = std::time::Instant::now();
+                s.spmv(&x, &mut y);
+                times[round % 2].push(t.elapsed().as_secs_f64());
+            }
+            let median = |t: &mut Vec<f64>| {
+                t.sort_by(f64::total_cmp);
+                t[t.len() / 2]
+            };
+            let [a, b] = times.each_mut().map(median);
+            eprintln!(
+                "kx_lab {} {nx}x{ny} ({} DOFs, fma {}): K·x unfused {:.3} ms, fused {:.3} ms, ratio {:.3}",
+                if q2 { "Q2" } else { "Q1" },
+                x.len(),
+                fused.fma,
+                a * 1e3,
+                b * 1e3,
+                b / a
+            );
         }
     }
 }
