@@ -16,10 +16,22 @@ initial state of Remark 4.1 and stickslip's state after `check_steps`).
   A careful user cannot refactorize per stuck set and keep `splu` once per
   Δt, so the Woodbury/Schur form is the scipy way to the same iteration.
 
+K, M and the lumped mass are the peer's own: scikit-fem assembles them on
+the dumped mesh (`ElementQuad1`/`ElementQuad2`, 2×2 and 3×3 Gauss points as
+stickslip's, plane-strain Lamé parameters), its DOFs are matched to
+stickslip's free DOFs by their locations, and each matrix must agree with
+stickslip's to 1e-10 of its largest entry before it is used (else exit 1;
+`peer_k_check`, `peer_m_check`). The lumped mass is HRZ's (the diagonal of
+the consistent mass scaled to the total mass), which on the bench's meshes
+of identical rectangular cells is the global diagonal scaled per
+component. The loads, the contact nodes and the initial state are read
+from the dump.
+
 Before timing, the state after `check_steps` steps is compared with
 stickslip's (max |Δ| / max |ours|, must be ≤ 1e-8, else exit 1). Prints
 `PEER peer_step=… peer_check=… check_steps=… check_slipping=ours/peer
-peer_setup=… peer_rss=…` (the most nodes slipping at once during the check
+peer_setup=… peer_rss=… peer_k_check=… peer_m_check=… peer_lumped_check=…
+peer_assembly=…` (peer_setup includes the assembly). (the most nodes slipping at once during the check
 steps, so that the friction branches are seen to be exercised).
 
     python3 bench/peer.py DIR [--steps N] [--repeats R]
@@ -51,21 +63,94 @@ def f64(name):
     return np.fromfile(os.path.join(d, name), dtype="<f8")
 
 
-indptr = np.fromfile(os.path.join(d, "indptr.i64"), dtype="<i8")
-indices = np.fromfile(os.path.join(d, "indices.i64"), dtype="<i8")
-# scipy picks int32 indices when they fit, as a user's matrix would have.
-K = sp.csr_matrix((f64("k.f64"), indices, indptr), shape=(n, n))
-K = sp.csr_matrix(K)
-K.sort_indices()
-del indices
-mass = f64("lumped.f64")
+def i64(name):
+    return np.fromfile(os.path.join(d, name), dtype="<i8")
+
+
+def ours(name):
+    """stickslip's matrix on K's pattern (values from `name`)."""
+    a = sp.csr_matrix((f64(name), i64("indices.i64"), i64("indptr.i64")), shape=(n, n))
+    a.sort_indices()
+    return a
+
+
+def assemble():
+    """K, M and the lumped mass by scikit-fem, in stickslip's free-DOF order."""
+    import skfem
+    from scipy.spatial import cKDTree
+    from skfem import (Basis, BilinearForm, ElementQuad1, ElementQuad2, ElementVector, MeshQuad,
+                       MeshQuad2, asm)
+    from skfem.helpers import dot
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    info = json.load(open(os.path.join(d, "mesh.json")))
+    assert info["plane"] == "strain"
+    nodes = f64("nodes.f64").reshape(-1, 2)
+    corners = i64("cells.i64").reshape(-1, 4)
+    free = i64("free.i64")
+    used, local = np.unique(corners, return_inverse=True)
+    mesh = MeshQuad(np.ascontiguousarray(nodes[used].T), np.ascontiguousarray(local.reshape(-1, 4).T))
+    q2 = info["order"] == 2
+    if q2:
+        mesh = MeshQuad2.from_mesh(mesh)
+    basis = Basis(mesh, ElementVector(ElementQuad2() if q2 else ElementQuad1()), intorder=4 if q2 else 2)
+    lam, mu = lame_parameters(info["young"], info["poisson"])  # plane strain
+    rho = info["density"]
+    Kf = asm(linear_elasticity(lam, mu), basis).tocsr()
+    Mf = asm(BilinearForm(lambda u, v, w: rho * dot(u, v)), basis).tocsr()
+    # Each of scikit-fem's DOFs is stickslip's DOF 2·node + component of
+    # the node at its location.
+    extent = np.ptp(nodes, axis=0).max()
+    tree = cKDTree(nodes)
+    full = np.empty(basis.N, dtype=np.int64)
+    lumped_full = np.empty(basis.N)
+    diag = Mf.diagonal()
+    for c, idx in enumerate(basis.split_indices()):
+        dist, node = tree.query(basis.doflocs[:, idx].T)
+        if dist.max() > 1e-9 * extent:
+            sys.exit(f"peer: a scikit-fem DOF is {dist.max():.2e} from every node")
+        full[idx] = 2 * node + c
+        one = np.zeros(basis.N)
+        one[idx] = 1.0
+        lumped_full[idx] = diag[idx] * ((one @ (Mf @ one)) / diag[idx].sum())
+    fr = free[full]
+    keep = np.nonzero(fr >= 0)[0]
+    if len(keep) != n or len(np.unique(fr[keep])) != n:
+        sys.exit("peer: scikit-fem's DOFs do not match stickslip's free DOFs one to one")
+    order = np.empty(n, dtype=np.int64)
+    order[fr[keep]] = keep
+    # scipy picks int32 indices when they fit, as a user's matrix would have.
+    K = sp.csr_matrix(Kf[order][:, order])
+    M = sp.csr_matrix(Mf[order][:, order])
+    K.sort_indices()
+    M.sort_indices()
+    return K, M, lumped_full[order]
+
+
+def agree(a, b):
+    """max |a − b| / max |b| (0 when equal)."""
+    d = (a - b) if sp.issparse(a) else sp.csr_matrix(a - b)
+    return abs(d).max() / abs(b).max()
+
+
+t_asm = time.perf_counter()
+K, M, mass = assemble()
+t_asm = time.perf_counter() - t_asm
+k_check = agree(K, ours("k.f64"))
+m_check = agree(M, ours("m.f64"))
+lumped_check = np.abs(mass - f64("lumped.f64")).max() / np.abs(mass).max()
+if max(k_check, m_check, lumped_check) > 1e-10:
+    sys.exit(f"peer: scikit-fem's K, M, lumped M differ from stickslip's by {k_check:.2e}, "
+             f"{m_check:.2e}, {lumped_check:.2e} (> 1e-10 of the largest entry)")
+if meta["scheme"] != "newmark":
+    del M
 constant = f64("constant.f64")
 loads = [f64(f"load{l}.f64") for l in range(len(meta["histories"]))]
 histories = meta["histories"]
 r, v, a = f64("r0.f64"), f64("v0.f64"), f64("a0.f64")
 r_check, v_check = f64("r_check.f64"), f64("v_check.f64")
 dt, beta, gamma, eps = meta["dt"], meta["beta"], meta["gamma"], meta["eps"]
-assert len(mass) == n and K.nnz == nnz
+assert len(mass) == n
 
 # Contact nodes: free DOFs (−1 = fixed), tangent, w·g.
 dx = np.array(meta["contact_dof_x"], dtype=np.int64)
@@ -145,7 +230,6 @@ def cd_step(s):
 
 
 if meta["scheme"] == "newmark":
-    M = sp.csr_matrix((f64("m.f64"), K.indices, K.indptr), shape=(n, n))
     A0 = ((beta / gamma) * dt) * K + (1.0 / (gamma * dt)) * M
     lu = spla.splu(A0.tocsc())
     # Pᵀ: column J is τ_J on node J's free DOFs; S = P A₀⁻¹ Pᵀ (symmetrized).
@@ -248,5 +332,7 @@ rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024.0
 print(
     f"PEER peer_step={times[len(times) // 2]:.4e} peer_check={check:.3e} "
     f"check_steps={meta['check_steps']} check_slipping={ours_slipping}/{most} "
-    f"peer_setup={setup:.3e} peer_steps={args.steps} peer_rss={rss:.0f}"
+    f"peer_setup={setup:.3e} peer_steps={args.steps} peer_rss={rss:.0f} "
+    f"peer_k_check={k_check:.1e} peer_m_check={m_check:.1e} peer_lumped_check={lumped_check:.1e} "
+    f"peer_assembly={t_asm:.3e}"
 )

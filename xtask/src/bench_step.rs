@@ -2,9 +2,10 @@
 //! implicit Newmark (Schur path) on the slab ladder (issue 7, deliverable
 //! 3), with the figures it is compared with measured in the same run: STREAM
 //! triad bandwidth and the bytes an explicit step moves; one forward+back
-//! solve for Newmark; the scipy peer (bench/peer.py, numpy + scipy,
-//! installed with pip if missing) on the paper's 85-node mesh and the rungs
-//! of ≥ 100k DOFs, checked against our state (1e-8) before it is timed;
+//! solve for Newmark; the scipy peer (bench/peer.py, numpy + scipy, its K
+//! and M assembled by scikit-fem, installed with pip if missing) on the
+//! paper's 85-node mesh and the rungs of ≥ 100k DOFs, its matrices checked
+//! against ours (1e-10) and its state against ours (1e-8) before it is timed;
 //! peak memory against what the run must hold.
 //!
 //! Runs `crates/time/examples/bench_step.rs` in the release profile (what
@@ -51,7 +52,11 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         }
     }
     if peer {
-        python::ensure_python_modules(&[("numpy", "numpy"), ("scipy", "scipy")])?;
+        python::ensure_python_modules(&[
+            ("numpy", "numpy"),
+            ("scipy", "scipy"),
+            ("skfem", "scikit-fem"),
+        ])?;
         pass.push("--peer".into());
     }
     gmsh_slab(root);

@@ -4,8 +4,9 @@
 //! forward+back solve with the factor of A₀; the scipy peer (bench/peer.py,
 //! `--peer`) on the paper's 85-node mesh and the generated rungs of ≥ 100k
 //! DOFs, which reads the problem this process dumps (target/bench/peer/),
-//! checks its state after a few steps against ours (≤ 1e-8) and times its
-//! own steps; peak memory: VmHWM of the whole process (`peak_rss`) and of
+//! assembles K and M on the dumped mesh with scikit-fem and checks them
+//! against ours (≤ 1e-10), checks its state after a few steps against ours
+//! (≤ 1e-8) and times its own steps; peak memory: VmHWM of the whole process (`peak_rss`) and of
 //! the run after setup (`peak_run`, VmHWM reset through clear_refs), each
 //! over what the run must hold (`matrix_bytes` + `factor_bytes` +
 //! `vector_bytes`).
@@ -212,6 +213,39 @@ fn dump_problem(
     std::fs::write(dir.join("meta.json"), json).unwrap();
 }
 
+/// Writes the mesh for bench/peer.py's own assembly (scikit-fem): node
+/// coordinates (x, y per node), each cell's four corners (counter-clockwise;
+/// a Q2 cell's other nodes are its edges' midpoints and its centre), our
+/// free DOF of each full DOF 2·node + component (−1: fixed), and the
+/// element order and material (mesh.json).
+fn dump_mesh(dir: &std::path::Path, mesh: &Mesh, model: &Model) {
+    std::fs::create_dir_all(dir).unwrap();
+    write_f64(
+        &dir.join("nodes.f64"),
+        &mesh.nodes.iter().flatten().copied().collect::<Vec<_>>(),
+    );
+    let per = mesh.kind.nodes_per_cell();
+    let corners: Vec<usize> = mesh
+        .cells
+        .chunks(per)
+        .flat_map(|c| c[..4].to_vec())
+        .collect();
+    write_i64(&dir.join("cells.i64"), &corners);
+    let free =
+        (0..model.dofs.n_full()).map(|d| model.dofs.free_of_full(d).map_or(-1, |f| f as i64));
+    write_le(&dir.join("free.i64"), free.map(i64::to_le_bytes));
+    let m = slab_material();
+    let order = if per == 9 { 2 } else { 1 };
+    std::fs::write(
+        dir.join("mesh.json"),
+        format!(
+            "{{\"order\": {order}, \"young\": {:e}, \"poisson\": {:e}, \"density\": {:e}, \"plane\": \"strain\"}}\n",
+            m.youngs_modulus, m.poisson_ratio, m.density
+        ),
+    )
+    .unwrap();
+}
+
 /// STREAM triad a = b + s c, bytes per second (3 × 8 bytes per entry, the
 /// STREAM convention), best of 10, on the rayon pool.
 fn stream_triad() -> f64 {
@@ -255,6 +289,9 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     } else {
         None
     };
+    if let Some(dir) = &dump {
+        dump_mesh(dir, &mesh, &model);
+    }
     drop(mesh);
     let n = model.dofs.n_free();
     let nnz = model.stiffness.nnz();
