@@ -3236,7 +3236,13 @@ pub(crate) mod tests {
     /// explicit step of the Q2 1M slab, with and without alternating in
     /// one process, medians of 59 blocks of 10 steps): m, ṙ, r̈ 64 or 128
     /// rows ahead 0.7% and 2.6% slower, with the three outputs (prefetchw)
-    /// 128, 256 and 512 rows ahead 0.5%, 1.6% and 2.2% slower.
+    /// 128, 256 and 512 rows ahead 0.5%, 1.6% and 2.2% slower. Sweeping
+    /// each batch in pieces between the next batch's 16-row stencil sums
+    /// (so that the core would hold both in flight), the same bits, this
+    /// lab alternating both, 22:45: 16-row pieces 2.73 / 3.43 ms against
+    /// 2.07 / 2.79 (Q1 / Q2), 32 rows 2.56 / 3.17 against 2.24 / 2.89,
+    /// the whole batch one batch late 2.28 / 3.21 against 2.11 / 3.13:
+    /// the calls cost more than any overlap gained.
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn sweep_lab() {
