@@ -92,14 +92,7 @@ fn grid_order_takes_gmsh_rounding_and_declines_meshes_that_are_no_grid() {
     let keep = std::env::var("STICKSLIP_DOF_ORDER").as_deref() == Ok("mesh");
     for file in ["hole-q1.msh", "hole-q2.msh", "slab-unstructured-q1.msh"] {
         let mesh = committed(file);
-        let group = mesh
-            .groups
-            .iter()
-            .find(|g| g.dim == 1)
-            .unwrap()
-            .name
-            .clone();
-        let d = DofMap::new(&mesh, &[Dirichlet::new(group, 0, 0.0)]).unwrap();
+        let d = edge_fixed(&mesh);
         let expected = if keep {
             NodeOrder::Mesh
         } else {
@@ -108,6 +101,12 @@ fn grid_order_takes_gmsh_rounding_and_declines_meshes_that_are_no_grid() {
         assert_eq!(d.node_order(), expected, "{file}");
         assert!(d.renumbered(&mesh, NodeOrder::Grid).is_none(), "{file}");
     }
+}
+
+/// The DOF map of `mesh` with u_x fixed on its first boundary group.
+fn edge_fixed(mesh: &Mesh) -> DofMap {
+    let group = mesh.groups.iter().find(|g| g.dim == 1).unwrap();
+    DofMap::new(mesh, &[Dirichlet::new(group.name.clone(), 0, 0.0)]).unwrap()
 }
 
 /// Largest |i − j| over the free DOFs of nodes that share a cell.
@@ -136,14 +135,7 @@ fn reverse_cuthill_mckee_narrows_gmsh_unstructured_meshes() {
         "slab-unstructured-q2.msh",
     ] {
         let mesh = committed(file);
-        let group = mesh
-            .groups
-            .iter()
-            .find(|g| g.dim == 1)
-            .unwrap()
-            .name
-            .clone();
-        let d = DofMap::new(&mesh, &[Dirichlet::new(group, 0, 0.0)]).unwrap();
+        let d = edge_fixed(&mesh);
         let (m, b) = (
             d.renumbered(&mesh, NodeOrder::Mesh).unwrap(),
             d.renumbered(&mesh, NodeOrder::Bandwidth).unwrap(),
