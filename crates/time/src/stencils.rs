@@ -897,3 +897,222 @@ mod lab {
         }
     }
 }
+
+/// Lab (timing; not the step's sums, and no load or friction rows): the
+/// sweep's per-row work done inside the 8-wide unit kernel, on the 8 rows
+/// whose K·x is still in a register, so that their vectors' loads and
+/// stores issue while the next rows' sums run; against the sweep as it is
+/// (K·x of a 64-row batch into L1, then the batch's rows), alternating in
+/// one process, 1M DOFs, 2 threads, medians of 30:
+///
+///     cargo test --release -p stickslip-time --lib fused_lab -- --ignored --nocapture
+///
+/// 2026-11-24 23:26, two runs: Q1 2.09 → 1.67 and 2.18 → 1.76 ms, Q2 2.75
+/// → 2.34 and 2.98 → 2.59 ms, ṙ_K the same bits. The next step for the
+/// explicit step's bandwidth (README, "Where we stand"): this in the
+/// sweep, with the load and friction rows and the position-keyed strain
+/// and kinetic sums of `kernels::batch_rows` (the same bits).
+#[cfg(all(test, target_arch = "x86_64"))]
+mod fused_lab {
+    use super::*;
+    use crate::kernels::tests::{lab_slab, x_of};
+    use crate::kernels::{StepData, CHUNK};
+    use rayon::prelude::*;
+    use std::arch::x86_64::*;
+
+    struct Out<'a> {
+        vn: &'a mut [f64],
+        an: &'a mut [f64],
+        rx: &'a mut [f64],
+    }
+
+    #[target_feature(enable = "avx512f,fma")]
+    #[allow(unsafe_code)]
+    #[allow(clippy::too_many_arguments)]
+    fn fused_units(
+        offsets: &[i32],
+        values: &[[[f64; 4]; 2]],
+        r: usize,
+        base: usize,
+        rows: usize,
+        s: &StepData,
+        out: &mut Out,
+        acc: &mut [__m512d; 2],
+    ) {
+        let x = s.r_new;
+        let (cv, ca, scale, ratio) = (
+            _mm512_set1_pd(s.cv),
+            _mm512_set1_pd(s.ca),
+            _mm512_set1_pd(s.scale),
+            _mm512_set1_pd(s.ratio),
+        );
+        let (c1, c2) = (_mm512_set1_pd(s.next.0), _mm512_set1_pd(s.next.1));
+        let mut j = 0;
+        while j < rows / 8 {
+            let r0 = (r + 8 * j) as isize;
+            let mut d = _mm512_setzero_pd();
+            let mut o = _mm512_setzero_pd();
+            for (&off, v) in offsets.iter().zip(values) {
+                unsafe {
+                    let vd = _mm512_broadcast_f64x4(_mm256_loadu_pd(v[0].as_ptr()));
+                    let vo = _mm512_broadcast_f64x4(_mm256_loadu_pd(v[1].as_ptr()));
+                    let c = (r0 + off as isize) as usize;
+                    let xv = _mm512_loadu_pd(x[c..c + 8].as_ptr());
+                    d = _mm512_fmadd_pd(vd, xv, d);
+                    o = _mm512_fmadd_pd(vo, _mm512_permute_pd::<0b0101_0101>(xv), o);
+                }
+            }
+            let ku = _mm512_add_pd(d, o);
+            let i = r0 as usize;
+            let k = i - base;
+            unsafe {
+                let m = _mm512_loadu_pd(s.mass[i..i + 8].as_ptr());
+                let v = _mm512_loadu_pd(s.v[i..i + 8].as_ptr());
+                let a = _mm512_loadu_pd(s.a[i..i + 8].as_ptr());
+                let rn = _mm512_loadu_pd(x[i..i + 8].as_ptr());
+                let b = _mm512_add_pd(
+                    _mm512_sub_pd(_mm512_setzero_pd(), ku),
+                    _mm512_mul_pd(m, _mm512_add_pd(_mm512_mul_pd(cv, v), _mm512_mul_pd(ca, a))),
+                );
+                let vn = _mm512_div_pd(b, _mm512_mul_pd(m, scale));
+                let an = _mm512_sub_pd(
+                    _mm512_mul_pd(_mm512_sub_pd(vn, v), scale),
+                    _mm512_mul_pd(ratio, a),
+                );
+                let rx = _mm512_add_pd(
+                    _mm512_add_pd(rn, _mm512_mul_pd(c1, vn)),
+                    _mm512_mul_pd(c2, an),
+                );
+                _mm512_storeu_pd(out.vn[k..k + 8].as_mut_ptr(), vn);
+                _mm512_storeu_pd(out.an[k..k + 8].as_mut_ptr(), an);
+                _mm512_storeu_pd(out.rx[k..k + 8].as_mut_ptr(), rx);
+                acc[0] = _mm512_add_pd(acc[0], _mm512_mul_pd(rn, ku));
+                acc[1] = _mm512_add_pd(acc[1], _mm512_mul_pd(m, _mm512_mul_pd(vn, vn)));
+            }
+            j += 1;
+        }
+    }
+
+    /// Scalar sweep of one row given its K·x (for the groups outside units).
+    fn row_sweep(s: &StepData, i: usize, ku: f64, k: usize, out: &mut Out, sums: &mut [f64; 2]) {
+        let (m, v, a, rn) = (s.mass[i], s.v[i], s.a[i], s.r_new[i]);
+        let b = 0.0 - ku + m * (s.cv * v + s.ca * a);
+        let vn = b / (m * s.scale);
+        let an = (vn - v) * s.scale - s.ratio * a;
+        out.vn[k] = vn;
+        out.an[k] = an;
+        out.rx[k] = rn + s.next.0 * vn + s.next.1 * an;
+        sums[0] += rn * ku;
+        sums[1] += m * vn * vn;
+    }
+
+    #[allow(unsafe_code)]
+    fn fused_chunk(st: &Stencils, c: usize, s: &StepData, out: &mut Out) -> [f64; 2] {
+        let (g0, g1) = (st.chunk_groups[c] as usize, st.chunk_groups[c + 1] as usize);
+        let base = c * CHUNK;
+        let n = s.r_new.len();
+        let mut acc = [unsafe { _mm512_setzero_pd() }; 2];
+        let mut sums = [0.0; 2];
+        let mut g = g0;
+        while g < g1 {
+            if let Some(b) = st.unit_run(g, g1, n) {
+                let u = st.unit_of[g];
+                let r = st.group_rows[g] as usize;
+                let last = st.unit_offsets[b.end - 1] as isize;
+                let mut count = 1;
+                while st.unit_run_continues(g + 4 * count, g1, u)
+                    && (r + 8 * (count + 1)) as isize + last <= n as isize
+                {
+                    count += 1;
+                }
+                let (o, v) = (&st.unit_offsets[b.clone()], &st.unit_values[b]);
+                unsafe { fused_units(o, v, r, base, 8 * count, s, out, &mut acc) };
+                g += 4 * count;
+            } else {
+                let ks = st.sums_of(g, s.r_new);
+                let (r0, r1) = (st.group_rows[g] as usize, st.group_rows[g + 1] as usize);
+                for (q, i) in (r0..r1).enumerate() {
+                    row_sweep(s, i, ks[q], i - base, out, &mut sums);
+                }
+                g += 1;
+            }
+        }
+        let mut lanes = [[0.0; 8]; 2];
+        unsafe {
+            _mm512_storeu_pd(lanes[0].as_mut_ptr(), acc[0]);
+            _mm512_storeu_pd(lanes[1].as_mut_ptr(), acc[1]);
+        }
+        [
+            sums[0] + lanes[0].iter().sum::<f64>(),
+            sums[1] + lanes[1].iter().sum::<f64>(),
+        ]
+    }
+
+    #[test]
+    #[ignore = "a measurement: prints times"]
+    fn fused_lab() {
+        if !(crate::kernels::avx512() && crate::kernels::fma()) {
+            return;
+        }
+        for name in ["q1-1416x354", "q2-708x177"] {
+            let (_, _, model) = lab_slab(name);
+            let n = model.stiffness.nrows();
+            let st = Stencils::new(&model.stiffness).unwrap();
+            drop(model);
+            let x = x_of(n);
+            let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
+            let (rn, m, v, a) = (w(1.3), w(1.2), w(1.5), w(1.6));
+            let zero = vec![0.0; n];
+            let data = StepData {
+                load_new: &zero,
+                load_rows: &[],
+                mass: &m,
+                r_new: &rn,
+                v: &v,
+                a: &a,
+                cv: 2e3,
+                ca: 1.0,
+                scale: 2e3,
+                ratio: 1.0,
+                next: (1e-3, 0.5e-6),
+            };
+            let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            let (mut vn2, mut an2, mut rx2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            let mut p = crate::kernels::partials(n);
+            let mut t = [Vec::new(), Vec::new()];
+            stickslip_fem::testing::on_threads(2, || {
+                for _ in 0..30 {
+                    let s0 = std::time::Instant::now();
+                    let out = [&mut vn[..], &mut an[..], &mut rx[..]];
+                    crate::kernels::sweep(true, &st, &data, &[], None, out, &mut p);
+                    t[0].push(s0.elapsed().as_secs_f64());
+                    let s0 = std::time::Instant::now();
+                    vn2.par_chunks_mut(CHUNK)
+                        .zip(an2.par_chunks_mut(CHUNK))
+                        .zip(rx2.par_chunks_mut(CHUNK))
+                        .enumerate()
+                        .for_each(|(c, ((vn, an), rx))| {
+                            let mut out = Out { vn, an, rx };
+                            std::hint::black_box(fused_chunk(&st, c, &data, &mut out));
+                        });
+                    t[1].push(s0.elapsed().as_secs_f64());
+                }
+            });
+            let dv = vn
+                .iter()
+                .zip(&vn2)
+                .map(|(p, q)| (p - q).abs())
+                .fold(0.0, f64::max);
+            let vmax = vn.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            for t in &mut t {
+                t.sort_by(f64::total_cmp);
+            }
+            eprintln!(
+                "fused_lab {name}: sweep {:.3} ms, fused in the kernel {:.3} ms (max |Δṙ| / max |ṙ| {:.1e})",
+                t[0][15] * 1e3,
+                t[1][15] * 1e3,
+                dv / vmax
+            );
+        }
+    }
+}
