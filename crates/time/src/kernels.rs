@@ -1326,6 +1326,129 @@ pub trait RowProduct: Sync {
     fn spmv(&self, x: &[f64], y: &mut [f64]);
     /// Bytes one K x streams from the operator's data.
     fn bytes(&self) -> usize;
+    /// The sweep of chunk `c` with K r_K formed row by row in the
+    /// operator's own kernel and handed to `rows` as it is formed, in row
+    /// order; false (nothing done) where the operator has no such kernel.
+    fn sweep_chunk(&self, _c: usize, _rows: &mut SweepRows) -> bool {
+        false
+    }
+}
+
+/// The sweep's per-row work for an operator that forms K r_K itself
+/// ([`RowProduct::sweep_chunk`]): the rows of one chunk, in order.
+pub(crate) struct SweepRows<'a, 'b> {
+    avx: bool,
+    s: &'a StepData<'a>,
+    friction: &'a [(usize, f64)],
+    start: usize,
+    out: [&'b mut [f64]; 3],
+    run: &'b mut Running,
+}
+
+impl SweepRows<'_, '_> {
+    /// x of K x: r_K.
+    pub(crate) fn x(&self) -> &[f64] {
+        self.s.r_new
+    }
+
+    /// Rows r0..r0 + ku.len() given their K r_K ([`batch_rows`]).
+    #[inline(always)]
+    pub(crate) fn rows(&mut self, r0: usize, ku: &[f64]) {
+        let o = r0 - self.start;
+        let [vn, an, rx] = &mut self.out;
+        let out = [&mut vn[o..], &mut an[o..], &mut rx[o..]];
+        batch_rows_on(self.avx, self.s, self.friction, r0, ku, out, self.run);
+    }
+
+    /// Rows i..i + 8 given their K r_K in a register: [`batch_rows`]'s
+    /// operations 8 wide (no fused multiply-add; the strain and kinetic
+    /// sums into the lanes of their rows, in row order), so the same bits;
+    /// through [`SweepRows::rows`] where a load or friction row is among
+    /// them.
+    ///
+    /// # Safety
+    /// The CPU has AVX-512 (foundation) and AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub(crate) unsafe fn eight(&mut self, i: usize, ku: std::arch::x86_64::__m512d) {
+        use std::arch::x86_64::*;
+        let s = self.s;
+        let run = &mut *self.run;
+        let load_here = s.load_new.len() <= CHUNK
+            || (run.load < s.load_rows.len() && s.load_rows[run.load] < i + 8);
+        let friction_here =
+            run.friction < self.friction.len() && self.friction[run.friction].0 < i + 8;
+        if load_here || friction_here {
+            let mut k = [0.0; 8];
+            // SAFETY: k holds 8 doubles.
+            unsafe { _mm512_storeu_pd(k.as_mut_ptr(), ku) };
+            self.rows(i, &k);
+            return;
+        }
+        let o = i - self.start;
+        let [vn_out, an_out, rx_out] = &mut self.out;
+        let (vn_out, an_out, rx_out) = (
+            &mut vn_out[o..o + 8],
+            &mut an_out[o..o + 8],
+            &mut rx_out[o..o + 8],
+        );
+        let (m, v, a, rn) = (
+            &s.mass[i..i + 8],
+            &s.v[i..i + 8],
+            &s.a[i..i + 8],
+            &s.r_new[i..i + 8],
+        );
+        // SAFETY: the caller's features; every slice above holds 8 doubles.
+        unsafe {
+            let set = _mm512_set1_pd;
+            let (m, v, a, rn) = (
+                _mm512_loadu_pd(m.as_ptr()),
+                _mm512_loadu_pd(v.as_ptr()),
+                _mm512_loadu_pd(a.as_ptr()),
+                _mm512_loadu_pd(rn.as_ptr()),
+            );
+            // bi = 0 − ku + m (cv ṙ + ca r̈); ṙ_K = bi / (m scale).
+            let bi = _mm512_add_pd(
+                _mm512_sub_pd(_mm512_setzero_pd(), ku),
+                _mm512_mul_pd(
+                    m,
+                    _mm512_add_pd(_mm512_mul_pd(set(s.cv), v), _mm512_mul_pd(set(s.ca), a)),
+                ),
+            );
+            let vn = _mm512_div_pd(bi, _mm512_mul_pd(m, set(s.scale)));
+            let an = _mm512_sub_pd(
+                _mm512_mul_pd(_mm512_sub_pd(vn, v), set(s.scale)),
+                _mm512_mul_pd(set(s.ratio), a),
+            );
+            let rx = _mm512_add_pd(
+                _mm512_add_pd(rn, _mm512_mul_pd(set(s.next.0), vn)),
+                _mm512_mul_pd(set(s.next.1), an),
+            );
+            _mm512_storeu_pd(vn_out.as_mut_ptr(), vn);
+            _mm512_storeu_pd(an_out.as_mut_ptr(), an);
+            _mm512_storeu_pd(rx_out.as_mut_ptr(), rx);
+            let inf = set(f64::INFINITY);
+            let finite = |x: __m512d| _mm512_cmp_pd_mask::<_CMP_LT_OQ>(_mm512_abs_pd(x), inf);
+            run.finite &= (finite(rn) & finite(vn)) == 0xff;
+            // Row i + k into lane (i + k) mod 4, rows in order.
+            let strain = _mm512_mul_pd(rn, ku);
+            let kinetic = _mm512_mul_pd(_mm512_mul_pd(m, vn), vn);
+            for (lanes, t) in [(&mut run.strain, strain), (&mut run.kinetic, kinetic)] {
+                let mut acc = _mm256_loadu_pd(lanes.0.as_ptr());
+                for half in [_mm512_castpd512_pd256(t), _mm512_extractf64x4_pd::<1>(t)] {
+                    let rotated = match i % 4 {
+                        0 => half,
+                        1 => _mm256_permute4x64_pd::<0b10_01_00_11>(half),
+                        2 => _mm256_permute4x64_pd::<0b01_00_11_10>(half),
+                        _ => _mm256_permute4x64_pd::<0b00_11_10_01>(half),
+                    };
+                    acc = _mm256_add_pd(acc, rotated);
+                }
+                _mm256_storeu_pd(lanes.0.as_mut_ptr(), acc);
+            }
+        }
+    }
 }
 
 impl RowProduct for Sliced {
@@ -1422,6 +1545,12 @@ impl RowProduct for Product {
             Product::Classes(k) => RowProduct::bytes(k),
             Product::Stencils(k) => k.bytes(),
             Product::Sliced(k) => k.bytes(),
+        }
+    }
+    fn sweep_chunk(&self, c: usize, rows: &mut SweepRows) -> bool {
+        match self {
+            Product::Stencils(k) => k.sweep_chunk(c, rows),
+            _ => false,
         }
     }
 }
@@ -1748,7 +1877,7 @@ impl Lanes {
 }
 
 /// The sweep's running sums over a chunk ([`Lanes`]).
-struct Running {
+pub(crate) struct Running {
     strain: Lanes,
     kinetic: Lanes,
     finite: bool,
@@ -1895,6 +2024,18 @@ pub(crate) fn avx512() -> bool {
     }
 }
 
+/// Whether this CPU has AVX2.
+pub(crate) fn avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// Whether this CPU has fused multiply-add (FMA3).
 pub(crate) fn fma() -> bool {
     #[cfg(target_arch = "x86_64")]
@@ -2010,6 +2151,17 @@ fn sweep_batches<K: RowProduct>(
     run: &mut Running,
 ) {
     let start = c * CHUNK;
+    let mut rows = SweepRows {
+        avx,
+        s,
+        friction,
+        start,
+        out: [&mut *vn, &mut *an, &mut *rx],
+        run: &mut *run,
+    };
+    if k.sweep_chunk(c, &mut rows) {
+        return;
+    }
     k.chunk_batches(c, s.r_new, |r0, ku| {
         let o = r0 - start;
         let (vn, an, rx) = (&mut vn[o..], &mut an[o..], &mut rx[o..]);

@@ -92,6 +92,9 @@ pub struct Stencils {
     /// multiply-add, on every path (scalar, 4 and 8 wide), so that they
     /// keep giving the same bits ([`Stencils::groups_into`]).
     pub(crate) fma: bool,
+    /// The sweep forms K r_K in its own kernel ([`Stencils::sweep_chunk_512`])
+    /// where the CPU allows; false (tests, labs): by batches.
+    pub(crate) fused_sweep: bool,
 }
 
 /// [`Stencils::unit_of`] of a group that starts no unit.
@@ -188,6 +191,7 @@ impl Stencils {
             avx: avx::available(),
             avx512: avx::available() && avx::available_512(),
             fma: avx::available() && kernels::fma(),
+            fused_sweep: true,
         };
         if stencils.avx {
             stencils.build_units();
@@ -239,6 +243,66 @@ impl Stencils {
         }
         (self.unit_of, self.unit_blocks) = (unit_of, blocks);
         (self.unit_offsets, self.unit_values) = (offsets, values);
+    }
+
+    /// The sweep of chunk `c` with its per-row work on each 8 rows of a
+    /// unit run as soon as their K r_K is in a register
+    /// ([`kernels::SweepRows::eight`]), so that their vectors' loads and
+    /// stores issue while the next rows' sums run, instead of K r_K of a
+    /// 64-row batch into L1 and then the batch's rows: `fused_lab`,
+    /// 2026-11-24, 1M DOFs, Q1 2.09 → 1.67 ms, Q2 2.75 → 2.34 ms. K r_K
+    /// has the bits of [`Stencils::groups_into`] (the same operations per
+    /// row) and the rows the bits of [`kernels::batch_rows`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx2,fma")]
+    #[allow(unsafe_code)]
+    fn sweep_chunk_512(&self, c: usize, rows: &mut kernels::SweepRows) {
+        use std::arch::x86_64::*;
+        let (g0, g1) = (
+            self.chunk_groups[c] as usize,
+            self.chunk_groups[c + 1] as usize,
+        );
+        let n = rows.x().len();
+        let mut g = g0;
+        while g < g1 {
+            if let Some(b) = self.unit_run(g, g1, n) {
+                let u = self.unit_of[g];
+                let r = self.group_rows[g] as usize;
+                let last = self.unit_offsets[b.end - 1] as isize;
+                let mut count = 1;
+                while self.unit_run_continues(g + 4 * count, g1, u)
+                    && (r + 8 * (count + 1)) as isize + last <= n as isize
+                {
+                    count += 1;
+                }
+                let (offsets, values) = (&self.unit_offsets[b.clone()], &self.unit_values[b]);
+                for j in 0..count {
+                    let rj = (r + 8 * j) as isize;
+                    let x = rows.x();
+                    let (mut d, mut o) = (_mm512_setzero_pd(), _mm512_setzero_pd());
+                    for (&off, v) in offsets.iter().zip(values) {
+                        let c = (rj + off as isize) as usize;
+                        let xs: &[f64; 8] = x[c..c + 8].try_into().expect("8 columns");
+                        // SAFETY: v and xs hold 8 doubles; unaligned loads.
+                        unsafe {
+                            let vd = _mm512_broadcast_f64x4(_mm256_loadu_pd(v[0].as_ptr()));
+                            let vo = _mm512_broadcast_f64x4(_mm256_loadu_pd(v[1].as_ptr()));
+                            let xv = _mm512_loadu_pd(xs.as_ptr());
+                            d = _mm512_fmadd_pd(vd, xv, d);
+                            o = _mm512_fmadd_pd(vo, _mm512_permute_pd::<0b0101_0101>(xv), o);
+                        }
+                    }
+                    // SAFETY: this function's features.
+                    unsafe { rows.eight(rj as usize, _mm512_add_pd(d, o)) };
+                }
+                g += 4 * count;
+            } else {
+                let sums = self.group_sums::<true>(g, rows.x());
+                let (r0, r1) = (self.group_rows[g] as usize, self.group_rows[g + 1] as usize);
+                rows.rows(r0, &sums[..r1 - r0]);
+                g += 1;
+            }
+        }
     }
 
     /// Type t's blocks: offsets and values.
@@ -686,6 +750,20 @@ impl RowProduct for Stencils {
         });
     }
 
+    fn sweep_chunk(&self, c: usize, rows: &mut kernels::SweepRows) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if self.fused_sweep && self.avx512 && self.fma && kernels::avx2() {
+            // SAFETY: AVX-512, AVX2 and FMA, as the CPU reported them.
+            #[allow(unsafe_code)]
+            unsafe {
+                self.sweep_chunk_512(c, rows)
+            };
+            return true;
+        }
+        let _ = (c, rows);
+        false
+    }
+
     fn bytes(&self) -> usize {
         4 * (self.group_rows.len() + self.types.len() + self.chunk_groups.len())
             + 4 * (self.type_blocks.len() + self.unit_of.len() + self.unit_blocks.len())
@@ -832,6 +910,116 @@ mod tests {
         }
     }
 
+    /// The sweep with K r_K formed in its own kernel (`sweep_chunk_512`)
+    /// has the bits of the sweep by batches: ṙ_K, r̈_K, the next predictor,
+    /// the strain and kinetic sums and the finiteness flag, with load and
+    /// friction rows (on both sides of chunk seams and inside unit runs),
+    /// on 1 and 2 threads; on slabs numbered row by row and on Gmsh's Q1
+    /// slab, whose nodes with one free DOF shift the rows' lanes.
+    #[test]
+    fn fused_sweep_has_the_bits_of_the_batches() {
+        use crate::kernels::{partials, sweep, StepData, CHUNK};
+        use stickslip_fem::testing::rectangle;
+        use stickslip_mesh::CellKind;
+        let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes");
+        let rect = |kind, nx, ny| rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
+        let meshes = [
+            ("q1 200x50", rect(CellKind::Quad4, 200, 50), "top"),
+            ("q2 64x16", rect(CellKind::Quad9, 64, 16), "top"),
+            (
+                "slab-q1-128x32.msh",
+                Mesh::from_file(dir.join("slab-q1-128x32.msh")).unwrap(),
+                "support",
+            ),
+        ];
+        for (name, mesh, support) in meshes {
+            let model = slab_model(&mesh, support);
+            let k = &model.stiffness;
+            let n = k.nrows();
+            assert!(n > CHUNK, "{name}: several chunks");
+            let fused = Stencils::new(k).unwrap();
+            let ran = fused.fused_sweep && fused.avx512 && fused.fma && kernels::avx2();
+            let batched = Stencils {
+                fused_sweep: false,
+                ..fused.clone()
+            };
+            let x = x_of(n);
+            let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + 0.1 * c).collect() };
+            let (r_new, v, a) = (w(1.0), w(-0.7), w(3.0));
+            let mass: Vec<f64> = x.iter().map(|x| 1.0 + x.abs()).collect();
+            let load_rows: Vec<usize> = (0..n)
+                .filter(|i| i % 61 == 5 || i % CHUNK == 0 || i % CHUNK == CHUNK - 1)
+                .collect();
+            let mut load_new = vec![0.0; n];
+            for &i in &load_rows {
+                load_new[i] = 0.3 + 1e-3 * i as f64;
+            }
+            let friction: Vec<(usize, f64)> = (0..n)
+                .filter(|i| i % 97 == 0 || i % CHUNK == 1 || i % CHUNK == CHUNK - 2)
+                .map(|i| (i, -0.25 * i as f64))
+                .collect();
+            let data = StepData {
+                load_new: &load_new,
+                load_rows: &load_rows,
+                mass: &mass,
+                r_new: &r_new,
+                v: &v,
+                a: &a,
+                cv: 2e3,
+                ca: 1.0,
+                scale: 2e3,
+                ratio: 1.0,
+                next: (1e-3, 0.5e-6),
+            };
+            let run = |s: &Stencils, threads: usize| {
+                let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+                let mut p = partials(n);
+                let (strain, sums) = on_threads(threads, || {
+                    let out = [&mut vn[..], &mut an[..], &mut rx[..]];
+                    sweep(kernels::avx(), s, &data, &friction, None, out, &mut p)
+                });
+                (strain, sums.kinetic, sums.finite, vn, an, rx)
+            };
+            let reference = run(&batched, 1);
+            for threads in [1, 2] {
+                let got = run(&fused, threads);
+                let what = format!("{name}, {threads} threads (fused kernel ran: {ran})");
+                assert_eq!(reference.0.to_bits(), got.0.to_bits(), "{what}: strain");
+                assert_eq!(reference.1.to_bits(), got.1.to_bits(), "{what}: kinetic");
+                assert!(reference.2 && got.2, "{what}: finite");
+                for i in 0..n {
+                    assert_eq!(
+                        reference.3[i].to_bits(),
+                        got.3[i].to_bits(),
+                        "{what}: ṙ {i}"
+                    );
+                    assert_eq!(
+                        reference.4[i].to_bits(),
+                        got.4[i].to_bits(),
+                        "{what}: r̈ {i}"
+                    );
+                    assert_eq!(
+                        reference.5[i].to_bits(),
+                        got.5[i].to_bits(),
+                        "{what}: r {i}"
+                    );
+                }
+            }
+            // A NaN in r_K clears the flag on the fused path too.
+            let mut bad = r_new.clone();
+            bad[n / 2 + 3] = f64::NAN;
+            let data = StepData {
+                r_new: &bad,
+                ..data
+            };
+            let mut p = partials(n);
+            let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            let out = [&mut vn[..], &mut an[..], &mut rx[..]];
+            let (_, sums) = sweep(kernels::avx(), &fused, &data, &friction, None, out, &mut p);
+            assert!(!sums.finite, "{name}: NaN not flagged");
+        }
+    }
+
     /// Unstructured meshes: nearly every group its own stencil, declined.
     #[test]
     fn stencils_decline_unstructured_meshes() {
@@ -898,167 +1086,29 @@ mod lab {
     }
 }
 
-/// Lab (timing; not the step's sums, and no load or friction rows): the
-/// sweep's per-row work done inside the 8-wide unit kernel, on the 8 rows
-/// whose K·x is still in a register, so that their vectors' loads and
-/// stores issue while the next rows' sums run; against the sweep as it is
-/// (K·x of a 64-row batch into L1, then the batch's rows), alternating in
-/// one process, 1M DOFs, 2 threads, medians of 30:
+/// The sweep with K r_K formed in its own kernel
+/// ([`Stencils::sweep_chunk_512`]) against the sweep by 64-row batches,
+/// alternating in one process, 1M DOFs, 2 threads, medians of 30:
 ///
 ///     cargo test --release -p stickslip-time --lib fused_lab -- --ignored --nocapture
-///
-/// 2026-11-24 23:26, two runs: Q1 2.09 → 1.67 and 2.18 → 1.76 ms, Q2 2.75
-/// → 2.34 and 2.98 → 2.59 ms, ṙ_K the same bits. The next step for the
-/// explicit step's bandwidth (README, "Where we stand"): this in the
-/// sweep, with the load and friction rows and the position-keyed strain
-/// and kinetic sums of `kernels::batch_rows` (the same bits).
-#[cfg(all(test, target_arch = "x86_64"))]
+#[cfg(test)]
 mod fused_lab {
     use super::*;
     use crate::kernels::tests::{lab_slab, x_of};
-    use crate::kernels::{StepData, CHUNK};
-    use rayon::prelude::*;
-    use std::arch::x86_64::*;
-
-    struct Out<'a> {
-        vn: &'a mut [f64],
-        an: &'a mut [f64],
-        rx: &'a mut [f64],
-    }
-
-    #[target_feature(enable = "avx512f,fma")]
-    #[allow(unsafe_code)]
-    #[allow(clippy::too_many_arguments)]
-    fn fused_units(
-        offsets: &[i32],
-        values: &[[[f64; 4]; 2]],
-        r: usize,
-        base: usize,
-        rows: usize,
-        s: &StepData,
-        out: &mut Out,
-        acc: &mut [__m512d; 2],
-    ) {
-        let x = s.r_new;
-        let (cv, ca, scale, ratio) = (
-            _mm512_set1_pd(s.cv),
-            _mm512_set1_pd(s.ca),
-            _mm512_set1_pd(s.scale),
-            _mm512_set1_pd(s.ratio),
-        );
-        let (c1, c2) = (_mm512_set1_pd(s.next.0), _mm512_set1_pd(s.next.1));
-        let mut j = 0;
-        while j < rows / 8 {
-            let r0 = (r + 8 * j) as isize;
-            let mut d = _mm512_setzero_pd();
-            let mut o = _mm512_setzero_pd();
-            for (&off, v) in offsets.iter().zip(values) {
-                unsafe {
-                    let vd = _mm512_broadcast_f64x4(_mm256_loadu_pd(v[0].as_ptr()));
-                    let vo = _mm512_broadcast_f64x4(_mm256_loadu_pd(v[1].as_ptr()));
-                    let c = (r0 + off as isize) as usize;
-                    let xv = _mm512_loadu_pd(x[c..c + 8].as_ptr());
-                    d = _mm512_fmadd_pd(vd, xv, d);
-                    o = _mm512_fmadd_pd(vo, _mm512_permute_pd::<0b0101_0101>(xv), o);
-                }
-            }
-            let ku = _mm512_add_pd(d, o);
-            let i = r0 as usize;
-            let k = i - base;
-            unsafe {
-                let m = _mm512_loadu_pd(s.mass[i..i + 8].as_ptr());
-                let v = _mm512_loadu_pd(s.v[i..i + 8].as_ptr());
-                let a = _mm512_loadu_pd(s.a[i..i + 8].as_ptr());
-                let rn = _mm512_loadu_pd(x[i..i + 8].as_ptr());
-                let b = _mm512_add_pd(
-                    _mm512_sub_pd(_mm512_setzero_pd(), ku),
-                    _mm512_mul_pd(m, _mm512_add_pd(_mm512_mul_pd(cv, v), _mm512_mul_pd(ca, a))),
-                );
-                let vn = _mm512_div_pd(b, _mm512_mul_pd(m, scale));
-                let an = _mm512_sub_pd(
-                    _mm512_mul_pd(_mm512_sub_pd(vn, v), scale),
-                    _mm512_mul_pd(ratio, a),
-                );
-                let rx = _mm512_add_pd(
-                    _mm512_add_pd(rn, _mm512_mul_pd(c1, vn)),
-                    _mm512_mul_pd(c2, an),
-                );
-                _mm512_storeu_pd(out.vn[k..k + 8].as_mut_ptr(), vn);
-                _mm512_storeu_pd(out.an[k..k + 8].as_mut_ptr(), an);
-                _mm512_storeu_pd(out.rx[k..k + 8].as_mut_ptr(), rx);
-                acc[0] = _mm512_add_pd(acc[0], _mm512_mul_pd(rn, ku));
-                acc[1] = _mm512_add_pd(acc[1], _mm512_mul_pd(m, _mm512_mul_pd(vn, vn)));
-            }
-            j += 1;
-        }
-    }
-
-    /// Scalar sweep of one row given its K·x (for the groups outside units).
-    fn row_sweep(s: &StepData, i: usize, ku: f64, k: usize, out: &mut Out, sums: &mut [f64; 2]) {
-        let (m, v, a, rn) = (s.mass[i], s.v[i], s.a[i], s.r_new[i]);
-        let b = 0.0 - ku + m * (s.cv * v + s.ca * a);
-        let vn = b / (m * s.scale);
-        let an = (vn - v) * s.scale - s.ratio * a;
-        out.vn[k] = vn;
-        out.an[k] = an;
-        out.rx[k] = rn + s.next.0 * vn + s.next.1 * an;
-        sums[0] += rn * ku;
-        sums[1] += m * vn * vn;
-    }
-
-    #[allow(unsafe_code)]
-    fn fused_chunk(st: &Stencils, c: usize, s: &StepData, out: &mut Out) -> [f64; 2] {
-        let (g0, g1) = (st.chunk_groups[c] as usize, st.chunk_groups[c + 1] as usize);
-        let base = c * CHUNK;
-        let n = s.r_new.len();
-        let mut acc = [unsafe { _mm512_setzero_pd() }; 2];
-        let mut sums = [0.0; 2];
-        let mut g = g0;
-        while g < g1 {
-            if let Some(b) = st.unit_run(g, g1, n) {
-                let u = st.unit_of[g];
-                let r = st.group_rows[g] as usize;
-                let last = st.unit_offsets[b.end - 1] as isize;
-                let mut count = 1;
-                while st.unit_run_continues(g + 4 * count, g1, u)
-                    && (r + 8 * (count + 1)) as isize + last <= n as isize
-                {
-                    count += 1;
-                }
-                let (o, v) = (&st.unit_offsets[b.clone()], &st.unit_values[b]);
-                unsafe { fused_units(o, v, r, base, 8 * count, s, out, &mut acc) };
-                g += 4 * count;
-            } else {
-                let ks = st.sums_of(g, s.r_new);
-                let (r0, r1) = (st.group_rows[g] as usize, st.group_rows[g + 1] as usize);
-                for (q, i) in (r0..r1).enumerate() {
-                    row_sweep(s, i, ks[q], i - base, out, &mut sums);
-                }
-                g += 1;
-            }
-        }
-        let mut lanes = [[0.0; 8]; 2];
-        unsafe {
-            _mm512_storeu_pd(lanes[0].as_mut_ptr(), acc[0]);
-            _mm512_storeu_pd(lanes[1].as_mut_ptr(), acc[1]);
-        }
-        [
-            sums[0] + lanes[0].iter().sum::<f64>(),
-            sums[1] + lanes[1].iter().sum::<f64>(),
-        ]
-    }
+    use crate::kernels::{partials, sweep, StepData};
 
     #[test]
     #[ignore = "a measurement: prints times"]
     fn fused_lab() {
-        if !(crate::kernels::avx512() && crate::kernels::fma()) {
-            return;
-        }
         for name in ["q1-1416x354", "q2-708x177"] {
             let (_, _, model) = lab_slab(name);
             let n = model.stiffness.nrows();
-            let st = Stencils::new(&model.stiffness).unwrap();
+            let fused = Stencils::new(&model.stiffness).unwrap();
             drop(model);
+            let batched = Stencils {
+                fused_sweep: false,
+                ..fused.clone()
+            };
             let x = x_of(n);
             let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
             let (rn, m, v, a) = (w(1.3), w(1.2), w(1.5), w(1.6));
@@ -1077,41 +1127,25 @@ mod fused_lab {
                 next: (1e-3, 0.5e-6),
             };
             let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            let (mut vn2, mut an2, mut rx2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            let mut p = crate::kernels::partials(n);
+            let mut p = partials(n);
             let mut t = [Vec::new(), Vec::new()];
             stickslip_fem::testing::on_threads(2, || {
-                for _ in 0..30 {
-                    let s0 = std::time::Instant::now();
+                for round in 0..60 {
+                    let s = [&batched, &fused][round % 2];
+                    let t0 = std::time::Instant::now();
                     let out = [&mut vn[..], &mut an[..], &mut rx[..]];
-                    crate::kernels::sweep(true, &st, &data, &[], None, out, &mut p);
-                    t[0].push(s0.elapsed().as_secs_f64());
-                    let s0 = std::time::Instant::now();
-                    vn2.par_chunks_mut(CHUNK)
-                        .zip(an2.par_chunks_mut(CHUNK))
-                        .zip(rx2.par_chunks_mut(CHUNK))
-                        .enumerate()
-                        .for_each(|(c, ((vn, an), rx))| {
-                            let mut out = Out { vn, an, rx };
-                            std::hint::black_box(fused_chunk(&st, c, &data, &mut out));
-                        });
-                    t[1].push(s0.elapsed().as_secs_f64());
+                    sweep(kernels::avx(), s, &data, &[], None, out, &mut p);
+                    t[round % 2].push(t0.elapsed().as_secs_f64());
                 }
             });
-            let dv = vn
-                .iter()
-                .zip(&vn2)
-                .map(|(p, q)| (p - q).abs())
-                .fold(0.0, f64::max);
-            let vmax = vn.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
             for t in &mut t {
                 t.sort_by(f64::total_cmp);
             }
             eprintln!(
-                "fused_lab {name}: sweep {:.3} ms, fused in the kernel {:.3} ms (max |Δṙ| / max |ṙ| {:.1e})",
+                "fused_lab {name} (fused kernel: {}): sweep by batches {:.3} ms, in the kernel {:.3} ms",
+                fused.fused_sweep && fused.avx512 && fused.fma && kernels::avx2(),
                 t[0][15] * 1e3,
-                t[1][15] * 1e3,
-                dv / vmax
+                t[1][15] * 1e3
             );
         }
     }
