@@ -49,6 +49,15 @@ pub const TOLERANCE: f64 = 1e-10;
 /// the tolerance).
 const COARSE: f64 = (1u64 << 24) as f64;
 
+/// Rows from which the sweep forms K r_K in its own kernel: where the
+/// step's vectors (7 × 8 bytes a row) outgrow the L3 (32 MB here), the
+/// vectors' traffic it overlaps with the sums pays for its per-8-row
+/// work; below, that work costs more (`fused_lab`, 2026-11-24, against
+/// the sweep by batches, two to four runs each: Q1 1M 0.78-0.97 of its
+/// time, Q2 1M 0.86-0.94; Q1 502k 0.84-0.88, Q2 501k 0.97-1.00; Q1 252k
+/// 1.00-1.07, Q2 249k 1.11-1.15).
+const FUSED_MIN_ROWS: usize = 400_000;
+
 /// Groups of one type summed in lockstep ([`Stencils::lockstep`]).
 const LOCKSTEP: usize = 4;
 
@@ -92,9 +101,10 @@ pub struct Stencils {
     /// multiply-add, on every path (scalar, 4 and 8 wide), so that they
     /// keep giving the same bits ([`Stencils::groups_into`]).
     pub(crate) fma: bool,
-    /// The sweep forms K r_K in its own kernel ([`Stencils::sweep_chunk_512`])
-    /// where the CPU allows; false (tests, labs): by batches.
-    pub(crate) fused_sweep: bool,
+    /// From this many rows the sweep forms K r_K in its own kernel
+    /// ([`Stencils::sweep_chunk_512`]) where the CPU allows
+    /// ([`FUSED_MIN_ROWS`]; tests and labs set 0 or `usize::MAX`).
+    pub(crate) fused_min_rows: usize,
 }
 
 /// [`Stencils::unit_of`] of a group that starts no unit.
@@ -191,7 +201,7 @@ impl Stencils {
             avx: avx::available(),
             avx512: avx::available() && avx::available_512(),
             fma: avx::available() && kernels::fma(),
-            fused_sweep: true,
+            fused_min_rows: FUSED_MIN_ROWS,
         };
         if stencils.avx {
             stencils.build_units();
@@ -752,7 +762,7 @@ impl RowProduct for Stencils {
 
     fn sweep_chunk(&self, c: usize, rows: &mut kernels::SweepRows) -> bool {
         #[cfg(target_arch = "x86_64")]
-        if self.fused_sweep && self.avx512 && self.fma && kernels::avx2() {
+        if rows.x().len() >= self.fused_min_rows && self.avx512 && self.fma && kernels::avx2() {
             // SAFETY: AVX-512, AVX2 and FMA, as the CPU reported them.
             #[allow(unsafe_code)]
             unsafe {
@@ -937,10 +947,14 @@ mod tests {
             let k = &model.stiffness;
             let n = k.nrows();
             assert!(n > CHUNK, "{name}: several chunks");
-            let fused = Stencils::new(k).unwrap();
-            let ran = fused.fused_sweep && fused.avx512 && fused.fma && kernels::avx2();
+            // Forced at these sizes (below FUSED_MIN_ROWS).
+            let fused = Stencils {
+                fused_min_rows: 0,
+                ..Stencils::new(k).unwrap()
+            };
+            let ran = fused.avx512 && fused.fma && kernels::avx2();
             let batched = Stencils {
-                fused_sweep: false,
+                fused_min_rows: usize::MAX,
                 ..fused.clone()
             };
             let x = x_of(n);
@@ -1088,7 +1102,8 @@ mod lab {
 
 /// The sweep with K r_K formed in its own kernel
 /// ([`Stencils::sweep_chunk_512`]) against the sweep by 64-row batches,
-/// alternating in one process, 1M DOFs, 2 threads, medians of 30:
+/// alternating in one process, 2 threads, medians of 30 (meshes:
+/// STICKSLIP_LAB_MESHES, default the 1M-DOF slabs q1-1416x354,q2-708x177):
 ///
 ///     cargo test --release -p stickslip-time --lib fused_lab -- --ignored --nocapture
 #[cfg(test)]
@@ -1100,13 +1115,18 @@ mod fused_lab {
     #[test]
     #[ignore = "a measurement: prints times"]
     fn fused_lab() {
-        for name in ["q1-1416x354", "q2-708x177"] {
+        let meshes = std::env::var("STICKSLIP_LAB_MESHES")
+            .unwrap_or_else(|_| "q1-1416x354,q2-708x177".into());
+        for name in meshes.split(',') {
             let (_, _, model) = lab_slab(name);
             let n = model.stiffness.nrows();
-            let fused = Stencils::new(&model.stiffness).unwrap();
+            let fused = Stencils {
+                fused_min_rows: 0,
+                ..Stencils::new(&model.stiffness).unwrap()
+            };
             drop(model);
             let batched = Stencils {
-                fused_sweep: false,
+                fused_min_rows: usize::MAX,
                 ..fused.clone()
             };
             let x = x_of(n);
@@ -1143,7 +1163,7 @@ mod fused_lab {
             }
             eprintln!(
                 "fused_lab {name} (fused kernel: {}): sweep by batches {:.3} ms, in the kernel {:.3} ms",
-                fused.fused_sweep && fused.avx512 && fused.fma && kernels::avx2(),
+                fused.avx512 && fused.fma && kernels::avx2(),
                 t[0][15] * 1e3,
                 t[1][15] * 1e3
             );
