@@ -2147,26 +2147,20 @@ fn sweep_batches<K: RowProduct>(
     s: &StepData,
     friction: &[(usize, f64)],
     c: usize,
-    [vn, an, rx]: [&mut [f64]; 3],
+    out: [&mut [f64]; 3],
     run: &mut Running,
 ) {
-    let start = c * CHUNK;
     let mut rows = SweepRows {
         avx,
         s,
         friction,
-        start,
-        out: [&mut *vn, &mut *an, &mut *rx],
-        run: &mut *run,
+        start: c * CHUNK,
+        out,
+        run,
     };
-    if k.sweep_chunk(c, &mut rows) {
-        return;
+    if !k.sweep_chunk(c, &mut rows) {
+        k.chunk_batches(c, s.r_new, |r0, ku| rows.rows(r0, ku));
     }
-    k.chunk_batches(c, s.r_new, |r0, ku| {
-        let o = r0 - start;
-        let (vn, an, rx) = (&mut vn[o..], &mut an[o..], &mut rx[o..]);
-        batch_rows_on(avx, s, friction, r0, ku, [vn, an, rx], run);
-    })
 }
 
 #[cfg(test)]
@@ -2239,7 +2233,7 @@ pub(crate) mod tests {
 
     /// A step's data with the labs' coefficients (Δt = 1e-3, γ = ½, no
     /// load rows).
-    fn lab_data<'a>(
+    pub(crate) fn lab_data<'a>(
         load_new: &'a [f64],
         mass: &'a [f64],
         r_new: &'a [f64],

@@ -259,9 +259,8 @@ impl Stencils {
     /// unit run as soon as their K r_K is in a register
     /// ([`kernels::SweepRows::eight`]), so that their vectors' loads and
     /// stores issue while the next rows' sums run, instead of K r_K of a
-    /// 64-row batch into L1 and then the batch's rows: `fused_lab`,
-    /// 2026-11-24, 1M DOFs, Q1 2.09 → 1.67 ms, Q2 2.75 → 2.34 ms. K r_K
-    /// has the bits of [`Stencils::groups_into`] (the same operations per
+    /// 64-row batch into L1 and then the batch's rows (from
+    /// [`FUSED_MIN_ROWS`], which has the figures). K r_K has the bits of [`Stencils::groups_into`] (the same operations per
     /// row) and the rows the bits of [`kernels::batch_rows`].
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx2,fma")]
@@ -276,15 +275,8 @@ impl Stencils {
         let mut g = g0;
         while g < g1 {
             if let Some(b) = self.unit_run(g, g1, n) {
-                let u = self.unit_of[g];
                 let r = self.group_rows[g] as usize;
-                let last = self.unit_offsets[b.end - 1] as isize;
-                let mut count = 1;
-                while self.unit_run_continues(g + 4 * count, g1, u)
-                    && (r + 8 * (count + 1)) as isize + last <= n as isize
-                {
-                    count += 1;
-                }
+                let count = self.run_length(g, g1, &b, n);
                 let (offsets, values) = (&self.unit_offsets[b.clone()], &self.unit_values[b]);
                 for j in 0..count {
                     let rj = (r + 8 * j) as isize;
@@ -369,6 +361,22 @@ impl Stencils {
         inside.then_some(b)
     }
 
+    /// How many fours of groups from g (below g1) hold the unit of
+    /// [`Stencils::unit_run`]'s blocks `b` (their 8 rows each follow on:
+    /// `build_units`) with their padded lanes inside x (of length n).
+    #[inline(always)]
+    fn run_length(&self, g: usize, g1: usize, b: &std::ops::Range<usize>, n: usize) -> usize {
+        let (u, r) = (self.unit_of[g], self.group_rows[g] as usize);
+        let last = self.unit_offsets[b.end - 1] as isize;
+        let mut count = 1;
+        while self.unit_run_continues(g + 4 * count, g1, u)
+            && (r + 8 * (count + 1)) as isize + last <= n as isize
+        {
+            count += 1;
+        }
+        count
+    }
+
     /// Whether groups g..g + 4 (below g1) are two units `u` again (their
     /// rows follow the previous four's).
     #[inline(always)]
@@ -448,15 +456,8 @@ impl Stencils {
                 // one type (Q1) or of two types in turn (a Q2 node row),
                 // and as many more fours after them as hold the same unit
                 // (their 8 rows each follow on: `build_units`).
-                let u = self.unit_of[g];
                 let r = self.group_rows[g] as usize;
-                let last = self.unit_offsets[b.end - 1] as isize;
-                let mut count = 1;
-                while self.unit_run_continues(g + 4 * count, g1, u)
-                    && (r + 8 * (count + 1)) as isize + last <= x.len() as isize
-                {
-                    count += 1;
-                }
+                let count = self.run_length(g, g1, &b, x.len());
                 let run = &mut out[r - base..r - base + 8 * count];
                 let (o, v) = (&self.unit_offsets[b.clone()], &self.unit_values[b]);
                 avx::units::<F>(self.avx512, o, v, r, x, run);
@@ -1109,8 +1110,8 @@ mod lab {
 #[cfg(test)]
 mod fused_lab {
     use super::*;
-    use crate::kernels::tests::{lab_slab, x_of};
-    use crate::kernels::{partials, sweep, StepData};
+    use crate::kernels::tests::{lab_data, lab_slab, x_of};
+    use crate::kernels::{partials, sweep};
 
     #[test]
     #[ignore = "a measurement: prints times"]
@@ -1133,19 +1134,7 @@ mod fused_lab {
             let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
             let (rn, m, v, a) = (w(1.3), w(1.2), w(1.5), w(1.6));
             let zero = vec![0.0; n];
-            let data = StepData {
-                load_new: &zero,
-                load_rows: &[],
-                mass: &m,
-                r_new: &rn,
-                v: &v,
-                a: &a,
-                cv: 2e3,
-                ca: 1.0,
-                scale: 2e3,
-                ratio: 1.0,
-                next: (1e-3, 0.5e-6),
-            };
+            let data = lab_data(&zero, &m, &rn, &v, &a);
             let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
             let mut p = partials(n);
             let mut t = [Vec::new(), Vec::new()];
