@@ -1238,11 +1238,14 @@ impl Integrator {
                     // (the same bits as the sweep's), then one sweep.
                     self.nodal
                         .prepare(contact, &self.dynamics.lumped_mass, scale);
-                    let (ku, r_new) = (&self.b, &self.r_new);
+                    if !one_chunk {
+                        self.nodal.form_products(k, &self.r_new);
+                    }
+                    let (ku, at_dofs) = (&self.b, self.nodal.products());
                     let (friction, slots) = (&mut self.friction, &self.friction_slots);
                     self.nodal.velocities(
-                        |i| {
-                            let ku = if one_chunk { ku[i] } else { k.row(i, r_new) };
+                        |i, n| {
+                            let ku = if one_chunk { ku[i] } else { at_dofs[n] };
                             kernels::rhs_entry(&data, i, ku)
                         },
                         |j, c, _, v| {
@@ -1305,7 +1308,8 @@ impl Integrator {
                             self.nodal
                                 .prepare(contact, &self.dynamics.lumped_mass, scale);
                             let (b, v_new) = (&self.b, &mut self.v_new);
-                            self.nodal.velocities(|i| b[i], |_, _, i, v| v_new[i] = v);
+                            self.nodal
+                                .velocities(|i, _| b[i], |_, _, i, v| v_new[i] = v);
                             contact.classify(&self.v_new, &mut self.scratch_classes);
                             1
                         }

@@ -1322,6 +1322,13 @@ pub trait RowProduct: Sync {
     fn chunk_batches(&self, c: usize, x: &[f64], f: impl FnMut(usize, &[f64]));
     /// (K x)_i alone, with the bits the batches give it.
     fn row(&self, i: usize, x: &[f64]) -> f64;
+    /// (K x)_i for each i of `rows` into `out`, with the bits the batches
+    /// give them (by default [`RowProduct::row`] each).
+    fn rows_at(&self, rows: &[usize], x: &[f64], out: &mut [f64]) {
+        for (o, &i) in out.iter_mut().zip(rows) {
+            *o = self.row(i, x);
+        }
+    }
     /// y = K x.
     fn spmv(&self, x: &[f64], y: &mut [f64]);
     /// Bytes one K x streams from the operator's data.
@@ -1345,9 +1352,9 @@ pub(crate) struct SweepRows<'a, 'b> {
     run: &'b mut Running,
 }
 
-impl SweepRows<'_, '_> {
-    /// x of K x: r_K.
-    pub(crate) fn x(&self) -> &[f64] {
+impl<'a> SweepRows<'a, '_> {
+    /// x of K x: r_K (borrowed from the step's data, not from `self`).
+    pub(crate) fn x(&self) -> &'a [f64] {
         self.s.r_new
     }
 
@@ -1529,6 +1536,16 @@ impl RowProduct for Product {
             Product::Classes(k) => k.row(i, x),
             Product::Stencils(k) => k.row(i, x),
             Product::Sliced(k) => k.row(i, x),
+        }
+    }
+    fn rows_at(&self, rows: &[usize], x: &[f64], out: &mut [f64]) {
+        match self {
+            Product::Stencils(k) => k.rows_at(rows, x, out),
+            _ => {
+                for (o, &i) in out.iter_mut().zip(rows) {
+                    *o = self.row(i, x);
+                }
+            }
         }
     }
     fn spmv(&self, x: &[f64], y: &mut [f64]) {

@@ -14,6 +14,8 @@
 
 use stickslip_contact::{ContactSurface, SlipState};
 
+use crate::kernels::RowProduct;
+
 /// The constants of one contact node for one Δt.
 #[derive(Clone, Copy, Debug)]
 struct Node {
@@ -42,6 +44,11 @@ pub(crate) struct NodalFriction {
     eps: f64,
     inv_eps: f64,
     nodes: Vec<Node>,
+    /// The nodes' free DOFs in the order [`NodalFriction::velocities`]
+    /// asks `b` for them, and a slot per DOF for K r_K there
+    /// ([`NodalFriction::products`]).
+    dofs: Vec<usize>,
+    ku: Vec<f64>,
 }
 
 impl NodalFriction {
@@ -55,7 +62,9 @@ impl NodalFriction {
         self.eps = eps;
         self.inv_eps = 1.0 / eps;
         self.nodes.clear();
+        self.dofs.clear();
         for node in &contact.nodes {
+            self.dofs.extend(node.dofs.iter().flatten());
             let wg = node.force_scale();
             let (mut a, mut inv_d, mut w, mut q) = ([0.0; 2], [0.0; 2], [0.0; 2], 0.0);
             for c in 0..2 {
@@ -78,25 +87,43 @@ impl NodalFriction {
                 force_scale: wg,
             });
         }
+        self.ku.resize(self.dofs.len(), 0.0);
         self.scale = Some(scale.to_bits());
     }
 
+    /// K x at the contact nodes' free DOFs, in one call of
+    /// [`RowProduct::rows_at`] (the rows' own sums, vector-wide where they
+    /// follow on: before, one [`RowProduct::row`] per DOF, a search and a
+    /// node's two sums each time, was 6% of the Q2 1M slab's step on one
+    /// thread). `b`'s k-th call in [`NodalFriction::velocities`] is for
+    /// `self.products()[k]`. [`NodalFriction::prepare`] first.
+    pub(crate) fn form_products(&mut self, k: &impl RowProduct, x: &[f64]) {
+        k.rows_at(&self.dofs, x, &mut self.ku);
+    }
+
+    /// What [`NodalFriction::form_products`] formed.
+    pub(crate) fn products(&self) -> &[f64] {
+        &self.ku
+    }
+
     /// Calls `out(node, component, dof, ṙ_K)` for every free DOF of every
-    /// contact node, given `b(dof)` = R̂_K there. [`NodalFriction::prepare`]
-    /// first.
+    /// contact node, given `b(dof, k)` = R̂_K there, the k-th contact DOF
+    /// in node order. [`NodalFriction::prepare`] first.
     #[inline]
     pub(crate) fn velocities(
         &self,
-        mut b: impl FnMut(usize) -> f64,
+        mut b: impl FnMut(usize, usize) -> f64,
         mut out: impl FnMut(usize, usize, usize, f64),
     ) {
         let (eps, inv_eps) = (self.eps, self.inv_eps);
+        let mut k = 0;
         for (j, node) in self.nodes.iter().enumerate() {
             let mut bj = [0.0; 2];
             let mut p = 0.0;
             for c in 0..2 {
                 if let Some(i) = node.dofs[c] {
-                    bj[c] = b(i);
+                    bj[c] = b(i, k);
+                    k += 1;
                     p += node.a[c] * bj[c];
                 }
             }
@@ -296,7 +323,7 @@ mod tests {
             for amp in [1e-9, 1e-6, 1e-3, 1.0, -1.0, 30.0, -30.0] {
                 let b: Vec<f64> = (0..n).map(|i| amp * (1.0 + 0.3 * i as f64)).collect();
                 let mut got = vec![f64::NAN; n];
-                nodal.velocities(|i| b[i], |_, _, i, v| got[i] = v);
+                nodal.velocities(|i, _| b[i], |_, _, i, v| got[i] = v);
                 for node in &contact.nodes {
                     let (mut p, mut q) = (0.0, 0.0);
                     for c in 0..2 {

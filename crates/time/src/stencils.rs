@@ -14,9 +14,11 @@
 //! wide (AVX) or, where the CPU has AVX-512, 8 wide, each term by a fused
 //! multiply-add where it has FMA (on every path: the same bits): `sweep_lab`,
 //! 2026-11-24, 1M DOFs, K·x Q1 1.2 → 0.95-1.0 ms, Q2 1.9 → 1.7 ms (2
-//! threads, median of 20, two runs each). Rows are independent and each
-//! is summed in its type's block order whatever batch or thread computes
-//! it: the same bits on any number of threads. Not the bits of the
+//! threads, median of 20, two runs each); with four 8-row blocks in
+//! lockstep ([`avx::run_512`]), 2026-11-25, Q1 0.89-0.93, Q2 1.32-1.35
+//! ms. Rows are independent and each is summed in its type's block order
+//! whatever batch or thread computes it: the same bits on any number of
+//! threads. Not the bits of the
 //! assembled K's product: within [`TOLERANCE`] · max |K_ij| · Σ_j |x_j|
 //! over the row's columns of it (tests below); the classes of
 //! `stickslip_fem::ElementClasses` make the same trade on Q2 meshes.
@@ -55,7 +57,10 @@ const COARSE: f64 = (1u64 << 24) as f64;
 /// work; below, that work costs more (`fused_lab`, 2026-11-24, against
 /// the sweep by batches, two to four runs each: Q1 1M 0.78-0.97 of its
 /// time, Q2 1M 0.86-0.94; Q1 502k 0.84-0.88, Q2 501k 0.97-1.00; Q1 252k
-/// 1.00-1.07, Q2 249k 1.11-1.15).
+/// 1.00-1.07, Q2 249k 1.11-1.15). With four blocks in lockstep
+/// ([`avx::run_512`], both paths), 2026-11-25: Q1 1M 0.89-0.95, Q2 1M
+/// 0.81-0.89 (three runs); Q1 502k 0.90-0.99, Q2 501k 0.83-0.89; Q1 252k
+/// 0.94-1.00, Q2 249k 1.00-1.01 (two runs): the threshold stays.
 const FUSED_MIN_ROWS: usize = 400_000;
 
 /// Groups of one type summed in lockstep ([`Stencils::lockstep`]).
@@ -266,7 +271,6 @@ impl Stencils {
     #[target_feature(enable = "avx512f,avx2,fma")]
     #[allow(unsafe_code)]
     fn sweep_chunk_512(&self, c: usize, rows: &mut kernels::SweepRows) {
-        use std::arch::x86_64::*;
         let (g0, g1) = (
             self.chunk_groups[c] as usize,
             self.chunk_groups[c + 1] as usize,
@@ -278,25 +282,9 @@ impl Stencils {
                 let r = self.group_rows[g] as usize;
                 let count = self.run_length(g, g1, &b, n);
                 let (offsets, values) = (&self.unit_offsets[b.clone()], &self.unit_values[b]);
-                for j in 0..count {
-                    let rj = (r + 8 * j) as isize;
-                    let x = rows.x();
-                    let (mut d, mut o) = (_mm512_setzero_pd(), _mm512_setzero_pd());
-                    for (&off, v) in offsets.iter().zip(values) {
-                        let c = (rj + off as isize) as usize;
-                        let xs: &[f64; 8] = x[c..c + 8].try_into().expect("8 columns");
-                        // SAFETY: v and xs hold 8 doubles; unaligned loads.
-                        unsafe {
-                            let vd = _mm512_broadcast_f64x4(_mm256_loadu_pd(v[0].as_ptr()));
-                            let vo = _mm512_broadcast_f64x4(_mm256_loadu_pd(v[1].as_ptr()));
-                            let xv = _mm512_loadu_pd(xs.as_ptr());
-                            d = _mm512_fmadd_pd(vd, xv, d);
-                            o = _mm512_fmadd_pd(vo, _mm512_permute_pd::<0b0101_0101>(xv), o);
-                        }
-                    }
-                    // SAFETY: this function's features.
-                    unsafe { rows.eight(rj as usize, _mm512_add_pd(d, o)) };
-                }
+                let x = rows.x();
+                // SAFETY: this function's features.
+                unsafe { avx::run_512::<true>(offsets, values, r, count, x, rows) };
                 g += 4 * count;
             } else {
                 let sums = self.group_sums::<true>(g, rows.x());
@@ -627,7 +615,7 @@ mod avx {
     }
 
     /// [`units`] 8 wide: the 8 rows of two units in one register each for
-    /// the diagonal and the other terms, two such groups in lockstep.
+    /// the diagonal and the other terms, into `out`.
     /// Inlined into the callers above, which give it their features.
     ///
     /// # Safety
@@ -642,46 +630,138 @@ mod avx {
         x: &[f64],
         out: &mut [f64],
     ) {
-        use std::arch::x86_64::*;
-        let mut j = 0;
-        let groups = out.len() / 8;
-        while j < groups {
-            let two = j + 2 <= groups;
-            let (r0, r1) = ((r + 8 * j) as isize, (r + 8 * j + 8) as isize);
-            // SAFETY (every block below): the caller's features; v and xs
-            // hold 8 doubles (unaligned loads), out 8 (16 with `two`)
-            // from 8 j.
-            let mut d = [unsafe { _mm512_setzero_pd() }; 2];
-            let mut o = d;
-            for (&off, v) in offsets.iter().zip(values) {
-                let (vd, vo) = unsafe {
-                    (
-                        _mm512_broadcast_f64x4(_mm256_loadu_pd(v[0].as_ptr())),
-                        _mm512_broadcast_f64x4(_mm256_loadu_pd(v[1].as_ptr())),
-                    )
-                };
-                for (h, rh) in [r0, r1].into_iter().enumerate() {
-                    if h == 1 && !two {
-                        break;
-                    }
-                    let c = (rh + off as isize) as usize;
-                    let xs: &[f64; 8] = x[c..c + 8].try_into().expect("8 columns");
-                    unsafe {
-                        let xv = _mm512_loadu_pd(xs.as_ptr());
-                        d[h] = term_512::<F>(d[h], vd, xv);
-                        let swapped = _mm512_permute_pd::<0b0101_0101>(xv);
-                        o[h] = term_512::<F>(o[h], vo, swapped);
-                    }
-                }
-            }
-            unsafe {
-                _mm512_storeu_pd(out.as_mut_ptr().add(8 * j), _mm512_add_pd(d[0], o[0]));
-                if two {
-                    _mm512_storeu_pd(out.as_mut_ptr().add(8 * j + 8), _mm512_add_pd(d[1], o[1]));
-                }
-            }
-            j += if two { 2 } else { 1 };
+        let blocks = out.len() / 8;
+        // SAFETY: the caller's features; out holds 8 doubles from row - r
+        // for each of the blocks' rows.
+        unsafe { run_512::<F>(offsets, values, r, blocks, x, &mut Stored { r, out }) }
+    }
+
+    /// Where [`run_512`] hands each block's sums: a trait with an
+    /// always-inlined method, not a closure, which the compiler left as a
+    /// call per block (40% of the Q2 1M step's samples, 2026-11-25).
+    #[cfg(target_arch = "x86_64")]
+    pub(super) trait Sink {
+        /// Rows row..row + 8 sum to `sum`.
+        ///
+        /// # Safety
+        /// The CPU has AVX-512 (foundation), and AVX2 for the sweep's rows
+        /// ([`crate::kernels::SweepRows::eight`]).
+        #[allow(unsafe_code)]
+        unsafe fn put(&mut self, row: usize, sum: std::arch::x86_64::__m512d);
+    }
+
+    /// [`body_512`]'s sink: the sums stored into `out` from row r.
+    #[cfg(target_arch = "x86_64")]
+    struct Stored<'o> {
+        r: usize,
+        out: &'o mut [f64],
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    impl Sink for Stored<'_> {
+        #[inline(always)]
+        #[allow(unsafe_code)]
+        unsafe fn put(&mut self, row: usize, sum: std::arch::x86_64::__m512d) {
+            let o = &mut self.out[row - self.r..row - self.r + 8];
+            // SAFETY: the caller's features; o holds 8 doubles.
+            unsafe { std::arch::x86_64::_mm512_storeu_pd(o.as_mut_ptr(), sum) };
         }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    impl Sink for crate::kernels::SweepRows<'_, '_> {
+        #[inline(always)]
+        #[allow(unsafe_code)]
+        unsafe fn put(&mut self, row: usize, sum: std::arch::x86_64::__m512d) {
+            // SAFETY: the caller's features.
+            unsafe { self.eight(row, sum) };
+        }
+    }
+
+    /// The sums of rows r..r + 8 `blocks` of a run of one unit (8 rows a
+    /// block, as [`body_512`] reads them), each block's handed to `f` with
+    /// its first row, in row order: four blocks in lockstep, then two,
+    /// then one, so that each value's broadcast serves four blocks' terms
+    /// (2026-11-25, 1M DOFs, the fused sweep of `fused_lab`'s data, the
+    /// variants alternating in one process, 2 threads, medians of 30:
+    /// against one block at a time, two took 0.86-0.90 of its time on Q2
+    /// and 0.92-1.02 on Q1 (four runs); against two, four took 0.91-0.95
+    /// on Q2 and 0.95-0.97 on Q1 (three runs); eight against four
+    /// 0.96-1.02 on both (two runs)). Each row's terms are summed in the
+    /// same order whatever the lockstep: the same bits.
+    ///
+    /// # Safety
+    /// The CPU has AVX-512 (and FMA with `F`) and what `f`'s
+    /// [`Sink::put`] needs.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub(super) unsafe fn run_512<const F: bool>(
+        offsets: &[i32],
+        values: &[[[f64; 4]; 2]],
+        r: usize,
+        blocks: usize,
+        x: &[f64],
+        f: &mut impl Sink,
+    ) {
+        let mut j = 0;
+        // SAFETY (each block): the caller's.
+        while j + 4 <= blocks {
+            let sums = unsafe { lockstep_512::<F, 4>(offsets, values, r + 8 * j, x) };
+            for (q, sum) in sums.into_iter().enumerate() {
+                unsafe { f.put(r + 8 * (j + q), sum) };
+            }
+            j += 4;
+        }
+        if j + 2 <= blocks {
+            let sums = unsafe { lockstep_512::<F, 2>(offsets, values, r + 8 * j, x) };
+            for (q, sum) in sums.into_iter().enumerate() {
+                unsafe { f.put(r + 8 * (j + q), sum) };
+            }
+            j += 2;
+        }
+        if j < blocks {
+            let [sum] = unsafe { lockstep_512::<F, 1>(offsets, values, r + 8 * j, x) };
+            unsafe { f.put(r + 8 * j, sum) };
+        }
+    }
+
+    /// The sums of N blocks of 8 rows from row r ([`run_512`]): per
+    /// block, the diagonal and the other terms in one register each, x in
+    /// one load and its pairs swapped in one shuffle.
+    ///
+    /// # Safety
+    /// The CPU has AVX-512 (and FMA with `F`).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn lockstep_512<const F: bool, const N: usize>(
+        offsets: &[i32],
+        values: &[[[f64; 4]; 2]],
+        r: usize,
+        x: &[f64],
+    ) -> [std::arch::x86_64::__m512d; N] {
+        use std::arch::x86_64::*;
+        // SAFETY (every block below): the caller's features; v holds 8
+        // doubles, xs 8 N (unaligned loads).
+        let mut d = [unsafe { _mm512_setzero_pd() }; N];
+        let mut o = d;
+        for (&off, v) in offsets.iter().zip(values) {
+            let c = (r as isize + off as isize) as usize;
+            let xs = &x[c..c + 8 * N];
+            unsafe {
+                let vd = _mm512_broadcast_f64x4(_mm256_loadu_pd(v[0].as_ptr()));
+                let vo = _mm512_broadcast_f64x4(_mm256_loadu_pd(v[1].as_ptr()));
+                for q in 0..N {
+                    let xv = _mm512_loadu_pd(xs.as_ptr().add(8 * q));
+                    d[q] = term_512::<F>(d[q], vd, xv);
+                    let swapped = _mm512_permute_pd::<0b0101_0101>(xv);
+                    o[q] = term_512::<F>(o[q], vo, swapped);
+                }
+            }
+        }
+        // SAFETY: the caller's features.
+        std::array::from_fn(|q| unsafe { _mm512_add_pd(d[q], o[q]) })
     }
 
     /// [`units`] 4 wide: a unit's four rows in one register each for the
@@ -748,6 +828,42 @@ impl RowProduct for Stencils {
             s[0]
         } else {
             s[1]
+        }
+    }
+
+    /// Where rows follow on over whole groups (a contact surface numbered
+    /// along a grid line), those groups' rows at once by
+    /// [`Stencils::groups_into`] (vector-wide); elsewhere a group's sums
+    /// once for its rows. The same bits as [`Stencils::row`].
+    fn rows_at(&self, rows: &[usize], x: &[f64], out: &mut [f64]) {
+        let mut k = 0;
+        while k < rows.len() {
+            let i = rows[k];
+            let g = self.group_rows.partition_point(|&r| r as usize <= i) - 1;
+            let r0 = self.group_rows[g] as usize;
+            // Rows i, i + 1, … of `rows` from k.
+            let on = rows[k..]
+                .iter()
+                .enumerate()
+                .take_while(|&(m, &r)| r == i + m)
+                .count();
+            if i == r0 {
+                // The whole groups g..g1 among them.
+                let end = i + on;
+                let g1 = g + self.group_rows[g..].partition_point(|&r| r as usize <= end) - 1;
+                let r1 = self.group_rows[g1] as usize;
+                if g1 > g + 1 {
+                    self.groups_into(g, g1, x, &mut out[k..k + r1 - r0]);
+                    k += r1 - r0;
+                    continue;
+                }
+            }
+            let s = self.sums_of(g, x);
+            let r1 = self.group_rows[g + 1] as usize;
+            while k < rows.len() && (r0..r1).contains(&rows[k]) {
+                out[k] = s[rows[k] - r0];
+                k += 1;
+            }
         }
     }
 
@@ -927,6 +1043,50 @@ mod tests {
     /// friction rows (on both sides of chunk seams and inside unit runs),
     /// on 1 and 2 threads; on slabs numbered row by row and on Gmsh's Q1
     /// slab, whose nodes with one free DOF shift the rows' lanes.
+    /// `rows_at` gives each row `row`'s bits: runs of rows over whole
+    /// groups (the vector-wide sums), runs starting or ending inside a
+    /// group, single rows, rows out of order and repeated, on a Q1 and a
+    /// Q2 slab and the Gmsh slab whose single-DOF nodes make one-row
+    /// groups.
+    #[test]
+    fn rows_at_has_the_bits_of_row() {
+        use stickslip_fem::testing::rectangle;
+        use stickslip_mesh::CellKind;
+        let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes");
+        let rect = |kind, nx, ny| rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
+        let meshes = [
+            ("q1 200x50", rect(CellKind::Quad4, 200, 50), "top"),
+            ("q2 64x16", rect(CellKind::Quad9, 64, 16), "top"),
+            (
+                "slab-q1-128x32.msh",
+                Mesh::from_file(dir.join("slab-q1-128x32.msh")).unwrap(),
+                "support",
+            ),
+        ];
+        for (name, mesh, support) in meshes {
+            let model = slab_model(&mesh, support);
+            let k = &model.stiffness;
+            let n = k.nrows();
+            let s = Stencils::new(k).unwrap();
+            let x = x_of(n);
+            let lists: Vec<Vec<usize>> = vec![
+                (0..260).collect(),
+                (1..261).collect(),
+                (n - 300..n).collect(),
+                (0..n).step_by(3).collect(),
+                vec![7, 6, 5, 40, 41, 42, 43, 44, 45, 46, 47, 48, 3, 3, n - 1, 0],
+                (100..140).chain(141..200).chain(10..20).collect(),
+            ];
+            for rows in lists {
+                let mut got = vec![f64::NAN; rows.len()];
+                s.rows_at(&rows, &x, &mut got);
+                for (&i, g) in rows.iter().zip(&got) {
+                    assert_eq!(g.to_bits(), s.row(i, &x).to_bits(), "{name}: row {i}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn fused_sweep_has_the_bits_of_the_batches() {
         use crate::kernels::{partials, sweep, StepData, CHUNK};
