@@ -1773,7 +1773,9 @@ impl Integrator {
 
     /// Bytes one explicit step of the run's Δt moves through memory
     /// (closed-form friction, `kernels.rs`): K
-    /// ([`Integrator::explicit_matrix_bytes`]), the free-DOF vectors its
+    /// ([`Integrator::explicit_matrix_bytes`], or what the one sweep reads
+    /// of it where that is less: the stencil types' unit runs, found once,
+    /// and the groups outside them), the free-DOF vectors its
     /// passes read or write (7 of n f64 for the one sweep, whose previous
     /// run formed the predictor; 9 when it has one chunk and K r_K is
     /// stored for the friction; 20 for the compact product and passes B
@@ -1797,7 +1799,13 @@ impl Integrator {
         } else {
             streams
         };
-        self.explicit_matrix_bytes() + 8 * streams * n + self.sparse_loads.bytes()
+        // The one sweep of several chunks may read less of K than a
+        // product (RowProduct::sweep_bytes).
+        let matrix = match &self.product {
+            Some(k) if streams == 7 => k.sweep_bytes(n),
+            _ => self.explicit_matrix_bytes(),
+        };
+        matrix + 8 * streams * n + self.sparse_loads.bytes()
     }
 
     /// (distinct blocks, stored blocks) of K's compact form when its values

@@ -1331,8 +1331,14 @@ pub trait RowProduct: Sync {
     }
     /// y = K x.
     fn spmv(&self, x: &[f64], y: &mut [f64]);
-    /// Bytes one K x streams from the operator's data.
+    /// Bytes one K x streams from the operator's data (all of them).
     fn bytes(&self) -> usize;
+    /// Bytes the sweep over `n` rows streams from the operator's data
+    /// (where it forms K r_K in its own kernel, it may need less than a
+    /// product).
+    fn sweep_bytes(&self, _n: usize) -> usize {
+        self.bytes()
+    }
     /// The sweep of chunk `c` with K r_K formed row by row in the
     /// operator's own kernel and handed to `rows` as it is formed, in row
     /// order; false (nothing done) where the operator has no such kernel.
@@ -1562,6 +1568,12 @@ impl RowProduct for Product {
             Product::Classes(k) => RowProduct::bytes(k),
             Product::Stencils(k) => k.bytes(),
             Product::Sliced(k) => k.bytes(),
+        }
+    }
+    fn sweep_bytes(&self, n: usize) -> usize {
+        match self {
+            Product::Stencils(k) => k.sweep_bytes(n),
+            _ => self.bytes(),
         }
     }
     fn sweep_chunk(&self, c: usize, rows: &mut SweepRows) -> bool {

@@ -96,6 +96,15 @@ pub struct Stencils {
     /// other column); +0 where A or B has no block at the offset (s + 0·x
     /// = s: the bits of the pair's own blocks).
     unit_values: Vec<[[f64; 4]; 2]>,
+    /// The unit runs the sweep's own kernel takes, found once
+    /// ([`Stencils::build_units`], by [`Stencils::unit_run`] and
+    /// [`Stencils::run_length`] from each chunk's first group on): per run
+    /// its first group, its count of fours of groups and its unit. Chunk
+    /// c's are runs[chunk_runs[c]..chunk_runs[c + 1]]. The kernel then
+    /// reads nothing per group of a run (before, `unit_of` of each, a
+    /// scan 6% of the Q2 1M step's samples, 2026-11-25).
+    runs: Vec<[u32; 3]>,
+    chunk_runs: Vec<u32>,
     /// The CPU has AVX (checked at run time): runs of two alike units are
     /// summed 4 doubles wide ([`avx::units`]), the same bits.
     avx: bool,
@@ -203,6 +212,8 @@ impl Stencils {
             unit_blocks: vec![0],
             unit_offsets: Vec::new(),
             unit_values: Vec::new(),
+            runs: Vec::new(),
+            chunk_runs: vec![0],
             avx: avx::available(),
             avx512: avx::available() && avx::available_512(),
             fma: avx::available() && kernels::fma(),
@@ -258,6 +269,32 @@ impl Stencils {
         }
         (self.unit_of, self.unit_blocks) = (unit_of, blocks);
         (self.unit_offsets, self.unit_values) = (offsets, values);
+        let n = *self.group_rows.last().expect("then n") as usize;
+        for c in 0..self.chunk_groups.len() - 1 {
+            let (g0, g1) = (
+                self.chunk_groups[c] as usize,
+                self.chunk_groups[c + 1] as usize,
+            );
+            let mut g = g0;
+            while g < g1 {
+                match self.unit_run(g, g1, n) {
+                    Some(b) => {
+                        let count = self.run_length(g, g1, &b, n);
+                        self.runs.push([g as u32, count as u32, self.unit_of[g]]);
+                        g += 4 * count;
+                    }
+                    None => g += 1,
+                }
+            }
+            self.chunk_runs.push(self.runs.len() as u32);
+        }
+        self.runs.shrink_to_fit();
+    }
+
+    /// Whether the sweep over `n` rows forms K r_K in its own kernel
+    /// ([`Stencils::sweep_chunk_512`]).
+    fn fused(&self, n: usize) -> bool {
+        n >= self.fused_min_rows && self.avx512 && self.fma && kernels::avx2()
     }
 
     /// The sweep of chunk `c` with its per-row work on each 8 rows of a
@@ -275,23 +312,27 @@ impl Stencils {
             self.chunk_groups[c] as usize,
             self.chunk_groups[c + 1] as usize,
         );
-        let n = rows.x().len();
+        let x = rows.x();
         let mut g = g0;
-        while g < g1 {
-            if let Some(b) = self.unit_run(g, g1, n) {
-                let r = self.group_rows[g] as usize;
-                let count = self.run_length(g, g1, &b, n);
-                let (offsets, values) = (&self.unit_offsets[b.clone()], &self.unit_values[b]);
-                let x = rows.x();
-                // SAFETY: this function's features.
-                unsafe { avx::run_512::<true>(offsets, values, r, count, x, rows) };
-                g += 4 * count;
-            } else {
-                let sums = self.group_sums::<true>(g, rows.x());
+        let runs = &self.runs[self.chunk_runs[c] as usize..self.chunk_runs[c + 1] as usize];
+        for &[first, count, u] in runs.iter().chain([&[g1 as u32, 0, NO_UNIT]]) {
+            // The groups before the run one by one.
+            while g < first as usize {
+                let sums = self.group_sums::<true>(g, x);
                 let (r0, r1) = (self.group_rows[g] as usize, self.group_rows[g + 1] as usize);
                 rows.rows(r0, &sums[..r1 - r0]);
                 g += 1;
             }
+            if u == NO_UNIT {
+                break;
+            }
+            let b =
+                self.unit_blocks[u as usize] as usize..self.unit_blocks[u as usize + 1] as usize;
+            let (offsets, values) = (&self.unit_offsets[b.clone()], &self.unit_values[b]);
+            let r = self.group_rows[g] as usize;
+            // SAFETY: this function's features.
+            unsafe { avx::run_512::<true>(offsets, values, r, count as usize, x, rows) };
+            g += 4 * count as usize;
         }
     }
 
@@ -879,7 +920,7 @@ impl RowProduct for Stencils {
 
     fn sweep_chunk(&self, c: usize, rows: &mut kernels::SweepRows) -> bool {
         #[cfg(target_arch = "x86_64")]
-        if rows.x().len() >= self.fused_min_rows && self.avx512 && self.fma && kernels::avx2() {
+        if self.fused(rows.x().len()) {
             // SAFETY: AVX-512, AVX2 and FMA, as the CPU reported them.
             #[allow(unsafe_code)]
             unsafe {
@@ -891,11 +932,28 @@ impl RowProduct for Stencils {
         false
     }
 
+    /// Where the sweep's own kernel runs, the runs, the groups outside
+    /// them (first row and type each) and the stencils; else [`bytes`].
+    ///
+    /// [`bytes`]: RowProduct::bytes
+    fn sweep_bytes(&self, n: usize) -> usize {
+        if !self.fused(n) {
+            return self.bytes();
+        }
+        let in_runs: usize = self.runs.iter().map(|r| 4 * r[1] as usize).sum();
+        4 * (3 * self.runs.len() + self.chunk_runs.len() + self.chunk_groups.len())
+            + 8 * (self.types.len() - in_runs)
+            + 4 * (self.type_blocks.len() + self.unit_blocks.len())
+            + 36 * self.values.len()
+            + 68 * self.unit_values.len()
+    }
+
     fn bytes(&self) -> usize {
         4 * (self.group_rows.len() + self.types.len() + self.chunk_groups.len())
             + 4 * (self.type_blocks.len() + self.unit_of.len() + self.unit_blocks.len())
             + 36 * self.values.len()
             + 68 * self.unit_values.len()
+            + 4 * (3 * self.runs.len() + self.chunk_runs.len())
     }
 }
 
