@@ -690,6 +690,40 @@ fn main() {
         println!("{row}");
         rows.push(row);
     }
+    // The highest triad of the whole run, what the memory delivered when
+    // the host let it: a rung's own nine blocks may all fall in a busy
+    // spell (2026-11-24 23:37: the 1M rungs saw 35 GB/s at most, other
+    // rungs of the run up to 56.9), so each explicit rung's bandwidth is
+    // also given as a share of this.
+    let field = |row: &str, k: &str| {
+        row.split_whitespace()
+            .find_map(|kv| kv.strip_prefix(&format!("{k}=")))
+            .and_then(|v| v.parse::<f64>().ok())
+    };
+    let run_max = rows
+        .iter()
+        .filter_map(|r| field(r, "stream_bw"))
+        .fold(0.0, f64::max);
+    if run_max > 0.0 {
+        println!(
+            "highest STREAM triad of the run: {:.1} GB/s; explicit rungs against it:",
+            run_max / 1e9
+        );
+        for row in &mut rows {
+            if let Some(bw) = field(row, "step_bw") {
+                let pct = 100.0 * bw / run_max;
+                row.push_str(&format!(
+                    " stream_bw_run={run_max:.4e} pct_stream_run={pct:.1}"
+                ));
+                let name = row
+                    .split_whitespace()
+                    .nth(1)
+                    .unwrap_or("")
+                    .trim_start_matches("mesh=");
+                println!("  {name}: {:.1} GB/s, {pct:.1}%", bw / 1e9);
+            }
+        }
+    }
     std::fs::create_dir_all(&dir).unwrap();
     let mut csv = String::new();
     let mut header: Vec<String> = Vec::new();
