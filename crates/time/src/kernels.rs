@@ -3397,6 +3397,11 @@ pub(crate) mod tests {
     /// | Q1 1416×354 (1,004,298) | 0.964       | 1.926       | 2.325       | 2.178       |
     /// | Q2 708×177 (1,004,298)  | 1.688       | 2.065       | 3.242       | 3.244       |
     ///
+    /// 2026-11-25 01:00, with four 8-row blocks in lockstep
+    /// (`stencils::avx::run_512`) and the fused sweep, two runs: Q1 1M
+    /// K·x 0.89-0.93, vectors 1.77-1.78, sweep 1.95-2.01 ms; Q2 1M 1.32-1.35,
+    /// 1.88-2.03, 2.41.
+    ///
     /// At 1M DOFs the sweep now costs less than its parts: the product's
     /// arithmetic of one batch overlaps the vectors' traffic of the next
     /// ([`BATCH`]), in part (22:42, with fused multiply-adds: Q1 K·x 0.90,
@@ -3419,6 +3424,18 @@ pub(crate) mod tests {
     /// 2.07 / 2.79 (Q1 / Q2), 32 rows 2.56 / 3.17 against 2.24 / 2.89,
     /// the whole batch one batch late 2.28 / 3.21 against 2.11 / 3.13:
     /// the calls cost more than any overlap gained.
+    /// On the fused kernel (2026-11-25 00:45-01:30, its sweep of
+    /// `fused_lab`'s data, each variant alternating with the kept one in
+    /// one process, three runs unless said, Q1 / Q2 1M): non-temporal
+    /// stores of the three outputs (by 64, 32 or 16 bytes as aligned)
+    /// 0.7-3.4% / 1.6-6.3% slower; the seven vectors on transparent huge
+    /// pages (madvise) 0-31% slower / 2.7-4.0% faster; prefetching m, ṙ, r̈,
+    /// r_K 128 rows ahead into L1 0.6% / 2.4% slower, into L2 no change,
+    /// 512 rows ahead into L1 3.3% / 4.8% slower, into L2 0.6% / 1.5%
+    /// faster on a busy host (one run each); handing the rows outside the
+    /// unit runs on in stretches of up to 64 rather than a node pair at a
+    /// time, within 3% either way; vectors 0, 16, 32 or 48 bytes past a
+    /// 64-byte line, within 6% with no order between them (two runs).
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn sweep_lab() {
