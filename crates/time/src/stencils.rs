@@ -1176,6 +1176,20 @@ mod tests {
                 fused_min_rows: usize::MAX,
                 ..fused.clone()
             };
+            // What the sweep reads of K: all of it by batches; by the
+            // kernel, the runs cover most node pairs, which it then reads
+            // nothing of, so less, but never less than the stencils.
+            assert_eq!(batched.sweep_bytes(n), batched.bytes(), "{name}");
+            if ran {
+                let stencils = 36 * fused.values.len() + 68 * fused.unit_values.len();
+                let covered: usize = fused.runs.iter().map(|r| 4 * r[1] as usize).sum();
+                assert!(
+                    2 * covered > fused.types.len(),
+                    "{name}: runs cover most groups"
+                );
+                assert!(fused.sweep_bytes(n) < fused.bytes(), "{name}");
+                assert!(fused.sweep_bytes(n) > stencils, "{name}");
+            }
             let x = x_of(n);
             let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + 0.1 * c).collect() };
             let (r_new, v, a) = (w(1.0), w(-0.7), w(3.0));
