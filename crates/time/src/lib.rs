@@ -26,6 +26,7 @@ mod integrator;
 mod kernels;
 pub mod linalg;
 mod memory;
+pub use memory::fix_thresholds;
 mod modal;
 mod nodal;
 pub mod scenes;
