@@ -150,9 +150,6 @@ fn fail(e: &anyhow::Error) -> ExitCode {
 }
 
 fn main() -> ExitCode {
-    // Large blocks mapped and unmapped whole, so that setup's freed
-    // memory leaves the run (stickslip_time's memory.rs).
-    stickslip_time::fix_thresholds();
     let cli = Cli::parse();
     match cli.command {
         Command::Run {

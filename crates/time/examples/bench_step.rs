@@ -555,8 +555,6 @@ fn run_peer(
 }
 
 fn main() {
-    // As the CLI does (memory.rs in stickslip-time).
-    stickslip_time::fix_thresholds();
     let args: Vec<String> = std::env::args().skip(1).collect();
     if let Some(k) = args.iter().position(|a| a == "--case") {
         let scheme = &args[k + 1];

@@ -543,7 +543,6 @@ impl Integrator {
         loads: Vec<Load>,
         settings: Settings,
     ) -> Result<Integrator, TimeError> {
-        crate::memory::fix_thresholds();
         let n = dynamics.n();
         let (beta, gamma, mass_kind) = check_settings(&settings, n)?;
         // A scene without friction nodes runs no friction code.

@@ -26,7 +26,6 @@ mod integrator;
 mod kernels;
 pub mod linalg;
 mod memory;
-pub use memory::fix_thresholds;
 mod modal;
 mod nodal;
 pub mod scenes;
