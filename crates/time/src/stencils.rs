@@ -1095,12 +1095,6 @@ mod tests {
         }
     }
 
-    /// The sweep with K r_K formed in its own kernel (`sweep_chunk_512`)
-    /// has the bits of the sweep by batches: ṙ_K, r̈_K, the next predictor,
-    /// the strain and kinetic sums and the finiteness flag, with load and
-    /// friction rows (on both sides of chunk seams and inside unit runs),
-    /// on 1 and 2 threads; on slabs numbered row by row and on Gmsh's Q1
-    /// slab, whose nodes with one free DOF shift the rows' lanes.
     /// `rows_at` gives each row `row`'s bits: runs of rows over whole
     /// groups (the vector-wide sums), runs starting or ending inside a
     /// group, single rows, rows out of order and repeated, on a Q1 and a
@@ -1108,20 +1102,7 @@ mod tests {
     /// groups.
     #[test]
     fn rows_at_has_the_bits_of_row() {
-        use stickslip_fem::testing::rectangle;
-        use stickslip_mesh::CellKind;
-        let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes");
-        let rect = |kind, nx, ny| rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
-        let meshes = [
-            ("q1 200x50", rect(CellKind::Quad4, 200, 50), "top"),
-            ("q2 64x16", rect(CellKind::Quad9, 64, 16), "top"),
-            (
-                "slab-q1-128x32.msh",
-                Mesh::from_file(dir.join("slab-q1-128x32.msh")).unwrap(),
-                "support",
-            ),
-        ];
-        for (name, mesh, support) in meshes {
+        for (name, mesh, support) in sweep_meshes() {
             let model = slab_model(&mesh, support);
             let k = &model.stiffness;
             let n = k.nrows();
@@ -1145,14 +1126,15 @@ mod tests {
         }
     }
 
-    #[test]
-    fn fused_sweep_has_the_bits_of_the_batches() {
-        use crate::kernels::{partials, sweep, StepData, CHUNK};
+    /// Q1 and Q2 slabs of several chunks numbered row by row, and Gmsh's
+    /// Q1 slab, whose nodes with one free DOF make one-row groups: name,
+    /// mesh, the group held.
+    fn sweep_meshes() -> [(&'static str, Mesh, &'static str); 3] {
         use stickslip_fem::testing::rectangle;
         use stickslip_mesh::CellKind;
         let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes");
         let rect = |kind, nx, ny| rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
-        let meshes = [
+        [
             ("q1 200x50", rect(CellKind::Quad4, 200, 50), "top"),
             ("q2 64x16", rect(CellKind::Quad9, 64, 16), "top"),
             (
@@ -1160,8 +1142,19 @@ mod tests {
                 Mesh::from_file(dir.join("slab-q1-128x32.msh")).unwrap(),
                 "support",
             ),
-        ];
-        for (name, mesh, support) in meshes {
+        ]
+    }
+
+    /// The sweep with K r_K formed in its own kernel (`sweep_chunk_512`)
+    /// has the bits of the sweep by batches: ṙ_K, r̈_K, the next predictor,
+    /// the strain and kinetic sums and the finiteness flag, with load and
+    /// friction rows (on both sides of chunk seams and inside unit runs),
+    /// on 1 and 2 threads; on slabs numbered row by row and on Gmsh's Q1
+    /// slab, whose nodes with one free DOF shift the rows' lanes.
+    #[test]
+    fn fused_sweep_has_the_bits_of_the_batches() {
+        use crate::kernels::{partials, sweep, StepData, CHUNK};
+        for (name, mesh, support) in sweep_meshes() {
             let model = slab_model(&mesh, support);
             let k = &model.stiffness;
             let n = k.nrows();
