@@ -695,11 +695,6 @@ fn main() {
     // spell (2026-11-24 23:37: the 1M rungs saw 35 GB/s at most, other
     // rungs of the run up to 56.9), so each explicit rung's bandwidth is
     // also given as a share of this.
-    let field = |row: &str, k: &str| {
-        row.split_whitespace()
-            .find_map(|kv| kv.strip_prefix(&format!("{k}=")))
-            .and_then(|v| v.parse::<f64>().ok())
-    };
     let run_max = rows
         .iter()
         .filter_map(|r| field(r, "stream_bw"))

@@ -1546,12 +1546,10 @@ impl RowProduct for Product {
     }
     fn rows_at(&self, rows: &[usize], x: &[f64], out: &mut [f64]) {
         match self {
+            Product::Compact(k) => k.rows_at(rows, x, out),
+            Product::Classes(k) => k.rows_at(rows, x, out),
             Product::Stencils(k) => k.rows_at(rows, x, out),
-            _ => {
-                for (o, &i) in out.iter_mut().zip(rows) {
-                    *o = self.row(i, x);
-                }
-            }
+            Product::Sliced(k) => k.rows_at(rows, x, out),
         }
     }
     fn spmv(&self, x: &[f64], y: &mut [f64]) {

@@ -302,8 +302,9 @@ impl Stencils {
     /// ([`kernels::SweepRows::eight`]), so that their vectors' loads and
     /// stores issue while the next rows' sums run, instead of K r_K of a
     /// 64-row batch into L1 and then the batch's rows (from
-    /// [`FUSED_MIN_ROWS`], which has the figures). K r_K has the bits of [`Stencils::groups_into`] (the same operations per
-    /// row) and the rows the bits of [`kernels::batch_rows`].
+    /// [`FUSED_MIN_ROWS`], which has the figures). K r_K has the bits of
+    /// [`Stencils::groups_into`] (the same operations per row) and the
+    /// rows the bits of [`kernels::batch_rows`].
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx2,fma")]
     #[allow(unsafe_code)]
@@ -334,6 +335,11 @@ impl Stencils {
             unsafe { avx::run_512::<true>(offsets, values, r, count as usize, x, rows) };
             g += 4 * count as usize;
         }
+    }
+
+    /// The group that holds row i.
+    fn group_of(&self, i: usize) -> usize {
+        self.group_rows.partition_point(|&r| r as usize <= i) - 1
     }
 
     /// Type t's blocks: offsets and values.
@@ -863,7 +869,7 @@ impl RowProduct for Stencils {
     }
 
     fn row(&self, i: usize, x: &[f64]) -> f64 {
-        let g = self.group_rows.partition_point(|&r| r as usize <= i) - 1;
+        let g = self.group_of(i);
         let s = self.sums_of(g, x);
         if i == self.group_rows[g] as usize {
             s[0]
@@ -880,7 +886,7 @@ impl RowProduct for Stencils {
         let mut k = 0;
         while k < rows.len() {
             let i = rows[k];
-            let g = self.group_rows.partition_point(|&r| r as usize <= i) - 1;
+            let g = self.group_of(i);
             let r0 = self.group_rows[g] as usize;
             // Rows i, i + 1, … of `rows` from k.
             let on = rows[k..]
