@@ -22,7 +22,11 @@
 //! form every predictor anew, across Remark 4.3's Δt changes). Vector
 //! streams per step: 7 (the sweep reads r_K, m, ṙ, r̈ and writes ṙ_K,
 //! r̈_K, r_{K+1}); 10 with pass A (which reads r, ṙ, r̈ and writes r_K),
-//! 17 with dense loads, 24 for the three passes.
+//! 17 with dense loads, 24 for the three passes. On systems of several
+//! chunks the sweep writes ṙ_K and r̈_K over ṙ and r̈ where the last
+//! sweep's bound shows that it cannot fail half way (`Integrator`'s
+//! `SweepBounds`): stores into lines just read, which the core need not
+//! fetch first.
 //!
 //! Work is split into fixed chunks of [`CHUNK`] DOFs whatever the number of
 //! threads, and sums are formed per chunk and added in chunk order, so a
@@ -213,7 +217,7 @@ pub(crate) fn each_chunk(y: &mut [f64], body: impl Fn(usize, &mut [f64]) + Sync)
 pub(crate) fn each_chunk_summed(
     y: &mut [f64],
     partials: &mut Partials,
-    body: impl Fn(usize, &mut [f64], &mut [f64; 5]) + Sync,
+    body: impl Fn(usize, &mut [f64], &mut [f64; 6]) + Sync,
 ) {
     if parallel(y.len()) {
         y.par_chunks_mut(CHUNK)
@@ -233,7 +237,7 @@ pub(crate) fn each_chunk_pair(
     y: &mut [f64],
     z: &mut [f64],
     partials: &mut Partials,
-    body: impl Fn(usize, &mut [f64], &mut [f64], &mut [f64; 5]) + Sync,
+    body: impl Fn(usize, &mut [f64], &mut [f64], &mut [f64; 6]) + Sync,
 ) {
     if parallel(y.len()) {
         y.par_chunks_mut(CHUNK)
@@ -254,7 +258,7 @@ pub(crate) fn each_chunk_pair(
 fn each_chunk_triple(
     [y, z, w]: [&mut [f64]; 3],
     partials: &mut Partials,
-    body: impl Fn(usize, [&mut [f64]; 3], &mut [f64; 5]) + Sync,
+    body: impl Fn(usize, [&mut [f64]; 3], &mut [f64; 6]) + Sync,
 ) {
     if parallel(y.len()) {
         y.par_chunks_mut(CHUNK)
@@ -294,14 +298,14 @@ pub fn spmv(a: &CsrMatrix<f64>, x: &[f64], y: &mut [f64]) {
 }
 
 /// Per-chunk partial sums, added in chunk order.
-pub type Partials = Vec<[f64; 5]>;
+pub type Partials = Vec<[f64; 6]>;
 
 /// Partial sums for vectors of length n.
 pub fn partials(n: usize) -> Partials {
-    vec![[0.0; 5]; chunks(n)]
+    vec![[0.0; 6]; chunks(n)]
 }
 
-pub(crate) fn total(partials: &[[f64; 5]], k: usize) -> f64 {
+pub(crate) fn total(partials: &[[f64; 6]], k: usize) -> f64 {
     partials.iter().map(|p| p[k]).sum()
 }
 
@@ -455,7 +459,7 @@ pub fn rhs_and_velocity(
     v_new: &mut [f64],
     partials: &mut Partials,
 ) -> f64 {
-    let body = |c: usize, b: &mut [f64], vn: &mut [f64], partial: &mut [f64; 5]| {
+    let body = |c: usize, b: &mut [f64], vn: &mut [f64], partial: &mut [f64; 6]| {
         let range = c * CHUNK..c * CHUNK + b.len();
         let (l, m, rn) = (
             &load_new[range.clone()],
@@ -487,6 +491,9 @@ pub struct Sums {
     pub load_dot: f64,
     /// Every entry of r_K and ṙ_K is finite.
     pub finite: bool,
+    /// The sweep's Σ |ṙ_K| + |r̈_K| + |r_{K+1}| over the rows ([`fused_step`]):
+    /// finite, it bounds every entry of the three; ∞ where not formed.
+    pub bound: f64,
 }
 
 /// Pass C: r̈_K = (ṙ_K − ṙ)·scale − (1−γ)/γ r̈ into `a_new` (scale =
@@ -506,7 +513,7 @@ pub fn accelerate_and_sum(
     a_new: &mut [f64],
     partials: &mut Partials,
 ) -> Sums {
-    let body = |c: usize, an: &mut [f64], partial: &mut [f64; 5]| {
+    let body = |c: usize, an: &mut [f64], partial: &mut [f64; 6]| {
         let range = c * CHUNK..c * CHUNK + an.len();
         let (m, l, ln) = (
             &mass[range.clone()],
@@ -534,6 +541,7 @@ pub fn accelerate_and_sum(
         kinetic: 0.5 * total(partials, 1),
         load_dot: total(partials, 2),
         finite: total(partials, 3) == 0.0,
+        bound: f64::INFINITY,
     }
 }
 
@@ -1406,19 +1414,21 @@ impl<'a> SweepRows<'a, '_> {
             &mut an_out[o..o + 8],
             &mut rx_out[o..o + 8],
         );
-        let (m, v, a, rn) = (
-            &s.mass[i..i + 8],
-            &s.v[i..i + 8],
-            &s.a[i..i + 8],
-            &s.r_new[i..i + 8],
-        );
+        let (m, rn) = (&s.mass[i..i + 8], &s.r_new[i..i + 8]);
+        // ṙ_{K−1} and r̈_{K−1} where ṙ_K and r̈_K go when in place (read
+        // before they are written below).
+        let (v, a) = if s.in_place {
+            (vn_out.as_ptr(), an_out.as_ptr())
+        } else {
+            (s.v[i..i + 8].as_ptr(), s.a[i..i + 8].as_ptr())
+        };
         // SAFETY: the caller's features; every slice above holds 8 doubles.
         unsafe {
             let set = _mm512_set1_pd;
             let (m, v, a, rn) = (
                 _mm512_loadu_pd(m.as_ptr()),
-                _mm512_loadu_pd(v.as_ptr()),
-                _mm512_loadu_pd(a.as_ptr()),
+                _mm512_loadu_pd(v),
+                _mm512_loadu_pd(a),
                 _mm512_loadu_pd(rn.as_ptr()),
             );
             // bi = 0 − ku + m (cv ṙ + ca r̈); ṙ_K = bi / (m scale).
@@ -1447,6 +1457,12 @@ impl<'a> SweepRows<'a, '_> {
             // Row i + k into lane (i + k) mod 4, rows in order.
             let strain = _mm512_mul_pd(rn, ku);
             let kinetic = _mm512_mul_pd(_mm512_mul_pd(m, vn), vn);
+            let abs = _mm512_abs_pd;
+            let bound = _mm512_add_pd(_mm512_add_pd(abs(vn), abs(an)), abs(rx));
+            let mut acc = _mm256_loadu_pd(run.bound.0.as_ptr());
+            acc = _mm256_add_pd(acc, _mm512_castpd512_pd256(bound));
+            acc = _mm256_add_pd(acc, _mm512_extractf64x4_pd::<1>(bound));
+            _mm256_storeu_pd(run.bound.0.as_mut_ptr(), acc);
             for (lanes, t) in [(&mut run.strain, strain), (&mut run.kinetic, kinetic)] {
                 let mut acc = _mm256_loadu_pd(lanes.0.as_ptr());
                 for half in [_mm512_castpd512_pd256(t), _mm512_extractf64x4_pd::<1>(t)] {
@@ -1780,7 +1796,7 @@ pub fn spmv_rhs_and_velocity<K: RowProduct>(
     v_new: &mut [f64],
     partials: &mut Partials,
 ) -> f64 {
-    let body = |c: usize, b: &mut [f64], vn: &mut [f64], partial: &mut [f64; 5]| {
+    let body = |c: usize, b: &mut [f64], vn: &mut [f64], partial: &mut [f64; 6]| {
         let start = c * CHUNK;
         let mut strain = 0.0;
         k.chunk_batches(c, r_new, |r0, kus| {
@@ -1808,10 +1824,13 @@ pub struct StepData<'a> {
     pub mass: &'a [f64],
     /// r_K (the predictor, final for β = 0).
     pub r_new: &'a [f64],
-    /// ṙ_{K−1}.
+    /// ṙ_{K−1} (empty when `in_place`).
     pub v: &'a [f64],
-    /// r̈_{K−1}.
+    /// r̈_{K−1} (empty when `in_place`).
     pub a: &'a [f64],
+    /// The sweep reads ṙ_{K−1} and r̈_{K−1} from its outputs for ṙ_K and
+    /// r̈_K and writes those over them ([`fused_step`]).
+    pub in_place: bool,
     /// Coefficients of R̂_K: 1/(γΔt) and 1/γ − 1.
     pub cv: f64,
     /// See `cv`.
@@ -1825,10 +1844,36 @@ pub struct StepData<'a> {
     pub next: (f64, f64),
 }
 
+impl StepData<'_> {
+    /// The step's coefficients, with no vectors (their slices empty).
+    pub fn coefficients(&self) -> StepData<'static> {
+        StepData {
+            load_new: &[],
+            load_rows: &[],
+            mass: &[],
+            r_new: &[],
+            v: &[],
+            a: &[],
+            in_place: self.in_place,
+            cv: self.cv,
+            ca: self.ca,
+            scale: self.scale,
+            ratio: self.ratio,
+            next: self.next,
+        }
+    }
+}
+
 /// R̂_K at one row from its K r_K (pass B's arithmetic).
 #[inline]
 pub fn rhs_entry(s: &StepData, i: usize, ku: f64) -> f64 {
-    s.load_new[i] - ku + s.mass[i] * (s.cv * s.v[i] + s.ca * s.a[i])
+    rhs_value(s, i, ku, s.v[i], s.a[i])
+}
+
+/// [`rhs_entry`] with row i's ṙ_{K−1} and r̈_{K−1} given.
+#[inline(always)]
+fn rhs_value(s: &StepData, i: usize, ku: f64, v: f64, a: f64) -> f64 {
+    s.load_new[i] - ku + s.mass[i] * (s.cv * v + s.ca * a)
 }
 
 /// A sum over rows in four lanes, row i in lane i mod 4, added
@@ -1907,6 +1952,9 @@ impl Lanes {
 pub(crate) struct Running {
     strain: Lanes,
     kinetic: Lanes,
+    /// Σ |ṙ_K| + |r̈_K| + |r_{K+1}|, for the in-place guard
+    /// (`Integrator`): finite, it bounds every entry of the three.
+    bound: Lanes,
     finite: bool,
     /// Next entries of `load_rows` and `friction`.
     load: usize,
@@ -1919,7 +1967,9 @@ pub(crate) struct Running {
 /// the friction's velocities at the contact DOFs, r̈_K, and the strain and
 /// kinetic sums ([`Lanes`]). Loops over the batch rather than one pass
 /// per row: the first two have no dependence between rows, so their
-/// divisions overlap.
+/// divisions overlap. In place ([`StepData::in_place`]) ṙ_K waits in the
+/// predictor's slot, which is written last, so that the first loops still
+/// read ṙ_{K−1} and r̈_{K−1} where the last writes ṙ_K and r̈_K.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn batch_rows(
@@ -1933,13 +1983,49 @@ fn batch_rows(
     let [vn, an, r_next] = out;
     let n = ku.len();
     let rows = r0..r0 + n;
-    let (m, v, a) = (
-        &s.mass[rows.clone()],
-        &s.v[rows.clone()],
-        &s.a[rows.clone()],
-    );
-    let rn = &s.r_new[rows];
-    let (vn, an, r_next) = (&mut vn[..n], &mut an[..n], &mut r_next[..n]);
+    let rn = &s.r_new[rows.clone()];
+    let r_next = &mut r_next[..n];
+    if s.in_place {
+        let (v, a) = (&mut vn[..n], &mut an[..n]);
+        velocities(s, friction, r0, ku, [&*v, &*a], r_next, run);
+        let mut finite = run.finite;
+        for k in 0..n {
+            let vk = r_next[k];
+            let [ak, rx] = accelerate(s, rn[k], vk, v[k], a[k]);
+            (v[k], a[k], r_next[k]) = (vk, ak, rx);
+            finite &= rn[k].is_finite() & vk.is_finite();
+        }
+        run.finite = finite;
+        sums(s, r0, ku, [&*v, &*a, &*r_next], run);
+    } else {
+        let (v, a) = (&s.v[rows.clone()], &s.a[rows]);
+        let (vn, an) = (&mut vn[..n], &mut an[..n]);
+        velocities(s, friction, r0, ku, [v, a], vn, run);
+        let mut finite = run.finite;
+        for k in 0..n {
+            [an[k], r_next[k]] = accelerate(s, rn[k], vn[k], v[k], a[k]);
+            // `&`, not `&&`: no branch, so the loop stays vectorized.
+            finite &= rn[k].is_finite() & vn[k].is_finite();
+        }
+        run.finite = finite;
+        sums(s, r0, ku, [&*vn, &*an, &*r_next], run);
+    }
+}
+
+/// [`batch_rows`]' ṙ_K into `vn` from ṙ_{K−1} and r̈_{K−1} (`old`).
+#[inline(always)]
+fn velocities(
+    s: &StepData,
+    friction: &[(usize, f64)],
+    r0: usize,
+    ku: &[f64],
+    [v, a]: [&[f64]; 2],
+    vn: &mut [f64],
+    run: &mut Running,
+) {
+    let n = ku.len();
+    let m = &s.mass[r0..r0 + n];
+    let (v, a, vn) = (&v[..n], &a[..n], &mut vn[..n]);
     let (cv, ca, scale) = (s.cv, s.ca, s.scale);
     if s.load_new.len() <= CHUNK {
         // One chunk: the vectors are in cache, so R_K is read densely (+0
@@ -1962,7 +2048,7 @@ fn batch_rows(
     {
         let i = s.load_rows[run.load];
         let k = i - r0;
-        vn[k] = rhs_entry(s, i, ku[k]) / (m[k] * scale);
+        vn[k] = rhs_value(s, i, ku[k], v[k], a[k]) / (m[k] * scale);
         run.load += 1;
     }
     while run.friction < friction.len() && friction[run.friction].0 < r0 + n {
@@ -1970,19 +2056,29 @@ fn batch_rows(
         vn[i - r0] = vi;
         run.friction += 1;
     }
-    let ratio = s.ratio;
-    let (c1, c2) = s.next;
-    let mut finite = run.finite;
-    for k in 0..n {
-        let ak = (vn[k] - v[k]) * s.scale - ratio * a[k];
-        an[k] = ak;
-        r_next[k] = rn[k] + c1 * vn[k] + c2 * ak;
-        // `&`, not `&&`: no branch, so the loop stays vectorized.
-        finite &= rn[k].is_finite() & vn[k].is_finite();
-    }
+}
+
+/// r̈_K and the next predictor r_K + c1 ṙ_K + c2 r̈_K of one row, from
+/// r_K, ṙ_K, ṙ_{K−1} and r̈_{K−1}.
+#[inline(always)]
+fn accelerate(s: &StepData, rn: f64, vn: f64, v: f64, a: f64) -> [f64; 2] {
+    let ak = (vn - v) * s.scale - s.ratio * a;
+    [ak, rn + s.next.0 * vn + s.next.1 * ak]
+}
+
+/// [`batch_rows`]' sums over its rows from r0: strain and kinetic
+/// ([`Lanes`]) and, on systems of more than one chunk (the only ones that
+/// step in place), the in-place guard's Σ |ṙ_K| + |r̈_K| + |r_{K+1}|.
+#[inline(always)]
+fn sums(s: &StepData, r0: usize, ku: &[f64], [vn, an, rx]: [&[f64]; 3], run: &mut Running) {
+    let n = ku.len();
+    let (rn, m) = (&s.r_new[r0..r0 + n], &s.mass[r0..r0 + n]);
     run.strain.add_pairs(r0, rn, ku, |r, u| r * u);
     run.kinetic.add_pairs(r0, m, vn, |m, v| m * v * v);
-    run.finite = finite;
+    if s.mass.len() > CHUNK {
+        run.bound.add_pairs(r0, vn, an, |v, a| v.abs() + a.abs());
+        run.bound.add_pairs(r0, rx, rx, |r, _| r.abs());
+    }
 }
 
 /// [`batch_rows`] compiled for AVX: the same IEEE operations (no fused
@@ -2095,6 +2191,12 @@ pub(crate) fn fma() -> bool {
 /// (`s.next`), with [`predict`]'s operations, so that a next step of the
 /// same Δt skips pass A's sweep (three vector streams read and one
 /// written fewer, one written here: 7 streams a step instead of 10).
+///
+/// With [`StepData::in_place`], `v_new` and `a_new` hold ṙ_{K−1} and
+/// r̈_{K−1} (`s.v`, `s.a` empty), and ṙ_K and r̈_K are written over them:
+/// the same bits, and the lines written were just read, so the core does
+/// not fetch them first (a store to a line not in cache reads it, the
+/// write-allocate the separate outputs paid on 2 of their 3 streams).
 #[allow(clippy::too_many_arguments)]
 pub fn fused_step<K: RowProduct>(
     k: &K,
@@ -2120,11 +2222,12 @@ pub(crate) fn sweep<K: RowProduct>(
     out: [&mut [f64]; 3],
     partials: &mut Partials,
 ) -> (f64, Sums) {
-    let body = |c: usize, [vn, an, rx]: [&mut [f64]; 3], partial: &mut [f64; 5]| {
+    let body = |c: usize, [vn, an, rx]: [&mut [f64]; 3], partial: &mut [f64; 6]| {
         let start = c * CHUNK;
         let mut run = Running {
             strain: Lanes::default(),
             kinetic: Lanes::default(),
+            bound: Lanes::default(),
             finite: true,
             // (Chunk 0, the only one of small systems, starts at both
             // lists' starts: no binary search, a chain of dependent loads.)
@@ -2149,6 +2252,7 @@ pub(crate) fn sweep<K: RowProduct>(
         partial[1] = run.kinetic.total();
         partial[3] = if run.finite { 0.0 } else { 1.0 };
         partial[4] = run.strain.total();
+        partial[5] = run.bound.total();
     };
     each_chunk_triple(out, partials, body);
     (
@@ -2158,6 +2262,11 @@ pub(crate) fn sweep<K: RowProduct>(
             kinetic: 0.5 * total(partials, 1),
             load_dot: total(partials, 2),
             finite: total(partials, 3) == 0.0,
+            bound: if chunks(s.mass.len()) > 1 {
+                total(partials, 5)
+            } else {
+                f64::INFINITY
+            },
         },
     )
 }
@@ -2274,6 +2383,7 @@ pub(crate) mod tests {
             r_new,
             v,
             a,
+            in_place: false,
             cv: 2e3,
             ca: 1.0,
             scale: 2e3,
@@ -2522,6 +2632,7 @@ pub(crate) mod tests {
                     r_new: &r_new,
                     v: &v,
                     a: &zero,
+                    in_place: false,
                     cv: 2.0,
                     ca: 1.0,
                     scale: 2.0,
@@ -2695,6 +2806,7 @@ pub(crate) mod tests {
             r_new: &r_new,
             v: &v,
             a: &a,
+            in_place: false,
             cv: 1.0 / (0.5 * 1e-3),
             ca: 1.0,
             scale: 1.0 / (0.5 * 1e-3),
@@ -3452,8 +3564,20 @@ pub(crate) mod tests {
             let zero = vec![0.0; n];
             let mut ku = vec![0.0; n];
             let data = lab_data(&zero, &m, &rn, &v, &a);
-            let labels = ["K·x", "vectors (K·x given)", "sweep, SSE2", "sweep"];
-            let mut t: [Vec<f64>; 4] = Default::default();
+            let labels = [
+                "K·x",
+                "vectors (K·x given)",
+                "sweep, SSE2",
+                "sweep",
+                "sweep in place",
+            ];
+            let mut t: [Vec<f64>; 5] = Default::default();
+            let in_place = StepData {
+                v: &[],
+                a: &[],
+                in_place: true,
+                ..data
+            };
             on_threads(2, || {
                 let mut p = partials(n);
                 let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
@@ -3470,6 +3594,7 @@ pub(crate) mod tests {
                         let mut run = Running {
                             strain: Lanes::default(),
                             kinetic: Lanes::default(),
+                            bound: Lanes::default(),
                             finite: true,
                             load: 0,
                             friction: 0,
@@ -3486,6 +3611,14 @@ pub(crate) mod tests {
                         sweep(avx, &stencils, &data, &[], None, out, &mut p);
                         t[slot].push(s.elapsed().as_secs_f64());
                     }
+                    // In place: ṙ and r̈ handed in the outputs (copied
+                    // first, untimed, so that each round starts alike).
+                    vn.copy_from_slice(&v);
+                    an.copy_from_slice(&a);
+                    let s = Instant::now();
+                    let out = [&mut vn[..], &mut an[..], &mut rx[..]];
+                    sweep(avx(), &stencils, &in_place, &[], None, out, &mut p);
+                    t[4].push(s.elapsed().as_secs_f64());
                 }
             });
             println!("{name}: n = {n}, {} stencil types", stencils.types());

@@ -1155,8 +1155,10 @@ mod tests {
     /// has the bits of the sweep by batches: ṙ_K, r̈_K, the next predictor,
     /// the strain and kinetic sums and the finiteness flag, with load and
     /// friction rows (on both sides of chunk seams and inside unit runs),
-    /// on 1 and 2 threads; on slabs numbered row by row and on Gmsh's Q1
-    /// slab, whose nodes with one free DOF shift the rows' lanes.
+    /// on 1 and 2 threads, apart and in place (both kernels); on slabs
+    /// numbered row by row and on Gmsh's Q1 slab, whose nodes with one
+    /// free DOF shift the rows' lanes. The in-place guard's bound is the
+    /// sum of the three vectors' magnitudes.
     #[test]
     fn fused_sweep_has_the_bits_of_the_batches() {
         use crate::kernels::{partials, sweep, StepData, CHUNK};
@@ -1211,25 +1213,51 @@ mod tests {
                 r_new: &r_new,
                 v: &v,
                 a: &a,
+                in_place: false,
                 cv: 2e3,
                 ca: 1.0,
                 scale: 2e3,
                 ratio: 1.0,
                 next: (1e-3, 0.5e-6),
             };
-            let run = |s: &Stencils, threads: usize| {
-                let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            // In place: ṙ_{K−1} and r̈_{K−1} handed in the outputs.
+            let in_place = StepData {
+                v: &[],
+                a: &[],
+                in_place: true,
+                ..data
+            };
+            let run = |s: &Stencils, threads: usize, here: bool| {
+                let (mut vn, mut an, mut rx) = if here {
+                    (v.clone(), a.clone(), vec![0.0; n])
+                } else {
+                    (vec![0.0; n], vec![0.0; n], vec![0.0; n])
+                };
                 let mut p = partials(n);
                 let (strain, sums) = on_threads(threads, || {
                     let out = [&mut vn[..], &mut an[..], &mut rx[..]];
-                    sweep(kernels::avx(), s, &data, &friction, None, out, &mut p)
+                    let data = if here { &in_place } else { &data };
+                    sweep(kernels::avx(), s, data, &friction, None, out, &mut p)
                 });
+                // The guard's bound: the sum of the magnitudes, whatever
+                // its order of additions.
+                let exact: f64 = (0..n)
+                    .map(|i| vn[i].abs() + an[i].abs() + rx[i].abs())
+                    .sum();
+                let what = format!("{name}, {threads} threads, in place {here}");
+                assert!((sums.bound - exact).abs() <= 1e-12 * exact, "{what}: bound");
                 (strain, sums.kinetic, sums.finite, vn, an, rx)
             };
-            let reference = run(&batched, 1);
-            for threads in [1, 2] {
-                let got = run(&fused, threads);
-                let what = format!("{name}, {threads} threads (fused kernel ran: {ran})");
+            let reference = run(&batched, 1, false);
+            for (threads, kernel, here) in [1, 2]
+                .into_iter()
+                .flat_map(|t| [(t, &fused, false), (t, &fused, true), (t, &batched, true)])
+            {
+                let got = run(kernel, threads, here);
+                let fused_ran = ran && std::ptr::eq(kernel, &fused);
+                let what = format!(
+                    "{name}, {threads} threads, in place {here} (fused kernel ran: {fused_ran})"
+                );
                 assert_eq!(reference.0.to_bits(), got.0.to_bits(), "{what}: strain");
                 assert_eq!(reference.1.to_bits(), got.1.to_bits(), "{what}: kinetic");
                 assert!(reference.2 && got.2, "{what}: finite");
