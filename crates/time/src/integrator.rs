@@ -426,8 +426,11 @@ pub struct Integrator {
 ///
 /// The in-place sweep stores into lines it has just read; apart, 2 of its
 /// 3 outputs are stores to lines not in cache, which the core reads
-/// first. `sweep_lab`, 2026-11-25, 1M DOFs, 2 threads, medians of 20 in
-/// two runs: Q1 2.30 → 2.03, 2.21 → 1.87 ms; Q2 2.44 → 2.31, 2.21 → 2.13.
+/// first. `sweep_lab` ("sweep" against "sweep in place", alternating in
+/// one process), 2026-11-25, 1M DOFs, 2 threads, medians of 20, three
+/// runs: Q1 0.87, 0.90, 0.94 of the time apart (1.65-1.75 ms); Q2 0.98,
+/// 1.00, 0.98 (2.53-2.61 ms), whose sums keep the core busier than its
+/// stores do.
 #[derive(Clone, Copy, Debug)]
 struct SweepBounds {
     /// max_i Σ_j |K_ij|.
