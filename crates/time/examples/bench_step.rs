@@ -453,8 +453,11 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         let (dict, blocks) = i.explicit_dictionary().unwrap_or((0, 0));
         let classes = i.explicit_classes().unwrap_or(0);
         let stencils = i.explicit_stencils().unwrap_or(0);
+        // The share of the steps swept in place (several chunks; the first
+        // step of each Δt forms its predictor apart).
+        let in_place = i.in_place_steps() as f64 / i.steps().max(1) as f64;
         format!(
-            "dict_blocks={dict} of_blocks={blocks} element_classes={classes} stencil_types={stencils} bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1} stream_bw_median={bw_median:.4e} pct_stream_paired={:.1}",
+            "dict_blocks={dict} of_blocks={blocks} element_classes={classes} stencil_types={stencils} bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1} stream_bw_median={bw_median:.4e} pct_stream_paired={:.1} in_place={in_place:.3}",
             bytes / per_step.0,
             100.0 * bytes / per_step.0 / bw,
             100.0 * paired
