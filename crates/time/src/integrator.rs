@@ -397,7 +397,7 @@ pub struct Integrator {
     /// What bounds a sweep's entries by its inputs' ([`SweepBounds`]),
     /// explicit runs of more than one chunk.
     sweep_bounds: Option<SweepBounds>,
-    /// Explicit steps swept in place.
+    /// Explicit steps swept in place since the integrator was made.
     in_place_steps: u64,
     /// K as the explicit step reads it (`kernels::Product`: the compact
     /// form or the element classes); the CSR K is then no longer held.
@@ -1825,8 +1825,9 @@ impl Integrator {
     pub fn steps(&self) -> u64 {
         self.steps
     }
-    /// Explicit steps swept in place ([`kernels::fused_step`]: ṙ_K and
-    /// r̈_K written over ṙ_{K−1} and r̈_{K−1}).
+    /// Explicit steps this integrator swept in place since it was made
+    /// ([`kernels::fused_step`]: ṙ_K and r̈_K written over ṙ_{K−1} and
+    /// r̈_{K−1}; not part of a checkpoint, not reset by a restore).
     pub fn in_place_steps(&self) -> u64 {
         self.in_place_steps
     }
