@@ -1337,43 +1337,15 @@ impl Integrator {
                 // In place when the last sweep's bound and this step's
                 // loads and friction show that no entry can overflow: a
                 // failed step then never leaves a state half written.
+                // (Both out of line: inlined into this function they cost
+                // the paper mesh's step, which never takes them, 7-10%.)
                 in_place = match (predicted, &self.sweep_bounds) {
-                    (Some((_, bound)), Some(b)) => {
-                        let loads = self.sparse_loads.rows().iter();
-                        let l: f64 = loads.map(|&i| data.load_new[i].abs()).sum();
-                        let f: f64 = self.friction.iter().map(|&(_, v)| v.abs()).sum();
-                        b.finite(bound, l, f, &data)
-                    }
+                    (Some((_, bound)), Some(b)) => self.may_sweep_in_place(b, bound, &data),
                     _ => false,
                 };
                 let (strain, sums) = if in_place {
-                    // The ledger's ṙ_{K−1} at the contact DOFs, where the
-                    // sweep writes ṙ_K.
-                    for &(i, _) in &self.friction {
-                        self.v_new[i] = self.v[i];
-                    }
-                    // (Formed anew, not `..data`: that would keep v and
-                    // a borrowed.)
-                    let data = kernels::StepData {
-                        load_new: &self.load_new,
-                        load_rows: self.sparse_loads.rows(),
-                        mass: &self.dynamics.lumped_mass,
-                        r_new: &self.r_new,
-                        v: &[],
-                        a: &[],
-                        in_place: true,
-                        ..data.coefficients()
-                    };
-                    kernels::fused_step(
-                        k,
-                        &data,
-                        &self.friction,
-                        None,
-                        &mut self.v,
-                        &mut self.a,
-                        &mut self.r_next,
-                        &mut self.partials,
-                    )
+                    let coefficients = data.coefficients();
+                    self.sweep_in_place(coefficients)
                 } else {
                     kernels::fused_step(
                         k,
@@ -1761,6 +1733,48 @@ impl Integrator {
 
     /// The step's NaN/infinity error, with the critical step as advice for
     /// an explicit run.
+    /// Whether this step's sweep may go in place ([`SweepBounds`]): the
+    /// last sweep's `bound`, the loads on their rows and the friction's
+    /// velocities (formed before the sweep) bound all it can form.
+    #[inline(never)]
+    fn may_sweep_in_place(&self, b: &SweepBounds, bound: f64, data: &kernels::StepData) -> bool {
+        let loads = self.sparse_loads.rows().iter();
+        let l: f64 = loads.map(|&i| data.load_new[i].abs()).sum();
+        let f: f64 = self.friction.iter().map(|&(_, v)| v.abs()).sum();
+        b.finite(bound, l, f, data)
+    }
+
+    /// The closed-form step's sweep in place: ṙ_K and r̈_K over ṙ and r̈
+    /// (`kernels::fused_step`), the step's `coefficients`; ṙ_{K−1} at the
+    /// contact DOFs kept in `v_new` for the ledger.
+    #[inline(never)]
+    fn sweep_in_place(&mut self, coefficients: kernels::StepData<'static>) -> (f64, kernels::Sums) {
+        let k = self.product.as_ref().expect("an explicit product");
+        for &(i, _) in &self.friction {
+            self.v_new[i] = self.v[i];
+        }
+        let data = kernels::StepData {
+            load_new: &self.load_new,
+            load_rows: self.sparse_loads.rows(),
+            mass: &self.dynamics.lumped_mass,
+            r_new: &self.r_new,
+            v: &[],
+            a: &[],
+            in_place: true,
+            ..coefficients
+        };
+        kernels::fused_step(
+            k,
+            &data,
+            &self.friction,
+            None,
+            &mut self.v,
+            &mut self.a,
+            &mut self.r_next,
+            &mut self.partials,
+        )
+    }
+
     fn non_finite(&self, step: u64, t: f64) -> TimeError {
         let hint = match self.dt_crit {
             Some(c) => format!(" below the critical step Δt_crit = {c:.4e}"),
