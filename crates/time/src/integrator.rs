@@ -1731,8 +1731,6 @@ impl Integrator {
         self.settings.t_end = t_end;
     }
 
-    /// The step's NaN/infinity error, with the critical step as advice for
-    /// an explicit run.
     /// Whether this step's sweep may go in place ([`SweepBounds`]): the
     /// last sweep's `bound`, the loads on their rows and the friction's
     /// velocities (formed before the sweep) bound all it can form.
@@ -1775,6 +1773,8 @@ impl Integrator {
         )
     }
 
+    /// The step's NaN/infinity error, with the critical step as advice for
+    /// an explicit run.
     fn non_finite(&self, step: u64, t: f64) -> TimeError {
         let hint = match self.dt_crit {
             Some(c) => format!(" below the critical step Δt_crit = {c:.4e}"),
