@@ -688,13 +688,32 @@ mod avx {
     /// call per block (40% of the Q2 1M step's samples, 2026-11-25).
     #[cfg(target_arch = "x86_64")]
     pub(super) trait Sink {
+        /// What the sink keeps in registers over a run.
+        type Regs: Copy;
+        /// A run's blocks from `row` on are coming.
+        ///
+        /// # Safety
+        /// As for [`Sink::put`].
+        #[allow(unsafe_code)]
+        unsafe fn begin(&mut self, row: usize) -> Self::Regs;
         /// Rows row..row + 8 sum to `sum`.
         ///
         /// # Safety
         /// The CPU has AVX-512 (foundation), and AVX2 for the sweep's rows
         /// ([`crate::kernels::SweepRows::eight`]).
         #[allow(unsafe_code)]
-        unsafe fn put(&mut self, row: usize, sum: std::arch::x86_64::__m512d);
+        unsafe fn put(
+            &mut self,
+            regs: &mut Self::Regs,
+            row: usize,
+            sum: std::arch::x86_64::__m512d,
+        );
+        /// The run is over.
+        ///
+        /// # Safety
+        /// As for [`Sink::put`].
+        #[allow(unsafe_code)]
+        unsafe fn end(&mut self, regs: Self::Regs);
     }
 
     /// [`body_512`]'s sink: the sums stored into `out` from row r.
@@ -706,9 +725,16 @@ mod avx {
 
     #[cfg(target_arch = "x86_64")]
     impl Sink for Stored<'_> {
+        type Regs = ();
         #[inline(always)]
         #[allow(unsafe_code)]
-        unsafe fn put(&mut self, row: usize, sum: std::arch::x86_64::__m512d) {
+        unsafe fn begin(&mut self, _row: usize) {}
+        #[inline(always)]
+        #[allow(unsafe_code)]
+        unsafe fn end(&mut self, _regs: ()) {}
+        #[inline(always)]
+        #[allow(unsafe_code)]
+        unsafe fn put(&mut self, _regs: &mut (), row: usize, sum: std::arch::x86_64::__m512d) {
             let o = &mut self.out[row - self.r..row - self.r + 8];
             // SAFETY: the caller's features; o holds 8 doubles.
             unsafe { std::arch::x86_64::_mm512_storeu_pd(o.as_mut_ptr(), sum) };
@@ -717,11 +743,29 @@ mod avx {
 
     #[cfg(target_arch = "x86_64")]
     impl Sink for crate::kernels::SweepRows<'_, '_> {
+        type Regs = crate::kernels::SumRegs;
         #[inline(always)]
         #[allow(unsafe_code)]
-        unsafe fn put(&mut self, row: usize, sum: std::arch::x86_64::__m512d) {
+        unsafe fn begin(&mut self, row: usize) -> Self::Regs {
             // SAFETY: the caller's features.
-            unsafe { self.eight(row, sum) };
+            unsafe { self.begin_sums(row) }
+        }
+        #[inline(always)]
+        #[allow(unsafe_code)]
+        unsafe fn end(&mut self, regs: Self::Regs) {
+            // SAFETY: the caller's features.
+            unsafe { self.end_sums(regs) }
+        }
+        #[inline(always)]
+        #[allow(unsafe_code)]
+        unsafe fn put(
+            &mut self,
+            regs: &mut Self::Regs,
+            row: usize,
+            sum: std::arch::x86_64::__m512d,
+        ) {
+            // SAFETY: the caller's features.
+            unsafe { self.eight(regs, row, sum) };
         }
     }
 
@@ -753,24 +797,26 @@ mod avx {
     ) {
         let mut j = 0;
         // SAFETY (each block): the caller's.
+        let mut regs = unsafe { f.begin(r) };
         while j + 4 <= blocks {
             let sums = unsafe { lockstep_512::<F, 4>(offsets, values, r + 8 * j, x) };
             for (q, sum) in sums.into_iter().enumerate() {
-                unsafe { f.put(r + 8 * (j + q), sum) };
+                unsafe { f.put(&mut regs, r + 8 * (j + q), sum) };
             }
             j += 4;
         }
         if j + 2 <= blocks {
             let sums = unsafe { lockstep_512::<F, 2>(offsets, values, r + 8 * j, x) };
             for (q, sum) in sums.into_iter().enumerate() {
-                unsafe { f.put(r + 8 * (j + q), sum) };
+                unsafe { f.put(&mut regs, r + 8 * (j + q), sum) };
             }
             j += 2;
         }
         if j < blocks {
             let [sum] = unsafe { lockstep_512::<F, 1>(offsets, values, r + 8 * j, x) };
-            unsafe { f.put(r + 8 * j, sum) };
+            unsafe { f.put(&mut regs, r + 8 * j, sum) };
         }
+        unsafe { f.end(regs) };
     }
 
     /// The sums of N blocks of 8 rows from row r ([`run_512`]): per
