@@ -3627,6 +3627,12 @@ pub(crate) mod tests {
     /// both orders alternating in one process, Q2 1M: K·x 1.27 against
     /// 1.25 ms, the sweep in place 2.27 against 2.20: the FMAs saved buy
     /// nothing, and a node row's neighbours then sit in two places of x.
+    /// Non-temporal stores of r_{K+1} alone, in place (ṙ and r̈ read
+    /// just before are written back from cache; r_{K+1}'s lines then
+    /// skip their read for ownership), zmm where 64-byte aligned and xmm
+    /// elsewhere, a fence per chunk, alternating with the kept sweep in
+    /// one process, 2026-11-25 15:50, three runs: Q1 1M 1.04-1.08, Q2 1M
+    /// 1.04-1.07 of its time (medians). Not kept.
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn sweep_lab() {
