@@ -3633,6 +3633,19 @@ pub(crate) mod tests {
     /// elsewhere, a fence per chunk, alternating with the kept sweep in
     /// one process, 2026-11-25 15:50, three runs: Q1 1M 1.04-1.08, Q2 1M
     /// 1.04-1.07 of its time (medians). Not kept.
+    /// What does not bound the fused sweep (2026-11-25 15:40-16:35, each
+    /// variant switched at run time and alternating with the kept sweep
+    /// in place in one process, three runs, ratios of medians; the
+    /// variants give wrong numbers and were never kept): the lumped mass
+    /// as a constant register instead of its stream (an eighth of the
+    /// bytes) Q1 1M 0.74-0.95, Q2 1M 0.98-1.03; no finiteness check, no
+    /// bound sum and the two other sums 8 wide with no reduction to 4
+    /// lanes (a third of the per-row instructions) Q1 0.95-0.98, Q2
+    /// 0.93-1.03; the division as a multiplication Q1 0.98-1.01, Q2
+    /// 0.97-1.03. K·x alone (its unaligned loads of x, the swaps and the
+    /// FMAs, about 8 cycles each per offset and 32 rows) is the larger
+    /// part: at 250k DOFs, where the vectors sit in the L3, it takes the
+    /// same time per row as at 1M (Q2 0.32 against 1.33 ms).
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn sweep_lab() {
