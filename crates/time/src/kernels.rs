@@ -3645,7 +3645,13 @@ pub(crate) mod tests {
     /// 0.97-1.03. K·x alone (its unaligned loads of x, the swaps and the
     /// FMAs, about 8 cycles each per offset and 32 rows) is the larger
     /// part: at 250k DOFs, where the vectors sit in the L3, it takes the
-    /// same time per row as at 1M (Q2 0.32 against 1.33 ms).
+    /// same time per row as at 1M (Q2 0.32 against 1.33 ms). Nor do
+    /// K·x's loads of x from the L2 bound it (the window of ±2 grid rows
+    /// is 90 KB on the Q2 708×177 slab, beyond the 32 KB L1): the same
+    /// DOFs on a slab four times narrower (Q2 177×708, a 23 KB window)
+    /// took K·x 1.84-2.02 against 1.48-1.69 ms, Q1 354×1416 0.87-1.02
+    /// against 0.94-1.08 ms (two runs, 17:00), so tiling the sweep into
+    /// strips would not pay.
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
     fn sweep_lab() {
