@@ -3641,7 +3641,7 @@ pub(crate) mod tests {
     /// bytes) Q1 1M 0.74-0.95, Q2 1M 0.98-1.03; no finiteness check, no
     /// bound sum and the two other sums 8 wide with no reduction to 4
     /// lanes (a third of the per-row instructions) Q1 0.95-0.98, Q2
-    /// 0.93-1.03; the division as a multiplication Q1 0.98-1.01, Q2
+    /// 0.89-1.03; the division as a multiplication Q1 0.98-1.01, Q2
     /// 0.97-1.03. K·x alone (its unaligned loads of x, the swaps and the
     /// FMAs, about 8 cycles each per offset and 32 rows) is the larger
     /// part: at 250k DOFs, where the vectors sit in the L3, it takes the
