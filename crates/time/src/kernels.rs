@@ -1489,7 +1489,7 @@ impl<'a> SweepRows<'a, '_> {
     /// 2026-11-25, the fused sweep took 0.88-0.90 of its time without
     /// those sums). `sweep_lab`'s sweep in place, this build against the
     /// one before alternating, three runs each, fastest of 20, 2026-11-25
-    /// 15:20: Q1 1M 1.50-1.59 against 1.63-1.66 ms, Q2 1M 2.06-2.09
+    /// 14:55: Q1 1M 1.50-1.59 against 1.63-1.66 ms, Q2 1M 2.06-2.09
     /// against 2.10-2.23 ms.
     ///
     /// # Safety
@@ -3631,9 +3631,9 @@ pub(crate) mod tests {
     /// just before are written back from cache; r_{K+1}'s lines then
     /// skip their read for ownership), zmm where 64-byte aligned and xmm
     /// elsewhere, a fence per chunk, alternating with the kept sweep in
-    /// one process, 2026-11-25 15:50, three runs: Q1 1M 1.04-1.08, Q2 1M
+    /// one process, 2026-11-25 15:05, three runs: Q1 1M 1.04-1.08, Q2 1M
     /// 1.04-1.07 of its time (medians). Not kept.
-    /// What does not bound the fused sweep (2026-11-25 15:40-16:35, each
+    /// What does not bound the fused sweep (2026-11-25 15:00-15:20, each
     /// variant switched at run time and alternating with the kept sweep
     /// in place in one process, three runs, ratios of medians; the
     /// variants give wrong numbers and were never kept): the lumped mass
@@ -3650,7 +3650,7 @@ pub(crate) mod tests {
     /// is 90 KB on the Q2 708×177 slab, beyond the 32 KB L1): the same
     /// DOFs on a slab four times narrower (Q2 177×708, a 23 KB window)
     /// took K·x 1.84-2.02 against 1.48-1.69 ms, Q1 354×1416 0.87-1.02
-    /// against 0.94-1.08 ms (two runs, 17:00), so tiling the sweep into
+    /// against 0.94-1.08 ms (two runs, 15:25), so tiling the sweep into
     /// strips would not pay.
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
