@@ -1489,7 +1489,7 @@ impl<'a> SweepRows<'a, '_> {
     /// 2026-11-25, the fused sweep took 0.88-0.90 of its time without
     /// those sums). `sweep_lab`'s sweep in place, this build against the
     /// one before alternating, three runs each, fastest of 20, 2026-11-25
-    /// 14:55: Q1 1M 1.50-1.59 against 1.63-1.66 ms, Q2 1M 2.06-2.09
+    /// 14:48: Q1 1M 1.50-1.59 against 1.63-1.66 ms, Q2 1M 2.06-2.09
     /// against 2.10-2.23 ms.
     ///
     /// # Safety
@@ -3631,9 +3631,9 @@ pub(crate) mod tests {
     /// just before are written back from cache; r_{K+1}'s lines then
     /// skip their read for ownership), zmm where 64-byte aligned and xmm
     /// elsewhere, a fence per chunk, alternating with the kept sweep in
-    /// one process, 2026-11-25 15:05, three runs: Q1 1M 1.04-1.08, Q2 1M
+    /// one process, 2026-11-25 14:55, three runs: Q1 1M 1.04-1.08, Q2 1M
     /// 1.04-1.07 of its time (medians). Not kept.
-    /// What does not bound the fused sweep (2026-11-25 15:00-15:20, each
+    /// What does not bound the fused sweep (2026-11-25 14:57-15:13, each
     /// variant switched at run time and alternating with the kept sweep
     /// in place in one process, three runs, ratios of medians; the
     /// variants give wrong numbers and were never kept): the lumped mass
@@ -3650,7 +3650,7 @@ pub(crate) mod tests {
     /// is 90 KB on the Q2 708×177 slab, beyond the 32 KB L1): the same
     /// DOFs on a slab four times narrower (Q2 177×708, a 23 KB window)
     /// took K·x 1.84-2.02 against 1.48-1.69 ms, Q1 354×1416 0.87-1.02
-    /// against 0.94-1.08 ms (two runs, 15:25), so tiling the sweep into
+    /// against 0.94-1.08 ms (two runs, 15:19), so tiling the sweep into
     /// strips would not pay.
     #[test]
     #[ignore = "timing; run by hand (see the doc comment)"]
@@ -3736,6 +3736,103 @@ pub(crate) mod tests {
                     1e3 * t[0]
                 );
             }
+        }
+    }
+
+    /// A copy of `src` starting at byte `offset` of a 4 KiB page (64-byte
+    /// steps), in a buffer it returns beside the slice's start.
+    fn at_page_offset(src: &[f64], offset: usize) -> (Vec<f64>, usize) {
+        let mut buf = vec![0.0; src.len() + 1024];
+        let base = buf.as_ptr() as usize;
+        let start = (0..1024)
+            .find(|&k| (base + 8 * k) % 4096 == offset)
+            .expect("a 4 KiB page holds every 8-byte offset");
+        buf[start..start + src.len()].copy_from_slice(src);
+        (buf, start)
+    }
+
+    /// Whether the page offsets of the sweep's five vectors (m, r_K, ṙ,
+    /// r̈, r_{K+1}) matter: the sweep in place with all five at one
+    /// offset against three spreads, alternating in one process, 2
+    /// threads, median (fastest) of 29 rounds, ms. Run by hand:
+    ///
+    ///     cargo test --release -p stickslip-time --lib page_offset_lab -- --ignored --nocapture
+    ///
+    /// 2026-11-25 15:40-15:50, five runs: at one offset the fastest round
+    /// took 1.04-1.12 of the best spread's on Q1 1M and 1.03-1.08 on Q2
+    /// 1M; the spreads among themselves within the noise. The
+    /// integrator's own vectors come from the heap at offsets already
+    /// apart (the Q2 708×177 bench rung, two runs: m 3056, r_K 3072 /
+    /// 960 / 2880 as the three buffers turn, ṙ 1120, r̈ 768 or 880), so
+    /// there is nothing to gain by placing them.
+    #[test]
+    #[ignore = "timing lab"]
+    fn page_offset_lab() {
+        use std::time::Instant;
+        let meshes = std::env::var("STICKSLIP_LAB_MESHES")
+            .unwrap_or_else(|_| "q1-1416x354,q2-708x177".into());
+        // Page offsets (bytes) of m, r_K, ṙ, r̈, r_{K+1}.
+        let layouts: [(&str, [usize; 5]); 4] = [
+            ("same", [0, 0, 0, 0, 0]),
+            ("spread 576", [0, 576, 1152, 1728, 2304]),
+            ("spread 832", [0, 832, 1664, 2496, 3328]),
+            ("spread 320", [0, 320, 640, 960, 1280]),
+        ];
+        for name in meshes.split(',') {
+            let (_, _, model) = lab_slab(name);
+            let n = model.stiffness.nrows();
+            let stencils = Stencils::new(&model.stiffness).expect("structured");
+            drop(model);
+            let x = x_of(n);
+            let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
+            let (rn0, m0, v0, a0) = (w(1.3), w(1.2), w(1.5), w(1.6));
+            let zero = vec![0.0; n];
+            let mut t: Vec<Vec<f64>> = vec![Vec::new(); layouts.len()];
+            let bufs: Vec<_> = layouts
+                .iter()
+                .map(|(_, o)| {
+                    [
+                        at_page_offset(&m0, o[0]),
+                        at_page_offset(&rn0, o[1]),
+                        at_page_offset(&v0, o[2]),
+                        at_page_offset(&a0, o[3]),
+                        at_page_offset(&zero, o[4]),
+                    ]
+                })
+                .collect();
+            let mut bufs = bufs;
+            on_threads(2, || {
+                let mut p = partials(n);
+                for round in 0..30 {
+                    for (l, b) in bufs.iter_mut().enumerate() {
+                        let [(mb, ms), (rb, rs), (vb, vs), (ab, as_), (xb, xs)] = b;
+                        vb[*vs..*vs + n].copy_from_slice(&v0);
+                        ab[*as_..*as_ + n].copy_from_slice(&a0);
+                        let data = StepData {
+                            v: &[],
+                            a: &[],
+                            in_place: true,
+                            ..lab_data(&zero, &mb[*ms..*ms + n], &rb[*rs..*rs + n], &[], &[])
+                        };
+                        let (vn, an, rx) = (
+                            &mut vb[*vs..*vs + n],
+                            &mut ab[*as_..*as_ + n],
+                            &mut xb[*xs..*xs + n],
+                        );
+                        let s = Instant::now();
+                        sweep(avx(), &stencils, &data, &[], None, [vn, an, rx], &mut p);
+                        if round > 0 {
+                            t[l].push(s.elapsed().as_secs_f64());
+                        }
+                    }
+                }
+            });
+            print!("{name}:");
+            for ((label, _), t) in layouts.iter().zip(&mut t) {
+                t.sort_by(f64::total_cmp);
+                print!("  {label} {:.3} ({:.3})", 1e3 * t[t.len() / 2], 1e3 * t[0]);
+            }
+            println!(" ms");
         }
     }
 
