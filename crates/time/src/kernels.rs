@@ -3758,7 +3758,7 @@ pub(crate) mod tests {
     ///
     ///     cargo test --release -p stickslip-time --lib page_offset_lab -- --ignored --nocapture
     ///
-    /// 2026-11-25 15:40-15:50, five runs: at one offset the fastest round
+    /// 2026-11-25 15:33-15:35, five runs: at one offset the fastest round
     /// took 1.04-1.12 of the best spread's on Q1 1M and 1.03-1.08 on Q2
     /// 1M; the spreads among themselves within the noise. The
     /// integrator's own vectors come from the heap at offsets already
