@@ -124,6 +124,9 @@ pub struct Supernodal {
     w: Vec<f64>,
     tmp: Vec<f64>,
     scratch: [BinScratch; 2],
+    /// How far ahead the solves ask for L ([`prefetch_block`]; 0: not at
+    /// all, which only the timing lab sets).
+    prefetch: usize,
 }
 
 impl std::fmt::Debug for Supernodal {
@@ -215,6 +218,7 @@ impl Supernodal {
             w: vec![0.0; n],
             tmp: vec![0.0; max_pattern],
             scratch: Default::default(),
+            prefetch: PREFETCH,
         };
         this.split_tree(split_min);
         this.reach = Plan {
@@ -758,6 +762,7 @@ impl Supernodal {
         let plan = if reach { &self.reach } else { &self.full };
         for &s in &plan.top {
             let s = s as usize;
+            prefetch_block(l, &self.val_ptr, s, true, self.prefetch);
             let (c0, c1) = (self.begin[s], self.begin[s + 1]);
             let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
             let tmp = &mut self.tmp[..pattern.len()];
@@ -804,6 +809,7 @@ impl Supernodal {
         sc.acc.fill(0.0);
         for &s in list {
             let s = s as usize;
+            prefetch_block(l, &self.val_ptr, s, true, self.prefetch);
             let c0 = self.slot[self.begin[s]] as usize;
             let k = self.begin[s + 1] - self.begin[s];
             let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
@@ -830,6 +836,7 @@ impl Supernodal {
         let plan = if reach { &self.reach } else { &self.full };
         for &s in plan.top.iter().rev() {
             let s = s as usize;
+            prefetch_block(l, &self.val_ptr, s, false, self.prefetch);
             let (c0, c1) = (self.begin[s], self.begin[s + 1]);
             let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
             let tmp = &mut self.tmp[..pattern.len()];
@@ -857,6 +864,7 @@ impl Supernodal {
         }
         for &s in list.iter().rev() {
             let s = s as usize;
+            prefetch_block(l, &self.val_ptr, s, false, self.prefetch);
             let c0 = self.slot[self.begin[s]] as usize;
             let k = self.begin[s + 1] - self.begin[s];
             let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
@@ -877,6 +885,47 @@ impl Supernodal {
         }
     }
 }
+
+/// Asks for the lines of L `distance` values ([`PREFETCH`]) past supernode s's block
+/// (`ahead`: the forward solve, which visits the blocks in the order they
+/// are stored) or before it (the back solve, which visits them in reverse),
+/// each line once over a pass, so that L streams in ahead of the columns'
+/// axpys and dots. The hardware's prefetchers alone left the solve waiting
+/// on L's lines: the loads of the dot products held most of the samples.
+#[inline(always)]
+fn prefetch_block(l: &[f64], val_ptr: &[usize], s: usize, ahead: bool, distance: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if distance > 0 {
+        let (a, b) = (val_ptr[s], val_ptr[s + 1]);
+        let (a, b) = if ahead {
+            ((a + distance).min(l.len()), (b + distance).min(l.len()))
+        } else {
+            (a.saturating_sub(distance), b.saturating_sub(distance))
+        };
+        let mut i = a & !7;
+        while i < b {
+            // SAFETY: i < b <= l.len(): an address inside `l` (a prefetch
+            // reads nothing into the program either way).
+            #[allow(unsafe_code)]
+            unsafe {
+                std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+                    l.as_ptr().add(i).cast(),
+                );
+            }
+            i += 8;
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (l, val_ptr, s, ahead, distance);
+}
+
+/// How far ahead of the solve [`prefetch_block`] asks for L, in values (16
+/// KB). `prefetch_lab`, one solve on the Q2 352×88 slab's operator (29.3M
+/// values), 2026-11-25, distances 0 / 1024 / 2048 / 4096 alternating in one
+/// process, three runs, medians of 15: one thread 70.9-72.0 / 60.2-60.6 /
+/// 60.1-61.1 / 60.5-61.0 ms, two threads 40.8-46.5 / 35.8-38.0 / 36.1-36.8
+/// / 36.3-42.0 ms.
+const PREFETCH: usize = 2048;
 
 fn permute_in(fwd: &[u32], b: &[f64], xp: &mut [f64]) {
     for (y, &f) in xp.iter_mut().zip(fwd) {
@@ -1215,6 +1264,44 @@ mod tests {
                     g[j * p + i]
                 );
             }
+        }
+    }
+
+    /// Timing lab (run by hand): one solve on the Q2 352×88 slab's
+    /// operator on one and on two threads, with [`prefetch_block`]'s
+    /// distances alternating in one process (0: none), median (fastest)
+    /// of 15 solves each.
+    ///
+    ///     cargo test --release -p stickslip-fem --lib prefetch_lab -- --ignored --nocapture
+    #[test]
+    #[ignore = "timing lab, run by hand"]
+    fn prefetch_lab() {
+        let a = operator(CellKind::Quad9, 352, 88);
+        let n = a.nrows();
+        let f = factor(&a);
+        let b = rhs(n);
+        for threads in [1, 2] {
+            crate::testing::on_threads(threads, || {
+                let mut sn = Supernodal::new(&f.symbolic).unwrap();
+                let mut x = b.clone();
+                let distances = [0, 1024, 2048, 4096];
+                let mut t: Vec<Vec<f64>> = vec![Vec::new(); distances.len()];
+                for _ in 0..15 {
+                    for (d, t) in distances.iter().zip(&mut t) {
+                        sn.prefetch = *d;
+                        x.copy_from_slice(&b);
+                        let s = std::time::Instant::now();
+                        sn.solve(&f.l, &mut x);
+                        t.push(s.elapsed().as_secs_f64());
+                    }
+                }
+                print!("{threads} thread(s), L {} values:", f.l.len());
+                for (d, t) in distances.iter().zip(&mut t) {
+                    t.sort_by(f64::total_cmp);
+                    print!("  {d}: {:.2} ({:.2})", t[7] * 1e3, t[0] * 1e3);
+                }
+                println!(" ms");
+            });
         }
     }
 
