@@ -497,6 +497,118 @@ const PEER_MESHES: [&str; 6] = [
 ];
 
 /// A value of a `key=value` row.
+/// A row's text field (`scheme`, `mesh`).
+fn text<'a>(row: &'a str, key: &str) -> Option<&'a str> {
+    row.split_whitespace()
+        .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+}
+
+/// Issue 7's targets against this run's rows, each with its figures and a
+/// verdict for this run alone (one run meeting a target does not make it
+/// met on a shared host: the README weighs the runs).
+fn print_targets(rows: &[String]) {
+    let verdict = |ok: bool| if ok { "met" } else { "NOT met" };
+    let of = |scheme: &str| {
+        rows.iter()
+            .filter(move |r| text(r, "scheme") == Some(scheme))
+            .collect::<Vec<_>>()
+    };
+    let (cd, newmark) = (of("cd"), of("newmark"));
+    let dofs = |r: &&String| field(r, "dofs").unwrap_or(0.0);
+    println!("issue 7's targets in this run:");
+    // The largest explicit rungs (the 1M slabs), against the run's highest
+    // triad.
+    let largest = cd.iter().map(dofs).fold(0.0, f64::max);
+    let top: Vec<(&str, f64)> = cd
+        .iter()
+        .filter(|r| dofs(r) == largest)
+        .filter_map(|r| Some((text(r, "mesh")?, field(r, "pct_stream_run")?)))
+        .collect();
+    if !top.is_empty() {
+        let text: Vec<String> = top.iter().map(|(m, p)| format!("{m} {p:.1}%")).collect();
+        println!(
+            "  explicit step >= 50% of the run's highest STREAM triad on the largest mesh: {} -- {}",
+            text.join(", "),
+            verdict(top.iter().all(|(_, p)| *p >= 50.0))
+        );
+    }
+    if let Some(step) = cd
+        .iter()
+        .find(|r| text(r, "mesh") == Some("gen-q1-1416x354"))
+        .and_then(|r| field(r, "step"))
+    {
+        println!(
+            "  1000 steps of the 1M-DOF Q1 slab under 30 s: {:.2} s -- {}",
+            1000.0 * step,
+            verdict(1000.0 * step < 30.0)
+        );
+    }
+    let large = |r: &&&String| dofs(r) >= 1e5;
+    let worst = |rs: &[&String], key: &str, max: bool| {
+        let v: Vec<f64> = rs
+            .iter()
+            .filter(large)
+            .filter_map(|r| field(r, key))
+            .collect();
+        let pick = if max { f64::max } else { f64::min };
+        (!v.is_empty()).then(|| {
+            v.iter()
+                .copied()
+                .fold(if max { 0.0 } else { f64::INFINITY }, pick)
+        })
+    };
+    if let Some(w) = worst(&newmark, "step_over_solve", true) {
+        println!(
+            "  Newmark step <= 2.5 forward+back solves from 100k DOFs: at most {w:.2} -- {}",
+            verdict(w <= 2.5)
+        );
+    }
+    // From the times, not the rounded ratio column.
+    let ratio = |rs: &[&String]| {
+        let v: Vec<f64> = rs
+            .iter()
+            .filter(large)
+            .filter_map(|r| Some(field(r, "peer_step")? / field(r, "step")?))
+            .collect();
+        (!v.is_empty()).then(|| v.iter().copied().fold(f64::INFINITY, f64::min))
+    };
+    if let (Some(c), Some(n)) = (ratio(&cd), ratio(&newmark)) {
+        println!(
+            "  >= 5x the scipy peer per step from 100k DOFs: central difference at least {c:.2}x, Newmark at least {n:.2}x -- {}",
+            verdict(c >= 5.0 && n >= 5.0)
+        );
+    }
+    let paper: Vec<String> = [("central difference", &cd), ("Newmark", &newmark)]
+        .iter()
+        .filter_map(|(name, rs)| {
+            let r = rs
+                .iter()
+                .find(|r| dofs(r) < 1000.0 && field(r, "peer_over_ours").is_some())?;
+            Some((
+                name,
+                field(r, "peer_over_ours")?,
+                field(r, "peer_over_ours_paired").unwrap_or(f64::NAN),
+            ))
+        })
+        .map(|(name, first, paired)| {
+            format!(
+                "{name} {first:.1}x (median of the pairs {paired:.2}x) -- {}",
+                verdict(paired >= 50.0)
+            )
+        })
+        .collect();
+    if !paper.is_empty() {
+        println!("  >= 50x the peer on the paper mesh: {}", paper.join("; "));
+    }
+    let all: Vec<&String> = cd.iter().chain(&newmark).copied().collect();
+    if let Some(w) = worst(&all, "peak_run_over_need", true) {
+        println!(
+            "  peak memory of the run <= 1.5x matrix + factor + vectors from 100k DOFs: at most {w:.2} -- {}",
+            verdict(w <= 1.5)
+        );
+    }
+}
+
 fn field(row: &str, key: &str) -> Option<f64> {
     row.split_whitespace()
         .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
@@ -576,6 +688,35 @@ fn peer_fields(
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    // The targets of a run already written (docs/bench-step.csv).
+    if let Some(k) = args.iter().position(|a| a == "--targets") {
+        let Some(path) = args.get(k + 1) else {
+            eprintln!("--targets needs the CSV a bench run wrote (docs/bench-step.csv)");
+            std::process::exit(2);
+        };
+        let csv = match std::fs::read_to_string(path) {
+            Ok(csv) => csv,
+            Err(e) => {
+                eprintln!("{path}: {e}");
+                std::process::exit(2);
+            }
+        };
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+        let rows: Vec<String> = lines
+            .map(|l| {
+                header
+                    .iter()
+                    .zip(l.split(','))
+                    .filter(|(_, v)| !v.is_empty())
+                    .map(|(h, v)| format!("{h}={v}"))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .collect();
+        print_targets(&rows);
+        return;
+    }
     if let Some(k) = args.iter().position(|a| a == "--case") {
         let scheme = &args[k + 1];
         let name = &args[k + 2];
@@ -732,7 +873,7 @@ fn main() {
                         text.join(", ")
                     );
                     row.push_str(&format!(
-                        " peer_over_ours_pairs={} peer_over_ours_paired={:.1}",
+                        " peer_over_ours_pairs={} peer_over_ours_paired={:.2}",
                         ratios.len(),
                         median(ratios)
                     ));
@@ -771,6 +912,7 @@ fn main() {
             }
         }
     }
+    print_targets(&rows);
     std::fs::create_dir_all(&dir).unwrap();
     let mut csv = String::new();
     let mut header: Vec<String> = Vec::new();
