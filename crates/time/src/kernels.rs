@@ -3660,13 +3660,8 @@ pub(crate) mod tests {
         let meshes = std::env::var("STICKSLIP_LAB_MESHES")
             .unwrap_or_else(|_| "q1-1416x354,q2-708x177".into());
         for name in meshes.split(',') {
-            let (_, _, model) = lab_slab(name);
-            let n = model.stiffness.nrows();
-            let stencils = Stencils::new(&model.stiffness).expect("structured");
-            drop(model);
-            let x = x_of(n);
-            let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
-            let (rn, m, v, a) = (w(1.3), w(1.2), w(1.5), w(1.6));
+            let (stencils, [rn, m, v, a]) = sweep_lab_vectors(name);
+            let n = rn.len();
             let zero = vec![0.0; n];
             let mut ku = vec![0.0; n];
             let data = lab_data(&zero, &m, &rn, &v, &a);
@@ -3739,6 +3734,18 @@ pub(crate) mod tests {
         }
     }
 
+    /// The sweep labs' stencils of slab `name` and their r_K, lumped mass,
+    /// ṙ and r̈ (made-up values of the sizes of the slab's).
+    fn sweep_lab_vectors(name: &str) -> (Stencils, [Vec<f64>; 4]) {
+        let (_, _, model) = lab_slab(name);
+        let n = model.stiffness.nrows();
+        let stencils = Stencils::new(&model.stiffness).expect("structured");
+        drop(model);
+        let x = x_of(n);
+        let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
+        (stencils, [w(1.3), w(1.2), w(1.5), w(1.6)])
+    }
+
     /// A copy of `src` starting at byte `offset` of a 4 KiB page (64-byte
     /// steps), in a buffer it returns beside the slice's start.
     fn at_page_offset(src: &[f64], offset: usize) -> (Vec<f64>, usize) {
@@ -3779,13 +3786,8 @@ pub(crate) mod tests {
             ("spread 320", [0, 320, 640, 960, 1280]),
         ];
         for name in meshes.split(',') {
-            let (_, _, model) = lab_slab(name);
-            let n = model.stiffness.nrows();
-            let stencils = Stencils::new(&model.stiffness).expect("structured");
-            drop(model);
-            let x = x_of(n);
-            let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + c).collect() };
-            let (rn0, m0, v0, a0) = (w(1.3), w(1.2), w(1.5), w(1.6));
+            let (stencils, [rn0, m0, v0, a0]) = sweep_lab_vectors(name);
+            let n = rn0.len();
             let zero = vec![0.0; n];
             let mut t: Vec<Vec<f64>> = vec![Vec::new(); layouts.len()];
             let bufs: Vec<_> = layouts
