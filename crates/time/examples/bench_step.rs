@@ -497,6 +497,10 @@ const PEER_MESHES: [&str; 6] = [
 ];
 
 /// A value of a `key=value` row.
+fn field(row: &str, key: &str) -> Option<f64> {
+    text(row, key)?.parse().ok()
+}
+
 /// A row's text field (`scheme`, `mesh`).
 fn text<'a>(row: &'a str, key: &str) -> Option<&'a str> {
     row.split_whitespace()
@@ -543,21 +547,17 @@ fn print_targets(rows: &[String]) {
             verdict(1000.0 * step < 30.0)
         );
     }
-    let large = |r: &&&String| dofs(r) >= 1e5;
-    let worst = |rs: &[&String], key: &str, max: bool| {
-        let v: Vec<f64> = rs
-            .iter()
-            .filter(large)
-            .filter_map(|r| field(r, key))
-            .collect();
-        let pick = if max { f64::max } else { f64::min };
-        (!v.is_empty()).then(|| {
-            v.iter()
-                .copied()
-                .fold(if max { 0.0 } else { f64::INFINITY }, pick)
-        })
+    // A quantity over the rungs of 100k DOFs and more.
+    let large = |rs: &[&String], value: &dyn Fn(&str) -> Option<f64>| -> Vec<f64> {
+        rs.iter()
+            .filter(|r| dofs(r) >= 1e5)
+            .filter_map(|r| value(r))
+            .collect()
     };
-    if let Some(w) = worst(&newmark, "step_over_solve", true) {
+    let most = |v: Vec<f64>| (!v.is_empty()).then(|| v.into_iter().fold(0.0, f64::max));
+    let least = |v: Vec<f64>| (!v.is_empty()).then(|| v.into_iter().fold(f64::INFINITY, f64::min));
+    let worst = |rs: &[&String], key: &str| most(large(rs, &|r| field(r, key)));
+    if let Some(w) = worst(&newmark, "step_over_solve") {
         println!(
             "  Newmark step <= 2.5 forward+back solves from 100k DOFs: at most {w:.2} -- {}",
             verdict(w <= 2.5)
@@ -565,12 +565,9 @@ fn print_targets(rows: &[String]) {
     }
     // From the times, not the rounded ratio column.
     let ratio = |rs: &[&String]| {
-        let v: Vec<f64> = rs
-            .iter()
-            .filter(large)
-            .filter_map(|r| Some(field(r, "peer_step")? / field(r, "step")?))
-            .collect();
-        (!v.is_empty()).then(|| v.iter().copied().fold(f64::INFINITY, f64::min))
+        least(large(rs, &|r| {
+            Some(field(r, "peer_step")? / field(r, "step")?)
+        }))
     };
     if let (Some(c), Some(n)) = (ratio(&cd), ratio(&newmark)) {
         println!(
@@ -601,18 +598,12 @@ fn print_targets(rows: &[String]) {
         println!("  >= 50x the peer on the paper mesh: {}", paper.join("; "));
     }
     let all: Vec<&String> = cd.iter().chain(&newmark).copied().collect();
-    if let Some(w) = worst(&all, "peak_run_over_need", true) {
+    if let Some(w) = worst(&all, "peak_run_over_need") {
         println!(
             "  peak memory of the run <= 1.5x matrix + factor + vectors from 100k DOFs: at most {w:.2} -- {}",
             verdict(w <= 1.5)
         );
     }
-}
-
-fn field(row: &str, key: &str) -> Option<f64> {
-    row.split_whitespace()
-        .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
-        .and_then(|v| v.parse().ok())
 }
 
 /// Runs bench/peer.py on a dumped rung; returns " peer_step=… peer_over_ours=…

@@ -3790,7 +3790,7 @@ pub(crate) mod tests {
             let n = rn0.len();
             let zero = vec![0.0; n];
             let mut t: Vec<Vec<f64>> = vec![Vec::new(); layouts.len()];
-            let bufs: Vec<_> = layouts
+            let mut bufs: Vec<_> = layouts
                 .iter()
                 .map(|(_, o)| {
                     [
@@ -3802,7 +3802,6 @@ pub(crate) mod tests {
                     ]
                 })
                 .collect();
-            let mut bufs = bufs;
             on_threads(2, || {
                 let mut p = partials(n);
                 for round in 0..30 {
