@@ -1381,9 +1381,7 @@ impl<'a> SweepRows<'a, '_> {
         batch_rows_on(self.avx, self.s, self.friction, r0, ku, out, self.run);
     }
 
-    /// Rows i..i + 8 given their K r_K in a register: [`batch_rows`]'s
-    /// operations 8 wide (no fused multiply-add; the strain and kinetic
-    /// sums into the lanes of their rows, in row order), so the same bits;
+    /// Rows i..i + 8 given their K r_K in a register ([`Rows8::eight`]);
     /// through [`SweepRows::rows`] where a load or friction row is among
     /// them.
     ///
@@ -1398,18 +1396,11 @@ impl<'a> SweepRows<'a, '_> {
         i: usize,
         ku: std::arch::x86_64::__m512d,
     ) {
-        use std::arch::x86_64::*;
-        let s = self.s;
-        let run = &*self.run;
-        let load_here = s.load_new.len() <= CHUNK
-            || (run.load < s.load_rows.len() && s.load_rows[run.load] < i + 8);
-        let friction_here =
-            run.friction < self.friction.len() && self.friction[run.friction].0 < i + 8;
-        if load_here || friction_here {
+        if !self.plain(i, i + 8) {
             let mut k = [0.0; 8];
             // SAFETY: k holds 8 doubles; the caller's features.
             unsafe {
-                _mm512_storeu_pd(k.as_mut_ptr(), ku);
+                std::arch::x86_64::_mm512_storeu_pd(k.as_mut_ptr(), ku);
                 // batch_rows sums through the lanes in memory.
                 self.end_sums(*regs);
                 self.rows(i, &k);
@@ -1417,67 +1408,69 @@ impl<'a> SweepRows<'a, '_> {
             }
             return;
         }
-        let o = i - self.start;
-        let [vn_out, an_out, rx_out] = &mut self.out;
-        let (vn_out, an_out, rx_out) = (
-            &mut vn_out[o..o + 8],
-            &mut an_out[o..o + 8],
-            &mut rx_out[o..o + 8],
-        );
-        let (m, rn) = (&s.mass[i..i + 8], &s.r_new[i..i + 8]);
-        // ṙ_{K−1} and r̈_{K−1} where ṙ_K and r̈_K go when in place (read
-        // before they are written below).
-        let (v, a) = if s.in_place {
-            (vn_out.as_ptr(), an_out.as_ptr())
-        } else {
-            (s.v[i..i + 8].as_ptr(), s.a[i..i + 8].as_ptr())
-        };
-        // SAFETY: the caller's features; every slice above holds 8 doubles.
+        // SAFETY: the caller's; rows i..i + 8 are in this chunk.
+        unsafe { self.rows8().eight(regs, i, ku) }
+    }
+
+    /// Rows i..i + ku.len() (at most 8) given their K r_K: by
+    /// [`Rows8::some`] where plain, else [`SweepRows::rows`].
+    ///
+    /// # Safety
+    /// The CPU has AVX-512 (foundation) and AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub(crate) unsafe fn few(&mut self, i: usize, ku: &[f64]) {
+        use std::arch::x86_64::*;
+        if !self.plain(i, i + ku.len()) {
+            self.rows(i, ku);
+            return;
+        }
+        let k: __mmask8 = (0xffu16 >> (8 - ku.len())) as u8;
+        // SAFETY: the caller's features; the masked load reads ku only.
         unsafe {
-            let set = _mm512_set1_pd;
-            let (m, v, a, rn) = (
-                _mm512_loadu_pd(m.as_ptr()),
-                _mm512_loadu_pd(v),
-                _mm512_loadu_pd(a),
-                _mm512_loadu_pd(rn.as_ptr()),
-            );
-            // bi = 0 − ku + m (cv ṙ + ca r̈); ṙ_K = bi / (m scale).
-            let bi = _mm512_add_pd(
-                _mm512_sub_pd(_mm512_setzero_pd(), ku),
-                _mm512_mul_pd(
-                    m,
-                    _mm512_add_pd(_mm512_mul_pd(set(s.cv), v), _mm512_mul_pd(set(s.ca), a)),
-                ),
-            );
-            let vn = _mm512_div_pd(bi, _mm512_mul_pd(m, set(s.scale)));
-            let an = _mm512_sub_pd(
-                _mm512_mul_pd(_mm512_sub_pd(vn, v), set(s.scale)),
-                _mm512_mul_pd(set(s.ratio), a),
-            );
-            let rx = _mm512_add_pd(
-                _mm512_add_pd(rn, _mm512_mul_pd(set(s.next.0), vn)),
-                _mm512_mul_pd(set(s.next.1), an),
-            );
-            _mm512_storeu_pd(vn_out.as_mut_ptr(), vn);
-            _mm512_storeu_pd(an_out.as_mut_ptr(), an);
-            _mm512_storeu_pd(rx_out.as_mut_ptr(), rx);
-            let inf = set(f64::INFINITY);
-            let finite = |x: __m512d| _mm512_cmp_pd_mask::<_CMP_LT_OQ>(_mm512_abs_pd(x), inf);
-            regs.finite &= (finite(rn) & finite(vn)) == 0xff;
-            // Row i + k into lane (i + k) mod 4, rows in order: register
-            // position k holds that lane ([`SweepRows::begin_sums`]).
-            let strain = _mm512_mul_pd(rn, ku);
-            let kinetic = _mm512_mul_pd(_mm512_mul_pd(m, vn), vn);
-            let abs = _mm512_abs_pd;
-            let bound = _mm512_add_pd(_mm512_add_pd(abs(vn), abs(an)), abs(rx));
-            for (acc, t) in [
-                (&mut regs.strain, strain),
-                (&mut regs.kinetic, kinetic),
-                (&mut regs.bound, bound),
-            ] {
-                *acc = _mm256_add_pd(*acc, _mm512_castpd512_pd256(t));
-                *acc = _mm256_add_pd(*acc, _mm512_extractf64x4_pd::<1>(t));
-            }
+            let sum = _mm512_maskz_loadu_pd(k, ku.as_ptr());
+            let mut regs = self.begin_sums(i);
+            self.rows8().some(&mut regs, i, ku.len(), sum);
+            self.end_sums(regs);
+        }
+    }
+
+    /// Whether rows lo..hi of this chunk hold no load row and no friction
+    /// row: then [`Rows8::eight`] serves all of them.
+    #[inline(always)]
+    pub(crate) fn plain(&self, lo: usize, hi: usize) -> bool {
+        let (s, run) = (self.s, &*self.run);
+        debug_assert!(lo >= self.start && hi - self.start <= self.out[0].len());
+        let load_here = s.load_new.len() <= CHUNK
+            || (run.load < s.load_rows.len() && s.load_rows[run.load] < hi);
+        let friction_here =
+            run.friction < self.friction.len() && self.friction[run.friction].0 < hi;
+        !(load_here || friction_here)
+    }
+
+    /// The operands of [`Rows8::eight`] for this chunk's rows.
+    #[inline(always)]
+    pub(crate) fn rows8(&mut self) -> Rows8 {
+        let s = self.s;
+        let [vn, an, rx] = &mut self.out;
+        // ṙ_{K−1} and r̈_{K−1} where ṙ_K and r̈_K go when in place (each
+        // block reads them before it writes them).
+        let (v, a) = if s.in_place {
+            (vn.as_ptr(), an.as_ptr())
+        } else {
+            (s.v[self.start..].as_ptr(), s.a[self.start..].as_ptr())
+        };
+        Rows8 {
+            start: self.start,
+            m: s.mass[self.start..].as_ptr(),
+            rn: s.r_new[self.start..].as_ptr(),
+            v,
+            a,
+            vn: vn.as_mut_ptr(),
+            an: an.as_mut_ptr(),
+            rx: rx.as_mut_ptr(),
+            c: [s.cv, s.ca, s.scale, s.ratio, s.next.0, s.next.1],
         }
     }
 
@@ -1551,6 +1544,188 @@ pub(crate) struct SumRegs {
     finite: bool,
     /// The first row's residue mod 4 (every block's: they are 8 apart).
     rot: usize,
+}
+
+/// [`SweepRows::eight`]'s operands for one chunk: its vectors from the
+/// chunk's first row (`start`) as pointers and the step's constants, a
+/// plain value taken once per unit run with no load or friction row
+/// ([`SweepRows::plain`]), so that a block neither reloads them through
+/// [`SweepRows`] nor checks for those rows and bounds. With the node
+/// pairs between runs taken 8 rows at a time ([`Rows8::some`]), the
+/// sweep took 0.84-0.92 of its time before on the 1M slabs (`sweep_lab`'s
+/// notes); the bench's Q2 1M step 1.92-2.09 against 2.25-2.28 ms, four
+/// pairs of runs alternating, 2026-11-25 17:35 (Q1 1M within the host's
+/// noise: 1.46-1.96 against 1.66-1.93).
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy)]
+pub(crate) struct Rows8 {
+    start: usize,
+    m: *const f64,
+    rn: *const f64,
+    v: *const f64,
+    a: *const f64,
+    vn: *mut f64,
+    an: *mut f64,
+    rx: *mut f64,
+    /// cv, ca, scale, ratio, next.0, next.1 of [`StepData`].
+    c: [f64; 6],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Rows8 {
+    /// Rows i..i + 8 given their K r_K in a register: [`batch_rows`]'s
+    /// operations 8 wide (no fused multiply-add; the strain and kinetic
+    /// sums into the lanes of their rows, in row order), so the same bits.
+    ///
+    /// # Safety
+    /// The CPU has AVX-512 (foundation) and AVX2; rows i..i + 8 are in
+    /// the chunk these operands came from and hold no load or friction
+    /// row ([`SweepRows::plain`]).
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub(crate) unsafe fn eight(
+        &self,
+        regs: &mut SumRegs,
+        i: usize,
+        ku: std::arch::x86_64::__m512d,
+    ) {
+        use std::arch::x86_64::*;
+        let o = i - self.start;
+        // SAFETY: the caller's features; every pointer holds 8 doubles
+        // from o (rows i..i + 8 of the chunk).
+        unsafe {
+            let (m, v, a, rn) = (
+                _mm512_loadu_pd(self.m.add(o)),
+                _mm512_loadu_pd(self.v.add(o)),
+                _mm512_loadu_pd(self.a.add(o)),
+                _mm512_loadu_pd(self.rn.add(o)),
+            );
+            let [vn, an, rx] = self.math(m, v, a, rn, ku);
+            _mm512_storeu_pd(self.vn.add(o), vn);
+            _mm512_storeu_pd(self.an.add(o), an);
+            _mm512_storeu_pd(self.rx.add(o), rx);
+            let inf = _mm512_set1_pd(f64::INFINITY);
+            let finite = |x: __m512d| _mm512_cmp_pd_mask::<_CMP_LT_OQ>(_mm512_abs_pd(x), inf);
+            regs.finite &= (finite(rn) & finite(vn)) == 0xff;
+            let abs = _mm512_abs_pd;
+            regs.add([
+                _mm512_mul_pd(rn, ku),
+                _mm512_mul_pd(_mm512_mul_pd(m, vn), vn),
+                _mm512_add_pd(_mm512_add_pd(abs(vn), abs(an)), abs(rx)),
+            ]);
+        }
+    }
+
+    /// [`Rows8::eight`] for rows i..i + len (len ≤ 8), their K r_K in
+    /// `ku`'s first len lanes: the other lanes neither read nor written,
+    /// and +0 into their sums (which start at +0 and so never hold −0:
+    /// s + 0 = s, the same bits).
+    ///
+    /// # Safety
+    /// As for [`Rows8::eight`], for rows i..i + len.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub(crate) unsafe fn some(
+        &self,
+        regs: &mut SumRegs,
+        i: usize,
+        len: usize,
+        ku: std::arch::x86_64::__m512d,
+    ) {
+        use std::arch::x86_64::*;
+        debug_assert!(len <= 8);
+        let k: __mmask8 = (0xffu16 >> (8 - len)) as u8;
+        let o = i - self.start;
+        // SAFETY: the caller's features; masked loads and stores touch
+        // the rows i..i + len of the chunk only.
+        unsafe {
+            let (m, v, a, rn) = (
+                _mm512_maskz_loadu_pd(k, self.m.add(o)),
+                _mm512_maskz_loadu_pd(k, self.v.add(o)),
+                _mm512_maskz_loadu_pd(k, self.a.add(o)),
+                _mm512_maskz_loadu_pd(k, self.rn.add(o)),
+            );
+            let [vn, an, rx] = self.math(m, v, a, rn, ku);
+            _mm512_mask_storeu_pd(self.vn.add(o), k, vn);
+            _mm512_mask_storeu_pd(self.an.add(o), k, an);
+            _mm512_mask_storeu_pd(self.rx.add(o), k, rx);
+            let inf = _mm512_set1_pd(f64::INFINITY);
+            let finite =
+                |x: __m512d| _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(k, _mm512_abs_pd(x), inf);
+            regs.finite &= (finite(rn) & finite(vn)) == k;
+            let abs = _mm512_abs_pd;
+            regs.add([
+                _mm512_maskz_mul_pd(k, rn, ku),
+                _mm512_maskz_mul_pd(k, _mm512_mul_pd(m, vn), vn),
+                _mm512_maskz_add_pd(k, _mm512_add_pd(abs(vn), abs(an)), abs(rx)),
+            ]);
+        }
+    }
+
+    /// ṙ_K, r̈_K and r_{K+1} of 8 rows: [`batch_rows`]'s operations.
+    ///
+    /// # Safety
+    /// The CPU has AVX-512 (foundation).
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn math(
+        &self,
+        m: std::arch::x86_64::__m512d,
+        v: std::arch::x86_64::__m512d,
+        a: std::arch::x86_64::__m512d,
+        rn: std::arch::x86_64::__m512d,
+        ku: std::arch::x86_64::__m512d,
+    ) -> [std::arch::x86_64::__m512d; 3] {
+        use std::arch::x86_64::*;
+        let set = _mm512_set1_pd;
+        let [cv, ca, scale, ratio, n0, n1] = self.c;
+        // SAFETY: the caller's features.
+        unsafe {
+            // bi = 0 − ku + m (cv ṙ + ca r̈); ṙ_K = bi / (m scale).
+            let bi = _mm512_add_pd(
+                _mm512_sub_pd(_mm512_setzero_pd(), ku),
+                _mm512_mul_pd(
+                    m,
+                    _mm512_add_pd(_mm512_mul_pd(set(cv), v), _mm512_mul_pd(set(ca), a)),
+                ),
+            );
+            let vn = _mm512_div_pd(bi, _mm512_mul_pd(m, set(scale)));
+            let an = _mm512_sub_pd(
+                _mm512_mul_pd(_mm512_sub_pd(vn, v), set(scale)),
+                _mm512_mul_pd(set(ratio), a),
+            );
+            let rx = _mm512_add_pd(
+                _mm512_add_pd(rn, _mm512_mul_pd(set(n0), vn)),
+                _mm512_mul_pd(set(n1), an),
+            );
+            [vn, an, rx]
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl SumRegs {
+    /// Rows' strain, kinetic and bound terms (register position k: row
+    /// i + k of a block from row i) into their lanes: positions k and
+    /// k + 4 share a lane, added in row order.
+    ///
+    /// # Safety
+    /// The CPU has AVX-512 (foundation).
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn add(&mut self, terms: [std::arch::x86_64::__m512d; 3]) {
+        use std::arch::x86_64::*;
+        for (acc, t) in [&mut self.strain, &mut self.kinetic, &mut self.bound]
+            .into_iter()
+            .zip(terms)
+        {
+            // SAFETY: the caller's features.
+            unsafe {
+                *acc = _mm256_add_pd(*acc, _mm512_castpd512_pd256(t));
+                *acc = _mm256_add_pd(*acc, _mm512_extractf64x4_pd::<1>(t));
+            }
+        }
+    }
 }
 
 impl RowProduct for Sliced {
@@ -3633,6 +3808,34 @@ pub(crate) mod tests {
     /// elsewhere, a fence per chunk, alternating with the kept sweep in
     /// one process, 2026-11-25 14:55, three runs: Q1 1M 1.04-1.08, Q2 1M
     /// 1.04-1.07 of its time (medians). Not kept.
+    /// What did bound it (2026-11-25 17:05-17:45; each variant switched at
+    /// run time and alternating with the sweep in one process, vectors 576
+    /// bytes apart in their pages, medians of 20 or 29 rounds, three or
+    /// four runs). A stand-in with the sweep's seven streams, the same
+    /// unit runs and K·x, and 4 operations per row in place of
+    /// [`batch_rows`]' arithmetic and sums, skipping the node pairs
+    /// between runs, took 0.60-0.72 of the sweep's time on Q1 1M and
+    /// 0.66-0.79 on Q2 1M. Of the difference: the node pairs between the
+    /// unit runs (1% of the rows: a node row's ends, chunk seams), summed
+    /// and swept one pair at a time through a call of [`batch_rows`], cost
+    /// 12-15% (Q1: 1.35-1.41 ms without them against 1.58-1.61); a block's
+    /// operands reloaded through [`SweepRows`] with its checks for load
+    /// and friction rows and its bounds, 9-13%; the three sums and the
+    /// finiteness check, 5-8%. Now a run with no load or friction row
+    /// takes its operands once ([`Rows8`]), and the pairs between runs go
+    /// 8 rows at a time ([`Rows8::some`]): against the sweep before, 0.84
+    /// -0.92 of its time on Q1 1M (1.52-1.84 against 1.78-2.08 ms) and
+    /// 0.84-0.91 on Q2 1M (2.07-2.11 against 2.31-2.51), three runs,
+    /// 17:43. The pairs between runs still cost 5-12% (a variant skipping
+    /// them), in their K·x sums (a variant with their sums and not their
+    /// rows took as long as the sweep; one with their rows and zero sums
+    /// as long as skipping them), though not by the sums' arithmetic
+    /// (four-wide, a block's four products in one fused multiply-add: no
+    /// change) nor by their stencils' blocks missing the cache (nearly
+    /// every such pair has a type of its own, 2,845 types for 4,846 pairs
+    /// on Q1 1M; their lines requested while the run before is summed: no
+    /// change). The sums and the arithmetic stay: they give
+    /// [`batch_rows`]' bits.
     /// What does not bound the fused sweep (2026-11-25 14:57-15:13, each
     /// variant switched at run time and alternating with the kept sweep
     /// in place in one process, three runs, ratios of medians; the

@@ -105,6 +105,7 @@ pub struct Stencils {
     /// scan 6% of the Q2 1M step's samples, 2026-11-25).
     runs: Vec<[u32; 3]>,
     chunk_runs: Vec<u32>,
+
     /// The CPU has AVX (checked at run time): runs of two alike units are
     /// summed 4 doubles wide ([`avx::units`]), the same bits.
     avx: bool,
@@ -299,7 +300,8 @@ impl Stencils {
 
     /// The sweep of chunk `c` with its per-row work on each 8 rows of a
     /// unit run as soon as their K r_K is in a register
-    /// ([`kernels::SweepRows::eight`]), so that their vectors' loads and
+    /// ([`kernels::Rows8::eight`] for runs with no load or friction row,
+    /// else [`kernels::SweepRows::eight`]), so that their vectors' loads and
     /// stores issue while the next rows' sums run, instead of K r_K of a
     /// 64-row batch into L1 and then the batch's rows (from
     /// [`FUSED_MIN_ROWS`], which has the figures). K r_K has the bits of
@@ -317,12 +319,25 @@ impl Stencils {
         let mut g = g0;
         let runs = &self.runs[self.chunk_runs[c] as usize..self.chunk_runs[c + 1] as usize];
         for &[first, count, u] in runs.iter().chain([&[g1 as u32, 0, NO_UNIT]]) {
-            // The groups before the run one by one.
+            // The groups before the run (a node row's ends, chunk seams):
+            // their sums one group at a time, their rows up to 8 at once.
             while g < first as usize {
-                let sums = self.group_sums::<true>(g, x);
-                let (r0, r1) = (self.group_rows[g] as usize, self.group_rows[g + 1] as usize);
-                rows.rows(r0, &sums[..r1 - r0]);
-                g += 1;
+                let r0 = self.group_rows[g] as usize;
+                let mut ku = [0.0; 8];
+                while g < first as usize && self.group_rows[g + 1] as usize - r0 <= 8 {
+                    let sums = self.group_sums::<true>(g, x);
+                    let (a, b) = (self.group_rows[g] as usize, self.group_rows[g + 1] as usize);
+                    // Element by element: a copy of one or two doubles
+                    // was a call of memcpy.
+                    ku[a - r0] = sums[0];
+                    if b - a == 2 {
+                        ku[a - r0 + 1] = sums[1];
+                    }
+                    g += 1;
+                }
+                let len = self.group_rows[g] as usize - r0;
+                // SAFETY: this function's features.
+                unsafe { rows.few(r0, &ku[..len]) };
             }
             if u == NO_UNIT {
                 break;
@@ -331,9 +346,25 @@ impl Stencils {
                 self.unit_blocks[u as usize] as usize..self.unit_blocks[u as usize + 1] as usize;
             let (offsets, values) = (&self.unit_offsets[b.clone()], &self.unit_values[b]);
             let r = self.group_rows[g] as usize;
-            // SAFETY: this function's features.
-            unsafe { avx::run_512::<true>(offsets, values, r, count as usize, x, rows) };
-            g += 4 * count as usize;
+            let count = count as usize;
+            // SAFETY: this function's features; the run's rows are in
+            // chunk c (`build_units`), and plain where `Plain` takes them.
+            unsafe {
+                if rows.plain(r, r + 8 * count) {
+                    let eight = rows.rows8();
+                    avx::run_512::<true>(
+                        offsets,
+                        values,
+                        r,
+                        count,
+                        x,
+                        &mut avx::Plain { rows, eight },
+                    );
+                } else {
+                    avx::run_512::<true>(offsets, values, r, count, x, rows);
+                }
+            }
+            g += 4 * count;
         }
     }
 
@@ -714,6 +745,42 @@ mod avx {
         /// As for [`Sink::put`].
         #[allow(unsafe_code)]
         unsafe fn end(&mut self, regs: Self::Regs);
+    }
+
+    /// The sweep's sink for a run with no load or friction row: each
+    /// block's rows by [`Rows8::eight`] from operands held over the run.
+    pub(super) struct Plain<'r, 'a, 'b> {
+        pub rows: &'r mut crate::kernels::SweepRows<'a, 'b>,
+        pub eight: crate::kernels::Rows8,
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    impl Sink for Plain<'_, '_, '_> {
+        type Regs = crate::kernels::SumRegs;
+        #[inline(always)]
+        #[allow(unsafe_code)]
+        unsafe fn begin(&mut self, row: usize) -> Self::Regs {
+            // SAFETY: the caller's features.
+            unsafe { self.rows.begin_sums(row) }
+        }
+        #[inline(always)]
+        #[allow(unsafe_code)]
+        unsafe fn end(&mut self, regs: Self::Regs) {
+            // SAFETY: the caller's features.
+            unsafe { self.rows.end_sums(regs) }
+        }
+        #[inline(always)]
+        #[allow(unsafe_code)]
+        unsafe fn put(
+            &mut self,
+            regs: &mut Self::Regs,
+            row: usize,
+            sum: std::arch::x86_64::__m512d,
+        ) {
+            // SAFETY: the caller's features; the run's rows are plain
+            // rows of the chunk `eight` came from.
+            unsafe { self.eight.eight(regs, row, sum) };
+        }
     }
 
     /// [`body_512`]'s sink: the sums stored into `out` from row r.
@@ -1241,102 +1308,107 @@ mod tests {
             let w = |c: f64| -> Vec<f64> { x.iter().map(|v| v * c + 0.1 * c).collect() };
             let (r_new, v, a) = (w(1.0), w(-0.7), w(3.0));
             let mass: Vec<f64> = x.iter().map(|x| 1.0 + x.abs()).collect();
-            let load_rows: Vec<usize> = (0..n)
-                .filter(|i| i % 61 == 5 || i % CHUNK == 0 || i % CHUNK == CHUNK - 1)
-                .collect();
-            let mut load_new = vec![0.0; n];
-            for &i in &load_rows {
-                load_new[i] = 0.3 + 1e-3 * i as f64;
-            }
-            let friction: Vec<(usize, f64)> = (0..n)
-                .filter(|i| i % 97 == 0 || i % CHUNK == 1 || i % CHUNK == CHUNK - 2)
-                .map(|i| (i, -0.25 * i as f64))
-                .collect();
-            let data = StepData {
-                load_new: &load_new,
-                load_rows: &load_rows,
-                mass: &mass,
-                r_new: &r_new,
-                v: &v,
-                a: &a,
-                in_place: false,
-                cv: 2e3,
-                ca: 1.0,
-                scale: 2e3,
-                ratio: 1.0,
-                next: (1e-3, 0.5e-6),
-            };
-            // In place: ṙ_{K−1} and r̈_{K−1} handed in the outputs.
-            let in_place = StepData {
-                v: &[],
-                a: &[],
-                in_place: true,
-                ..data
-            };
-            let run = |s: &Stencils, threads: usize, here: bool| {
-                let (mut vn, mut an, mut rx) = if here {
-                    (v.clone(), a.clone(), vec![0.0; n])
-                } else {
-                    (vec![0.0; n], vec![0.0; n], vec![0.0; n])
+            // Load and friction rows every 61 and 97 rows (in every unit
+            // run: each block by SweepRows::eight's check), then every 4099
+            // and 5003 (most runs and gaps plain: Rows8 throughout).
+            for every in [(61, 97), (4099, 5003)] {
+                let load_rows: Vec<usize> = (0..n)
+                    .filter(|i| i % every.0 == 5 || i % CHUNK == 0 || i % CHUNK == CHUNK - 1)
+                    .collect();
+                let mut load_new = vec![0.0; n];
+                for &i in &load_rows {
+                    load_new[i] = 0.3 + 1e-3 * i as f64;
+                }
+                let friction: Vec<(usize, f64)> = (0..n)
+                    .filter(|i| i % every.1 == 0 || i % CHUNK == 1 || i % CHUNK == CHUNK - 2)
+                    .map(|i| (i, -0.25 * i as f64))
+                    .collect();
+                let data = StepData {
+                    load_new: &load_new,
+                    load_rows: &load_rows,
+                    mass: &mass,
+                    r_new: &r_new,
+                    v: &v,
+                    a: &a,
+                    in_place: false,
+                    cv: 2e3,
+                    ca: 1.0,
+                    scale: 2e3,
+                    ratio: 1.0,
+                    next: (1e-3, 0.5e-6),
+                };
+                // In place: ṙ_{K−1} and r̈_{K−1} handed in the outputs.
+                let in_place = StepData {
+                    v: &[],
+                    a: &[],
+                    in_place: true,
+                    ..data
+                };
+                let run = |s: &Stencils, threads: usize, here: bool| {
+                    let (mut vn, mut an, mut rx) = if here {
+                        (v.clone(), a.clone(), vec![0.0; n])
+                    } else {
+                        (vec![0.0; n], vec![0.0; n], vec![0.0; n])
+                    };
+                    let mut p = partials(n);
+                    let (strain, sums) = on_threads(threads, || {
+                        let out = [&mut vn[..], &mut an[..], &mut rx[..]];
+                        let data = if here { &in_place } else { &data };
+                        sweep(kernels::avx(), s, data, &friction, None, out, &mut p)
+                    });
+                    // The guard's bound: the sum of the magnitudes, whatever
+                    // its order of additions.
+                    let exact: f64 = (0..n)
+                        .map(|i| vn[i].abs() + an[i].abs() + rx[i].abs())
+                        .sum();
+                    let what = format!("{name} {every:?}, {threads} threads, in place {here}");
+                    assert!((sums.bound - exact).abs() <= 1e-12 * exact, "{what}: bound");
+                    (strain, sums.kinetic, sums.finite, vn, an, rx)
+                };
+                let reference = run(&batched, 1, false);
+                for (threads, kernel, here) in [1, 2]
+                    .into_iter()
+                    .flat_map(|t| [(t, &fused, false), (t, &fused, true), (t, &batched, true)])
+                {
+                    let got = run(kernel, threads, here);
+                    let fused_ran = ran && std::ptr::eq(kernel, &fused);
+                    let what = format!(
+                    "{name} {every:?}, {threads} threads, in place {here} (fused kernel ran: {fused_ran})"
+                );
+                    assert_eq!(reference.0.to_bits(), got.0.to_bits(), "{what}: strain");
+                    assert_eq!(reference.1.to_bits(), got.1.to_bits(), "{what}: kinetic");
+                    assert!(reference.2 && got.2, "{what}: finite");
+                    for i in 0..n {
+                        assert_eq!(
+                            reference.3[i].to_bits(),
+                            got.3[i].to_bits(),
+                            "{what}: ṙ {i}"
+                        );
+                        assert_eq!(
+                            reference.4[i].to_bits(),
+                            got.4[i].to_bits(),
+                            "{what}: r̈ {i}"
+                        );
+                        assert_eq!(
+                            reference.5[i].to_bits(),
+                            got.5[i].to_bits(),
+                            "{what}: r {i}"
+                        );
+                    }
+                }
+                // A NaN in r_K clears the flag on the fused path too.
+                let mut bad = r_new.clone();
+                bad[n / 2 + 3] = f64::NAN;
+                let data = StepData {
+                    r_new: &bad,
+                    ..data
                 };
                 let mut p = partials(n);
-                let (strain, sums) = on_threads(threads, || {
-                    let out = [&mut vn[..], &mut an[..], &mut rx[..]];
-                    let data = if here { &in_place } else { &data };
-                    sweep(kernels::avx(), s, data, &friction, None, out, &mut p)
-                });
-                // The guard's bound: the sum of the magnitudes, whatever
-                // its order of additions.
-                let exact: f64 = (0..n)
-                    .map(|i| vn[i].abs() + an[i].abs() + rx[i].abs())
-                    .sum();
-                let what = format!("{name}, {threads} threads, in place {here}");
-                assert!((sums.bound - exact).abs() <= 1e-12 * exact, "{what}: bound");
-                (strain, sums.kinetic, sums.finite, vn, an, rx)
-            };
-            let reference = run(&batched, 1, false);
-            for (threads, kernel, here) in [1, 2]
-                .into_iter()
-                .flat_map(|t| [(t, &fused, false), (t, &fused, true), (t, &batched, true)])
-            {
-                let got = run(kernel, threads, here);
-                let fused_ran = ran && std::ptr::eq(kernel, &fused);
-                let what = format!(
-                    "{name}, {threads} threads, in place {here} (fused kernel ran: {fused_ran})"
-                );
-                assert_eq!(reference.0.to_bits(), got.0.to_bits(), "{what}: strain");
-                assert_eq!(reference.1.to_bits(), got.1.to_bits(), "{what}: kinetic");
-                assert!(reference.2 && got.2, "{what}: finite");
-                for i in 0..n {
-                    assert_eq!(
-                        reference.3[i].to_bits(),
-                        got.3[i].to_bits(),
-                        "{what}: ṙ {i}"
-                    );
-                    assert_eq!(
-                        reference.4[i].to_bits(),
-                        got.4[i].to_bits(),
-                        "{what}: r̈ {i}"
-                    );
-                    assert_eq!(
-                        reference.5[i].to_bits(),
-                        got.5[i].to_bits(),
-                        "{what}: r {i}"
-                    );
-                }
+                let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+                let out = [&mut vn[..], &mut an[..], &mut rx[..]];
+                let (_, sums) = sweep(kernels::avx(), &fused, &data, &friction, None, out, &mut p);
+                assert!(!sums.finite, "{name} {every:?}: NaN not flagged");
             }
-            // A NaN in r_K clears the flag on the fused path too.
-            let mut bad = r_new.clone();
-            bad[n / 2 + 3] = f64::NAN;
-            let data = StepData {
-                r_new: &bad,
-                ..data
-            };
-            let mut p = partials(n);
-            let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            let out = [&mut vn[..], &mut an[..], &mut rx[..]];
-            let (_, sums) = sweep(kernels::avx(), &fused, &data, &friction, None, out, &mut p);
-            assert!(!sums.finite, "{name}: NaN not flagged");
         }
     }
 
@@ -1442,7 +1514,7 @@ mod fused_lab {
             let data = lab_data(&zero, &m, &rn, &v, &a);
             let (mut vn, mut an, mut rx) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
             let mut p = partials(n);
-            let mut t = [Vec::new(), Vec::new()];
+            let mut t: Vec<Vec<f64>> = vec![Vec::new(); 9];
             stickslip_fem::testing::on_threads(2, || {
                 for round in 0..60 {
                     let s = [&batched, &fused][round % 2];
