@@ -3835,7 +3835,11 @@ pub(crate) mod tests {
     /// every such pair has a type of its own, 2,845 types for 4,846 pairs
     /// on Q1 1M; their lines requested while the run before is summed: no
     /// change). The sums and the arithmetic stay: they give
-    /// [`batch_rows`]' bits.
+    /// [`batch_rows`]' bits. Nor does the stencils' broadcast bound the
+    /// K·x loop: the unit values stored twice over, 8 wide, so that a
+    /// block's values are a plain load, took as long (Q1 1M 1.95-2.30
+    /// against 1.95-2.20 ms, Q2 1M 2.27-3.62 against 2.42-3.49, three
+    /// runs, 18:00).
     /// What does not bound the fused sweep (2026-11-25 14:57-15:13, each
     /// variant switched at run time and alternating with the kept sweep
     /// in place in one process, three runs, ratios of medians; the
