@@ -105,7 +105,6 @@ pub struct Stencils {
     /// scan 6% of the Q2 1M step's samples, 2026-11-25).
     runs: Vec<[u32; 3]>,
     chunk_runs: Vec<u32>,
-
     /// The CPU has AVX (checked at run time): runs of two alike units are
     /// summed 4 doubles wide ([`avx::units`]), the same bits.
     avx: bool,
@@ -749,6 +748,7 @@ mod avx {
 
     /// The sweep's sink for a run with no load or friction row: each
     /// block's rows by [`Rows8::eight`] from operands held over the run.
+    #[cfg(target_arch = "x86_64")]
     pub(super) struct Plain<'r, 'a, 'b> {
         pub rows: &'r mut crate::kernels::SweepRows<'a, 'b>,
         pub eight: crate::kernels::Rows8,
@@ -1324,19 +1324,25 @@ mod tests {
                     .map(|i| (i, -0.25 * i as f64))
                     .collect();
                 let data = StepData {
-                    load_new: &load_new,
                     load_rows: &load_rows,
-                    mass: &mass,
-                    r_new: &r_new,
-                    v: &v,
-                    a: &a,
-                    in_place: false,
-                    cv: 2e3,
-                    ca: 1.0,
-                    scale: 2e3,
-                    ratio: 1.0,
-                    next: (1e-3, 0.5e-6),
+                    ..crate::kernels::tests::lab_data(&load_new, &mass, &r_new, &v, &a)
                 };
+                // The runs the sparse rows leave plain (Rows8's path).
+                let special = |r: usize, hi: usize| {
+                    load_rows
+                        .iter()
+                        .chain(friction.iter().map(|f| &f.0))
+                        .any(|&i| r <= i && i < hi)
+                };
+                let plain = fused
+                    .runs
+                    .iter()
+                    .filter(|&&[g, count, _]| {
+                        let r = fused.group_rows[g as usize] as usize;
+                        !special(r, r + 8 * count as usize)
+                    })
+                    .count();
+                assert!(!ran || every.0 < 1000 || plain > 0, "{name}: no plain run");
                 // In place: ṙ_{K−1} and r̈_{K−1} handed in the outputs.
                 let in_place = StepData {
                     v: &[],
