@@ -3839,7 +3839,11 @@ pub(crate) mod tests {
     /// K·x loop: the unit values stored twice over, 8 wide, so that a
     /// block's values are a plain load, took as long (Q1 1M 1.95-2.30
     /// against 1.95-2.20 ms, Q2 1M 2.27-3.62 against 2.42-3.49, three
-    /// runs, 18:00).
+    /// runs, 18:00). Nor did ending a run with its unit's 4 rows once more
+    /// (a block of 8 with 4 lanes dropped) where the two node pairs after
+    /// it are that unit (two of the five pairs between runs on a node row
+    /// of the 1M slabs): Q1 1M 1.81-2.31 against 1.68-2.34 ms, Q2 1M
+    /// 2.37-3.10 against 2.47-3.09, four runs, 18:25.
     /// What does not bound the fused sweep (2026-11-25 14:57-15:13, each
     /// variant switched at run time and alternating with the kept sweep
     /// in place in one process, three runs, ratios of medians; the
