@@ -747,7 +747,8 @@ mod avx {
     }
 
     /// The sweep's sink for a run with no load or friction row: each
-    /// block's rows by [`Rows8::eight`] from operands held over the run.
+    /// block's rows by [`crate::kernels::Rows8::eight`] from operands
+    /// held over the run.
     #[cfg(target_arch = "x86_64")]
     pub(super) struct Plain<'r, 'a, 'b> {
         pub rows: &'r mut crate::kernels::SweepRows<'a, 'b>,
