@@ -3843,7 +3843,11 @@ pub(crate) mod tests {
     /// (a block of 8 with 4 lanes dropped) where the two node pairs after
     /// it are that unit (two of the five pairs between runs on a node row
     /// of the 1M slabs): Q1 1M 1.81-2.31 against 1.68-2.34 ms, Q2 1M
-    /// 2.37-3.10 against 2.47-3.09, four runs, 18:25.
+    /// 2.37-3.10 against 2.47-3.09, four runs, 18:25. The per-row
+    /// arithmetic by fused multiply-adds (10 operations in place of 16 per
+    /// 8 rows; other bits, on every explicit path) would buy little:
+    /// 0.96-0.99 of the time on Q1 1M, 0.98-0.99 on Q2 1M (four runs,
+    /// 18:55), so `batch_rows`' operations stay.
     /// What does not bound the fused sweep (2026-11-25 14:57-15:13, each
     /// variant switched at run time and alternating with the kept sweep
     /// in place in one process, three runs, ratios of medians; the
