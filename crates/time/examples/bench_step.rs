@@ -529,10 +529,10 @@ fn print_targets(rows: &[String]) {
         .filter_map(|r| Some((text(r, "mesh")?, field(r, "pct_stream_run")?)))
         .collect();
     if !top.is_empty() {
-        let text: Vec<String> = top.iter().map(|(m, p)| format!("{m} {p:.1}%")).collect();
+        let figures: Vec<String> = top.iter().map(|(m, p)| format!("{m} {p:.1}%")).collect();
         println!(
             "  explicit step >= 50% of the run's highest STREAM triad on the largest mesh: {} -- {}",
-            text.join(", "),
+            figures.join(", "),
             verdict(top.iter().all(|(_, p)| *p >= 50.0))
         );
     }

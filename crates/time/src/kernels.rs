@@ -1421,17 +1421,15 @@ impl<'a> SweepRows<'a, '_> {
     #[inline(always)]
     #[allow(unsafe_code)]
     pub(crate) unsafe fn few(&mut self, i: usize, ku: &[f64]) {
-        use std::arch::x86_64::*;
         if !self.plain(i, i + ku.len()) {
             self.rows(i, ku);
             return;
         }
-        let k: __mmask8 = (0xffu16 >> (8 - ku.len())) as u8;
-        // SAFETY: the caller's features; the masked load reads ku only.
+        // SAFETY: the caller's features; rows i..i + ku.len() are in
+        // this chunk.
         unsafe {
-            let sum = _mm512_maskz_loadu_pd(k, ku.as_ptr());
             let mut regs = self.begin_sums(i);
-            self.rows8().some(&mut regs, i, ku.len(), sum);
+            self.rows8().some(&mut regs, i, ku);
             self.end_sums(regs);
         }
     }
@@ -1604,41 +1602,30 @@ impl Rows8 {
             _mm512_storeu_pd(self.vn.add(o), vn);
             _mm512_storeu_pd(self.an.add(o), an);
             _mm512_storeu_pd(self.rx.add(o), rx);
-            let inf = _mm512_set1_pd(f64::INFINITY);
-            let finite = |x: __m512d| _mm512_cmp_pd_mask::<_CMP_LT_OQ>(_mm512_abs_pd(x), inf);
-            regs.finite &= (finite(rn) & finite(vn)) == 0xff;
-            let abs = _mm512_abs_pd;
-            regs.add([
-                _mm512_mul_pd(rn, ku),
-                _mm512_mul_pd(_mm512_mul_pd(m, vn), vn),
-                _mm512_add_pd(_mm512_add_pd(abs(vn), abs(an)), abs(rx)),
-            ]);
+            // All lanes: the masks below are all ones, which the compiler
+            // drops.
+            regs.tally(0xff, ku, m, rn, [vn, an, rx]);
         }
     }
 
-    /// [`Rows8::eight`] for rows i..i + len (len ≤ 8), their K r_K in
-    /// `ku`'s first len lanes: the other lanes neither read nor written,
-    /// and +0 into their sums (which start at +0 and so never hold −0:
-    /// s + 0 = s, the same bits).
+    /// [`Rows8::eight`] for rows i..i + ku.len() (at most 8) given their
+    /// K r_K: the other lanes neither read nor written, and +0 into their
+    /// sums (which start at +0 and so never hold −0: s + 0 = s, the same
+    /// bits).
     ///
     /// # Safety
-    /// As for [`Rows8::eight`], for rows i..i + len.
+    /// As for [`Rows8::eight`], for rows i..i + ku.len().
     #[inline(always)]
     #[allow(unsafe_code)]
-    pub(crate) unsafe fn some(
-        &self,
-        regs: &mut SumRegs,
-        i: usize,
-        len: usize,
-        ku: std::arch::x86_64::__m512d,
-    ) {
+    pub(crate) unsafe fn some(&self, regs: &mut SumRegs, i: usize, ku: &[f64]) {
         use std::arch::x86_64::*;
-        debug_assert!(len <= 8);
-        let k: __mmask8 = (0xffu16 >> (8 - len)) as u8;
+        debug_assert!(!ku.is_empty() && ku.len() <= 8);
+        let k: __mmask8 = (0xffu16 >> (8 - ku.len())) as u8;
         let o = i - self.start;
         // SAFETY: the caller's features; masked loads and stores touch
-        // the rows i..i + len of the chunk only.
+        // the rows i..i + ku.len() of the chunk (and of ku) only.
         unsafe {
+            let ku = _mm512_maskz_loadu_pd(k, ku.as_ptr());
             let (m, v, a, rn) = (
                 _mm512_maskz_loadu_pd(k, self.m.add(o)),
                 _mm512_maskz_loadu_pd(k, self.v.add(o)),
@@ -1649,16 +1636,7 @@ impl Rows8 {
             _mm512_mask_storeu_pd(self.vn.add(o), k, vn);
             _mm512_mask_storeu_pd(self.an.add(o), k, an);
             _mm512_mask_storeu_pd(self.rx.add(o), k, rx);
-            let inf = _mm512_set1_pd(f64::INFINITY);
-            let finite =
-                |x: __m512d| _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(k, _mm512_abs_pd(x), inf);
-            regs.finite &= (finite(rn) & finite(vn)) == k;
-            let abs = _mm512_abs_pd;
-            regs.add([
-                _mm512_maskz_mul_pd(k, rn, ku),
-                _mm512_maskz_mul_pd(k, _mm512_mul_pd(m, vn), vn),
-                _mm512_maskz_add_pd(k, _mm512_add_pd(abs(vn), abs(an)), abs(rx)),
-            ]);
+            regs.tally(k, ku, m, rn, [vn, an, rx]);
         }
     }
 
@@ -1705,16 +1683,37 @@ impl Rows8 {
 
 #[cfg(target_arch = "x86_64")]
 impl SumRegs {
-    /// Rows' strain, kinetic and bound terms (register position k: row
-    /// i + k of a block from row i) into their lanes: positions k and
-    /// k + 4 share a lane, added in row order.
+    /// The finiteness of r_K and ṙ_K and the strain, kinetic and bound
+    /// terms of the rows of a block from row i in the lanes of `k`
+    /// (register position p: row i + p) into their sums: positions p and
+    /// p + 4 share a lane, added in row order; the other lanes add +0.
     ///
     /// # Safety
     /// The CPU has AVX-512 (foundation).
     #[inline(always)]
     #[allow(unsafe_code)]
-    unsafe fn add(&mut self, terms: [std::arch::x86_64::__m512d; 3]) {
+    unsafe fn tally(
+        &mut self,
+        k: std::arch::x86_64::__mmask8,
+        ku: std::arch::x86_64::__m512d,
+        m: std::arch::x86_64::__m512d,
+        rn: std::arch::x86_64::__m512d,
+        [vn, an, rx]: [std::arch::x86_64::__m512d; 3],
+    ) {
         use std::arch::x86_64::*;
+        // SAFETY: the caller's features.
+        let terms = unsafe {
+            let inf = _mm512_set1_pd(f64::INFINITY);
+            let finite =
+                |x: __m512d| _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(k, _mm512_abs_pd(x), inf);
+            self.finite &= (finite(rn) & finite(vn)) == k;
+            let abs = _mm512_abs_pd;
+            [
+                _mm512_maskz_mul_pd(k, rn, ku),
+                _mm512_maskz_mul_pd(k, _mm512_mul_pd(m, vn), vn),
+                _mm512_maskz_add_pd(k, _mm512_add_pd(abs(vn), abs(an)), abs(rx)),
+            ]
+        };
         for (acc, t) in [&mut self.strain, &mut self.kinetic, &mut self.bound]
             .into_iter()
             .zip(terms)
