@@ -3847,6 +3847,21 @@ pub(crate) mod tests {
     /// 8 rows; other bits, on every explicit path) would buy little:
     /// 0.96-0.99 of the time on Q1 1M, 0.98-0.99 on Q2 1M (four runs,
     /// 18:55), so `batch_rows`' operations stay.
+    /// Where the 1M step stands against its own vectors in the caches
+    /// (2026-11-25 19:28-19:32, the fused sweep in place forced on every
+    /// size, per million rows): with the vectors in the L2 (33k DOFs) Q1
+    /// 1.08, Q2 1.72 ms; in the L3 (250k) Q1 1.41-1.44, Q2 1.90-2.06;
+    /// from memory (1M) Q1 1.50-1.67, Q2 1.95-2.07. The 1M step is
+    /// within 15-40% of its speed out of the L2: its arithmetic, not the
+    /// memory, holds it under the triad. Nor did two ways of feeding the
+    /// cores more evenly help (each switched at run time, alternating in
+    /// one process, 19:26-19:33): the swap of the "other" terms applied
+    /// once per block to the sums instead of per offset to x (the same
+    /// bits: a lane's products move, unchanged), K·x alone 0.975-0.98 of
+    /// its time, the sweep 0.98-1.03; the rows of the previous four
+    /// blocks interleaved among the current four's offsets (so that the
+    /// per-row arithmetic shares the window with the FMAs), Q1 1M
+    /// 1.00-1.03, Q2 1M 0.97-1.05, three runs.
     /// What does not bound the fused sweep (2026-11-25 14:57-15:13, each
     /// variant switched at run time and alternating with the kept sweep
     /// in place in one process, three runs, ratios of medians; the
