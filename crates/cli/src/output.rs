@@ -459,6 +459,17 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         },
         initial_mechanical: get_scalar(&g, "initial_mechanical")?,
         reduced_remaining: get_scalar(&g, "reduced_remaining")?,
+        // Absent in files written before the drift-free clock: the
+        // restart then starts a new run of steps at t.
+        clock: if g.attr("clock_t0").is_ok() {
+            Some((
+                get_scalar(&g, "clock_t0")?,
+                get_scalar(&g, "clock_dt")?,
+                get_scalar(&g, "clock_steps")?,
+            ))
+        } else {
+            None
+        },
         total_iterations: get_scalar(&g, "total_iterations")?,
         factorizations: get_scalar(&g, "factorizations")?,
         // Absent in files of versions before the modal step: the restart
@@ -816,6 +827,11 @@ impl ResultsWriter {
         put_scalar(&g, "steps", cp.steps)?;
         put_scalar(&g, "initial_mechanical", cp.initial_mechanical)?;
         put_scalar(&g, "reduced_remaining", cp.reduced_remaining)?;
+        if let Some((t0, dt, k)) = cp.clock {
+            put_scalar(&g, "clock_t0", t0)?;
+            put_scalar(&g, "clock_dt", dt)?;
+            put_scalar(&g, "clock_steps", k)?;
+        }
         put_scalar(&g, "total_iterations", cp.total_iterations)?;
         put_scalar(&g, "factorizations", cp.factorizations)?;
         put_scalar(&g, "rows", extra.rows as u64)?;

@@ -389,7 +389,9 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         stickslip_time::stability::critical_step(&p.model.stiffness, &p.model.lumped_mass)
     });
     println!("dt_crit     {crit:.6e} (central difference, lumped mass: 2/omega_max)");
-    let steps = (case.time.t_end / case.time.dt).ceil();
+    // As the integrator counts: a last step within 1e-6 Δt of t_end is
+    // not a step of its own.
+    let steps = (case.time.t_end / case.time.dt - 1e-6).ceil().max(1.0);
     if i.is_explicit() {
         println!(
             "solver      explicit: no linear system; friction solved node by node in closed form; K·x by {}",
