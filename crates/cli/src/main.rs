@@ -161,7 +161,8 @@ fn main() -> ExitCode {
             json,
             restart,
         } => {
-            let case = match case::load(&case, &sets) {
+            let case_path = case;
+            let case = match case::load(&case_path, &sets) {
                 Ok(c) => c,
                 Err(e) => {
                     report(&e.0);
@@ -173,26 +174,17 @@ fn main() -> ExitCode {
                 None => output.unwrap_or_else(|| case.output.file.clone()),
             };
             if restart.is_none() {
-                if out.exists() && !force {
-                    report(&format!(
-                        "{} already exists; use --force to overwrite it, -o to write elsewhere, \
-                         or --restart {} to continue it",
-                        out.display(),
-                        out.display()
-                    ));
+                if let Err(e) = run::check_output(&out, &case_path, force) {
+                    report(&e.0);
                     return ExitCode::from(2);
                 }
-                if let Some(dir) = out
-                    .parent()
-                    .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
-                {
-                    report(&format!(
-                        "{}: the directory {} does not exist; create it, or choose another file with -o",
-                        out.display(),
-                        dir.display()
-                    ));
-                    return ExitCode::from(2);
-                }
+            } else if run::in_use(&out) {
+                report(&format!(
+                    "--restart {}: the file is open in another process (a run still writing it, \
+                     or a reader such as h5py or ParaView); wait for it or close it",
+                    out.display()
+                ));
+                return ExitCode::from(2);
             }
             let stop = match run::StopFlags::install() {
                 Ok(s) => s,

@@ -95,6 +95,22 @@ fn parse_point(at: &str) -> Result<[f64; 2], InputError> {
     Ok([x, y])
 }
 
+/// Opens a results file, saying so when a run is still writing it (HDF5
+/// refuses a file another process holds).
+fn open_results(file: &Path) -> Result<File, InputError> {
+    let name = file.display();
+    File::open(file).map_err(|e| {
+        InputError(if crate::run::in_use(file) {
+            format!(
+                "{name}: a run is still writing it (HDF5 locks the file); wait for the run to end, \
+                 or read the records flushed so far with HDF5_USE_FILE_LOCKING=FALSE set"
+            )
+        } else {
+            format!("{name}: cannot open it as HDF5: {e}; give a results file written by `stickslip run`")
+        })
+    })
+}
+
 /// Reads the history of `field` at the node of `file` nearest to `at`.
 ///
 /// # Errors
@@ -108,7 +124,7 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
             "{name}: {what}: {e}; give a results file written by `stickslip run`"
         ))
     };
-    let f = File::open(file).map_err(|e| h5("cannot open it as HDF5", e))?;
+    let f = open_results(file)?;
     let nodes = f
         .dataset("mesh/nodes")
         .and_then(|d| d.read_2d::<f64>())
@@ -437,7 +453,7 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
             "{name}: {what}: {e}; give a results file written by `stickslip run`"
         ))
     };
-    let f = File::open(file).map_err(|e| h5("cannot open it as HDF5", e))?;
+    let f = open_results(file)?;
     let nodes = f
         .dataset("mesh/nodes")
         .and_then(|d| d.read_2d::<f64>())

@@ -1002,3 +1002,78 @@ fn restart_across_node_orders_continues_the_run() {
         }
     }
 }
+
+/// The results file is protected: `--force` does not touch a file another
+/// run is writing (before, HDF5 truncated it and then failed on its lock,
+/// leaving both runs without results), an OUT.xdmf is not overwritten
+/// without `--force`, the case file cannot be the output, and a place that
+/// cannot be written is bad input (2), not a failed run (1).
+#[test]
+fn the_results_file_is_never_clobbered() {
+    let dir = scratch("clobber");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let out = dir.join("live.h5");
+    let mut first = start_long(&case, &out, &["--quiet"], 0.5);
+    let second = run(&case, &out, &[]);
+    let still_running = first.try_wait().unwrap().is_none();
+    signal(&first, "-INT");
+    let status = first.wait().unwrap();
+    assert!(
+        still_running,
+        "the first run lasts past the second's attempt"
+    );
+    assert_eq!(second.status.code(), Some(2), "{}", stderr(&second));
+    assert!(
+        stderr(&second).contains("open in another process"),
+        "{}",
+        stderr(&second)
+    );
+    assert_eq!(status.code(), Some(130), "the first run ends by its SIGINT");
+    let f = hdf5::File::open(&out).expect("the first run's file is intact");
+    assert!(
+        f.dataset("time").unwrap().size() > 1,
+        "its records are there"
+    );
+    drop(f);
+
+    let lone = dir.join("lone.h5");
+    std::fs::write(dir.join("lone.xdmf"), "mine").unwrap();
+    let o = bin()
+        .arg("run")
+        .arg(&case)
+        .arg("-o")
+        .arg(&lone)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("lone.xdmf already exists"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("lone.xdmf")).unwrap(),
+        "mine"
+    );
+
+    let o = run(&case, &case, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is the case file itself"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(std::fs::read_to_string(&case).unwrap().contains("[time]"));
+
+    for bad in [dir.clone(), case.join("x.h5")] {
+        let o = run(&case, &bad, &[]);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{}: {}",
+            bad.display(),
+            stderr(&o)
+        );
+    }
+}
