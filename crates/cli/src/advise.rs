@@ -1356,6 +1356,13 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
         )));
     }
     if let Some(w) = &o.write {
+        // Never over a file: it may be the case being advised, or another.
+        if w.exists() {
+            return Err(input(format!(
+                "--write {}: the file exists; give a new name (advise never overwrites a file)",
+                w.display()
+            )));
+        }
         if let Some(dir) = w
             .parent()
             .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())

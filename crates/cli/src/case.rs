@@ -144,7 +144,25 @@ pub enum History {
         omega: f64,
     },
     /// Piecewise linear through (t_i, f_i), constant beyond the ends.
+    #[serde(deserialize_with = "table_points")]
     Table(Vec<[f64; 2]>),
+}
+
+/// A table's rows, each exactly [t, f] (serde's [f64; 2] took [t, f, x]
+/// and dropped x).
+fn table_points<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    let rows = Vec::<Vec<f64>>::deserialize(d)?;
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| match r[..] {
+            [t, f] => Ok([t, f]),
+            _ => Err(serde::de::Error::custom(format!(
+                "table row {} has {} numbers; each row is [t, f]",
+                i + 1,
+                r.len()
+            ))),
+        })
+        .collect()
 }
 
 impl History {
@@ -470,9 +488,9 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
             };
             if !(msg.starts_with("missing field") && removed_leaf(&msg)) {
                 let hint = if msg.starts_with("unknown field") {
-                    "; check the spelling (DESIGN.md \"Case file\" lists the keys)"
+                    "; check the spelling (docs/case-file.md lists the keys)"
                 } else if msg.starts_with("missing field") {
-                    "; add it (DESIGN.md \"Case file\" lists the keys)"
+                    "; add it (docs/case-file.md lists the keys)"
                 } else if msg.contains("variant") {
                     "; use one of the values listed"
                 } else if msg.starts_with("invalid type") || msg.starts_with("invalid length") {
@@ -977,11 +995,18 @@ fn convert(
     check(
         mesh_file.is_file(),
         raw.mesh.file.span(),
-        format!(
-            "mesh.file: {} does not exist (paths are relative to the case file's directory); \
-             check the name, or make the mesh with Gmsh",
-            mesh_file.display()
-        ),
+        if mesh_file.is_dir() {
+            format!(
+                "mesh.file: {} is a directory; give the .msh file in it",
+                mesh_file.display()
+            )
+        } else {
+            format!(
+                "mesh.file: {} does not exist (paths are relative to the case file's directory); \
+                 check the name, or make the mesh with Gmsh",
+                mesh_file.display()
+            )
+        },
     );
 
     // mesh.ladder: at least one entry. Whether its files exist is checked
@@ -1463,12 +1488,12 @@ impl<'a> Locator<'a> {
                         !leaf.is_empty() && text.contains(leaf)
                     })
                     .collect();
-                let which: Vec<&String> = if on_line.is_empty() {
-                    self.sets.iter().collect()
-                } else {
-                    on_line
-                };
-                let which: Vec<&str> = which.iter().map(|s| s.as_str()).collect();
+                // No override on the line (a key missing from a file
+                // with no such line, e.g. an empty one): the file.
+                if on_line.is_empty() {
+                    return self.file.to_string();
+                }
+                let which: Vec<&str> = on_line.iter().map(|s| s.as_str()).collect();
                 format!("--set {} (in {})", which.join(" --set "), self.file)
             }
         }
@@ -1757,6 +1782,29 @@ t_end = 0.5
                 "{e}"
             );
         }
+    }
+
+    #[test]
+    fn table_rows_are_pairs_and_an_empty_file_names_itself() {
+        let with = |rows: &str| {
+            GOOD.replace(
+                "t = [-150.0, 0.0]   # compressive",
+                &format!("t = [-150.0, 0.0]\nhistory = {{ table = {rows} }}"),
+            )
+        };
+        assert!(load_text("rows-ok", &with("[[0.0, 0.0], [0.1, 1.0]]"), &[]).is_ok());
+        // serde's [f64; 2] took a third number and dropped it.
+        let text = with("[[0.0, 0.0], [0.1, 1.0, 99.0]]");
+        let e = load_text("rows-3", &text, &[]).unwrap_err().0;
+        assert!(e.contains("table row 2 has 3 numbers"), "{e}");
+        assert!(
+            e.contains(&format!("case.toml:{}:", line_of(&text, "history ="))),
+            "{e}"
+        );
+        // No --set to blame in an empty file.
+        let e = load_text("empty", "", &[]).unwrap_err().0;
+        assert!(e.contains("case.toml: missing field `mesh`"), "{e}");
+        assert!(!e.contains("--set"), "{e}");
     }
 
     #[test]

@@ -287,6 +287,14 @@ fn main() -> ExitCode {
                     ExitCode::from(2)
                 }
             },
+            // clap's `requires` does not hold across the flattened group.
+            Some(_) if along.output.is_some() || along.times.is_some() => {
+                report(
+                    "probe: -o and --times go with --along GROUP; with --at the history goes to \
+                     stdout (redirect it: > FILE)",
+                );
+                ExitCode::from(2)
+            }
             Some(at) => match probe::probe(&file, &at, field, csv) {
                 Ok(p) => {
                     if csv {

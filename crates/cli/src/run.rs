@@ -441,6 +441,17 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
             max_iterations: c.max_iterations,
         };
         match ContactSurface::from_group(&mesh, &model.dofs, &c.group, c.pressure, c.mu, c.eps) {
+            // Every node's tangential DOF held: the friction the case asks
+            // for could act nowhere (before, it was dropped silently, and
+            // the file had no /contact).
+            Ok(s) if s.is_empty() => problems.push(format!(
+                "{}[contact]: no node of group \"{}\" can slide: [[dirichlet]] conditions hold the tangential \
+                 motion of all its {} nodes, so friction would act nowhere; remove the [[dirichlet]] on the \
+                 contact surface's tangential direction, or remove [contact] for a run without friction",
+                case.at("contact.group"),
+                c.group,
+                s.excluded.len()
+            )),
             Ok(s) => contact = Some(s),
             Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
         }

@@ -228,6 +228,7 @@ fn advise_command_writes_a_case_that_loads_and_keeps_comments() {
     let dir = std::env::temp_dir().join(format!("stickslip-advise-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("adjusted.toml");
+    std::fs::remove_file(&out).ok();
     let case_path = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
     let st = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
         .args(["advise"])
@@ -267,4 +268,23 @@ fn advise_command_writes_a_case_that_loads_and_keeps_comments() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("needs --at X,Y"));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn advise_never_writes_over_a_file() {
+    let dir = std::env::temp_dir().join(format!("stickslip-advise-over-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("mine.toml");
+    std::fs::write(&out, "mine").unwrap();
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
+        .arg("advise")
+        .arg(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
+        .args(["--tol", "3e-2", "--on", "ux", "--at", "8,1", "--write"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert_eq!(st.status.code(), Some(2), "{err}");
+    assert!(err.contains("the file exists"), "{err}");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "mine");
 }

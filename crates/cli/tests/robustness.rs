@@ -286,6 +286,21 @@ fn mesh_problems_are_gathered_and_list_the_groups() {
 }
 
 #[test]
+fn a_contact_surface_held_in_its_tangent_is_refused() {
+    // ux = 0 on the whole (horizontal) contact line: friction could act
+    // nowhere; before, it was dropped silently and the file had no /contact.
+    let dir = scratch("held-contact");
+    let (case, _) = slab_case(&dir, "held", |t| {
+        t.replace(
+            "[contact]",
+            "[[dirichlet]]\ngroup = \"contact\"\nux = 0.0\n\n[contact]",
+        )
+    });
+    let e = refused(&case, &[], &["can slide", "friction would act nowhere"]);
+    assert!(e.contains("held.toml:"), "{e}");
+}
+
+#[test]
 fn supports_that_leave_a_rigid_motion_free_are_refused() {
     // Without the left end's ux = 0 nothing holds the slab in x (the
     // initial static solve is frictionless, Remark 4.1).
@@ -1075,5 +1090,23 @@ fn the_results_file_is_never_clobbered() {
             bad.display(),
             stderr(&o)
         );
+    }
+}
+
+/// `-o` and `--times` belong to `--along`: with `--at` they were silently
+/// ignored (the history went to stdout and no file was written).
+#[test]
+fn probe_refuses_along_options_with_at() {
+    let dir = scratch("probe-o");
+    for extra in [["-o", "x.csv"], ["--times", "0.1"]] {
+        let o = bin()
+            .arg("probe")
+            .arg(dir.join("any.h5"))
+            .args(["--at", "8,0"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains("go with --along"), "{}", stderr(&o));
     }
 }

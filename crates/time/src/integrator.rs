@@ -232,8 +232,8 @@ pub enum TimeError {
     /// The stick/slip iteration did not settle.
     #[error(
         "step {step} (t = {t:.6e}): the stick/slip iteration did not converge in {iterations} \
-         iterations ({changing} nodes still changing class); enable Remark 4.2 \
-         (contact.remark_4_2 = true), raise contact.max_iterations, or reduce time.dt"
+         iterations ({changing} nodes still changing class); {hint}raise contact.max_iterations, \
+         or reduce time.dt"
     )]
     IterationCap {
         /// Step number (1-based).
@@ -244,6 +244,8 @@ pub enum TimeError {
         iterations: usize,
         /// Nodes still changing class.
         changing: usize,
+        /// "enable Remark 4.2 (…), " where the run had it off, else "".
+        hint: &'static str,
     },
     /// NaN or infinity in the state.
     #[error("step {step} (t = {t:.6e}): the solution is no longer finite; reduce time.dt{hint}")]
@@ -522,8 +524,7 @@ impl SweepBounds {
 /// the failed solve as `solve` maps it.
 fn iteration_error<E>(
     failure: IterationFailure<E>,
-    step: u64,
-    t: f64,
+    (step, t, remark_4_2): (u64, f64, bool),
     solve: impl FnOnce(E) -> TimeError,
 ) -> TimeError {
     match failure {
@@ -535,6 +536,11 @@ fn iteration_error<E>(
             t,
             iterations,
             changing,
+            hint: if remark_4_2 {
+                ""
+            } else {
+                "enable Remark 4.2 (contact.remark_4_2 = true, the default), "
+            },
         },
         IterationFailure::Solve(e) => solve(e),
     }
@@ -1540,7 +1546,11 @@ impl Integrator {
             self.settings.iteration,
         ) {
             Ok(report) => Ok(report.iterations),
-            Err(failure) => Err(iteration_error(failure, step, t, |never| match never {})),
+            Err(failure) => Err(iteration_error(
+                failure,
+                (step, t, self.settings.iteration.remark_4_2),
+                |never| match never {},
+            )),
         }
     }
 
@@ -1583,9 +1593,11 @@ impl Integrator {
                 op.finish(&mut self.v_new);
                 Ok(report.iterations)
             }
-            Err(failure) => Err(iteration_error(failure, step, t, |source| {
-                TimeError::Solve { step, t, source }
-            })),
+            Err(failure) => Err(iteration_error(
+                failure,
+                (step, t, self.settings.iteration.remark_4_2),
+                |source| TimeError::Solve { step, t, source },
+            )),
         }
     }
 
@@ -1624,9 +1636,11 @@ impl Integrator {
         );
         match result {
             Ok(report) => Ok(report.iterations),
-            Err(failure) => Err(iteration_error(failure, step, t, |source| {
-                TimeError::Solve { step, t, source }
-            })),
+            Err(failure) => Err(iteration_error(
+                failure,
+                (step, t, self.settings.iteration.remark_4_2),
+                |source| TimeError::Solve { step, t, source },
+            )),
         }
     }
 
