@@ -593,7 +593,36 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         "steps       about {steps} to t_end = {} with dt = {:e}",
         case.time.t_end, case.time.dt
     );
+    // Per record: u, v, a at every node (6 doubles), the contact's stress
+    // and slip (2 doubles) and state (1 byte), about 12 scalars besides
+    // (time, the ledger, dt, iterations); uncompressed.
+    let every = case.output.every.max(1) as f64;
+    let records = (steps / every).floor() + 1.0;
+    let n_c = i.contact().map_or(0, |c| c.len()) as f64;
+    let bytes = records * (48.0 * p.mesh.nodes.len() as f64 + 17.0 * n_c + 96.0);
+    println!(
+        "output      about {records} records (every {} steps) of {}, {}",
+        case.output.every,
+        case.output.file.display(),
+        human_bytes(bytes)
+    );
     Ok(())
+}
+
+/// "1.2 GB"-style size (decimal units).
+fn human_bytes(b: f64) -> String {
+    let units = ["bytes", "kB", "MB", "GB", "TB", "PB"];
+    let mut u = 0;
+    let mut v = b;
+    while v >= 1000.0 && u + 1 < units.len() {
+        v /= 1000.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{v:.0} {}", units[0])
+    } else {
+        format!("{v:.1} {}", units[u])
+    }
 }
 
 /// Full-length (2 × nodes) copies of the free-DOF state for output.
