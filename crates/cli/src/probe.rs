@@ -95,19 +95,22 @@ fn parse_point(at: &str) -> Result<[f64; 2], InputError> {
     Ok([x, y])
 }
 
-/// Opens a results file, saying so when a run is still writing it (HDF5
-/// refuses a file another process holds).
+/// Opens a results file that no run is writing: with HDF5's locking off
+/// (HDF5_USE_FILE_LOCKING=FALSE, as `cargo run` sets it) the file opens,
+/// but its datasets may be caught between two records.
 fn open_results(file: &Path) -> Result<File, InputError> {
     let name = file.display();
+    if crate::run::being_written(file) {
+        return Err(InputError(format!(
+            "{name}: a run is still writing it; wait for the run to end (or stop it: Ctrl-C \
+             keeps every step) and probe it then"
+        )));
+    }
     File::open(file).map_err(|e| {
-        InputError(if crate::run::in_use(file) {
-            format!(
-                "{name}: a run is still writing it (HDF5 locks the file); wait for the run to end, \
-                 or read the records flushed so far with HDF5_USE_FILE_LOCKING=FALSE set"
-            )
-        } else {
-            format!("{name}: cannot open it as HDF5: {e}; give a results file written by `stickslip run`")
-        })
+        InputError(format!(
+            "{name}: cannot open it as HDF5: {e}; give a results file written by `stickslip run`, \
+             and close any program that is writing it"
+        ))
     })
 }
 

@@ -132,17 +132,21 @@ pub fn check_output(out: &Path, case_file: &Path, force: bool) -> Result<(), Inp
 pub fn in_use(path: &Path) -> bool {
     let flocked = std::fs::File::open(path)
         .is_ok_and(|f| matches!(f.try_lock(), Err(std::fs::TryLockError::WouldBlock)));
-    // A write lock of our own, released when `f` closes, conflicts with a
-    // run's read lock.
+    flocked || being_written(path)
+}
+
+/// Whether a run is writing `path` ([`RunLock`]), whatever HDF5's own
+/// locking: a write lock of ours, released when `f` closes, conflicts
+/// with the run's read lock.
+pub fn being_written(path: &Path) -> bool {
     let held = |e: std::io::Error| {
         e.kind() == std::io::ErrorKind::WouldBlock || e.raw_os_error() == Some(libc::EACCES)
     };
-    let run_lock = std::fs::OpenOptions::new()
+    std::fs::OpenOptions::new()
         .read(true)
         .write(true)
         .open(path)
-        .is_ok_and(|f| ofd_lock(&f, false).is_err_and(held));
-    flocked || run_lock
+        .is_ok_and(|f| ofd_lock(&f, false).is_err_and(held))
 }
 
 /// A run's lock on its results file, held while it writes: an open file
