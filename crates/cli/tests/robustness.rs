@@ -1030,6 +1030,14 @@ fn the_results_file_is_never_clobbered() {
     let out = dir.join("live.h5");
     let mut first = start_long(&case, &out, &["--quiet"], 0.5);
     let second = run(&case, &out, &[]);
+    // Under cargo test HDF5's locking is off (.cargo/config.toml), so
+    // only the run's own lock tells probe to wait.
+    let probe = bin()
+        .arg("probe")
+        .arg(&out)
+        .args(["--at", "8,0"])
+        .output()
+        .unwrap();
     let still_running = first.try_wait().unwrap().is_none();
     signal(&first, "-INT");
     let status = first.wait().unwrap();
@@ -1042,6 +1050,12 @@ fn the_results_file_is_never_clobbered() {
         stderr(&second).contains("open in another process"),
         "{}",
         stderr(&second)
+    );
+    assert_eq!(probe.status.code(), Some(2), "{}", stderr(&probe));
+    assert!(
+        stderr(&probe).contains("still writing it"),
+        "{}",
+        stderr(&probe)
     );
     assert_eq!(status.code(), Some(130), "the first run ends by its SIGINT");
     let f = hdf5::File::open(&out).expect("the first run's file is intact");
