@@ -210,6 +210,26 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
     if !complete {
         info.push_str(" (the run did not complete)");
     }
+    // A point off the body by more than a hundredth of its size is likely
+    // a typo (or the other coordinate order): say so, the history follows.
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for row in nodes.rows() {
+        for k in 0..2 {
+            lo[k] = lo[k].min(row[k]);
+            hi[k] = hi[k].max(row[k]);
+        }
+    }
+    let size = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+    let off = (0..2)
+        .map(|k| (lo[k] - p[k]).max(p[k] - hi[k]).max(0.0))
+        .fold(0.0_f64, f64::hypot);
+    if off > 0.01 * size {
+        let _ = write!(
+            info,
+            "; note: ({}, {}) lies outside the mesh (x in [{}, {}], y in [{}, {}])",
+            p[0], p[1], lo[0], hi[0], lo[1], hi[1]
+        );
+    }
     info.push('\n');
     let mut table = String::new();
     if csv {
@@ -744,9 +764,16 @@ mod tests {
             "{}",
             p.info
         );
+        assert!(!p.info.contains("outside"), "{}", p.info);
         assert_eq!(
             probe(&path, "2,0", Field::Vy, false).unwrap().values,
             vec![0.0, 0.5, 1.0, 1.5]
+        );
+        let far = probe(&path, "20,0.5", Field::Ux, false).unwrap();
+        assert!(
+            far.info.contains("note: (20, 0.5) lies outside the mesh"),
+            "{}",
+            far.info
         );
         // Contact node 1 is index 1 along the surface: σ_T = k − 1.
         let fs = probe(&path, "1,0", Field::FrictionStress, true).unwrap();
