@@ -50,7 +50,7 @@ A second Ctrl-C while the first is being handled exits at once (the file keeps e
         /// Overwrite an existing results file.
         #[arg(long)]
         force: bool,
-        /// No progress bar or summary.
+        /// No progress (a bar on a terminal, a line a minute in a log) and no summary.
         #[arg(short, long)]
         quiet: bool,
         /// Print the closing summary as one JSON object on stdout.

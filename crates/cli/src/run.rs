@@ -218,6 +218,9 @@ fn make_room(out: &Path) -> anyhow::Result<()> {
     std::fs::remove_file(out).with_context(|| format!("cannot remove the empty {}", out.display()))
 }
 
+/// Seconds between progress lines where stderr is not a terminal.
+const PROGRESS_LOG_SECS: u64 = 60;
+
 fn input(msg: impl Into<String>) -> anyhow::Error {
     anyhow::Error::new(InputError(msg.into()))
 }
@@ -942,7 +945,14 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         );
         bar
     });
+    // Where stderr is a log, not a terminal: a line a minute instead of
+    // the bar, so a batch job's log shows a long run moving.
+    let log_progress = !quiet && !std::io::stderr().is_terminal();
+    let mut last_log = Instant::now();
     let t_end = integrator.t_end();
+    // A restart starts where its checkpoint was: the share done and the
+    // time left count from there.
+    let t_start = integrator.time();
     let steps_before = integrator.steps();
     let mut failure: Option<String> = None;
     let mut interrupted: Option<&'static str> = None;
@@ -1010,6 +1020,19 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                     if last_xdmf.elapsed().as_secs_f64() >= case.output.flush_seconds {
                         xdmf(&times)?;
                         last_xdmf = Instant::now();
+                    }
+                    if log_progress && last_log.elapsed().as_secs() >= PROGRESS_LOG_SECS {
+                        last_log = Instant::now();
+                        let wall = started.elapsed().as_secs_f64();
+                        let done = (integrator.time() - t_start) / (t_end - t_start).max(1e-300);
+                        eprintln!(
+                            "progress: t = {:.6e} of {t_end} ({:.1}%), step {}, {:.0} s elapsed, about {:.0} s left",
+                            integrator.time(),
+                            100.0 * done,
+                            integrator.steps(),
+                            wall,
+                            wall * (1.0 - done) / done.max(1e-12)
+                        );
                     }
                 }
                 if let Some(bar) = &bar {
