@@ -24,7 +24,7 @@ pub fn report(path: &Path, as_json: bool) -> Result<String, InputError> {
 }
 
 /// The DESIGN.md object: format, version, binary, nodes, cells,
-/// boundary_elements, groups, bbox, reoriented.
+/// boundary_elements, groups, bbox, reoriented, unused_nodes.
 pub fn to_json(mesh: &Mesh) -> serde_json::Value {
     let groups: serde_json::Map<String, serde_json::Value> = mesh
         .groups
@@ -47,6 +47,7 @@ pub fn to_json(mesh: &Mesh) -> serde_json::Value {
         "groups": groups,
         "bbox": mesh.bbox(),
         "reoriented": mesh.source.reoriented,
+        "unused_nodes": mesh.source.unused_nodes,
     })
 }
 
@@ -64,6 +65,13 @@ fn to_table(path: &Path, mesh: &Mesh) -> String {
         mesh.source.version
     );
     let _ = writeln!(s, "  nodes        {}", mesh.nodes.len());
+    if mesh.source.unused_nodes > 0 {
+        let _ = writeln!(
+            s,
+            "  unused nodes  {} dropped (in no cell: Gmsh's Mesh.SaveAll or geometry points)",
+            mesh.source.unused_nodes
+        );
+    }
     let _ = writeln!(s, "  cells        {} {}", mesh.n_cells(), mesh.kind.name());
     let boundary: Vec<String> = mesh
         .source

@@ -180,3 +180,39 @@ fn usage_errors_exit_2_and_help_has_examples() {
         .unwrap()
         .starts_with("stickslip "));
 }
+
+/// A mesh written to a file of its own in the temp directory (the tests of
+/// one binary run in parallel, so each file name is the test's).
+fn temp_mesh(name: &str, text: &str) -> PathBuf {
+    let p = std::env::temp_dir().join(format!("stickslip-cli-mesh-{}-{name}", std::process::id()));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Two quad4 cells and two nodes used by no cell (tags 7 and 8, far out).
+const ORPHANS: &str = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n\
+1 0 0 0\n2 1 0 0\n3 2 0 0\n4 0 1 0\n5 1 1 0\n6 2 1 0\n7 5 5 0\n8 -3 7 0\n$EndNodes\n\
+$Elements\n2\n1 3 2 2 1 1 2 5 4\n2 3 2 2 1 2 3 6 5\n$EndElements\n";
+
+#[test]
+fn mesh_reports_dropped_unused_nodes() {
+    let p = temp_mesh("orphans.msh", ORPHANS);
+    let j = mesh_json(&p);
+    assert_eq!(j["nodes"], 6);
+    assert_eq!(j["unused_nodes"], 2);
+    assert_eq!(j["bbox"], serde_json::json!([[0.0, 0.0], [2.0, 1.0]]));
+    let o = bin().arg("mesh").arg(&p).output().unwrap();
+    let out = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        out.contains(
+            "  unused nodes  2 dropped (in no cell: Gmsh's Mesh.SaveAll or geometry points)\n"
+        ),
+        "{out}"
+    );
+    std::fs::remove_file(&p).unwrap();
+    // Shown only when there are some; the JSON key always.
+    let slab = root().join("cases/meshes/slab-q2-8x2.msh");
+    assert_eq!(mesh_json(&slab)["unused_nodes"], 0);
+    let o = bin().arg("mesh").arg(&slab).output().unwrap();
+    assert!(!String::from_utf8(o.stdout).unwrap().contains("unused"));
+}

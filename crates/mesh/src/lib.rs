@@ -104,12 +104,15 @@ pub struct SourceInfo {
     pub reoriented: usize,
     /// Boundary elements by type name ("line2", "line3", "point") → count.
     pub boundary_elements: BTreeMap<String, usize>,
+    /// Nodes of the file used by no cell (geometry points saved with
+    /// Gmsh's `Mesh.SaveAll = 1`, hand-edited leftovers), dropped on import.
+    pub unused_nodes: usize,
 }
 
 /// A 2-D quadrilateral mesh with named groups.
 ///
-/// Invariants (established by the reader and its checks): every cell has
-/// `kind.nodes_per_cell()` valid node indices, is counter-clockwise with a
+/// Invariants (established by the reader and its checks): every node is
+/// used by a cell; every cell has `kind.nodes_per_cell()` valid node indices, is counter-clockwise with a
 /// positive Jacobian determinant at its corners; every edge of a dimension-1
 /// group is a side of its `cell` and oriented with that cell on its left.
 #[derive(Clone, Debug, PartialEq)]

@@ -473,13 +473,13 @@ impl Builder {
         let Builder {
             version,
             binary,
-            nodes,
-            node_tags,
+            mut nodes,
+            mut node_tags,
             max_z,
             memberships,
             names,
             kind,
-            cells,
+            mut cells,
             cell_tags,
             cell_member,
             reoriented,
@@ -656,6 +656,46 @@ impl Builder {
             }
         }
 
+        // Nodes in no cell (Gmsh's Mesh.SaveAll = 1 saves geometry points
+        // such as a circle's centre) would be free, unloaded DOFs that make
+        // K singular: drop them. Edges of groups are cell sides, so only
+        // cells and points refer to dropped nodes.
+        let mut used = vec![false; nodes.len()];
+        for &n in &cells {
+            used[n] = true;
+        }
+        let unused_nodes = used.iter().filter(|&&u| !u).count();
+        if unused_nodes > 0 {
+            let mut new = vec![usize::MAX; nodes.len()];
+            let mut k = 0;
+            for (i, &u) in used.iter().enumerate() {
+                if u {
+                    new[i] = k;
+                    nodes[k] = nodes[i];
+                    node_tags[k] = node_tags[i];
+                    k += 1;
+                }
+            }
+            nodes.truncate(k);
+            node_tags.truncate(k);
+            for n in &mut cells {
+                *n = new[*n];
+            }
+            for g in acc.values_mut() {
+                for e in &mut g.edges {
+                    e.nodes = e.nodes.map(|n| new[n]);
+                    e.mid = e.mid.map(|n| new[n]);
+                }
+                // A point on a dropped node leaves its group.
+                let before = g.points.len();
+                g.points.retain(|&p| used[p]);
+                g.elements -= before - g.points.len();
+                for p in &mut g.points {
+                    *p = new[*p];
+                }
+            }
+        }
+
         // Node sets: a mark array for big groups, sort + dedup for small ones.
         let mut mark = Vec::new();
         for g in acc.values_mut() {
@@ -709,6 +749,7 @@ impl Builder {
                 binary,
                 reoriented,
                 boundary_elements,
+                unused_nodes,
             },
         })
     }

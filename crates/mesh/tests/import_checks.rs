@@ -1,0 +1,88 @@
+//! Checks the reader makes beyond the format itself (from a user review of
+//! the import): what it drops, what it refuses and what it records. The
+//! meshes are small and written inline, each exercising one finding.
+
+mod common;
+use common::*;
+
+// ---- nodes used by no cell ----
+
+/// Two quad4 cells (tags 1-6) and two nodes no cell uses (9 and 8, one in
+/// the middle of the list), node 9 a dimension-0 group of its own as a
+/// geometry point saved with Mesh.SaveAll = 1 would be.
+const ORPHANS_22: &str = "\
+$MeshFormat
+2.2 0 8
+$EndMeshFormat
+$PhysicalNames
+4
+0 5 \"pin\"
+0 6 \"centre\"
+1 1 \"bottom\"
+2 2 \"body\"
+$EndPhysicalNames
+$Nodes
+8
+1 0 0 0
+2 1 0 0
+9 5 5 0
+3 2 0 0
+4 0 1 0
+5 1 1 0
+6 2 1 0
+8 -3 7 0
+$EndNodes
+$Elements
+6
+1 15 2 5 1 4
+2 15 2 6 2 9
+3 1 2 1 1 1 2
+4 1 2 1 1 2 3
+5 3 2 2 1 1 2 5 4
+6 3 2 2 1 2 3 6 5
+$EndElements
+";
+
+#[test]
+fn nodes_in_no_cell_are_dropped() {
+    let m = parse_str(ORPHANS_22).unwrap();
+    check_invariants(&m);
+    assert_eq!(m.source.unused_nodes, 2);
+    assert_eq!(m.node_tags, [1, 2, 3, 4, 5, 6]);
+    assert_eq!(m.nodes.len(), 6);
+    assert_eq!(m.nodes[2], [2.0, 0.0], "tag 3 follows the dropped tag 9");
+    assert_eq!(m.cells, [0, 1, 4, 3, 1, 2, 5, 4]);
+    // The bounding box is the cells', not the far geometry points'.
+    assert_eq!(m.bbox(), [[0.0, 0.0], [2.0, 1.0]]);
+    let bottom = m.group("bottom").unwrap();
+    let ends: Vec<[usize; 2]> = bottom.edges.iter().map(|e| e.nodes).collect();
+    assert_eq!(ends, [[0, 1], [1, 2]]);
+    assert_eq!(bottom.nodes, [0, 1, 2]);
+    let pin = m.group("pin").unwrap();
+    assert_eq!((pin.points.as_slice(), pin.elements), (&[3][..], 1));
+    assert_eq!(pin.nodes, [3]);
+    // The point on the dropped node leaves its group, which stays (empty).
+    let centre = m.group("centre").unwrap();
+    assert!(centre.points.is_empty() && centre.nodes.is_empty());
+    assert_eq!(centre.elements, 0);
+    assert_eq!(m.group("body").unwrap().nodes, [0, 1, 2, 3, 4, 5]);
+}
+
+#[test]
+fn a_mesh_without_unused_nodes_reports_none() {
+    let m = load("slab_q9_v41_ascii.msh");
+    assert_eq!(m.source.unused_nodes, 0);
+}
+
+/// Gmsh 4.1 output with Mesh.SaveAll = 1 (from the user review: the plate
+/// with a hole, quad4): the circle's centre (tag 5 at (2, 1)) is saved as
+/// a node that no cell uses.
+#[test]
+fn gmsh_save_all_centre_point_is_dropped() {
+    let m = load("hole_q4_saveall_v41_ascii.msh");
+    check_invariants(&m);
+    assert_eq!(m.source.unused_nodes, 1);
+    assert_eq!(m.nodes.len(), 268);
+    assert!(!m.node_tags.contains(&5));
+    assert!(m.node_tags.windows(2).all(|w| w[0] < w[1]));
+}
