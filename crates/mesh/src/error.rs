@@ -154,6 +154,13 @@ pub enum MeshErrorKind {
         /// The cell's Gmsh tag.
         element: u64,
     },
+    /// A quad9 whose corners are fine but whose mid-side or centre node
+    /// turns it inside out somewhere inside.
+    #[error("cell {element} is inverted inside: its Jacobian determinant is not positive at every node and Gauss point, so a mid-side or centre node lies outside the cell or across its middle; move that node, or mesh again with the curved cells untangled (Mesh.HighOrderOptimize = 2) or a finer size there")]
+    InvertedCell {
+        /// The cell's Gmsh tag.
+        element: u64,
+    },
     /// A boundary element of a physical group that is not the side of any cell.
     #[error("boundary element {element} of group {group:?} is not a side of any cell; a boundary group must consist of lines of the meshed surface's boundary (mesh curves and surface together, and do not mix meshes)")]
     EdgeNotOnCell {

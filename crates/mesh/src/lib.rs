@@ -112,9 +112,10 @@ pub struct SourceInfo {
 /// A 2-D quadrilateral mesh with named groups.
 ///
 /// Invariants (established by the reader and its checks): every node is
-/// used by a cell; every cell has `kind.nodes_per_cell()` valid node indices, is counter-clockwise with a
-/// positive Jacobian determinant at its corners; every edge of a dimension-1
-/// group is a side of its `cell` and oriented with that cell on its left.
+/// used by a cell; every cell has `kind.nodes_per_cell()` valid node
+/// indices, is counter-clockwise with a positive Jacobian determinant at its
+/// corners (quad9: also at its other nodes and 3×3 Gauss points); every
+/// edge of a dimension-1 group is a side of its `cell` and oriented with that cell on its left.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     /// Node coordinates (x, y); z is dropped (must be 0 in a 2-D mesh).

@@ -4,6 +4,14 @@
 
 mod common;
 use common::*;
+use stickslip_mesh::{Location, MeshError, MeshErrorKind as K};
+
+fn err(s: &str) -> MeshError {
+    match parse_str(s) {
+        Ok(_) => panic!("bad input was accepted"),
+        Err(e) => e,
+    }
+}
 
 // ---- nodes used by no cell ----
 
@@ -85,4 +93,69 @@ fn gmsh_save_all_centre_point_is_dropped() {
     assert_eq!(m.nodes.len(), 268);
     assert!(!m.node_tags.contains(&5));
     assert!(m.node_tags.windows(2).all(|w| w[0] < w[1]));
+}
+
+// ---- quad9 inverted inside ----
+
+/// One quad9 cell on the unit square (Gmsh's node order: corners, mid-sides
+/// of (0,1) (1,2) (2,3) (3,0), centre), node `moved` (1-based) put at `at`,
+/// given clockwise if `cw`. The element is on line 18.
+fn quad9(moved: usize, at: [f64; 2], cw: bool) -> String {
+    let mut p = [
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [1.0, 1.0],
+        [0.0, 1.0],
+        [0.5, 0.0],
+        [1.0, 0.5],
+        [0.5, 1.0],
+        [0.0, 0.5],
+        [0.5, 0.5],
+    ];
+    p[moved - 1] = at;
+    let nodes: String = p
+        .iter()
+        .enumerate()
+        .map(|(i, q)| format!("{} {} {} 0\n", i + 1, q[0], q[1]))
+        .collect();
+    let conn = if cw {
+        "1 4 3 2 8 7 6 5 9"
+    } else {
+        "1 2 3 4 5 6 7 8 9"
+    };
+    format!(
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n9\n{nodes}$EndNodes\n\
+         $Elements\n1\n7 10 2 1 1 {conn}\n$EndElements\n"
+    )
+}
+
+#[test]
+fn quad9_inverted_by_its_centre_or_a_mid_side_node_is_refused() {
+    for (moved, at) in [
+        (9, [0.5, 1.4]),  // centre above the top side
+        (6, [-0.2, 0.5]), // right mid-side node beyond the left side
+        (5, [0.5, 1.3]),  // bottom mid-side node beyond the top side
+    ] {
+        for cw in [false, true] {
+            let e = err(&quad9(moved, at, cw));
+            assert_eq!(e.kind, K::InvertedCell { element: 7 }, "{moved} {at:?}");
+            assert_eq!(e.location, Location::Line(18));
+            assert!(e.to_string().contains("line 18: cell 7 is inverted"), "{e}");
+        }
+    }
+}
+
+#[test]
+fn curved_quad9_inside_out_nowhere_is_read() {
+    for (moved, at) in [
+        (9, [0.5, 0.5]),
+        (9, [0.6, 0.4]),
+        (6, [1.3, 0.5]),
+        (5, [0.5, 0.2]),
+    ] {
+        for cw in [false, true] {
+            let m = parse_str(&quad9(moved, at, cw)).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(m.source.reoriented, usize::from(cw));
+        }
+    }
 }

@@ -1,7 +1,7 @@
 //! Collects what the version-specific parsers read (nodes, then elements)
 //! into a [`Mesh`], checking as it goes: node tags map to dense indices,
 //! every cell is oriented counter-clockwise with a positive Jacobian at its
-//! corners, boundary elements of groups lie on cell sides and are oriented
+//! corners (quad9: also at its other nodes and Gauss points), boundary elements of groups lie on cell sides and are oriented
 //! with their cell on the left.
 
 use std::collections::{BTreeMap, HashMap};
@@ -359,6 +359,12 @@ impl Builder {
                     }
                     None => {
                         return Err(cur.error(pos, MeshErrorKind::DegenerateCell { element: tag }))
+                    }
+                }
+                if kind == CellKind::Quad9 {
+                    let p: [[f64; 2]; 9] = std::array::from_fn(|k| self.nodes[cell[k]]);
+                    if !quad9_inside_positive(&p) {
+                        return Err(cur.error(pos, MeshErrorKind::InvertedCell { element: tag }));
                     }
                 }
                 self.cells.extend_from_slice(cell);
@@ -784,6 +790,107 @@ fn corner_sign(a: [f64; 2], b: [f64; 2], a2: f64, b2: f64, sign: &mut i8) -> Opt
     }
     *sign = s;
     Some(())
+}
+
+/// Fem node index of the quad9 node at (ξ, η) = (a - 1, b - 1), `[a][b]`.
+const QUAD9_GRID: [[usize; 3]; 3] = [[0, 7, 3], [4, 8, 6], [1, 5, 2]];
+
+/// √(3/5), the abscissa of the 3-point Gauss rule the fem crate integrates with.
+const G: f64 = 0.774_596_669_241_483_4;
+
+/// The quadratic Lagrange basis on -1, 0, 1 (`[i][a]`: basis `a` at point
+/// `i`): derivatives at the nodes, values and derivatives at -G, 0, G.
+const D_NODE: [[f64; 3]; 3] = [[-1.5, 2.0, -0.5], [-0.5, 0.0, 0.5], [0.5, -2.0, 1.5]];
+const L_GAUSS: [[f64; 3]; 3] = [
+    [0.5 * G * (G + 1.0), 1.0 - G * G, 0.5 * G * (G - 1.0)],
+    [0.0, 1.0, 0.0],
+    [0.5 * G * (G - 1.0), 1.0 - G * G, 0.5 * G * (G + 1.0)],
+];
+const D_GAUSS: [[f64; 3]; 3] = [
+    [-G - 0.5, 2.0 * G, 0.5 - G],
+    [-0.5, 0.0, 0.5],
+    [G - 0.5, -2.0 * G, G + 0.5],
+];
+
+/// `w[0] v[0] + w[1] v[1] + w[2] v[2]`.
+#[inline(always)]
+fn comb(w: [f64; 3], v: [[f64; 2]; 3]) -> [f64; 2] {
+    [
+        w[0] * v[0][0] + w[1] * v[1][0] + w[2] * v[2][0],
+        w[0] * v[0][1] + w[1] * v[1][1] + w[2] * v[2][1],
+    ]
+}
+
+/// `det [a b] > 0`, false for NaN.
+#[inline(always)]
+fn positive(a: [f64; 2], b: [f64; 2]) -> bool {
+    a[0] * b[1] - a[1] * b[0] > 0.0
+}
+
+/// Whether the Jacobian determinant of a counter-clockwise quad9 is positive
+/// at its 9 nodes and 9 Gauss points. The corner test sees only the
+/// corners; a mid-side or centre node pulled across the cell inverts it
+/// inside.
+fn quad9_inside_positive(p: &[[f64; 2]; 9]) -> bool {
+    // Most cells of a Gmsh mesh are straight-sided (mid-side nodes at the
+    // sides' midpoints, the centre at the corners' mean): their map is the
+    // bilinear one, whose determinant is affine in ξ and in η and so
+    // positive inside once it is at the corners. The full check, five
+    // times dearer, is for curved cells only.
+    let mid = |a: [f64; 2], b: [f64; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+    let bilinear = [
+        mid(p[0], p[1]),
+        mid(p[1], p[2]),
+        mid(p[2], p[3]),
+        mid(p[3], p[0]),
+        mid(mid(p[0], p[2]), mid(p[1], p[3])),
+    ];
+    let mut dev = 0.0f64;
+    let mut size = 0.0f64;
+    for k in 0..5 {
+        let (q, b) = (p[4 + k], bilinear[k]);
+        dev = dev.max((q[0] - b[0]).abs()).max((q[1] - b[1]).abs());
+        let c = p[k % 4];
+        size = size.max((c[0] - p[0][0]).abs()).max((c[1] - p[0][1]).abs());
+    }
+    // Rounding of Gmsh's coordinates (ASCII %.16g) is far below this.
+    if dev <= 1e-12 * size {
+        return true;
+    }
+    // Relative to node 0 and scaled to O(1): no overflow at 1e200, no
+    // underflow at 1e-200, whatever the magnitude of the coordinates.
+    let o = p[0];
+    let m = p.iter().fold(0.0f64, |m, q| {
+        m.max((q[0] - o[0]).abs()).max((q[1] - o[1]).abs())
+    });
+    let s = if m > 0.0 && (1.0 / m).is_finite() {
+        1.0 / m
+    } else {
+        1.0
+    };
+    let x: [[[f64; 2]; 3]; 3] =
+        QUAD9_GRID.map(|row| row.map(|k| [(p[k][0] - o[0]) * s, (p[k][1] - o[1]) * s]));
+    let column = |v: &[[[f64; 2]; 3]; 3], j: usize| [v[0][j], v[1][j], v[2][j]];
+    // At the nodes the basis is the identity: one 3-term sum a derivative.
+    for (i, &di) in D_NODE.iter().enumerate() {
+        for (j, &dj) in D_NODE.iter().enumerate() {
+            if !positive(comb(di, column(&x, j)), comb(dj, x[i])) {
+                return false;
+            }
+        }
+    }
+    // At the Gauss points, values and η-derivatives along η first (sum
+    // factorization), then the ξ sums.
+    let along = |w: &[[f64; 3]; 3]| x.map(|row| w.map(|wj| comb(wj, row)));
+    let (pv, qv) = (along(&L_GAUSS), along(&D_GAUSS));
+    for (&li, &di) in L_GAUSS.iter().zip(&D_GAUSS) {
+        for j in 0..3 {
+            if !positive(comb(di, column(&pv, j)), comb(li, column(&qv, j))) {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// Reverses a cell's orientation keeping node 0: corners 0 3 2 1, and for
