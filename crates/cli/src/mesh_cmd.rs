@@ -26,16 +26,22 @@ pub fn report(path: &Path, as_json: bool) -> Result<String, InputError> {
 /// The DESIGN.md object: format, version, binary, nodes, cells,
 /// boundary_elements, groups, bbox, reoriented, unused_nodes.
 pub fn to_json(mesh: &Mesh) -> serde_json::Value {
-    let groups: serde_json::Map<String, serde_json::Value> = mesh
-        .groups
-        .iter()
-        .map(|g| {
-            (
-                g.name.clone(),
-                json!({"dim": g.dim, "elements": g.elements, "nodes": g.nodes.len()}),
-            )
-        })
-        .collect();
+    // Gmsh lets groups of different dimensions share a name; an object
+    // keeps one value a key, so later ones get their dimension (and, for a
+    // hand-made same-dimension twin, their tag) in the key.
+    let mut groups = serde_json::Map::new();
+    for g in &mesh.groups {
+        let value = json!({"dim": g.dim, "elements": g.elements, "nodes": g.nodes.len()});
+        let key = [
+            g.name.clone(),
+            format!("{} (dim {})", g.name, g.dim),
+            format!("{} (dim {} tag {})", g.name, g.dim, g.tag),
+        ]
+        .into_iter()
+        .find(|k| !groups.contains_key(k))
+        .unwrap_or_default();
+        groups.insert(key, value);
+    }
     let cells: BTreeMap<&str, usize> = [(mesh.kind.name(), mesh.n_cells())].into();
     json!({
         "format": "msh",

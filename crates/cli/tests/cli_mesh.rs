@@ -216,3 +216,24 @@ fn mesh_reports_dropped_unused_nodes() {
     let o = bin().arg("mesh").arg(&slab).output().unwrap();
     assert!(!String::from_utf8(o.stdout).unwrap().contains("unused"));
 }
+
+#[test]
+fn mesh_json_keeps_groups_sharing_a_name() {
+    // Groups "body" of dimension 1 (the bottom) and 2; the first keeps the name.
+    let text = ORPHANS
+        .replace(
+            "$EndMeshFormat\n",
+            "$EndMeshFormat\n$PhysicalNames\n2\n1 1 \"body\"\n2 2 \"body\"\n$EndPhysicalNames\n",
+        )
+        .replace("$Elements\n2\n", "$Elements\n3\n3 1 2 1 1 1 2\n");
+    let p = temp_mesh("same-name.msh", &text);
+    let j = mesh_json(&p);
+    std::fs::remove_file(&p).unwrap();
+    assert_eq!(
+        j["groups"],
+        serde_json::json!({
+            "body": {"dim": 1, "elements": 1, "nodes": 2},
+            "body (dim 2)": {"dim": 2, "elements": 2, "nodes": 6},
+        })
+    );
+}

@@ -29,6 +29,14 @@ pub enum MeshErrorKind {
         /// The names the mesh has.
         available: Vec<String>,
     },
+    /// A physical group name given to groups of several dimensions.
+    #[error("the mesh has several physical groups called {name:?} ({}), so which one is meant is unknown; rename all but one in the .geo (e.g. Physical Curve(\"{name}_edge\")) and mesh again", groups.iter().map(|(d, t)| format!("dim {d} tag {t}")).collect::<Vec<_>>().join(", "))]
+    AmbiguousGroup {
+        /// The name asked for.
+        name: String,
+        /// Dimension and physical tag of each group with that name, in mesh order.
+        groups: Vec<(u8, i32)>,
+    },
     /// The file does not start with `$MeshFormat`.
     #[error("this is not a Gmsh .msh file (it does not start with $MeshFormat); export the mesh from Gmsh with File > Export > .msh or `gmsh -2 FILE.geo -o FILE.msh`")]
     NotMsh,

@@ -177,14 +177,29 @@ impl Mesh {
     /// The physical group called `name` (`"#3"` for an unnamed group 3).
     ///
     /// # Errors
-    /// [`MeshErrorKind::UnknownGroup`] listing the names the mesh has.
+    /// [`MeshErrorKind::UnknownGroup`] listing the names the mesh has;
+    /// [`MeshErrorKind::AmbiguousGroup`] if groups of several dimensions
+    /// have that name (Gmsh allows it; which one was meant is unknowable).
     pub fn group(&self, name: &str) -> Result<&Group, MeshError> {
-        self.groups.iter().find(|g| g.name == name).ok_or_else(|| {
-            MeshError::new(MeshErrorKind::UnknownGroup {
+        let mut named = self.groups.iter().filter(|g| g.name == name);
+        let Some(first) = named.next() else {
+            return Err(MeshError::new(MeshErrorKind::UnknownGroup {
                 name: name.to_string(),
                 available: self.group_names().iter().map(|s| s.to_string()).collect(),
-            })
-        })
+            }));
+        };
+        if named.next().is_some() {
+            return Err(MeshError::new(MeshErrorKind::AmbiguousGroup {
+                name: name.to_string(),
+                groups: self
+                    .groups
+                    .iter()
+                    .filter(|g| g.name == name)
+                    .map(|g| (g.dim, g.tag))
+                    .collect(),
+            }));
+        }
+        Ok(first)
     }
 
     /// Names of all physical groups, in the order of [`Mesh::groups`].

@@ -159,3 +159,31 @@ fn curved_quad9_inside_out_nowhere_is_read() {
         }
     }
 }
+
+// ---- one name, several groups ----
+
+#[test]
+fn a_name_of_groups_of_two_dimensions_is_ambiguous() {
+    // The orphans mesh with its line group renamed "body", like the surface.
+    let t = ORPHANS_22.replace("1 1 \"bottom\"", "1 1 \"body\"");
+    let m = parse_str(&t).unwrap();
+    let e = m.group("body").unwrap_err();
+    assert_eq!(
+        e.kind,
+        K::AmbiguousGroup {
+            name: "body".into(),
+            groups: vec![(1, 1), (2, 2)],
+        }
+    );
+    let msg = e.to_string();
+    assert!(
+        msg.contains("\"body\" (dim 1 tag 1, dim 2 tag 2)") && msg.contains("rename"),
+        "{msg}"
+    );
+    // Unique names are found as before; an unknown one is still unknown.
+    assert_eq!(m.group("pin").unwrap().dim, 0);
+    assert!(matches!(
+        m.group("nope").unwrap_err().kind,
+        K::UnknownGroup { .. }
+    ));
+}
