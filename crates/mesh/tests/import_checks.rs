@@ -4,7 +4,7 @@
 
 mod common;
 use common::*;
-use stickslip_mesh::{Location, MeshError, MeshErrorKind as K};
+use stickslip_mesh::{Location, Mesh, MeshError, MeshErrorKind as K};
 
 fn err(s: &str) -> MeshError {
     match parse_str(s) {
@@ -186,4 +186,71 @@ fn a_name_of_groups_of_two_dimensions_is_ambiguous() {
         m.group("nope").unwrap_err().kind,
         K::UnknownGroup { .. }
     ));
+}
+
+// ---- a mesh in another plane ----
+
+/// One quad4 in the xz-plane: flat in xy, so degenerate there, but the
+/// cause is the plane. Node 3 (line 8) is the first with the largest |z|.
+const XZ_22: &str = "\
+$MeshFormat
+2.2 0 8
+$EndMeshFormat
+$Nodes
+4
+1 0 0 0
+2 2 0 0
+3 2 0 1
+4 0 0 1
+$EndNodes
+$Elements
+1
+1 3 2 1 1 1 2 3 4
+$EndElements
+";
+
+/// The same in MSH 4.1: node 3's coordinates are on line 13.
+const XZ_41: &str = "\
+$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$Nodes
+1 4 1 4
+2 1 0 4
+1
+2
+3
+4
+0 0 0
+2 0 0
+2 0 1
+0 0 1
+$EndNodes
+$Elements
+1 1 1 1
+2 1 3 1
+1 1 2 3 4
+$EndElements
+";
+
+#[test]
+fn a_mesh_in_the_xz_plane_is_not_planar_at_its_node() {
+    for (t, line) in [(XZ_22, 8), (XZ_41, 13)] {
+        let e = err(t);
+        assert_eq!(e.kind, K::NotPlanar { node: 3, z: 1.0 }, "{e}");
+        assert_eq!(e.location, Location::Line(line), "{e}");
+    }
+}
+
+#[test]
+fn binary_not_planar_names_the_node_record() {
+    // MSH 2.2 binary node records: i32 tag, 3 f64; put z = 2 into tag 7's.
+    let mut b = bytes("slab_q4_v22_bin.msh");
+    let data = find(&b, b"$Nodes\n15\n") + 10;
+    let rec = data + 28 * 6;
+    assert_eq!(b[rec..rec + 4], 7i32.to_le_bytes());
+    b[rec + 20..rec + 28].copy_from_slice(&2.0f64.to_le_bytes());
+    let e = Mesh::from_bytes(&b).unwrap_err();
+    assert_eq!(e.kind, K::NotPlanar { node: 7, z: 2.0 });
+    assert_eq!(e.location, Location::Byte(rec));
 }

@@ -433,7 +433,13 @@ fn not_planar() {
         "9 6.000000000002768 1.375000000000173 0",
         "9 6.000000000002768 1.375000000000173 0.5",
     );
-    assert_eq!(err(&t).kind, K::NotPlanar { node: 9, z: 0.5 });
+    let e = err(&t);
+    assert_eq!(e.kind, K::NotPlanar { node: 9, z: 0.5 });
+    // The node's line, where the fix is.
+    assert_eq!(
+        e.location,
+        Location::Line(line_no(&t, "9 6.000000000002768 1.375000000000173 0.5"))
+    );
     // Rounding-level z (1e-14 of an 8-long mesh) is accepted.
     let t = replace_line(
         &text(Q4_22),

@@ -126,8 +126,8 @@ pub(crate) struct Builder {
     pub(crate) binary: bool,
     pub(crate) nodes: Vec<[f64; 2]>,
     pub(crate) node_tags: Vec<u64>,
-    /// The z of largest magnitude seen and the node's tag.
-    pub(crate) max_z: (f64, u64),
+    /// The z of largest magnitude seen, the node's tag and its position.
+    pub(crate) max_z: (f64, u64, usize),
     index: Option<NodeIndex>,
     /// Physical tag lists; entry 0 is empty.
     pub(crate) memberships: Vec<Vec<i32>>,
@@ -156,7 +156,7 @@ impl Builder {
             binary,
             nodes: Vec::new(),
             node_tags: Vec::new(),
-            max_z: (0.0, 0),
+            max_z: (0.0, 0, 0),
             index: None,
             memberships: vec![Vec::new()],
             membership_ids: HashMap::new(),
@@ -193,24 +193,42 @@ impl Builder {
         id
     }
 
+    /// A node read at `pos` (any position on its line, or its record).
     #[inline]
-    pub(crate) fn push_node(&mut self, tag: u64, x: f64, y: f64, z: f64) {
+    pub(crate) fn push_node(&mut self, tag: u64, x: f64, y: f64, z: f64, pos: usize) {
         self.node_tags.push(tag);
-        self.push_xyz(x, y, z, tag);
+        self.push_xyz(x, y, z, tag, pos);
     }
 
     /// Coordinates of a node whose tag was pushed before (4.1 gives a
-    /// block's tags first, then its coordinates).
+    /// block's tags first, then its coordinates), read at `pos`.
     #[inline]
-    pub(crate) fn push_xyz(&mut self, x: f64, y: f64, z: f64, tag: u64) {
+    pub(crate) fn push_xyz(&mut self, x: f64, y: f64, z: f64, tag: u64, pos: usize) {
         if z.abs() > self.max_z.0.abs() {
-            self.max_z = (z, tag);
+            self.max_z = (z, tag, pos);
         }
         self.nodes.push([x, y]);
     }
 
     /// Called once all nodes are read: builds the tag → index map.
     pub(crate) fn finish_nodes(&mut self, cur: &Cursor<'_>, pos: usize) -> Result<()> {
+        // z must be 0 up to rounding relative to the mesh size. Checked
+        // here, before any cell: a mesh in another plane has flat cells in
+        // xy, and "degenerate cell" would hide the cause.
+        let (z, tag, at) = self.max_z;
+        if z != 0.0 {
+            let mut bb = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
+            for p in &self.nodes {
+                for k in 0..2 {
+                    bb[0][k] = bb[0][k].min(p[k]);
+                    bb[1][k] = bb[1][k].max(p[k]);
+                }
+            }
+            let extent = (bb[1][0] - bb[0][0]).max(bb[1][1] - bb[0][1]).max(0.0);
+            if z.abs() > Z_TOL * extent {
+                return Err(cur.error(at, MeshErrorKind::NotPlanar { node: tag, z }));
+            }
+        }
         let n = self.node_tags.len();
         if n >= u32::MAX as usize {
             return Err(cur.error(
@@ -481,7 +499,6 @@ impl Builder {
             binary,
             mut nodes,
             mut node_tags,
-            max_z,
             memberships,
             names,
             kind,
@@ -502,21 +519,6 @@ impl Builder {
             return Err(MeshError::new(MeshErrorKind::NoCells));
         };
         let npc = kind.nodes_per_cell();
-        // z must be 0 up to rounding relative to the mesh size.
-        let mut bb = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
-        for p in &nodes {
-            for k in 0..2 {
-                bb[0][k] = bb[0][k].min(p[k]);
-                bb[1][k] = bb[1][k].max(p[k]);
-            }
-        }
-        let extent = (bb[1][0] - bb[0][0]).max(bb[1][1] - bb[0][1]).max(0.0);
-        if max_z.0.abs() > Z_TOL * extent {
-            return Err(MeshError::new(MeshErrorKind::NotPlanar {
-                node: max_z.1,
-                z: max_z.0,
-            }));
-        }
 
         // Groups, keyed (dim, tag) so the BTreeMap gives the required order.
         let mut acc: BTreeMap<(u8, i32), Group> = BTreeMap::new();
@@ -998,7 +1000,7 @@ mod tests {
             }
             let mut b = Builder::new("4.1", false);
             for (i, q) in p.iter().enumerate() {
-                b.push_node(i as u64 + 1, q[0], q[1], 0.0);
+                b.push_node(i as u64 + 1, q[0], q[1], 0.0, 0);
             }
             let cell: Vec<usize> = (0..n).collect();
             let got = b.orientation(&cell);

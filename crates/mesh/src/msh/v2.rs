@@ -47,7 +47,7 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                         },
                     ));
                 }
-                b.push_node(tag, x, y, z);
+                b.push_node(tag, x, y, z, at);
             }
         }
     } else {
@@ -60,7 +60,7 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
             let x = cur.f64("a node coordinate")?;
             let y = cur.f64("a node coordinate")?;
             let z = cur.f64("a node coordinate")?;
-            b.push_node(tag, x, y, z);
+            b.push_node(tag, x, y, z, cur.pos());
         }
     }
     cur.expect_end()?;

@@ -172,7 +172,7 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                         ));
                     }
                     let tag = b.node_tags.get(i).copied().unwrap_or(0);
-                    b.push_xyz(x, y, z, tag);
+                    b.push_xyz(x, y, z, tag, start + size * j);
                     i += 1;
                 }
             }
@@ -185,11 +185,12 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                 let x = cur.f64("a node coordinate")?;
                 let y = cur.f64("a node coordinate")?;
                 let z = cur.f64("a node coordinate")?;
+                let at = cur.pos();
                 for _ in 0..extra {
                     cur.f64("a parametric node coordinate")?;
                 }
                 let tag = b.node_tags.get(first + i).copied().unwrap_or(0);
-                b.push_xyz(x, y, z, tag);
+                b.push_xyz(x, y, z, tag, at);
             }
         }
     }
