@@ -140,6 +140,18 @@ pub enum MeshErrorKind {
         /// Its Gmsh name, when known.
         name: &'static str,
     },
+    /// An element of order 3 or more (`gmsh -order 3` and up).
+    #[error("element {element} is a {name} (Gmsh type {type_id}), of order {order}; stickslip reads elements of order 1 or 2 only (quad4 or quad9 cells, line2 or line3 boundaries): mesh with `gmsh -order 1` or `-order 2` (Mesh.ElementOrder = 1 or 2)")]
+    UnsupportedOrder {
+        /// The element's Gmsh tag.
+        element: u64,
+        /// Gmsh element type number.
+        type_id: i32,
+        /// Its Gmsh name.
+        name: &'static str,
+        /// Its polynomial order (3 or more).
+        order: u8,
+    },
     /// 2-D cells that are not all quad4 or all quad9.
     #[error("the 2-D cells include {found}; stickslip needs all quad4 or all quad9 cells: in Gmsh add `Recombine Surface{{...}};` (or Mesh.RecombineAll = 1) for quadrilaterals, and for quad9 use Mesh.ElementOrder = 2 (or `gmsh -order 2`) with Mesh.SecondOrderIncomplete = 0")]
     NotQuads {

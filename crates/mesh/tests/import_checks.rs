@@ -254,3 +254,47 @@ fn binary_not_planar_names_the_node_record() {
     assert_eq!(e.kind, K::NotPlanar { node: 7, z: 2.0 });
     assert_eq!(e.location, Location::Byte(rec));
 }
+
+// ---- element order 3 and up ----
+
+#[test]
+fn order_3_elements_are_refused_for_their_order() {
+    // MSH 2.2: a line4 (type 26) where the first line2 was.
+    let t = ORPHANS_22.replace("3 1 2 1 1 1 2\n", "3 26 2 1 1 1 2 3 5\n");
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::UnsupportedOrder {
+            element: 3,
+            type_id: 26,
+            name: "line4",
+            order: 3
+        }
+    );
+    assert_eq!(
+        e.location,
+        Location::Line(line_no(&t, "3 26 2 1 1 1 2 3 5"))
+    );
+    let msg = e.to_string();
+    assert!(
+        msg.contains("order 3") && msg.contains("`gmsh -order 1` or `-order 2`"),
+        "{msg}"
+    );
+    assert!(!msg.contains("3-D"), "{msg}");
+    // MSH 4.1: a block of quad16 (type 36) cells, located at its header.
+    let t = XZ_41.replace("2 0 1\n0 0 1\n", "2 2 0\n0 2 0\n").replace(
+        "2 1 3 1\n1 1 2 3 4\n",
+        "2 1 36 1\n8 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4\n",
+    );
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::UnsupportedOrder {
+            element: 8,
+            type_id: 36,
+            name: "quad16",
+            order: 3
+        }
+    );
+    assert_eq!(e.location, Location::Line(line_no(&t, "2 1 36 1")));
+}

@@ -28,23 +28,13 @@ pub(crate) fn nodes_of(type_id: i32) -> Option<usize> {
     }
 }
 
-/// Gmsh's name and dimension of an element type (for messages).
+/// Gmsh's name and dimension of an element type of order 1 or 2 (for
+/// messages; higher orders are [`high_order`]).
 fn describe(type_id: i32) -> (&'static str, u8) {
     match type_id {
         2 => ("tri3", 2),
         9 => ("tri6", 2),
         16 => ("quad8", 2),
-        20 => ("tri9", 2),
-        21 => ("tri10", 2),
-        22 => ("tri12", 2),
-        23 | 24 => ("tri15", 2),
-        25 => ("tri21", 2),
-        36 | 40 => ("quad16", 2),
-        37 | 41 => ("quad25", 2),
-        38 => ("quad36", 2),
-        39 => ("quad12", 2),
-        42..=46 | 52..=55 => ("high-order triangle", 2),
-        47..=51 | 56..=59 => ("high-order quadrangle", 2),
         4 => ("tet4", 3),
         5 => ("hex8", 3),
         6 => ("prism6", 3),
@@ -56,15 +46,73 @@ fn describe(type_id: i32) -> (&'static str, u8) {
         17 => ("hex20", 3),
         18 => ("prism15", 3),
         19 => ("pyramid13", 3),
-        26 => ("line4", 1),
-        27 => ("line5", 1),
-        28 => ("line6", 1),
         _ => ("unknown type", 9),
     }
 }
 
+/// Gmsh's name and the order of a line, triangle or quadrangle type of
+/// order 3 or more (GmshDefines.h; "incomplete" types have no interior
+/// nodes). These come from `gmsh -order 3` and up: the problem is the order,
+/// not the dimension or the shape.
+fn high_order(type_id: i32) -> Option<(&'static str, u8)> {
+    Some(match type_id {
+        26 => ("line4", 3),
+        27 => ("line5", 4),
+        28 => ("line6", 5),
+        62 => ("line7", 6),
+        63 => ("line8", 7),
+        64 => ("line9", 8),
+        65 => ("line10", 9),
+        66 => ("line11", 10),
+        20 => ("tri9", 3),
+        21 => ("tri10", 3),
+        22 => ("tri12", 4),
+        23 => ("tri15", 4),
+        24 => ("tri15 (incomplete)", 5),
+        25 => ("tri21", 5),
+        42 => ("tri28", 6),
+        43 => ("tri36", 7),
+        44 => ("tri45", 8),
+        45 => ("tri55", 9),
+        46 => ("tri66", 10),
+        52 => ("tri18", 6),
+        53 => ("tri21 (incomplete)", 7),
+        54 => ("tri24", 8),
+        55 => ("tri27", 9),
+        56 => ("tri30", 10),
+        36 => ("quad16", 3),
+        37 => ("quad25", 4),
+        38 => ("quad36", 5),
+        39 => ("quad12", 3),
+        40 => ("quad16 (incomplete)", 4),
+        41 => ("quad20", 5),
+        47 => ("quad49", 6),
+        48 => ("quad64", 7),
+        49 => ("quad81", 8),
+        50 => ("quad100", 9),
+        51 => ("quad121", 10),
+        57 => ("quad24", 6),
+        58 => ("quad28", 7),
+        59 => ("quad32", 8),
+        60 => ("quad36 (incomplete)", 9),
+        61 => ("quad40", 10),
+        _ => return None,
+    })
+}
+
 /// The error for an element type the reader does not take.
 pub(crate) fn unsupported(cur: &Cursor<'_>, pos: usize, element: u64, type_id: i32) -> MeshError {
+    if let Some((name, order)) = high_order(type_id) {
+        return cur.error(
+            pos,
+            MeshErrorKind::UnsupportedOrder {
+                element,
+                type_id,
+                name,
+                order,
+            },
+        );
+    }
     let (name, dim) = describe(type_id);
     if dim == 2 {
         cur.error(
