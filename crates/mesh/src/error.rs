@@ -69,6 +69,9 @@ pub enum MeshErrorKind {
         /// The closing keyword expected, e.g. `$EndNodes`.
         end: String,
     },
+    /// An MSH 4.1 file of a partitioned mesh.
+    #[error("the mesh is partitioned (it has $PartitionedEntities, as `gmsh -part N` writes); stickslip reads unpartitioned meshes only: mesh and save without `-part` (or call gmsh.model.mesh.unpartition() before writing)")]
+    Partitioned,
     /// A section the reader needs is not in the file.
     #[error("the file has no {section} section; a mesh file needs $MeshFormat, $Nodes and $Elements: generate the 2-D mesh (`gmsh -2`) before saving")]
     MissingSection {

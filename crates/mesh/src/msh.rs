@@ -71,6 +71,12 @@ fn parse_with(cur: &mut Cursor<'_>) -> Result<Mesh> {
                 }
                 entities = Some(v4::entities(cur, &mut b)?);
             }
+            // Its entities carry the physical tags of a partitioned mesh, and
+            // a split file (Mesh.PartitionSplitMeshFiles) holds only a part of
+            // the body: refused rather than read wrong.
+            b"$PartitionedEntities" if version == "4.1" => {
+                return Err(cur.error(p, MeshErrorKind::Partitioned));
+            }
             b"$Nodes" => {
                 if seen_nodes {
                     return Err(out_of_place(cur, p, t, "a second $Nodes section"));

@@ -298,3 +298,27 @@ fn order_3_elements_are_refused_for_their_order() {
     );
     assert_eq!(e.location, Location::Line(line_no(&t, "2 1 36 1")));
 }
+
+// ---- partitioned meshes ----
+
+/// Gmsh 4.1 output of the slab partitioned in two (`gmsh -part 2`; from the
+/// user review), ASCII quad4 and binary quad9.
+#[test]
+fn partitioned_41_meshes_are_refused_at_their_partitioned_entities() {
+    let t = text("slab_q4_part2_v41_ascii.msh");
+    let e = Mesh::from_bytes(t.as_bytes()).unwrap_err();
+    assert_eq!(e.kind, K::Partitioned);
+    assert_eq!(
+        e.location,
+        Location::Line(line_no(&t, "$PartitionedEntities"))
+    );
+    let msg = e.to_string();
+    assert!(msg.contains("without `-part`"), "{msg}");
+    let b = bytes("slab_q9_part2_v41_bin.msh");
+    let e = Mesh::from_bytes(&b).unwrap_err();
+    assert_eq!(e.kind, K::Partitioned);
+    assert_eq!(
+        e.location,
+        Location::Byte(find(&b, b"$PartitionedEntities"))
+    );
+}
