@@ -3,8 +3,8 @@
 //!
 //! One pass over the bytes: `$MeshFormat` decides the version and encoding,
 //! then each section is parsed where it stands (`$PhysicalNames`,
-//! `$Entities`, `$Nodes`, `$Elements`; anything else, e.g. `$Periodic` or
-//! `$NodeData`, is skipped up to its `$End…`). Elements are mapped to dense
+//! `$Entities`, `$Nodes` or in 2.2 `$ParametricNodes`, `$Elements`; anything
+//! else, e.g. `$Periodic` or `$NodeData`, is skipped up to its `$End…`). Elements are mapped to dense
 //! node indices and checked as they are read, so `$Nodes` must come before
 //! `$Elements` (and `$Entities` before `$Elements` in 4.1), as Gmsh writes them.
 
@@ -77,20 +77,32 @@ fn parse_with(cur: &mut Cursor<'_>) -> Result<Mesh> {
             b"$PartitionedEntities" if version == "4.1" => {
                 return Err(cur.error(p, MeshErrorKind::Partitioned));
             }
-            b"$Nodes" => {
+            b"$Nodes" | b"$ParametricNodes" => {
                 if seen_nodes {
                     return Err(out_of_place(cur, p, t, "a second $Nodes section"));
                 }
                 seen_nodes = true;
                 if version == "2.2" {
-                    v2::nodes(cur, &mut b)?;
+                    v2::nodes(cur, &mut b, t == b"$ParametricNodes")?;
+                } else if t == b"$ParametricNodes" {
+                    return Err(out_of_place(
+                        cur,
+                        p,
+                        t,
+                        "MSH 4.1 gives parametric nodes in $Nodes",
+                    ));
                 } else {
                     v4::nodes(cur, &mut b)?;
                 }
             }
             b"$Elements" => {
                 if !seen_nodes {
-                    return Err(out_of_place(cur, p, t, "$Nodes must come before $Elements"));
+                    return Err(out_of_place(
+                        cur,
+                        p,
+                        t,
+                        "$Nodes (or $ParametricNodes) must come before $Elements",
+                    ));
                 }
                 if seen_elements {
                     return Err(out_of_place(cur, p, t, "a second $Elements section"));

@@ -322,3 +322,95 @@ fn partitioned_41_meshes_are_refused_at_their_partitioned_entities() {
         Location::Byte(find(&b, b"$PartitionedEntities"))
     );
 }
+
+// ---- MSH 2.2 $ParametricNodes ----
+
+/// Gmsh 4.15 output of a 2 x 1 slab of two quad4 cells with
+/// Mesh.SaveParametric = 1 (MSH 2.2 ASCII); the binary twin is the fixture
+/// small_q4_param_v22_bin.msh, and small_q4_v22_bin.msh the same mesh
+/// saved without parameters.
+const PARAM_22: &str = "\
+$MeshFormat
+2.2 0 8
+$EndMeshFormat
+$PhysicalNames
+2
+1 1 \"contact\"
+2 2 \"body\"
+$EndPhysicalNames
+$ParametricNodes
+6
+1 0 0 0 0 1
+2 2 0 0 0 2
+3 2 1 0 0 3
+4 0 1 0 0 4
+5 0.9999999999973842 0 0 1 1 0.4999999999986921
+6 1.000000000004119 1 0 1 3 0.4999999999979405
+$EndParametricNodes
+$Elements
+4
+1 1 2 1 1 1 5
+2 1 2 1 1 5 2
+3 3 2 2 1 1 5 6 4
+4 3 2 2 1 5 2 3 6
+$EndElements
+";
+
+#[test]
+fn msh22_parametric_nodes_are_read_as_nodes() {
+    let m = parse_str(PARAM_22).unwrap_or_else(|e| panic!("{e}"));
+    check_invariants(&m);
+    assert_eq!(m.nodes.len(), 6);
+    assert_eq!(m.nodes[4], [0.9999999999973842, 0.0]);
+    // The same mesh as its plain $Nodes form (entity and parameters cut).
+    let mut plain = String::new();
+    let mut in_nodes = false;
+    for l in PARAM_22.lines() {
+        let l = match l {
+            "$ParametricNodes" => {
+                in_nodes = true;
+                "$Nodes".to_string()
+            }
+            "$EndParametricNodes" => {
+                in_nodes = false;
+                "$EndNodes".to_string()
+            }
+            l if in_nodes && l.split(' ').count() > 1 => {
+                l.split(' ').take(4).collect::<Vec<_>>().join(" ")
+            }
+            l => l.to_string(),
+        };
+        plain += &l;
+        plain.push('\n');
+    }
+    assert_eq!(parse_str(&plain).unwrap(), m);
+    // Binary: records of 36 bytes plus 8 per parameter.
+    let b = load("small_q4_param_v22_bin.msh");
+    same_mesh(&b, &m, "binary parametric");
+    same_mesh(&b, &load("small_q4_v22_bin.msh"), "binary plain");
+}
+
+#[test]
+fn msh22_parametric_nodes_damaged_are_located() {
+    // A node on a "dimension 5" entity.
+    let t = PARAM_22.replace(
+        "\n6 1.000000000004119 1 0 1 3 ",
+        "\n6 1.000000000004119 1 0 5 3 ",
+    );
+    let e = err(&t);
+    assert!(matches!(e.kind, K::Malformed { .. }), "{e}");
+    assert_eq!(e.location, Location::Line(16));
+    // A curve node without its parameter: the count is off by then.
+    let t = PARAM_22.replace(" 1 3 0.4999999999979405\n", " 1 3\n");
+    let e = err(&t);
+    assert!(
+        matches!(
+            &e.kind,
+            K::WrongCount {
+                section: "$ParametricNodes",
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
