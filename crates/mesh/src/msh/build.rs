@@ -177,6 +177,12 @@ pub(crate) struct Builder {
     /// The z of largest magnitude seen, the node's tag and its position.
     pub(crate) max_z: (f64, u64, usize),
     index: Option<NodeIndex>,
+    /// The largest node tag read so far.
+    max_tag: Option<u64>,
+    /// (index, position) of each node whose tag is not above all tags
+    /// before it: only there can a duplicate be, and Gmsh's increasing tags
+    /// leave this empty. Gives a duplicate's line without a position a node.
+    late_tags: Vec<(usize, usize)>,
     /// Physical tag lists; entry 0 is empty.
     pub(crate) memberships: Vec<Vec<i32>>,
     membership_ids: HashMap<Vec<i32>, Membership>,
@@ -206,6 +212,8 @@ impl Builder {
             node_tags: Vec::new(),
             max_z: (0.0, 0, 0),
             index: None,
+            max_tag: None,
+            late_tags: Vec::new(),
             memberships: vec![Vec::new()],
             membership_ids: HashMap::new(),
             names: BTreeMap::new(),
@@ -244,8 +252,28 @@ impl Builder {
     /// A node read at `pos` (any position on its line, or its record).
     #[inline]
     pub(crate) fn push_node(&mut self, tag: u64, x: f64, y: f64, z: f64, pos: usize) {
-        self.node_tags.push(tag);
+        self.push_tag(tag, pos);
         self.push_xyz(x, y, z, tag, pos);
+    }
+
+    /// A node's tag, read at `pos`.
+    #[inline]
+    pub(crate) fn push_tag(&mut self, tag: u64, pos: usize) {
+        match self.max_tag {
+            Some(m) if tag <= m => self.late_tags.push((self.node_tags.len(), pos)),
+            _ => self.max_tag = Some(tag),
+        }
+        self.node_tags.push(tag);
+    }
+
+    /// The error for a second node of tag `tag`, node `index`: at its line
+    /// (or record), else at the `$Nodes` header.
+    fn duplicate(&self, cur: &Cursor<'_>, header: usize, index: usize, tag: u64) -> MeshError {
+        let pos = self
+            .late_tags
+            .binary_search_by_key(&index, |&(i, _)| i)
+            .map_or(header, |k| self.late_tags[k].1);
+        cur.error(pos, MeshErrorKind::DuplicateNode { tag })
     }
 
     /// Coordinates of a node whose tag was pushed before (4.1 gives a
@@ -304,7 +332,7 @@ impl Builder {
                 for (i, &t) in self.node_tags.iter().enumerate() {
                     let slot = &mut table[(t - min) as usize];
                     if *slot != u32::MAX {
-                        return Err(cur.error(pos, MeshErrorKind::DuplicateNode { tag: t }));
+                        return Err(self.duplicate(cur, pos, i, t));
                     }
                     *slot = i as u32;
                 }
@@ -313,7 +341,7 @@ impl Builder {
                 let mut map = HashMap::with_capacity(n);
                 for (i, &t) in self.node_tags.iter().enumerate() {
                     if map.insert(t, i as u32).is_some() {
-                        return Err(cur.error(pos, MeshErrorKind::DuplicateNode { tag: t }));
+                        return Err(self.duplicate(cur, pos, i, t));
                     }
                 }
                 NodeIndex::Map(map)

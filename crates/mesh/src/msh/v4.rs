@@ -151,7 +151,9 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                 let (start, k) = cur.batch(left, 8)?;
                 left -= k as u64;
                 let tags = cur.records(start, 8 * k);
-                b.node_tags.extend(tags.chunks_exact(8).map(le_u64));
+                for (j, t) in tags.chunks_exact(8).enumerate() {
+                    b.push_tag(le_u64(t), start + 8 * j);
+                }
             }
             let size = 8 * (3 + extra);
             cur.check_items(n, size)?;
@@ -179,7 +181,7 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
         } else {
             for _ in 0..n {
                 let t = cur.u64("a node tag")?;
-                b.node_tags.push(t);
+                b.push_tag(t, cur.pos());
             }
             for i in 0..n as usize {
                 let x = cur.f64("a node coordinate")?;
