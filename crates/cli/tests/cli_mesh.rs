@@ -237,3 +237,16 @@ fn mesh_json_keeps_groups_sharing_a_name() {
         })
     );
 }
+
+#[test]
+fn an_empty_mesh_file_is_called_empty() {
+    let p = temp_mesh("empty.msh", "");
+    let o = bin().arg("mesh").arg(&p).output().unwrap();
+    std::fs::remove_file(&p).unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(
+        e.starts_with(&format!("error: {}: the file is empty", p.display())),
+        "{e}"
+    );
+}

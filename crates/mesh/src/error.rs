@@ -37,6 +37,9 @@ pub enum MeshErrorKind {
         /// Dimension and physical tag of each group with that name, in mesh order.
         groups: Vec<(u8, i32)>,
     },
+    /// The file is empty or blank.
+    #[error("the file is empty (it holds no text, or only blank space): the mesh was not saved into it; mesh and save again (`gmsh -2 FILE.geo -o FILE.msh`, or File > Export in Gmsh)")]
+    EmptyFile,
     /// The file does not start with `$MeshFormat`.
     #[error("this is not a Gmsh .msh file (it does not start with $MeshFormat); export the mesh from Gmsh with File > Export > .msh or `gmsh -2 FILE.geo -o FILE.msh`")]
     NotMsh,

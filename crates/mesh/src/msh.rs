@@ -49,6 +49,7 @@ fn parse(mut cur: Cursor<'_>) -> Result<Mesh> {
 fn parse_with(cur: &mut Cursor<'_>) -> Result<Mesh> {
     match cur.token() {
         Some((_, t)) if t == b"$MeshFormat" => {}
+        None => return Err(MeshError::new(MeshErrorKind::EmptyFile)),
         _ => return Err(cur.error(0, MeshErrorKind::NotMsh)),
     }
     let (version, binary) = mesh_format(cur)?;

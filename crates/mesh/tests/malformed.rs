@@ -514,7 +514,12 @@ fn not_an_msh_file() {
     let e = err("hello\n");
     assert_eq!(e.kind, K::NotMsh);
     assert_eq!(e.location, Location::Line(1));
-    assert_eq!(err_bytes(b"").kind, K::NotMsh);
+    // An empty file is not "not a mesh file": it is empty.
+    for empty in [&b""[..], b"\n", b"  \r\n\t\n"] {
+        let e = err_bytes(empty);
+        assert_eq!(e.kind, K::EmptyFile);
+        assert_eq!(e.location, Location::Nowhere);
+    }
 }
 
 #[test]
