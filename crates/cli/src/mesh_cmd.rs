@@ -125,5 +125,18 @@ fn to_table(path: &Path, mesh: &Mesh) -> String {
             g.nodes.len()
         );
     }
+    // Not an error (an interior line may be meant), but a traction or
+    // contact surface there would act inside the body.
+    for g in &mesh.groups {
+        let k = mesh.interior_edges(g);
+        if k > 0 {
+            let _ = writeln!(
+                s,
+                "  note: group {:?} has {k} {} inside the body (shared by two cells); as a traction or contact surface it would act inside the body",
+                g.name,
+                if k == 1 { "edge" } else { "edges" }
+            );
+        }
+    }
     s
 }

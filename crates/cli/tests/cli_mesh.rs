@@ -250,3 +250,28 @@ fn an_empty_mesh_file_is_called_empty() {
         "{e}"
     );
 }
+
+#[test]
+fn mesh_table_notes_a_line_group_inside_the_body() {
+    // Gmsh output of a slab with an embedded curve, group "crack" (16 edges).
+    let p = root().join("crates/mesh/tests/data/slab_q4_embedded_v41_ascii.msh");
+    let o = bin().arg("mesh").arg(&p).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8(o.stdout).unwrap();
+    let notes: Vec<&str> = out.lines().filter(|l| l.contains("note:")).collect();
+    assert_eq!(
+        notes,
+        [
+            "  note: group \"crack\" has 16 edges inside the body (shared by two cells); \
+          as a traction or contact surface it would act inside the body"
+        ],
+        "{out}"
+    );
+    // None for a mesh whose line groups are all on the boundary.
+    let o = bin()
+        .arg("mesh")
+        .arg(root().join("cases/meshes/slab-q2-8x2.msh"))
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8(o.stdout).unwrap().contains("note:"));
+}

@@ -107,6 +107,12 @@ pub struct SourceInfo {
     /// Nodes of the file used by no cell (geometry points saved with
     /// Gmsh's `Mesh.SaveAll = 1`, hand-edited leftovers), dropped on import.
     pub unused_nodes: usize,
+    /// Dimension-1 groups with edges inside the body (sides of two cells,
+    /// e.g. an embedded curve, `Line{5} In Surface{1}`): physical tag →
+    /// number of such edges; groups on the boundary only are absent. Read
+    /// it with [`Mesh::interior_edges`]. (Here rather than in [`Group`],
+    /// whose literals other crates build.)
+    pub interior_edges: BTreeMap<i32, usize>,
 }
 
 /// A 2-D quadrilateral mesh with named groups.
@@ -200,6 +206,21 @@ impl Mesh {
             }));
         }
         Ok(first)
+    }
+
+    /// How many edges of `group` lie inside the body, each a side of two
+    /// cells: 0 for a boundary group (and for groups of dimension 0 or 2).
+    /// Not an error (an interior line can be harmless), but as a traction or
+    /// contact surface such a group would act inside the body.
+    pub fn interior_edges(&self, group: &Group) -> usize {
+        if group.dim != 1 {
+            return 0;
+        }
+        self.source
+            .interior_edges
+            .get(&group.tag)
+            .copied()
+            .unwrap_or(0)
     }
 
     /// Names of all physical groups, in the order of [`Mesh::groups`].

@@ -414,3 +414,35 @@ fn msh22_parametric_nodes_damaged_are_located() {
         "{e}"
     );
 }
+
+// ---- line groups inside the body ----
+
+#[test]
+fn a_line_group_between_two_cells_is_counted_as_interior() {
+    // The orphans mesh with a group "mid" on the side 2-5 the cells share.
+    let t = ORPHANS_22
+        .replace("4\n0 5 \"pin\"", "5\n1 7 \"mid\"\n0 5 \"pin\"")
+        .replace("$Elements\n6\n", "$Elements\n7\n7 1 2 7 1 5 2\n");
+    let m = parse_str(&t).unwrap_or_else(|e| panic!("{e}"));
+    check_invariants(&m);
+    let mid = m.group("mid").unwrap();
+    assert_eq!(mid.edges.len(), 1);
+    assert_eq!(m.interior_edges(mid), 1);
+    assert_eq!(m.interior_edges(m.group("bottom").unwrap()), 0);
+    assert_eq!(m.interior_edges(m.group("body").unwrap()), 0);
+    assert_eq!(m.source.interior_edges.len(), 1);
+}
+
+/// Gmsh 4.1 output (from the user review): the slab with an embedded curve
+/// `Line{5} In Surface{1}` from (2, 0.5) to (6, 0.5), group "crack".
+#[test]
+fn an_embedded_curve_group_is_inside_the_body() {
+    let m = load("slab_q4_embedded_v41_ascii.msh");
+    check_invariants(&m);
+    let crack = m.group("crack").unwrap();
+    assert_eq!(crack.elements, 16);
+    assert_eq!(m.interior_edges(crack), 16);
+    for g in ["contact", "load", "support", "left"] {
+        assert_eq!(m.interior_edges(m.group(g).unwrap()), 0, "{g}");
+    }
+}

@@ -669,8 +669,10 @@ impl Builder {
         // Boundary lines of groups: find the cell side each one is.
         let grouped: Vec<usize> = (0..lines.len()).filter(|&l| line_member[l] != 0).collect();
         let mut marked = vec![false; if grouped.is_empty() { 0 } else { nodes.len() }];
-        let mut sides: HashMap<(usize, usize), Option<(usize, usize)>> =
-            HashMap::with_capacity(grouped.len());
+        // Side → the first cell having it (cell, side), and whether a second
+        // cell has it too (the line is inside the body).
+        type Side = (Option<(usize, usize)>, bool);
+        let mut sides: HashMap<(usize, usize), Side> = HashMap::with_capacity(grouped.len());
         for &l in &grouped {
             let [a, b, mid] = lines[l];
             if (mid == usize::MAX) != (kind == CellKind::Quad4) {
@@ -686,23 +688,30 @@ impl Builder {
             }
             marked[a] = true;
             marked[b] = true;
-            sides.insert((a.min(b), a.max(b)), None);
+            sides.insert((a.min(b), a.max(b)), (None, false));
         }
         if !grouped.is_empty() {
             for (c, cell) in cells.chunks_exact(npc).enumerate() {
                 for i in 0..4 {
                     let (a, b) = (cell[i], cell[(i + 1) % 4]);
                     if marked[a] && marked[b] {
-                        if let Some(slot @ None) = sides.get_mut(&(a.min(b), a.max(b))) {
-                            *slot = Some((c, i));
+                        if let Some(slot) = sides.get_mut(&(a.min(b), a.max(b))) {
+                            match slot.0 {
+                                None => slot.0 = Some((c, i)),
+                                Some(_) => slot.1 = true,
+                            }
                         }
                     }
                 }
             }
         }
+        let mut interior_edges = BTreeMap::new();
         for &l in &grouped {
             let [a, b, mid] = lines[l];
-            let found = sides.get(&(a.min(b), a.max(b))).copied().flatten();
+            let (found, shared) = sides
+                .get(&(a.min(b), a.max(b)))
+                .copied()
+                .unwrap_or((None, false));
             let edge = found.and_then(|(c, i)| {
                 let cell = cells.get(c * npc..(c + 1) * npc)?;
                 if mid != usize::MAX && cell.get(4 + i) != Some(&mid) {
@@ -726,6 +735,9 @@ impl Builder {
                     Some(e) => {
                         g.edges.push(e);
                         g.elements += 1;
+                        if shared {
+                            *interior_edges.entry(t).or_insert(0) += 1;
+                        }
                     }
                     None => {
                         return Err(cur.error(
@@ -834,6 +846,7 @@ impl Builder {
                 reoriented,
                 boundary_elements,
                 unused_nodes,
+                interior_edges,
             },
         })
     }
