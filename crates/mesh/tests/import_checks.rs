@@ -239,6 +239,8 @@ fn a_mesh_in_the_xz_plane_is_not_planar_at_its_node() {
         let e = err(t);
         assert_eq!(e.kind, K::NotPlanar { node: 3, z: 1.0 }, "{e}");
         assert_eq!(e.location, Location::Line(line), "{e}");
+        // Also what a 3-D mesh meets first now: say to mesh in 2-D.
+        assert!(e.to_string().contains("mesh it in 2-D (`gmsh -2`)"), "{e}");
     }
 }
 

@@ -1,8 +1,9 @@
 //! Collects what the version-specific parsers read (nodes, then elements)
 //! into a [`Mesh`], checking as it goes: node tags map to dense indices,
 //! every cell is oriented counter-clockwise with a positive Jacobian at its
-//! corners (quad9: also at its other nodes and Gauss points), boundary elements of groups lie on cell sides and are oriented
-//! with their cell on the left.
+//! corners (quad9: also at its other nodes and Gauss points), boundary
+//! elements of groups lie on cell sides and are oriented with their cell on
+//! the left, nodes in no cell are dropped.
 
 use std::collections::{BTreeMap, HashMap};
 
