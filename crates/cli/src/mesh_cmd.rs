@@ -24,18 +24,24 @@ pub fn report(path: &Path, as_json: bool) -> Result<String, InputError> {
 }
 
 /// The DESIGN.md object: format, version, binary, nodes, cells,
-/// boundary_elements, groups, bbox, reoriented.
+/// boundary_elements, groups, bbox, reoriented, unused_nodes.
 pub fn to_json(mesh: &Mesh) -> serde_json::Value {
-    let groups: serde_json::Map<String, serde_json::Value> = mesh
-        .groups
-        .iter()
-        .map(|g| {
-            (
-                g.name.clone(),
-                json!({"dim": g.dim, "elements": g.elements, "nodes": g.nodes.len()}),
-            )
-        })
-        .collect();
+    // Gmsh lets groups of different dimensions share a name; an object
+    // keeps one value a key, so later ones get their dimension (and, for a
+    // hand-made same-dimension twin, their tag) in the key.
+    let mut groups = serde_json::Map::new();
+    for g in &mesh.groups {
+        let value = json!({"dim": g.dim, "elements": g.elements, "nodes": g.nodes.len()});
+        let key = [
+            g.name.clone(),
+            format!("{} (dim {})", g.name, g.dim),
+            format!("{} (dim {} tag {})", g.name, g.dim, g.tag),
+        ]
+        .into_iter()
+        .find(|k| !groups.contains_key(k))
+        .unwrap_or_default();
+        groups.insert(key, value);
+    }
     let cells: BTreeMap<&str, usize> = [(mesh.kind.name(), mesh.n_cells())].into();
     json!({
         "format": "msh",
@@ -47,6 +53,7 @@ pub fn to_json(mesh: &Mesh) -> serde_json::Value {
         "groups": groups,
         "bbox": mesh.bbox(),
         "reoriented": mesh.source.reoriented,
+        "unused_nodes": mesh.source.unused_nodes,
     })
 }
 
@@ -64,6 +71,13 @@ fn to_table(path: &Path, mesh: &Mesh) -> String {
         mesh.source.version
     );
     let _ = writeln!(s, "  nodes        {}", mesh.nodes.len());
+    if mesh.source.unused_nodes > 0 {
+        let _ = writeln!(
+            s,
+            "  unused nodes  {} dropped (in no cell: Gmsh's Mesh.SaveAll or geometry points)",
+            mesh.source.unused_nodes
+        );
+    }
     let _ = writeln!(s, "  cells        {} {}", mesh.n_cells(), mesh.kind.name());
     let boundary: Vec<String> = mesh
         .source
@@ -110,6 +124,19 @@ fn to_table(path: &Path, mesh: &Mesh) -> String {
             g.elements,
             g.nodes.len()
         );
+    }
+    // Not an error (an interior line may be meant), but a traction or
+    // contact surface there would act inside the body.
+    for g in &mesh.groups {
+        let k = mesh.interior_edges(g);
+        if k > 0 {
+            let _ = writeln!(
+                s,
+                "  note: group {:?} has {k} {} inside the body (shared by two cells); as a traction or contact surface it would act inside the body",
+                g.name,
+                if k == 1 { "edge" } else { "edges" }
+            );
+        }
     }
     s
 }

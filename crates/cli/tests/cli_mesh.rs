@@ -180,3 +180,98 @@ fn usage_errors_exit_2_and_help_has_examples() {
         .unwrap()
         .starts_with("stickslip "));
 }
+
+/// A mesh written to a file of its own in the temp directory (the tests of
+/// one binary run in parallel, so each file name is the test's).
+fn temp_mesh(name: &str, text: &str) -> PathBuf {
+    let p = std::env::temp_dir().join(format!("stickslip-cli-mesh-{}-{name}", std::process::id()));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Two quad4 cells and two nodes used by no cell (tags 7 and 8, far out).
+const ORPHANS: &str = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n\
+1 0 0 0\n2 1 0 0\n3 2 0 0\n4 0 1 0\n5 1 1 0\n6 2 1 0\n7 5 5 0\n8 -3 7 0\n$EndNodes\n\
+$Elements\n2\n1 3 2 2 1 1 2 5 4\n2 3 2 2 1 2 3 6 5\n$EndElements\n";
+
+#[test]
+fn mesh_reports_dropped_unused_nodes() {
+    let p = temp_mesh("orphans.msh", ORPHANS);
+    let j = mesh_json(&p);
+    assert_eq!(j["nodes"], 6);
+    assert_eq!(j["unused_nodes"], 2);
+    assert_eq!(j["bbox"], serde_json::json!([[0.0, 0.0], [2.0, 1.0]]));
+    let o = bin().arg("mesh").arg(&p).output().unwrap();
+    let out = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        out.contains(
+            "  unused nodes  2 dropped (in no cell: Gmsh's Mesh.SaveAll or geometry points)\n"
+        ),
+        "{out}"
+    );
+    std::fs::remove_file(&p).unwrap();
+    // Shown only when there are some; the JSON key always.
+    let slab = root().join("cases/meshes/slab-q2-8x2.msh");
+    assert_eq!(mesh_json(&slab)["unused_nodes"], 0);
+    let o = bin().arg("mesh").arg(&slab).output().unwrap();
+    assert!(!String::from_utf8(o.stdout).unwrap().contains("unused"));
+}
+
+#[test]
+fn mesh_json_keeps_groups_sharing_a_name() {
+    // Groups "body" of dimension 1 (the bottom) and 2; the first keeps the name.
+    let text = ORPHANS
+        .replace(
+            "$EndMeshFormat\n",
+            "$EndMeshFormat\n$PhysicalNames\n2\n1 1 \"body\"\n2 2 \"body\"\n$EndPhysicalNames\n",
+        )
+        .replace("$Elements\n2\n", "$Elements\n3\n3 1 2 1 1 1 2\n");
+    let p = temp_mesh("same-name.msh", &text);
+    let j = mesh_json(&p);
+    std::fs::remove_file(&p).unwrap();
+    assert_eq!(
+        j["groups"],
+        serde_json::json!({
+            "body": {"dim": 1, "elements": 1, "nodes": 2},
+            "body (dim 2)": {"dim": 2, "elements": 2, "nodes": 6},
+        })
+    );
+}
+
+#[test]
+fn an_empty_mesh_file_is_called_empty() {
+    let p = temp_mesh("empty.msh", "");
+    let o = bin().arg("mesh").arg(&p).output().unwrap();
+    std::fs::remove_file(&p).unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(
+        e.starts_with(&format!("error: {}: the file is empty", p.display())),
+        "{e}"
+    );
+}
+
+#[test]
+fn mesh_table_notes_a_line_group_inside_the_body() {
+    // Gmsh output of a slab with an embedded curve, group "crack" (16 edges).
+    let p = root().join("crates/mesh/tests/data/slab_q4_embedded_v41_ascii.msh");
+    let o = bin().arg("mesh").arg(&p).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8(o.stdout).unwrap();
+    let notes: Vec<&str> = out.lines().filter(|l| l.contains("note:")).collect();
+    assert_eq!(
+        notes,
+        [
+            "  note: group \"crack\" has 16 edges inside the body (shared by two cells); \
+          as a traction or contact surface it would act inside the body"
+        ],
+        "{out}"
+    );
+    // None for a mesh whose line groups are all on the boundary.
+    let o = bin()
+        .arg("mesh")
+        .arg(root().join("cases/meshes/slab-q2-8x2.msh"))
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8(o.stdout).unwrap().contains("note:"));
+}

@@ -29,6 +29,17 @@ pub enum MeshErrorKind {
         /// The names the mesh has.
         available: Vec<String>,
     },
+    /// A physical group name given to groups of several dimensions.
+    #[error("the mesh has several physical groups called {name:?} ({}), so which one is meant is unknown; rename all but one in the .geo (e.g. Physical Curve(\"{name}_edge\")) and mesh again", groups.iter().map(|(d, t)| format!("dim {d} tag {t}")).collect::<Vec<_>>().join(", "))]
+    AmbiguousGroup {
+        /// The name asked for.
+        name: String,
+        /// Dimension and physical tag of each group with that name, in mesh order.
+        groups: Vec<(u8, i32)>,
+    },
+    /// The file is empty or blank.
+    #[error("the file is empty (it holds no text, or only blank space): the mesh was not saved into it; mesh and save again (`gmsh -2 FILE.geo -o FILE.msh`, or File > Export in Gmsh)")]
+    EmptyFile,
     /// The file does not start with `$MeshFormat`.
     #[error("this is not a Gmsh .msh file (it does not start with $MeshFormat); export the mesh from Gmsh with File > Export > .msh or `gmsh -2 FILE.geo -o FILE.msh`")]
     NotMsh,
@@ -61,6 +72,9 @@ pub enum MeshErrorKind {
         /// The closing keyword expected, e.g. `$EndNodes`.
         end: String,
     },
+    /// An MSH 4.1 file of a partitioned mesh.
+    #[error("the mesh is partitioned (it has $PartitionedEntities, as `gmsh -part N` writes); stickslip reads unpartitioned meshes only: mesh and save without `-part` (or call gmsh.model.mesh.unpartition() before writing)")]
+    Partitioned,
     /// A section the reader needs is not in the file.
     #[error("the file has no {section} section; a mesh file needs $MeshFormat, $Nodes and $Elements: generate the 2-D mesh (`gmsh -2`) before saving")]
     MissingSection {
@@ -132,6 +146,18 @@ pub enum MeshErrorKind {
         /// Its Gmsh name, when known.
         name: &'static str,
     },
+    /// An element of order 3 or more (`gmsh -order 3` and up).
+    #[error("element {element} is a {name} (Gmsh type {type_id}), of order {order}; stickslip reads elements of order 1 or 2 only (quad4 or quad9 cells, line2 or line3 boundaries): mesh with `gmsh -order 1` or `-order 2` (Mesh.ElementOrder = 1 or 2)")]
+    UnsupportedOrder {
+        /// The element's Gmsh tag.
+        element: u64,
+        /// Gmsh element type number.
+        type_id: i32,
+        /// Its Gmsh name.
+        name: &'static str,
+        /// Its polynomial order (3 or more).
+        order: u8,
+    },
     /// 2-D cells that are not all quad4 or all quad9.
     #[error("the 2-D cells include {found}; stickslip needs all quad4 or all quad9 cells: in Gmsh add `Recombine Surface{{...}};` (or Mesh.RecombineAll = 1) for quadrilaterals, and for quad9 use Mesh.ElementOrder = 2 (or `gmsh -order 2`) with Mesh.SecondOrderIncomplete = 0")]
     NotQuads {
@@ -154,6 +180,13 @@ pub enum MeshErrorKind {
         /// The cell's Gmsh tag.
         element: u64,
     },
+    /// A quad9 whose corners are fine but whose mid-side or centre node
+    /// turns it inside out somewhere inside.
+    #[error("cell {element} is inverted inside: its Jacobian determinant is not positive at every node and Gauss point, so a mid-side or centre node lies outside the cell or across its middle; move that node, or mesh again with the curved cells untangled (Mesh.HighOrderOptimize = 2) or a finer size there")]
+    InvertedCell {
+        /// The cell's Gmsh tag.
+        element: u64,
+    },
     /// A boundary element of a physical group that is not the side of any cell.
     #[error("boundary element {element} of group {group:?} is not a side of any cell; a boundary group must consist of lines of the meshed surface's boundary (mesh curves and surface together, and do not mix meshes)")]
     EdgeNotOnCell {
@@ -166,7 +199,7 @@ pub enum MeshErrorKind {
     #[error("the file has no quad cells; mesh the surface (`gmsh -2`), and either put the surface in a physical group or save all elements (Mesh.SaveAll = 1)")]
     NoCells,
     /// A node off the z = 0 plane.
-    #[error("node {node} has z = {z}; stickslip reads plane meshes in the z = 0 plane: build the geometry in the xy-plane")]
+    #[error("node {node} has z = {z}; stickslip reads plane meshes in the z = 0 plane: build the geometry in the xy-plane and mesh it in 2-D (`gmsh -2`)")]
     NotPlanar {
         /// The node's tag.
         node: u64,

@@ -104,14 +104,24 @@ pub struct SourceInfo {
     pub reoriented: usize,
     /// Boundary elements by type name ("line2", "line3", "point") → count.
     pub boundary_elements: BTreeMap<String, usize>,
+    /// Nodes of the file used by no cell (geometry points saved with
+    /// Gmsh's `Mesh.SaveAll = 1`, hand-edited leftovers), dropped on import.
+    pub unused_nodes: usize,
+    /// Dimension-1 groups with edges inside the body (sides of two cells,
+    /// e.g. an embedded curve, `Line{5} In Surface{1}`): physical tag →
+    /// number of such edges; groups on the boundary only are absent. Read
+    /// it with [`Mesh::interior_edges`]. (Here rather than in [`Group`],
+    /// whose literals other crates build.)
+    pub interior_edges: BTreeMap<i32, usize>,
 }
 
 /// A 2-D quadrilateral mesh with named groups.
 ///
-/// Invariants (established by the reader and its checks): every cell has
-/// `kind.nodes_per_cell()` valid node indices, is counter-clockwise with a
-/// positive Jacobian determinant at its corners; every edge of a dimension-1
-/// group is a side of its `cell` and oriented with that cell on its left.
+/// Invariants (established by the reader and its checks): every node is
+/// used by a cell; every cell has `kind.nodes_per_cell()` valid node
+/// indices, is counter-clockwise with a positive Jacobian determinant at its
+/// corners (quad9: also at its other nodes and 3×3 Gauss points); every
+/// edge of a dimension-1 group is a side of its `cell` and oriented with that cell on its left.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     /// Node coordinates (x, y); z is dropped (must be 0 in a 2-D mesh).
@@ -173,14 +183,44 @@ impl Mesh {
     /// The physical group called `name` (`"#3"` for an unnamed group 3).
     ///
     /// # Errors
-    /// [`MeshErrorKind::UnknownGroup`] listing the names the mesh has.
+    /// [`MeshErrorKind::UnknownGroup`] listing the names the mesh has;
+    /// [`MeshErrorKind::AmbiguousGroup`] if groups of several dimensions
+    /// have that name (Gmsh allows it; which one was meant is unknowable).
     pub fn group(&self, name: &str) -> Result<&Group, MeshError> {
-        self.groups.iter().find(|g| g.name == name).ok_or_else(|| {
-            MeshError::new(MeshErrorKind::UnknownGroup {
+        let mut named = self.groups.iter().filter(|g| g.name == name);
+        let Some(first) = named.next() else {
+            return Err(MeshError::new(MeshErrorKind::UnknownGroup {
                 name: name.to_string(),
                 available: self.group_names().iter().map(|s| s.to_string()).collect(),
-            })
-        })
+            }));
+        };
+        if named.next().is_some() {
+            return Err(MeshError::new(MeshErrorKind::AmbiguousGroup {
+                name: name.to_string(),
+                groups: self
+                    .groups
+                    .iter()
+                    .filter(|g| g.name == name)
+                    .map(|g| (g.dim, g.tag))
+                    .collect(),
+            }));
+        }
+        Ok(first)
+    }
+
+    /// How many edges of `group` lie inside the body, each a side of two
+    /// cells: 0 for a boundary group (and for groups of dimension 0 or 2).
+    /// Not an error (an interior line can be harmless), but as a traction or
+    /// contact surface such a group would act inside the body.
+    pub fn interior_edges(&self, group: &Group) -> usize {
+        if group.dim != 1 {
+            return 0;
+        }
+        self.source
+            .interior_edges
+            .get(&group.tag)
+            .copied()
+            .unwrap_or(0)
     }
 
     /// Names of all physical groups, in the order of [`Mesh::groups`].

@@ -3,8 +3,8 @@
 //!
 //! One pass over the bytes: `$MeshFormat` decides the version and encoding,
 //! then each section is parsed where it stands (`$PhysicalNames`,
-//! `$Entities`, `$Nodes`, `$Elements`; anything else, e.g. `$Periodic` or
-//! `$NodeData`, is skipped up to its `$End…`). Elements are mapped to dense
+//! `$Entities`, `$Nodes` or in 2.2 `$ParametricNodes`, `$Elements`; anything
+//! else, e.g. `$Periodic` or `$NodeData`, is skipped up to its `$End…`). Elements are mapped to dense
 //! node indices and checked as they are read, so `$Nodes` must come before
 //! `$Elements` (and `$Entities` before `$Elements` in 4.1), as Gmsh writes them.
 
@@ -49,6 +49,7 @@ fn parse(mut cur: Cursor<'_>) -> Result<Mesh> {
 fn parse_with(cur: &mut Cursor<'_>) -> Result<Mesh> {
     match cur.token() {
         Some((_, t)) if t == b"$MeshFormat" => {}
+        None => return Err(MeshError::new(MeshErrorKind::EmptyFile)),
         _ => return Err(cur.error(0, MeshErrorKind::NotMsh)),
     }
     let (version, binary) = mesh_format(cur)?;
@@ -71,20 +72,38 @@ fn parse_with(cur: &mut Cursor<'_>) -> Result<Mesh> {
                 }
                 entities = Some(v4::entities(cur, &mut b)?);
             }
-            b"$Nodes" => {
+            // Its entities carry the physical tags of a partitioned mesh, and
+            // a split file (Mesh.PartitionSplitMeshFiles) holds only a part of
+            // the body: refused rather than read wrong.
+            b"$PartitionedEntities" if version == "4.1" => {
+                return Err(cur.error(p, MeshErrorKind::Partitioned));
+            }
+            b"$Nodes" | b"$ParametricNodes" => {
                 if seen_nodes {
                     return Err(out_of_place(cur, p, t, "a second $Nodes section"));
                 }
                 seen_nodes = true;
                 if version == "2.2" {
-                    v2::nodes(cur, &mut b)?;
+                    v2::nodes(cur, &mut b, t == b"$ParametricNodes")?;
+                } else if t == b"$ParametricNodes" {
+                    return Err(out_of_place(
+                        cur,
+                        p,
+                        t,
+                        "MSH 4.1 gives parametric nodes in $Nodes",
+                    ));
                 } else {
                     v4::nodes(cur, &mut b)?;
                 }
             }
             b"$Elements" => {
                 if !seen_nodes {
-                    return Err(out_of_place(cur, p, t, "$Nodes must come before $Elements"));
+                    return Err(out_of_place(
+                        cur,
+                        p,
+                        t,
+                        "$Nodes (or $ParametricNodes) must come before $Elements",
+                    ));
                 }
                 if seen_elements {
                     return Err(out_of_place(cur, p, t, "a second $Elements section"));

@@ -433,7 +433,13 @@ fn not_planar() {
         "9 6.000000000002768 1.375000000000173 0",
         "9 6.000000000002768 1.375000000000173 0.5",
     );
-    assert_eq!(err(&t).kind, K::NotPlanar { node: 9, z: 0.5 });
+    let e = err(&t);
+    assert_eq!(e.kind, K::NotPlanar { node: 9, z: 0.5 });
+    // The node's line, where the fix is.
+    assert_eq!(
+        e.location,
+        Location::Line(line_no(&t, "9 6.000000000002768 1.375000000000173 0.5"))
+    );
     // Rounding-level z (1e-14 of an 8-long mesh) is accepted.
     let t = replace_line(
         &text(Q4_22),
@@ -449,7 +455,56 @@ fn duplicate_node_tag() {
     let t = replace_line(&t, "106", "103");
     let e = err(&t);
     assert_eq!(e.kind, K::DuplicateNode { tag: 103 });
-    assert_eq!(e.location, Location::Line(line_no(&t, "9 15 103 145")));
+    // The second 103, where the fix is, not the $Nodes header: after
+    // $Nodes come the header, a block header, 103, its coordinates, the
+    // next block header and the duplicate.
+    let second = line_no(&t, "$Nodes") + 6;
+    assert_eq!(t.lines().nth(second - 1), Some("103"));
+    assert_eq!(e.location, Location::Line(second));
+}
+
+#[test]
+fn duplicate_node_tag_22_ascii_and_binary() {
+    // Sparse tags (a table index): node 9's line repeats tag 5.
+    let t = text("slab_q4_gaps_v22_ascii.msh");
+    let nodes = line_no(&t, "$Nodes");
+    let lines: Vec<&str> = t.lines().collect();
+    let (l5, l9) = (lines[nodes + 5], lines[nodes + 9]);
+    let tag5 = l5.split(' ').next().unwrap();
+    let dup = format!("{tag5} {}", l9.split_once(' ').unwrap().1);
+    let t = replace_line(&t, l9, &dup);
+    let e = err(&t);
+    assert_eq!(
+        e.kind,
+        K::DuplicateNode {
+            tag: tag5.parse().unwrap()
+        }
+    );
+    assert_eq!(e.location, Location::Line(nodes + 10));
+    // Binary: the 8th record takes the 3rd one's tag.
+    let mut b = bytes("slab_q4_gaps_v22_bin.msh");
+    let data = find(&b, b"$Nodes\n15\n") + 10;
+    let third: [u8; 4] = b[data + 28 * 2..data + 28 * 2 + 4].try_into().unwrap();
+    b[data + 28 * 7..data + 28 * 7 + 4].copy_from_slice(&third);
+    let e = err_bytes(&b);
+    assert!(matches!(e.kind, K::DuplicateNode { .. }), "{e}");
+    assert_eq!(e.location, Location::Byte(data + 28 * 7));
+    // MSH 4.1 binary: the second block's tag (after the 32-byte header, a
+    // 20-byte block header, a tag and 24 bytes of coordinates, and the next
+    // block header) takes the first one's.
+    let mut b = bytes("slab_q4_gaps_v41_bin.msh");
+    let first = find(&b, b"$Nodes\n") + 7 + 32 + 20;
+    let second = first + 8 + 24 + 20;
+    let tag: [u8; 8] = b[first..first + 8].try_into().unwrap();
+    b[second..second + 8].copy_from_slice(&tag);
+    let e = err_bytes(&b);
+    assert_eq!(
+        e.kind,
+        K::DuplicateNode {
+            tag: u64::from_le_bytes(tag)
+        }
+    );
+    assert_eq!(e.location, Location::Byte(second));
 }
 
 // ---- file structure ----
@@ -459,7 +514,12 @@ fn not_an_msh_file() {
     let e = err("hello\n");
     assert_eq!(e.kind, K::NotMsh);
     assert_eq!(e.location, Location::Line(1));
-    assert_eq!(err_bytes(b"").kind, K::NotMsh);
+    // An empty file is not "not a mesh file": it is empty.
+    for empty in [&b""[..], b"\n", b"  \r\n\t\n"] {
+        let e = err_bytes(empty);
+        assert_eq!(e.kind, K::EmptyFile);
+        assert_eq!(e.location, Location::Nowhere);
+    }
 }
 
 #[test]

@@ -1,8 +1,9 @@
 //! Collects what the version-specific parsers read (nodes, then elements)
 //! into a [`Mesh`], checking as it goes: node tags map to dense indices,
 //! every cell is oriented counter-clockwise with a positive Jacobian at its
-//! corners, boundary elements of groups lie on cell sides and are oriented
-//! with their cell on the left.
+//! corners (quad9: also at its other nodes and Gauss points), boundary
+//! elements of groups lie on cell sides and are oriented with their cell on
+//! the left, nodes in no cell are dropped.
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -28,23 +29,13 @@ pub(crate) fn nodes_of(type_id: i32) -> Option<usize> {
     }
 }
 
-/// Gmsh's name and dimension of an element type (for messages).
+/// Gmsh's name and dimension of an element type of order 1 or 2 (for
+/// messages; higher orders are [`high_order`]).
 fn describe(type_id: i32) -> (&'static str, u8) {
     match type_id {
         2 => ("tri3", 2),
         9 => ("tri6", 2),
         16 => ("quad8", 2),
-        20 => ("tri9", 2),
-        21 => ("tri10", 2),
-        22 => ("tri12", 2),
-        23 | 24 => ("tri15", 2),
-        25 => ("tri21", 2),
-        36 | 40 => ("quad16", 2),
-        37 | 41 => ("quad25", 2),
-        38 => ("quad36", 2),
-        39 => ("quad12", 2),
-        42..=46 | 52..=55 => ("high-order triangle", 2),
-        47..=51 | 56..=59 => ("high-order quadrangle", 2),
         4 => ("tet4", 3),
         5 => ("hex8", 3),
         6 => ("prism6", 3),
@@ -56,15 +47,73 @@ fn describe(type_id: i32) -> (&'static str, u8) {
         17 => ("hex20", 3),
         18 => ("prism15", 3),
         19 => ("pyramid13", 3),
-        26 => ("line4", 1),
-        27 => ("line5", 1),
-        28 => ("line6", 1),
         _ => ("unknown type", 9),
     }
 }
 
+/// Gmsh's name and the order of a line, triangle or quadrangle type of
+/// order 3 or more (GmshDefines.h; "incomplete" types have no interior
+/// nodes). These come from `gmsh -order 3` and up: the problem is the order,
+/// not the dimension or the shape.
+fn high_order(type_id: i32) -> Option<(&'static str, u8)> {
+    Some(match type_id {
+        26 => ("line4", 3),
+        27 => ("line5", 4),
+        28 => ("line6", 5),
+        62 => ("line7", 6),
+        63 => ("line8", 7),
+        64 => ("line9", 8),
+        65 => ("line10", 9),
+        66 => ("line11", 10),
+        20 => ("tri9", 3),
+        21 => ("tri10", 3),
+        22 => ("tri12", 4),
+        23 => ("tri15", 4),
+        24 => ("tri15 (incomplete)", 5),
+        25 => ("tri21", 5),
+        42 => ("tri28", 6),
+        43 => ("tri36", 7),
+        44 => ("tri45", 8),
+        45 => ("tri55", 9),
+        46 => ("tri66", 10),
+        52 => ("tri18", 6),
+        53 => ("tri21 (incomplete)", 7),
+        54 => ("tri24", 8),
+        55 => ("tri27", 9),
+        56 => ("tri30", 10),
+        36 => ("quad16", 3),
+        37 => ("quad25", 4),
+        38 => ("quad36", 5),
+        39 => ("quad12", 3),
+        40 => ("quad16 (incomplete)", 4),
+        41 => ("quad20", 5),
+        47 => ("quad49", 6),
+        48 => ("quad64", 7),
+        49 => ("quad81", 8),
+        50 => ("quad100", 9),
+        51 => ("quad121", 10),
+        57 => ("quad24", 6),
+        58 => ("quad28", 7),
+        59 => ("quad32", 8),
+        60 => ("quad36 (incomplete)", 9),
+        61 => ("quad40", 10),
+        _ => return None,
+    })
+}
+
 /// The error for an element type the reader does not take.
 pub(crate) fn unsupported(cur: &Cursor<'_>, pos: usize, element: u64, type_id: i32) -> MeshError {
+    if let Some((name, order)) = high_order(type_id) {
+        return cur.error(
+            pos,
+            MeshErrorKind::UnsupportedOrder {
+                element,
+                type_id,
+                name,
+                order,
+            },
+        );
+    }
     let (name, dim) = describe(type_id);
     if dim == 2 {
         cur.error(
@@ -126,9 +175,15 @@ pub(crate) struct Builder {
     pub(crate) binary: bool,
     pub(crate) nodes: Vec<[f64; 2]>,
     pub(crate) node_tags: Vec<u64>,
-    /// The z of largest magnitude seen and the node's tag.
-    pub(crate) max_z: (f64, u64),
+    /// The z of largest magnitude seen, the node's tag and its position.
+    pub(crate) max_z: (f64, u64, usize),
     index: Option<NodeIndex>,
+    /// The largest node tag read so far.
+    max_tag: Option<u64>,
+    /// (index, position) of each node whose tag is not above all tags
+    /// before it: only there can a duplicate be, and Gmsh's increasing tags
+    /// leave this empty. Gives a duplicate's line without a position a node.
+    late_tags: Vec<(usize, usize)>,
     /// Physical tag lists; entry 0 is empty.
     pub(crate) memberships: Vec<Vec<i32>>,
     membership_ids: HashMap<Vec<i32>, Membership>,
@@ -156,8 +211,10 @@ impl Builder {
             binary,
             nodes: Vec::new(),
             node_tags: Vec::new(),
-            max_z: (0.0, 0),
+            max_z: (0.0, 0, 0),
             index: None,
+            max_tag: None,
+            late_tags: Vec::new(),
             memberships: vec![Vec::new()],
             membership_ids: HashMap::new(),
             names: BTreeMap::new(),
@@ -193,24 +250,62 @@ impl Builder {
         id
     }
 
+    /// A node read at `pos` (any position on its line, or its record).
     #[inline]
-    pub(crate) fn push_node(&mut self, tag: u64, x: f64, y: f64, z: f64) {
+    pub(crate) fn push_node(&mut self, tag: u64, x: f64, y: f64, z: f64, pos: usize) {
+        self.push_tag(tag, pos);
+        self.push_xyz(x, y, z, tag, pos);
+    }
+
+    /// A node's tag, read at `pos`.
+    #[inline]
+    pub(crate) fn push_tag(&mut self, tag: u64, pos: usize) {
+        match self.max_tag {
+            Some(m) if tag <= m => self.late_tags.push((self.node_tags.len(), pos)),
+            _ => self.max_tag = Some(tag),
+        }
         self.node_tags.push(tag);
-        self.push_xyz(x, y, z, tag);
+    }
+
+    /// The error for a second node of tag `tag`, node `index`: at its line
+    /// (or record), else at the `$Nodes` header.
+    fn duplicate(&self, cur: &Cursor<'_>, header: usize, index: usize, tag: u64) -> MeshError {
+        let pos = self
+            .late_tags
+            .binary_search_by_key(&index, |&(i, _)| i)
+            .map_or(header, |k| self.late_tags[k].1);
+        cur.error(pos, MeshErrorKind::DuplicateNode { tag })
     }
 
     /// Coordinates of a node whose tag was pushed before (4.1 gives a
-    /// block's tags first, then its coordinates).
+    /// block's tags first, then its coordinates), read at `pos`.
     #[inline]
-    pub(crate) fn push_xyz(&mut self, x: f64, y: f64, z: f64, tag: u64) {
+    pub(crate) fn push_xyz(&mut self, x: f64, y: f64, z: f64, tag: u64, pos: usize) {
         if z.abs() > self.max_z.0.abs() {
-            self.max_z = (z, tag);
+            self.max_z = (z, tag, pos);
         }
         self.nodes.push([x, y]);
     }
 
     /// Called once all nodes are read: builds the tag → index map.
     pub(crate) fn finish_nodes(&mut self, cur: &Cursor<'_>, pos: usize) -> Result<()> {
+        // z must be 0 up to rounding relative to the mesh size. Checked
+        // here, before any cell: a mesh in another plane has flat cells in
+        // xy, and "degenerate cell" would hide the cause.
+        let (z, tag, at) = self.max_z;
+        if z != 0.0 {
+            let mut bb = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
+            for p in &self.nodes {
+                for k in 0..2 {
+                    bb[0][k] = bb[0][k].min(p[k]);
+                    bb[1][k] = bb[1][k].max(p[k]);
+                }
+            }
+            let extent = (bb[1][0] - bb[0][0]).max(bb[1][1] - bb[0][1]).max(0.0);
+            if z.abs() > Z_TOL * extent {
+                return Err(cur.error(at, MeshErrorKind::NotPlanar { node: tag, z }));
+            }
+        }
         let n = self.node_tags.len();
         if n >= u32::MAX as usize {
             return Err(cur.error(
@@ -238,7 +333,7 @@ impl Builder {
                 for (i, &t) in self.node_tags.iter().enumerate() {
                     let slot = &mut table[(t - min) as usize];
                     if *slot != u32::MAX {
-                        return Err(cur.error(pos, MeshErrorKind::DuplicateNode { tag: t }));
+                        return Err(self.duplicate(cur, pos, i, t));
                     }
                     *slot = i as u32;
                 }
@@ -247,7 +342,7 @@ impl Builder {
                 let mut map = HashMap::with_capacity(n);
                 for (i, &t) in self.node_tags.iter().enumerate() {
                     if map.insert(t, i as u32).is_some() {
-                        return Err(cur.error(pos, MeshErrorKind::DuplicateNode { tag: t }));
+                        return Err(self.duplicate(cur, pos, i, t));
                     }
                 }
                 NodeIndex::Map(map)
@@ -359,6 +454,12 @@ impl Builder {
                     }
                     None => {
                         return Err(cur.error(pos, MeshErrorKind::DegenerateCell { element: tag }))
+                    }
+                }
+                if kind == CellKind::Quad9 {
+                    let p: [[f64; 2]; 9] = std::array::from_fn(|k| self.nodes[cell[k]]);
+                    if !quad9_inside_positive(&p) {
+                        return Err(cur.error(pos, MeshErrorKind::InvertedCell { element: tag }));
                     }
                 }
                 self.cells.extend_from_slice(cell);
@@ -473,13 +574,12 @@ impl Builder {
         let Builder {
             version,
             binary,
-            nodes,
-            node_tags,
-            max_z,
+            mut nodes,
+            mut node_tags,
             memberships,
             names,
             kind,
-            cells,
+            mut cells,
             cell_tags,
             cell_member,
             reoriented,
@@ -496,21 +596,6 @@ impl Builder {
             return Err(MeshError::new(MeshErrorKind::NoCells));
         };
         let npc = kind.nodes_per_cell();
-        // z must be 0 up to rounding relative to the mesh size.
-        let mut bb = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
-        for p in &nodes {
-            for k in 0..2 {
-                bb[0][k] = bb[0][k].min(p[k]);
-                bb[1][k] = bb[1][k].max(p[k]);
-            }
-        }
-        let extent = (bb[1][0] - bb[0][0]).max(bb[1][1] - bb[0][1]).max(0.0);
-        if max_z.0.abs() > Z_TOL * extent {
-            return Err(MeshError::new(MeshErrorKind::NotPlanar {
-                node: max_z.1,
-                z: max_z.0,
-            }));
-        }
 
         // Groups, keyed (dim, tag) so the BTreeMap gives the required order.
         let mut acc: BTreeMap<(u8, i32), Group> = BTreeMap::new();
@@ -585,8 +670,10 @@ impl Builder {
         // Boundary lines of groups: find the cell side each one is.
         let grouped: Vec<usize> = (0..lines.len()).filter(|&l| line_member[l] != 0).collect();
         let mut marked = vec![false; if grouped.is_empty() { 0 } else { nodes.len() }];
-        let mut sides: HashMap<(usize, usize), Option<(usize, usize)>> =
-            HashMap::with_capacity(grouped.len());
+        // Side → the first cell having it (cell, side), and whether a second
+        // cell has it too (the line is inside the body).
+        type Side = (Option<(usize, usize)>, bool);
+        let mut sides: HashMap<(usize, usize), Side> = HashMap::with_capacity(grouped.len());
         for &l in &grouped {
             let [a, b, mid] = lines[l];
             if (mid == usize::MAX) != (kind == CellKind::Quad4) {
@@ -602,23 +689,30 @@ impl Builder {
             }
             marked[a] = true;
             marked[b] = true;
-            sides.insert((a.min(b), a.max(b)), None);
+            sides.insert((a.min(b), a.max(b)), (None, false));
         }
         if !grouped.is_empty() {
             for (c, cell) in cells.chunks_exact(npc).enumerate() {
                 for i in 0..4 {
                     let (a, b) = (cell[i], cell[(i + 1) % 4]);
                     if marked[a] && marked[b] {
-                        if let Some(slot @ None) = sides.get_mut(&(a.min(b), a.max(b))) {
-                            *slot = Some((c, i));
+                        if let Some(slot) = sides.get_mut(&(a.min(b), a.max(b))) {
+                            match slot.0 {
+                                None => slot.0 = Some((c, i)),
+                                Some(_) => slot.1 = true,
+                            }
                         }
                     }
                 }
             }
         }
+        let mut interior_edges = BTreeMap::new();
         for &l in &grouped {
             let [a, b, mid] = lines[l];
-            let found = sides.get(&(a.min(b), a.max(b))).copied().flatten();
+            let (found, shared) = sides
+                .get(&(a.min(b), a.max(b)))
+                .copied()
+                .unwrap_or((None, false));
             let edge = found.and_then(|(c, i)| {
                 let cell = cells.get(c * npc..(c + 1) * npc)?;
                 if mid != usize::MAX && cell.get(4 + i) != Some(&mid) {
@@ -642,6 +736,9 @@ impl Builder {
                     Some(e) => {
                         g.edges.push(e);
                         g.elements += 1;
+                        if shared {
+                            *interior_edges.entry(t).or_insert(0) += 1;
+                        }
                     }
                     None => {
                         return Err(cur.error(
@@ -652,6 +749,46 @@ impl Builder {
                             },
                         ))
                     }
+                }
+            }
+        }
+
+        // Nodes in no cell (Gmsh's Mesh.SaveAll = 1 saves geometry points
+        // such as a circle's centre) would be free, unloaded DOFs that make
+        // K singular: drop them. Edges of groups are cell sides, so only
+        // cells and points refer to dropped nodes.
+        let mut used = vec![false; nodes.len()];
+        for &n in &cells {
+            used[n] = true;
+        }
+        let unused_nodes = used.iter().filter(|&&u| !u).count();
+        if unused_nodes > 0 {
+            let mut new = vec![usize::MAX; nodes.len()];
+            let mut k = 0;
+            for (i, &u) in used.iter().enumerate() {
+                if u {
+                    new[i] = k;
+                    nodes[k] = nodes[i];
+                    node_tags[k] = node_tags[i];
+                    k += 1;
+                }
+            }
+            nodes.truncate(k);
+            node_tags.truncate(k);
+            for n in &mut cells {
+                *n = new[*n];
+            }
+            for g in acc.values_mut() {
+                for e in &mut g.edges {
+                    e.nodes = e.nodes.map(|n| new[n]);
+                    e.mid = e.mid.map(|n| new[n]);
+                }
+                // A point on a dropped node leaves its group.
+                let before = g.points.len();
+                g.points.retain(|&p| used[p]);
+                g.elements -= before - g.points.len();
+                for p in &mut g.points {
+                    *p = new[*p];
                 }
             }
         }
@@ -709,6 +846,8 @@ impl Builder {
                 binary,
                 reoriented,
                 boundary_elements,
+                unused_nodes,
+                interior_edges,
             },
         })
     }
@@ -743,6 +882,107 @@ fn corner_sign(a: [f64; 2], b: [f64; 2], a2: f64, b2: f64, sign: &mut i8) -> Opt
     }
     *sign = s;
     Some(())
+}
+
+/// Fem node index of the quad9 node at (ξ, η) = (a - 1, b - 1), `[a][b]`.
+const QUAD9_GRID: [[usize; 3]; 3] = [[0, 7, 3], [4, 8, 6], [1, 5, 2]];
+
+/// √(3/5), the abscissa of the 3-point Gauss rule the fem crate integrates with.
+const G: f64 = 0.774_596_669_241_483_4;
+
+/// The quadratic Lagrange basis on -1, 0, 1 (`[i][a]`: basis `a` at point
+/// `i`): derivatives at the nodes, values and derivatives at -G, 0, G.
+const D_NODE: [[f64; 3]; 3] = [[-1.5, 2.0, -0.5], [-0.5, 0.0, 0.5], [0.5, -2.0, 1.5]];
+const L_GAUSS: [[f64; 3]; 3] = [
+    [0.5 * G * (G + 1.0), 1.0 - G * G, 0.5 * G * (G - 1.0)],
+    [0.0, 1.0, 0.0],
+    [0.5 * G * (G - 1.0), 1.0 - G * G, 0.5 * G * (G + 1.0)],
+];
+const D_GAUSS: [[f64; 3]; 3] = [
+    [-G - 0.5, 2.0 * G, 0.5 - G],
+    [-0.5, 0.0, 0.5],
+    [G - 0.5, -2.0 * G, G + 0.5],
+];
+
+/// `w[0] v[0] + w[1] v[1] + w[2] v[2]`.
+#[inline(always)]
+fn comb(w: [f64; 3], v: [[f64; 2]; 3]) -> [f64; 2] {
+    [
+        w[0] * v[0][0] + w[1] * v[1][0] + w[2] * v[2][0],
+        w[0] * v[0][1] + w[1] * v[1][1] + w[2] * v[2][1],
+    ]
+}
+
+/// `det [a b] > 0`, false for NaN.
+#[inline(always)]
+fn positive(a: [f64; 2], b: [f64; 2]) -> bool {
+    a[0] * b[1] - a[1] * b[0] > 0.0
+}
+
+/// Whether the Jacobian determinant of a counter-clockwise quad9 is positive
+/// at its 9 nodes and 9 Gauss points. The corner test sees only the
+/// corners; a mid-side or centre node pulled across the cell inverts it
+/// inside.
+fn quad9_inside_positive(p: &[[f64; 2]; 9]) -> bool {
+    // Most cells of a Gmsh mesh are straight-sided (mid-side nodes at the
+    // sides' midpoints, the centre at the corners' mean): their map is the
+    // bilinear one, whose determinant is affine in ξ and in η and so
+    // positive inside once it is at the corners. The full check, five
+    // times dearer, is for curved cells only.
+    let mid = |a: [f64; 2], b: [f64; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+    let bilinear = [
+        mid(p[0], p[1]),
+        mid(p[1], p[2]),
+        mid(p[2], p[3]),
+        mid(p[3], p[0]),
+        mid(mid(p[0], p[2]), mid(p[1], p[3])),
+    ];
+    let mut dev = 0.0f64;
+    let mut size = 0.0f64;
+    for k in 0..5 {
+        let (q, b) = (p[4 + k], bilinear[k]);
+        dev = dev.max((q[0] - b[0]).abs()).max((q[1] - b[1]).abs());
+        let c = p[k % 4];
+        size = size.max((c[0] - p[0][0]).abs()).max((c[1] - p[0][1]).abs());
+    }
+    // Rounding of Gmsh's coordinates (ASCII %.16g) is far below this.
+    if dev <= 1e-12 * size {
+        return true;
+    }
+    // Relative to node 0 and scaled to O(1): no overflow at 1e200, no
+    // underflow at 1e-200, whatever the magnitude of the coordinates.
+    let o = p[0];
+    let m = p.iter().fold(0.0f64, |m, q| {
+        m.max((q[0] - o[0]).abs()).max((q[1] - o[1]).abs())
+    });
+    let s = if m > 0.0 && (1.0 / m).is_finite() {
+        1.0 / m
+    } else {
+        1.0
+    };
+    let x: [[[f64; 2]; 3]; 3] =
+        QUAD9_GRID.map(|row| row.map(|k| [(p[k][0] - o[0]) * s, (p[k][1] - o[1]) * s]));
+    let column = |v: &[[[f64; 2]; 3]; 3], j: usize| [v[0][j], v[1][j], v[2][j]];
+    // At the nodes the basis is the identity: one 3-term sum a derivative.
+    for (i, &di) in D_NODE.iter().enumerate() {
+        for (j, &dj) in D_NODE.iter().enumerate() {
+            if !positive(comb(di, column(&x, j)), comb(dj, x[i])) {
+                return false;
+            }
+        }
+    }
+    // At the Gauss points, values and η-derivatives along η first (sum
+    // factorization), then the ξ sums.
+    let along = |w: &[[f64; 3]; 3]| x.map(|row| w.map(|wj| comb(wj, row)));
+    let (pv, qv) = (along(&L_GAUSS), along(&D_GAUSS));
+    for (&li, &di) in L_GAUSS.iter().zip(&D_GAUSS) {
+        for j in 0..3 {
+            if !positive(comb(di, column(&pv, j)), comb(li, column(&qv, j))) {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// Reverses a cell's orientation keeping node 0: corners 0 3 2 1, and for
@@ -850,7 +1090,7 @@ mod tests {
             }
             let mut b = Builder::new("4.1", false);
             for (i, q) in p.iter().enumerate() {
-                b.push_node(i as u64 + 1, q[0], q[1], 0.0);
+                b.push_node(i as u64 + 1, q[0], q[1], 0.0, 0);
             }
             let cell: Vec<usize> = (0..n).collect();
             let got = b.orientation(&cell);

@@ -356,6 +356,7 @@ impl<'a> Cursor<'a> {
     fn section_what(&self) -> &'static str {
         match self.section {
             "$Nodes" => "the $Nodes section",
+            "$ParametricNodes" => "the $ParametricNodes section",
             "$Elements" => "the $Elements section",
             "$Entities" => "the $Entities section",
             "$PhysicalNames" => "the $PhysicalNames section",

@@ -81,7 +81,8 @@ fn fixtures_read_the_same_through_any_window() {
     for (name, bytes) in fixtures() {
         // The fixtures must be valid meshes except the refused ones.
         let ok = read(&bytes).is_ok();
-        assert_eq!(ok, !name.contains("tri") && !name.contains("q8"), "{name}");
+        let refused = ["tri", "q8", "part"].iter().any(|r| name.contains(r));
+        assert_eq!(ok, !refused, "{name}");
         check_same(&name, &bytes, true);
     }
 }

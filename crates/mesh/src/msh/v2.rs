@@ -11,13 +11,22 @@ use super::build::{nodes_of, unsupported, Builder, Membership};
 use super::cursor::{le_f64, le_i32, Cursor, Result};
 use crate::MeshErrorKind;
 
-pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
-    cur.enter("$Nodes", "$EndNodes");
+/// `$Nodes`, or `$ParametricNodes` (Mesh.SaveParametric = 1): each node
+/// then also has the dimension and tag of its geometric entity and, on a
+/// curve or surface, 1 or 2 parametric coordinates, which are skipped.
+pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder, parametric: bool) -> Result<()> {
+    if parametric {
+        cur.enter("$ParametricNodes", "$EndParametricNodes");
+    } else {
+        cur.enter("$Nodes", "$EndNodes");
+    }
     cur.skip_ws();
     let header = cur.pos();
     let n = cur.u64("the number of nodes")?;
     cur.counts("nodes", n);
-    if cur.binary {
+    if parametric {
+        parametric_nodes(cur, b, n)?;
+    } else if cur.binary {
         cur.end_of_line()?;
         let bytes = cur.check_items(n, 28)?;
         b.nodes.reserve(bytes / 28);
@@ -47,7 +56,7 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                         },
                     ));
                 }
-                b.push_node(tag, x, y, z);
+                b.push_node(tag, x, y, z, at);
             }
         }
     } else {
@@ -60,11 +69,89 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
             let x = cur.f64("a node coordinate")?;
             let y = cur.f64("a node coordinate")?;
             let z = cur.f64("a node coordinate")?;
-            b.push_node(tag, x, y, z);
+            b.push_node(tag, x, y, z, cur.pos());
         }
     }
     cur.expect_end()?;
     b.finish_nodes(cur, header)
+}
+
+/// The records of `$ParametricNodes`: `tag x y z dim entity [u [v]]`,
+/// binary as i32, 3 f64, 2 i32 and `dim` f64 (Gmsh writes parameters on
+/// curves and surfaces only). Records differ in length: read one by one.
+fn parametric_nodes(cur: &mut Cursor<'_>, b: &mut Builder, n: u64) -> Result<()> {
+    if cur.binary {
+        cur.end_of_line()?;
+        // At least tag, x, y, z, dim and entity: 36 bytes a node.
+        let cap = cur.check_items(n, 36)? / 36;
+        b.nodes.reserve(cap);
+        b.node_tags.reserve(cap);
+        for _ in 0..n {
+            let at = cur.pos();
+            let tag = cur.bin_i32()?;
+            let tag = u64::try_from(tag).map_err(|_| {
+                cur.error(
+                    at,
+                    MeshErrorKind::Malformed {
+                        what: format!("node tag {tag} is negative"),
+                    },
+                )
+            })?;
+            let xyz =
+                [cur.take::<8>()?, cur.take::<8>()?, cur.take::<8>()?].map(f64::from_le_bytes);
+            let [x, y, z] = xyz;
+            if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+                return Err(cur.error(
+                    at + 4,
+                    MeshErrorKind::NotANumber {
+                        what: "a node coordinate",
+                        found: format!("{x} {y} {z}"),
+                    },
+                ));
+            }
+            let dp = cur.pos();
+            let dim = cur.bin_i32()?;
+            cur.bin_i32()?;
+            cur.skip(8 * parameters(cur, dp, dim)?)?;
+            b.push_node(tag, x, y, z, at);
+        }
+    } else {
+        // A node line is at least "1 0 0 0 0 1\n".
+        let cap = cur.capped(n, 12);
+        b.nodes.reserve(cap);
+        b.node_tags.reserve(cap);
+        for _ in 0..n {
+            let tag = cur.u64("a node tag")?;
+            let x = cur.f64("a node coordinate")?;
+            let y = cur.f64("a node coordinate")?;
+            let z = cur.f64("a node coordinate")?;
+            let at = cur.pos();
+            cur.skip_ws();
+            let dp = cur.pos();
+            let dim = cur.i32("the dimension of a node's geometric entity")?;
+            cur.i32("the tag of a node's geometric entity")?;
+            for _ in 0..parameters(cur, dp, dim)? {
+                cur.f64("a parametric node coordinate")?;
+            }
+            b.push_node(tag, x, y, z, at);
+        }
+    }
+    Ok(())
+}
+
+/// How many parametric coordinates a node on an entity of dimension `dim`
+/// has in MSH 2.2 (Gmsh writes u on curves, u v on surfaces).
+fn parameters(cur: &Cursor<'_>, pos: usize, dim: i32) -> Result<usize> {
+    match dim {
+        0 | 3 => Ok(0),
+        1 | 2 => Ok(dim as usize),
+        _ => Err(cur.error(
+            pos,
+            MeshErrorKind::Malformed {
+                what: format!("a parametric node's entity dimension is {dim}, not 0 to 3"),
+            },
+        )),
+    }
 }
 
 /// Physical tag → membership id, without a Vec per element.

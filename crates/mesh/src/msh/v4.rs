@@ -151,7 +151,9 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                 let (start, k) = cur.batch(left, 8)?;
                 left -= k as u64;
                 let tags = cur.records(start, 8 * k);
-                b.node_tags.extend(tags.chunks_exact(8).map(le_u64));
+                for (j, t) in tags.chunks_exact(8).enumerate() {
+                    b.push_tag(le_u64(t), start + 8 * j);
+                }
             }
             let size = 8 * (3 + extra);
             cur.check_items(n, size)?;
@@ -172,24 +174,25 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                         ));
                     }
                     let tag = b.node_tags.get(i).copied().unwrap_or(0);
-                    b.push_xyz(x, y, z, tag);
+                    b.push_xyz(x, y, z, tag, start + size * j);
                     i += 1;
                 }
             }
         } else {
             for _ in 0..n {
                 let t = cur.u64("a node tag")?;
-                b.node_tags.push(t);
+                b.push_tag(t, cur.pos());
             }
             for i in 0..n as usize {
                 let x = cur.f64("a node coordinate")?;
                 let y = cur.f64("a node coordinate")?;
                 let z = cur.f64("a node coordinate")?;
+                let at = cur.pos();
                 for _ in 0..extra {
                     cur.f64("a parametric node coordinate")?;
                 }
                 let tag = b.node_tags.get(first + i).copied().unwrap_or(0);
-                b.push_xyz(x, y, z, tag);
+                b.push_xyz(x, y, z, tag, at);
             }
         }
     }
