@@ -249,6 +249,14 @@ fn check_group(
     problems: &mut Vec<String>,
 ) -> bool {
     match mesh.group(name) {
+        Err(e) if matches!(e.kind, stickslip_mesh::MeshErrorKind::AmbiguousGroup { .. }) => {
+            problems.push(format!(
+                "{}{key} = {name:?}: in {}: {e}",
+                case.at(key),
+                case.mesh.file.display()
+            ));
+            false
+        }
         Err(_) => {
             let have: Vec<String> = mesh
                 .groups
@@ -275,6 +283,19 @@ fn check_group(
                      but {name:?} has dimension {}; name the boundary edges in Gmsh with a Physical Curve",
                     case.at(key),
                     g.dim
+                ));
+                false
+            }
+            // A line inside the body (Gmsh's `Line{..} In Surface{..}`):
+            // a load or friction there would act inside the body.
+            Some(_) if mesh.interior_edges(g) > 0 => {
+                problems.push(format!(
+                    "{}{key} = {name:?}: {purpose} must be on the boundary, but {} of the group's {} edges \
+                     lie inside the body (each a side of two cells, as an embedded curve's are); name the \
+                     boundary edges instead",
+                    case.at(key),
+                    mesh.interior_edges(g),
+                    g.edges.len()
                 ));
                 false
             }

@@ -1124,3 +1124,39 @@ fn probe_refuses_along_options_with_at() {
         assert!(stderr(&o).contains("go with --along"), "{}", stderr(&o));
     }
 }
+
+/// A load or friction on a line inside the body (Gmsh's embedded curve)
+/// and a group name two groups share are refused with the group named
+/// (before: accepted, and the first of the two groups taken).
+#[test]
+fn interior_lines_and_shared_group_names_are_refused() {
+    let dir = scratch("interior");
+    let msh = std::fs::read_to_string(
+        root().join("crates/mesh/tests/data/slab_q4_embedded_v41_ascii.msh"),
+    )
+    .unwrap();
+    let embedded = dir.join("embedded.msh");
+    std::fs::write(&embedded, &msh).unwrap();
+    let on = |mesh: &Path, t: String| {
+        t.replace(
+            &root()
+                .join("cases/meshes/slab-q2-8x2.msh")
+                .display()
+                .to_string(),
+            &mesh.display().to_string(),
+        )
+    };
+    let (case, _) = slab_case(&dir, "crack", |t| {
+        on(&embedded, t).replace("group = \"load\"", "group = \"crack\"")
+    });
+    refused(
+        &case,
+        &[],
+        &["traction.0.group = \"crack\"", "must be on the boundary"],
+    );
+
+    let shared = dir.join("shared.msh");
+    std::fs::write(&shared, msh.replace("1 5 \"crack\"", "1 5 \"support\"")).unwrap();
+    let (case, _) = slab_case(&dir, "shared", |t| on(&shared, t));
+    refused(&case, &[], &["several physical groups called \"support\""]);
+}
