@@ -29,12 +29,14 @@ How
 
     python3 examples/02-sliding-block/run.py --out /tmp/block
 
-The stickslip binary is $STICKSLIP_BIN, else `cargo run -q -p stickslip --`.
+The stickslip binary is $STICKSLIP_BIN, else `stickslip` on PATH, else
+`cargo run` in this checkout.
 """
 
 import argparse
 import os
 import shlex
+import shutil
 import subprocess
 import sys
 
@@ -42,9 +44,31 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def stickslip():
-    """The command that runs stickslip: $STICKSLIP_BIN, else cargo run."""
+    """The command that runs stickslip: $STICKSLIP_BIN, else `stickslip` on
+    PATH, else `cargo run` in this checkout (whatever the current directory)."""
     exe = os.environ.get("STICKSLIP_BIN")
-    return shlex.split(exe) if exe else ["cargo", "run", "-q", "-p", "stickslip", "--"]
+    if exe:
+        return shlex.split(exe)
+    if shutil.which("stickslip"):
+        return ["stickslip"]
+    manifest = os.path.join(HERE, "..", "..", "Cargo.toml")
+    if shutil.which("cargo") and os.path.exists(manifest):
+        return ["cargo", "run", "-q", "--manifest-path", manifest, "-p", "stickslip", "--"]
+    sys.exit(
+        "stickslip not found: build it (cargo build --release -p stickslip in the checkout) "
+        "and put it on PATH, or set STICKSLIP_BIN to its path"
+    )
+
+
+def run_stickslip(args):
+    """Runs stickslip; its own message says what went wrong, so no traceback."""
+    cmd = stickslip() + args
+    try:
+        done = subprocess.run(cmd)
+    except OSError as e:
+        sys.exit(f"cannot start {cmd[0]}: {e}; set STICKSLIP_BIN to the stickslip binary")
+    if done.returncode != 0:
+        sys.exit(f"stickslip exited with {done.returncode} (its message is above)")
 
 
 def mesh(geo, msh, order, params):
@@ -80,7 +104,7 @@ def main():
 
     # 2. Run.
     h5 = os.path.join(args.out, "block.h5")
-    subprocess.run(stickslip() + ["run", case, "-o", h5, "--force", "--quiet"], check=True)
+    run_stickslip(["run", case, "-o", h5, "--force", "--quiet"])
 
     # 3. Read.
     import h5py

@@ -20,7 +20,8 @@ const USAGE: &str = "\
 usage: cargo xtask <command> [args]
 
   demo              install what is missing (HDF5), build, and run the paper's
-                    slab (central difference, eps = 1e-4) into target/demo/slab.h5
+                    slab (central difference, eps = 1e-4) into target/demo/slab.h5;
+                    more arguments go to `stickslip run` (-o OUT.h5, --set K=V)
   test              install what is missing (HDF5, Python modules), then run the whole
                     test suite (what .ci/run and CI run)
   setup             only install what is missing: libhdf5-dev, and h5py, numpy,
@@ -77,7 +78,10 @@ fn main() -> ExitCode {
             print!("{USAGE}");
             Ok(())
         }
-        other => Err(format!("unknown command {other:?}\n{USAGE}")),
+        other => {
+            eprintln!("xtask: unknown command {other:?}\n{USAGE}");
+            return ExitCode::from(2);
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -206,14 +210,32 @@ fn is_root() -> bool {
 
 /// The main job: the paper's slab under a step load, central difference.
 fn demo(root: &Path, rest: &[String]) -> Result<(), String> {
+    if rest.iter().any(|a| a == "-h" || a == "--help") {
+        print!("{USAGE}");
+        return Ok(());
+    }
     setup(false)?;
     let case = root.join("cases/martins-oden/cd-step-eps1e-4.toml");
-    let out = root.join("target/demo/slab.h5");
-    std::fs::create_dir_all(out.parent().expect("has parent")).map_err(|e| e.to_string())?;
+    // `-o OUT.h5` (or --output) among the arguments replaces the default.
+    let given = rest
+        .iter()
+        .position(|a| a == "-o" || a == "--output")
+        .and_then(|i| rest.get(i + 1))
+        .map(|o| root.join(o));
+    let out = given
+        .clone()
+        .unwrap_or_else(|| root.join("target/demo/slab.h5"));
+    if let Some(dir) = out.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
     let mut cmd = cargo();
     cmd.current_dir(root)
         .args(["run", "--quiet", "-p", "stickslip", "--", "run"]);
-    cmd.arg(&case).arg("-o").arg(&out).arg("--force").args(rest);
+    cmd.arg(&case);
+    if given.is_none() {
+        cmd.arg("-o").arg(&out).arg("--force");
+    }
+    cmd.args(rest);
     run(&mut cmd)?;
     eprintln!("demo: results in {}", out.display());
     eprintln!(
