@@ -288,3 +288,38 @@ fn advise_never_writes_over_a_file() {
     assert!(err.contains("the file exists"), "{err}");
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "mine");
 }
+
+/// A ladder of two bodies, and a probe point off the body, are bad input
+/// (before: 21 pilots, then "add finer meshes"; and a silent snap to the
+/// nearest node).
+#[test]
+fn advise_refuses_a_ladder_of_two_bodies_and_a_point_off_the_body() {
+    let dir = std::env::temp_dir().join(format!("stickslip-advise-bodies-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let meshes = root().join("cases/meshes");
+    let text = std::fs::read_to_string(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
+        .unwrap()
+        .replace("\"../meshes/", &format!("\"{}/", meshes.display()));
+    let case = dir.join("case.toml");
+    std::fs::write(&case, &text).unwrap();
+    let advise = |case: &Path, at: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
+            .arg("advise")
+            .arg(case)
+            .args(["--tol", "2e-2", "--on", "ux", "--at", at])
+            .output()
+            .unwrap()
+    };
+    let o = advise(&case, "100,100");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("lies outside the mesh"), "{err}");
+
+    let bodies = dir.join("bodies.toml");
+    std::fs::write(&bodies, text.replace("slab-q2-16x4.msh", "hole-q1.msh")).unwrap();
+    let o = advise(&bodies, "8,1");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("a ladder is one geometry"), "{err}");
+    assert!(!err.contains("pilot"), "refused before any pilot: {err}");
+}
