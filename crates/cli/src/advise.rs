@@ -1679,14 +1679,15 @@ mod tests {
             measured_h: true,
             run: false,
         };
+        // Times more than TIE apart: the cheapest that meets the tolerance.
         let all = vec![
             cand(1.0, 0.5),
             cand(2.0, 0.05),
-            cand(3.0, 0.01),
+            cand(3.5, 0.01),
             cand(0.5, f64::NAN),
         ];
         assert_eq!(pick(&all, 0.1).unwrap().predicted_time, 2.0);
-        assert_eq!(pick(&all, 0.02).unwrap().predicted_time, 3.0);
+        assert_eq!(pick(&all, 0.02).unwrap().predicted_time, 3.5);
         assert!(pick(&all, 1e-3).is_none());
         // Within TIE of the cheapest, the most accurate: 1.4 s over 1.0 s
         // (0.05 against 0.09); 1.6 s is past 1.5 × 1.0 s.
