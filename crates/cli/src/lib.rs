@@ -1,7 +1,8 @@
 //! The `stickslip` command's library: case files ([`case`]), the HDF5
 //! results and checkpoints ([`output`]), runs and checks ([`run`]), the
-//! `mesh` report ([`mesh_cmd`]), the `probe` reader ([`probe`]) and the
-//! `advise` command ([`advise`]: the cheapest configuration for a tolerance).
+//! `mesh` report ([`mesh_cmd`]), the `probe` reader ([`probe`]), the
+//! results file's protection ([`results_file`]) and the `advise` command
+//! ([`advise`]: the cheapest configuration for a tolerance).
 //!
 //! This crate owns everything that touches files other than meshes and the
 //! terminal; the numerics live in the library crates below it. It is a
@@ -17,5 +18,6 @@ pub mod error;
 pub mod mesh_cmd;
 pub mod output;
 pub mod probe;
+pub mod results_file;
 pub mod run;
 pub mod xdmf;

@@ -174,11 +174,11 @@ fn main() -> ExitCode {
                 None => output.unwrap_or_else(|| case.output.file.clone()),
             };
             if restart.is_none() {
-                if let Err(e) = run::check_output(&out, &case_path, force) {
+                if let Err(e) = stickslip::results_file::check_output(&out, &case_path, force) {
                     report(&e.0);
                     return ExitCode::from(2);
                 }
-            } else if run::in_use(&out) {
+            } else if stickslip::results_file::in_use(&out) {
                 report(&format!(
                     "--restart {}: the file is open in another process (a run still writing it, \
                      or a reader such as h5py or ParaView); wait for it or close it",

@@ -100,7 +100,7 @@ fn parse_point(at: &str) -> Result<[f64; 2], InputError> {
 /// but its datasets may be caught between two records.
 fn open_results(file: &Path) -> Result<File, InputError> {
     let name = file.display();
-    if crate::run::being_written(file) {
+    if crate::results_file::being_written(file) {
         return Err(InputError(format!(
             "{name}: a run is still writing it; wait for the run to end (or stop it: Ctrl-C \
              keeps every step) and probe it then"
