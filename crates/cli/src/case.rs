@@ -1185,6 +1185,22 @@ fn convert(
             format!("newmark with beta = {beta}, gamma = {gamma} is not unconditionally stable (needs 2*beta >= gamma >= 0.5); use e.g. beta = 0.25, gamma = 0.5 (trapezoidal) or beta = 0.3025, gamma = 0.6 (damped)"),
         );
     }
+    if scheme == Scheme::CentralDifference {
+        // Newmark's parameters on an explicit run would be ignored
+        // silently: say so (a Newmark case switched by --set keeps them).
+        for (key, v) in [("beta", &tm.beta), ("gamma", &tm.gamma)] {
+            if let Some(v) = v {
+                check(
+                    false,
+                    v.span(),
+                    format!(
+                        "time.{key} is a Newmark parameter; scheme = \"central_difference\" has none: \
+                         remove it, or use scheme = \"newmark\""
+                    ),
+                );
+            }
+        }
+    }
     if let (Scheme::CentralDifference, Some(m)) = (scheme, &tm.mass) {
         check(
             *m.get_ref() == MassKind::Lumped,
@@ -1801,6 +1817,11 @@ t_end = 0.5
             e.contains(&format!("case.toml:{}:", line_of(&text, "history ="))),
             "{e}"
         );
+        // Newmark's parameters on a central-difference run were ignored.
+        let text = GOOD.replace("dt = 1e-3", "dt = 1e-3\nbeta = 0.3");
+        let e = load_text("cd-beta", &text, &[]).unwrap_err().0;
+        assert!(e.contains("time.beta is a Newmark parameter"), "{e}");
+        assert!(e.contains(&format!("case.toml:{}:", line_of(&text, "beta ="))), "{e}");
         // No --set to blame in an empty file.
         let e = load_text("empty", "", &[]).unwrap_err().0;
         assert!(e.contains("case.toml: missing field `mesh`"), "{e}");
