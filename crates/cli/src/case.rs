@@ -1801,7 +1801,7 @@ t_end = 0.5
     }
 
     #[test]
-    fn table_rows_are_pairs_and_an_empty_file_names_itself() {
+    fn table_rows_cd_parameters_and_an_empty_file_are_reported_where_they_are() {
         let with = |rows: &str| {
             GOOD.replace(
                 "t = [-150.0, 0.0]   # compressive",
