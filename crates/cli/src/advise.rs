@@ -773,10 +773,7 @@ pub fn read_ladder(
         match &first {
             None => {
                 if let Some(p) = at {
-                    let off = (0..2)
-                        .map(|k| (b[0][k] - p[k]).max(p[k] - b[1][k]).max(0.0))
-                        .fold(0.0_f64, f64::hypot);
-                    if off > 0.01 * size {
+                    if crate::probe::off_the_body(b, p) {
                         return Err(input(format!(
                             "--at {},{}: the point lies outside the mesh ({}); give a point on the body",
                             p[0],

@@ -1821,7 +1821,10 @@ t_end = 0.5
         let text = GOOD.replace("dt = 1e-3", "dt = 1e-3\nbeta = 0.3");
         let e = load_text("cd-beta", &text, &[]).unwrap_err().0;
         assert!(e.contains("time.beta is a Newmark parameter"), "{e}");
-        assert!(e.contains(&format!("case.toml:{}:", line_of(&text, "beta ="))), "{e}");
+        assert!(
+            e.contains(&format!("case.toml:{}:", line_of(&text, "beta ="))),
+            "{e}"
+        );
         // No --set to blame in an empty file.
         let e = load_text("empty", "", &[]).unwrap_err().0;
         assert!(e.contains("case.toml: missing field `mesh`"), "{e}");

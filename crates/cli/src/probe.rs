@@ -95,6 +95,17 @@ fn parse_point(at: &str) -> Result<[f64; 2], InputError> {
     Ok([x, y])
 }
 
+/// Whether `p` lies outside the box `b` ([min, max]) by more than a
+/// hundredth of its diagonal: likely a mistyped point, not a node's
+/// rounding.
+pub(crate) fn off_the_body(b: [[f64; 2]; 2], p: [f64; 2]) -> bool {
+    let size = (b[1][0] - b[0][0]).hypot(b[1][1] - b[0][1]);
+    let off = (0..2)
+        .map(|k| (b[0][k] - p[k]).max(p[k] - b[1][k]).max(0.0))
+        .fold(0.0_f64, f64::hypot);
+    off > 0.01 * size
+}
+
 /// Opens a results file that no run is writing: with HDF5's locking off
 /// (HDF5_USE_FILE_LOCKING=FALSE, as `cargo run` sets it) the file opens,
 /// but its datasets may be caught between two records.
@@ -219,11 +230,7 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
             hi[k] = hi[k].max(row[k]);
         }
     }
-    let size = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
-    let off = (0..2)
-        .map(|k| (lo[k] - p[k]).max(p[k] - hi[k]).max(0.0))
-        .fold(0.0_f64, f64::hypot);
-    if off > 0.01 * size {
+    if off_the_body([lo, hi], p) {
         let _ = write!(
             info,
             "; note: ({}, {}) lies outside the mesh (x in [{}, {}], y in [{}, {}])",
