@@ -38,24 +38,9 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder, parametric: bool) -> 
             let cur = &*cur;
             for (i, rec) in cur.records(start, 28 * k).chunks_exact(28).enumerate() {
                 let at = start + 28 * i;
-                let tag = u64::try_from(le_i32(rec)).map_err(|_| {
-                    cur.error(
-                        at,
-                        MeshErrorKind::Malformed {
-                            what: format!("node tag {} is negative", le_i32(rec)),
-                        },
-                    )
-                })?;
-                let (x, y, z) = (le_f64(&rec[4..]), le_f64(&rec[12..]), le_f64(&rec[20..]));
-                if !(x.is_finite() && y.is_finite() && z.is_finite()) {
-                    return Err(cur.error(
-                        at + 4,
-                        MeshErrorKind::NotANumber {
-                            what: "a node coordinate",
-                            found: format!("{x} {y} {z}"),
-                        },
-                    ));
-                }
+                let tag = binary_tag(cur, at, le_i32(rec))?;
+                let xyz = [le_f64(&rec[4..]), le_f64(&rec[12..]), le_f64(&rec[20..])];
+                let [x, y, z] = finite_xyz(cur, at + 4, xyz)?;
                 b.push_node(tag, x, y, z, at);
             }
         }
@@ -76,6 +61,33 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder, parametric: bool) -> 
     b.finish_nodes(cur, header)
 }
 
+/// A binary node record's tag, which must not be negative (at byte `at`).
+fn binary_tag(cur: &Cursor<'_>, at: usize, raw: i32) -> Result<u64> {
+    u64::try_from(raw).map_err(|_| {
+        cur.error(
+            at,
+            MeshErrorKind::Malformed {
+                what: format!("node tag {raw} is negative"),
+            },
+        )
+    })
+}
+
+/// A binary node record's coordinates, which must be finite (at byte `at`).
+fn finite_xyz(cur: &Cursor<'_>, at: usize, xyz: [f64; 3]) -> Result<[f64; 3]> {
+    if xyz.iter().all(|v| v.is_finite()) {
+        return Ok(xyz);
+    }
+    let [x, y, z] = xyz;
+    Err(cur.error(
+        at,
+        MeshErrorKind::NotANumber {
+            what: "a node coordinate",
+            found: format!("{x} {y} {z}"),
+        },
+    ))
+}
+
 /// The records of `$ParametricNodes`: `tag x y z dim entity [u [v]]`,
 /// binary as i32, 3 f64, 2 i32 and `dim` f64 (Gmsh writes parameters on
 /// curves and surfaces only). Records differ in length: read one by one.
@@ -88,27 +100,11 @@ fn parametric_nodes(cur: &mut Cursor<'_>, b: &mut Builder, n: u64) -> Result<()>
         b.node_tags.reserve(cap);
         for _ in 0..n {
             let at = cur.pos();
-            let tag = cur.bin_i32()?;
-            let tag = u64::try_from(tag).map_err(|_| {
-                cur.error(
-                    at,
-                    MeshErrorKind::Malformed {
-                        what: format!("node tag {tag} is negative"),
-                    },
-                )
-            })?;
+            let raw = cur.bin_i32()?;
+            let tag = binary_tag(cur, at, raw)?;
             let xyz =
                 [cur.take::<8>()?, cur.take::<8>()?, cur.take::<8>()?].map(f64::from_le_bytes);
-            let [x, y, z] = xyz;
-            if !(x.is_finite() && y.is_finite() && z.is_finite()) {
-                return Err(cur.error(
-                    at + 4,
-                    MeshErrorKind::NotANumber {
-                        what: "a node coordinate",
-                        found: format!("{x} {y} {z}"),
-                    },
-                ));
-            }
+            let [x, y, z] = finite_xyz(cur, at + 4, xyz)?;
             let dp = cur.pos();
             let dim = cur.bin_i32()?;
             cur.bin_i32()?;
