@@ -17,7 +17,7 @@
 //! quad9 as in `stickslip_mesh::GMSH_TO_FEM_QUAD9` are XDMF's (and VTK's)
 //! `Quadrilateral` and `Quadrilateral_9` orders.
 
-use std::fmt::Write as _;
+use std::io::Write;
 use std::path::Path;
 
 use stickslip_mesh::CellKind;
@@ -57,6 +57,14 @@ fn xml_escape(s: &str) -> String {
 /// The XML text for the results file named `h5_name` (a file name, no
 /// directory).
 pub fn xdmf_text(h5_name: &str, info: &XdmfInfo) -> String {
+    let mut x = Vec::with_capacity(1024 + info.times.len() * 1600);
+    write_xml(&mut x, h5_name, info).expect("writing to memory");
+    String::from_utf8(x).expect("the XML is UTF-8")
+}
+
+/// [`xdmf_text`] into `x`, grid by grid: a run of a million records has a
+/// text of about 1.8 GB, which is never held whole.
+fn write_xml(x: &mut impl Write, h5_name: &str, info: &XdmfInfo) -> std::io::Result<()> {
     let h5 = xml_escape(h5_name);
     let (n, n_out, n_cells) = (info.n_nodes, info.times.len(), info.n_cells);
     let npc = info.kind.nodes_per_cell();
@@ -64,21 +72,20 @@ pub fn xdmf_text(h5_name: &str, info: &XdmfInfo) -> String {
         CellKind::Quad4 => "Quadrilateral",
         CellKind::Quad9 => "Quadrilateral_9",
     };
-    let mut x = String::with_capacity(1024 + n_out * 1600);
-    x.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
-    x.push_str("<Xdmf Version=\"3.0\">\n");
-    x.push_str("  <Domain>\n");
-    x.push_str(
-        "    <Grid Name=\"stickslip\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
-    );
+    x.write_all(b"<?xml version=\"1.0\" encoding=\"utf-8\"?>\n")?;
+    x.write_all(b"<Xdmf Version=\"3.0\">\n")?;
+    x.write_all(b"  <Domain>\n")?;
+    x.write_all(
+        b"    <Grid Name=\"stickslip\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
+    )?;
     for (k, t) in info.times.iter().enumerate() {
         // `{:e}` is Rust's shortest round-trip form: the time read back is
         // the f64 in /time, bit for bit.
-        let _ = write!(
+        write!(
             x,
             "      <Grid Name=\"step {k}\" GridType=\"Uniform\">\n        <Time Value=\"{t:e}\"/>\n"
-        );
-        let _ = write!(
+        )?;
+        write!(
             x,
             "        <Topology TopologyType=\"{topology}\" NumberOfElements=\"{n_cells}\" NodesPerElement=\"{npc}\">\n\
           \x20         <DataItem Dimensions=\"{n_cells} {npc}\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">{h5}:/mesh/cells</DataItem>\n\
@@ -86,9 +93,9 @@ pub fn xdmf_text(h5_name: &str, info: &XdmfInfo) -> String {
           \x20       <Geometry GeometryType=\"XY\">\n\
           \x20         <DataItem Dimensions=\"{n} 2\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:/mesh/nodes</DataItem>\n\
           \x20       </Geometry>\n"
-        );
+        )?;
         for name in VECTORS {
-            let _ = write!(
+            write!(
                 x,
                 "        <Attribute Name=\"{name}\" AttributeType=\"Vector\" Center=\"Node\">\n\
               \x20         <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 {n} 2\" Type=\"HyperSlab\">\n\
@@ -96,12 +103,11 @@ pub fn xdmf_text(h5_name: &str, info: &XdmfInfo) -> String {
               \x20           <DataItem Dimensions=\"{n_out} {n} 2\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:/{name}</DataItem>\n\
               \x20         </DataItem>\n\
               \x20       </Attribute>\n"
-            );
+            )?;
         }
-        x.push_str("      </Grid>\n");
+        x.write_all(b"      </Grid>\n")?;
     }
-    x.push_str("    </Grid>\n  </Domain>\n</Xdmf>\n");
-    x
+    x.write_all(b"    </Grid>\n  </Domain>\n</Xdmf>\n")
 }
 
 /// Writes `xdmf_path`, pointing into `h5_path` by its file name only (the
@@ -125,7 +131,13 @@ pub fn write_xdmf(h5_path: &Path, xdmf_path: &Path, info: &XdmfInfo) -> std::io:
                 ),
             )
         })?;
-    std::fs::write(xdmf_path, xdmf_text(name, info))
+    // Written beside and renamed over: a reader (or a kill -9 mid-write)
+    // never meets half a file.
+    let tmp = xdmf_path.with_extension("xdmf.part");
+    let mut w = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+    write_xml(&mut w, name, info)?;
+    w.into_inner().map_err(|e| e.into_error())?;
+    std::fs::rename(&tmp, xdmf_path)
 }
 
 #[cfg(test)]
