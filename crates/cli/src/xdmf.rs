@@ -183,6 +183,25 @@ mod tests {
     }
 
     #[test]
+    fn the_file_is_the_text_and_no_part_is_left() {
+        let dir = std::env::temp_dir().join(format!("stickslip-xdmf-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let info = XdmfInfo {
+            n_nodes: 85,
+            kind: CellKind::Quad9,
+            n_cells: 16,
+            times: &[0.0, 0.25, 0.5],
+        };
+        let path = dir.join("slab.xdmf");
+        write_xdmf(&dir.join("slab.h5"), &path, &info).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            xdmf_text("slab.h5", &info)
+        );
+        assert!(!dir.join("slab.xdmf.part").exists());
+    }
+
+    #[test]
     fn quad4_topology_and_escaped_file_name() {
         let x = xdmf_text(
             "a&b<c>.h5",
