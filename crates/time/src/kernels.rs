@@ -31,7 +31,7 @@
 //! Work is split into fixed chunks of [`CHUNK`] DOFs whatever the number of
 //! threads, and sums are formed per chunk and added in chunk order, so a
 //! run is bit-identical on one thread and on many. Below [`PARALLEL_MIN`]
-//! chunks the passes run on the calling thread (a rayon dispatch costs
+//! whole chunks the passes run on the calling thread (a rayon dispatch costs
 //! microseconds, more than a pass over the paper's 148 free DOFs). Within
 //! a chunk the sweep forms K r_K for [`BATCH`] rows at a time into a buffer
 //! and then runs the per-row work in loops over the batch (the divisions
@@ -176,7 +176,11 @@ pub use crate::stencils::Stencils;
 
 /// DOFs per chunk of work.
 pub const CHUNK: usize = 8192;
-/// Chunks from which the passes go parallel.
+/// Whole chunks from which the passes go parallel: a partial second
+/// chunk leaves the other thread little to do for its wake-up and join
+/// (bench_step, 2026-11-25, 2 threads against 1: 8,352 DOFs, a chunk and
+/// 160 rows, 59 against 47 µs a step; through the cli 10,150 DOFs 94
+/// against 63 µs; 16,425 DOFs, two whole chunks, 57 against 69 µs).
 pub const PARALLEL_MIN: usize = 2;
 /// Rows per batch of the one-sweep step ([`Compact::chunk_batches`]).
 /// Small enough that the product's arithmetic and the vectors' memory
@@ -195,7 +199,7 @@ pub fn chunks(n: usize) -> usize {
 
 /// True when the passes should use the thread pool.
 fn parallel(n: usize) -> bool {
-    chunks(n) >= PARALLEL_MIN && rayon::current_num_threads() > 1
+    n / CHUNK >= PARALLEL_MIN && rayon::current_num_threads() > 1
 }
 
 /// Runs `body(c, chunk)` over the CHUNK-sized chunks of `y`, on the pool

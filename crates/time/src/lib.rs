@@ -40,5 +40,6 @@ pub use integrator::{
     Checkpoint, Dynamics, Energy, ExplicitFriction, Integrator, Load, MassKind, Scheme, Settings,
     StepInfo, StickReduction, TimeError,
 };
+pub use kernels::{CHUNK, PARALLEL_MIN};
 pub use modal::MODAL_MAX_DOFS;
 pub use schur::ImplicitSolver;

@@ -1151,7 +1151,7 @@ mod tests {
         let rect = |kind, nx, ny| rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
         let meshes = [
             ("q1 128x32", rect(CellKind::Quad4, 128, 32), "top"),
-            ("q2 64x16", rect(CellKind::Quad9, 64, 16), "top"),
+            ("q2 96x24", rect(CellKind::Quad9, 96, 24), "top"),
             ("q1 200x50", rect(CellKind::Quad4, 200, 50), "top"),
             (
                 "slab-q1-128x32.msh",
@@ -1246,9 +1246,10 @@ mod tests {
         }
     }
 
-    /// Q1 and Q2 slabs of several chunks numbered row by row, and Gmsh's
-    /// Q1 slab, whose nodes with one free DOF make one-row groups: name,
-    /// mesh, the group held.
+    /// Q1 and Q2 slabs of several chunks numbered row by row (at least
+    /// [`kernels::PARALLEL_MIN`] whole ones, so that two threads share
+    /// them), and Gmsh's Q1 slab, whose nodes with one free DOF make
+    /// one-row groups: name, mesh, the group held.
     fn sweep_meshes() -> [(&'static str, Mesh, &'static str); 3] {
         use stickslip_fem::testing::rectangle;
         use stickslip_mesh::CellKind;
@@ -1256,7 +1257,7 @@ mod tests {
         let rect = |kind, nx, ny| rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
         [
             ("q1 200x50", rect(CellKind::Quad4, 200, 50), "top"),
-            ("q2 64x16", rect(CellKind::Quad9, 64, 16), "top"),
+            ("q2 96x24", rect(CellKind::Quad9, 96, 24), "top"),
             (
                 "slab-q1-128x32.msh",
                 Mesh::from_file(dir.join("slab-q1-128x32.msh")).unwrap(),

@@ -11,7 +11,7 @@ use common::*;
 use stickslip_fem::testing::on_threads;
 use stickslip_fem::{ElementClasses, Hypothesis, Material};
 use stickslip_time::scenes::{E, NU};
-use stickslip_time::{Dynamics, History, Integrator, Scheme, Settings};
+use stickslip_time::{Dynamics, History, Integrator, Scheme, Settings, CHUNK, PARALLEL_MIN};
 
 /// K·x by: the assembled K, element classes, stencil types.
 #[derive(Clone, Copy, PartialEq)]
@@ -59,13 +59,12 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
 
 /// The run by `by` within 1e-10 of the assembled one, and the same bits
 /// on one thread and two.
-fn follows_the_assembled_run(mesh: &str, by: By) {
-    // > 8192 free DOFs: several chunks, the friction's rows formed alone.
-    let s = paper_slab(mesh, 1e-4, History::Step);
-    assert!(s.model.dofs.n_free() > 8192);
+fn follows_the_assembled_run(s: &Slab, by: By) {
+    // Several chunks: the friction's rows formed alone.
+    assert!(s.model.dofs.n_free() > CHUNK);
     let steps = 400;
-    let plain = run(&s, By::Assembled, 2, steps);
-    let with = run(&s, by, 2, steps);
+    let plain = run(s, By::Assembled, 2, steps);
+    let with = run(s, by, 2, steps);
     for (name, a, b) in [
         ("r", plain.displacement(), with.displacement()),
         ("ṙ", plain.velocity(), with.velocity()),
@@ -86,7 +85,7 @@ fn follows_the_assembled_run(mesh: &str, by: By) {
     }
     assert!(with.classes().iter().any(|c| !c.is_stuck()) || e1.dissipated > 0.0);
     // Bit-identical on one thread and two.
-    let one = run(&s, by, 1, steps);
+    let one = run(s, by, 1, steps);
     assert_eq!(one.displacement(), with.displacement());
     assert_eq!(one.velocity(), with.velocity());
     assert_eq!(one.acceleration(), with.acceleration());
@@ -95,13 +94,33 @@ fn follows_the_assembled_run(mesh: &str, by: By) {
 
 #[test]
 fn classes_follow_the_assembled_run() {
-    // Gmsh's numbering (boundary nodes first): no stencil types, classes.
-    follows_the_assembled_run("slab-q2-64x16.msh", By::Classes);
+    // Gmsh's numbering (boundary nodes first), where stencil types would
+    // not apply, in its own test: the committed 8,352-DOF slab is one whole
+    // chunk, so it runs on one thread.
+    follows_the_assembled_run(
+        &paper_slab("slab-q2-64x16.msh", 1e-4, History::Step),
+        By::Classes,
+    );
+    follows_the_assembled_run(&threaded_slab(96, 24, true), By::Classes);
+}
+
+/// The paper's slab on a generated structured mesh of nx × ny cells, of at
+/// least PARALLEL_MIN whole chunks, so that two threads share the passes.
+fn threaded_slab(nx: usize, ny: usize, q2: bool) -> Slab {
+    let s = slab(nx, ny, q2);
+    assert!(s.model.dofs.n_free() / CHUNK >= PARALLEL_MIN, "{nx}x{ny}");
+    s
+}
+
+/// The paper's slab on a generated structured mesh of nx × ny cells.
+fn slab(nx: usize, ny: usize, q2: bool) -> Slab {
+    let mesh = stickslip_time::scenes::structured_slab(nx, ny, q2);
+    Slab::paper(mesh, 1e-4, History::Step, true).unwrap()
 }
 
 #[test]
 fn stencils_follow_the_assembled_run() {
-    follows_the_assembled_run("slab-q1-128x32.msh", By::Stencils);
+    follows_the_assembled_run(&threaded_slab(192, 48, false), By::Stencils);
 }
 
 /// Newmark on structured slabs too large for the block copy of K and M

@@ -12,7 +12,8 @@ use common::*;
 use stickslip_fem::{ElementClasses, Hypothesis, Material};
 use stickslip_time::scenes::{E, NU};
 use stickslip_time::{
-    Dynamics, History, ImplicitSolver, Integrator, Scheme, Settings, StickReduction,
+    Dynamics, History, ImplicitSolver, Integrator, Scheme, Settings, StickReduction, CHUNK,
+    PARALLEL_MIN,
 };
 
 struct Counting;
@@ -64,10 +65,26 @@ fn steps_allocate_nothing() {
         .build()
         .unwrap();
     pool.broadcast(|_| ());
-    // Explicit: the paper's mesh (sequential passes) and a mesh of > 8192
-    // DOFs, whose passes run on the thread pool (kernels::CHUNK).
-    for mesh in ["slab-q2-8x2.msh", "slab-q1-128x32.msh"] {
-        let s = paper_slab(mesh, 1e-4, History::Step);
+    // Explicit: the paper's mesh (sequential passes) and a mesh of at
+    // least PARALLEL_MIN whole chunks of DOFs, whose passes run on the
+    // thread pool (CHUNK).
+    let threaded = stickslip_time::scenes::structured_slab(192, 48, false);
+    for (mesh, s) in [
+        (
+            "slab-q2-8x2.msh",
+            paper_slab("slab-q2-8x2.msh", 1e-4, History::Step),
+        ),
+        (
+            "Q1 192x48",
+            Slab::paper(threaded, 1e-4, History::Step, true).unwrap(),
+        ),
+    ] {
+        if mesh != "slab-q2-8x2.msh" {
+            assert!(
+                s.model.dofs.n_free() / CHUNK >= PARALLEL_MIN,
+                "{mesh} runs on one thread"
+            );
+        }
         let dt = 0.5
             * s.integrator(Settings::new(Scheme::CentralDifference, 1e-9, 1.0))
                 .unwrap()

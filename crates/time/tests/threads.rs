@@ -5,7 +5,8 @@
 mod common;
 use common::*;
 use stickslip_fem::testing::on_threads;
-use stickslip_time::{History, Integrator, Scheme, Settings};
+use stickslip_time::scenes::structured_slab;
+use stickslip_time::{History, Integrator, Scheme, Settings, CHUNK, PARALLEL_MIN};
 
 fn run(s: &Slab, threads: usize, steps: usize) -> Integrator {
     on_threads(threads, || {
@@ -26,11 +27,14 @@ fn run(s: &Slab, threads: usize, steps: usize) -> Integrator {
 
 #[test]
 fn one_thread_and_several_give_the_same_bits() {
-    // > 8192 free DOFs (kernels::CHUNK), so the passes split into several
-    // chunks and go parallel with more than one thread.
-    for mesh in ["slab-q1-128x32.msh", "slab-q2-64x16.msh"] {
-        let s = paper_slab(mesh, 1e-4, History::Step);
-        assert!(s.model.dofs.n_free() > 8192, "{mesh} too small to thread");
+    // At least PARALLEL_MIN whole chunks of free DOFs (CHUNK), so
+    // that the passes go parallel with more than one thread (the committed
+    // 128×32 slabs, 8,352 DOFs, no longer do).
+    for (nx, ny, q2) in [(192, 48, false), (96, 24, true)] {
+        let mesh = format!("{} {nx}x{ny}", if q2 { "Q2" } else { "Q1" });
+        let s = Slab::paper(structured_slab(nx, ny, q2), 1e-4, History::Step, true).unwrap();
+        let whole = s.model.dofs.n_free() / CHUNK;
+        assert!(whole >= PARALLEL_MIN, "{mesh} too small to thread");
         let one = run(&s, 1, 400);
         for threads in [2, 3] {
             let many = run(&s, threads, 400);
