@@ -149,6 +149,15 @@ fn check_group(
 /// # Errors
 /// Input problems (exit 2) as [`InputError`]; nothing else is expected.
 pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
+    prepare_for(case, false)
+}
+
+/// [`prepare`], for a run that will [`Integrator::restore`] a checkpoint
+/// when `restoring` (no initial static solve: the checkpoint has the state).
+///
+/// # Errors
+/// As [`prepare`].
+pub fn prepare_for(case: &Case, restoring: bool) -> anyhow::Result<Prepared> {
     let mesh = Mesh::from_file(&case.mesh.file)
         .map_err(|e| input(format!("{}{e}", case.at("mesh.file"))))?;
     let mut problems = Vec::new();
@@ -352,6 +361,7 @@ pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
         // steps end to end: 24.4 µs a step by the factor, 26.5 µs modal),
         // from every second step on the modal one.
         reads_every: Some(case.output.every.max(1) as u64),
+        restoring,
     };
     // The explicit step forms K·x by stencil types where the mesh's
     // numbering repeats its node rows (structured meshes numbered row by
@@ -632,7 +642,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         mesh,
         model,
         mut integrator,
-    } = prepare(case)?;
+    } = prepare_for(case, options.restart)?;
     let (contact_nodes, contact_s): (Vec<usize>, Vec<f64>) = integrator
         .contact()
         .map(|c| c.nodes.iter().map(|n| (n.node, n.s)).unzip())

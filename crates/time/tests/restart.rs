@@ -71,6 +71,19 @@ fn restored_runs_are_bit_identical_to_uninterrupted_ones() {
             finish(&mut second);
             assert_same_state(&whole, &second, &format!("{scheme:?} k = {k}"));
 
+            // Built to be restored: no static solve (its factor of K),
+            // the same continuation.
+            let mut restoring = settings(scheme, 0.5);
+            restoring.restoring = true;
+            let mut fourth = s.integrator(restoring).unwrap();
+            assert!(
+                fourth.displacement().iter().all(|&x| x == 0.0),
+                "no static state solved for"
+            );
+            fourth.restore(&c).unwrap();
+            finish(&mut fourth);
+            assert_same_state(&whole, &fourth, &format!("{scheme:?} k = {k}, restoring"));
+
             // A fresh integrator built for a shorter run, extended.
             let mut third = s.integrator(settings(scheme, c.t + 1e-2)).unwrap();
             third.restore(&c).unwrap();
