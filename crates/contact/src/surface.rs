@@ -180,10 +180,11 @@ impl ContactSurface {
         }
     }
 
-    /// Friction stress σ_T = −g φ_ε(v_T) at each node (paper eq. (4.10)).
+    /// Friction stress σ_T = −g φ_ε(v_T) at each node (paper eq. (4.10)),
+    /// +0 where v_T = 0 (−g · 0 is −0, which printed as "-0.000").
     pub fn friction_stress(&self, velocity: &[f64], out: &mut [f64]) {
         for (n, s) in self.nodes.iter().zip(out.iter_mut()) {
-            *s = -n.bound * self.law.phi(n.tangential(velocity));
+            *s = -n.bound * self.law.phi(n.tangential(velocity)) + 0.0;
         }
     }
 
