@@ -1413,6 +1413,13 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
         )));
     }
     if let Some(w) = &o.write {
+        if w.is_dir() {
+            return Err(input(format!(
+                "--write {}: it is a directory; give a file name in it, e.g. --write {}",
+                w.display(),
+                w.join("advised.toml").display()
+            )));
+        }
         // Never over a file: it may be the case being advised, or another.
         if w.exists() {
             return Err(input(format!(

@@ -90,7 +90,7 @@ Exit codes: 0 a configuration meets the tolerance (estimated), 1 none of the lad
         /// The case file (TOML) with mesh.ladder.
         case: PathBuf,
         /// Relative error to reach: L2 in time (ux, uy, friction_stress) or of E(t_end) (energy).
-        #[arg(long, value_name = "X")]
+        #[arg(long, value_name = "X", allow_negative_numbers = true)]
         tol: f64,
         /// The output the tolerance is on: ux, uy, friction_stress or energy.
         #[arg(long, value_name = "QUANTITY")]

@@ -287,6 +287,25 @@ fn advise_never_writes_over_a_file() {
     assert_eq!(st.status.code(), Some(2), "{err}");
     assert!(err.contains("the file exists"), "{err}");
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "mine");
+    // A directory, and a negative tolerance (clap took "-1" for a flag).
+    for (args, says) in [
+        (
+            vec!["--tol", "3e-2", "--write", dir.to_str().unwrap()],
+            "is a directory",
+        ),
+        (vec!["--tol", "-1"], "give a relative error > 0"),
+    ] {
+        let st = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
+            .arg("advise")
+            .arg(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
+            .args(["--on", "ux", "--at", "8,1"])
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert_eq!(st.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
 }
 
 /// A ladder of two bodies, and a probe point off the body, are bad input
