@@ -59,6 +59,10 @@ fn main() -> ExitCode {
     let result = match cmd {
         "demo" => demo(&root, rest),
         "test" | "ci" => test(&root, rest),
+        "setup" if !rest.is_empty() => Err(format!(
+            "setup takes no arguments (got {})\n{USAGE}",
+            rest.join(" ")
+        )),
         "setup" => setup(true),
         "meshes" => meshes::run(&root, rest),
         "verify" => verify::verify(&root, rest),
