@@ -223,13 +223,7 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
     }
     // A point off the body by more than a hundredth of its size is likely
     // a typo (or the other coordinate order): say so, the history follows.
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for row in nodes.rows() {
-        for k in 0..2 {
-            lo[k] = lo[k].min(row[k]);
-            hi[k] = hi[k].max(row[k]);
-        }
-    }
+    let [lo, hi] = stickslip_mesh::bounding_box(nodes.rows().into_iter().map(|r| [r[0], r[1]]));
     if off_the_body([lo, hi], p) {
         let _ = write!(
             info,

@@ -181,11 +181,17 @@ impl ContactSurface {
     }
 
     /// Friction stress σ_T = −g φ_ε(v_T) at each node (paper eq. (4.10)),
-    /// +0 where v_T = 0 (−g · 0 is −0, which printed as "-0.000").
+    /// by [`ContactSurface::stress`].
     pub fn friction_stress(&self, velocity: &[f64], out: &mut [f64]) {
         for (n, s) in self.nodes.iter().zip(out.iter_mut()) {
-            *s = -n.bound * self.law.phi(n.tangential(velocity)) + 0.0;
+            *s = self.stress(n, n.tangential(velocity));
         }
+    }
+
+    /// σ_T = −g φ_ε(v_T) of `node` at tangential velocity `v_t`, +0 where
+    /// v_T = 0 (−g · 0 is −0, which printed as "-0.000").
+    pub fn stress(&self, node: &ContactNode, v_t: f64) -> f64 {
+        -node.bound * self.law.phi(v_t) + 0.0
     }
 
     /// Adds the damping of stuck nodes, w g/ε ττᵀ, through `add(i, j, value)`

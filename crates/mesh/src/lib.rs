@@ -187,25 +187,18 @@ impl Mesh {
     /// [`MeshErrorKind::AmbiguousGroup`] if groups of several dimensions
     /// have that name (Gmsh allows it; which one was meant is unknowable).
     pub fn group(&self, name: &str) -> Result<&Group, MeshError> {
-        let mut named = self.groups.iter().filter(|g| g.name == name);
-        let Some(first) = named.next() else {
-            return Err(MeshError::new(MeshErrorKind::UnknownGroup {
+        let named: Vec<&Group> = self.groups.iter().filter(|g| g.name == name).collect();
+        match named[..] {
+            [one] => Ok(one),
+            [] => Err(MeshError::new(MeshErrorKind::UnknownGroup {
                 name: name.to_string(),
                 available: self.group_names().iter().map(|s| s.to_string()).collect(),
-            }));
-        };
-        if named.next().is_some() {
-            return Err(MeshError::new(MeshErrorKind::AmbiguousGroup {
+            })),
+            _ => Err(MeshError::new(MeshErrorKind::AmbiguousGroup {
                 name: name.to_string(),
-                groups: self
-                    .groups
-                    .iter()
-                    .filter(|g| g.name == name)
-                    .map(|g| (g.dim, g.tag))
-                    .collect(),
-            }));
+                groups: named.iter().map(|g| (g.dim, g.tag)).collect(),
+            })),
         }
-        Ok(first)
     }
 
     /// How many edges of `group` lie inside the body, each a side of two
@@ -230,13 +223,19 @@ impl Mesh {
 
     /// Bounding box `[[xmin, ymin], [xmax, ymax]]` of the nodes.
     pub fn bbox(&self) -> [[f64; 2]; 2] {
-        let mut b = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
-        for p in &self.nodes {
-            for k in 0..2 {
-                b[0][k] = b[0][k].min(p[k]);
-                b[1][k] = b[1][k].max(p[k]);
-            }
-        }
-        b
+        bounding_box(self.nodes.iter().copied())
     }
+}
+
+/// Bounding box `[[xmin, ymin], [xmax, ymax]]` of `points` (infinite bounds
+/// the wrong way round when there are none).
+pub fn bounding_box(points: impl IntoIterator<Item = [f64; 2]>) -> [[f64; 2]; 2] {
+    let mut b = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
+    for p in points {
+        for k in 0..2 {
+            b[0][k] = b[0][k].min(p[k]);
+            b[1][k] = b[1][k].max(p[k]);
+        }
+    }
+    b
 }

@@ -2132,7 +2132,7 @@ impl Integrator {
             match &self.modal {
                 Some(m) => {
                     for ((s, node), u) in out.iter_mut().zip(&c.nodes).zip(&m.contact_v) {
-                        *s = -node.bound * c.law.phi(*u) + 0.0;
+                        *s = c.stress(node, *u);
                     }
                 }
                 None => c.friction_stress(&self.v, out),

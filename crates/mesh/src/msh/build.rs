@@ -294,13 +294,7 @@ impl Builder {
         // xy, and "degenerate cell" would hide the cause.
         let (z, tag, at) = self.max_z;
         if z != 0.0 {
-            let mut bb = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
-            for p in &self.nodes {
-                for k in 0..2 {
-                    bb[0][k] = bb[0][k].min(p[k]);
-                    bb[1][k] = bb[1][k].max(p[k]);
-                }
-            }
+            let bb = crate::bounding_box(self.nodes.iter().copied());
             let extent = (bb[1][0] - bb[0][0]).max(bb[1][1] - bb[0][1]).max(0.0);
             if z.abs() > Z_TOL * extent {
                 return Err(cur.error(at, MeshErrorKind::NotPlanar { node: tag, z }));

@@ -50,15 +50,23 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder, parametric: bool) -> 
         b.nodes.reserve(cap);
         b.node_tags.reserve(cap);
         for _ in 0..n {
-            let tag = cur.u64("a node tag")?;
-            let x = cur.f64("a node coordinate")?;
-            let y = cur.f64("a node coordinate")?;
-            let z = cur.f64("a node coordinate")?;
+            let (tag, [x, y, z]) = ascii_node(cur)?;
             b.push_node(tag, x, y, z, cur.pos());
         }
     }
     cur.expect_end()?;
     b.finish_nodes(cur, header)
+}
+
+/// An ASCII node line's tag and coordinates (`$Nodes` and
+/// `$ParametricNodes` alike).
+#[inline(always)]
+fn ascii_node(cur: &mut Cursor<'_>) -> Result<(u64, [f64; 3])> {
+    let tag = cur.u64("a node tag")?;
+    let x = cur.f64("a node coordinate")?;
+    let y = cur.f64("a node coordinate")?;
+    let z = cur.f64("a node coordinate")?;
+    Ok((tag, [x, y, z]))
 }
 
 /// A binary node record's tag, which must not be negative (at byte `at`).
@@ -117,10 +125,7 @@ fn parametric_nodes(cur: &mut Cursor<'_>, b: &mut Builder, n: u64) -> Result<()>
         b.nodes.reserve(cap);
         b.node_tags.reserve(cap);
         for _ in 0..n {
-            let tag = cur.u64("a node tag")?;
-            let x = cur.f64("a node coordinate")?;
-            let y = cur.f64("a node coordinate")?;
-            let z = cur.f64("a node coordinate")?;
+            let (tag, [x, y, z]) = ascii_node(cur)?;
             let at = cur.pos();
             cur.skip_ws();
             let dp = cur.pos();
