@@ -677,8 +677,23 @@ fn peer_fields(
     }
 }
 
+/// What `--help` prints, and an unknown argument with it.
+const USAGE: &str = "usage: bench_step [--quick] [--peer] [--max-dofs N]   the whole ladder
+       bench_step --case cd|newmark MESH STEPS REPEATS [--dump DIR]   one rung
+       bench_step --targets CSV   the targets of a run already written
+MESH: gen-q1-NXxNY, gen-q2-NXxNY (built here), gmsh-qK-NXxNY[-fileorder],
+a .msh path, or a committed mesh's name (cases/meshes)";
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--help" || a == "-h") {
+        println!("{USAGE}");
+        return;
+    }
+    let fail = |what: String| -> ! {
+        eprintln!("bench_step: {what}\n{USAGE}");
+        std::process::exit(2);
+    };
     // The targets of a run already written (docs/bench-step.csv).
     if let Some(k) = args.iter().position(|a| a == "--targets") {
         let Some(path) = args.get(k + 1) else {
@@ -709,16 +724,38 @@ fn main() {
         return;
     }
     if let Some(k) = args.iter().position(|a| a == "--case") {
-        let scheme = &args[k + 1];
-        let name = &args[k + 2];
-        let steps: usize = args[k + 3].parse().unwrap();
-        let repeats: usize = args[k + 4].parse().unwrap();
+        let [scheme, name, steps, repeats] = std::array::from_fn(|j| args.get(k + 1 + j));
+        let (Some(scheme), Some(name), Some(steps), Some(repeats)) = (scheme, name, steps, repeats)
+        else {
+            fail("--case needs a scheme, a mesh, steps and repeats".into())
+        };
+        if scheme != "cd" && scheme != "newmark" {
+            fail(format!("--case {scheme}: the scheme is cd or newmark"));
+        }
+        let count = |what: &str, v: &str| -> usize {
+            match v.parse() {
+                Ok(n) if n > 0 => n,
+                _ => fail(format!("{what} {v:?}: expected a whole number above 0")),
+            }
+        };
+        let (steps, repeats) = (count("steps", steps), count("repeats", repeats));
         let dump = args
             .iter()
             .position(|a| a == "--dump")
             .map(|k| PathBuf::from(&args[k + 1]));
         run_case(scheme, name, steps, repeats, dump);
         return;
+    }
+    let mut rest = args.iter();
+    while let Some(a) = rest.next() {
+        match a.as_str() {
+            "--quick" | "--peer" => {}
+            "--max-dofs" => match rest.next().map(|v| v.parse::<f64>()) {
+                Some(Ok(v)) if v > 0.0 => {}
+                _ => fail("--max-dofs needs a number of DOFs above 0".into()),
+            },
+            other => fail(format!("unknown argument {other:?}")),
+        }
     }
     let quick = args.iter().any(|a| a == "--quick");
     let peer = args.iter().any(|a| a == "--peer");
