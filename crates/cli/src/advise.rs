@@ -24,6 +24,10 @@
 //! on the pilot mesh, and the change its ε makes there. Meshes finer than
 //! the measured ones continue the last measured decrease (observed order,
 //! capped at the theoretical one; none when the errors stopped decreasing).
+//! Newmark's errors per mesh, all at t_end/200, carry that Δt's error,
+//! which no mesh reduces: the decrease is continued on the errors less
+//! that part (estimated from the Δt pilots) and the part added back, so
+//! that a finer mesh's estimate does not fall below it.
 //!
 //! * h: the first three meshes of each element order in the ladder, run
 //!   with central difference at 0.9 Δt_crit of each mesh (its own family:
@@ -233,6 +237,49 @@ pub fn continue_errors(measured: &[f64], ratios: &[f64], max_order: f64) -> (Vec
         let next = extrapolate(e[k - 1], ratios[k - 1], p, 1);
         e.push(next);
     }
+    (e, p)
+}
+
+/// The error of a run at Δt from its changes at 2Δt and Δt/2 (`d_coarse`
+/// = |X(2Δt) − X(Δt)|, `d_fine` = |X(Δt) − X(Δt/2)|): X(Δt/2)'s error by
+/// [`richardson`] at the observed order (at least [`MIN_ORDER`], at most
+/// `max_order`; [`MIN_ORDER`] when the changes do not decrease), plus
+/// d_fine, as the aligned errors of a power law in Δt add.
+pub fn dt_error(d_coarse: f64, d_fine: f64, max_order: f64) -> f64 {
+    let p =
+        observed_order(d_coarse, d_fine, 2.0).map_or(MIN_ORDER, |p| p.clamp(MIN_ORDER, max_order));
+    d_fine + richardson(d_fine, 2.0, p)
+}
+
+/// [`continue_errors`] for errors with a part that no refinement of the
+/// mesh reduces (Newmark's Δt error at its fixed Δt, `floor`): the measured
+/// errors less the floor in quadrature are continued, and the floor is
+/// added back in quadrature. Continued errors stay at or above the floor
+/// (where [`continue_errors`] would take them below it on the decrease of
+/// the measured levels, which the floor slows) and at or below the last
+/// measured error; measured levels keep their measured errors.
+pub fn continue_errors_above(
+    measured: &[f64],
+    ratios: &[f64],
+    max_order: f64,
+    floor: f64,
+) -> (Vec<f64>, f64) {
+    let Some(&last) = measured.last() else {
+        return continue_errors(measured, ratios, max_order);
+    };
+    let above: Vec<f64> = measured
+        .iter()
+        .map(|e| (e * e - floor * floor).max(0.0).sqrt())
+        .collect();
+    let (e, p) = continue_errors(&above, ratios, max_order);
+    let e = e
+        .iter()
+        .enumerate()
+        .map(|(k, x)| match measured.get(k) {
+            Some(&m) => m,
+            None => x.hypot(floor).min(last),
+        })
+        .collect();
     (e, p)
 }
 
@@ -1000,9 +1047,7 @@ pub fn estimate(
     for g in &groups {
         let max_order = f64::from(g.order) + 1.0;
         let mc: Vec<f64> = g.cd_runs.iter().map(|&k| err_of(&pilots, k)).collect();
-        let mn: Vec<f64> = g.nm_runs.iter().map(|&k| err_of(&pilots, k)).collect();
         let (ec, pc) = continue_errors(&mc, &g.ratios, max_order);
-        let (en, pn) = continue_errors(&mn, &g.ratios, max_order);
         orders.push((
             format!(
                 "errors, Q{} meshes, central difference (0.9 dt_crit)",
@@ -1011,13 +1056,7 @@ pub fn estimate(
             pc,
             ec.clone(),
         ));
-        orders.push((
-            format!("errors, Q{} meshes, Newmark (t_end/200)", g.order),
-            pn,
-            en.clone(),
-        ));
         e_cd_all.push(ec);
-        e_nm_all.push(en);
     }
     // Δt and ε on the second mesh of the highest order: each run's change
     // from its family's base configuration on that mesh (central
@@ -1064,6 +1103,33 @@ pub fn estimate(
         d_dt_nm.push((method, d));
         nm_runs_by_method.push((method, runs));
     }
+    // Newmark's errors per mesh at t_end/200 hold that Δt's error, which
+    // no mesh reduces: it is estimated from the ¼/½ changes at t_end/100
+    // and t_end/400 on the pilot mesh (the same Δt on every mesh, so taken
+    // as every mesh's) and held as a floor under the finer meshes' errors
+    // ([`continue_errors_above`]; continued as mesh error, the errors of
+    // finer meshes went below it).
+    let k_h = NEWMARK_DIVISIONS
+        .iter()
+        .position(|d| *d == 200.0)
+        .expect("t_end/200 in the ladder");
+    let dt_floor = {
+        let d = &d_dt_nm[0].1;
+        dt_error(d[k_h - 1], d[k_h + 1], 2.0)
+    };
+    for g in &groups {
+        let mn: Vec<f64> = g.nm_runs.iter().map(|&k| err_of(&pilots, k)).collect();
+        let (en, pn) = continue_errors_above(&mn, &g.ratios, f64::from(g.order) + 1.0, dt_floor);
+        orders.push((
+            format!(
+                "errors, Q{} meshes, Newmark (t_end/200; its dt error {dt_floor:.2e} held under finer meshes)",
+                g.order
+            ),
+            pn,
+            en.clone(),
+        ));
+        e_nm_all.push(en);
+    }
     let mut d_eps = vec![0.0];
     let eps_list: Vec<f64> = if case.contact.is_some() {
         let base = cd_runs[0];
@@ -1085,10 +1151,6 @@ pub fn estimate(
     // Cost of the Newmark variants relative to Newmark ¼/½ at the same Δt on
     // the pilot mesh; extra steps of the reduction per contact node.
     let trap = &nm_runs_by_method[0].1;
-    let k_h = NEWMARK_DIVISIONS
-        .iter()
-        .position(|d| *d == 200.0)
-        .expect("t_end/200 in the ladder");
     // One cost constant per scheme for all meshes (geometric mean over the
     // element orders): a step's work is proportional to nnz(K), so the
     // ranking of meshes within a scheme is by steps × nnz, which is exact,
@@ -1665,6 +1727,43 @@ mod tests {
         let (est, p) = continue_errors(&[0.04, 0.015, 0.017], &[2.0; 3], 3.0);
         assert_eq!(p, 0.0);
         assert_eq!(est[3], 0.017);
+    }
+
+    #[test]
+    fn continue_errors_above_a_dt_floor() {
+        // e = √((C h^p)² + f²): a mesh part with p = 2 and a Δt part f
+        // that no mesh reduces, measured on three of five levels.
+        let f = 0.01;
+        let e = |k: i32| (3.0 * (0.2 / 2f64.powi(k)).powi(2)).hypot(f);
+        let measured = [e(0), e(1), e(2)];
+        let (est, p) = continue_errors_above(&measured, &[2.0; 4], 3.0, f);
+        assert!((p - 2.0).abs() < 1e-9, "{p}");
+        for k in 0..5 {
+            assert!(
+                (est[k] - e(k as i32)).abs() < 1e-9 * e(k as i32),
+                "{k}: {est:?}"
+            );
+        }
+        // Continued as mesh error, the floor's slower decrease was taken
+        // on, and the finest levels fell below the floor itself.
+        let (plain, _) = continue_errors(&measured, &[2.0; 4], 3.0);
+        assert!(plain[4] < f && plain[4] < 0.9 * e(4), "{plain:?}");
+        // A floor above the measured errors: they stay as measured and
+        // the finer levels at the last of them.
+        let (est, _) = continue_errors_above(&[0.03, 0.02, 0.015], &[2.0; 4], 3.0, 0.05);
+        assert_eq!(est, vec![0.03, 0.02, 0.015, 0.015, 0.015]);
+    }
+
+    #[test]
+    fn dt_error_of_a_power_law() {
+        // X(Δt) = X* + C Δt²: changes at 2Δt → Δt and Δt → Δt/2 give
+        // X(Δt)'s error C Δt².
+        let x = |dt: f64| 1.0 + 5.0 * dt * dt;
+        let dt = 0.01;
+        let (dc, df) = ((x(2.0 * dt) - x(dt)).abs(), (x(dt) - x(dt / 2.0)).abs());
+        assert!((dt_error(dc, df, 2.0) - 5.0 * dt * dt).abs() < 1e-12);
+        // Changes that do not decrease: the slowest order, a larger error.
+        assert!(dt_error(df, df, 2.0) > 2.0 * df);
     }
 
     #[test]

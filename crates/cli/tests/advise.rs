@@ -342,3 +342,88 @@ fn advise_refuses_a_ladder_of_two_bodies_and_a_point_off_the_body() {
     assert!(err.contains("a ladder is one geometry"), "{err}");
     assert!(!err.contains("pilot"), "refused before any pilot: {err}");
 }
+
+/// The README's ranges of advise's estimates over the chart's errors, for
+/// the configurations that were pilots and for the others, on the slab
+/// case (u_x at (8, 1)), with the five farthest of the others:
+///
+///     cargo test --release -p stickslip --test advise estimates_against_the_chart -- --ignored --nocapture
+#[test]
+#[ignore = "a measurement: prints the ranges the README quotes"]
+fn estimates_against_the_chart() {
+    let case_path = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let case = case::load(&case_path, &[]).expect("paper case loads");
+    let est = advise::estimate(&case, Quantity::Ux, Some(AT), &mut |_| {}).expect("estimates");
+    let rows = csv_rows();
+    let mut ratios: [Vec<(f64, String)>; 2] = [Vec::new(), Vec::new()];
+    for c in &est.candidates {
+        let name = Path::new(&c.mesh).file_name().unwrap().to_string_lossy();
+        let Some(r) = rows.iter().find(|r| {
+            r.mesh == name && r.method == c.method && same(r.dt, c.dt) && same(r.eps, c.eps)
+        }) else {
+            continue;
+        };
+        let what = format!(
+            "{name} {} dt {:.4e}: estimate {:.3e}, chart {:.3e}",
+            c.method.name(),
+            c.dt,
+            c.estimate(),
+            r.err_ux_8_1
+        );
+        ratios[usize::from(!c.run)].push((c.estimate() / r.err_ux_8_1, what));
+    }
+    for (label, r) in ["pilots", "not run"].iter().zip(&mut ratios) {
+        r.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (Some(lo), Some(hi)) = (r.first(), r.last()) else {
+            continue;
+        };
+        println!(
+            "{label}: {} configurations of the chart, estimate / chart error {:.2}-{:.2}",
+            r.len(),
+            lo.0,
+            hi.0
+        );
+    }
+    // The picks at five tolerances against the chart's cheapest
+    // configuration that meets each (the chart's times).
+    for tol in [5e-2, 4e-2, 3e-2, 2e-2, 1e-2] {
+        let Some(pick) = advise::pick(&est.candidates, tol) else {
+            println!("tol {tol:e}: no pick");
+            continue;
+        };
+        let name = Path::new(&pick.mesh).file_name().unwrap().to_string_lossy();
+        let row = rows.iter().find(|r| {
+            r.mesh == name
+                && r.method == pick.method
+                && same(r.dt, pick.dt)
+                && same(r.eps, pick.eps)
+        });
+        let cheapest = rows
+            .iter()
+            .filter(|r| r.err_ux_8_1 <= tol)
+            .min_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        match (row, cheapest) {
+            (Some(r), Some(c)) => println!(
+                "tol {tol:e}: pick {name} {} dt {:.4e} (chart error {:.3e}), {:.2}x the time of the chart's cheapest, {} {} dt {:.4e}",
+                pick.method.name(),
+                pick.dt,
+                r.err_ux_8_1,
+                r.time_s / c.time_s,
+                c.mesh,
+                c.method.name(),
+                c.dt
+            ),
+            _ => println!(
+                "tol {tol:e}: pick {name} {} dt {:.4e}, not in the chart",
+                pick.method.name(),
+                pick.dt
+            ),
+        }
+    }
+    let others = &ratios[1];
+    let mut far: Vec<&(f64, String)> = others.iter().collect();
+    far.sort_by(|a, b| a.0.ln().abs().total_cmp(&b.0.ln().abs()));
+    for (ratio, what) in far.iter().rev().take(5) {
+        println!("  {ratio:.2}x  {what}");
+    }
+}
