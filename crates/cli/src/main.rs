@@ -6,7 +6,7 @@
 //!
 //! Exit codes: 0 success; 2 bad input (case, mesh, arguments — clap's usage
 //! errors exit 2 too); 1 a run that failed after it started (the file keeps
-//! every step written); 130 interrupted by SIGINT or SIGTERM (the file is
+//! every step written); 130 interrupted by SIGINT, SIGTERM or SIGHUP (the file is
 //! valid and holds a checkpoint to `--restart` from).
 
 use std::path::PathBuf;
@@ -35,7 +35,7 @@ enum Command {
     #[command(
         after_help = "Example:\n  stickslip run case.toml -o out.h5 --set time.dt=5e-4 --set contact.eps=1e-2\n\n\
 Exit codes: 0 complete, 1 the run failed midway (the file keeps every step written, complete = false), \
-2 bad input, 130 interrupted by SIGINT/SIGTERM (the file is valid, complete = false; continue it with --restart OUT.h5).\n\n\
+2 bad input, 130 interrupted by SIGINT, SIGTERM or SIGHUP (the file is valid, complete = false; continue it with --restart OUT.h5).\n\n\
 A second Ctrl-C while the first is being handled exits at once (the file keeps every step up to its last flush)."
     )]
     Run {
@@ -133,8 +133,24 @@ Exit codes: 0 a configuration meets the tolerance (estimated), 1 none of the lad
 
 /// Prints each line of a message as `error: ...` on stderr.
 fn report(msg: &str) {
+    use std::io::Write;
+    let mut err = std::io::stderr().lock();
     for line in msg.lines() {
-        eprintln!("error: {line}");
+        // A closed stderr must not turn the exit code into a panic's 101.
+        let _ = writeln!(err, "error: {line}");
+    }
+}
+
+/// Writing to a closed pipe ends the process quietly, as other Unix
+/// tools do (`stickslip probe ... | head` panicked on the broken pipe,
+/// exit 101). Not for `run`, which must write its results whatever
+/// becomes of its stderr: it writes its messages without panicking.
+#[allow(unsafe_code)]
+fn default_sigpipe() {
+    // SAFETY: restores the default action of one signal before any thread
+    // starts; no handler of ours is involved.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 
@@ -151,6 +167,9 @@ fn fail(e: &anyhow::Error) -> ExitCode {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if !matches!(cli.command, Command::Run { .. }) {
+        default_sigpipe();
+    }
     match cli.command {
         Command::Run {
             case,
@@ -174,7 +193,11 @@ fn main() -> ExitCode {
                 None => output.unwrap_or_else(|| case.output.file.clone()),
             };
             if restart.is_none() {
-                if let Err(e) = stickslip::results_file::check_output(&out, &case_path, force) {
+                if let Err(e) = stickslip::results_file::check_output(
+                    &out,
+                    &[&case_path, &case.mesh.file],
+                    force,
+                ) {
                     report(&e.0);
                     return ExitCode::from(2);
                 }
@@ -189,7 +212,9 @@ fn main() -> ExitCode {
             let stop = match run::StopFlags::install() {
                 Ok(s) => s,
                 Err(e) => {
-                    report(&format!("cannot install the SIGINT/SIGTERM handlers: {e}"));
+                    report(&format!(
+                        "cannot install the SIGINT/SIGTERM/SIGHUP handlers: {e}"
+                    ));
                     return ExitCode::from(1);
                 }
             };
@@ -198,6 +223,7 @@ fn main() -> ExitCode {
                 json,
                 restart: restart.is_some(),
                 stop,
+                sets,
             };
             match run::execute(&case, &out, &options) {
                 Ok(run::Outcome::Complete) => ExitCode::SUCCESS,

@@ -274,6 +274,23 @@ fn string_attr(loc: &hdf5::Location, name: &str, value: &str) -> Result<()> {
     Ok(())
 }
 
+/// A text attribute of a results file, checked to be UTF-8: HDF5 stores
+/// bytes, and a damaged file's are not always text (`VarLenUnicode::as_str`
+/// does not check them).
+///
+/// # Errors
+/// No such attribute, not a text attribute, or bytes that are not UTF-8.
+pub fn text_attr(loc: &hdf5::Location, name: &str) -> Result<String> {
+    let v = loc.attr(name)?.read_scalar::<VarLenUnicode>()?;
+    match std::str::from_utf8(v.as_bytes()) {
+        Ok(text) => Ok(text.to_string()),
+        Err(e) => bail!(
+            "its attribute {name:?} is not UTF-8 text (byte {}): the file is damaged",
+            e.valid_up_to()
+        ),
+    }
+}
+
 fn scalar_attr<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<()> {
     loc.new_attr::<T>().create(name)?.write_scalar(&value)?;
     Ok(())
@@ -408,21 +425,18 @@ const ENERGY_ORDER: &str = "kinetic, strain, external_work, dissipated, total, b
 /// checkpoint (written before any flush, or by a version without restart).
 pub fn read_checkpoint(path: &Path) -> Result<Stored> {
     let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
-    let program = file
-        .attr("program")
-        .and_then(|a| a.read_scalar::<VarLenUnicode>())
-        .map(|v| v.as_str().to_string())
-        .unwrap_or_default();
+    let program = text_attr(&file, "program").unwrap_or_default();
     ensure!(
         program == "stickslip",
         "{} was not written by stickslip run (no program = \"stickslip\" attribute)",
         path.display()
     );
-    let case_source = file
-        .attr("case")?
-        .read_scalar::<VarLenUnicode>()?
-        .as_str()
-        .to_string();
+    let case_source = text_attr(&file, "case").with_context(|| {
+        format!(
+            "{}: cannot read the case it stores; start a new run instead of restarting",
+            path.display()
+        )
+    })?;
     let complete = file.attr("complete")?.read_scalar::<bool>()?;
     if !file.link_exists("checkpoint") {
         bail!(
@@ -499,6 +513,17 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         extra.rows
     );
     let times = time.read_slice_1d::<f64, _>(s![..extra.rows])?.to_vec();
+    // A file whose /time was damaged (rows never written read as the fill
+    // value 0) would be continued with a wrong history.
+    let rising = times.windows(2).all(|w| w[0] < w[1]);
+    let last = times.last().copied().unwrap_or(0.0);
+    ensure!(
+        rising && last <= checkpoint.t,
+        "/time's first {} rows do not rise to the checkpoint's t = {} (they end at {last}): \
+         the file is damaged; run the case again",
+        extra.rows,
+        checkpoint.t
+    );
     Ok(Stored {
         checkpoint,
         extra,
@@ -506,6 +531,57 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         complete,
         times,
     })
+}
+
+/// How the mesh stored in a results file differs from `mesh`, if it does
+/// (a restart must continue on the mesh the run started on: the case
+/// names the mesh file, and the file may have changed since).
+///
+/// # Errors
+/// The file's `/mesh` cannot be read.
+pub fn stored_mesh_change(path: &Path, mesh: &stickslip_mesh::Mesh) -> Result<Option<String>> {
+    let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    let g = file.group("mesh")?;
+    let kind = text_attr(&g, "kind")?;
+    if kind != mesh.kind.name() {
+        return Ok(Some(format!(
+            "the stored mesh's cells are {kind}, the mesh's now {}",
+            mesh.kind.name()
+        )));
+    }
+    let nodes = g.dataset("nodes")?;
+    let cells = g.dataset("cells")?;
+    let npc = mesh.kind.nodes_per_cell();
+    if nodes.shape() != [mesh.nodes.len(), 2] || cells.shape() != [mesh.n_cells(), npc] {
+        return Ok(Some(format!(
+            "the stored mesh has {} nodes and {} cells, the mesh now {} and {}",
+            nodes.shape().first().copied().unwrap_or(0),
+            cells.shape().first().copied().unwrap_or(0),
+            mesh.nodes.len(),
+            mesh.n_cells()
+        )));
+    }
+    let stored = nodes.read_2d::<f64>()?;
+    if let Some(i) = (0..mesh.nodes.len())
+        .find(|&i| (0..2).any(|k| stored[[i, k]].to_bits() != mesh.nodes[i][k].to_bits()))
+    {
+        return Ok(Some(format!(
+            "node {i} was at ({}, {}) and is now at ({}, {})",
+            stored[[i, 0]],
+            stored[[i, 1]],
+            mesh.nodes[i][0],
+            mesh.nodes[i][1]
+        )));
+    }
+    let stored = cells.read_2d::<i64>()?;
+    if let Some(c) = (0..mesh.n_cells())
+        .find(|&c| (0..npc).any(|k| stored[[c, k]] != mesh.cells[c * npc + k] as i64))
+    {
+        return Ok(Some(format!(
+            "cell {c} has other nodes than in the stored mesh"
+        )));
+    }
+    Ok(None)
 }
 
 fn index_array(v: impl ExactSizeIterator<Item = usize>) -> Array1<i64> {

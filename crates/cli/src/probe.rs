@@ -125,6 +125,38 @@ fn open_results(file: &Path) -> Result<File, InputError> {
     })
 }
 
+/// `/time`, checked against the records of `/displacement` before it is
+/// read: a damaged file may claim more rows than it holds, and reading
+/// them would allocate that much (a file that claimed 1e11 rows aborted
+/// probe on an 800 GB allocation). The two grow together; between two
+/// records one may be one row ahead.
+fn read_time(f: &File, name: &str) -> Result<Vec<f64>, InputError> {
+    let rows = |ds: &str| {
+        f.dataset(ds)
+            .map(|d| d.shape().first().copied().unwrap_or(0))
+            .map_err(|e| {
+                InputError(format!(
+                "{name}: cannot read /{ds}: {e}; give a results file written by `stickslip run`"
+            ))
+            })
+    };
+    let (t_rows, u_rows) = (rows("time")?, rows("displacement")?);
+    if t_rows > u_rows + 1 {
+        return Err(InputError(format!(
+            "{name}: /time has {t_rows} rows but /displacement {u_rows}: the file is damaged; \
+             run the case again"
+        )));
+    }
+    f.dataset("time")
+        .and_then(|d| d.read_1d::<f64>())
+        .map(|t| t.to_vec())
+        .map_err(|e| {
+            InputError(format!(
+                "{name}: cannot read /time: {e}; give a results file written by `stickslip run`"
+            ))
+        })
+}
+
 /// Reads the history of `field` at the node of `file` nearest to `at`.
 ///
 /// # Errors
@@ -153,11 +185,7 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
     let node = (0..nodes.nrows())
         .min_by(|&a, &b| dist(a).total_cmp(&dist(b)))
         .expect("n > 0");
-    let t = f
-        .dataset("time")
-        .and_then(|d| d.read_1d::<f64>())
-        .map_err(|e| h5("cannot read /time", e))?
-        .to_vec();
+    let t = read_time(&f, &name)?;
 
     let values: Vec<f64> = match field.node_dataset() {
         None => {
@@ -448,12 +476,8 @@ fn order_along(
 
 /// The contact group of the case stored in the file, if any.
 fn contact_group(f: &File) -> Option<String> {
-    let case = f
-        .attr("case")
-        .ok()?
-        .read_scalar::<hdf5::types::VarLenUnicode>()
-        .ok()?;
-    let doc: toml::Table = case.as_str().parse().ok()?;
+    let case = crate::output::text_attr(f, "case").ok()?;
+    let doc: toml::Table = case.parse().ok()?;
     doc.get("contact")?
         .get("group")?
         .as_str()
@@ -565,11 +589,7 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
     }
     let slots = slot(&order);
 
-    let t_all = f
-        .dataset("time")
-        .and_then(|d| d.read_1d::<f64>())
-        .map_err(|e| h5("cannot read /time", e))?
-        .to_vec();
+    let t_all = read_time(&f, &name)?;
     if t_all.is_empty() {
         return Err(InputError(format!(
             "{name}: /time is empty: the run wrote no output step"

@@ -16,8 +16,18 @@ use crate::error::InputError;
 ///
 /// # Errors
 /// The [`InputError`] naming the file and what to do.
-pub fn check_output(out: &Path, case_file: &Path, force: bool) -> Result<(), InputError> {
+pub fn check_output(out: &Path, inputs: &[&Path], force: bool) -> Result<(), InputError> {
     let name = out.display();
+    if out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xdmf"))
+    {
+        return Err(InputError(format!(
+            "-o {name}: -o names the HDF5 results file, and the .xdmf is written beside it \
+             under the same name; give -o {}",
+            out.with_extension("h5").display()
+        )));
+    }
     if out.as_os_str().is_empty() || out.file_name().is_none() {
         return Err(InputError(format!(
             "the results file name {:?} is empty or a directory; give a file such as -o out.h5",
@@ -34,9 +44,24 @@ pub fn check_output(out: &Path, case_file: &Path, force: bool) -> Result<(), Inp
         (Ok(a), Ok(b)) => a == b,
         _ => false,
     };
-    if same(out, case_file) {
+    for (k, input) in inputs.iter().enumerate() {
+        if same(out, input) {
+            let what = if k == 0 {
+                "the case file"
+            } else {
+                "an input of the case (its mesh)"
+            };
+            return Err(InputError(format!(
+                "{name} is {what} itself; write the results elsewhere with -o OUT.h5"
+            )));
+        }
+    }
+    // A device, FIFO or socket: --force would replace it with a file (a
+    // run as root replaced /dev/null), and a FIFO would hang the run.
+    if std::fs::metadata(out).is_ok_and(|m| !m.is_file()) {
         return Err(InputError(format!(
-            "{name} is the case file itself; write the results elsewhere with -o OUT.h5"
+            "{name} exists and is not a regular file (a device, FIFO or socket); \
+             write the results to a file with -o OUT.h5"
         )));
     }
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -58,7 +83,7 @@ pub fn check_output(out: &Path, case_file: &Path, force: bool) -> Result<(), Inp
             continue;
         }
         if !force {
-            let restart = if out.exists() {
+            let restart = if is_hdf5(out) {
                 format!(", or --restart {name} to continue it")
             } else {
                 String::new()
@@ -79,6 +104,16 @@ pub fn check_output(out: &Path, case_file: &Path, force: bool) -> Result<(), Inp
     Ok(())
 }
 
+/// Whether `path` starts with HDF5's signature (where our files put their
+/// superblock): only such a file can be continued with --restart.
+fn is_hdf5(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok_and(|()| head == *b"\x89HDF\r\n\x1a\n")
+}
+
 /// Whether another process has `path` open: HDF5's flock (taken on every
 /// file it opens unless HDF5_USE_FILE_LOCKING=FALSE) or a run's own lock
 /// ([`RunLock`]).
@@ -89,40 +124,61 @@ pub fn in_use(path: &Path) -> bool {
 }
 
 /// Whether a run is writing `path` ([`RunLock`]), whatever HDF5's own
-/// locking: a write lock of ours, released when `f` closes, conflicts
-/// with the run's read lock.
+/// locking: a read lock of ours, released when `f` closes, conflicts with
+/// the run's write lock (and needs only read access to the file).
 pub fn being_written(path: &Path) -> bool {
     let held = |e: std::io::Error| {
         e.kind() == std::io::ErrorKind::WouldBlock || e.raw_os_error() == Some(libc::EACCES)
     };
-    std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .open(path)
-        .is_ok_and(|f| ofd_lock(&f, false).is_err_and(held))
+    std::fs::File::open(path).is_ok_and(|f| ofd_lock(&f, true).is_err_and(held))
 }
 
 /// A run's lock on its results file, held while it writes: an open file
 /// description lock (F_OFD_SETLK), which HDF5's flock does not meet, which
 /// holds when HDF5's locking is off (HDF5_USE_FILE_LOCKING=FALSE, as under
 /// `cargo test`), and which no other descriptor's closing drops (as it
-/// would a classic fcntl lock).
+/// would a classic fcntl lock). Exclusive, so that of two runs started on
+/// one file at once only one gets it; taken before the run writes a byte.
 #[derive(Debug)]
 pub struct RunLock {
     _file: std::fs::File,
 }
 
 impl RunLock {
-    /// Takes the lock on `path` (a read lock: [`in_use`] asks for a write
-    /// lock).
+    /// Takes the lock on the existing file `path` (`--restart`).
     ///
     /// # Errors
-    /// The file cannot be opened, or another process holds a write lock.
-    pub fn take(path: &Path) -> std::io::Result<RunLock> {
-        let f = std::fs::File::open(path)?;
-        ofd_lock(&f, true)?;
+    /// The file cannot be opened for writing, or another process holds the
+    /// lock: an [`InputError`] saying which.
+    pub fn take(path: &Path) -> Result<RunLock, InputError> {
+        let f = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(path)
+            .map_err(|e| {
+                InputError(format!(
+                    "cannot open {} for writing: {e}; a restart appends to the file, so it must be writable \
+                     (check its permissions)",
+                    path.display()
+                ))
+            })?;
+        RunLock::on(f, path)
+    }
+
+    /// Takes the lock on `f`, the file `path` names.
+    fn on(f: std::fs::File, path: &Path) -> Result<RunLock, InputError> {
+        ofd_lock(&f, false).map_err(|_| busy(path))?;
         Ok(RunLock { _file: f })
     }
+}
+
+/// The message for a results file another process has open.
+fn busy(path: &Path) -> InputError {
+    InputError(format!(
+        "{} is open in another process (a run still writing it, or a reader such as h5py or ParaView); \
+         wait for it or close it, or write elsewhere with -o",
+        path.display()
+    ))
 }
 
 /// An F_OFD_SETLK lock on the whole of `f`: shared (`read`) or exclusive.
@@ -143,13 +199,21 @@ fn ofd_lock(f: &std::fs::File, read: bool) -> std::io::Result<()> {
     }
 }
 
-/// Removes an old results file (and its XDMF) before the new one is
-/// created, rather than letting HDF5 truncate it in place (a process that
-/// opened it since [`check_output`] keeps its own copy), and makes sure the
-/// place is writable: exit code 2 with what to do, not HDF5's message.
-pub(crate) fn make_room(out: &Path) -> Result<(), InputError> {
+/// Claims `out` for a new run: removes an old results file and its XDMF
+/// (rather than letting HDF5 truncate a file a reader may hold; refused
+/// while another process has it open), creates the file anew and takes the
+/// run's lock on it before HDF5 writes a byte, so that of two runs started
+/// on one file at once one gets it and the other is told. Exit code 2 with
+/// what to do, not HDF5's message.
+///
+/// # Errors
+/// The [`InputError`] naming the file and what to do.
+pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
     for path in [out.to_path_buf(), out.with_extension("xdmf")] {
         if path.exists() {
+            if in_use(&path) {
+                return Err(busy(&path));
+            }
             std::fs::remove_file(&path).map_err(|e| {
                 InputError(format!(
                     "cannot replace {}: {e}; remove it yourself, or write elsewhere with -o",
@@ -158,16 +222,36 @@ pub(crate) fn make_room(out: &Path) -> Result<(), InputError> {
             })?;
         }
     }
-    std::fs::OpenOptions::new()
+    let f = std::fs::OpenOptions::new()
+        .read(true)
         .write(true)
         .create_new(true)
         .open(out)
         .map_err(|e| {
-            InputError(format!(
-                "cannot create {}: {e}; choose a writable place with -o",
-                out.display()
-            ))
+            if e.kind() == std::io::ErrorKind::AlreadyExists {
+                InputError(format!(
+                    "{} was created by another process just now (a second run on the same file?); \
+                     wait for it, or write elsewhere with -o",
+                    out.display()
+                ))
+            } else {
+                InputError(format!(
+                    "cannot create {}: {e}; choose a writable place with -o",
+                    out.display()
+                ))
+            }
         })?;
-    std::fs::remove_file(out)
-        .map_err(|e| InputError(format!("cannot remove the empty {}: {e}", out.display())))
+    let lock = RunLock::on(f, out)?;
+    // Another run's claim may have removed our new file between its
+    // creation and the lock: then the name is that run's.
+    use std::os::unix::fs::MetadataExt;
+    let ours = lock._file.metadata().map(|m| (m.dev(), m.ino())).ok();
+    let named = std::fs::metadata(out).map(|m| (m.dev(), m.ino())).ok();
+    if ours.is_none() || ours != named {
+        return Err(InputError(format!(
+            "{} was taken by another run started at the same time; wait for it, or write elsewhere with -o",
+            out.display()
+        )));
+    }
+    Ok(lock)
 }

@@ -24,6 +24,25 @@ use stickslip_time::{
     Settings, StickReduction, TimeError,
 };
 
+/// `eprintln!` that does not panic when stderr is closed: a run's
+/// messages must not end it (`stickslip run ... 2>&1 | head` closes the
+/// pipe while the run goes on, and a panic there lost the steps since the
+/// last flush).
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), $($t)*);
+    }};
+}
+
+/// [`say!`] on stdout.
+macro_rules! say_out {
+    ($($t:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
 use crate::case::{self, Case};
 use crate::error::InputError;
 use crate::output::{self, CheckpointExtra, Header, Record, ResultsWriter, Summary};
@@ -38,7 +57,7 @@ pub enum Outcome {
     /// file holds every completed step, `complete = false` and the reason in
     /// its `failure` attribute.
     Failed,
-    /// Stopped by SIGINT/SIGTERM after a completed step; the file holds every
+    /// Stopped by SIGINT, SIGTERM or SIGHUP after a completed step; the file holds every
     /// output step so far and a checkpoint to `--restart` from.
     Interrupted,
 }
@@ -549,6 +568,7 @@ fn record<'a>(
 pub struct StopFlags {
     sigint: Arc<AtomicBool>,
     sigterm: Arc<AtomicBool>,
+    sighup: Arc<AtomicBool>,
 }
 
 impl StopFlags {
@@ -557,7 +577,9 @@ impl StopFlags {
         StopFlags::default()
     }
 
-    /// Registers SIGINT and SIGTERM: the first sets the flag (the run
+    /// Registers SIGINT, SIGTERM and SIGHUP (a closed terminal or a dropped
+    /// ssh session, which killed the run between flushes): the first sets
+    /// the flag (the run
     /// finishes its step, flushes, checkpoints and exits 130); a second
     /// signal of either kind exits at once with 130, as users expect of a
     /// second Ctrl-C (the file keeps every step up to its last flush).
@@ -565,10 +587,14 @@ impl StopFlags {
     /// # Errors
     /// The handlers cannot be installed.
     pub fn install() -> std::io::Result<StopFlags> {
-        use signal_hook::consts::{SIGINT, SIGTERM};
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
         let flags = StopFlags::default();
         let any = Arc::new(AtomicBool::new(false));
-        for (sig, flag) in [(SIGINT, &flags.sigint), (SIGTERM, &flags.sigterm)] {
+        for (sig, flag) in [
+            (SIGINT, &flags.sigint),
+            (SIGTERM, &flags.sigterm),
+            (SIGHUP, &flags.sighup),
+        ] {
             // Order matters: the shutdown hook must see `any` still false on
             // the first signal (signal-hook's documented pattern).
             signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&any))?;
@@ -584,6 +610,8 @@ impl StopFlags {
             Some("SIGINT")
         } else if self.sigterm.load(Ordering::Relaxed) {
             Some("SIGTERM")
+        } else if self.sighup.load(Ordering::Relaxed) {
+            Some("SIGHUP")
         } else {
             None
         }
@@ -601,6 +629,22 @@ pub struct RunOptions {
     pub restart: bool,
     /// Polled after every step.
     pub stop: StopFlags,
+    /// The `--set` overrides the run was given, repeated in the command
+    /// that continues it (a restart must read the same case).
+    pub sets: Vec<String>,
+}
+
+/// `s` as one shell word: as it is where it holds only characters no
+/// shell reads specially, else in single quotes.
+fn shell_word(s: &str) -> String {
+    let plain = !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "._-/=:,+@%".contains(c));
+    if plain {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', "'\\''"))
+    }
 }
 
 /// Multiple of the physically possible mechanical energy above which an
@@ -629,7 +673,7 @@ fn blow_up(i: &Integrator, initial: f64) -> Option<f64> {
 
 /// `stickslip run`: integrate to t_end writing every `output.every`-th
 /// step; flush and checkpoint every `output.flush_every` steps or
-/// `output.flush_seconds` seconds; stop cleanly on SIGINT/SIGTERM; with
+/// `output.flush_seconds` seconds; stop cleanly on SIGINT, SIGTERM or SIGHUP; with
 /// `options.restart`, continue the file `out` from its checkpoint.
 ///
 /// # Errors
@@ -661,6 +705,26 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     let node_order = model.dofs.node_order();
     let e0 = integrator.energy();
     let mut initial_mechanical = e0.kinetic + e0.strain;
+    // A signal during the setup: stop before the file is touched (with
+    // --force the old results would otherwise be gone for a run of one
+    // step).
+    if let Some(signal) = options.stop.received() {
+        if !quiet {
+            say!(
+                "stopped by {signal} before the first step; {} is as it was",
+                out.display()
+            );
+        }
+        return Ok(Outcome::Interrupted);
+    }
+    // Held until this run returns, from before its first write: a second
+    // run's --force or --restart, or a probe, sees the file in use
+    // ([`crate::results_file::in_use`]).
+    let _lock = if options.restart {
+        crate::results_file::RunLock::take(out)?
+    } else {
+        crate::results_file::claim(out)?
+    };
     let (mut writer, wall_before, mut max_balance, mut times) = if options.restart {
         let stored = output::read_checkpoint(out)
             .map_err(|e| input(format!("--restart {}: {e:#}", out.display())))?;
@@ -673,6 +737,17 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                 case.path.display(),
                 out.display(),
                 changes.join("\n  ")
+            )));
+        }
+        if let Some(change) = output::stored_mesh_change(out, &mesh)
+            .map_err(|e| input(format!("--restart {}: {e:#}", out.display())))?
+        {
+            return Err(input(format!(
+                "{}: --restart {}: {} has changed since the run began ({change}); restart with \
+                 the mesh the run began on, or start a new run with -o NEW.h5",
+                case.path.display(),
+                out.display(),
+                case.mesh.file.display()
             )));
         }
         let cp = &stored.checkpoint;
@@ -740,7 +815,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         let mut w = ResultsWriter::open_append(out, stored.extra.rows, mesh.nodes.len(), n_c)?;
         w.set_case(&case.source)?;
         if !quiet {
-            eprintln!(
+            say!(
                 "restart: continuing {} from step {}, t = {} ({} records kept)",
                 out.display(),
                 cp.steps,
@@ -761,20 +836,11 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             contact_nodes: &contact_nodes,
             contact_s: &contact_s,
         };
-        crate::results_file::make_room(out)?;
         let mut w = ResultsWriter::create_with(out, &header, case.output.compression)
             .with_context(|| format!("cannot create the results file {}", out.display()))?;
         w.append(&record(&integrator, &model, &mut full, 0.0, 0))?;
         (w, 0.0, 0.0, vec![integrator.time()])
     };
-    // Held until this run returns: a second run's --force or --restart
-    // sees the file in use ([`crate::results_file::in_use`]).
-    let _lock = crate::results_file::RunLock::take(out).map_err(|e| {
-        input(format!(
-            "{} is open in another process ({e}); wait for it, or write elsewhere with -o",
-            out.display()
-        ))
-    })?;
     writer.auto_flush = false;
     writer.flush_every_steps = case.output.flush_every.max(1);
     writer.flush_every_secs = case.output.flush_seconds;
@@ -899,7 +965,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                         last_log = Instant::now();
                         let wall = started.elapsed().as_secs_f64();
                         let done = (integrator.time() - t_start) / (t_end - t_start).max(1e-300);
-                        eprintln!(
+                        say!(
                             "progress: t = {:.6e} of {t_end} ({:.1}%), step {}, {:.0} s elapsed, about {:.0} s left",
                             integrator.time(),
                             100.0 * done,
@@ -939,7 +1005,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     let reason = match (&failure, interrupted) {
         (Some(f), _) => Some(f.clone()),
         (None, Some(sig)) => Some(format!(
-            "interrupted by {sig} at step {}, t = {}; continue with --restart",
+            "interrupted by {sig} at step {}, t = {}; continue with --restart (and the run's --set overrides, if any)",
             integrator.steps(),
             integrator.time()
         )),
@@ -965,7 +1031,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         "failed"
     };
     if !quiet {
-        eprintln!(
+        say!(
             "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations, K by {}) in {:.3} s",
             match status {
                 "complete" => "done:",
@@ -988,11 +1054,11 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         } else {
             String::new()
         };
-        eprintln!(
+        say!(
             "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}); largest |balance| {:.3e}{damped}",
             e.total, e.kinetic, e.strain, e.external_work, e.dissipated, max_balance
         );
-        eprintln!("results: {} ({rows} records)", out.display());
+        say!("results: {} ({rows} records)", out.display());
     }
     if options.json {
         let j = serde_json::json!({
@@ -1023,28 +1089,33 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             "failure": reason,
             "restarted": options.restart,
         });
-        println!("{j}");
+        say_out!("{j}");
     }
     if let Some(sig) = interrupted {
-        eprintln!(
+        say!(
             "interrupted by {sig}: stopped after step {}, t = {} of t_end = {t_end}; {} holds {rows} records (up to t = {}) and a checkpoint (complete = false)",
             integrator.steps(),
             integrator.time(),
             out.display(),
             times.last().copied().unwrap_or(0.0)
         );
-        eprintln!(
-            "continue with: stickslip run {} --restart {}",
-            case.path.display(),
-            out.display()
+        let sets: String = options
+            .sets
+            .iter()
+            .map(|s| format!(" --set {}", shell_word(s)))
+            .collect();
+        say!(
+            "continue with: stickslip run {} --restart {}{sets}",
+            shell_word(&case.path.display().to_string()),
+            shell_word(&out.display().to_string())
         );
         return Ok(Outcome::Interrupted);
     }
     match failure {
         None => Ok(Outcome::Complete),
         Some(e) => {
-            eprintln!("error: {}: {e}", case.path.display());
-            eprintln!(
+            say!("error: {}: {e}", case.path.display());
+            say!(
                 "error: {} keeps every step completed before the failure ({rows} records, complete = false, reason in its failure attribute)",
                 out.display()
             );

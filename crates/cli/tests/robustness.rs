@@ -521,7 +521,9 @@ print(n)
 fn sigint_and_sigterm_stop_cleanly_with_a_valid_file() {
     let dir = scratch("sigint");
     let (case, _) = slab_case(&dir, "sigint", |t| t);
-    for sig in ["SIGINT", "SIGTERM"] {
+    // SIGHUP: a closed terminal or a dropped ssh session (it ended the run
+    // between flushes, with no message and no checkpoint of its last steps).
+    for sig in ["SIGINT", "SIGTERM", "SIGHUP"] {
         let out = dir.join(format!("{sig}.h5"));
         let child = start_long(&case, &out, &[], 1.0);
         signal(&child, &format!("-{}", &sig[3..]));
@@ -531,6 +533,12 @@ fn sigint_and_sigterm_stop_cleanly_with_a_valid_file() {
         assert!(
             e.contains(&format!("interrupted by {sig}: stopped after step"))
                 && e.contains("--restart"),
+            "{e}"
+        );
+        // The command it suggests repeats the run's --set overrides (a
+        // restart without them was refused).
+        assert!(
+            e.contains(&format!("--restart {} --set time.t_end=200", out.display())),
             "{e}"
         );
         // Through the hdf5 crate: a valid, incomplete file whose last row is
@@ -1159,4 +1167,268 @@ fn interior_lines_and_shared_group_names_are_refused() {
     std::fs::write(&shared, msh.replace("1 5 \"crack\"", "1 5 \"support\"")).unwrap();
     let (case, _) = slab_case(&dir, "shared", |t| on(&shared, t));
     refused(&case, &[], &["several physical groups called \"support\""]);
+}
+
+/// `-o` never writes over an input of the case, a device or a FIFO, nor
+/// names the .xdmf (which is written beside the .h5 under its name): with
+/// --force a run as root replaced /dev/null with a results file, wrote
+/// over the case's mesh, hung on a FIFO, and `-o out.xdmf` wrote the XDMF
+/// over the HDF5 file. Without --force, only an HDF5 file is offered
+/// --restart.
+#[test]
+fn inputs_devices_fifos_and_the_xdmf_are_never_the_output() {
+    let dir = scratch("not-output");
+    let mesh = dir.join("m.msh");
+    std::fs::copy(root().join("cases/meshes/slab-q2-8x2.msh"), &mesh).unwrap();
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let set = format!("mesh.file={}", toml_str(&mesh));
+    let before = std::fs::read(&mesh).unwrap();
+    let o = run(&case, &mesh, &["--set", &set]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is an input of the case"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read(&mesh).unwrap(),
+        before,
+        "the mesh is untouched"
+    );
+
+    let fifo = dir.join("fifo");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let o = run(&case, &fifo, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is not a regular file"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run(&case, Path::new("/dev/null"), &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(std::fs::metadata("/dev/null").is_ok_and(|m| !m.is_file()));
+
+    let o = run(&case, &dir.join("out.xdmf"), &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("give -o"), "{}", stderr(&o));
+    assert!(!dir.join("out.xdmf").exists());
+
+    let text = dir.join("notes.h5");
+    std::fs::write(&text, "my notes").unwrap();
+    let o = bin()
+        .arg("run")
+        .arg(&case)
+        .arg("-o")
+        .arg(&text)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("already exists") && !stderr(&o).contains("--restart"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// A TOML basic string of a path.
+fn toml_str(p: &Path) -> String {
+    format!("{:?}", p.display().to_string())
+}
+
+/// Of two runs started on one file at once, one writes it and the other
+/// is refused: fresh runs with --force (the second removed the first's new
+/// file and both reported success, one result lost) and restarts (both
+/// appended, and the file claimed to be complete with wrong rows). HDF5's
+/// locking is off under cargo test, as when a user's environment turns it
+/// off; the run's own lock decides.
+#[test]
+fn of_two_runs_on_one_file_one_writes_it() {
+    let dir = scratch("two-runs");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let out = dir.join("two.h5");
+    let spawn = |args: &[&str]| {
+        bin()
+            .arg("run")
+            .arg(&case)
+            .args(args)
+            .args(["--quiet", "--set", "time.t_end=200"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let o = out.to_str().unwrap();
+    for args in [vec!["-o", o, "--force"], vec!["--restart", o]] {
+        if args[0] == "--restart" {
+            // A checkpoint to restart from.
+            let c = start_long(&case, &out, &["--quiet"], 0.5);
+            signal(&c, "-INT");
+            assert_eq!(c.wait_with_output().unwrap().status.code(), Some(130));
+        }
+        let mut runs = [spawn(&args), spawn(&args)];
+        let t0 = Instant::now();
+        let mut refused = None;
+        while refused.is_none() && t0.elapsed() < Duration::from_secs(60) {
+            for (k, r) in runs.iter_mut().enumerate() {
+                if r.try_wait().unwrap().is_some() {
+                    refused = Some(k);
+                }
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let k = refused.expect("one of the two ends at once");
+        let [a, b] = runs;
+        let (loser, winner) = if k == 0 { (a, b) } else { (b, a) };
+        let still = std::process::Command::new("kill")
+            .args(["-0", &winner.id().to_string()])
+            .status()
+            .unwrap()
+            .success();
+        signal(&winner, "-INT");
+        let lost = loser.wait_with_output().unwrap();
+        let won = winner.wait_with_output().unwrap();
+        assert!(still, "{args:?}: the other run goes on");
+        assert_eq!(lost.status.code(), Some(2), "{args:?}: {}", stderr(&lost));
+        assert!(
+            stderr(&lost).contains("another"),
+            "{args:?}: {}",
+            stderr(&lost)
+        );
+        assert_eq!(won.status.code(), Some(130), "{args:?}: {}", stderr(&won));
+        // The winner's file: records and checkpoint agree.
+        let f = hdf5::File::open(&out).unwrap();
+        let n = f.dataset("time").unwrap().size();
+        let rows = slot(&f).attr("rows").unwrap().read_scalar::<u64>().unwrap();
+        assert_eq!(rows as usize, n, "{args:?}");
+    }
+}
+
+/// A restart continues on the mesh its run began on: a mesh file changed
+/// since (here Q1 16x4 written over Q2 8x2, both 85 nodes) was continued
+/// silently with the other mesh.
+#[test]
+fn restart_refuses_a_changed_mesh() {
+    let dir = scratch("changed-mesh");
+    let mesh = dir.join("m.msh");
+    std::fs::copy(root().join("cases/meshes/slab-q2-8x2.msh"), &mesh).unwrap();
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let set = format!("mesh.file={}", toml_str(&mesh));
+    let out = dir.join("r.h5");
+    ok(&run(&case, &out, &["--set", &set]));
+    ok(&restart(
+        &case,
+        &out,
+        &["--set", &set, "--set", "time.t_end=0.06"],
+    ));
+    std::fs::copy(root().join("cases/meshes/slab-q1-16x4.msh"), &mesh).unwrap();
+    let before = std::fs::read(&out).unwrap();
+    let o = restart(&case, &out, &["--set", &set, "--set", "time.t_end=0.07"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("has changed since the run began"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        before,
+        "the file is untouched"
+    );
+}
+
+/// Damaged results files are refused, not read: a stored case that is
+/// not UTF-8 (probe and --restart panicked: exit 101), and a /time that
+/// claims 1e11 rows (probe aborted on an 800 GB allocation; a restart
+/// continued with zeros for the times).
+#[test]
+fn damaged_results_files_are_refused() {
+    let dir = scratch("damaged");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let good = dir.join("good.h5");
+    ok(&run(&case, &good, &[]));
+
+    let utf8 = dir.join("utf8.h5");
+    let mut bytes = std::fs::read(&good).unwrap();
+    let at = bytes
+        .windows(8)
+        .position(|w| w == b"\n\n[time]")
+        .expect("the case text in the file");
+    bytes[at + 2] = 0xbf;
+    std::fs::write(&utf8, bytes).unwrap();
+    let probe = bin()
+        .arg("probe")
+        .arg(&utf8)
+        .args(["--along", "contact", "--times", "0"])
+        .output()
+        .unwrap();
+    assert_ne!(probe.status.code(), Some(101), "{}", stderr(&probe));
+    let o = restart(&case, &utf8, &["--set", "time.t_end=0.1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("not UTF-8"), "{}", stderr(&o));
+
+    let huge = dir.join("huge.h5");
+    std::fs::copy(&good, &huge).unwrap();
+    {
+        let f = hdf5::File::open_rw(&huge).unwrap();
+        f.unlink("time").unwrap();
+        f.new_dataset::<f64>()
+            .chunk(1024)
+            .shape(100_000_000_000usize)
+            .create("time")
+            .unwrap();
+    }
+    let probe = bin()
+        .arg("probe")
+        .arg(&huge)
+        .args(["--at", "8,0"])
+        .output()
+        .unwrap();
+    assert_eq!(probe.status.code(), Some(2), "{}", stderr(&probe));
+    assert!(stderr(&probe).contains("damaged"), "{}", stderr(&probe));
+    let o = restart(&case, &huge, &["--set", "time.t_end=0.1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("damaged"), "{}", stderr(&o));
+}
+
+/// A closed pipe: `check | head` ends quietly (it panicked, exit 101), and
+/// a run whose stderr is closed still completes its file (it panicked at
+/// its first message and lost the steps since the last flush).
+#[test]
+fn closed_pipes_neither_panic_nor_end_a_run() {
+    let dir = scratch("pipes");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let mut c = bin()
+        .arg("check")
+        .arg(&case)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(c.stdout.take());
+    let o = c.wait_with_output().unwrap();
+    assert_ne!(o.status.code(), Some(101), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+
+    let out = dir.join("run.h5");
+    let mut c = bin()
+        .arg("run")
+        .arg(&case)
+        .arg("-o")
+        .arg(&out)
+        .args(["--set", "time.t_end=2"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(c.stderr.take());
+    let o = c.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    let f = hdf5::File::open(&out).unwrap();
+    assert!(f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
 }
