@@ -107,6 +107,15 @@ pub enum MeshErrorKind {
         /// The text found (shortened).
         found: String,
     },
+    /// An ASCII record (one line) with too few or too many numbers.
+    #[error("{record}, this line has {found}; every record of the mesh must be one whole line: the file is damaged or was edited by hand, re-export the mesh from Gmsh")]
+    FieldCount {
+        /// What the record needs, e.g. "a quad4 element needs 5 numbers
+        /// (its tag and 4 node tags)".
+        record: String,
+        /// How many numbers its line has.
+        found: usize,
+    },
     /// Something else that does not follow the MSH format.
     #[error("malformed file: {what}; re-export the mesh from Gmsh")]
     Malformed {
