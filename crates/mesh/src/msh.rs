@@ -57,10 +57,22 @@ fn parse_with(cur: &mut Cursor<'_>) -> Result<Mesh> {
     let mut entities: Option<v4::Entities> = None;
     let mut seen_nodes = false;
     let mut seen_elements = false;
+    let mut seen_names = false;
     while let Some((p, t)) = cur.token() {
         let t = &t[..];
         match t {
-            b"$PhysicalNames" => physical_names(cur, &mut b)?,
+            // A second one would silently rename groups.
+            b"$PhysicalNames" => {
+                if seen_names {
+                    return Err(out_of_place(cur, p, t, "a second $PhysicalNames section"));
+                }
+                seen_names = true;
+                physical_names(cur, &mut b)?;
+            }
+            // It could contradict the first (version, ASCII or binary).
+            b"$MeshFormat" => {
+                return Err(out_of_place(cur, p, t, "a second $MeshFormat section"));
+            }
             b"$Entities" if version == "4.1" => {
                 if seen_elements || entities.is_some() {
                     return Err(out_of_place(

@@ -686,3 +686,27 @@ fn ascii_with_crlf_line_ends() {
 fn err_free(t: &str) -> Mesh {
     Mesh::from_bytes(t.as_bytes()).unwrap_or_else(|e| panic!("{e}"))
 }
+
+// ---- sections given twice ----
+
+#[test]
+fn second_physical_names_or_mesh_format_refused() {
+    // A second $PhysicalNames renamed group 4 ("support" became "other").
+    let t = text(Q4_22) + "$PhysicalNames\n1\n1 4 \"other\"\n$EndPhysicalNames\n";
+    let e = err(&t);
+    assert!(
+        matches!(&e.kind, K::SectionOrder { found, .. } if found == "$PhysicalNames"),
+        "{e}"
+    );
+    let second = t.match_indices("$PhysicalNames").nth(1).unwrap().0;
+    let line = 1 + t[..second].matches('\n').count();
+    assert_eq!(e.location, Location::Line(line));
+    // A second $MeshFormat was skipped whatever it said.
+    let t = text(Q4_41) + "$MeshFormat\n2.2 1 8\n$EndMeshFormat\n";
+    let e = err(&t);
+    assert!(
+        matches!(&e.kind, K::SectionOrder { found, .. } if found == "$MeshFormat"),
+        "{e}"
+    );
+    assert_eq!(e.location, Location::Line(t.lines().count() - 2));
+}
