@@ -710,3 +710,74 @@ fn second_physical_names_or_mesh_format_refused() {
     );
     assert_eq!(e.location, Location::Line(t.lines().count() - 2));
 }
+
+// ---- binary files copied in text mode ----
+
+/// A binary file whose LF were turned into CR LF (a text-mode copy) is
+/// reported as such, at the end of the $MeshFormat line; it was reported as
+/// cut short, or as NaN coordinates.
+#[test]
+fn binary_with_crlf_line_ends() {
+    for name in ["slab_q4_v22_bin.msh", "slab_q4_v41_bin.msh"] {
+        let b = bytes(name);
+        let mut crlf = Vec::with_capacity(b.len() * 2);
+        for &c in &b {
+            if c == b'\n' {
+                crlf.push(b'\r');
+            }
+            crlf.push(c);
+        }
+        let e = err_bytes(&crlf);
+        assert_eq!(e.kind, K::TextModeTransfer, "{name}: {e}");
+        assert_eq!(e.location, Location::Byte(find(&crlf, b" 8\r\n") + 2));
+        assert!(e.to_string().contains("binary mode"), "{e}");
+        // Only the byte-order integer shifted by a CR.
+        let mut b = b.clone();
+        let at = find(&b, b" 8\n") + 3;
+        b.insert(at, b'\r');
+        let e = err_bytes(&b);
+        assert_eq!(e.kind, K::TextModeTransfer, "{name}: {e}");
+        assert_eq!(e.location, Location::Byte(at));
+    }
+}
+
+/// Values quoted in messages are short: a bad binary coordinate is shown in
+/// exponent form, not as 300 decimals.
+#[test]
+fn bad_binary_coordinates_are_quoted_short() {
+    for name in ["slab_q4_v22_bin.msh", "slab_q4_v41_bin.msh"] {
+        let mut b = bytes(name);
+        // The first node's coordinates: after the 2.2 count line and tag,
+        // or the 4.1 headers and the block's one tag.
+        let x = if name.contains("v22") {
+            find(&b, b"$Nodes\n15\n") + 10 + 4
+        } else {
+            find(&b, b"$Nodes\n") + 7 + 32 + 20 + 8
+        };
+        b[x..x + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+        b[x + 16..x + 24].copy_from_slice(&f64::MIN_POSITIVE.to_le_bytes());
+        let e = err_bytes(&b);
+        let K::NotANumber { found, .. } = &e.kind else {
+            panic!("{name}: {e}")
+        };
+        assert!(found.len() < 40, "{name}: {found}");
+        assert!(found.contains("2.2250738585072014e-308"), "{name}: {found}");
+    }
+}
+
+/// Other values quoted in messages: a huge z in exponent form, a long
+/// section keyword cut.
+#[test]
+fn long_values_are_quoted_short() {
+    let t = replace_line(
+        &text(Q4_22),
+        "9 6.000000000002768 1.375000000000173 0",
+        "9 6.000000000002768 1.375000000000173 1e300",
+    );
+    let e = err(&t);
+    assert!(e.to_string().contains("has z = 1e300;"), "{e}");
+    let t = text(Q4_22) + "$" + &"A".repeat(300) + "\n1 2 3\n";
+    let e = err(&t);
+    assert!(e.to_string().len() < 300, "{e}");
+    assert!(matches!(e.kind, K::MissingEnd { .. }), "{e}");
+}

@@ -581,13 +581,16 @@ impl<'a> Cursor<'a> {
     }
 
     /// After the ASCII count line of a binary section: skips to just after
-    /// the end of the line, where the binary data starts.
-    pub(crate) fn end_of_line(&mut self) -> Result<()> {
+    /// the end of the line, where the binary data starts. Returns whether
+    /// the line ended with CR LF (see `mesh_format`).
+    pub(crate) fn end_of_line(&mut self) -> Result<bool> {
+        let mut cr = false;
         while let Some(b) = self.peek_byte() {
             self.i += 1;
-            match b {
-                b'\n' => return Ok(()),
-                b' ' | b'\t' | b'\r' => {}
+            cr = match b {
+                b'\n' => return Ok(cr),
+                b'\r' => true,
+                b' ' | b'\t' => false,
                 _ => {
                     return Err(self.error(
                         self.pos() - 1,
@@ -599,7 +602,7 @@ impl<'a> Cursor<'a> {
                         },
                     ))
                 }
-            }
+            };
         }
         Err(self.truncated(self.pos()))
     }

@@ -100,7 +100,8 @@ fn finite_xyz(cur: &Cursor<'_>, at: usize, xyz: [f64; 3]) -> Result<[f64; 3]> {
         at,
         MeshErrorKind::NotANumber {
             what: "a node coordinate",
-            found: format!("{x} {y} {z}"),
+            // Debug, not Display: a tiny value would be 300 digits.
+            found: format!("{x:?} {y:?} {z:?}"),
         },
     ))
 }

@@ -229,7 +229,8 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                             start + size * j,
                             MeshErrorKind::NotANumber {
                                 what: "a node coordinate",
-                                found: format!("{x} {y} {z}"),
+                                // Debug, not Display: a tiny value would be 300 digits.
+                                found: format!("{x:?} {y:?} {z:?}"),
                             },
                         ));
                     }
