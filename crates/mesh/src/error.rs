@@ -107,6 +107,18 @@ pub enum MeshErrorKind {
         /// The text found (shortened).
         found: String,
     },
+    /// An ASCII record (one line) with too few or too many numbers.
+    #[error("{record}, this line has {found}; every record of the mesh must be one whole line: the file is damaged or was edited by hand, re-export the mesh from Gmsh")]
+    FieldCount {
+        /// What the record needs, e.g. "a quad4 element needs 5 numbers
+        /// (its tag and 4 node tags)".
+        record: String,
+        /// How many numbers its line has.
+        found: usize,
+    },
+    /// A binary file whose line ends were converted to CR LF.
+    #[error("the binary .msh file was transferred in text mode: its line ends were turned into CR LF (\\r\\n), which also changes bytes inside the binary data; copy the file again in binary mode (e.g. FTP `binary`, or `*.msh binary` in .gitattributes) or re-export it from Gmsh")]
+    TextModeTransfer,
     /// Something else that does not follow the MSH format.
     #[error("malformed file: {what}; re-export the mesh from Gmsh")]
     Malformed {
@@ -199,7 +211,7 @@ pub enum MeshErrorKind {
     #[error("the file has no quad cells; mesh the surface (`gmsh -2`), and either put the surface in a physical group or save all elements (Mesh.SaveAll = 1)")]
     NoCells,
     /// A node off the z = 0 plane.
-    #[error("node {node} has z = {z}; stickslip reads plane meshes in the z = 0 plane: build the geometry in the xy-plane and mesh it in 2-D (`gmsh -2`)")]
+    #[error("node {node} has z = {z:?}; stickslip reads plane meshes in the z = 0 plane: build the geometry in the xy-plane and mesh it in 2-D (`gmsh -2`)")]
     NotPlanar {
         /// The node's tag.
         node: u64,

@@ -57,10 +57,22 @@ fn parse_with(cur: &mut Cursor<'_>) -> Result<Mesh> {
     let mut entities: Option<v4::Entities> = None;
     let mut seen_nodes = false;
     let mut seen_elements = false;
+    let mut seen_names = false;
     while let Some((p, t)) = cur.token() {
         let t = &t[..];
         match t {
-            b"$PhysicalNames" => physical_names(cur, &mut b)?,
+            // A second one would silently rename groups.
+            b"$PhysicalNames" => {
+                if seen_names {
+                    return Err(out_of_place(cur, p, t, "a second $PhysicalNames section"));
+                }
+                seen_names = true;
+                physical_names(cur, &mut b)?;
+            }
+            // It could contradict the first (version, ASCII or binary).
+            b"$MeshFormat" => {
+                return Err(out_of_place(cur, p, t, "a second $MeshFormat section"));
+            }
             b"$Entities" if version == "4.1" => {
                 if seen_elements || entities.is_some() {
                     return Err(out_of_place(
@@ -193,10 +205,19 @@ fn mesh_format(cur: &mut Cursor<'_>) -> Result<(&'static str, bool)> {
         if data_size != 8 {
             return Err(cur.error(tp, MeshErrorKind::UnsupportedDataSize { size: data_size }));
         }
-        cur.end_of_line()?;
+        // Gmsh writes binary files with LF line ends. CR LF here, or a CR
+        // before the byte-order integer, means the file went through a
+        // text-mode copy, which also put a CR before every 0x0a byte of
+        // the data: say so rather than report what the shifted data looks
+        // like (an early end, NaN coordinates).
+        let eol = cur.pos();
+        if cur.end_of_line()? {
+            return Err(cur.error(eol, MeshErrorKind::TextModeTransfer));
+        }
         let p = cur.pos();
         match cur.take::<4>()? {
             [1, 0, 0, 0] => {}
+            [b'\r', 1, 0, 0] => return Err(cur.error(p, MeshErrorKind::TextModeTransfer)),
             [0, 0, 0, 1] => return Err(cur.error(p, MeshErrorKind::BigEndian)),
             other => {
                 return Err(cur.error(
@@ -316,7 +337,8 @@ fn skip_section(cur: &mut Cursor<'_>, pos: usize, keyword: &[u8]) -> Result<()> 
         }
         cur.advance(1);
     }
-    let section = String::from_utf8_lossy(keyword).into_owned();
+    // The keyword is whatever followed a '$', of any length.
+    let section = String::from_utf8_lossy(keyword.get(..40).unwrap_or(keyword)).into_owned();
     Err(cur.error(
         pos,
         MeshErrorKind::MissingEnd {

@@ -572,3 +572,212 @@ fn file_errors_name_the_file_and_line() {
     let e = Mesh::from_file(dir.join("none.msh")).unwrap_err();
     assert!(matches!(e.kind, K::Io(_)));
 }
+
+// ---- ASCII records are whole lines ----
+
+/// The error and line of `t`, which must be a [`K::FieldCount`] with `found`
+/// numbers on the line equal to `line`.
+fn short_or_long(t: &str, line: &str, found: usize) -> String {
+    let e = err(t);
+    assert!(
+        matches!(&e.kind, K::FieldCount { found: f, .. } if *f == found),
+        "{e}"
+    );
+    assert_eq!(e.location, Location::Line(line_no(t, line)), "{e}");
+    e.to_string()
+}
+
+/// One number too few or too many on an element line is reported there,
+/// with what the line needs; read as a stream of numbers, the records after
+/// it shifted and gave a wrong geometric diagnosis (a "degenerate" cell).
+#[test]
+fn element_line_with_a_number_missing_or_extra() {
+    // MSH 4.1: a quad4 line is its tag and 4 node tags.
+    let t = replace_line(&text(Q4_41), "14 1 5 13 12", "14 1 5 13");
+    let msg = short_or_long(&t, "14 1 5 13", 4);
+    assert!(
+        msg.contains("a quad4 element needs 5 numbers (its tag and 4 node tags), this line has 4")
+            && msg.contains("re-export the mesh from Gmsh"),
+        "{msg}"
+    );
+    let t = replace_line(&text(Q4_41), "14 1 5 13 12", "14 1 5 13 12 7");
+    short_or_long(&t, "14 1 5 13 12 7", 6);
+    // The last element before $EndElements.
+    let t = text(Q4_41);
+    let last = t.lines().nth(line_no(&t, "$EndElements") - 2).unwrap();
+    let cut = last.trim_end().rsplit_once(' ').unwrap().0;
+    let t = replace_line(&t, last.trim_end(), cut);
+    short_or_long(&t, cut, 4);
+    // MSH 2.2: number, type, number of tags, the tags, the node tags.
+    let t = replace_line(&text(Q4_22), "14 3 2 10 1 1 5 13 12", "14 3 2 10 1 1 5 13");
+    let msg = short_or_long(&t, "14 3 2 10 1 1 5 13", 8);
+    assert!(
+        msg.contains("a quad4 element with 2 tags needs 9 numbers"),
+        "{msg}"
+    );
+    let t = replace_line(
+        &text(Q4_22),
+        "14 3 2 10 1 1 5 13 12",
+        "14 3 2 10 1 1 5 13 12 9",
+    );
+    short_or_long(&t, "14 3 2 10 1 1 5 13 12 9", 10);
+    let t = replace_line(&text(Q4_22), "14 3 2 10 1 1 5 13 12", "14 3");
+    short_or_long(&t, "14 3", 2);
+    // quad9 (the review's q2short.msh): a node tag missing.
+    let t = text("slab_q9_v22_ascii.msh");
+    let line = t
+        .lines()
+        .find(|l| l.split(' ').nth(1) == Some("10") && l.split_whitespace().count() == 14)
+        .unwrap();
+    let cut = line.trim_end().rsplit_once(' ').unwrap().0;
+    let t = replace_line(&t, line.trim_end(), cut);
+    let msg = short_or_long(&t, cut, 13);
+    assert!(
+        msg.contains("a quad9 element with 2 tags needs 14 numbers"),
+        "{msg}"
+    );
+}
+
+/// Node lines, block headers and section headers too.
+#[test]
+fn node_and_header_lines_with_a_number_missing_or_extra() {
+    // MSH 2.2: tag x y z.
+    let t = replace_line(
+        &text(Q4_22),
+        "5 1.999999999995288 0 0",
+        "5 1.999999999995288 0",
+    );
+    short_or_long(&t, "5 1.999999999995288 0", 3);
+    let t = replace_line(
+        &text(Q4_22),
+        "5 1.999999999995288 0 0",
+        "5 1.999999999995288 0 0 0",
+    );
+    short_or_long(&t, "5 1.999999999995288 0 0 0", 5);
+    // MSH 4.1: the tags one a line, then x y z one node a line.
+    let t = replace_line(&text(Q4_41), "1.999999999995288 0 0", "1.999999999995288 0");
+    short_or_long(&t, "1.999999999995288 0", 2);
+    let t = text(Q4_41).replacen("\n5\n6\n7\n", "\n5 6\n6\n7\n", 1);
+    short_or_long(&t, "5 6", 2);
+    // An entity line (curve 1: bounding box, 1 physical tag, 2 points).
+    let t = text(Q4_41);
+    let line = t.lines().find(|l| l.starts_with("1 0 0 0 8 0 0 ")).unwrap();
+    let long = format!("{} 5", line.trim_end());
+    let t = replace_line(&t, line.trim_end(), &long);
+    let msg = short_or_long(&t, &long, 13);
+    assert!(msg.contains("a curve entity needs"), "{msg}");
+    // A block header and a section header.
+    let t = replace_line(&text(Q4_41), "0 1 15 1", "0 1 15");
+    short_or_long(&t, "0 1 15", 3);
+    let t = replace_line(&text(Q4_41), "6 21 1 21", "6 21 1 21 0");
+    short_or_long(&t, "6 21 1 21 0", 5);
+}
+
+/// ASCII files with CR LF line ends (written on Windows) are legitimate:
+/// CR is a blank, not a field, on a record's line.
+#[test]
+fn ascii_with_crlf_line_ends() {
+    for name in [Q4_22, Q4_41, "slab_q9_param_v41_ascii.msh"] {
+        let t = text(name).replace('\n', "\r\n");
+        same_mesh(&err_free(&t), &load(name), name);
+    }
+}
+
+fn err_free(t: &str) -> Mesh {
+    Mesh::from_bytes(t.as_bytes()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+// ---- sections given twice ----
+
+#[test]
+fn second_physical_names_or_mesh_format_refused() {
+    // A second $PhysicalNames renamed group 4 ("support" became "other").
+    let t = text(Q4_22) + "$PhysicalNames\n1\n1 4 \"other\"\n$EndPhysicalNames\n";
+    let e = err(&t);
+    assert!(
+        matches!(&e.kind, K::SectionOrder { found, .. } if found == "$PhysicalNames"),
+        "{e}"
+    );
+    let second = t.match_indices("$PhysicalNames").nth(1).unwrap().0;
+    let line = 1 + t[..second].matches('\n').count();
+    assert_eq!(e.location, Location::Line(line));
+    // A second $MeshFormat was skipped whatever it said.
+    let t = text(Q4_41) + "$MeshFormat\n2.2 1 8\n$EndMeshFormat\n";
+    let e = err(&t);
+    assert!(
+        matches!(&e.kind, K::SectionOrder { found, .. } if found == "$MeshFormat"),
+        "{e}"
+    );
+    assert_eq!(e.location, Location::Line(t.lines().count() - 2));
+}
+
+// ---- binary files copied in text mode ----
+
+/// A binary file whose LF were turned into CR LF (a text-mode copy) is
+/// reported as such, at the end of the $MeshFormat line; it was reported as
+/// cut short, or as NaN coordinates.
+#[test]
+fn binary_with_crlf_line_ends() {
+    for name in ["slab_q4_v22_bin.msh", "slab_q4_v41_bin.msh"] {
+        let b = bytes(name);
+        let mut crlf = Vec::with_capacity(b.len() * 2);
+        for &c in &b {
+            if c == b'\n' {
+                crlf.push(b'\r');
+            }
+            crlf.push(c);
+        }
+        let e = err_bytes(&crlf);
+        assert_eq!(e.kind, K::TextModeTransfer, "{name}: {e}");
+        assert_eq!(e.location, Location::Byte(find(&crlf, b" 8\r\n") + 2));
+        assert!(e.to_string().contains("binary mode"), "{e}");
+        // Only the byte-order integer shifted by a CR.
+        let mut b = b.clone();
+        let at = find(&b, b" 8\n") + 3;
+        b.insert(at, b'\r');
+        let e = err_bytes(&b);
+        assert_eq!(e.kind, K::TextModeTransfer, "{name}: {e}");
+        assert_eq!(e.location, Location::Byte(at));
+    }
+}
+
+/// Values quoted in messages are short: a bad binary coordinate is shown in
+/// exponent form, not as 300 decimals.
+#[test]
+fn bad_binary_coordinates_are_quoted_short() {
+    for name in ["slab_q4_v22_bin.msh", "slab_q4_v41_bin.msh"] {
+        let mut b = bytes(name);
+        // The first node's coordinates: after the 2.2 count line and tag,
+        // or the 4.1 headers and the block's one tag.
+        let x = if name.contains("v22") {
+            find(&b, b"$Nodes\n15\n") + 10 + 4
+        } else {
+            find(&b, b"$Nodes\n") + 7 + 32 + 20 + 8
+        };
+        b[x..x + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+        b[x + 16..x + 24].copy_from_slice(&f64::MIN_POSITIVE.to_le_bytes());
+        let e = err_bytes(&b);
+        let K::NotANumber { found, .. } = &e.kind else {
+            panic!("{name}: {e}")
+        };
+        assert!(found.len() < 40, "{name}: {found}");
+        assert!(found.contains("2.2250738585072014e-308"), "{name}: {found}");
+    }
+}
+
+/// Other values quoted in messages: a huge z in exponent form, a long
+/// section keyword cut.
+#[test]
+fn long_values_are_quoted_short() {
+    let t = replace_line(
+        &text(Q4_22),
+        "9 6.000000000002768 1.375000000000173 0",
+        "9 6.000000000002768 1.375000000000173 1e300",
+    );
+    let e = err(&t);
+    assert!(e.to_string().contains("has z = 1e300;"), "{e}");
+    let t = text(Q4_22) + "$" + &"A".repeat(300) + "\n1 2 3\n";
+    let e = err(&t);
+    assert!(e.to_string().len() < 300, "{e}");
+    assert!(matches!(e.kind, K::MissingEnd { .. }), "{e}");
+}

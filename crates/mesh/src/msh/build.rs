@@ -29,6 +29,24 @@ pub(crate) fn nodes_of(type_id: i32) -> Option<usize> {
     }
 }
 
+/// "1 node tag", "4 node tags": `n` and `noun`, plural unless `n` is 1.
+pub(crate) fn counted(n: u64, noun: &str) -> String {
+    let s = if n == 1 { "" } else { "s" };
+    format!("{n} {noun}{s}")
+}
+
+/// The name of a type [`nodes_of`] accepts, for messages.
+pub(crate) fn type_name(type_id: i32) -> &'static str {
+    match type_id {
+        POINT => "point",
+        LINE2 => "line2",
+        LINE3 => "line3",
+        QUAD4 => "quad4",
+        QUAD9 => "quad9",
+        _ => "element",
+    }
+}
+
 /// Gmsh's name and dimension of an element type of order 1 or 2 (for
 /// messages; higher orders are [`high_order`]).
 fn describe(type_id: i32) -> (&'static str, u8) {

@@ -507,14 +507,90 @@ impl<'a> Cursor<'a> {
         }
     }
 
+    /// Skips blanks (space, tab, CR) without leaving the line; true when
+    /// another field follows on it. ASCII records are one line each, so a
+    /// field missing here is reported on its line instead of being taken
+    /// from the next record (which would shift every record after it).
+    #[inline]
+    pub(crate) fn more_on_line(&mut self) -> bool {
+        // Fast path, as Gmsh writes: one space, then a field or the line end
+        // (4.1 element lines end in " \n"), inside the window.
+        if let Some(&[a, c]) = self.buf[..self.filled].get(self.i..self.i + 2) {
+            match (a, c) {
+                (b'\n', _) | (b' ', b'\n') => return false,
+                (b' ', c) if !is_ws(c) => {
+                    self.i += 1;
+                    return true;
+                }
+                _ => {}
+            }
+        }
+        loop {
+            match self.peek_byte() {
+                Some(b' ' | b'\t' | b'\r') => self.i += 1,
+                Some(b'\n') | None => return false,
+                Some(_) => return true,
+            }
+        }
+    }
+
+    /// Before field `found` (0-based) of the one-line record at `at`: the
+    /// field must be on the record's line. `record` says what the record
+    /// needs; it is built on the error path only.
+    #[inline]
+    pub(crate) fn need_field(
+        &mut self,
+        at: usize,
+        found: usize,
+        record: impl FnOnce() -> String,
+    ) -> Result<()> {
+        if self.more_on_line() {
+            Ok(())
+        } else if self.peek_byte().is_none() {
+            Err(self.truncated(self.pos()))
+        } else {
+            Err(self.field_count(at, record(), found))
+        }
+    }
+
+    /// After the `found` fields of the one-line record at `at`: nothing but
+    /// blanks may follow on its line.
+    #[inline]
+    pub(crate) fn line_done(
+        &mut self,
+        at: usize,
+        found: usize,
+        record: impl FnOnce() -> String,
+    ) -> Result<()> {
+        if !self.more_on_line() {
+            return Ok(());
+        }
+        let mut found = found;
+        while self.more_on_line() {
+            found += 1;
+            while self.peek_byte().is_some_and(|b| !is_ws(b)) {
+                self.i += 1;
+            }
+        }
+        Err(self.field_count(at, record(), found))
+    }
+
+    #[cold]
+    fn field_count(&self, at: usize, record: String, found: usize) -> MeshError {
+        self.error(at, MeshErrorKind::FieldCount { record, found })
+    }
+
     /// After the ASCII count line of a binary section: skips to just after
-    /// the end of the line, where the binary data starts.
-    pub(crate) fn end_of_line(&mut self) -> Result<()> {
+    /// the end of the line, where the binary data starts. Returns whether
+    /// the line ended with CR LF (see `mesh_format`).
+    pub(crate) fn end_of_line(&mut self) -> Result<bool> {
+        let mut cr = false;
         while let Some(b) = self.peek_byte() {
             self.i += 1;
-            match b {
-                b'\n' => return Ok(()),
-                b' ' | b'\t' | b'\r' => {}
+            cr = match b {
+                b'\n' => return Ok(cr),
+                b'\r' => true,
+                b' ' | b'\t' => false,
                 _ => {
                     return Err(self.error(
                         self.pos() - 1,
@@ -526,7 +602,7 @@ impl<'a> Cursor<'a> {
                         },
                     ))
                 }
-            }
+            };
         }
         Err(self.truncated(self.pos()))
     }

@@ -7,7 +7,7 @@
 
 use std::collections::HashMap;
 
-use super::build::{nodes_of, unsupported, Builder, Membership};
+use super::build::{counted, nodes_of, type_name, unsupported, Builder, Membership};
 use super::cursor::{le_f64, le_i32, Cursor, Result};
 use crate::MeshErrorKind;
 
@@ -50,7 +50,8 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder, parametric: bool) -> 
         b.nodes.reserve(cap);
         b.node_tags.reserve(cap);
         for _ in 0..n {
-            let (tag, [x, y, z]) = ascii_node(cur)?;
+            let (at, tag, [x, y, z]) = ascii_node(cur)?;
+            cur.line_done(at, 4, || NODE.into())?;
             b.push_node(tag, x, y, z, cur.pos());
         }
     }
@@ -58,15 +59,23 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder, parametric: bool) -> 
     b.finish_nodes(cur, header)
 }
 
-/// An ASCII node line's tag and coordinates (`$Nodes` and
-/// `$ParametricNodes` alike).
+const NODE: &str = "a node needs 4 numbers (its tag, x, y and z)";
+const PARAMETRIC: &str =
+    "a parametric node needs at least 6 numbers (its tag, x, y, z, entity dimension and entity tag)";
+
+/// An ASCII node line's start, tag and coordinates (`$Nodes` and
+/// `$ParametricNodes` alike); the caller checks the rest of the line.
 #[inline(always)]
-fn ascii_node(cur: &mut Cursor<'_>) -> Result<(u64, [f64; 3])> {
+fn ascii_node(cur: &mut Cursor<'_>) -> Result<(usize, u64, [f64; 3])> {
+    cur.skip_ws();
+    let at = cur.pos();
     let tag = cur.u64("a node tag")?;
-    let x = cur.f64("a node coordinate")?;
-    let y = cur.f64("a node coordinate")?;
-    let z = cur.f64("a node coordinate")?;
-    Ok((tag, [x, y, z]))
+    let mut xyz = [0.0; 3];
+    for (k, v) in xyz.iter_mut().enumerate() {
+        cur.need_field(at, 1 + k, || NODE.into())?;
+        *v = cur.f64("a node coordinate")?;
+    }
+    Ok((at, tag, xyz))
 }
 
 /// A binary node record's tag, which must not be negative (at byte `at`).
@@ -91,7 +100,8 @@ fn finite_xyz(cur: &Cursor<'_>, at: usize, xyz: [f64; 3]) -> Result<[f64; 3]> {
         at,
         MeshErrorKind::NotANumber {
             what: "a node coordinate",
-            found: format!("{x} {y} {z}"),
+            // Debug, not Display: a tiny value would be 300 digits.
+            found: format!("{x:?} {y:?} {z:?}"),
         },
     ))
 }
@@ -125,15 +135,26 @@ fn parametric_nodes(cur: &mut Cursor<'_>, b: &mut Builder, n: u64) -> Result<()>
         b.nodes.reserve(cap);
         b.node_tags.reserve(cap);
         for _ in 0..n {
-            let (tag, [x, y, z]) = ascii_node(cur)?;
+            let (line, tag, [x, y, z]) = ascii_node(cur)?;
             let at = cur.pos();
-            cur.skip_ws();
+            cur.need_field(line, 4, || PARAMETRIC.into())?;
             let dp = cur.pos();
             let dim = cur.i32("the dimension of a node's geometric entity")?;
+            cur.need_field(line, 5, || PARAMETRIC.into())?;
             cur.i32("the tag of a node's geometric entity")?;
-            for _ in 0..parameters(cur, dp, dim)? {
+            let np = parameters(cur, dp, dim)?;
+            let record = || {
+                format!(
+                    "a parametric node on an entity of dimension {dim} needs {} numbers (its tag, x, y, z, entity dimension, entity tag and {})",
+                    6 + np,
+                    counted(np as u64, "parametric coordinate")
+                )
+            };
+            for k in 0..np {
+                cur.need_field(line, 6 + k, record)?;
                 cur.f64("a parametric node coordinate")?;
             }
+            cur.line_done(line, 6 + np, record)?;
             b.push_node(tag, x, y, z, at);
         }
     }
@@ -277,14 +298,33 @@ pub(crate) fn elements(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
             read += following;
         }
     } else {
+        const HEAD: &str =
+            "an element needs at least 3 numbers (its number, type and number of tags)";
         for _ in 0..n {
             cur.skip_ws();
             let at = cur.pos();
             let tag = cur.u64("an element tag")?;
+            cur.need_field(at, 1, || HEAD.into())?;
             let type_id = cur.i32("an element type")?;
+            cur.need_field(at, 2, || HEAD.into())?;
             let ntags = cur.u64("the number of element tags")?;
+            // The type tells how many node tags follow the tags.
+            let Some(nn) = nodes_of(type_id) else {
+                return Err(unsupported(cur, at, tag, type_id));
+            };
+            let fields = 3usize.saturating_add(usize::try_from(ntags).unwrap_or(usize::MAX));
+            let record = || {
+                format!(
+                    "a {} element with {} needs {} numbers (its number, type, number of tags, the tags and {})",
+                    type_name(type_id),
+                    counted(ntags, "tag"),
+                    fields.saturating_add(nn),
+                    counted(nn as u64, "node tag")
+                )
+            };
             let (mut phys, mut elementary) = (0i32, 0i32);
             for k in 0..ntags {
+                cur.need_field(at, 3 + k as usize, record)?;
                 let (p, v) = cur.i64("an element tag (physical, elementary, ...)")?;
                 let v = i32::try_from(v).map_err(|_| {
                     cur.error(
@@ -301,10 +341,8 @@ pub(crate) fn elements(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                     _ => {}
                 }
             }
-            let Some(nn) = nodes_of(type_id) else {
-                return Err(unsupported(cur, at, tag, type_id));
-            };
-            for slot in nodes.iter_mut().take(nn) {
+            for (k, slot) in nodes.iter_mut().take(nn).enumerate() {
+                cur.need_field(at, fields + k, record)?;
                 let (_, v) = cur.i64("a node tag")?;
                 *slot = u64::try_from(v).map_err(|_| {
                     cur.error(
@@ -316,6 +354,7 @@ pub(crate) fn elements(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                     )
                 })?;
             }
+            cur.line_done(at, fields + nn, record)?;
             let member = members.get(b, phys);
             b.element(
                 cur,

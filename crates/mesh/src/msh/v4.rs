@@ -6,7 +6,7 @@
 
 use std::collections::HashMap;
 
-use super::build::{nodes_of, unsupported, Builder, Membership};
+use super::build::{counted, nodes_of, type_name, unsupported, Builder, Membership};
 use super::cursor::{le_f64, le_u64, Cursor, Result};
 use crate::MeshErrorKind;
 
@@ -19,12 +19,23 @@ pub(crate) fn entities(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<Entities
         cur.end_of_line()?;
     }
     let mut counts = [0u64; 4];
-    for c in &mut counts {
+    if !cur.binary {
+        cur.skip_ws();
+    }
+    let at = cur.pos();
+    const COUNTS: &str = "the $Entities header needs 4 numbers (the numbers of points, curves, surfaces and volumes)";
+    for (k, c) in counts.iter_mut().enumerate() {
         *c = if cur.binary {
             cur.bin_u64()?
         } else {
+            if k > 0 {
+                cur.need_field(at, k, || COUNTS.into())?;
+            }
             cur.u64("an entity count")?
         };
+    }
+    if !cur.binary {
+        cur.line_done(at, 4, || COUNTS.into())?;
     }
     cur.counts(
         "entities",
@@ -53,20 +64,36 @@ pub(crate) fn entities(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<Entities
                     cur.skip(bytes)?;
                 }
             } else {
+                // One entity a line; `k` counts the numbers read on it.
+                let record = || entity_record(dim);
+                cur.skip_ws();
+                let at = cur.pos();
                 tag = cur.i32("an entity tag")?;
+                let mut k = 1;
                 for _ in 0..if dim == 0 { 3 } else { 6 } {
+                    cur.need_field(at, k, record)?;
                     cur.f64("an entity coordinate")?;
+                    k += 1;
                 }
+                cur.need_field(at, k, record)?;
                 let np = cur.u64("a number of physical tags")?;
+                k += 1;
                 for _ in 0..np {
+                    cur.need_field(at, k, record)?;
                     phys.push(cur.i32("a physical tag")?);
+                    k += 1;
                 }
                 if dim > 0 {
+                    cur.need_field(at, k, record)?;
                     let nb = cur.u64("a number of bounding entities")?;
+                    k += 1;
                     for _ in 0..nb {
+                        cur.need_field(at, k, record)?;
                         cur.i32("a bounding entity tag")?;
+                        k += 1;
                     }
                 }
+                cur.line_done(at, k, record)?;
             }
             let id = b.membership(phys.clone());
             map.insert((dim as i32, tag), id);
@@ -74,6 +101,17 @@ pub(crate) fn entities(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<Entities
     }
     cur.expect_end()?;
     Ok(map)
+}
+
+fn entity_record(dim: usize) -> String {
+    if dim == 0 {
+        "a point entity needs its tag, x, y, z, the number of physical tags and those tags".into()
+    } else {
+        let kind = ["point", "curve", "surface", "volume"]
+            .get(dim)
+            .unwrap_or(&"");
+        format!("a {kind} entity needs its tag, 6 bounding-box coordinates, the number of physical tags and those tags, the number of bounding entities and their tags")
+    }
 }
 
 /// Reads a 4.1 section header of four size_t: blocks, items, min tag, max tag.
@@ -87,14 +125,24 @@ fn header(cur: &mut Cursor<'_>, what: &'static str) -> Result<(usize, u64, u64)>
     }
     let at = cur.pos();
     let mut h = [0u64; 4];
-    for v in &mut h {
+    for (k, v) in h.iter_mut().enumerate() {
         *v = if cur.binary {
             cur.bin_u64()?
         } else {
+            if k > 0 {
+                cur.need_field(at, k, || header_record(what))?;
+            }
             cur.u64(what)?
         };
     }
+    if !cur.binary {
+        cur.line_done(at, 4, || header_record(what))?;
+    }
     Ok((at, h[0], h[1]))
+}
+
+fn header_record(what: &str) -> String {
+    format!("{what} needs 4 numbers (the number of blocks, the number of entries, the smallest and the largest tag)")
 }
 
 /// A block header: three ints and a size_t.
@@ -109,8 +157,20 @@ fn block(cur: &mut Cursor<'_>, what: &'static str) -> Result<(usize, [i32; 3], u
     } else {
         cur.skip_ws();
         let at = cur.pos();
-        let a = [cur.i32(what)?, cur.i32(what)?, cur.i32(what)?];
-        Ok((at, a, cur.u64(what)?))
+        let record = || {
+            format!("{what} needs 4 numbers (entity dimension, entity tag, type or parametric flag, and the number of entries)")
+        };
+        let mut a = [0i32; 3];
+        for (k, v) in a.iter_mut().enumerate() {
+            if k > 0 {
+                cur.need_field(at, k, record)?;
+            }
+            *v = cur.i32(what)?;
+        }
+        cur.need_field(at, 3, record)?;
+        let n = cur.u64(what)?;
+        cur.line_done(at, 4, record)?;
+        Ok((at, a, n))
     }
 }
 
@@ -169,7 +229,8 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                             start + size * j,
                             MeshErrorKind::NotANumber {
                                 what: "a node coordinate",
-                                found: format!("{x} {y} {z}"),
+                                // Debug, not Display: a tiny value would be 300 digits.
+                                found: format!("{x:?} {y:?} {z:?}"),
                             },
                         ));
                     }
@@ -179,18 +240,41 @@ pub(crate) fn nodes(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
                 }
             }
         } else {
+            // Gmsh writes the block's tags one a line, then its
+            // coordinates one node a line.
+            const TAG: &str = "a node tag line needs 1 number";
             for _ in 0..n {
+                cur.skip_ws();
+                let line = cur.pos();
                 let t = cur.u64("a node tag")?;
+                cur.line_done(line, 1, || TAG.into())?;
                 b.push_tag(t, cur.pos());
             }
+            let record = || {
+                if extra == 0 {
+                    "a node coordinate line needs 3 numbers (x, y and z)".to_string()
+                } else {
+                    format!(
+                        "a parametric node coordinate line needs {} numbers (x, y, z and {})",
+                        3 + extra,
+                        counted(extra as u64, "parametric coordinate")
+                    )
+                }
+            };
             for i in 0..n as usize {
+                cur.skip_ws();
+                let line = cur.pos();
                 let x = cur.f64("a node coordinate")?;
+                cur.need_field(line, 1, record)?;
                 let y = cur.f64("a node coordinate")?;
+                cur.need_field(line, 2, record)?;
                 let z = cur.f64("a node coordinate")?;
                 let at = cur.pos();
-                for _ in 0..extra {
+                for k in 0..extra {
+                    cur.need_field(line, 3 + k, record)?;
                     cur.f64("a parametric node coordinate")?;
                 }
+                cur.line_done(line, 3 + extra, record)?;
                 let tag = b.node_tags.get(first + i).copied().unwrap_or(0);
                 b.push_xyz(x, y, z, tag, at);
             }
@@ -265,13 +349,23 @@ pub(crate) fn elements(
                 }
             }
         } else {
+            let record = || {
+                format!(
+                    "a {} element needs {} numbers (its tag and {})",
+                    type_name(type_id),
+                    1 + nn,
+                    counted(nn as u64, "node tag")
+                )
+            };
             for _ in 0..n {
                 cur.skip_ws();
                 let ep = cur.pos();
                 let tag = cur.u64("an element tag")?;
-                for slot in nodes.iter_mut().take(nn) {
+                for (k, slot) in nodes.iter_mut().take(nn).enumerate() {
+                    cur.need_field(ep, 1 + k, record)?;
                     *slot = cur.u64("a node tag")?;
                 }
+                cur.line_done(ep, 1 + nn, record)?;
                 b.element(cur, ep, type_id, tag, &nodes[..nn], member, None)?;
             }
         }
