@@ -203,6 +203,8 @@ pub struct ResultsWriter {
     n_c: usize,
     /// Rows appended, written or still in `pending`.
     rows: usize,
+    /// Rows on disk at the last flush that succeeded.
+    flushed_rows: usize,
     /// Appended rows not yet in the datasets.
     pending: Pending,
     /// Rows per chunk of the vector fields along time: `pending` is
@@ -700,6 +702,7 @@ impl ResultsWriter {
             n_nodes,
             n_c,
             rows: 0,
+            flushed_rows: 0,
             pending: Pending::default(),
             block_rows,
             since_flush: 0,
@@ -805,6 +808,7 @@ impl ResultsWriter {
             n_nodes,
             n_c,
             rows,
+            flushed_rows: rows,
             pending: Pending::default(),
             block_rows,
             since_flush: 0,
@@ -838,6 +842,20 @@ impl ResultsWriter {
             || self.last_flush.elapsed().as_secs_f64() >= self.flush_every_secs
     }
 
+    /// Bytes the file may need before the next flush has written its
+    /// records and checkpoint, with room to spare: twice the records since
+    /// the last flush and a checkpoint of `n_free` values a vector, and
+    /// 1 MiB for HDF5's own structures. A run stops while the disk has
+    /// that much free (`stickslip run`): on a full disk HDF5's flush fails
+    /// half way, and rows flushed before, in a chunk it rewrote, read as
+    /// zeros.
+    pub fn room_needed(&self, n_free: usize) -> u64 {
+        let record = (6 * self.n_nodes + 3 * self.n_c + 9) * 8;
+        let rows = self.rows - self.flushed_rows;
+        let checkpoint = 5 * n_free * 8;
+        (2 * (rows * record + checkpoint) + (1 << 20)) as u64
+    }
+
     /// Counts a step toward [`ResultsWriter::flush_due`] without writing a
     /// row (steps between output rows still count, so a checkpoint is taken
     /// every `flush_every_steps` steps).
@@ -852,6 +870,36 @@ impl ResultsWriter {
     /// # Errors
     /// HDF5 errors, or a state whose lengths changed since the last checkpoint.
     pub fn write_checkpoint(&mut self, cp: &Checkpoint, extra: &CheckpointExtra) -> Result<()> {
+        let r = self.write_checkpoint_unchecked(cp, extra);
+        self.failed_write(r)
+    }
+
+    /// What a failed write leaves: the datasets cut back to the rows of the
+    /// last flush (a failed flush left rows of fill values, which probe
+    /// read as a record of zeros; best effort, as the disk may still be
+    /// full), and a message that says what the file keeps and what to do.
+    fn failed_write(&mut self, r: Result<()>) -> Result<()> {
+        let Err(e) = r else {
+            return Ok(());
+        };
+        let kept = self.flushed_rows;
+        self.shrink_to(kept);
+        self.pending.clear();
+        self.rows = kept;
+        Err(e.context(format!(
+            "cannot write to the results file (is the disk full?); it keeps its first {kept} \
+             records and the checkpoint of its last flush: make room and continue the run with \
+             --restart"
+        )))
+    }
+
+    fn write_checkpoint_unchecked(
+        &mut self,
+        cp: &Checkpoint,
+        extra: &CheckpointExtra,
+    ) -> Result<()> {
+        // The rows the checkpoint counts go to the datasets first.
+        self.write_pending()?;
         self.write_pending()?;
         let (cg, slot) = if self.file.link_exists("checkpoint") {
             let cg = self.file.group("checkpoint")?;
@@ -925,8 +973,9 @@ impl ResultsWriter {
     /// # Errors
     /// HDF5 errors.
     pub fn flush(&mut self) -> Result<()> {
-        self.write_pending()?;
-        self.file.flush()?;
+        let r = self.write_pending().and_then(|()| Ok(self.file.flush()?));
+        self.failed_write(r)?;
+        self.flushed_rows = self.rows;
         self.since_flush = 0;
         self.last_flush = Instant::now();
         Ok(())
@@ -938,6 +987,28 @@ impl ResultsWriter {
     /// # Errors
     /// HDF5 errors.
     fn write_pending(&mut self) -> Result<()> {
+        self.write_pending_rows()
+    }
+
+    /// Cuts every growing dataset back to `rows` rows, ignoring errors.
+    fn shrink_to(&self, rows: usize) {
+        let (n, n_c, s) = (self.n_nodes, self.n_c, &self.series);
+        for d in [&s.time, &s.dt, &s.iterations].into_iter().chain(&s.energy) {
+            let _ = d.resize(rows);
+        }
+        for d in [&s.displacement, &s.velocity, &s.acceleration] {
+            let _ = d.resize((rows, n, 2));
+        }
+        if let Some(c) = &s.contact {
+            for d in [&c.friction_stress, &c.slip_velocity, &c.state] {
+                let _ = d.resize((rows, n_c));
+            }
+        }
+        let _ = self.file.flush();
+    }
+
+    /// [`ResultsWriter::write_pending`]'s writes.
+    fn write_pending_rows(&mut self) -> Result<()> {
         let p = &self.pending;
         let m = p.rows();
         if m == 0 {

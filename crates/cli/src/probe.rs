@@ -224,19 +224,27 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
             .map_err(|e| h5(&format!("cannot read /{ds}"), e))?
             .to_vec(),
     };
-    if values.len() != t.len() {
-        return Err(InputError(format!(
-            "{name}: /time has {} entries but {} has {}",
-            t.len(),
-            field.name(),
-            values.len()
-        )));
-    }
-
     let complete = f
         .attr("complete")
         .and_then(|a| a.read_scalar::<bool>())
         .unwrap_or(false);
+    let (mut t, mut values) = (t, values);
+    if values.len() != t.len() {
+        if complete {
+            return Err(InputError(format!(
+                "{name}: /time has {} entries but {} has {}",
+                t.len(),
+                field.name(),
+                values.len()
+            )));
+        }
+        // A run that stopped between writing two datasets (or on a full
+        // disk, which left rows it could not cut back): the records both
+        // hold.
+        let n = t.len().min(values.len());
+        t.truncate(n);
+        values.truncate(n);
+    }
     let mut info = format!(
         "node {node} at ({}, {}), distance {:.3e} from ({}, {}); {} output steps",
         nodes[[node, 0]],

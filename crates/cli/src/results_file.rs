@@ -255,3 +255,21 @@ pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
     }
     Ok(lock)
 }
+
+/// Bytes free to an unprivileged writer on the file system of `path`'s
+/// directory, where it can be asked.
+#[allow(unsafe_code)]
+pub fn free_bytes(path: &Path) -> Option<u64> {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+    // SAFETY: statvfs is plain data, all zeros a valid value; the call
+    // gets a NUL-terminated path and a pointer to a live statvfs.
+    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
+    let r = unsafe { libc::statvfs(c.as_ptr(), &mut st) };
+    #[allow(clippy::useless_conversion)] // u64 here; other platforms differ
+    (r == 0).then(|| u64::from(st.f_bavail).saturating_mul(u64::from(st.f_frsize)))
+}

@@ -948,6 +948,19 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                     break;
                 }
                 if writer.flush_due() {
+                    let need = writer.room_needed(model.dofs.n_free());
+                    if let Some(free) = crate::results_file::free_bytes(out).filter(|&f| f < need) {
+                        failure = Some(format!(
+                            "step {} (t = {}): the disk of {} is nearly full ({:.1} MB free, the next flush may need {:.1} MB): \
+                             stopped before HDF5 fails half way through a write; make room and continue the run with --restart",
+                            integrator.steps(),
+                            integrator.time(),
+                            out.display(),
+                            free as f64 / 1e6,
+                            need as f64 / 1e6
+                        ));
+                        break;
+                    }
                     writer.write_checkpoint(
                         &integrator.checkpoint(),
                         &extra(writer.rows(), max_balance),

@@ -1432,3 +1432,69 @@ fn closed_pipes_neither_panic_nor_end_a_run() {
     let f = hdf5::File::open(&out).unwrap();
     assert!(f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
 }
+
+/// A disk that fills up mid-run: the run stops before HDF5's flush fails
+/// half way (which left rows of fill values, and turned rows flushed
+/// before, in the chunk it rewrote, into zeros that probe printed as
+/// u = 0), says so and what to do; the file reads to its last record, and
+/// a restart with room continues it. Needs a small tmpfs: skipped where
+/// this process may not mount one (not root, or a container without the
+/// capability).
+#[test]
+fn a_disk_that_fills_up_stops_the_run_with_its_records() {
+    let dir = scratch("disk-full");
+    let small = dir.join("small");
+    std::fs::create_dir_all(&small).unwrap();
+    let mounted = Command::new("mount")
+        .args(["-t", "tmpfs", "-o", "size=4M", "tmpfs"])
+        .arg(&small)
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !mounted {
+        eprintln!("skipped: cannot mount a tmpfs here");
+        return;
+    }
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let out = small.join("full.h5");
+    let o = bin()
+        .arg("run")
+        .arg(&case)
+        .arg("-o")
+        .arg(&out)
+        .args(["--quiet", "--set", "time.t_end=200"])
+        .output()
+        .unwrap();
+    let read = hdf5::File::open(&out).map(|f| {
+        let u = f
+            .dataset("displacement")
+            .unwrap()
+            .read_raw::<f64>()
+            .unwrap();
+        let t = f.dataset("time").unwrap().size();
+        (u, t)
+    });
+    let grown = Command::new("mount")
+        .args(["-o", "remount,size=200M"])
+        .arg(&small)
+        .status()
+        .is_ok_and(|s| s.success());
+    let again = restart(&case, &out, &["--set", "time.t_end=5"]);
+    Command::new("umount").arg(&small).status().ok();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("is nearly full") && e.contains("--restart"),
+        "{e}"
+    );
+    let (u, rows) = read.expect("the file opens");
+    assert!(rows > 100, "it ran a while: {rows} records");
+    let per_row = u.len() / rows;
+    // Every record after the first (the slab at rest) moves.
+    let zero = (1..rows)
+        .filter(|&k| u[k * per_row..(k + 1) * per_row].iter().all(|&x| x == 0.0))
+        .count();
+    assert_eq!(zero, 0, "records of zeros among {rows}");
+    assert!(grown);
+    assert_eq!(again.status.code(), Some(0), "{}", stderr(&again));
+}
