@@ -391,9 +391,25 @@ struct RawOutput {
 /// `file:line:col: what; what to do` (or `--set KEY=VALUE: ...`).
 pub fn load(path: &Path, sets: &[String]) -> Result<Case, InputError> {
     let file = path.display().to_string();
-    let original = std::fs::read_to_string(path).map_err(|e| {
+    // A device or FIFO would be read forever (`check /dev/zero` hung).
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        return Err(InputError(format!(
+            "{file}: not a regular file (a device, FIFO or socket); give the case's .toml file"
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(|e| {
         InputError(format!(
             "{file}: cannot read the case file: {e}; check the path"
+        ))
+    })?;
+    let original = String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let text = &e.as_bytes()[..at];
+        let line = text.iter().filter(|&&b| b == b'\n').count() + 1;
+        let col = text.iter().rev().take_while(|&&b| b != b'\n').count() + 1;
+        InputError(format!(
+            "{file}:{line}:{col}: not UTF-8 text (byte {at}); TOML files are UTF-8: save it as \
+             UTF-8 in your editor (e.g. `iconv -f latin1 -t utf-8`)"
         ))
     })?;
     load_str(path, &original, sets)
@@ -694,6 +710,22 @@ fn is_number(v: &Value) -> bool {
     matches!(v, Value::Integer(_) | Value::Float(_))
 }
 
+/// Magnitudes a case's numbers may have (or 0): beyond them products such
+/// as E·h² or ρ·h²/Δt² overflow or underflow, and the run failed with a
+/// wrong diagnosis (E = 1e308: "a rigid-body motion left free"; ρ =
+/// 1e-300: "use time.dt < 0").
+const MODERATE: std::ops::RangeInclusive<f64> = 1e-100..=1e100;
+
+/// A finite number of `v` outside [`MODERATE`] (and not 0).
+fn extreme(v: &Value) -> Option<f64> {
+    let x = match v {
+        Value::Integer(i) => *i.value() as f64,
+        Value::Float(f) => *f.value(),
+        _ => return None,
+    };
+    (x.is_finite() && x != 0.0 && !MODERATE.contains(&x.abs())).then_some(x)
+}
+
 /// Checks every key of `table` (at `path`) against `schema`: calls `report`
 /// with the span and message of each problem and pushes the path of each
 /// offending key to `removals`.
@@ -735,6 +767,20 @@ fn check_table(
         };
         let name = dotted(path);
         let span = item.span().or_else(|| key_span.clone());
+        let numbers: Vec<&Value> = match (kind, item) {
+            (Kind::Num, Item::Value(v)) => vec![v],
+            (Kind::Vec2, Item::Value(Value::Array(a))) => a.iter().collect(),
+            _ => Vec::new(),
+        };
+        if let Some(x) = numbers.into_iter().find_map(extreme) {
+            report(
+                span.clone(),
+                format!(
+                    "{name} = {x:e} is beyond what the computation can carry (magnitudes from \
+                     1e-100 to 1e100, or 0); choose units that keep the case's values moderate"
+                ),
+            );
+        }
         let mut wrong = |want: &str, hint: &str| {
             report(
                 span.clone(),
@@ -998,6 +1044,11 @@ fn convert(
         if mesh_file.is_dir() {
             format!(
                 "mesh.file: {} is a directory; give the .msh file in it",
+                mesh_file.display()
+            )
+        } else if mesh_file.exists() {
+            format!(
+                "mesh.file: {} is not a regular file (a device, FIFO or socket); give the .msh file",
                 mesh_file.display()
             )
         } else {

@@ -209,6 +209,8 @@ fn ofd_lock(f: &std::fs::File, read: bool) -> std::io::Result<()> {
 /// # Errors
 /// The [`InputError`] naming the file and what to do.
 pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
+    // An XDMF half written when a run was killed (best effort).
+    let _ = std::fs::remove_file(out.with_extension("xdmf.part"));
     for path in [out.to_path_buf(), out.with_extension("xdmf")] {
         if path.exists() {
             if in_use(&path) {

@@ -1498,3 +1498,48 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
     assert!(grown);
     assert_eq!(again.status.code(), Some(0), "{}", stderr(&again));
 }
+
+/// Numbers so large or small that the computation overflows are refused
+/// by name (E = 1e308 was reported as "a rigid-body motion left free", ρ =
+/// 1e-300 as "use time.dt < 0"), and so are case and mesh files that are
+/// no regular files or no UTF-8 text (`check /dev/zero` hung; /dev/null as
+/// the mesh "did not exist"; a Latin-1 case file got "check the path").
+#[test]
+fn extreme_values_and_odd_files_are_refused_by_name() {
+    let dir = scratch("extreme");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    for set in [
+        "material.E=1e308",
+        "material.rho=1e-300",
+        "contact.eps=1e-320",
+        "body_force=[1e308, 0]",
+    ] {
+        let key = set.split('=').next().unwrap();
+        refused(&case, &[set], &[&format!("{key} = "), "moderate"]);
+    }
+    let o = Command::new("timeout")
+        .arg("20")
+        .arg(env!("CARGO_BIN_EXE_stickslip"))
+        .args(["check", "/dev/zero"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("not a regular file"), "{}", stderr(&o));
+    let (null_mesh, _) = slab_case(&dir, "null", |t| {
+        let start = t.find("file = ").unwrap();
+        let end = start + t[start..].find('\n').unwrap();
+        format!("{}file = \"/dev/null\"{}", &t[..start], &t[end..])
+    });
+    refused(&null_mesh, &[], &["/dev/null is not a regular file"]);
+    let latin1 = dir.join("latin1.toml");
+    let mut bytes = b"title = \"caf".to_vec();
+    bytes.extend([0xe9, b'"', b'\n']);
+    std::fs::write(&latin1, bytes).unwrap();
+    let o = check(&latin1, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("latin1.toml:1:13: not UTF-8"),
+        "{}",
+        stderr(&o)
+    );
+}
