@@ -716,6 +716,10 @@ fn is_number(v: &Value) -> bool {
 /// 1e-300: "use time.dt < 0").
 const MODERATE: std::ops::RangeInclusive<f64> = 1e-100..=1e100;
 
+/// Most steps a case may ask for: 1e12 steps of the paper's 85-node mesh
+/// (about 1 µs each) take twelve days.
+const MAX_STEPS: f64 = 1e12;
+
 /// A finite number of `v` outside [`MODERATE`] (and not 0).
 fn extreme(v: &Value) -> Option<f64> {
     let x = match v {
@@ -1219,6 +1223,17 @@ fn convert(
         t_end > 0.0 && t_end.is_finite(),
         tm.t_end.span(),
         format!("time.t_end = {t_end} must be > 0"),
+    );
+    // A run that cannot end (1e300 steps passed `check` and ran on).
+    let steps = t_end / dt;
+    check(
+        steps.is_nan() || steps <= MAX_STEPS,
+        tm.t_end.span(),
+        format!(
+            "time.t_end / time.dt = {t_end:e} / {dt:e} = {steps:.3e} steps, more than {MAX_STEPS:e}: \
+             a run that would not end in years; check the two values (their units, a missing minus \
+             sign in an exponent)"
+        ),
     );
     let beta = tm.beta.as_ref().map_or(0.25, |b| *b.get_ref());
     let gamma = tm.gamma.as_ref().map_or(0.5, |g| *g.get_ref());

@@ -1517,6 +1517,12 @@ fn extreme_values_and_odd_files_are_refused_by_name() {
         let key = set.split('=').next().unwrap();
         refused(&case, &[set], &[&format!("{key} = "), "moderate"]);
     }
+    // A run that would not end passed check and ran on.
+    refused(
+        &case,
+        &["time.dt=1e-90"],
+        &["time.t_end / time.dt", "steps"],
+    );
     let o = Command::new("timeout")
         .arg("20")
         .arg(env!("CARGO_BIN_EXE_stickslip"))
