@@ -522,10 +522,28 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
             match convert(raw, path, &base, source.clone(), &loc_text) {
                 Ok(case) if problems.is_empty() => return Ok(case),
                 Ok(_) => {}
-                Err(bad) => problems.extend(
-                    bad.into_iter()
-                        .filter(|p| !quiet_lines.iter().any(|l| p.starts_with(l.as_str()))),
-                ),
+                Err(bad) => {
+                    // A key given a placeholder (its type was wrong, which
+                    // is reported): what the checks say of the placeholder
+                    // is no problem of the user's, also where the value came
+                    // from --set (no line of the file to quiet).
+                    let placeholders: Vec<String> =
+                        typed.iter().map(|(p, _, _)| dotted(p)).collect();
+                    let of_placeholder = |p: &str| {
+                        placeholders.iter().any(|k| {
+                            [" ", ":"].iter().any(|end| {
+                                p.contains(&format!(": {k}{end}"))
+                                    || p.contains(&format!(
+                                        ": [{}]: {k}{end}",
+                                        k.split('.').next().unwrap_or("")
+                                    ))
+                            })
+                        })
+                    };
+                    problems.extend(bad.into_iter().filter(|p| {
+                        !quiet_lines.iter().any(|l| p.starts_with(l.as_str())) && !of_placeholder(p)
+                    }));
+                }
             }
         }
     }

@@ -1549,3 +1549,16 @@ fn extreme_values_and_odd_files_are_refused_by_name() {
         stderr(&o)
     );
 }
+
+/// A value of the wrong type is one problem: the placeholder that keeps
+/// the other checks going was reported too when the value came from --set
+/// ("material.nu = 1 must lie in (-1, 0.5)", "placeholder does not exist").
+#[test]
+fn a_wrong_type_is_reported_once() {
+    let dir = scratch("wrong-type");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    for set in ["material.nu=\"abc\"", "mesh.file=0", "mesh.ladder=0"] {
+        let e = refused(&case, &[set], &["expected"]);
+        assert_eq!(e.lines().count(), 1, "{set}: {e}");
+    }
+}
