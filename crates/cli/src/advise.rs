@@ -1468,11 +1468,25 @@ fn describe(c: &Candidate, ladder: &[LadderMesh]) -> String {
 /// # Errors
 /// Input problems as [`InputError`]; pilot runs that fail; an unwritable output.
 pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
-    if !(o.tol > 0.0 && o.tol.is_finite()) {
+    // A relative error of 1 or more is no accuracy (the coarsest pilot
+    // meets it whatever it computes).
+    if !(o.tol > 0.0 && o.tol < 1.0) {
+        let tol = o.tol.to_string();
+        let tol = if tol.len() > 12 {
+            format!("{:e}", o.tol)
+        } else {
+            tol
+        };
         return Err(input(format!(
-            "--tol {}: give a relative error > 0, e.g. --tol 1e-2",
-            o.tol
+            "--tol {tol}: give a relative error between 0 and 1, e.g. --tol 1e-2"
         )));
+    }
+    if o.quantity == Quantity::Energy && o.at.is_some() {
+        return Err(input(
+            "--at goes with --on ux, uy or friction_stress; --on energy is the body's total energy \
+             at t_end, at no point: leave --at out"
+                .to_string(),
+        ));
     }
     if let Some(w) = &o.write {
         if w.is_dir() {

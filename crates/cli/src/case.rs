@@ -507,6 +507,12 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
                     "; check the spelling (docs/case-file.md lists the keys)"
                 } else if msg.starts_with("missing field") {
                     "; add it (docs/case-file.md lists the keys)"
+                } else if msg.starts_with("wanted string or table")
+                    || msg.starts_with("wanted exactly 1 element")
+                {
+                    // Only a traction's history is a string or a one-key table.
+                    " (a traction's history); write history = \"step\", \
+                     history = { sin = { omega = 25.13 } } or history = { table = [[0.0, 0.0], [0.1, 1.0]] }"
                 } else if msg.contains("variant") {
                     "; use one of the values listed"
                 } else if msg.starts_with("invalid type") || msg.starts_with("invalid length") {
@@ -547,7 +553,7 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
             }
         }
     }
-    Err(InputError(problems.join("\n")))
+    Err(InputError(crate::error::listed(problems)))
 }
 
 /// [`load_str`] on text alone, named `case.toml` in the current directory

@@ -21,6 +21,22 @@ impl fmt::Display for InputError {
 
 impl std::error::Error for InputError {}
 
+/// Problems listed at once, at most this many (thousands of tables with one
+/// mistake each would bury the first).
+pub const SHOWN: usize = 50;
+
+/// `problems` one to a line, the first [`SHOWN`] and a count of the rest.
+pub fn listed(mut problems: Vec<String>) -> String {
+    if problems.len() > SHOWN {
+        let more = problems.len() - SHOWN;
+        problems.truncate(SHOWN);
+        problems.push(format!(
+            "and {more} more problems; fix the ones above and check again"
+        ));
+    }
+    problems.join("\n")
+}
+
 impl From<stickslip_mesh::MeshError> for InputError {
     fn from(e: stickslip_mesh::MeshError) -> Self {
         InputError(e.to_string())

@@ -270,7 +270,7 @@ pub fn prepare_for(case: &Case, restoring: bool) -> anyhow::Result<Prepared> {
         }
     }
     let Some(model) = model.filter(|_| groups_ok && problems.is_empty()) else {
-        return Err(input(problems.join("\n")));
+        return Err(input(crate::error::listed(problems)));
     };
 
     let n_full = 2 * mesh.nodes.len();
@@ -349,7 +349,7 @@ pub fn prepare_for(case: &Case, restoring: bool) -> anyhow::Result<Prepared> {
         }
     }
     if !problems.is_empty() {
-        return Err(input(problems.join("\n")));
+        return Err(input(crate::error::listed(problems)));
     }
     let scheme = match case.time.scheme {
         case::Scheme::CentralDifference => Scheme::CentralDifference,

@@ -293,7 +293,11 @@ fn advise_never_writes_over_a_file() {
             vec!["--tol", "3e-2", "--write", dir.to_str().unwrap()],
             "is a directory",
         ),
-        (vec!["--tol", "-1"], "give a relative error > 0"),
+        (vec!["--tol", "-1"], "give a relative error between 0 and 1"),
+        (
+            vec!["--tol", "1e308"],
+            "--tol 1e308: give a relative error between 0 and 1",
+        ),
     ] {
         let st = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
             .arg("advise")
@@ -306,6 +310,16 @@ fn advise_never_writes_over_a_file() {
         assert_eq!(st.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(says), "{args:?}: {err}");
     }
+    // --at with the energy, which has no point, was silently ignored.
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
+        .arg("advise")
+        .arg(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
+        .args(["--tol", "1e-2", "--on", "energy", "--at", "8,1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert_eq!(st.status.code(), Some(2), "{err}");
+    assert!(err.contains("--at goes with"), "{err}");
 }
 
 /// A ladder of two bodies, and a probe point off the body, are bad input

@@ -1562,3 +1562,30 @@ fn a_wrong_type_is_reported_once() {
         assert_eq!(e.lines().count(), 1, "{set}: {e}");
     }
 }
+
+/// A history of the wrong form is named as one (serde said only "wanted
+/// string or table"), and thousands of problems are listed fifty at a
+/// time (20,000 were printed).
+#[test]
+fn history_forms_are_named_and_long_lists_are_cut() {
+    let dir = scratch("history");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    for set in ["traction.0.history=0", "traction.0.history={}"] {
+        refused(
+            &case,
+            &[set],
+            &["a traction's history", "history = \"step\""],
+        );
+    }
+    let (many, _) = slab_case(&dir, "many", |t| {
+        let extra: String = (0..200)
+            .map(|i| format!("\n[[dirichlet]]\ngroup = \"nosuch{i}\"\nuy = 0.0\n"))
+            .collect();
+        t + &extra
+    });
+    let o = check(&many, &[]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert_eq!(e.lines().count(), 51, "{e}");
+    assert!(e.contains("and 150 more problems"), "{e}");
+}
