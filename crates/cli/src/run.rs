@@ -597,7 +597,7 @@ impl StopFlags {
         ] {
             // Order matters: the shutdown hook must see `any` still false on
             // the first signal (signal-hook's documented pattern).
-            signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&any))?;
+            second_signal_exits(sig, Arc::clone(&any))?;
             signal_hook::flag::register(sig, Arc::clone(&any))?;
             signal_hook::flag::register(sig, Arc::clone(flag))?;
         }
@@ -616,6 +616,27 @@ impl StopFlags {
             None
         }
     }
+}
+
+/// On `sig` after `any` is set (a second signal): one line on stderr and
+/// exit 130 at once (the file keeps every flushed step). signal-hook's
+/// conditional shutdown exited without a word, which left the user
+/// guessing what was kept.
+#[allow(unsafe_code)]
+fn second_signal_exits(sig: i32, any: Arc<AtomicBool>) -> std::io::Result<()> {
+    const MSG: &[u8] = b"\nstopped at once by a second signal: the results file keeps every step \
+up to its last flush (complete = false); continue it with --restart\n";
+    // SAFETY: the action only loads an atomic and calls write(2) and
+    // _exit(2), which are async-signal-safe.
+    unsafe {
+        signal_hook::low_level::register(sig, move || {
+            if any.load(Ordering::SeqCst) {
+                libc::write(2, MSG.as_ptr().cast(), MSG.len());
+                libc::_exit(130);
+            }
+        })?;
+    }
+    Ok(())
 }
 
 /// How `stickslip run` behaves.
