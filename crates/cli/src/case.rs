@@ -1129,8 +1129,8 @@ fn convert(
             d.ux.is_some() || d.uy.is_some(),
             d.group.span(),
             format!(
-                "dirichlet #{} (group {:?}) fixes neither ux nor uy; add ux = .. and/or uy = ..",
-                i + 1,
+                "dirichlet.{} (group {:?}) fixes neither ux nor uy; add ux = .. and/or uy = ..",
+                i,
                 d.group.get_ref()
             ),
         );
@@ -1138,7 +1138,15 @@ fn convert(
         check(
             finite,
             d.group.span(),
-            format!("dirichlet #{}: ux/uy must be finite numbers", i + 1),
+            format!(
+                "dirichlet.{i} (group {:?}): {}: give finite numbers",
+                d.group.get_ref(),
+                [("ux", d.ux), ("uy", d.uy)]
+                    .iter()
+                    .filter_map(|(k, v)| v.map(|v| format!("{k} = {v}")))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
         );
     }
 
@@ -1157,10 +1165,10 @@ fn convert(
                     false,
                     d.group.span(),
                     format!(
-                        "dirichlet #{} (group {:?}) sets {c} again, already set by dirichlet #{} ({}); give each component of a group once",
-                        i + 1,
+                        "dirichlet.{} (group {:?}) sets {c} again, already set by dirichlet.{} ({}); give each component of a group once",
+                        i,
                         d.group.get_ref(),
-                        first + 1,
+                        first,
                         loc.at(Some(raw.dirichlet[first].group.span()))
                     ),
                 );
@@ -1170,7 +1178,7 @@ fn convert(
 
     // [[traction]]
     for (i, t) in raw.traction.iter().enumerate() {
-        let what = format!("traction #{} (group {:?})", i + 1, t.group.get_ref());
+        let what = format!("traction.{i} (group {:?})", t.group.get_ref());
         check(
             t.t.is_some() != t.pressure.is_some(),
             t.group.span(),

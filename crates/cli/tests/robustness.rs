@@ -240,7 +240,7 @@ fn a_component_fixed_twice_is_refused() {
         &[],
         &[
             "sets uy again",
-            "dirichlet #1",
+            "already set by dirichlet.0",
             "give each component of a group once",
         ],
     );
