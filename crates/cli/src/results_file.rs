@@ -127,10 +127,12 @@ pub fn in_use(path: &Path) -> bool {
 /// locking: a read lock of ours, released when `f` closes, conflicts with
 /// the run's write lock (and needs only read access to the file).
 pub fn being_written(path: &Path) -> bool {
-    let held = |e: std::io::Error| {
-        e.kind() == std::io::ErrorKind::WouldBlock || e.raw_os_error() == Some(libc::EACCES)
-    };
-    std::fs::File::open(path).is_ok_and(|f| ofd_lock(&f, true).is_err_and(held))
+    std::fs::File::open(path).is_ok_and(|f| ofd_lock(&f, true).is_err_and(|e| held(&e)))
+}
+
+/// Whether a lock failed because another process holds one.
+fn held(e: &std::io::Error) -> bool {
+    e.kind() == std::io::ErrorKind::WouldBlock || e.raw_os_error() == Some(libc::EACCES)
 }
 
 /// A run's lock on its results file, held while it writes: an open file
@@ -167,8 +169,13 @@ impl RunLock {
 
     /// Takes the lock on `f`, the file `path` names.
     fn on(f: std::fs::File, path: &Path) -> Result<RunLock, InputError> {
-        ofd_lock(&f, false).map_err(|_| busy(path))?;
-        Ok(RunLock { _file: f })
+        match ofd_lock(&f, false) {
+            Err(e) if held(&e) => Err(busy(path)),
+            // A file system without such locks (ENOLCK, EINVAL on some
+            // network mounts): the run goes on unprotected, as HDF5's own
+            // locking would let it.
+            _ => Ok(RunLock { _file: f }),
+        }
     }
 }
 
