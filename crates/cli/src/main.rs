@@ -89,7 +89,9 @@ Exit codes: 0 a configuration meets the tolerance (estimated), 1 none of the lad
     Advise {
         /// The case file (TOML) with mesh.ladder.
         case: PathBuf,
-        /// Relative error to reach: L2 in time (ux, uy, friction_stress) or of E(t_end) (energy).
+        /// Relative error to reach, between 0 and 1: L2 in time over [0, t_end] of the
+        /// difference, relative to the motion since t = 0 (ux, uy: ‖u − u_ref‖ / ‖u_ref − u_ref(0)‖),
+        /// to the history (friction_stress), or |ΔE(t_end)| / |E(t_end) − E(0)| (energy).
         #[arg(long, value_name = "X", allow_negative_numbers = true)]
         tol: f64,
         /// The output the tolerance is on: ux, uy, friction_stress or energy.

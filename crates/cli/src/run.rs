@@ -486,20 +486,46 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         "steps       about {steps} to t_end = {} with dt = {:e}",
         case.time.t_end, case.time.dt
     );
-    // Per record: u, v, a at every node (6 doubles), the contact's stress
-    // and slip (2 doubles) and state (1 byte), about 12 scalars besides
-    // (time, the ledger, dt, iterations); uncompressed.
-    let every = case.output.every.max(1) as f64;
-    let records = (steps / every).floor() + 1.0;
-    let n_c = i.contact().map_or(0, |c| c.len()) as f64;
-    let bytes = records * (48.0 * p.mesh.nodes.len() as f64 + 17.0 * n_c + 96.0);
+    let (records, bytes) =
+        output_size(case, p.mesh.nodes.len(), i.contact().map_or(0, |c| c.len()));
     println!(
         "output      about {records} records (every {} steps) of {}, {}",
         case.output.every,
         case.output.file.display(),
         human_bytes(bytes)
     );
+    if let Some(free) = crate::results_file::free_bytes(&case.output.file) {
+        if bytes > free as f64 {
+            println!(
+                "warning     that is more than the {} free on its disk: `run` refuses it; write fewer records (output.every) or elsewhere (-o)",
+                human_bytes(free as f64)
+            );
+        }
+    }
     Ok(())
+}
+
+/// Records and bytes a run of `case` writes from t = 0 (uncompressed): per
+/// record u, v, a at every node (6 doubles), the contact's stress and slip
+/// (2 doubles) and state (1 byte), about 12 scalars besides (time, the
+/// ledger, dt, iterations).
+fn output_size(case: &Case, nodes: usize, contact_nodes: usize) -> (f64, f64) {
+    let steps = (case.time.t_end / case.time.dt - 1e-6).ceil().max(1.0);
+    let every = case.output.every.max(1) as f64;
+    let records = (steps / every).floor() + 1.0;
+    let bytes = records * (48.0 * nodes as f64 + 17.0 * contact_nodes as f64 + 96.0);
+    (records, bytes)
+}
+
+/// "12.3 µs"-style duration.
+fn human_seconds(s: f64) -> String {
+    if s >= 1.0 {
+        format!("{s:.3} s")
+    } else if s >= 1e-3 {
+        format!("{:.3} ms", s * 1e3)
+    } else {
+        format!("{:.3} µs", s * 1e6)
+    }
 }
 
 /// "1.2 GB"-style size (decimal units).
@@ -738,6 +764,22 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         }
         return Ok(Outcome::Interrupted);
     }
+    // A run whose records cannot fit on the disk (a t_end or output.every
+    // off by orders of magnitude filled 14 GB in 75 s): refused before it
+    // starts, where the run's own stop at a full disk would come late.
+    if !options.restart {
+        let (records, bytes) = output_size(case, mesh.nodes.len(), n_c);
+        if let Some(free) = crate::results_file::free_bytes(out).filter(|&f| bytes > f as f64) {
+            return Err(input(format!(
+                "{}: the run would write about {records} records ({}) to {}, whose disk has {} free; \
+                 write every Nth step (output.every), shorten time.t_end, or write elsewhere with -o",
+                case.path.display(),
+                human_bytes(bytes),
+                out.display(),
+                human_bytes(free as f64)
+            )));
+        }
+    }
     // Held until this run returns, from before its first write: a second
     // run's --force or --restart, or a probe, sees the file in use
     // ([`crate::results_file::in_use`]).
@@ -908,6 +950,16 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     // the bar, so a batch job's log shows a long run moving.
     let log_progress = !quiet && !std::io::stderr().is_terminal();
     let mut last_log = Instant::now();
+    let setup_s = started.elapsed().as_secs_f64();
+    let stepping = Instant::now();
+    if log_progress {
+        say!(
+            "setup done in {setup_s:.1} s; stepping from t = {} to t_end = {} (about {} steps), a progress line a minute",
+            integrator.time(),
+            integrator.t_end(),
+            ((integrator.t_end() - integrator.time()) / case.time.dt).ceil()
+        );
+    }
     let t_end = integrator.t_end();
     // A restart starts where its checkpoint was: the share done and the
     // time left count from there.
@@ -1053,6 +1105,8 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         failure: reason.clone(),
         stiffness_product: integrator.stiffness_product().into(),
     };
+    let steps_run = integrator.steps() - steps_before;
+    let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;
     let rows = writer.rows();
     writer.finish(complete, &summary)?;
     xdmf(&times)?;
@@ -1066,7 +1120,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     };
     if !quiet {
         say!(
-            "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations, K by {}) in {:.3} s",
+            "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations, K by {}) in {:.3} s (setup {setup_s:.3} s, {} a step with output)",
             match status {
                 "complete" => "done:",
                 "interrupted" => "interrupted:",
@@ -1077,7 +1131,8 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             integrator.total_iterations(),
             integrator.factorizations(),
             summary.stiffness_product,
-            summary.wall_time_s
+            summary.wall_time_s,
+            human_seconds(step_s)
         );
         // Newmark's γ > ½ dissipates by design, outside the ledger.
         let damped = if case.time.scheme == case::Scheme::Newmark && case.time.gamma > 0.5 {
@@ -1106,6 +1161,8 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             "t_end": t_end,
             "records": rows,
             "wall_time_s": summary.wall_time_s,
+            "setup_s": setup_s,
+            "step_s": step_s,
             "iterations": integrator.total_iterations(),
             "factorizations": integrator.factorizations(),
             "stiffness_product": summary.stiffness_product,

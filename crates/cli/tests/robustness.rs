@@ -1462,7 +1462,10 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
         .arg(&case)
         .arg("-o")
         .arg(&out)
-        .args(["--quiet", "--set", "time.t_end=200"])
+        // 801 records of 4.4 kB: they fit the 4 MB when the run starts
+        // (a run whose records cannot fit is refused before it starts),
+        // but not with the room each flush keeps.
+        .args(["--quiet", "--set", "time.t_end=0.8"])
         .output()
         .unwrap();
     let read = hdf5::File::open(&out).map(|f| {
@@ -1588,4 +1591,25 @@ fn history_forms_are_named_and_long_lists_are_cut() {
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert_eq!(e.lines().count(), 51, "{e}");
     assert!(e.contains("and 150 more problems"), "{e}");
+}
+
+/// A run whose records cannot fit on the disk is refused before it starts
+/// (t_end = 10 with every step written filled 14 GB in 75 s on its way to
+/// 950 GB); `check` says so as a warning.
+#[test]
+fn a_run_that_cannot_fit_on_its_disk_is_refused() {
+    let dir = scratch("no-room");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    // 1e10 records of 4.4 kB: 44 TB.
+    let c = check(&case, &["time.t_end=1e7"]);
+    let out = String::from_utf8_lossy(&c.stdout).into_owned();
+    assert_eq!(c.status.code(), Some(0), "{}", stderr(&c));
+    assert!(
+        out.contains("warning") && out.contains("free on its disk"),
+        "{out}"
+    );
+    let o = run(&case, &dir.join("big.h5"), &["--set", "time.t_end=1e7"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("output.every"), "{}", stderr(&o));
+    assert!(!dir.join("big.h5").exists());
 }

@@ -35,7 +35,7 @@ pub enum FemError {
         dim: u8,
     },
     /// A boundary group whose edges do not form one open or closed chain.
-    #[error("group {name:?} is not a single chain of boundary edges: {reason}; make the physical group one connected piece of the boundary (one group per piece)")]
+    #[error("group {name:?} is not a single chain of boundary edges: {reason}; make the physical group one connected piece of the boundary (a traction may use one group per piece; the friction surface is one piece)")]
     NotAChain {
         /// The group.
         name: String,
