@@ -226,9 +226,11 @@ fn demo(root: &Path, rest: &[String]) -> Result<(), String> {
         .position(|a| a == "-o" || a == "--output")
         .and_then(|i| rest.get(i + 1))
         .map(|o| root.join(o));
-    let out = given
-        .clone()
-        .unwrap_or_else(|| root.join("target/demo/slab.h5"));
+    // Into the target directory cargo builds in (CARGO_TARGET_DIR moves it).
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(|d| root.join(d))
+        .unwrap_or_else(|| root.join("target"));
+    let out = given.clone().unwrap_or_else(|| target.join("demo/slab.h5"));
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     }

@@ -1249,12 +1249,12 @@ fn convert(
     check(
         dt > 0.0 && dt.is_finite(),
         tm.dt.span(),
-        format!("time.dt = {dt} must be > 0"),
+        format!("time.dt = {dt} must be a finite number > 0"),
     );
     check(
         t_end > 0.0 && t_end.is_finite(),
         tm.t_end.span(),
-        format!("time.t_end = {t_end} must be > 0"),
+        format!("time.t_end = {t_end} must be a finite number > 0"),
     );
     // A run that cannot end (1e300 steps passed `check` and ran on).
     let steps = t_end / dt;

@@ -796,7 +796,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         if !changes.is_empty() {
             return Err(input(format!(
                 "{}: --restart {}: the case changes what the stored run computed:\n  {}\n\
-                 a restart may change only time.t_end and output.*; undo those changes, or start a new run with -o NEW.h5",
+                 a restart may change only time.t_end, output.*, title and mesh.ladder; undo those changes, or start a new run with -o NEW.h5",
                 case.path.display(),
                 out.display(),
                 changes.join("\n  ")
