@@ -94,7 +94,7 @@ fn case_errors_exit_2_with_file_and_line() {
             "dt-negative",
             |t| t.replace("dt = 1e-3", "dt = -1e-3"),
             "dt = -1e-3",
-            "time.dt = -0.001 must be > 0",
+            "time.dt = -0.001 must be a finite number > 0",
         ),
         (
             "t-end-zero",
