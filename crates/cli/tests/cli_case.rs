@@ -100,7 +100,7 @@ fn case_errors_exit_2_with_file_and_line() {
             "t-end-zero",
             |t| t.replace("t_end = 0.05", "t_end = 0.0"),
             "t_end = 0.0",
-            "time.t_end = 0 must be > 0",
+            "time.t_end = 0 must be a finite number > 0",
         ),
         (
             "newmark-unstable",
