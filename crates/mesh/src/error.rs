@@ -210,8 +210,8 @@ pub enum MeshErrorKind {
     /// The file has no 2-D cells.
     #[error("the file has no quad cells; mesh the surface (`gmsh -2`), and either put the surface in a physical group or save all elements (Mesh.SaveAll = 1)")]
     NoCells,
-    /// A node off the z = 0 plane.
-    #[error("node {node} has z = {z:?}; stickslip reads plane meshes in the z = 0 plane: build the geometry in the xy-plane and mesh it in 2-D (`gmsh -2`)")]
+    /// A node off the plane z = const of the first node.
+    #[error("node {node} has z = {z:?}, off the plane z = const of the mesh's first node; stickslip reads plane meshes parallel to the xy-plane: build the geometry in the xy-plane and mesh it in 2-D (`gmsh -2`)")]
     NotPlanar {
         /// The node's tag.
         node: u64,

@@ -426,6 +426,32 @@ fn no_cells() {
     assert_eq!(e.location, Location::Nowhere);
 }
 
+/// A mesh drawn in a plane z = const other than 0 reads, z dropped (it
+/// was refused at its first node).
+#[test]
+fn a_plane_at_constant_z_reads() {
+    let flat = text(Q4_22);
+    let shifted: String = flat
+        .lines()
+        .map(|l| {
+            let f: Vec<&str> = l.split(' ').collect();
+            // Node lines of $Nodes: tag x y z.
+            if f.len() == 4 && f.iter().all(|v| v.parse::<f64>().is_ok()) && l.ends_with(" 0") {
+                format!("{} {} {} 0.5", f[0], f[1], f[2])
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n";
+    assert_ne!(shifted, flat);
+    let a = Mesh::from_bytes(flat.as_bytes()).unwrap();
+    let b = Mesh::from_bytes(shifted.as_bytes()).unwrap();
+    assert_eq!(a.nodes, b.nodes);
+    assert_eq!(a.cells, b.cells);
+}
+
 #[test]
 fn not_planar() {
     let t = replace_line(
@@ -775,7 +801,7 @@ fn long_values_are_quoted_short() {
         "9 6.000000000002768 1.375000000000173 1e300",
     );
     let e = err(&t);
-    assert!(e.to_string().contains("has z = 1e300;"), "{e}");
+    assert!(e.to_string().contains("has z = 1e300,"), "{e}");
     let t = text(Q4_22) + "$" + &"A".repeat(300) + "\n1 2 3\n";
     let e = err(&t);
     assert!(e.to_string().len() < 300, "{e}");

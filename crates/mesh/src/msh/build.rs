@@ -193,8 +193,11 @@ pub(crate) struct Builder {
     pub(crate) binary: bool,
     pub(crate) nodes: Vec<[f64; 2]>,
     pub(crate) node_tags: Vec<u64>,
-    /// The z of largest magnitude seen, the node's tag and its position.
+    /// The z farthest from the first node's seen, the node's tag and its
+    /// position.
     pub(crate) max_z: (f64, u64, usize),
+    /// The first node's z: the mesh's plane z = const.
+    pub(crate) first_z: Option<f64>,
     index: Option<NodeIndex>,
     /// The largest node tag read so far.
     max_tag: Option<u64>,
@@ -230,6 +233,7 @@ impl Builder {
             nodes: Vec::new(),
             node_tags: Vec::new(),
             max_z: (0.0, 0, 0),
+            first_z: None,
             index: None,
             max_tag: None,
             late_tags: Vec::new(),
@@ -299,7 +303,14 @@ impl Builder {
     /// block's tags first, then its coordinates), read at `pos`.
     #[inline]
     pub(crate) fn push_xyz(&mut self, x: f64, y: f64, z: f64, tag: u64, pos: usize) {
-        if z.abs() > self.max_z.0.abs() {
+        // The plane is the first node's z = const (a mesh drawn at z = 0.5
+        // is as planar as one at 0): the node farthest off it is kept.
+        if self.first_z.is_none() {
+            self.first_z = Some(z);
+            self.max_z = (z, tag, pos);
+        }
+        let z0 = self.first_z.unwrap_or(z);
+        if (z - z0).abs() > (self.max_z.0 - z0).abs() {
             self.max_z = (z, tag, pos);
         }
         self.nodes.push([x, y]);
@@ -311,10 +322,11 @@ impl Builder {
         // here, before any cell: a mesh in another plane has flat cells in
         // xy, and "degenerate cell" would hide the cause.
         let (z, tag, at) = self.max_z;
-        if z != 0.0 {
+        let z0 = self.first_z.unwrap_or(0.0);
+        if z != z0 {
             let bb = crate::bounding_box(self.nodes.iter().copied());
             let extent = (bb[1][0] - bb[0][0]).max(bb[1][1] - bb[0][1]).max(0.0);
-            if z.abs() > Z_TOL * extent {
+            if (z - z0).abs() > Z_TOL * extent {
                 return Err(cur.error(at, MeshErrorKind::NotPlanar { node: tag, z }));
             }
         }
