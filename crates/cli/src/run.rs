@@ -517,6 +517,29 @@ fn output_size(case: &Case, nodes: usize, contact_nodes: usize) -> (f64, f64) {
     (records, bytes)
 }
 
+/// The initial (static) displacement, where it exceeds the part's size:
+/// no small strains are left, which is most often a mix of units (E in MPa
+/// with loads in Pa: displacements of 340% of the part went without a
+/// word). The paper's slab itself moves 12% of its length (0.975 of 8).
+fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
+    let [lo, hi] = stickslip_mesh::bounding_box(mesh.nodes.iter().copied());
+    let size = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let (node, max) = u
+        .chunks_exact(2)
+        .map(|d| d[0].hypot(d[1]))
+        .enumerate()
+        .fold((0, 0.0_f64), |m, (i, d)| if d > m.1 { (i, d) } else { m });
+    (size > 0.0 && max > size).then(|| {
+        format!(
+            "the initial static displacement reaches {max:.3e} at ({}, {}), {:.0}% of the part's size {size:.3e}: \
+             linear elasticity assumes small strains; check the units of E, the loads and the lengths",
+            mesh.nodes[node][0],
+            mesh.nodes[node][1],
+            100.0 * max / size
+        )
+    })
+}
+
 /// "12.3 µs"-style duration.
 fn human_seconds(s: f64) -> String {
     if s >= 1.0 {
@@ -902,6 +925,11 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         let mut w = ResultsWriter::create_with(out, &header, case.output.compression)
             .with_context(|| format!("cannot create the results file {}", out.display()))?;
         w.append(&record(&integrator, &model, &mut full, 0.0, 0))?;
+        if !quiet {
+            if let Some(w) = large_static_displacement(&mesh, &full.u) {
+                say!("{}: warning: {w}", case.path.display());
+            }
+        }
         (w, 0.0, 0.0, vec![integrator.time()])
     };
     writer.auto_flush = false;

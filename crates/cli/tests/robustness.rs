@@ -1613,3 +1613,35 @@ fn a_run_that_cannot_fit_on_its_disk_is_refused() {
     assert!(stderr(&o).contains("output.every"), "{}", stderr(&o));
     assert!(!dir.join("big.h5").exists());
 }
+
+/// Units mixed up (E a millionth of what the loads assume) move the part
+/// by more than its size: the run says so (it went without a word); the
+/// paper's case, whose slab moves 12% of its length, gets no warning.
+#[test]
+fn a_static_displacement_beyond_the_part_size_is_reported() {
+    let dir = scratch("units");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let loud = bin()
+        .arg("run")
+        .arg(&case)
+        .arg("-o")
+        .arg(dir.join("a.h5"))
+        .args(["--set", "material.E=1e-3"])
+        .output()
+        .unwrap();
+    assert_eq!(loud.status.code(), Some(0), "{}", stderr(&loud));
+    assert!(
+        stderr(&loud).contains("warning: the initial static displacement reaches"),
+        "{}",
+        stderr(&loud)
+    );
+    let calm = bin()
+        .arg("run")
+        .arg(&case)
+        .arg("-o")
+        .arg(dir.join("b.h5"))
+        .output()
+        .unwrap();
+    assert_eq!(calm.status.code(), Some(0), "{}", stderr(&calm));
+    assert!(!stderr(&calm).contains("warning"), "{}", stderr(&calm));
+}
