@@ -32,6 +32,16 @@ pub enum Field {
     /// Slip velocity v_T along τ (contact nodes only).
     #[value(name = "slip_velocity")]
     SlipVelocity,
+    /// Stress σ_xx at the node (the average of its cells' values there),
+    /// from the stored displacement and the case's material.
+    Sxx,
+    /// Stress σ_yy at the node.
+    Syy,
+    /// Shear stress σ_xy at the node.
+    Sxy,
+    /// Von Mises stress at the node (plane strain: with σ_zz = ν(σ_xx + σ_yy)).
+    #[value(name = "von_mises")]
+    VonMises,
 }
 
 impl Field {
@@ -45,7 +55,28 @@ impl Field {
             Field::Ay => "ay",
             Field::FrictionStress => "friction_stress",
             Field::SlipVelocity => "slip_velocity",
+            Field::Sxx => "sxx",
+            Field::Syy => "syy",
+            Field::Sxy => "sxy",
+            Field::VonMises => "von_mises",
         }
+    }
+
+    /// The stress component of a stress field: 0, 1, 2 for σ_xx, σ_yy,
+    /// σ_xy, 3 for von Mises.
+    fn stress(self) -> Option<usize> {
+        match self {
+            Field::Sxx => Some(0),
+            Field::Syy => Some(1),
+            Field::Sxy => Some(2),
+            Field::VonMises => Some(3),
+            _ => None,
+        }
+    }
+
+    /// A field of the contact nodes only.
+    fn on_contact(self) -> bool {
+        matches!(self, Field::FrictionStress | Field::SlipVelocity)
     }
 
     /// The node dataset and component of a node field; `None` for the
@@ -58,7 +89,7 @@ impl Field {
             Field::Vy => Some(("velocity", 1)),
             Field::Ax => Some(("acceleration", 0)),
             Field::Ay => Some(("acceleration", 1)),
-            Field::FrictionStress | Field::SlipVelocity => None,
+            _ => None,
         }
     }
 }
@@ -157,6 +188,126 @@ fn read_time(f: &File, name: &str) -> Result<Vec<f64>, InputError> {
         })
 }
 
+/// The mesh and material of the run stored in `f` (for the stress
+/// fields): cells and coordinates from `/mesh`, E, ν and the hypothesis
+/// from the case text the file stores.
+fn stored_model(
+    f: &File,
+    name: &str,
+) -> Result<(stickslip_mesh::Mesh, stickslip_fem::Material), InputError> {
+    let bad = |what: String| {
+        InputError(format!(
+            "{name}: {what}; the stress fields need a results file written by `stickslip run`"
+        ))
+    };
+    let nodes = f
+        .dataset("mesh/nodes")
+        .and_then(|d| d.read_2d::<f64>())
+        .map_err(|e| bad(format!("cannot read /mesh/nodes: {e}")))?;
+    let cells = f
+        .dataset("mesh/cells")
+        .and_then(|d| d.read_2d::<i64>())
+        .map_err(|e| bad(format!("cannot read /mesh/cells: {e}")))?;
+    let kind = match f
+        .group("mesh")
+        .ok()
+        .and_then(|g| crate::output::text_attr(&g, "kind").ok())
+        .as_deref()
+    {
+        Some("quad4") => stickslip_mesh::CellKind::Quad4,
+        Some("quad9") => stickslip_mesh::CellKind::Quad9,
+        other => {
+            return Err(bad(format!(
+                "/mesh has cell kind {other:?}, not quad4 or quad9"
+            )))
+        }
+    };
+    let n = nodes.nrows();
+    if cells.ncols() != kind.nodes_per_cell() || cells.iter().any(|&v| v < 0 || v as usize >= n) {
+        return Err(bad("/mesh/cells does not fit /mesh/nodes".into()));
+    }
+    let mesh = stickslip_mesh::Mesh {
+        nodes: nodes.rows().into_iter().map(|r| [r[0], r[1]]).collect(),
+        node_tags: (1..=n as u64).collect(),
+        kind,
+        cells: cells.iter().map(|&v| v as usize).collect(),
+        cell_tags: (1..=cells.nrows() as u64).collect(),
+        groups: Vec::new(),
+        source: Default::default(),
+    };
+    let case = crate::output::text_attr(f, "case")
+        .map_err(|e| bad(format!("cannot read the case it stores: {e:#}")))?;
+    let doc: toml::Table = case
+        .parse()
+        .map_err(|e| bad(format!("the case it stores does not parse: {e}")))?;
+    let m = doc.get("material").and_then(|m| m.as_table());
+    let num = |k: &str| {
+        m.and_then(|m| m.get(k))
+            .and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
+    };
+    let hypothesis = match m.and_then(|m| m.get("hypothesis")).and_then(|h| h.as_str()) {
+        None | Some("plane_strain") => stickslip_fem::Hypothesis::PlaneStrain,
+        Some("plane_stress") => stickslip_fem::Hypothesis::PlaneStress,
+        Some(other) => return Err(bad(format!("its case's material.hypothesis is {other:?}"))),
+    };
+    let (Some(e), Some(nu)) = (num("E"), num("nu")) else {
+        return Err(bad("its case has no material.E and material.nu".into()));
+    };
+    let material = stickslip_fem::Material::new(e, nu, num("rho").unwrap_or(1.0), hypothesis)
+        .map_err(|e| bad(format!("its case's material: {e}")))?;
+    Ok((mesh, material))
+}
+
+/// Component `field` of the stress `s` (von Mises for [`Field::VonMises`]).
+fn component(material: &stickslip_fem::Material, s: [f64; 3], field: Field) -> f64 {
+    match field.stress() {
+        Some(3) => stickslip_fem::von_mises(material, s),
+        Some(k) => s[k],
+        None => f64::NAN,
+    }
+}
+
+/// The history of stress field `field` at `node`: its cells' nodes'
+/// displacement histories read, the node's stress formed per record
+/// ([`stickslip_fem::stress_at_node`], the bits of the nodal average).
+fn stress_history(
+    f: &File,
+    name: &str,
+    mesh: &stickslip_mesh::Mesh,
+    material: &stickslip_fem::Material,
+    node: usize,
+    field: Field,
+) -> Result<Vec<f64>, InputError> {
+    let cells: Vec<usize> = (0..mesh.n_cells())
+        .filter(|&c| mesh.cell(c).contains(&node))
+        .collect();
+    let mut near: Vec<usize> = cells.iter().flat_map(|&c| mesh.cell(c).to_vec()).collect();
+    near.sort_unstable();
+    near.dedup();
+    let ds = f
+        .dataset("displacement")
+        .map_err(|e| InputError(format!("{name}: cannot read /displacement: {e}")))?;
+    let mut hist = std::collections::HashMap::new();
+    for &v in &near {
+        let read = |comp: usize| {
+            ds.read_slice_1d::<f64, _>(s![.., v, comp])
+                .map(|a| a.to_vec())
+                .map_err(|e| InputError(format!("{name}: cannot read /displacement: {e}")))
+        };
+        hist.insert(v, (read(0)?, read(1)?));
+    }
+    let records = hist.values().map(|(x, _)| x.len()).min().unwrap_or(0);
+    Ok((0..records)
+        .map(|k| {
+            let s = stickslip_fem::stress_at_node(mesh, material, node, &cells, |v| {
+                let (x, y) = &hist[&v];
+                [x[k], y[k]]
+            });
+            component(material, s, field)
+        })
+        .collect())
+}
+
 /// Reads the history of `field` at the node of `file` nearest to `at`.
 ///
 /// # Errors
@@ -188,6 +339,10 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
     let t = read_time(&f, &name)?;
 
     let values: Vec<f64> = match field.node_dataset() {
+        None if field.stress().is_some() => {
+            let (mesh, material) = stored_model(&f, &name)?;
+            stress_history(&f, &name, &mesh, &material, node, field)?
+        }
         None => {
             let contact = f
                 .dataset("contact/nodes")
@@ -541,7 +696,7 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
     };
     let (mut order, mut s) = order_along(&name, group, &nodes, &cells, &members)?;
 
-    let contact_field = field.node_dataset().is_none();
+    let contact_field = field.on_contact();
     let is_contact_group = contact_group(&f).as_deref() == Some(group);
     let contact: Option<(Vec<i64>, Vec<f64>)> = if contact_field || is_contact_group {
         let c = f
@@ -639,6 +794,24 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
         }
         info.push('\n');
         let row: Vec<f64> = match field.node_dataset() {
+            None if field.stress().is_some() => {
+                let (mesh, material) = stored_model(&f, &name)?;
+                let u: Vec<f64> = f
+                    .dataset("displacement")
+                    .and_then(|d| d.read_slice_2d::<f64, _>(s![k, .., ..]))
+                    .map_err(|e| h5("cannot read /displacement", e))?
+                    .iter()
+                    .copied()
+                    .collect();
+                let all = stickslip_fem::nodal_stresses(&mesh, &material, &u);
+                order
+                    .iter()
+                    .map(|&v| {
+                        all.get(v)
+                            .map_or(f64::NAN, |&st| component(&material, st, field))
+                    })
+                    .collect()
+            }
             Some((ds, comp)) => {
                 let all = f
                     .dataset(ds)

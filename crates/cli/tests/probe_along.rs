@@ -343,3 +343,49 @@ fn probe_along_through_the_binary() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("output step 100"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Stress fields from the stored displacement and the case's material. At
+/// t = 0 the paper's slab is in its static state: pressed by F_n = 300 on
+/// its bottom and held on its top, σ_yy = −300 everywhere and σ_xx = σ_xy
+/// = 0 (ends free in x but for the left roller, which holds no load);
+/// plane strain with ν = 0.3 gives σ_zz = −90 and von Mises √(300² + 90² −
+/// 300·90) = √71100. A node's history (`--at`) and the group's values
+/// (`--along`) are the same numbers at a later time.
+#[test]
+fn stress_fields_of_the_slab() {
+    let dir = scratch("stress");
+    let h5 = run_slab(&dir);
+    for (field, want) in [
+        (Field::Syy, -300.0),
+        (Field::Sxx, 0.0),
+        (Field::Sxy, 0.0),
+        (Field::VonMises, 71100f64.sqrt()),
+    ] {
+        let a = along(&h5, "contact", "0", field).unwrap();
+        for line in a.csv.lines().skip(1) {
+            let v: f64 = line.rsplit(',').next().unwrap().parse().unwrap();
+            assert!((v - want).abs() < 1e-9 * 300.0, "{field:?}: {line}");
+        }
+    }
+    let p = stickslip::probe::probe(&h5, "4,0", Field::Sxx, true).unwrap();
+    let at: Vec<(f64, f64)> = p
+        .table
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let mut f = l.split(',').map(|v| v.trim().parse::<f64>().unwrap());
+            (f.next().unwrap(), f.next().unwrap())
+        })
+        .collect();
+    let (t, v) = at[at.len() - 1];
+    assert!(t > 0.09 && v.abs() > 1e-6, "the slab moves: {t} {v}");
+    let a = along(&h5, "contact", &t.to_string(), Field::Sxx).unwrap();
+    let node = a
+        .csv
+        .lines()
+        .skip(1)
+        .find(|l| l.split(',').nth(4) == Some("4e0"))
+        .expect("the node at x = 4");
+    let w: f64 = node.rsplit(',').next().unwrap().parse().unwrap();
+    assert_eq!(v.to_bits(), w.to_bits(), "{node}");
+}

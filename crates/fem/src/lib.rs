@@ -42,7 +42,9 @@ pub use loads::{
 pub use material::{Hypothesis, Material};
 pub use model::Model;
 pub use solver::{analyze_symbolic, csc_view, SolverError, SparseCholesky};
-pub use statics::{gauss_point_stresses, nodal_stresses, static_solve, GaussPointStress};
+pub use statics::{
+    gauss_point_stresses, nodal_stresses, static_solve, stress_at_node, von_mises, GaussPointStress,
+};
 pub use supernodal::{ContactOperator, Supernodal};
 
 /// The physical group `name` of `mesh`, wanted for `purpose`.

@@ -128,6 +128,65 @@ pub fn nodal_stresses(mesh: &Mesh, material: &Material, u_full: &[f64]) -> Vec<[
     sum
 }
 
+/// The stress at `node` as [`nodal_stresses`] gives it (the average over
+/// its cells of each cell's stress there, the same operations in the same
+/// order: the same bits), from `cells`, the cells holding `node` in
+/// ascending order, and `u(v)`, the displacement of each of their nodes.
+/// For a history at one node without the whole mesh's displacement.
+///
+/// # Panics
+/// If `node` is not a node of every cell of `cells`.
+pub fn stress_at_node(
+    mesh: &Mesh,
+    material: &Material,
+    node: usize,
+    cells: &[usize],
+    u: impl Fn(usize) -> [f64; 2],
+) -> [f64; 3] {
+    let d = material.elasticity();
+    let n = mesh.kind.nodes_per_cell();
+    let (mut coords, mut ue) = ([[0.0; 2]; MAX_NODES], [0.0; 2 * MAX_NODES]);
+    let mut sum = [0.0; 3];
+    for &c in cells {
+        let cell = mesh.cell(c);
+        for (a, &v) in cell.iter().enumerate() {
+            coords[a] = mesh.nodes[v];
+            let [x, y] = u(v);
+            ue[2 * a] = x;
+            ue[2 * a + 1] = y;
+        }
+        let a = cell
+            .iter()
+            .position(|&v| v == node)
+            .expect("node of the cell");
+        let xi = cell_nodes(mesh.kind)[a];
+        let e = strain_at(mesh.kind, &coords[..n], &ue[..2 * n], xi).unwrap_or([f64::NAN; 3]);
+        let s = stress_from_strain(&d, e);
+        for k in 0..3 {
+            sum[k] += s[k];
+        }
+    }
+    if !cells.is_empty() {
+        for v in sum.iter_mut() {
+            *v /= cells.len() as f64;
+        }
+    }
+    sum
+}
+
+/// The von Mises stress of an in-plane stress state [σxx, σyy, σxy]: with
+/// σzz = ν(σxx + σyy) in plane strain, 0 in plane stress.
+pub fn von_mises(material: &Material, s: [f64; 3]) -> f64 {
+    let szz = match material.hypothesis {
+        crate::Hypothesis::PlaneStrain => material.poisson_ratio * (s[0] + s[1]),
+        crate::Hypothesis::PlaneStress => 0.0,
+    };
+    let [sxx, syy, sxy] = s;
+    (sxx * sxx + syy * syy + szz * szz - sxx * syy - syy * szz - szz * sxx + 3.0 * sxy * sxy)
+        .max(0.0)
+        .sqrt()
+}
+
 fn gather(
     mesh: &Mesh,
     c: usize,

@@ -5,8 +5,8 @@
 
 use stickslip_fem::testing::{add_point_group, map_nodes, rectangle};
 use stickslip_fem::{
-    gauss_point_stresses, nodal_stresses, static_solve, traction_load_with, Dirichlet, Hypothesis,
-    Material, Model,
+    gauss_point_stresses, nodal_stresses, static_solve, stress_at_node, traction_load_with,
+    von_mises, Dirichlet, Hypothesis, Material, Model,
 };
 use stickslip_mesh::{CellKind, Mesh};
 
@@ -171,4 +171,35 @@ fn traction_patch_test_on_curved_q2_and_distorted_q1() {
         let es = stress_error(&mesh, &u);
         assert!(es < 1e-11, "{name}: relative stress error {es:e}");
     }
+}
+
+/// One node's stress from its cells alone (what `stickslip probe` reads
+/// over a history) has the bits of the whole mesh's nodal stresses, on the
+/// distorted Q1 and curved Q2 meshes with a pseudo-random displacement.
+#[test]
+fn stress_at_one_node_is_the_nodal_stress() {
+    for mesh in [distorted_q1(), curved_q2()] {
+        let mut state = 7u64;
+        let u: Vec<f64> = (0..2 * mesh.nodes.len()).map(|_| lcg(&mut state)).collect();
+        let all = nodal_stresses(&mesh, &material(), &u);
+        for (v, expected) in all.iter().enumerate() {
+            let cells: Vec<usize> = (0..mesh.n_cells())
+                .filter(|&c| mesh.cell(c).contains(&v))
+                .collect();
+            let s = stress_at_node(&mesh, &material(), v, &cells, |w| [u[2 * w], u[2 * w + 1]]);
+            assert_eq!(s.map(f64::to_bits), expected.map(f64::to_bits), "node {v}");
+        }
+    }
+}
+
+/// Von Mises by hand: uniaxial σ in plane stress is σ; pure shear τ is
+/// √3 τ; plane strain's σzz = ν(σxx + σyy) enters (equibiaxial σ, ν = 0.3:
+/// σzz = 0.6σ, von Mises |σ − 0.6σ| = 0.4σ).
+#[test]
+fn von_mises_by_hand() {
+    let stress = Material::new(1.0, 0.3, 1.0, Hypothesis::PlaneStress).unwrap();
+    let strain = Material::new(1.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    assert!((von_mises(&stress, [5.0, 0.0, 0.0]) - 5.0).abs() < 1e-14);
+    assert!((von_mises(&stress, [0.0, 0.0, 2.0]) - 2.0 * 3f64.sqrt()).abs() < 1e-14);
+    assert!((von_mises(&strain, [1.0, 1.0, 0.0]) - 0.4).abs() < 1e-14);
 }
