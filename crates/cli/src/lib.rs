@@ -20,4 +20,5 @@ pub mod output;
 pub mod probe;
 pub mod results_file;
 pub mod run;
+pub mod stress_cmd;
 pub mod xdmf;

@@ -107,6 +107,16 @@ Exit codes: 0 a configuration meets the tolerance (estimated), 1 none of the lad
         #[arg(long)]
         json: bool,
     },
+    /// Write a finished run's stress fields (/stress, /von_mises) into its results file and
+    /// list them in its XDMF, for ParaView.
+    #[command(after_help = "Example:\n  stickslip stress slab.h5")]
+    Stress {
+        /// A results file written by `stickslip run` (no run may be writing it).
+        file: PathBuf,
+        /// No progress lines.
+        #[arg(short, long)]
+        quiet: bool,
+    },
     /// Print the time history of one field at the node nearest to a point.
     #[command(
         after_help = "Example:\n  stickslip probe slab.h5 --at 8,0 --field ux --csv > node81.csv"
@@ -288,6 +298,19 @@ fn main() -> ExitCode {
                 Err(e) => fail(&e),
             }
         }
+        Command::Stress { file, quiet } => match stickslip::stress_cmd::command(&file, quiet) {
+            Ok((rows, nodes)) => {
+                if !quiet {
+                    eprintln!(
+                        "stress: {rows} records of {nodes} nodes into {} (/stress, /von_mises), listed in {}",
+                        file.display(),
+                        file.with_extension("xdmf").display()
+                    );
+                }
+                ExitCode::SUCCESS
+            }
+            Err(e) => fail(&e),
+        },
         Command::Mesh { file, json } => match mesh_cmd::report(&file, json) {
             Ok(text) => {
                 print!("{text}");

@@ -745,6 +745,13 @@ impl ResultsWriter {
             path.display(),
             nodes.first().copied().unwrap_or(0)
         );
+        // `stickslip stress` datasets end where the earlier run ended: a
+        // restart removes them (run the command again after it).
+        for stale in ["stress", "von_mises"] {
+            if file.link_exists(stale) {
+                file.unlink(stale)?;
+            }
+        }
         let contact = if file.link_exists("contact") {
             ContactSeries {
                 friction_stress: ds("contact/friction_stress")?,

@@ -191,7 +191,7 @@ fn read_time(f: &File, name: &str) -> Result<Vec<f64>, InputError> {
 /// The mesh and material of the run stored in `f` (for the stress
 /// fields): cells and coordinates from `/mesh`, E, ν and the hypothesis
 /// from the case text the file stores.
-fn stored_model(
+pub(crate) fn stored_model(
     f: &File,
     name: &str,
 ) -> Result<(stickslip_mesh::Mesh, stickslip_fem::Material), InputError> {

@@ -948,6 +948,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             kind: mesh.kind,
             n_cells: mesh.n_cells(),
             times,
+            stress: false,
         };
         crate::xdmf::write_xdmf(out, &xdmf_path, &info)
             .with_context(|| format!("cannot write {}", xdmf_path.display()))

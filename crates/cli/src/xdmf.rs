@@ -33,6 +33,9 @@ pub struct XdmfInfo<'a> {
     pub n_cells: usize,
     /// `/time`, one entry per output step written so far.
     pub times: &'a [f64],
+    /// The file holds `/stress` [n_out, n_nodes, 3] and `/von_mises`
+    /// [n_out, n_nodes] (`stickslip stress`): listed per step too.
+    pub stress: bool,
 }
 
 /// The node vectors written per step: (dataset, attribute name).
@@ -105,6 +108,28 @@ fn write_xml(x: &mut impl Write, h5_name: &str, info: &XdmfInfo) -> std::io::Res
               \x20       </Attribute>\n"
             )?;
         }
+        if info.stress {
+            for (name, dims, comps, kind) in [
+                ("stress", format!("1 {n} 3"), " 3", "Vector"),
+                ("von_mises", format!("1 {n}"), "", "Scalar"),
+            ] {
+                let (start, stride, count) = if comps.is_empty() {
+                    (format!("{k} 0"), "1 1", format!("1 {n}"))
+                } else {
+                    (format!("{k} 0 0"), "1 1 1", format!("1 {n} 3"))
+                };
+                let rank = if comps.is_empty() { 2 } else { 3 };
+                write!(
+                    x,
+                    "        <Attribute Name=\"{name}\" AttributeType=\"{kind}\" Center=\"Node\">\n\
+                  \x20         <DataItem ItemType=\"HyperSlab\" Dimensions=\"{dims}\" Type=\"HyperSlab\">\n\
+                  \x20           <DataItem Dimensions=\"3 {rank}\" NumberType=\"Int\" Format=\"XML\">{start} {stride} {count}</DataItem>\n\
+                  \x20           <DataItem Dimensions=\"{n_out} {n}{comps}\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:/{name}</DataItem>\n\
+                  \x20         </DataItem>\n\
+                  \x20       </Attribute>\n"
+                )?;
+            }
+        }
         x.write_all(b"      </Grid>\n")?;
     }
     x.write_all(b"    </Grid>\n  </Domain>\n</Xdmf>\n")
@@ -158,6 +183,7 @@ mod tests {
                 kind: CellKind::Quad9,
                 n_cells: 16,
                 times: &times,
+                stress: false,
             },
         );
         assert_eq!(count(&x, "GridType=\"Uniform\""), 3);
@@ -191,6 +217,7 @@ mod tests {
             kind: CellKind::Quad9,
             n_cells: 16,
             times: &[0.0, 0.25, 0.5],
+            stress: false,
         };
         let path = dir.join("slab.xdmf");
         write_xdmf(&dir.join("slab.h5"), &path, &info).unwrap();
@@ -210,6 +237,7 @@ mod tests {
                 kind: CellKind::Quad4,
                 n_cells: 2,
                 times: &[0.0],
+                stress: false,
             },
         );
         assert!(x.contains(
@@ -232,6 +260,7 @@ mod tests {
                 kind: CellKind::Quad4,
                 n_cells: 1,
                 times: &[0.0, 1.0],
+                stress: false,
             },
         )
         .unwrap();
@@ -247,6 +276,7 @@ mod tests {
                 kind: CellKind::Quad4,
                 n_cells: 1,
                 times: &[],
+                stress: false,
             },
         )
         .unwrap_err();

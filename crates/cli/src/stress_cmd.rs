@@ -1,0 +1,129 @@
+//! `stickslip stress OUT.h5`: a finished run's stress fields written into
+//! its results file, for ParaView.
+//!
+//! The run itself writes no stresses (a record is u, v, a and the friction
+//! fields; stresses at every node and step would cost a pass over the
+//! cells per record, which most runs never read). This command forms them
+//! afterwards from `/displacement` and the material of the case the file
+//! stores, as `stickslip probe --field sxx` does at one node: at each node
+//! the average of its cells' σ = D ε there (`stickslip_fem::nodal_stresses`),
+//! into `/stress` [n_out, n_nodes, 3] (σ_xx, σ_yy, σ_xy) and `/von_mises`
+//! [n_out, n_nodes], and lists both in the XDMF. A `--restart` of the run
+//! removes them (they would end where the earlier run ended): run this
+//! command again after it.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::Context;
+use hdf5::File;
+use ndarray::{s, Array1, Array2};
+
+use crate::error::InputError;
+
+/// Writes the stress datasets of the results file `path` and rewrites its
+/// XDMF; returns the records and nodes written.
+///
+/// # Errors
+/// An [`InputError`] for a file that is missing, being written, or not a
+/// results file of `stickslip run`; other errors for HDF5 failures.
+pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
+    let name = path.display().to_string();
+    if !path.is_file() {
+        return Err(InputError(format!(
+            "{name}: no such results file; give the OUT.h5 a `stickslip run` wrote"
+        ))
+        .into());
+    }
+    if crate::results_file::in_use(path) {
+        return Err(InputError(format!(
+            "{name}: a run or a reader has it open; wait for the run to end (or close the reader) and run this again"
+        ))
+        .into());
+    }
+    // No run may start on the file while the stresses go in.
+    let _lock = crate::results_file::RunLock::take(path)?;
+    let f = File::open_rw(path).map_err(|e| {
+        InputError(format!(
+            "{name}: cannot open it as HDF5 for writing: {e}; give a results file written by `stickslip run`"
+        ))
+    })?;
+    if crate::output::text_attr(&f, "program").ok().as_deref() != Some("stickslip") {
+        return Err(InputError(format!(
+            "{name} was not written by `stickslip run` (no program = \"stickslip\" attribute)"
+        ))
+        .into());
+    }
+    let (mesh, material) = crate::probe::stored_model(&f, &name)?;
+    let n_nodes = mesh.nodes.len();
+    let u = f.dataset("displacement")?;
+    let times = f.dataset("time")?.read_1d::<f64>()?.to_vec();
+    let rows = times.len().min(u.shape().first().copied().unwrap_or(0));
+    for old in ["stress", "von_mises"] {
+        if f.link_exists(old) {
+            f.unlink(old)?;
+        }
+    }
+    let stress = f
+        .new_dataset::<f64>()
+        .chunk((1, n_nodes, 3))
+        .shape((rows, n_nodes, 3))
+        .create("stress")?;
+    let mises = f
+        .new_dataset::<f64>()
+        .chunk((1, n_nodes))
+        .shape((rows, n_nodes))
+        .create("von_mises")?;
+    let about = "at each node the average of its cells' stress sigma = D eps there, from /displacement \
+                 and the material of the stored case (stickslip stress); [sigma_xx, sigma_yy, sigma_xy]";
+    for (ds, text) in [
+        (&stress, about),
+        (
+            &mises,
+            "von Mises stress of /stress (plane strain: sigma_zz = nu (sigma_xx + sigma_yy))",
+        ),
+    ] {
+        let v: hdf5::types::VarLenUnicode = text.parse().expect("no NUL");
+        ds.new_attr::<hdf5::types::VarLenUnicode>()
+            .create("about")?
+            .write_scalar(&v)?;
+    }
+    let started = Instant::now();
+    let mut last = Instant::now();
+    for k in 0..rows {
+        let row: Vec<f64> = u
+            .read_slice_2d::<f64, _>(s![k, .., ..])?
+            .iter()
+            .copied()
+            .collect();
+        let st = stickslip_fem::nodal_stresses(&mesh, &material, &row);
+        let a = Array2::from_shape_fn((n_nodes, 3), |(i, c)| st[i][c]);
+        stress.write_slice(&a, s![k, .., ..])?;
+        let vm: Array1<f64> = st
+            .iter()
+            .map(|&s| stickslip_fem::von_mises(&material, s))
+            .collect();
+        mises.write_slice(&vm, s![k, ..])?;
+        if !quiet && last.elapsed().as_secs() >= 10 {
+            last = Instant::now();
+            eprintln!(
+                "stress: {} of {rows} records, {:.0} s",
+                k + 1,
+                started.elapsed().as_secs_f64()
+            );
+        }
+    }
+    f.flush()?;
+    drop((stress, mises, u, f));
+    let xdmf_path = path.with_extension("xdmf");
+    let info = crate::xdmf::XdmfInfo {
+        n_nodes,
+        kind: mesh.kind,
+        n_cells: mesh.n_cells(),
+        times: &times[..rows],
+        stress: true,
+    };
+    crate::xdmf::write_xdmf(path, &xdmf_path, &info)
+        .with_context(|| format!("cannot write {}", xdmf_path.display()))?;
+    Ok((rows, n_nodes))
+}

@@ -1,0 +1,119 @@
+//! `stickslip stress OUT.h5`: a finished run's stress fields into its file
+//! and XDMF. Expected values: the paper's slab at t = 0 is in its static
+//! state, pressed by F_n = 300 on its bottom and held on its top: σ_yy =
+//! −300 at every node, σ_xx = σ_xy = 0, and plane strain with ν = 0.3 gives
+//! von Mises √(300² + 90² − 300·90) = √71100. Later rows are checked
+//! against `probe --along` (the same nodal average, formed independently of
+//! this command's loop).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use stickslip::probe::{along, Field};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("stress-{name}"));
+    std::fs::remove_dir_all(&d).ok();
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn stickslip(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stickslip"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn stress_fields_go_into_the_file_and_its_xdmf() {
+    let dir = scratch("slab");
+    let h5 = dir.join("slab.h5");
+    let (case, out) = (
+        root().join("cases/martins-oden/cd-step-eps1e-4.toml"),
+        h5.to_str().unwrap().to_string(),
+    );
+    let o = stickslip(&[
+        "run",
+        case.to_str().unwrap(),
+        "-o",
+        &out,
+        "--quiet",
+        "--set",
+        "time.t_end=0.1",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = stickslip(&["stress", &out]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let f = hdf5::File::open(&h5).unwrap();
+    let stress = f
+        .dataset("stress")
+        .unwrap()
+        .read::<f64, ndarray::Ix3>()
+        .unwrap();
+    let mises = f.dataset("von_mises").unwrap().read_2d::<f64>().unwrap();
+    let rows = f.dataset("time").unwrap().size();
+    assert_eq!(stress.shape(), [rows, 85, 3]);
+    assert_eq!(mises.shape(), [rows, 85]);
+    for v in 0..85 {
+        let s = [stress[[0, v, 0]], stress[[0, v, 1]], stress[[0, v, 2]]];
+        for (got, want) in s.iter().zip([0.0, -300.0, 0.0]) {
+            assert!((got - want).abs() < 1e-9 * 300.0, "node {v}: {s:?}");
+        }
+        assert!((mises[[0, v]] - 71100f64.sqrt()).abs() < 1e-9 * 300.0);
+    }
+    // The last row against probe --along at the same step, bit for bit.
+    let t_last = f.dataset("time").unwrap().read_1d::<f64>().unwrap()[rows - 1];
+    drop(f);
+    for (field, comp) in [(Field::Sxx, 0), (Field::Syy, 1), (Field::Sxy, 2)] {
+        let a = along(&h5, "contact", &t_last.to_string(), field).unwrap();
+        for line in a.csv.lines().skip(1) {
+            let cols: Vec<&str> = line.split(',').collect();
+            let node: usize = cols[3].parse().unwrap();
+            let v: f64 = cols[7].parse().unwrap();
+            assert_eq!(
+                v.to_bits(),
+                stress[[rows - 1, node, comp]].to_bits(),
+                "{field:?} at node {node}"
+            );
+        }
+    }
+    let xml = std::fs::read_to_string(dir.join("slab.xdmf")).unwrap();
+    assert_eq!(xml.matches("<Attribute Name=\"von_mises\"").count(), rows);
+    assert_eq!(xml.matches("<Attribute Name=\"stress\"").count(), rows);
+
+    // A restart ends the run elsewhere: the stresses are removed, and the
+    // command writes them again.
+    let o = stickslip(&[
+        "run",
+        case.to_str().unwrap(),
+        "--restart",
+        &out,
+        "--quiet",
+        "--set",
+        "time.t_end=0.12",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let f = hdf5::File::open(&h5).unwrap();
+    assert!(!f.link_exists("stress") && !f.link_exists("von_mises"));
+    drop(f);
+    assert!(!std::fs::read_to_string(dir.join("slab.xdmf"))
+        .unwrap()
+        .contains("von_mises"));
+
+    // Bad input: no file, not a results file.
+    for bad in [dir.join("none.h5"), case.clone()] {
+        let o = stickslip(&["stress", bad.to_str().unwrap()]);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}
