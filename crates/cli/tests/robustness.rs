@@ -1645,3 +1645,20 @@ fn a_static_displacement_beyond_the_part_size_is_reported() {
     assert_eq!(calm.status.code(), Some(0), "{}", stderr(&calm));
     assert!(!stderr(&calm).contains("warning"), "{}", stderr(&calm));
 }
+
+/// `check` of a Newmark case says what its Δt resolves (it printed only
+/// central difference's critical step, which does not bound Newmark).
+#[test]
+fn check_says_what_a_newmark_step_resolves() {
+    let dir = scratch("nm-resolves");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let o = check(&case, &["time.scheme=\"newmark\"", "time.dt=5e-3"]);
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        out.contains("accuracy") && out.contains("periods above 5.000e-2"),
+        "{out}"
+    );
+    let o = check(&case, &[]);
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("accuracy    "));
+}
