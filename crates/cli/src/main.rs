@@ -107,8 +107,8 @@ Exit codes: 0 a configuration meets the tolerance (estimated), 1 none of the lad
         #[arg(long)]
         json: bool,
     },
-    /// Write a finished run's stress fields (/stress, /von_mises) into its results file and
-    /// list them in its XDMF, for ParaView.
+    /// Write a finished run's stress fields (/stress, /von_mises) into OUT.stress.h5 beside its
+    /// results file and list them in its XDMF, for ParaView.
     #[command(after_help = "Example:\n  stickslip stress slab.h5")]
     Stress {
         /// A results file written by `stickslip run` (no run may be writing it).
@@ -303,7 +303,7 @@ fn main() -> ExitCode {
                 if !quiet {
                     eprintln!(
                         "stress: {rows} records of {nodes} nodes into {} (/stress, /von_mises), listed in {}",
-                        file.display(),
+                        stickslip::stress_cmd::stress_path(&file).display(),
                         file.with_extension("xdmf").display()
                     );
                 }

@@ -351,8 +351,15 @@ fn series_2d<T: H5Type>(g: &Group, name: &str, n: usize, level: u8) -> Result<Da
         .create(name)?)
 }
 
+/// Rows per chunk along time of the node vectors (`/displacement` and the
+/// others) of a mesh of `n` nodes: a run's file grows by whole chunks of
+/// them.
+pub fn vector_chunk_rows(n: usize) -> usize {
+    chunk_rows(n * 16).clamp(1, 16)
+}
+
 fn series_3d(g: &Group, name: &str, n: usize, level: u8) -> Result<Dataset> {
-    let rows = chunk_rows(n * 16).clamp(1, 16);
+    let rows = vector_chunk_rows(n);
     Ok(filtered(g.new_dataset::<f64>(), level)
         .chunk((rows, n, 2))
         .shape((0.., n, 2))
@@ -745,13 +752,6 @@ impl ResultsWriter {
             path.display(),
             nodes.first().copied().unwrap_or(0)
         );
-        // `stickslip stress` datasets end where the earlier run ended: a
-        // restart removes them (run the command again after it).
-        for stale in ["stress", "von_mises"] {
-            if file.link_exists(stale) {
-                file.unlink(stale)?;
-            }
-        }
         let contact = if file.link_exists("contact") {
             ContactSeries {
                 friction_stress: ds("contact/friction_stress")?,
@@ -857,10 +857,21 @@ impl ResultsWriter {
     /// half way, and rows flushed before, in a chunk it rewrote, read as
     /// zeros.
     pub fn room_needed(&self, n_free: usize) -> u64 {
+        // The rows go to the datasets a chunk at a time (whole chunks are
+        // allocated), so the next write may take a chunk of every series.
         let record = (6 * self.n_nodes + 3 * self.n_c + 9) * 8;
-        let rows = self.rows - self.flushed_rows;
         let checkpoint = 5 * n_free * 8;
-        (2 * (rows * record + checkpoint) + (1 << 20)) as u64
+        // And the XDMF's next rewrite, made beside the old one.
+        let xdmf = crate::xdmf::BYTES_PER_STEP * (self.rows + self.block_rows);
+        (2 * (self.block_rows * record + checkpoint) + xdmf + (1 << 20)) as u64
+    }
+
+    /// Whether the next [`ResultsWriter::append`] writes its chunk of rows
+    /// to the file (where [`ResultsWriter::room_needed`] should be checked,
+    /// besides before a flush: HDF5 writes chunks as they fill, not at the
+    /// flush).
+    pub fn append_writes(&self) -> bool {
+        (self.rows + 1).is_multiple_of(self.block_rows)
     }
 
     /// Counts a step toward [`ResultsWriter::flush_due`] without writing a

@@ -56,6 +56,13 @@ pub fn check_output(out: &Path, inputs: &[&Path], force: bool) -> Result<(), Inp
             )));
         }
     }
+    // A symbolic link: the run would replace the link, not its target (and
+    // a dangling one read as a file another run had just created).
+    if std::fs::symlink_metadata(out).is_ok_and(|m| m.file_type().is_symlink()) {
+        return Err(InputError(format!(
+            "{name} is a symbolic link; give the file it stands for, or another name, with -o"
+        )));
+    }
     // A device, FIFO or socket: --force would replace it with a file (a
     // run as root replaced /dev/null), and a FIFO would hang the run.
     if std::fs::metadata(out).is_ok_and(|m| !m.is_file()) {
@@ -216,8 +223,12 @@ fn ofd_lock(f: &std::fs::File, read: bool) -> std::io::Result<()> {
 /// # Errors
 /// The [`InputError`] naming the file and what to do.
 pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
-    // An XDMF half written when a run was killed (best effort).
-    let _ = std::fs::remove_file(out.with_extension("xdmf.part"));
+    // An XDMF half written when a run was killed, and the stresses of the
+    // old run (`stickslip stress`), which the new one does not have (best
+    // effort).
+    for stale in ["xdmf.part", "stress.h5", "stress.h5.part"] {
+        let _ = std::fs::remove_file(out.with_extension(stale));
+    }
     for path in [out.to_path_buf(), out.with_extension("xdmf")] {
         if path.exists() {
             if in_use(&path) {

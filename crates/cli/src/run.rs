@@ -503,7 +503,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         case.output.file.display(),
         human_bytes(bytes)
     );
-    if let Some(free) = crate::results_file::free_bytes(&case.output.file) {
+    if let Some(free) = room_for(&case.output.file, true) {
         if bytes > free as f64 {
             println!(
                 "warning     that is more than the {} free on its disk: `run` refuses it; write fewer records (output.every) or elsewhere (-o)",
@@ -514,6 +514,27 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The failure of a run whose disk has less room than its next write
+/// may take ([`ResultsWriter::room_needed`]), if it has.
+fn disk_nearly_full(
+    writer: &ResultsWriter,
+    model: &Model,
+    out: &Path,
+    integrator: &Integrator,
+) -> Option<String> {
+    let need = writer.room_needed(model.dofs.n_free());
+    let free = crate::results_file::free_bytes(out).filter(|&f| f < need)?;
+    Some(format!(
+        "step {} (t = {}): the disk of {} is nearly full ({:.1} MB free, the next write may need {:.1} MB): \
+         stopped before HDF5 fails half way through a write; make room and continue the run with --restart",
+        integrator.steps(),
+        integrator.time(),
+        out.display(),
+        free as f64 / 1e6,
+        need as f64 / 1e6
+    ))
+}
+
 /// Records and bytes a run of `case` writes from t = 0 (uncompressed): per
 /// record u, v, a at every node (6 doubles), the contact's stress and slip
 /// (2 doubles) and state (1 byte), about 12 scalars besides (time, the
@@ -522,8 +543,29 @@ fn output_size(case: &Case, nodes: usize, contact_nodes: usize) -> (f64, f64) {
     let steps = (case.time.t_end / case.time.dt - 1e-6).ceil().max(1.0);
     let every = case.output.every.max(1) as f64;
     let records = (steps / every).floor() + 1.0;
-    let bytes = records * (48.0 * nodes as f64 + 17.0 * contact_nodes as f64 + 96.0);
+    // The node vectors take whole chunks of rows.
+    let block = output::vector_chunk_rows(nodes) as f64;
+    let rows = (records / block).ceil() * block;
+    let bytes = rows * 48.0 * nodes as f64
+        + records * (17.0 * contact_nodes as f64 + 96.0 + crate::xdmf::BYTES_PER_STEP as f64);
     (records, bytes)
+}
+
+/// Bytes free for the results file `out`: its disk's free space, and with
+/// `force` the old OUT.h5 and OUT.xdmf, which the run removes first.
+fn room_for(out: &Path, force: bool) -> Option<u64> {
+    let free = crate::results_file::free_bytes(out)?;
+    let old: u64 = if force {
+        [out.to_path_buf(), out.with_extension("xdmf")]
+            .iter()
+            .filter_map(|p| std::fs::metadata(p).ok())
+            .filter(|m| m.is_file())
+            .map(|m| m.len())
+            .sum()
+    } else {
+        0
+    };
+    Some(free.saturating_add(old))
 }
 
 /// The initial (static) displacement, where it exceeds the part's size:
@@ -801,7 +843,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     // starts, where the run's own stop at a full disk would come late.
     if !options.restart {
         let (records, bytes) = output_size(case, mesh.nodes.len(), n_c);
-        if let Some(free) = crate::results_file::free_bytes(out).filter(|&f| bytes > f as f64) {
+        if let Some(free) = room_for(out, true).filter(|&f| bytes > f as f64) {
             return Err(input(format!(
                 "{}: the run would write about {records} records ({}) to {}, whose disk has {} free; \
                  write every Nth step (output.every), shorten time.t_end, or write elsewhere with -o",
@@ -816,7 +858,20 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     // run's --force or --restart, or a probe, sees the file in use
     // ([`crate::results_file::in_use`]).
     let _lock = if options.restart {
-        crate::results_file::RunLock::take(out)?
+        let lock = crate::results_file::RunLock::take(out)?;
+        // `stickslip stress`'s file ends where the earlier run ended.
+        let stress = crate::stress_cmd::stress_path(out);
+        if stress.is_file() {
+            std::fs::remove_file(&stress).ok();
+            if !quiet {
+                say!(
+                    "restart: removed {} (the earlier run's stresses); run `stickslip stress {}` again after this run",
+                    stress.display(),
+                    out.display()
+                );
+            }
+        }
+        lock
     } else {
         crate::results_file::claim(out)?
     };
@@ -957,7 +1012,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             kind: mesh.kind,
             n_cells: mesh.n_cells(),
             times,
-            stress: false,
+            stress: None,
         };
         crate::xdmf::write_xdmf(out, &xdmf_path, &info)
             .with_context(|| format!("cannot write {}", xdmf_path.display()))
@@ -1028,6 +1083,14 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                     ))
                 };
                 if write {
+                    // HDF5 writes a chunk of rows as it fills: the room for
+                    // it is checked before, as before a flush.
+                    if writer.append_writes() {
+                        if let Some(e) = disk_nearly_full(&writer, &model, out, &integrator) {
+                            failure = Some(e);
+                            break;
+                        }
+                    }
                     rec(&mut writer, &mut full)?;
                 }
                 if integrator.is_explicit() {
@@ -1059,17 +1122,8 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                     break;
                 }
                 if writer.flush_due() {
-                    let need = writer.room_needed(model.dofs.n_free());
-                    if let Some(free) = crate::results_file::free_bytes(out).filter(|&f| f < need) {
-                        failure = Some(format!(
-                            "step {} (t = {}): the disk of {} is nearly full ({:.1} MB free, the next flush may need {:.1} MB): \
-                             stopped before HDF5 fails half way through a write; make room and continue the run with --restart",
-                            integrator.steps(),
-                            integrator.time(),
-                            out.display(),
-                            free as f64 / 1e6,
-                            need as f64 / 1e6
-                        ));
+                    if let Some(e) = disk_nearly_full(&writer, &model, out, &integrator) {
+                        failure = Some(e);
                         break;
                     }
                     writer.write_checkpoint(

@@ -1,5 +1,5 @@
-//! `stickslip stress OUT.h5`: a finished run's stress fields written into
-//! its results file, for ParaView.
+//! `stickslip stress OUT.h5`: a finished run's stress fields in a file
+//! beside its results, for ParaView.
 //!
 //! The run itself writes no stresses (a record is u, v, a and the friction
 //! fields; stresses at every node and step would cost a pass over the
@@ -7,10 +7,12 @@
 //! afterwards from `/displacement` and the material of the case the file
 //! stores, as `stickslip probe --field sxx` does at one node: at each node
 //! the average of its cells' σ = D ε there (`stickslip_fem::nodal_stresses`),
-//! into `/stress` [n_out, n_nodes, 3] (σ_xx, σ_yy, σ_xy) and `/von_mises`
-//! [n_out, n_nodes], and lists both in the XDMF. A `--restart` of the run
-//! removes them (they would end where the earlier run ended): run this
-//! command again after it.
+//! into `OUT.stress.h5`: `/stress` [n_out, n_nodes, 3] (σ_xx, σ_yy, σ_xy)
+//! and `/von_mises` [n_out, n_nodes]; and lists them in `OUT.xdmf`. The
+//! results file is only read: a full disk or a kill leaves it as it was
+//! (the stress file is written beside and renamed into place). A new run
+//! or a `--restart` on OUT.h5 removes OUT.stress.h5 (it would end where
+//! the earlier run ended): run the command again after it.
 
 use std::path::Path;
 use std::time::Instant;
@@ -43,9 +45,9 @@ pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
     }
     // No run may start on the file while the stresses go in.
     let _lock = crate::results_file::RunLock::take(path)?;
-    let f = File::open_rw(path).map_err(|e| {
+    let f = File::open(path).map_err(|e| {
         InputError(format!(
-            "{name}: cannot open it as HDF5 for writing: {e}; give a results file written by `stickslip run`"
+            "{name}: cannot open it as HDF5: {e}; give a results file written by `stickslip run`"
         ))
     })?;
     if crate::output::text_attr(&f, "program").ok().as_deref() != Some("stickslip") {
@@ -59,23 +61,88 @@ pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
     let u = f.dataset("displacement")?;
     let times = f.dataset("time")?.read_1d::<f64>()?.to_vec();
     let rows = times.len().min(u.shape().first().copied().unwrap_or(0));
-    for old in ["stress", "von_mises"] {
-        if f.link_exists(old) {
-            f.unlink(old)?;
+    let complete = f
+        .attr("complete")
+        .and_then(|a| a.read_scalar::<bool>())
+        .unwrap_or(false);
+    if !complete && !quiet {
+        eprintln!(
+            "stress: note: {name} is of a run that did not complete; its {rows} records get their stresses \
+             (a --restart of the run removes them: run this again after it)"
+        );
+    }
+    let target = stress_path(path);
+    let old = std::fs::metadata(&target).map_or(0, |m| m.len());
+    let need = (rows * n_nodes * 32) as u64 + (1 << 20);
+    if let Some(free) = crate::results_file::free_bytes(&target) {
+        if free.saturating_add(old) < need {
+            return Err(InputError(format!(
+                "{}: the stresses of {rows} records need about {:.1} MB and its disk has {:.1} MB free; \
+                 make room and run this again",
+                target.display(),
+                need as f64 / 1e6,
+                free as f64 / 1e6
+            ))
+            .into());
         }
     }
-    let stress = f
+    // Written beside and renamed into place: a failure leaves no half file.
+    let part = path.with_extension("stress.h5.part");
+    let written = write_stresses(&part, &u, &mesh, &material, rows, quiet);
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&part);
+        return Err(e.context(format!("cannot write {}", target.display())));
+    }
+    std::fs::rename(&part, &target)
+        .with_context(|| format!("cannot rename {} to {}", part.display(), target.display()))?;
+    drop((u, f));
+    let xdmf_path = path.with_extension("xdmf");
+    let stress_name = target
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("stress.h5")
+        .to_string();
+    let info = crate::xdmf::XdmfInfo {
+        n_nodes,
+        kind: mesh.kind,
+        n_cells: mesh.n_cells(),
+        times: &times[..rows],
+        stress: Some(&stress_name),
+    };
+    crate::xdmf::write_xdmf(path, &xdmf_path, &info)
+        .with_context(|| format!("cannot write {}", xdmf_path.display()))?;
+    Ok((rows, n_nodes))
+}
+
+/// The stress file of the results file `out`: OUT.stress.h5 beside it.
+pub fn stress_path(out: &Path) -> std::path::PathBuf {
+    out.with_extension("stress.h5")
+}
+
+/// `/stress` and `/von_mises` of `rows` records of `u` into a new file at
+/// `part`.
+fn write_stresses(
+    part: &Path,
+    u: &hdf5::Dataset,
+    mesh: &stickslip_mesh::Mesh,
+    material: &stickslip_fem::Material,
+    rows: usize,
+    quiet: bool,
+) -> anyhow::Result<()> {
+    let n_nodes = mesh.nodes.len();
+    let g = File::create(part)?;
+    let stress = g
         .new_dataset::<f64>()
         .chunk((1, n_nodes, 3))
         .shape((rows, n_nodes, 3))
         .create("stress")?;
-    let mises = f
+    let mises = g
         .new_dataset::<f64>()
         .chunk((1, n_nodes))
         .shape((rows, n_nodes))
         .create("von_mises")?;
     let about = "at each node the average of its cells' stress sigma = D eps there, from /displacement \
-                 and the material of the stored case (stickslip stress); [sigma_xx, sigma_yy, sigma_xy]";
+                 of the results file and the material of its case (stickslip stress); [sigma_xx, sigma_yy, sigma_xy]";
     for (ds, text) in [
         (&stress, about),
         (
@@ -96,12 +163,12 @@ pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
             .iter()
             .copied()
             .collect();
-        let st = stickslip_fem::nodal_stresses(&mesh, &material, &row);
+        let st = stickslip_fem::nodal_stresses(mesh, material, &row);
         let a = Array2::from_shape_fn((n_nodes, 3), |(i, c)| st[i][c]);
         stress.write_slice(&a, s![k, .., ..])?;
         let vm: Array1<f64> = st
             .iter()
-            .map(|&s| stickslip_fem::von_mises(&material, s))
+            .map(|&s| stickslip_fem::von_mises(material, s))
             .collect();
         mises.write_slice(&vm, s![k, ..])?;
         if !quiet && last.elapsed().as_secs() >= 10 {
@@ -113,17 +180,6 @@ pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
             );
         }
     }
-    f.flush()?;
-    drop((stress, mises, u, f));
-    let xdmf_path = path.with_extension("xdmf");
-    let info = crate::xdmf::XdmfInfo {
-        n_nodes,
-        kind: mesh.kind,
-        n_cells: mesh.n_cells(),
-        times: &times[..rows],
-        stress: true,
-    };
-    crate::xdmf::write_xdmf(path, &xdmf_path, &info)
-        .with_context(|| format!("cannot write {}", xdmf_path.display()))?;
-    Ok((rows, n_nodes))
+    g.flush()?;
+    Ok(())
 }

@@ -33,10 +33,16 @@ pub struct XdmfInfo<'a> {
     pub n_cells: usize,
     /// `/time`, one entry per output step written so far.
     pub times: &'a [f64],
-    /// The file holds `/stress` [n_out, n_nodes, 3] and `/von_mises`
-    /// [n_out, n_nodes] (`stickslip stress`): listed per step too.
-    pub stress: bool,
+    /// The file name of `stickslip stress`'s `/stress` [n_out, n_nodes, 3]
+    /// and `/von_mises` [n_out, n_nodes], beside the results file: listed
+    /// per step too, σ_xx, σ_yy, σ_xy and von Mises as scalars (ParaView
+    /// would call a 3-vector's third component "Z").
+    pub stress: Option<&'a str>,
 }
+
+/// About the bytes of XML per step of a run (2,557 for the slab's `st.h5`;
+/// each character of a longer file name adds five).
+pub const BYTES_PER_STEP: usize = 2600;
 
 /// The node vectors written per step: (dataset, attribute name).
 const VECTORS: [&str; 3] = ["displacement", "velocity", "acceleration"];
@@ -108,27 +114,28 @@ fn write_xml(x: &mut impl Write, h5_name: &str, info: &XdmfInfo) -> std::io::Res
               \x20       </Attribute>\n"
             )?;
         }
-        if info.stress {
-            for (name, dims, comps, kind) in [
-                ("stress", format!("1 {n} 3"), " 3", "Vector"),
-                ("von_mises", format!("1 {n}"), "", "Scalar"),
-            ] {
-                let (start, stride, count) = if comps.is_empty() {
-                    (format!("{k} 0"), "1 1", format!("1 {n}"))
-                } else {
-                    (format!("{k} 0 0"), "1 1 1", format!("1 {n} 3"))
-                };
-                let rank = if comps.is_empty() { 2 } else { 3 };
+        if let Some(file) = info.stress {
+            let file = xml_escape(file);
+            for (name, c) in [("sxx", 0), ("syy", 1), ("sxy", 2)] {
                 write!(
                     x,
-                    "        <Attribute Name=\"{name}\" AttributeType=\"{kind}\" Center=\"Node\">\n\
-                  \x20         <DataItem ItemType=\"HyperSlab\" Dimensions=\"{dims}\" Type=\"HyperSlab\">\n\
-                  \x20           <DataItem Dimensions=\"3 {rank}\" NumberType=\"Int\" Format=\"XML\">{start} {stride} {count}</DataItem>\n\
-                  \x20           <DataItem Dimensions=\"{n_out} {n}{comps}\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:/{name}</DataItem>\n\
+                    "        <Attribute Name=\"{name}\" AttributeType=\"Scalar\" Center=\"Node\">\n\
+                  \x20         <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 {n} 1\" Type=\"HyperSlab\">\n\
+                  \x20           <DataItem Dimensions=\"3 3\" NumberType=\"Int\" Format=\"XML\">{k} 0 {c} 1 1 1 1 {n} 1</DataItem>\n\
+                  \x20           <DataItem Dimensions=\"{n_out} {n} 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{file}:/stress</DataItem>\n\
                   \x20         </DataItem>\n\
                   \x20       </Attribute>\n"
                 )?;
             }
+            write!(
+                x,
+                "        <Attribute Name=\"von_mises\" AttributeType=\"Scalar\" Center=\"Node\">\n\
+              \x20         <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 {n}\" Type=\"HyperSlab\">\n\
+              \x20           <DataItem Dimensions=\"3 2\" NumberType=\"Int\" Format=\"XML\">{k} 0 1 1 1 {n}</DataItem>\n\
+              \x20           <DataItem Dimensions=\"{n_out} {n}\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{file}:/von_mises</DataItem>\n\
+              \x20         </DataItem>\n\
+              \x20       </Attribute>\n"
+            )?;
         }
         x.write_all(b"      </Grid>\n")?;
     }
@@ -183,7 +190,7 @@ mod tests {
                 kind: CellKind::Quad9,
                 n_cells: 16,
                 times: &times,
-                stress: false,
+                stress: None,
             },
         );
         assert_eq!(count(&x, "GridType=\"Uniform\""), 3);
@@ -217,7 +224,7 @@ mod tests {
             kind: CellKind::Quad9,
             n_cells: 16,
             times: &[0.0, 0.25, 0.5],
-            stress: false,
+            stress: None,
         };
         let path = dir.join("slab.xdmf");
         write_xdmf(&dir.join("slab.h5"), &path, &info).unwrap();
@@ -237,7 +244,7 @@ mod tests {
                 kind: CellKind::Quad4,
                 n_cells: 2,
                 times: &[0.0],
-                stress: false,
+                stress: None,
             },
         );
         assert!(x.contains(
@@ -260,7 +267,7 @@ mod tests {
                 kind: CellKind::Quad4,
                 n_cells: 1,
                 times: &[0.0, 1.0],
-                stress: false,
+                stress: None,
             },
         )
         .unwrap();
@@ -276,7 +283,7 @@ mod tests {
                 kind: CellKind::Quad4,
                 n_cells: 1,
                 times: &[],
-                stress: false,
+                stress: None,
             },
         )
         .unwrap_err();

@@ -1213,6 +1213,17 @@ fn inputs_devices_fifos_and_the_xdmf_are_never_the_output() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(std::fs::metadata("/dev/null").is_ok_and(|m| !m.is_file()));
 
+    // A symbolic link, dangling or not (a dangling one read as "created by
+    // another process just now").
+    for target in [dir.join("nowhere/x.h5"), dir.join("real.h5")] {
+        let link = dir.join("link.h5");
+        std::fs::remove_file(&link).ok();
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        let o = run(&case, &link, &[]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains("is a symbolic link"), "{}", stderr(&o));
+    }
+
     let o = run(&case, &dir.join("out.xdmf"), &[]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("give -o"), "{}", stderr(&o));
@@ -1462,10 +1473,11 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
         .arg(&case)
         .arg("-o")
         .arg(&out)
-        // 801 records of 4.4 kB: they fit the 4 MB when the run starts
-        // (a run whose records cannot fit is refused before it starts),
-        // but not with the room each flush keeps.
-        .args(["--quiet", "--set", "time.t_end=0.8"])
+        // 501 records of 4.4 kB and 2.6 kB of XDMF each: they fit the
+        // 4 MB when the run starts (a run whose records cannot fit is
+        // refused before it starts), but not with the room each write
+        // keeps.
+        .args(["--quiet", "--set", "time.t_end=0.5"])
         .output()
         .unwrap();
     let read = hdf5::File::open(&out).map(|f| {

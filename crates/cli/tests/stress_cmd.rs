@@ -1,5 +1,5 @@
-//! `stickslip stress OUT.h5`: a finished run's stress fields into its file
-//! and XDMF. Expected values: the paper's slab at t = 0 is in its static
+//! `stickslip stress OUT.h5`: a finished run's stress fields into
+//! OUT.stress.h5 and its XDMF; the results file is only read. Expected values: the paper's slab at t = 0 is in its static
 //! state, pressed by F_n = 300 on its bottom and held on its top: σ_yy =
 //! −300 at every node, σ_xx = σ_xy = 0, and plane strain with ν = 0.3 gives
 //! von Mises √(300² + 90² − 300·90) = √71100. Later rows are checked
@@ -47,16 +47,24 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
         "time.t_end=0.1",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let before = std::fs::read(&h5).unwrap();
     let o = stickslip(&["stress", &out]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        std::fs::read(&h5).unwrap(),
+        before,
+        "the results file is only read"
+    );
 
-    let f = hdf5::File::open(&h5).unwrap();
-    let stress = f
+    let g = hdf5::File::open(dir.join("slab.stress.h5")).unwrap();
+    let stress = g
         .dataset("stress")
         .unwrap()
         .read::<f64, ndarray::Ix3>()
         .unwrap();
-    let mises = f.dataset("von_mises").unwrap().read_2d::<f64>().unwrap();
+    let mises = g.dataset("von_mises").unwrap().read_2d::<f64>().unwrap();
+    drop(g);
+    let f = hdf5::File::open(&h5).unwrap();
     let rows = f.dataset("time").unwrap().size();
     assert_eq!(stress.shape(), [rows, 85, 3]);
     assert_eq!(mises.shape(), [rows, 85]);
@@ -84,8 +92,19 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
         }
     }
     let xml = std::fs::read_to_string(dir.join("slab.xdmf")).unwrap();
-    assert_eq!(xml.matches("<Attribute Name=\"von_mises\"").count(), rows);
-    assert_eq!(xml.matches("<Attribute Name=\"stress\"").count(), rows);
+    for name in ["sxx", "syy", "sxy", "von_mises"] {
+        let attr = format!("<Attribute Name=\"{name}\" AttributeType=\"Scalar\"");
+        assert_eq!(xml.matches(&attr).count(), rows, "{name}");
+    }
+    assert_eq!(xml.matches("slab.stress.h5:/stress<").count(), 3 * rows);
+    // Again: the same file, not a bigger one.
+    let size = std::fs::metadata(dir.join("slab.stress.h5")).unwrap().len();
+    let o = stickslip(&["stress", &out, "--quiet"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        std::fs::metadata(dir.join("slab.stress.h5")).unwrap().len(),
+        size
+    );
 
     // A restart ends the run elsewhere: the stresses are removed, and the
     // command writes them again.
@@ -99,9 +118,7 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
         "time.t_end=0.12",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let f = hdf5::File::open(&h5).unwrap();
-    assert!(!f.link_exists("stress") && !f.link_exists("von_mises"));
-    drop(f);
+    assert!(!dir.join("slab.stress.h5").exists());
     assert!(!std::fs::read_to_string(dir.join("slab.xdmf"))
         .unwrap()
         .contains("von_mises"));

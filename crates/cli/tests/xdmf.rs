@@ -74,7 +74,7 @@ fn write_companion(h5: &Path) -> PathBuf {
             kind,
             n_cells,
             times: &times,
-            stress: false,
+            stress: None,
         },
     )
     .unwrap();

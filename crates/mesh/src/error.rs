@@ -210,13 +210,15 @@ pub enum MeshErrorKind {
     /// The file has no 2-D cells.
     #[error("the file has no quad cells; mesh the surface (`gmsh -2`), and either put the surface in a physical group or save all elements (Mesh.SaveAll = 1)")]
     NoCells,
-    /// A node off the plane z = const of the first node.
-    #[error("node {node} has z = {z:?}, off the plane z = const of the mesh's first node; stickslip reads plane meshes parallel to the xy-plane: build the geometry in the xy-plane and mesh it in 2-D (`gmsh -2`)")]
+    /// A node off the plane z = const the others lie in.
+    #[error("node {node} has z = {z:?}, while the nodes' mean z is {plane:?}: the mesh is not in one plane z = const; stickslip reads plane meshes parallel to the xy-plane: build the geometry in the xy-plane and mesh it in 2-D (`gmsh -2`)")]
     NotPlanar {
         /// The node's tag.
         node: u64,
         /// Its z coordinate.
         z: f64,
+        /// The mean z of the nodes.
+        plane: f64,
     },
     /// More nodes or cells than the reader indexes.
     #[error("the mesh has more than {limit} {what}; split the problem")]

@@ -237,7 +237,10 @@ $EndElements
 fn a_mesh_in_the_xz_plane_is_not_planar_at_its_node() {
     for (t, line) in [(XZ_22, 8), (XZ_41, 13)] {
         let e = err(t);
-        assert_eq!(e.kind, K::NotPlanar { node: 3, z: 1.0 }, "{e}");
+        assert!(
+            matches!(e.kind, K::NotPlanar { node: 3, z, .. } if z == 1.0),
+            "{e}"
+        );
         assert_eq!(e.location, Location::Line(line), "{e}");
         // Also what a 3-D mesh meets first now: say to mesh in 2-D.
         assert!(e.to_string().contains("mesh it in 2-D (`gmsh -2`)"), "{e}");
@@ -253,7 +256,7 @@ fn binary_not_planar_names_the_node_record() {
     assert_eq!(b[rec..rec + 4], 7i32.to_le_bytes());
     b[rec + 20..rec + 28].copy_from_slice(&2.0f64.to_le_bytes());
     let e = Mesh::from_bytes(&b).unwrap_err();
-    assert_eq!(e.kind, K::NotPlanar { node: 7, z: 2.0 });
+    assert!(matches!(e.kind, K::NotPlanar { node: 7, z, .. } if z == 2.0));
     assert_eq!(e.location, Location::Byte(rec));
 }
 

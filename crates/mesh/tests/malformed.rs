@@ -431,25 +431,42 @@ fn no_cells() {
 #[test]
 fn a_plane_at_constant_z_reads() {
     let flat = text(Q4_22);
-    let shifted: String = flat
-        .lines()
-        .map(|l| {
-            let f: Vec<&str> = l.split(' ').collect();
-            // Node lines of $Nodes: tag x y z.
-            if f.len() == 4 && f.iter().all(|v| v.parse::<f64>().is_ok()) && l.ends_with(" 0") {
-                format!("{} {} {} 0.5", f[0], f[1], f[2])
-            } else {
-                l.to_string()
-            }
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
-        + "\n";
-    assert_ne!(shifted, flat);
+    // Node lines of $Nodes (tag x y z) with z given by `z(tag)`.
+    let at = |z: &dyn Fn(u64) -> String| -> String {
+        flat.lines()
+            .map(|l| {
+                let f: Vec<&str> = l.split(' ').collect();
+                if f.len() == 4 && f.iter().all(|v| v.parse::<f64>().is_ok()) && l.ends_with(" 0") {
+                    format!("{} {} {} {}", f[0], f[1], f[2], z(f[0].parse().unwrap()))
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+            + "\n"
+    };
     let a = Mesh::from_bytes(flat.as_bytes()).unwrap();
-    let b = Mesh::from_bytes(shifted.as_bytes()).unwrap();
-    assert_eq!(a.nodes, b.nodes);
-    assert_eq!(a.cells, b.cells);
+    // At z = 0.5; at z = 1e6 with one ulp of noise on every other node.
+    for shifted in [
+        at(&|_| "0.5".into()),
+        at(&|t| {
+            if t % 2 == 0 {
+                "1e6".into()
+            } else {
+                "1000000.0000000001".into()
+            }
+        }),
+    ] {
+        assert_ne!(shifted, flat);
+        let b = Mesh::from_bytes(shifted.as_bytes()).unwrap();
+        assert_eq!(a.nodes, b.nodes);
+        assert_eq!(a.cells, b.cells);
+    }
+    // One node off by 1e-9 (beyond the rounding of an extent of 8): that
+    // node is named, not another.
+    let e = err(&at(&|t| if t == 1 { "1e-9".into() } else { "0".into() }));
+    assert!(matches!(e.kind, K::NotPlanar { node: 1, .. }), "{e}");
 }
 
 #[test]
@@ -460,7 +477,7 @@ fn not_planar() {
         "9 6.000000000002768 1.375000000000173 0.5",
     );
     let e = err(&t);
-    assert_eq!(e.kind, K::NotPlanar { node: 9, z: 0.5 });
+    assert!(matches!(e.kind, K::NotPlanar { node: 9, z, .. } if z == 0.5));
     // The node's line, where the fix is.
     assert_eq!(
         e.location,

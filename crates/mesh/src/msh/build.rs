@@ -167,8 +167,8 @@ enum NodeIndex {
 /// corner angle is 0 or 180 degrees within rounding of Gmsh's coordinates.
 const JACOBIAN_TOL: f64 = 1e-10;
 
-/// A z coordinate up to this times the xy extent counts as 0 (Gmsh writes
-/// rounded coordinates).
+/// Nodes whose z spread up to this times the xy extent plus |z| lie in one
+/// plane z = const (Gmsh writes rounded coordinates).
 const Z_TOL: f64 = 1e-12;
 
 /// Which physical groups an element belongs to: an index into
@@ -196,8 +196,10 @@ pub(crate) struct Builder {
     /// The z farthest from the first node's seen, the node's tag and its
     /// position.
     pub(crate) max_z: (f64, u64, usize),
-    /// The first node's z: the mesh's plane z = const.
-    pub(crate) first_z: Option<f64>,
+    /// The least z seen, its node's tag and position.
+    pub(crate) min_z: (f64, u64, usize),
+    /// Σ z over the nodes read.
+    pub(crate) sum_z: f64,
     index: Option<NodeIndex>,
     /// The largest node tag read so far.
     max_tag: Option<u64>,
@@ -232,8 +234,9 @@ impl Builder {
             binary,
             nodes: Vec::new(),
             node_tags: Vec::new(),
-            max_z: (0.0, 0, 0),
-            first_z: None,
+            max_z: (f64::NEG_INFINITY, 0, 0),
+            min_z: (f64::INFINITY, 0, 0),
+            sum_z: 0.0,
             index: None,
             max_tag: None,
             late_tags: Vec::new(),
@@ -305,14 +308,13 @@ impl Builder {
     pub(crate) fn push_xyz(&mut self, x: f64, y: f64, z: f64, tag: u64, pos: usize) {
         // The plane is the first node's z = const (a mesh drawn at z = 0.5
         // is as planar as one at 0): the node farthest off it is kept.
-        if self.first_z.is_none() {
-            self.first_z = Some(z);
+        if z > self.max_z.0 {
             self.max_z = (z, tag, pos);
         }
-        let z0 = self.first_z.unwrap_or(z);
-        if (z - z0).abs() > (self.max_z.0 - z0).abs() {
-            self.max_z = (z, tag, pos);
+        if z < self.min_z.0 {
+            self.min_z = (z, tag, pos);
         }
+        self.sum_z += z;
         self.nodes.push([x, y]);
     }
 
@@ -321,13 +323,27 @@ impl Builder {
         // z must be 0 up to rounding relative to the mesh size. Checked
         // here, before any cell: a mesh in another plane has flat cells in
         // xy, and "degenerate cell" would hide the cause.
-        let (z, tag, at) = self.max_z;
-        let z0 = self.first_z.unwrap_or(0.0);
-        if z != z0 {
+        // One plane z = const (any const: a mesh drawn at z = 0.5 is as
+        // planar as one at 0); else the node farthest from the nodes' mean z
+        // is named, with that mean.
+        if !self.nodes.is_empty() && self.max_z.0 != self.min_z.0 {
+            let mean = self.sum_z / self.nodes.len() as f64;
             let bb = crate::bounding_box(self.nodes.iter().copied());
             let extent = (bb[1][0] - bb[0][0]).max(bb[1][1] - bb[0][1]).max(0.0);
-            if (z - z0).abs() > Z_TOL * extent {
-                return Err(cur.error(at, MeshErrorKind::NotPlanar { node: tag, z }));
+            if self.max_z.0 - self.min_z.0 > Z_TOL * (extent + mean.abs()) {
+                let (z, tag, at) = if self.max_z.0 - mean >= mean - self.min_z.0 {
+                    self.max_z
+                } else {
+                    self.min_z
+                };
+                return Err(cur.error(
+                    at,
+                    MeshErrorKind::NotPlanar {
+                        node: tag,
+                        z,
+                        plane: mean,
+                    },
+                ));
             }
         }
         let n = self.node_tags.len();
