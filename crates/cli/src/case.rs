@@ -402,6 +402,12 @@ pub fn load(path: &Path, sets: &[String]) -> Result<Case, InputError> {
             "{file}: cannot read the case file: {e}; check the path"
         ))
     })?;
+    if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        return Err(InputError(format!(
+            "{file}: UTF-16 text (it starts with a UTF-16 byte-order mark); TOML files are UTF-8: \
+             save it as UTF-8 in your editor (e.g. `iconv -f utf-16 -t utf-8`)"
+        )));
+    }
     let original = String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let text = &e.as_bytes()[..at];

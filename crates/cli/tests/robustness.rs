@@ -1552,6 +1552,17 @@ fn extreme_values_and_odd_files_are_refused_by_name() {
         format!("{}file = \"/dev/null\"{}", &t[..start], &t[end..])
     });
     refused(&null_mesh, &[], &["/dev/null is not a regular file"]);
+    let utf16 = dir.join("utf16.toml");
+    let mut bytes = vec![0xff, 0xfe];
+    bytes.extend(
+        "title = \"x\"\n"
+            .encode_utf16()
+            .flat_map(|u| u.to_le_bytes()),
+    );
+    std::fs::write(&utf16, bytes).unwrap();
+    let o = check(&utf16, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("UTF-16"), "{}", stderr(&o));
     let latin1 = dir.join("latin1.toml");
     let mut bytes = b"title = \"caf".to_vec();
     bytes.extend([0xe9, b'"', b'\n']);
