@@ -127,7 +127,14 @@ fn is_hdf5(path: &Path) -> bool {
 pub fn in_use(path: &Path) -> bool {
     let flocked = std::fs::File::open(path)
         .is_ok_and(|f| matches!(f.try_lock(), Err(std::fs::TryLockError::WouldBlock)));
-    flocked || being_written(path)
+    // A run's exclusive lock, or a reader's shared one (`stickslip stress`),
+    // which only an exclusive request meets.
+    let locked = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(path)
+        .is_ok_and(|f| ofd_lock(&f, false).is_err_and(|e| held(&e)));
+    flocked || locked || being_written(path)
 }
 
 /// Whether a run is writing `path` ([`RunLock`]), whatever HDF5's own
@@ -172,6 +179,21 @@ impl RunLock {
                 ))
             })?;
         RunLock::on(f, path)
+    }
+
+    /// A shared lock on `path`, for a reader that must keep runs out while
+    /// it reads (`stickslip stress`): a run's exclusive lock conflicts
+    /// with it, and it needs only read access.
+    ///
+    /// # Errors
+    /// The file cannot be opened, or a run holds its lock.
+    pub fn shared(path: &Path) -> Result<RunLock, InputError> {
+        let f = std::fs::File::open(path)
+            .map_err(|e| InputError(format!("cannot open {}: {e}", path.display())))?;
+        match ofd_lock(&f, true) {
+            Err(e) if held(&e) => Err(busy(path)),
+            _ => Ok(RunLock { _file: f }),
+        }
     }
 
     /// Takes the lock on `f`, the file `path` names.

@@ -43,8 +43,8 @@ pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
         ))
         .into());
     }
-    // No run may start on the file while the stresses go in.
-    let _lock = crate::results_file::RunLock::take(path)?;
+    // No run may start on the file while its stresses are formed.
+    let _lock = crate::results_file::RunLock::shared(path)?;
     let f = File::open(path).map_err(|e| {
         InputError(format!(
             "{name}: cannot open it as HDF5: {e}; give a results file written by `stickslip run`"
