@@ -134,3 +134,69 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
         );
     }
 }
+
+/// While `stickslip stress` reads a results file (its shared lock, held
+/// here by the library call it makes), a run's `--force` or `--restart` on
+/// the file is refused: a `--force` run would remove the file under it
+/// and then get the old run's stresses beside its own results.
+#[test]
+fn runs_keep_out_while_the_stresses_are_read() {
+    let dir = scratch("shared");
+    let h5 = dir.join("slab.h5");
+    let (case, out) = (
+        root().join("cases/martins-oden/cd-step-eps1e-4.toml"),
+        h5.to_str().unwrap().to_string(),
+    );
+    let o = stickslip(&[
+        "run",
+        case.to_str().unwrap(),
+        "-o",
+        &out,
+        "--quiet",
+        "--set",
+        "time.t_end=0.05",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let lock = stickslip::results_file::RunLock::shared(&h5).unwrap();
+    for args in [
+        vec![
+            "run",
+            case.to_str().unwrap(),
+            "-o",
+            &out,
+            "--force",
+            "--quiet",
+        ],
+        vec![
+            "run",
+            case.to_str().unwrap(),
+            "--restart",
+            &out,
+            "--quiet",
+            "--set",
+            "time.t_end=0.06",
+        ],
+    ] {
+        let o = stickslip(&args);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(h5.exists(), "{args:?}: the file is still there");
+    }
+    // probe reads alongside.
+    let o = stickslip(&["probe", &out, "--at", "8,0"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    drop(lock);
+    let o = stickslip(&[
+        "run",
+        case.to_str().unwrap(),
+        "-o",
+        &out,
+        "--force",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
