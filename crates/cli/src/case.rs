@@ -541,15 +541,12 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
                     // from --set (no line of the file to quiet).
                     let placeholders: Vec<String> =
                         typed.iter().map(|(p, _, _)| dotted(p)).collect();
+                    // ": key " also matches "[section]: key ".
                     let of_placeholder = |p: &str| {
                         placeholders.iter().any(|k| {
-                            [" ", ":"].iter().any(|end| {
-                                p.contains(&format!(": {k}{end}"))
-                                    || p.contains(&format!(
-                                        ": [{}]: {k}{end}",
-                                        k.split('.').next().unwrap_or("")
-                                    ))
-                            })
+                            [" ", ":"]
+                                .iter()
+                                .any(|end| p.contains(&format!(": {k}{end}")))
                         })
                     };
                     problems.extend(bad.into_iter().filter(|p| {

@@ -111,6 +111,29 @@ struct Series {
     iterations: Dataset,
 }
 
+impl Series {
+    /// Every growing dataset resized to `rows` rows (of `n` nodes and `n_c`
+    /// contact nodes); all are tried, the first error returned.
+    fn resize(&self, rows: usize, n: usize, n_c: usize) -> Result<()> {
+        let mut results = Vec::new();
+        for d in [&self.time, &self.dt, &self.iterations]
+            .into_iter()
+            .chain(&self.energy)
+        {
+            results.push(d.resize(rows));
+        }
+        for d in [&self.displacement, &self.velocity, &self.acceleration] {
+            results.push(d.resize((rows, n, 2)));
+        }
+        if let Some(c) = &self.contact {
+            for d in [&c.friction_stress, &c.slip_velocity, &c.state] {
+                results.push(d.resize((rows, n_c)));
+            }
+        }
+        Ok(results.into_iter().collect::<Result<(), _>>()?)
+    }
+}
+
 #[derive(Debug)]
 struct ContactSeries {
     friction_stress: Dataset,
@@ -265,7 +288,7 @@ fn node_order(kind: stickslip_mesh::CellKind) -> &'static str {
     }
 }
 
-fn string_attr(loc: &hdf5::Location, name: &str, value: &str) -> Result<()> {
+pub(crate) fn string_attr(loc: &hdf5::Location, name: &str, value: &str) -> Result<()> {
     let v: VarLenUnicode = value
         .replace('\0', " ")
         .parse()
@@ -791,18 +814,7 @@ impl ResultsWriter {
             path.display()
         );
         // Rows past the checkpoint (written before a crash) are recomputed.
-        let s = &series;
-        for d in [&s.time, &s.dt, &s.iterations].into_iter().chain(&s.energy) {
-            d.resize(rows)?;
-        }
-        for d in [&s.displacement, &s.velocity, &s.acceleration] {
-            d.resize((rows, n_nodes, 2))?;
-        }
-        if let Some(c) = &s.contact {
-            for d in [&c.friction_stress, &c.slip_velocity, &c.state] {
-                d.resize((rows, n_c))?;
-            }
-        }
+        series.resize(rows, n_nodes, n_c)?;
         file.attr("complete")?.write_scalar(&false)?;
         if file.attr("failure").is_ok() {
             file.delete_attr("failure")?;
@@ -901,7 +913,9 @@ impl ResultsWriter {
             return Ok(());
         };
         let kept = self.flushed_rows;
-        self.shrink_to(kept);
+        // Best effort: the disk may still be full.
+        let _ = self.series.resize(kept, self.n_nodes, self.n_c);
+        let _ = self.file.flush();
         self.pending.clear();
         self.rows = kept;
         Err(e.context(format!(
@@ -917,7 +931,6 @@ impl ResultsWriter {
         extra: &CheckpointExtra,
     ) -> Result<()> {
         // The rows the checkpoint counts go to the datasets first.
-        self.write_pending()?;
         self.write_pending()?;
         let (cg, slot) = if self.file.link_exists("checkpoint") {
             let cg = self.file.group("checkpoint")?;
@@ -1005,28 +1018,6 @@ impl ResultsWriter {
     /// # Errors
     /// HDF5 errors.
     fn write_pending(&mut self) -> Result<()> {
-        self.write_pending_rows()
-    }
-
-    /// Cuts every growing dataset back to `rows` rows, ignoring errors.
-    fn shrink_to(&self, rows: usize) {
-        let (n, n_c, s) = (self.n_nodes, self.n_c, &self.series);
-        for d in [&s.time, &s.dt, &s.iterations].into_iter().chain(&s.energy) {
-            let _ = d.resize(rows);
-        }
-        for d in [&s.displacement, &s.velocity, &s.acceleration] {
-            let _ = d.resize((rows, n, 2));
-        }
-        if let Some(c) = &s.contact {
-            for d in [&c.friction_stress, &c.slip_velocity, &c.state] {
-                let _ = d.resize((rows, n_c));
-            }
-        }
-        let _ = self.file.flush();
-    }
-
-    /// [`ResultsWriter::write_pending`]'s writes.
-    fn write_pending_rows(&mut self) -> Result<()> {
         let p = &self.pending;
         let m = p.rows();
         if m == 0 {

@@ -143,18 +143,12 @@ fn write_stresses(
         .create("von_mises")?;
     let about = "at each node the average of its cells' stress sigma = D eps there, from /displacement \
                  of the results file and the material of its case (stickslip stress); [sigma_xx, sigma_yy, sigma_xy]";
-    for (ds, text) in [
-        (&stress, about),
-        (
-            &mises,
-            "von Mises stress of /stress (plane strain: sigma_zz = nu (sigma_xx + sigma_yy))",
-        ),
-    ] {
-        let v: hdf5::types::VarLenUnicode = text.parse().expect("no NUL");
-        ds.new_attr::<hdf5::types::VarLenUnicode>()
-            .create("about")?
-            .write_scalar(&v)?;
-    }
+    crate::output::string_attr(&stress, "about", about)?;
+    crate::output::string_attr(
+        &mises,
+        "about",
+        "von Mises stress of /stress (plane strain: sigma_zz = nu (sigma_xx + sigma_yy))",
+    )?;
     let started = Instant::now();
     let mut last = Instant::now();
     for k in 0..rows {

@@ -29,24 +29,30 @@ fn stickslip(args: &[&str]) -> Output {
         .unwrap()
 }
 
-#[test]
-fn stress_fields_go_into_the_file_and_its_xdmf() {
-    let dir = scratch("slab");
+/// The paper's slab case run to `t_end` into a new scratch directory
+/// `name`: (the directory, the case, the results file).
+fn run_slab(name: &str, t_end: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let dir = scratch(name);
     let h5 = dir.join("slab.h5");
-    let (case, out) = (
-        root().join("cases/martins-oden/cd-step-eps1e-4.toml"),
-        h5.to_str().unwrap().to_string(),
-    );
+    let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let t_end = format!("time.t_end={t_end}");
     let o = stickslip(&[
         "run",
         case.to_str().unwrap(),
         "-o",
-        &out,
+        h5.to_str().unwrap(),
         "--quiet",
         "--set",
-        "time.t_end=0.1",
+        &t_end,
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    (dir, case, h5)
+}
+
+#[test]
+fn stress_fields_go_into_the_file_and_its_xdmf() {
+    let (dir, case, h5) = run_slab("slab", "0.1");
+    let out = h5.to_str().unwrap().to_string();
     let before = std::fs::read(&h5).unwrap();
     let o = stickslip(&["stress", &out]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -141,22 +147,8 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
 /// and then get the old run's stresses beside its own results.
 #[test]
 fn runs_keep_out_while_the_stresses_are_read() {
-    let dir = scratch("shared");
-    let h5 = dir.join("slab.h5");
-    let (case, out) = (
-        root().join("cases/martins-oden/cd-step-eps1e-4.toml"),
-        h5.to_str().unwrap().to_string(),
-    );
-    let o = stickslip(&[
-        "run",
-        case.to_str().unwrap(),
-        "-o",
-        &out,
-        "--quiet",
-        "--set",
-        "time.t_end=0.05",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_, case, h5) = run_slab("shared", "0.05");
+    let out = h5.to_str().unwrap().to_string();
     let lock = stickslip::results_file::RunLock::shared(&h5).unwrap();
     for args in [
         vec![
