@@ -102,6 +102,15 @@ fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
 /// The symbolic analysis of `a`'s pattern (AMD ordering), always
 /// supernodal so that [`Supernodal`] solves on its layout.
 ///
+/// Tried and not kept: a nested dissection by coordinate median splits
+/// (one-sided vertex separators, both DOFs of a node together, leaves of
+/// 8-256 nodes), given to faer as its ordering. Best leaf size 16,
+/// 2026-11-26, against AMD: Q1 slab 126k DOFs 15.2M factor values against
+/// 12.2M, Q2 slab 125k 11.7M against 11.3M, Gmsh's `cases/hole.geo` at
+/// 238k DOFs 29.3M against 32.6M (31.0M from the file's node order), the
+/// solve 0.95 of AMD's time there. Too little on a user's mesh to carry an
+/// ordering of our own.
+///
 /// # Errors
 /// [`SolverError::Analysis`] if faer fails.
 pub fn analyze_symbolic(a: &CsrMatrix<f64>) -> Result<SymbolicCholesky<usize>, SolverError> {
