@@ -107,3 +107,56 @@ fn remark_4_2_leaves_no_failed_steps() {
         assert!(without.failed > 0, "{scheme:?}: {without:?}");
     }
 }
+
+/// The committed tables, docs/stability-*.csv, are what `cargo xtask
+/// stability` writes now: a change to the integrators that moves a figure
+/// must regenerate them. Numbers agree to 1e-5 relative (they are printed
+/// to 5-7 significant digits; the last may differ on another CPU's
+/// kernels), every other field exactly.
+#[test]
+fn committed_tables_are_what_the_study_writes() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = std::env::temp_dir().join(format!("stickslip-stability-{}", std::process::id()));
+    std::fs::create_dir_all(&out).unwrap();
+    stickslip_study::stability::main(&out, false).unwrap();
+    let mut problems = Vec::new();
+    for name in [
+        "stability-critical.csv",
+        "stability-ringing.csv",
+        "stability-iteration.csv",
+    ] {
+        let committed = std::fs::read_to_string(root.join("docs").join(name)).unwrap();
+        let fresh = std::fs::read_to_string(out.join(name)).unwrap();
+        let (c_lines, f_lines): (Vec<&str>, Vec<&str>) =
+            (committed.lines().collect(), fresh.lines().collect());
+        if c_lines.len() != f_lines.len() {
+            problems.push(format!(
+                "{name}: {} lines committed, {} written",
+                c_lines.len(),
+                f_lines.len()
+            ));
+            continue;
+        }
+        for (i, (c, f)) in c_lines.iter().zip(&f_lines).enumerate() {
+            let differs = c.split(',').count() != f.split(',').count()
+                || c.split(',').zip(f.split(',')).any(|(a, b)| {
+                    match (a.parse::<f64>(), b.parse::<f64>()) {
+                        (Ok(x), Ok(y)) => (x - y).abs() > 1e-5 * x.abs().max(y.abs()),
+                        _ => a != b,
+                    }
+                });
+            if differs {
+                problems.push(format!(
+                    "{name} line {}:\n  committed {c}\n  written   {f}",
+                    i + 1
+                ));
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&out);
+    assert!(
+        problems.is_empty(),
+        "docs/stability-*.csv differ from a fresh run; run `cargo xtask stability` and commit them:\n{}",
+        problems.join("\n")
+    );
+}
