@@ -463,7 +463,8 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         );
     } else if i.implicit_solver() == ImplicitSolver::Direct {
         println!(
-            "solver      implicit Newmark: sparse Cholesky (faer, AMD) of A₀ + C, analysed once, refactorized when dt or the stuck set changes; nnz(K) = {}; K·x by {}",
+            "solver      implicit Newmark: sparse Cholesky (faer, {}) of A₀ + C, analysed once, refactorized when dt or the stuck set changes; nnz(K) = {}; K·x by {}",
+            p.model.fill_order.name(),
             p.model.stiffness.nnz(),
             i.stiffness_product()
         );
@@ -477,7 +478,8 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     } else {
         let n_c = i.contact().map_or(0, |c| c.len());
         println!(
-            "solver      implicit Newmark: sparse Cholesky (faer, AMD) of A₀, analysed once, factorized once per distinct dt; friction on the {n_c} contact unknowns by the Schur complement; nnz(K) = {}; K·x by {}",
+            "solver      implicit Newmark: sparse Cholesky (faer, {}) of A₀, analysed once, factorized once per distinct dt; friction on the {n_c} contact unknowns by the Schur complement; nnz(K) = {}; K·x by {}",
+            p.model.fill_order.name(),
             p.model.stiffness.nnz(),
             i.stiffness_product()
         );

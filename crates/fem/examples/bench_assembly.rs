@@ -78,7 +78,7 @@ fn main() {
     model.dofs.restrict(&full, &mut load);
 
     let t = Instant::now();
-    let mut chol = SparseCholesky::analyze(&model.stiffness).unwrap();
+    let mut chol = SparseCholesky::analyze(&model.stiffness, &model.fill_order).unwrap();
     let symbolic_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
     chol.factorize(&model.stiffness).unwrap();

@@ -5,7 +5,8 @@
 //! (a roller fixes one component, a clamp both) to a prescribed value; the
 //! fixed DOFs are eliminated and the rest numbered node by node (x before
 //! y), which keeps each node's DOFs adjacent (the assembly exploits it).
-//! Bandwidth is left to the Cholesky's fill-reducing ordering (AMD).
+//! Bandwidth is left to the Cholesky's fill-reducing ordering (AMD, or
+//! from 100k free DOFs a nested dissection of the cells: `ordering.rs`).
 //!
 //! The node order ([`NodeOrder`]) is not the file's: where the nodes form
 //! a structured grid they are taken row by row, as a generator that knows
@@ -22,7 +23,8 @@
 //! (medians of five). AMD orders Gmsh's numbering worse too: Newmark's
 //! factor of A₀ on that 249k-DOF slab has 38.5M entries from the file's
 //! order against 24.6M from the grid's (step 88.3 against 56.0 ms,
-//! medians of three). Gmsh's unstructured quad meshes come with a node's
+//! medians of three); systems that large are now ordered by nested
+//! dissection, which does not depend on the numbering (`ordering.rs`). Gmsh's unstructured quad meshes come with a node's
 //! neighbours a median 17,832 numbers away (on a 71k-node slab), so that
 //! K·x gathers x from all over memory: on a 285k-node unstructured slab
 //! (569k DOFs) the explicit step took 7.47 ms in the file's order against

@@ -24,6 +24,7 @@ pub mod geometry;
 pub mod loads;
 pub mod material;
 pub mod model;
+pub mod ordering;
 pub mod quadrature;
 pub mod reference;
 mod solver;
@@ -41,6 +42,7 @@ pub use loads::{
 };
 pub use material::{Hypothesis, Material};
 pub use model::Model;
+pub use ordering::FillOrder;
 pub use solver::{analyze_symbolic, csc_view, SolverError, SparseCholesky};
 pub use statics::{
     gauss_point_stresses, nodal_stresses, static_solve, stress_at_node, von_mises, GaussPointStress,

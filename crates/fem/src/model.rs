@@ -9,6 +9,7 @@ use crate::assembly::{assemble, free_dof_pattern, Assembly};
 use crate::dofs::{Dirichlet, DofMap};
 use crate::error::FemError;
 use crate::material::Material;
+use crate::ordering::FillOrder;
 
 /// K, M and lumped M of a mesh and material under Dirichlet conditions,
 /// restricted to the free DOFs.
@@ -27,6 +28,9 @@ pub struct Model {
     pub dirichlet_load: Vec<f64>,
     /// Area of the mesh (∫ dA by the element rule).
     pub area: f64,
+    /// The ordering of the Cholesky factors of K, M and their sums (AMD
+    /// or nested dissection, by the mesh: `ordering.rs`).
+    pub fill_order: FillOrder,
 }
 
 impl Model {
@@ -74,7 +78,9 @@ impl Model {
             .expect("one value per pattern entry");
         let mass = CsrMatrix::try_from_pattern_and_values(pattern, m)
             .expect("one value per pattern entry");
+        let fill_order = FillOrder::choose(mesh, &dofs);
         Ok(Model {
+            fill_order,
             dofs,
             stiffness,
             mass,

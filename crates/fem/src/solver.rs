@@ -5,8 +5,9 @@
 //! factorization are computed once ([`SparseCholesky::analyze`]) and every
 //! change of Δt or of the stick/slip classes only redoes the numeric part
 //! ([`SparseCholesky::factorize`]). Measured choice: DEPENDENCIES.md §3 (AMD +
-//! supernodal, about 80× faster than an unordered simplicial Cholesky). The
-//! factor is always supernodal and solved by [`Supernodal`]'s loops (2.7×
+//! supernodal, about 80× faster than an unordered simplicial Cholesky; from
+//! 100k free DOFs the ordering is a nested dissection of the mesh's cells
+//! instead, [`crate::FillOrder`]). The factor is always supernodal and solved by [`Supernodal`]'s loops (2.7×
 //! faster than faer's one-column solve at 250k DOFs; `supernodal.rs`).
 
 use std::cell::RefCell;
@@ -21,7 +22,8 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Par, Side, Spec};
 
-use crate::Supernodal;
+use crate::{FillOrder, Supernodal};
+use faer::perm::PermRef;
 use nalgebra_sparse::CsrMatrix;
 
 /// Why a factorization failed.
@@ -99,25 +101,39 @@ fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
     csc_view(a, a.values())
 }
 
-/// The symbolic analysis of `a`'s pattern (AMD ordering), always
-/// supernodal so that [`Supernodal`] solves on its layout.
-///
-/// Tried and not kept: a nested dissection by coordinate median splits
-/// (one-sided vertex separators, both DOFs of a node together, leaves of
-/// 8-256 nodes), given to faer as its ordering. Best leaf size 16,
-/// 2026-11-26, against AMD: Q1 slab 126k DOFs 15.2M factor values against
-/// 12.2M, Q2 slab 125k 11.7M against 11.3M, Gmsh's `cases/hole.geo` at
-/// 238k DOFs 29.3M against 32.6M (31.0M from the file's node order), the
-/// solve 0.95 of AMD's time there. Too little on a user's mesh to carry an
-/// ordering of our own.
+/// The symbolic analysis of `a`'s pattern in `order` (AMD, or the model's
+/// nested dissection: `ordering.rs`), always supernodal so that
+/// [`Supernodal`] solves on its layout.
 ///
 /// # Errors
 /// [`SolverError::Analysis`] if faer fails.
-pub fn analyze_symbolic(a: &CsrMatrix<f64>) -> Result<SymbolicCholesky<usize>, SolverError> {
+pub fn analyze_symbolic(
+    a: &CsrMatrix<f64>,
+    order: &FillOrder,
+) -> Result<SymbolicCholesky<usize>, SolverError> {
+    let inverse;
+    let ordering = match order.as_slice() {
+        None => SymmetricOrdering::Amd,
+        Some(forward) => {
+            if forward.len() != a.nrows() {
+                return Err(SolverError::Analysis(format!(
+                    "an ordering of {} rows for a matrix of {}",
+                    forward.len(),
+                    a.nrows()
+                )));
+            }
+            let mut inv = vec![0; forward.len()];
+            for (i, &row) in forward.iter().enumerate() {
+                inv[row] = i;
+            }
+            inverse = inv;
+            SymmetricOrdering::Custom(PermRef::new_checked(forward, &inverse, a.nrows()))
+        }
+    };
     factorize_symbolic_cholesky(
         as_csc(a).symbolic(),
         Side::Lower,
-        SymmetricOrdering::Amd,
+        ordering,
         CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
@@ -127,19 +143,19 @@ pub fn analyze_symbolic(a: &CsrMatrix<f64>) -> Result<SymbolicCholesky<usize>, S
 }
 
 impl SparseCholesky {
-    /// Computes the fill-reducing ordering (AMD) and the symbolic factor of
-    /// `a`'s pattern. Values are not read.
+    /// The symbolic factor of `a`'s pattern in `order` (AMD or a given
+    /// permutation: [`FillOrder`]). Values are not read.
     ///
     /// # Errors
     /// [`SolverError::NotSquare`], or [`SolverError::Analysis`] if faer fails.
-    pub fn analyze(a: &CsrMatrix<f64>) -> Result<SparseCholesky, SolverError> {
+    pub fn analyze(a: &CsrMatrix<f64>, order: &FillOrder) -> Result<SparseCholesky, SolverError> {
         if a.nrows() != a.ncols() {
             return Err(SolverError::NotSquare {
                 rows: a.nrows(),
                 cols: a.ncols(),
             });
         }
-        let symbolic = analyze_symbolic(a)?;
+        let symbolic = analyze_symbolic(a, order)?;
         let factor_scratch = MemBuffer::new(
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
         );
@@ -241,7 +257,7 @@ mod tests {
     fn solves_against_the_closed_form_inverse() {
         let n = 50;
         let a = laplacian(n, 0.0);
-        let mut chol = SparseCholesky::analyze(&a).unwrap();
+        let mut chol = SparseCholesky::analyze(&a, &FillOrder::default()).unwrap();
         chol.factorize(&a).unwrap();
         // x = A⁻¹ e_k is column k of the closed-form inverse.
         let k = 17;
@@ -262,7 +278,7 @@ mod tests {
     fn refactorizes_with_new_values_on_the_same_pattern() {
         let n = 30;
         let mut a = laplacian(n, 0.0);
-        let mut chol = SparseCholesky::analyze(&a).unwrap();
+        let mut chol = SparseCholesky::analyze(&a, &FillOrder::default()).unwrap();
         chol.factorize(&a).unwrap();
         // Shift the diagonal: same pattern, new values; check A x = b by residual.
         let b: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
@@ -291,7 +307,7 @@ mod tests {
             }
         }
         let a = CsrMatrix::from(&coo);
-        let mut chol = SparseCholesky::analyze(&a).unwrap();
+        let mut chol = SparseCholesky::analyze(&a, &FillOrder::default()).unwrap();
         match chol.factorize(&a) {
             Err(SolverError::NotPositiveDefinite { .. }) => {}
             other => panic!("expected NotPositiveDefinite, got {other:?}"),

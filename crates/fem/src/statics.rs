@@ -37,7 +37,7 @@ pub fn static_solve(model: &Model, load_free: &[f64]) -> Result<Vec<f64>, FemErr
         .map(|(a, b)| a + b)
         .collect();
     if dofs.n_free() > 0 {
-        let mut chol = SparseCholesky::analyze(&model.stiffness)
+        let mut chol = SparseCholesky::analyze(&model.stiffness, &model.fill_order)
             .map_err(|e| FemError::Solver(e.to_string()))?;
         chol.factorize(&model.stiffness).map_err(|e| match e {
             SolverError::NotPositiveDefinite { .. } => FemError::RigidBodyMotion {

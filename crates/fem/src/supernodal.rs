@@ -1047,7 +1047,7 @@ mod tests {
     }
 
     fn factor(a: &CsrMatrix<f64>) -> Factor {
-        let symbolic = crate::analyze_symbolic(a).unwrap();
+        let symbolic = crate::analyze_symbolic(a, &crate::FillOrder::default()).unwrap();
         let mut l = vec![0.0; symbolic.len_val()];
         let mut scratch = MemBuffer::new(
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),

@@ -326,9 +326,10 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         None
     } else {
         // One forward+back solve with a factor of A₀ (fem's wrapper: the
-        // same AMD ordering and faer supernodal Cholesky as the step's).
+        // same ordering, the model's, and faer supernodal Cholesky as the
+        // step's).
         let a0 = model.combined(0.5 * newmark_dt, 1.0 / (0.5 * newmark_dt));
-        let mut chol = SparseCholesky::analyze(&a0).unwrap();
+        let mut chol = SparseCholesky::analyze(&a0, &model.fill_order).unwrap();
         chol.factorize(&a0).unwrap();
         let mut x = vec![1.0; n];
         let mut times = Vec::new();

@@ -3,7 +3,7 @@
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{ContactSurface, SlipState, StepSystem};
-use stickslip_fem::{SolverError, SparseCholesky};
+use stickslip_fem::{FillOrder, SolverError, SparseCholesky};
 
 use crate::linalg::csr_index;
 
@@ -27,9 +27,10 @@ impl ImplicitOperator {
     /// Analyses the pattern of K (which M shares) once for the run.
     pub fn new(
         stiffness: &CsrMatrix<f64>,
+        order: &FillOrder,
         contact: Option<&ContactSurface>,
     ) -> Result<ImplicitOperator, SolverError> {
-        let cholesky = SparseCholesky::analyze(stiffness)?;
+        let cholesky = SparseCholesky::analyze(stiffness, order)?;
         let entries = contact
             .map(|s| {
                 s.nodes

@@ -2,7 +2,7 @@
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{iterate, ContactSurface, IterationFailure, IterationOptions, SlipState};
-use stickslip_fem::{ElementClasses, Model, SolverError, SparseCholesky};
+use stickslip_fem::{ElementClasses, FillOrder, Model, SolverError, SparseCholesky};
 
 use crate::history::History;
 use crate::implicit::{DiagonalStep, ImplicitOperator, ImplicitStep};
@@ -39,6 +39,8 @@ pub struct Dynamics {
     /// one copy; on structured meshes numbered row by row). Default true;
     /// false keeps the assembled K's bits (the compact form's products).
     pub stencils: bool,
+    /// The ordering of the factors of K, A₀ and M ([`Model::fill_order`]).
+    pub fill_order: FillOrder,
 }
 
 impl Dynamics {
@@ -51,6 +53,7 @@ impl Dynamics {
             constant_load: model.dirichlet_load.clone(),
             element_classes: None,
             stencils: true,
+            fill_order: model.fill_order.clone(),
         }
     }
 
@@ -65,6 +68,7 @@ impl Dynamics {
             constant_load: model.dirichlet_load,
             element_classes: None,
             stencils: true,
+            fill_order: model.fill_order,
         }
     }
 
@@ -741,8 +745,13 @@ impl Integrator {
             None
         } else {
             Some(
-                SchurOperator::new(&dynamics.stiffness, contact.as_ref(), ImplicitSolver::Schur)
-                    .map_err(TimeError::Static)?,
+                SchurOperator::new(
+                    &dynamics.stiffness,
+                    &dynamics.fill_order,
+                    contact.as_ref(),
+                    ImplicitSolver::Schur,
+                )
+                .map_err(TimeError::Static)?,
             )
         };
 
@@ -764,7 +773,8 @@ impl Integrator {
             r.fill(0.0);
         } else if r.iter().any(|&x| x != 0.0) {
             let mut static_solver =
-                SparseCholesky::analyze(&dynamics.stiffness).map_err(TimeError::Static)?;
+                SparseCholesky::analyze(&dynamics.stiffness, &dynamics.fill_order)
+                    .map_err(TimeError::Static)?;
             static_solver
                 .factorize(&dynamics.stiffness)
                 .map_err(TimeError::Static)?;
@@ -865,8 +875,8 @@ impl Integrator {
                 }
             }
             MassKind::Consistent => {
-                let mut m =
-                    SparseCholesky::analyze(&this.mass_matrix).map_err(TimeError::Static)?;
+                let mut m = SparseCholesky::analyze(&this.mass_matrix, &this.dynamics.fill_order)
+                    .map_err(TimeError::Static)?;
                 m.factorize(&this.mass_matrix).map_err(TimeError::Static)?;
                 this.a.copy_from_slice(&this.tmp);
                 m.solve_in_place(&mut this.a);
@@ -2093,14 +2103,22 @@ impl Integrator {
         self.implicit = None;
         self.schur = None;
         if solver == ImplicitSolver::Direct {
-            let mut op = ImplicitOperator::new(&self.dynamics.stiffness, self.contact.as_ref())
-                .map_err(TimeError::Static)?;
+            let mut op = ImplicitOperator::new(
+                &self.dynamics.stiffness,
+                &self.dynamics.fill_order,
+                self.contact.as_ref(),
+            )
+            .map_err(TimeError::Static)?;
             op.factorizations = count;
             self.implicit = Some(op);
         } else {
-            let mut op =
-                SchurOperator::new(&self.dynamics.stiffness, self.contact.as_ref(), solver)
-                    .map_err(TimeError::Static)?;
+            let mut op = SchurOperator::new(
+                &self.dynamics.stiffness,
+                &self.dynamics.fill_order,
+                self.contact.as_ref(),
+                solver,
+            )
+            .map_err(TimeError::Static)?;
             op.factorizations = count;
             self.schur = Some(op);
         }

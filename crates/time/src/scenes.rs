@@ -374,6 +374,7 @@ pub mod sdof {
             constant_load: vec![0.0],
             element_classes: None,
             stencils: true,
+            fill_order: Default::default(),
         };
         let node = ContactNode {
             node: 0,

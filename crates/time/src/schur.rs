@@ -41,7 +41,7 @@ use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{ContactNode, ContactSurface, SlipState, StepSystem};
-use stickslip_fem::{analyze_symbolic, csc_view, ContactOperator, SolverError};
+use stickslip_fem::{analyze_symbolic, csc_view, ContactOperator, FillOrder, SolverError};
 
 use stickslip_fem::Supernodal;
 
@@ -186,6 +186,7 @@ impl SchurOperator {
     /// Analyses K's pattern (which M shares) once for the run.
     pub fn new(
         stiffness: &CsrMatrix<f64>,
+        order: &FillOrder,
         contact: Option<&ContactSurface>,
         solver: ImplicitSolver,
     ) -> Result<SchurOperator, SolverError> {
@@ -196,7 +197,7 @@ impl SchurOperator {
                 cols: stiffness.ncols(),
             });
         }
-        let symbolic = analyze_symbolic(stiffness)?;
+        let symbolic = analyze_symbolic(stiffness, order)?;
         let mut sn = Supernodal::new(&symbolic).ok_or_else(|| {
             SolverError::Analysis("faer returned a factor layout this solver does not know".into())
         })?;

@@ -769,7 +769,7 @@ mod tests {
             }
         }
         let a = CsrMatrix::from(&coo);
-        let symbolic = analyze_symbolic(&a).unwrap();
+        let symbolic = analyze_symbolic(&a, &Default::default()).unwrap();
         let mut l = vec![0.0; symbolic.len_val()];
         let mut scratch = MemBuffer::new(
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),

@@ -187,3 +187,57 @@ fn every_schur_step_equals_the_direct_step_from_the_same_state() {
         }
     }
 }
+
+/// The factors ordered by nested dissection (the order large meshes get,
+/// `stickslip_fem::ordering`) give the runs AMD's give, through the static
+/// solve of the initial state and every Schur variant's and the direct
+/// path's steps: the ordering changes round-off only.
+#[test]
+fn nested_dissection_gives_the_runs_of_amd() {
+    use stickslip_fem::ordering::nested_dissection;
+    use stickslip_fem::FillOrder;
+    for mesh in ["slab-q2-8x2.msh", "slab-q1-32x8.msh"] {
+        let amd = paper_slab(mesh, 1e-4, History::Step);
+        let mut nd = paper_slab(mesh, 1e-4, History::Step);
+        nd.model.fill_order = FillOrder(Some(nested_dissection(&nd.mesh, &nd.model.dofs)));
+        assert_eq!(
+            amd.model.fill_order,
+            FillOrder(None),
+            "{mesh}: AMD by default"
+        );
+        for (name, scheme, reduction) in cases().into_iter().filter(|c| c.2.is_none()) {
+            let mut reference = build(&amd, scheme, reduction, ImplicitSolver::Direct);
+            let mut others: Vec<Integrator> = [ImplicitSolver::Direct]
+                .into_iter()
+                .map(|solver| build(&nd, scheme, reduction, solver))
+                .chain(schur_variants(&nd, scheme, reduction))
+                .collect();
+            let mut worst: f64 = 0.0;
+            for i in &others {
+                for (a, b) in i.displacement().iter().zip(reference.displacement()) {
+                    worst = worst.max((a - b).abs());
+                }
+            }
+            assert!(
+                worst > 0.0 || mesh.contains("8x2"),
+                "{mesh}: the orders differ in round-off"
+            );
+            assert!(worst < 1e-12, "{mesh} {name}: r₀ differs by {worst:e}");
+            while !reference.done() {
+                reference.step().unwrap();
+                for i in others.iter_mut() {
+                    i.step().unwrap();
+                    assert_eq!(i.classes(), reference.classes(), "{mesh} {name}: classes");
+                    for (a, b) in i.velocity().iter().zip(reference.velocity()) {
+                        worst = worst.max((a - b).abs());
+                    }
+                    for (a, b) in i.displacement().iter().zip(reference.displacement()) {
+                        worst = worst.max((a - b).abs());
+                    }
+                }
+            }
+            println!("{mesh} {name}: nested dissection against AMD, max difference {worst:.2e}");
+            assert!(worst < 1e-10, "{mesh} {name}: differs by {worst:e}");
+        }
+    }
+}

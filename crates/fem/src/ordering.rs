@@ -1,0 +1,258 @@
+//! The fill-reducing ordering of the Cholesky factors (the static solve,
+//! Newmark's A₀, the consistent mass): faer's AMD on small systems, a
+//! nested dissection by cells from [`DISSECTION_MIN_DOFS`] ([`FillOrder`]).
+//!
+//! Nested dissection: the cells are split at the median of their centroids
+//! across the longer side of their bounding box, the nodes the two halves
+//! share are the separator and are numbered after both halves, and each
+//! half is split again down to single cells. The separator is the line of
+//! nodes between two rows of cells, one node wide for Q1 and Q2 alike.
+//! Measured against AMD (faer's symbolic and numeric factorization of K,
+//! `Par::Seq`, 2026-11-26; `cases/hole.geo` meshed by Gmsh with lc_hole =
+//! lc/2, the slabs built in code):
+//!
+//! | mesh                   | DOFs  | factor values, ND / AMD | numeric factorization | ordering + symbolic |
+//! |------------------------|-------|-------------------------|-----------------------|---------------------|
+//! | hole Q1, lc 0.0196     | 61k   | 6.11M / 6.25M           | 0.061 / 0.065 s       | 0.028 / 0.039 s     |
+//! | hole Q1, lc 0.0098     | 238k  | 28.7M / 32.6M           | 0.46 / 0.61 s         | 0.13 / 0.27 s       |
+//! | hole Q2, lc 0.0196     | 243k  | 29.5M / 35.9M           | 0.52 / 0.71 s         | 0.15 / 0.31 s       |
+//! | hole Q1, lc 0.0045     | 1.12M | 164M / 196M             | 3.55 / 5.26 s         | 0.91 / 1.64 s       |
+//! | hole Q2, lc 0.009      | 1.13M | 165M / 233M             | 3.67 / 6.90 s         | 0.72 / 1.78 s       |
+//! | slab Q2, row by row    | 62k   | 5.21M / 5.08M           | 0.052 / 0.051 s       | 0.020 / 0.045 s     |
+//! | slab Q1, row by row    | 249k  | 25.1M / 24.6M           | 0.38 / 0.37 s         | 0.10 / 0.20 s       |
+//! | slab Q2, row by row    | 993k  | 115M / 121M             | 2.24 / 2.41 s         | 0.52 / 1.40 s       |
+//!
+//! On unstructured meshes from 238k DOFs the dissection has 12-29% fewer
+//! values and factorizes 1.3-1.9× faster; on grids numbered row by row its
+//! fill is within 5% of AMD's either way. Its supernodes are larger, and
+//! the Newmark step is as fast or faster even on the grids (`bench_step
+//! --case newmark MESH 10 3`, `STICKSLIP_FILL_ORDER` = nd against amd, two
+//! alternating runs each): slab Q2 352×88 (249k DOFs) 43.6-46.1 against
+//! 50.9-51.7 ms, slab Q1 708×177 (251k) 45.8-49.0 against 49.1-50.1 ms,
+//! Gmsh's `hole.geo` Q1 at 238k 44.0-45.8 against 49.7-50.3 ms and Q2 at
+//! 243k 51.3-51.8 against 57.5-59.9 ms, with setups of 2.7-3.0 against
+//! 3.7-4.4 s on those two. Below [`DISSECTION_MIN_DOFS`] AMD stays (the
+//! paper's Q2 16×4 mesh: 18.1k factor values against AMD's 16.0k).
+//!
+//! Tried and not kept: leaves of 2, 4 or 16 cells in any order (up to 31%
+//! more fill than AMD on the Q2 slab of 249k DOFs with 16; 2 and 4 never
+//! better than single cells); separators of nodes (one side's nodes
+//! touching the other, by the node graph): equal on Q1, 10% more fill
+//! than AMD on the Q2 mesh of 1.13M DOFs, where the median cuts through
+//! cells whose nodes couple two node rows apart.
+
+use stickslip_mesh::Mesh;
+
+use crate::dofs::DofMap;
+
+/// Free DOFs from which the factors are ordered by nested dissection (the
+/// table above: at 61-62k the two are within 3% either way).
+pub const DISSECTION_MIN_DOFS: usize = 100_000;
+
+/// Environment variable that overrides the choice, for comparisons:
+/// `amd` or `nd` (as [`crate::dofs::ORDER_ENV`] keeps the file's node
+/// order).
+pub const FILL_ORDER_ENV: &str = "STICKSLIP_FILL_ORDER";
+
+/// The ordering a factorization of a model's matrices uses: `None` is
+/// faer's AMD, else the free DOFs in elimination order.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct FillOrder(pub Option<Vec<usize>>);
+
+impl FillOrder {
+    /// AMD or nested dissection for `mesh` under `dofs` by their size (module
+    /// documentation), unless [`FILL_ORDER_ENV`] says which.
+    pub fn choose(mesh: &Mesh, dofs: &DofMap) -> FillOrder {
+        let dissect = match std::env::var(FILL_ORDER_ENV).as_deref() {
+            Ok("amd") => false,
+            Ok("nd") => true,
+            _ => dofs.n_free() >= DISSECTION_MIN_DOFS,
+        };
+        FillOrder(dissect.then(|| nested_dissection(mesh, dofs)))
+    }
+
+    /// "AMD" or "nested dissection", for messages.
+    pub fn name(&self) -> &'static str {
+        match self.0 {
+            None => "AMD",
+            Some(_) => "nested dissection",
+        }
+    }
+
+    /// The permutation, if not AMD.
+    pub fn as_slice(&self) -> Option<&[usize]> {
+        self.0.as_deref()
+    }
+}
+
+/// The free DOFs of `dofs` in nested-dissection order (module
+/// documentation), each node's DOFs together, x before y. Deterministic:
+/// the same mesh gives the same order.
+pub fn nested_dissection(mesh: &Mesh, dofs: &DofMap) -> Vec<usize> {
+    let n_nodes = mesh.nodes.len();
+    let centroid: Vec<[f64; 2]> = (0..mesh.n_cells())
+        .map(|c| {
+            // Corners first in both cell kinds.
+            let corners = &mesh.cell(c)[..4];
+            let mut x = [0.0; 2];
+            for &v in corners {
+                x[0] += 0.25 * mesh.nodes[v][0];
+                x[1] += 0.25 * mesh.nodes[v][1];
+            }
+            x
+        })
+        .collect();
+    #[derive(Clone, Copy, PartialEq)]
+    enum State {
+        Open,
+        Separator,
+        Numbered,
+    }
+    let mut state = vec![State::Open; n_nodes];
+    let mut in_first = vec![u32::MAX; n_nodes];
+    let mut nodes = Vec::with_capacity(n_nodes);
+    enum Job {
+        Split(Vec<u32>),
+        Number(Vec<usize>),
+    }
+    let mut jobs = vec![Job::Split((0..mesh.n_cells() as u32).collect())];
+    let mut split = 0u32;
+    while let Some(job) = jobs.pop() {
+        let mut cells = match job {
+            Job::Number(separator) => {
+                for v in separator {
+                    state[v] = State::Numbered;
+                    nodes.push(v);
+                }
+                continue;
+            }
+            Job::Split(cells) => cells,
+        };
+        if cells.len() <= 1 {
+            for &c in &cells {
+                for &v in mesh.cell(c as usize) {
+                    if state[v] == State::Open {
+                        state[v] = State::Numbered;
+                        nodes.push(v);
+                    }
+                }
+            }
+            continue;
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for &c in &cells {
+            for d in 0..2 {
+                lo[d] = lo[d].min(centroid[c as usize][d]);
+                hi[d] = hi[d].max(centroid[c as usize][d]);
+            }
+        }
+        let axis = usize::from(hi[1] - lo[1] > hi[0] - lo[0]);
+        let key = |c: &u32| centroid[*c as usize][axis];
+        let mid = cells.len() / 2;
+        cells.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)));
+        // Split at a coordinate, so that cells of one row or column (equal
+        // centroids on a grid) stay on one side and the separator is a
+        // straight line; by position when none lies below the median.
+        let at = key(&cells[mid]);
+        let (first, second): (Vec<u32>, Vec<u32>) = if cells[..mid].iter().any(|c| key(c) < at) {
+            cells.iter().partition(|c| key(c) < at)
+        } else {
+            (cells[..mid].to_vec(), cells[mid..].to_vec())
+        };
+        for &c in &first {
+            for &v in mesh.cell(c as usize) {
+                in_first[v] = split;
+            }
+        }
+        let mut separator = Vec::new();
+        for &c in &second {
+            for &v in mesh.cell(c as usize) {
+                if in_first[v] == split && state[v] == State::Open {
+                    state[v] = State::Separator;
+                    separator.push(v);
+                }
+            }
+        }
+        split += 1;
+        jobs.push(Job::Number(separator));
+        jobs.push(Job::Split(second));
+        jobs.push(Job::Split(first));
+    }
+    // Nodes in no cell (a mesh may carry them) last.
+    nodes.extend((0..n_nodes).filter(|&v| state[v] == State::Open));
+    nodes
+        .iter()
+        .flat_map(|&v| (0..2).filter_map(move |k| dofs.free(v, k)))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::slab;
+    use crate::Dirichlet;
+    use stickslip_mesh::CellKind;
+
+    fn slab_dofs(kind: CellKind, refine: usize) -> (Mesh, DofMap) {
+        let mesh = slab(kind, refine);
+        let dofs = DofMap::new(
+            &mesh,
+            &[
+                Dirichlet::new("support", 1, 0.0),
+                Dirichlet::new("left", 0, 0.0),
+            ],
+        )
+        .unwrap();
+        (mesh, dofs)
+    }
+
+    #[test]
+    fn every_free_dof_once() {
+        for kind in [CellKind::Quad4, CellKind::Quad9] {
+            let (mesh, dofs) = slab_dofs(kind, 4);
+            let order = nested_dissection(&mesh, &dofs);
+            let mut seen = vec![false; dofs.n_free()];
+            for &d in &order {
+                assert!(!seen[d], "{kind:?}: DOF {d} twice");
+                seen[d] = true;
+            }
+            assert_eq!(order.len(), dofs.n_free(), "{kind:?}");
+        }
+    }
+
+    /// The first split of the 64×16 Q1 slab (8 × 1) is across x at the
+    /// median cell column: its separator, numbered last, is the 17 nodes of
+    /// the line x = 4 (less the support's y, fixed: 33 free DOFs).
+    #[test]
+    fn the_last_dofs_are_the_middle_line() {
+        let (mesh, dofs) = slab_dofs(CellKind::Quad4, 4);
+        let order = nested_dissection(&mesh, &dofs);
+        let dofs = &dofs;
+        let line: Vec<usize> = (0..mesh.nodes.len())
+            .filter(|&v| (mesh.nodes[v][0] - 4.0).abs() < 1e-12)
+            .flat_map(|v| (0..2).filter_map(move |k| dofs.free(v, k)))
+            .collect();
+        assert_eq!(line.len(), 33);
+        let mut last: Vec<usize> = order[order.len() - line.len()..].to_vec();
+        last.sort_unstable();
+        let mut want = line.clone();
+        want.sort_unstable();
+        assert_eq!(last, want);
+    }
+
+    #[test]
+    fn amd_on_small_meshes_dissection_on_large_ones() {
+        if std::env::var_os(FILL_ORDER_ENV).is_some() {
+            return;
+        }
+        let (mesh, dofs) = slab_dofs(CellKind::Quad4, 4);
+        assert_eq!(FillOrder::choose(&mesh, &dofs), FillOrder(None));
+        // 28 × (16×4) cells: 100,912 free DOFs.
+        let (mesh, dofs) = slab_dofs(CellKind::Quad4, 28);
+        assert!(dofs.n_free() >= DISSECTION_MIN_DOFS);
+        assert_eq!(
+            FillOrder::choose(&mesh, &dofs),
+            FillOrder(Some(nested_dissection(&mesh, &dofs)))
+        );
+    }
+}
