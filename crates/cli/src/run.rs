@@ -15,7 +15,7 @@ use std::time::Instant;
 use anyhow::Context;
 use stickslip_contact::{ContactSurface, IterationOptions};
 use stickslip_fem::{
-    body_force_load, traction_load, Dirichlet, ElementClasses, Hypothesis as FemHypothesis,
+    body_force_load, traction_load, Dirichlet, DofMap, ElementClasses, Hypothesis as FemHypothesis,
     Material, Model, NodeOrder, Traction,
 };
 use stickslip_mesh::Mesh;
@@ -62,13 +62,27 @@ pub enum Outcome {
     Interrupted,
 }
 
-/// A case turned into the objects that run it.
+/// A case turned into the objects that run it, with the model kept for
+/// inspection (`check`, `advise`).
 #[derive(Debug)]
 pub struct Prepared {
     /// The mesh.
     pub mesh: Mesh,
     /// K, M, lumped M, DOF map.
     pub model: Model,
+    /// The integrator at t = 0 (initial state computed).
+    pub integrator: Integrator,
+}
+
+/// A case turned into the objects that run it, for `run`: K and M have
+/// moved into the integrator (a copy left in a model would be held for the
+/// whole run, 24 bytes per stored entry of K beside the step's own data).
+#[derive(Debug)]
+pub struct Running {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// The DOF map of the integrator's free DOFs.
+    pub dofs: DofMap,
     /// The integrator at t = 0 (initial state computed).
     pub integrator: Integrator,
 }
@@ -168,15 +182,36 @@ fn check_group(
 /// # Errors
 /// Input problems (exit 2) as [`InputError`]; nothing else is expected.
 pub fn prepare(case: &Case) -> anyhow::Result<Prepared> {
-    prepare_for(case, false)
+    let (mesh, _, model, integrator) = build(case, false, true)?;
+    Ok(Prepared {
+        mesh,
+        model: model.expect("kept when asked"),
+        integrator,
+    })
 }
 
-/// [`prepare`], for a run that will [`Integrator::restore`] a checkpoint
+/// [`prepare`] for a run, which will [`Integrator::restore`] a checkpoint
 /// when `restoring` (no initial static solve: the checkpoint has the state).
+/// K and M move into the integrator.
 ///
 /// # Errors
 /// As [`prepare`].
-pub fn prepare_for(case: &Case, restoring: bool) -> anyhow::Result<Prepared> {
+pub fn prepare_run(case: &Case, restoring: bool) -> anyhow::Result<Running> {
+    let (mesh, dofs, _, integrator) = build(case, restoring, false)?;
+    Ok(Running {
+        mesh,
+        dofs,
+        integrator,
+    })
+}
+
+/// [`prepare`] and [`prepare_run`]: the model is returned when
+/// `keep_model`, else its matrices move into the integrator.
+fn build(
+    case: &Case,
+    restoring: bool,
+    keep_model: bool,
+) -> anyhow::Result<(Mesh, DofMap, Option<Model>, Integrator)> {
     let mesh = Mesh::from_file(&case.mesh.file)
         .map_err(|e| input(format!("{}{e}", case.at("mesh.file"))))?;
     let mut problems = Vec::new();
@@ -393,7 +428,13 @@ pub fn prepare_for(case: &Case, restoring: bool) -> anyhow::Result<Prepared> {
         }
         _ => None,
     };
-    let dynamics = Dynamics::from_model(&model).with_element_classes(classes);
+    let dofs = model.dofs.clone();
+    let (dynamics, model) = if keep_model {
+        (Dynamics::from_model(&model), Some(model))
+    } else {
+        (Dynamics::from_model_owned(model), None)
+    };
+    let dynamics = dynamics.with_element_classes(classes);
     let integrator = Integrator::new(dynamics, contact, loads, settings).map_err(|e| {
         let key = match e {
             TimeError::Unstable { .. } => "time.dt",
@@ -402,11 +443,7 @@ pub fn prepare_for(case: &Case, restoring: bool) -> anyhow::Result<Prepared> {
         };
         input(format!("{}[time]: {e}", case.at(key)))
     })?;
-    Ok(Prepared {
-        mesh,
-        model,
-        integrator,
-    })
+    Ok((mesh, dofs, model, integrator))
 }
 
 /// `stickslip check`: validate, print the model size, Δt_crit and solver.
@@ -520,11 +557,11 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
 /// may take ([`ResultsWriter::room_needed`]), if it has.
 fn disk_nearly_full(
     writer: &ResultsWriter,
-    model: &Model,
+    dofs: &DofMap,
     out: &Path,
     integrator: &Integrator,
 ) -> Option<String> {
-    let need = writer.room_needed(model.dofs.n_free());
+    let need = writer.room_needed(dofs.n_free());
     let free = crate::results_file::free_bytes(out).filter(|&f| f < need)?;
     Some(format!(
         "step {} (t = {}): the disk of {} is nearly full ({:.1} MB free, the next write may need {:.1} MB): \
@@ -632,14 +669,14 @@ struct FullState {
 
 fn record<'a>(
     i: &Integrator,
-    model: &Model,
+    dofs: &DofMap,
     s: &'a mut FullState,
     dt: f64,
     iterations: u32,
 ) -> Record<'a> {
-    model.dofs.expand(i.displacement(), &mut s.u);
-    model.dofs.expand_homogeneous(i.velocity(), &mut s.v);
-    model.dofs.expand_homogeneous(i.acceleration(), &mut s.a);
+    dofs.expand(i.displacement(), &mut s.u);
+    dofs.expand_homogeneous(i.velocity(), &mut s.v);
+    dofs.expand_homogeneous(i.acceleration(), &mut s.a);
     i.friction_stress(&mut s.stress);
     i.slip_velocity(&mut s.slip);
     for (o, c) in s.state.iter_mut().zip(i.classes()) {
@@ -805,11 +842,11 @@ fn blow_up(i: &Integrator, initial: f64) -> Option<f64> {
 pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<Outcome> {
     let started = Instant::now();
     let quiet = options.quiet;
-    let Prepared {
+    let Running {
         mesh,
-        model,
+        dofs,
         mut integrator,
-    } = prepare_for(case, options.restart)?;
+    } = prepare_run(case, options.restart)?;
     let (contact_nodes, contact_s): (Vec<usize>, Vec<f64>) = integrator
         .contact()
         .map(|c| c.nodes.iter().map(|n| (n.node, n.s)).unzip())
@@ -825,7 +862,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         state: vec![0; n_c],
     };
     // E₀ for the blow-up test: kinetic + strain at t = 0.
-    let node_order = model.dofs.node_order();
+    let node_order = dofs.node_order();
     let e0 = integrator.energy();
     let mut initial_mechanical = e0.kinetic + e0.strain;
     // A signal during the setup: stop before the file is touched (with
@@ -933,14 +970,14 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         // into this run's numbering; the modal state, whose modes depend
         // on the numbering, is then formed again from it.
         let remapped;
-        let n_free = model.dofs.n_free();
+        let n_free = dofs.n_free();
         let lengths_fit = [&cp.displacement, &cp.velocity, &cp.acceleration]
             .iter()
             .all(|x| x.len() == n_free);
         // (Other lengths: `restore` says what is wrong.)
         let cp = if stored.extra.node_order != node_order.code() && lengths_fit {
             let theirs = NodeOrder::from_code(stored.extra.node_order)
-                .and_then(|order| model.dofs.renumbered(&mesh, order))
+                .and_then(|order| dofs.renumbered(&mesh, order))
                 .ok_or_else(|| {
                     input(format!(
                         "--restart {}: its state's node_order {} does not apply to {} (a newer version's order, or a structured grid's on a mesh that is none); restart with the version and the mesh the run started from",
@@ -949,7 +986,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                         case.mesh.file.display()
                     ))
                 })?;
-            let to_ours = |x: &[f64]| model.dofs.from_numbering(&theirs, x);
+            let to_ours = |x: &[f64]| dofs.from_numbering(&theirs, x);
             remapped = stickslip_time::Checkpoint {
                 displacement: to_ours(&cp.displacement),
                 velocity: to_ours(&cp.velocity),
@@ -990,7 +1027,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         };
         let mut w = ResultsWriter::create_with(out, &header, case.output.compression)
             .with_context(|| format!("cannot create the results file {}", out.display()))?;
-        w.append(&record(&integrator, &model, &mut full, 0.0, 0))?;
+        w.append(&record(&integrator, &dofs, &mut full, 0.0, 0))?;
         if !quiet {
             if let Some(w) = large_static_displacement(&mesh, &full.u) {
                 say!("{}: warning: {w}", case.path.display());
@@ -1078,7 +1115,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                     times.push(integrator.time());
                     writer.append(&record(
                         &integrator,
-                        &model,
+                        &dofs,
                         full,
                         info.dt,
                         info.iterations as u32,
@@ -1088,7 +1125,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                     // HDF5 writes a chunk of rows as it fills: the room for
                     // it is checked before, as before a flush.
                     if writer.append_writes() {
-                        if let Some(e) = disk_nearly_full(&writer, &model, out, &integrator) {
+                        if let Some(e) = disk_nearly_full(&writer, &dofs, out, &integrator) {
                             failure = Some(e);
                             break;
                         }
@@ -1124,7 +1161,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                     break;
                 }
                 if writer.flush_due() {
-                    if let Some(e) = disk_nearly_full(&writer, &model, out, &integrator) {
+                    if let Some(e) = disk_nearly_full(&writer, &dofs, out, &integrator) {
                         failure = Some(e);
                         break;
                     }
