@@ -549,7 +549,7 @@ fn probe_of(
 /// Input problems as [`InputError`]; a step that fails.
 pub fn run_traced(case: &Case, q: Quantity, at: Option<[f64; 2]>) -> anyhow::Result<Trace> {
     let start = Instant::now();
-    let mut p = prepare(case)?;
+    let mut p = prepare(case, false)?;
     let (probe, _) = probe_of(case, &p, q, at)?;
     let n_c = p.integrator.contact().map_or(0, |c| c.len());
     let mut stress = vec![0.0; n_c];
@@ -799,7 +799,7 @@ pub fn read_ladder(
             case.time.t_end / 50.0,
             eps_of(case),
         );
-        let p = prepare(&c).map_err(|e| {
+        let p = prepare(&c, false).map_err(|e| {
             let msg = match e.downcast_ref::<InputError>() {
                 Some(i) => i.0.clone(),
                 None => format!("{e:#}"),
