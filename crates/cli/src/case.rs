@@ -1260,10 +1260,16 @@ fn convert(
         format!("time.t_end = {t_end} must be a finite number > 0"),
     );
     // A run that cannot end (1e300 steps passed `check` and ran on).
+    // Blamed on t_end, or on dt where only dt came from --set.
     let steps = t_end / dt;
+    let blamed = if loc.set_by_override(&tm.dt.span()) && !loc.set_by_override(&tm.t_end.span()) {
+        tm.dt.span()
+    } else {
+        tm.t_end.span()
+    };
     check(
         steps.is_nan() || steps <= MAX_STEPS,
-        tm.t_end.span(),
+        blamed,
         format!(
             "time.t_end / time.dt = {t_end:e} / {dt:e} = {steps:.3e} steps, more than {MAX_STEPS:e}: \
              a run that would not end in years; check the two values (their units, a missing minus \
@@ -1578,6 +1584,12 @@ impl<'a> Locator<'a> {
             sets,
             map,
         }
+    }
+
+    /// Whether the line of `span` was changed or added by `--set`.
+    fn set_by_override(&self, span: &Range<usize>) -> bool {
+        let (line, _) = line_col(self.source, span.start);
+        self.map.get(line - 1).copied().flatten().is_none()
     }
 
     fn at(&self, span: Option<Range<usize>>) -> String {
@@ -1961,6 +1973,31 @@ t_end = 0.5
         let e = load_text("set-shift", &text, &["contact.remark_4_2=false"])
             .unwrap_err()
             .0;
+        assert!(
+            e.contains(&format!("case.toml:{}:", line_of(&text, "t_end"))),
+            "{e}"
+        );
+    }
+
+    /// Too many steps is blamed on the value that came from --set: a tiny
+    /// dt given by --set named t_end's line of the file.
+    #[test]
+    fn endless_runs_blame_the_set_value() {
+        let e = load_text("set-dt", GOOD, &["time.dt=1e-14"]).unwrap_err().0;
+        assert!(
+            e.contains("--set time.dt=1e-14") && e.contains("more than 1e12"),
+            "{e}"
+        );
+        let e = load_text("set-t-end", GOOD, &["time.t_end=1e20"])
+            .unwrap_err()
+            .0;
+        assert!(
+            e.contains("--set time.t_end=1e20") && e.contains("more than 1e12"),
+            "{e}"
+        );
+        // Neither set: t_end's line of the file.
+        let text = GOOD.replace("t_end = 0.5", "t_end = 1e20");
+        let e = load_text("file-t-end", &text, &[]).unwrap_err().0;
         assert!(
             e.contains(&format!("case.toml:{}:", line_of(&text, "t_end"))),
             "{e}"
