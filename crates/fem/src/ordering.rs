@@ -220,6 +220,69 @@ mod tests {
         }
     }
 
+    /// Meshes the slabs are not: two disjoint parts, two parts on top of
+    /// each other (equal centroids in pairs), one part all clamped, a
+    /// single row and a single column of cells, a third of the nodes
+    /// clamped, nodes in no cell (free or clamped): each free DOF once.
+    #[test]
+    fn every_free_dof_once_on_odd_meshes() {
+        use crate::testing::{add_point_group, rectangle};
+        fn merge(a: &Mesh, b: &Mesh) -> Mesh {
+            let mut m = a.clone();
+            let off = a.nodes.len();
+            m.nodes.extend(&b.nodes);
+            m.node_tags = (1..=m.nodes.len() as u64).collect();
+            m.cells.extend(b.cells.iter().map(|v| v + off));
+            m.cell_tags = (1..=(m.cells.len() / m.kind.nodes_per_cell()) as u64).collect();
+            m
+        }
+        let clamp = |group: &str| [Dirichlet::new(group, 0, 0.0), Dirichlet::new(group, 1, 0.0)];
+        for kind in [CellKind::Quad4, CellKind::Quad9] {
+            let a = rectangle(kind, 12, 7, [0.0, 0.0], [3.0, 2.0]);
+            let mut meshes = Vec::new();
+            for (origin, fixed) in [([5.0, 0.5], false), ([0.0, 0.0], false), ([5.0, 0.0], true)] {
+                let b = rectangle(kind, 6, 9, origin, [1.0, 2.0]);
+                let mut m = merge(&a, &b);
+                let off = a.nodes.len();
+                let held: Vec<usize> = if fixed {
+                    (off..m.nodes.len()).collect()
+                } else {
+                    b.groups[0].nodes.iter().map(|v| v + off).collect()
+                };
+                add_point_group(&mut m, "held", &held);
+                meshes.push(m);
+            }
+            for (nx, ny) in [(40, 1), (1, 40)] {
+                let mut m = rectangle(kind, nx, ny, [0.0, 0.0], [nx as f64, ny as f64]);
+                add_point_group(&mut m, "held", &[0]);
+                meshes.push(m);
+            }
+            let mut m = a.clone();
+            let third: Vec<usize> = (0..m.nodes.len()).step_by(3).collect();
+            add_point_group(&mut m, "held", &third);
+            meshes.push(m);
+            let mut m = a.clone();
+            let n = m.nodes.len();
+            m.nodes.extend([[9.0, 9.0], [9.0, 1.0]]);
+            m.node_tags.extend([n as u64 + 1, n as u64 + 2]);
+            add_point_group(&mut m, "held", &[n]);
+            meshes.push(m);
+            for (i, mesh) in meshes.iter().enumerate() {
+                let conditions: Vec<Dirichlet> =
+                    clamp("bottom").into_iter().chain(clamp("held")).collect();
+                let dofs = DofMap::new(mesh, &conditions).unwrap();
+                let order = nested_dissection(mesh, &dofs);
+                let mut seen = vec![false; dofs.n_free()];
+                for &d in &order {
+                    assert!(!seen[d], "{kind:?} mesh {i}: DOF {d} twice");
+                    seen[d] = true;
+                }
+                assert_eq!(order.len(), dofs.n_free(), "{kind:?} mesh {i}");
+                assert_eq!(order, nested_dissection(mesh, &dofs), "{kind:?} mesh {i}");
+            }
+        }
+    }
+
     /// The first split of the 64×16 Q1 slab (8 × 1) is across x at the
     /// median cell column: its separator, numbered last, is the 17 nodes of
     /// the line x = 4 (less the support's y, fixed: 33 free DOFs).
