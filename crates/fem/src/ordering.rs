@@ -32,7 +32,14 @@
 //! Gmsh's `hole.geo` Q1 at 238k 44.0-45.8 against 49.7-50.3 ms and Q2 at
 //! 243k 51.3-51.8 against 57.5-59.9 ms, with setups of 2.7-3.0 against
 //! 3.7-4.4 s on those two. Below [`DISSECTION_MIN_DOFS`] AMD stays (the
-//! paper's Q2 16×4 mesh: 18.1k factor values against AMD's 16.0k).
+//! slab Q2 16×4, 552 DOFs: 18.1k factor values against AMD's 16.0k; the
+//! paper's Q2 8×2, 148 DOFs: 3.3k against 3.5k).
+//!
+//! Not every mesh above [`DISSECTION_MIN_DOFS`] gains: on non-convex
+//! domains and long thin strips the dissection's factor is larger than
+//! AMD's (a comb of 114k DOFs 1.28-1.37×, strips of 500:1 1.23-1.28×,
+//! 200:1 1.11×: `cargo run --release -p stickslip-fem --example
+//! fill_order_shapes`); `STICKSLIP_FILL_ORDER=amd` keeps AMD there.
 //!
 //! Tried and not kept: leaves of 2, 4 or 16 cells in any order (up to 31%
 //! more fill than AMD on the Q2 slab of 249k DOFs with 16; 2 and 4 never
@@ -51,7 +58,7 @@ pub const DISSECTION_MIN_DOFS: usize = 100_000;
 
 /// Environment variable that overrides the choice, for comparisons:
 /// `amd` or `nd` (as [`crate::dofs::ORDER_ENV`] keeps the file's node
-/// order).
+/// order); any other value, or none, chooses by size.
 pub const FILL_ORDER_ENV: &str = "STICKSLIP_FILL_ORDER";
 
 /// The ordering a factorization of a model's matrices uses: `None` is
