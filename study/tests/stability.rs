@@ -139,12 +139,9 @@ fn committed_tables_are_what_the_study_writes() {
         }
         for (i, (c, f)) in c_lines.iter().zip(&f_lines).enumerate() {
             let differs = c.split(',').count() != f.split(',').count()
-                || c.split(',').zip(f.split(',')).any(|(a, b)| {
-                    match (a.parse::<f64>(), b.parse::<f64>()) {
-                        (Ok(x), Ok(y)) => (x - y).abs() > 1e-5 * x.abs().max(y.abs()),
-                        _ => a != b,
-                    }
-                });
+                || c.split(',')
+                    .zip(f.split(','))
+                    .any(|(a, b)| fields_differ(a, b));
             if differs {
                 problems.push(format!(
                     "{name} line {}:\n  committed {c}\n  written   {f}",
@@ -159,4 +156,38 @@ fn committed_tables_are_what_the_study_writes() {
         "docs/stability-*.csv differ from a fresh run; run `cargo xtask stability` and commit them:\n{}",
         problems.join("\n")
     );
+}
+
+/// Whether a committed CSV field `a` and a fresh one `b` differ: numbers by
+/// more than 1e-5 relative, anything else as text. A NaN or an infinity
+/// equals only itself (in the arithmetic test it would equal anything).
+fn fields_differ(a: &str, b: &str) -> bool {
+    match (a.parse::<f64>(), b.parse::<f64>()) {
+        (Ok(x), Ok(y)) if x.is_finite() && y.is_finite() => {
+            (x - y).abs() > 1e-5 * x.abs().max(y.abs())
+        }
+        (Ok(x), Ok(y)) => !(x == y || x.is_nan() && y.is_nan()),
+        _ => a != b,
+    }
+}
+
+#[test]
+fn the_tables_comparison_sees_nan_and_infinity() {
+    assert!(!fields_differ("1.0000e0", "1.00001e0"));
+    assert!(fields_differ("1.0000e0", "1.0001e0"));
+    assert!(fields_differ("true", "false"));
+    for (committed, fresh) in [
+        ("1.2509e7", "NaN"),
+        ("NaN", "1.2509e7"),
+        ("1.2509e7", "inf"),
+        ("inf", "-inf"),
+        ("inf", "1e308"),
+    ] {
+        assert!(
+            fields_differ(committed, fresh),
+            "{committed} against {fresh} passed"
+        );
+    }
+    assert!(!fields_differ("NaN", "NaN"));
+    assert!(!fields_differ("inf", "inf"));
 }

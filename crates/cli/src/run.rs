@@ -521,8 +521,20 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     // not a step of its own.
     let steps = (case.time.t_end / case.time.dt - 1e-6).ceil().max(1.0);
     if i.is_explicit() {
+        // A preload (a constant load, nonzero prescribed displacements)
+        // puts the initial state at r₀ = K⁻¹ R(0⁻): one factorization of
+        // K, the only one of the run; else r₀ = 0 and there is none.
+        let preloaded = i.displacement().iter().any(|&x| x != 0.0);
         println!(
-            "solver      explicit: no linear system; friction solved node by node in closed form; K·x by {}",
+            "solver      explicit: {}; friction solved node by node in closed form; K·x by {}",
+            if preloaded {
+                format!(
+                    "no linear system per step (the preloaded initial state by one sparse Cholesky (faer, {}) of K)",
+                    p.model.fill_order.name()
+                )
+            } else {
+                "no linear system".to_string()
+            },
             i.stiffness_product()
         );
     } else if i.implicit_solver() == ImplicitSolver::Direct {

@@ -333,3 +333,37 @@ fn run_then_probe_node_81() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("not a contact node"), "{}", stderr(&o));
 }
+
+/// `check` of an explicit case with a preload (the contact pressure, a
+/// constant traction) names the factorization of K its initial state
+/// takes, and its ordering; with no preload there is none.
+#[test]
+fn check_names_the_explicit_preloads_factorization() {
+    let (path, _) = case_with("check-preload", |t| {
+        t.replace("history = \"step\"", "history = \"constant\"")
+    });
+    let o = bin().arg("check").arg(&path).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    let solver = out
+        .lines()
+        .find(|l| l.starts_with("solver"))
+        .expect("a solver line");
+    assert!(
+        solver.contains("sparse Cholesky (faer, AMD) of K"),
+        "{solver}"
+    );
+    // No contact (its pressure is a constant load) and a step: r₀ = 0.
+    let (path, _) = case_with("check-no-preload", |t| {
+        let (head, rest) = t.split_once("[contact]").unwrap();
+        format!("{head}{}", &rest[rest.find("[time]").unwrap()..])
+    });
+    let o = bin().arg("check").arg(&path).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    let solver = out.lines().find(|l| l.starts_with("solver")).unwrap();
+    assert!(
+        solver.contains("explicit: no linear system;") && !solver.contains("Cholesky"),
+        "{solver}"
+    );
+}

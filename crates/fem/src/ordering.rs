@@ -32,7 +32,14 @@
 //! Gmsh's `hole.geo` Q1 at 238k 44.0-45.8 against 49.7-50.3 ms and Q2 at
 //! 243k 51.3-51.8 against 57.5-59.9 ms, with setups of 2.7-3.0 against
 //! 3.7-4.4 s on those two. Below [`DISSECTION_MIN_DOFS`] AMD stays (the
-//! paper's Q2 16×4 mesh: 18.1k factor values against AMD's 16.0k).
+//! slab Q2 16×4, 552 DOFs: 18.1k factor values against AMD's 16.0k; the
+//! paper's Q2 8×2, 148 DOFs: 3.3k against 3.5k).
+//!
+//! Not every mesh above [`DISSECTION_MIN_DOFS`] gains: on non-convex
+//! domains and long thin strips the dissection's factor is larger than
+//! AMD's (a comb of 114k DOFs 1.28-1.37×, strips of 500:1 1.23-1.28×,
+//! 200:1 1.11×: `cargo run --release -p stickslip-fem --example
+//! fill_order_shapes`); `STICKSLIP_FILL_ORDER=amd` keeps AMD there.
 //!
 //! Tried and not kept: leaves of 2, 4 or 16 cells in any order (up to 31%
 //! more fill than AMD on the Q2 slab of 249k DOFs with 16; 2 and 4 never
@@ -51,7 +58,7 @@ pub const DISSECTION_MIN_DOFS: usize = 100_000;
 
 /// Environment variable that overrides the choice, for comparisons:
 /// `amd` or `nd` (as [`crate::dofs::ORDER_ENV`] keeps the file's node
-/// order).
+/// order); any other value, or none, chooses by size.
 pub const FILL_ORDER_ENV: &str = "STICKSLIP_FILL_ORDER";
 
 /// The ordering a factorization of a model's matrices uses: `None` is
@@ -217,6 +224,69 @@ mod tests {
                 seen[d] = true;
             }
             assert_eq!(order.len(), dofs.n_free(), "{kind:?}");
+        }
+    }
+
+    /// Meshes the slabs are not: two disjoint parts, two parts on top of
+    /// each other (equal centroids in pairs), one part all clamped, a
+    /// single row and a single column of cells, a third of the nodes
+    /// clamped, nodes in no cell (free or clamped): each free DOF once.
+    #[test]
+    fn every_free_dof_once_on_odd_meshes() {
+        use crate::testing::{add_point_group, rectangle};
+        fn merge(a: &Mesh, b: &Mesh) -> Mesh {
+            let mut m = a.clone();
+            let off = a.nodes.len();
+            m.nodes.extend(&b.nodes);
+            m.node_tags = (1..=m.nodes.len() as u64).collect();
+            m.cells.extend(b.cells.iter().map(|v| v + off));
+            m.cell_tags = (1..=(m.cells.len() / m.kind.nodes_per_cell()) as u64).collect();
+            m
+        }
+        let clamp = |group: &str| [Dirichlet::new(group, 0, 0.0), Dirichlet::new(group, 1, 0.0)];
+        for kind in [CellKind::Quad4, CellKind::Quad9] {
+            let a = rectangle(kind, 12, 7, [0.0, 0.0], [3.0, 2.0]);
+            let mut meshes = Vec::new();
+            for (origin, fixed) in [([5.0, 0.5], false), ([0.0, 0.0], false), ([5.0, 0.0], true)] {
+                let b = rectangle(kind, 6, 9, origin, [1.0, 2.0]);
+                let mut m = merge(&a, &b);
+                let off = a.nodes.len();
+                let held: Vec<usize> = if fixed {
+                    (off..m.nodes.len()).collect()
+                } else {
+                    b.groups[0].nodes.iter().map(|v| v + off).collect()
+                };
+                add_point_group(&mut m, "held", &held);
+                meshes.push(m);
+            }
+            for (nx, ny) in [(40, 1), (1, 40)] {
+                let mut m = rectangle(kind, nx, ny, [0.0, 0.0], [nx as f64, ny as f64]);
+                add_point_group(&mut m, "held", &[0]);
+                meshes.push(m);
+            }
+            let mut m = a.clone();
+            let third: Vec<usize> = (0..m.nodes.len()).step_by(3).collect();
+            add_point_group(&mut m, "held", &third);
+            meshes.push(m);
+            let mut m = a.clone();
+            let n = m.nodes.len();
+            m.nodes.extend([[9.0, 9.0], [9.0, 1.0]]);
+            m.node_tags.extend([n as u64 + 1, n as u64 + 2]);
+            add_point_group(&mut m, "held", &[n]);
+            meshes.push(m);
+            for (i, mesh) in meshes.iter().enumerate() {
+                let conditions: Vec<Dirichlet> =
+                    clamp("bottom").into_iter().chain(clamp("held")).collect();
+                let dofs = DofMap::new(mesh, &conditions).unwrap();
+                let order = nested_dissection(mesh, &dofs);
+                let mut seen = vec![false; dofs.n_free()];
+                for &d in &order {
+                    assert!(!seen[d], "{kind:?} mesh {i}: DOF {d} twice");
+                    seen[d] = true;
+                }
+                assert_eq!(order.len(), dofs.n_free(), "{kind:?} mesh {i}");
+                assert_eq!(order, nested_dissection(mesh, &dofs), "{kind:?} mesh {i}");
+            }
         }
     }
 
