@@ -68,10 +68,10 @@ fn main() {
         };
         let model = Model::new(&mesh, &material, &supports).unwrap();
         let t = Instant::now();
-        let nd = FillOrder(Some(nested_dissection(&mesh, &model.dofs)));
+        let nd = FillOrder::dissection(nested_dissection(&mesh, &model.dofs));
         let nd_s = t.elapsed().as_secs_f64();
         let (nd_analysis, nd_values, nd_numeric) = factorize(&model, &nd, nd_s);
-        let (amd_analysis, amd_values, amd_numeric) = factorize(&model, &FillOrder(None), 0.0);
+        let (amd_analysis, amd_values, amd_numeric) = factorize(&model, &FillOrder::amd(), 0.0);
         println!(
             "{name},{},{nd_values},{amd_values},{nd_numeric:.3},{amd_numeric:.3},{nd_analysis:.3},{amd_analysis:.3}",
             model.dofs.n_free()

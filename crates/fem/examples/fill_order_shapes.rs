@@ -84,8 +84,11 @@ fn main() {
         assert!(model.dofs.n_free() >= DISSECTION_MIN_DOFS);
         let values =
             |order: &FillOrder| analyze_symbolic(&model.stiffness, order).unwrap().len_val();
-        let nd = values(&FillOrder(Some(nested_dissection(&mesh, &model.dofs))));
-        let amd = values(&FillOrder(None));
+        let nd = values(&FillOrder::dissection(nested_dissection(
+            &mesh,
+            &model.dofs,
+        )));
+        let amd = values(&FillOrder::amd());
         println!(
             "{name},{},{nd},{amd},{:.3}",
             model.dofs.n_free(),

@@ -1,6 +1,7 @@
 //! The fill-reducing ordering of the Cholesky factors (the static solve,
 //! Newmark's A₀, the consistent mass): faer's AMD on small systems, a
-//! nested dissection by cells from [`DISSECTION_MIN_DOFS`] ([`FillOrder`]).
+//! nested dissection by cells from [`DISSECTION_MIN_DOFS`] unless AMD's
+//! factor is clearly smaller ([`FillOrder`]).
 //!
 //! Nested dissection: the cells are split at the median of their centroids
 //! across the longer side of their bounding box, the nodes the two halves
@@ -39,7 +40,13 @@
 //! domains and long thin strips the dissection's factor is larger than
 //! AMD's (a comb of 114k DOFs 1.28-1.37×, strips of 500:1 1.23-1.28×,
 //! 200:1 1.11×: `cargo run --release -p stickslip-fem --example
-//! fill_order_shapes`); `STICKSLIP_FILL_ORDER=amd` keeps AMD there.
+//! fill_order_shapes`). So from [`DISSECTION_MIN_DOFS`] the first
+//! factorization of a run analyses its pattern in both orders and keeps
+//! the dissection unless AMD's factor has [`AMD_MARGIN`] fewer values
+//! ([`FillOrder::choose`]); K, A₀ and M share the pattern, and the later
+//! factorizations reuse the choice. The price is AMD's analysis beside the
+//! dissection's (1.5 s at 1.12M DOFs, where the dissection saves 1.7 s of
+//! factorization; 0.3 s at 250k).
 //!
 //! Tried and not kept: leaves of 2, 4 or 16 cells in any order (up to 31%
 //! more fill than AMD on the Q2 slab of 249k DOFs with 16; 2 and 4 never
@@ -47,6 +54,8 @@
 //! touching the other, by the node graph): equal on Q1, 10% more fill
 //! than AMD on the Q2 mesh of 1.13M DOFs, where the median cuts through
 //! cells whose nodes couple two node rows apart.
+
+use std::sync::{Arc, OnceLock};
 
 use stickslip_mesh::Mesh;
 
@@ -56,39 +65,80 @@ use crate::dofs::DofMap;
 /// table above: at 61-62k the two are within 3% either way).
 pub const DISSECTION_MIN_DOFS: usize = 100_000;
 
+/// The dissection is kept unless its factor has more than this many times
+/// AMD's values: at about equal values its supernodes are larger and its
+/// solves faster (the Q2 352×88 slab: 24.62M values against AMD's 24.60M,
+/// Newmark's solve 27.3-28.7 against 35.8-36.5 ms in the runs above), and
+/// the meshes where AMD wins (comb, strips) are 1.11-1.37×.
+pub const AMD_MARGIN: f64 = 1.1;
+
 /// Environment variable that overrides the choice, for comparisons:
 /// `amd` or `nd` (as [`crate::dofs::ORDER_ENV`] keeps the file's node
 /// order); any other value, or none, chooses by size.
 pub const FILL_ORDER_ENV: &str = "STICKSLIP_FILL_ORDER";
 
-/// The ordering a factorization of a model's matrices uses: `None` is
-/// faer's AMD, else the free DOFs in elimination order.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct FillOrder(pub Option<Vec<usize>>);
+/// The ordering the factorizations of a model's matrices use: faer's AMD,
+/// a nested dissection, or (from [`DISSECTION_MIN_DOFS`]) the dissection
+/// unless AMD's factor is smaller by [`AMD_MARGIN`], decided at the first
+/// analysis ([`crate::analyze_symbolic`]) and shared by every clone.
+#[derive(Clone, Debug, Default)]
+pub struct FillOrder {
+    /// The dissection's elimination order of the free DOFs, if a candidate.
+    dissection: Option<Arc<Vec<usize>>>,
+    /// Whether AMD is to be tried beside it.
+    compare: bool,
+    /// The comparison's outcome, once made: true when the dissection won.
+    chosen: Arc<OnceLock<bool>>,
+}
 
 impl FillOrder {
-    /// AMD or nested dissection for `mesh` under `dofs` by their size (module
-    /// documentation), unless [`FILL_ORDER_ENV`] says which.
-    pub fn choose(mesh: &Mesh, dofs: &DofMap) -> FillOrder {
-        let dissect = match std::env::var(FILL_ORDER_ENV).as_deref() {
-            Ok("amd") => false,
-            Ok("nd") => true,
-            _ => dofs.n_free() >= DISSECTION_MIN_DOFS,
-        };
-        FillOrder(dissect.then(|| nested_dissection(mesh, dofs)))
+    /// faer's AMD.
+    pub fn amd() -> FillOrder {
+        FillOrder::default()
     }
 
-    /// "AMD" or "nested dissection", for messages.
-    pub fn name(&self) -> &'static str {
-        match self.0 {
-            None => "AMD",
-            Some(_) => "nested dissection",
+    /// The nested dissection `order`, whatever its factor.
+    pub fn dissection(order: Vec<usize>) -> FillOrder {
+        FillOrder {
+            dissection: Some(Arc::new(order)),
+            ..FillOrder::default()
         }
     }
 
-    /// The permutation, if not AMD.
-    pub fn as_slice(&self) -> Option<&[usize]> {
-        self.0.as_deref()
+    /// AMD below [`DISSECTION_MIN_DOFS`] free DOFs, else the dissection or
+    /// AMD by their factors ([`AMD_MARGIN`]), unless [`FILL_ORDER_ENV`]
+    /// says which.
+    pub fn choose(mesh: &Mesh, dofs: &DofMap) -> FillOrder {
+        match std::env::var(FILL_ORDER_ENV).as_deref() {
+            Ok("amd") => FillOrder::amd(),
+            Ok("nd") => FillOrder::dissection(nested_dissection(mesh, dofs)),
+            _ if dofs.n_free() < DISSECTION_MIN_DOFS => FillOrder::amd(),
+            _ => FillOrder {
+                compare: true,
+                ..FillOrder::dissection(nested_dissection(mesh, dofs))
+            },
+        }
+    }
+
+    /// "AMD" or "nested dissection" (what the factors use, once decided),
+    /// for messages.
+    pub fn name(&self) -> &'static str {
+        match (self.dissection.is_some(), self.compare, self.chosen.get()) {
+            (false, _, _) | (true, true, Some(false)) => "AMD",
+            (true, false, _) | (true, true, Some(true)) => "nested dissection",
+            (true, true, None) => "nested dissection, or AMD where its factor is clearly smaller",
+        }
+    }
+
+    /// The dissection's order, if it is a candidate.
+    pub fn dissection_order(&self) -> Option<&[usize]> {
+        self.dissection.as_deref().map(Vec::as_slice)
+    }
+
+    /// Whether AMD is still to be tried against the dissection: `None`
+    /// when not, else the outcome so far (`Some(None)`: not yet decided).
+    pub(crate) fn comparison(&self) -> Option<&OnceLock<bool>> {
+        (self.dissection.is_some() && self.compare).then_some(&*self.chosen)
     }
 }
 
@@ -196,7 +246,7 @@ pub fn nested_dissection(mesh: &Mesh, dofs: &DofMap) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::slab;
+    use crate::testing::{rectangle, slab};
     use crate::Dirichlet;
     use stickslip_mesh::CellKind;
 
@@ -324,12 +374,12 @@ mod tests {
             let band = grid.renumbered(&mesh, NodeOrder::Bandwidth).unwrap();
             let mut values = Vec::new();
             for dofs in [grid, band] {
-                let nd = FillOrder(Some(nested_dissection(&mesh, &dofs)));
+                let nd = FillOrder::dissection(nested_dissection(&mesh, &dofs));
                 let model = Model::with_dofs(&mesh, &material, dofs).unwrap();
                 let count = |order: &FillOrder| {
                     analyze_symbolic(&model.stiffness, order).unwrap().len_val() as f64
                 };
-                values.push((count(&nd), count(&FillOrder(None))));
+                values.push((count(&nd), count(&FillOrder::amd())));
             }
             let ((nd_grid, amd_grid), (nd_band, _)) = (values[0], values[1]);
             assert!(
@@ -344,18 +394,60 @@ mod tests {
     }
 
     #[test]
-    fn amd_on_small_meshes_dissection_on_large_ones() {
+    fn amd_on_small_meshes_the_smaller_factor_on_large_ones() {
+        use crate::{analyze_symbolic, Hypothesis, Material, Model};
         if std::env::var_os(FILL_ORDER_ENV).is_some() {
             return;
         }
         let (mesh, dofs) = slab_dofs(CellKind::Quad4, 4);
-        assert_eq!(FillOrder::choose(&mesh, &dofs), FillOrder(None));
-        // 28 × (16×4) cells: 100,912 free DOFs.
-        let (mesh, dofs) = slab_dofs(CellKind::Quad4, 28);
-        assert!(dofs.n_free() >= DISSECTION_MIN_DOFS);
-        assert_eq!(
-            FillOrder::choose(&mesh, &dofs),
-            FillOrder(Some(nested_dissection(&mesh, &dofs)))
-        );
+        let small = FillOrder::choose(&mesh, &dofs);
+        assert!(small.dissection_order().is_none());
+        assert_eq!(small.name(), "AMD");
+        // 28 × (16×4) cells: 100,912 free DOFs, the dissection a
+        // candidate, kept; and a strip of 5000 × 10 cells (110k DOFs),
+        // where AMD's factor is the smaller by more than the margin (1.23×,
+        // fill_order_shapes).
+        let (slab, slab_dofs) = slab_dofs(CellKind::Quad4, 28);
+        let strip = rectangle(CellKind::Quad4, 5000, 10, [0.0, 0.0], [5000.0, 10.0]);
+        let strip_dofs = DofMap::new(
+            &strip,
+            &[
+                Dirichlet::new("left", 0, 0.0),
+                Dirichlet::new("left", 1, 0.0),
+            ],
+        )
+        .unwrap();
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        for (mesh, dofs, amd_wins) in [(slab, slab_dofs, false), (strip, strip_dofs, true)] {
+            assert!(dofs.n_free() >= DISSECTION_MIN_DOFS);
+            let order = FillOrder::choose(&mesh, &dofs);
+            assert_eq!(
+                order.dissection_order(),
+                Some(&nested_dissection(&mesh, &dofs)[..])
+            );
+            assert!(order.name().contains("clearly"), "{}", order.name());
+            let model = Model::with_dofs(&mesh, &material, dofs).unwrap();
+            let k = &model.stiffness;
+            let values = |order: &FillOrder| analyze_symbolic(k, order).unwrap().len_val();
+            let (nd, amd) = (
+                values(&FillOrder::dissection(
+                    order.dissection_order().unwrap().to_vec(),
+                )),
+                values(&FillOrder::amd()),
+            );
+            let dissection_kept = nd as f64 <= AMD_MARGIN * amd as f64;
+            assert_eq!(!dissection_kept, amd_wins, "AMD {amd}, the dissection {nd}");
+            let kept = if dissection_kept { nd } else { amd };
+            // A clone shares the decision.
+            let copy = order.clone();
+            assert_eq!(values(&order), kept);
+            let want = if dissection_kept {
+                "nested dissection"
+            } else {
+                "AMD"
+            };
+            assert_eq!(copy.name(), want, "{nd} against AMD's {amd}");
+            assert_eq!(values(&copy), kept);
+        }
     }
 }

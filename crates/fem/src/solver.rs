@@ -101,9 +101,11 @@ fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
     csc_view(a, a.values())
 }
 
-/// The symbolic analysis of `a`'s pattern in `order` (AMD, or the model's
-/// nested dissection: `ordering.rs`), always supernodal so that
-/// [`Supernodal`] solves on its layout.
+/// The symbolic analysis of `a`'s pattern in `order` (AMD, the model's
+/// nested dissection, or the dissection unless AMD's factor is clearly
+/// smaller, decided here on the first call and kept in `order`:
+/// `ordering.rs`), always
+/// supernodal so that [`Supernodal`] solves on its layout.
 ///
 /// # Errors
 /// [`SolverError::Analysis`] if faer fails.
@@ -111,8 +113,36 @@ pub fn analyze_symbolic(
     a: &CsrMatrix<f64>,
     order: &FillOrder,
 ) -> Result<SymbolicCholesky<usize>, SolverError> {
+    let Some(forward) = order.dissection_order() else {
+        return symbolic_in(a, None);
+    };
+    match order.comparison().map(|c| c.get().copied()) {
+        // The dissection alone, or the comparison made already.
+        None | Some(Some(true)) => symbolic_in(a, Some(forward)),
+        Some(Some(false)) => symbolic_in(a, None),
+        // The first analysis of the run: both, AMD's kept only where its
+        // factor is clearly the smaller (`ordering.rs`, AMD_MARGIN).
+        Some(None) => {
+            let dissected = symbolic_in(a, Some(forward))?;
+            let amd = symbolic_in(a, None)?;
+            let dissection_won =
+                dissected.len_val() as f64 <= crate::ordering::AMD_MARGIN * amd.len_val() as f64;
+            if let Some(chosen) = order.comparison() {
+                let _ = chosen.set(dissection_won);
+            }
+            Ok(if dissection_won { dissected } else { amd })
+        }
+    }
+}
+
+/// The symbolic analysis in the elimination order `forward` (AMD's when
+/// `None`).
+fn symbolic_in(
+    a: &CsrMatrix<f64>,
+    forward: Option<&[usize]>,
+) -> Result<SymbolicCholesky<usize>, SolverError> {
     let inverse;
-    let ordering = match order.as_slice() {
+    let ordering = match forward {
         None => SymmetricOrdering::Amd,
         Some(forward) => {
             if forward.len() != a.nrows() {
