@@ -32,7 +32,10 @@
 //! 50.9-51.7 ms, slab Q1 708×177 (251k) 45.8-49.0 against 49.1-50.1 ms,
 //! Gmsh's `hole.geo` Q1 at 238k 44.0-45.8 against 49.7-50.3 ms and Q2 at
 //! 243k 51.3-51.8 against 57.5-59.9 ms, with setups of 2.7-3.0 against
-//! 3.7-4.4 s on those two. Below [`DISSECTION_MIN_DOFS`] AMD stays (the
+//! 3.7-4.4 s on those two (the dissection alone; with AMD's analysis
+//! beside it, below, the Q2 mesh's setup read 3.44-3.52 against 4.71-4.83
+//! s and its step 51.8-56.7 against 61.8-62.0 ms, two alternating runs on
+//! a busier host). Below [`DISSECTION_MIN_DOFS`] AMD stays (the
 //! slab Q2 16×4, 552 DOFs: 18.1k factor values against AMD's 16.0k; the
 //! paper's Q2 8×2, 148 DOFs: 3.3k against 3.5k).
 //!
