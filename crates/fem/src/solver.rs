@@ -6,9 +6,10 @@
 //! change of Δt or of the stick/slip classes only redoes the numeric part
 //! ([`SparseCholesky::factorize`]). Measured choice: DEPENDENCIES.md §3 (AMD +
 //! supernodal, about 80× faster than an unordered simplicial Cholesky; from
-//! 100k free DOFs the ordering is a nested dissection of the mesh's cells
-//! instead, [`crate::FillOrder`]). The factor is always supernodal and solved by [`Supernodal`]'s loops (2.7×
-//! faster than faer's one-column solve at 250k DOFs; `supernodal.rs`).
+//! 100k free DOFs a nested dissection of the mesh's cells unless AMD's
+//! factor is clearly smaller, [`crate::FillOrder`]). The factor is always
+//! supernodal and solved by [`Supernodal`]'s loops (2.7× faster than faer's
+//! one-column solve at 250k DOFs; `supernodal.rs`).
 
 use std::cell::RefCell;
 
@@ -104,8 +105,8 @@ fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
 /// The symbolic analysis of `a`'s pattern in `order` (AMD, the model's
 /// nested dissection, or the dissection unless AMD's factor is clearly
 /// smaller, decided here on the first call and kept in `order`:
-/// `ordering.rs`), always
-/// supernodal so that [`Supernodal`] solves on its layout.
+/// `ordering.rs`), always supernodal so that [`Supernodal`] solves on its
+/// layout.
 ///
 /// # Errors
 /// [`SolverError::Analysis`] if faer fails.
