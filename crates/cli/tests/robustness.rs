@@ -1638,12 +1638,26 @@ fn a_run_that_cannot_fit_on_its_disk_is_refused() {
 }
 
 /// Units mixed up (E a millionth of what the loads assume) move the part
-/// by more than its size: the run says so (it went without a word); the
-/// paper's case, whose slab moves 12% of its length, gets no warning.
+/// by more than its size: the run and `check` say so (it went without a
+/// word); the paper's case, whose slab moves 12% of its length, gets no
+/// warning.
 #[test]
 fn a_static_displacement_beyond_the_part_size_is_reported() {
     let dir = scratch("units");
     let (case, _) = slab_case(&dir, "slab", |t| t);
+    let checked = check(&case, &["material.E=1e-3"]);
+    let said = String::from_utf8_lossy(&checked.stdout).into_owned();
+    assert_eq!(checked.status.code(), Some(0), "{}", stderr(&checked));
+    assert!(
+        said.contains("warning     the initial static displacement reaches"),
+        "{said}"
+    );
+    let calm = check(&case, &[]);
+    assert!(
+        !String::from_utf8_lossy(&calm.stdout).contains("warning"),
+        "{}",
+        String::from_utf8_lossy(&calm.stdout)
+    );
     let loud = bin()
         .arg("run")
         .arg(&case)
