@@ -440,20 +440,20 @@ fn build(
     };
     let dofs = model.dofs.clone();
     if progress && dofs.n_free() >= SETUP_NOTE_DOFS {
+        let order = model.fill_order.name();
         let work = match (scheme, restoring) {
-            (_, true) => "the step's operators",
-            (Scheme::CentralDifference, false) => {
-                "the initial state (a static solve when loads act before t = 0) and the step's operators"
-            }
-            (Scheme::Newmark { .. }, false) => {
-                "the initial state and the factor of the step's operator"
-            }
+            (Scheme::CentralDifference, true) => "the step's operators".to_string(),
+            (Scheme::CentralDifference, false) => format!(
+                "the initial state (a static solve by sparse Cholesky, ordered by {order}, when loads act before t = 0) and the step's operators"
+            ),
+            (Scheme::Newmark { .. }, _) => format!(
+                "the factor of the step's operator (sparse Cholesky, ordered by {order}) and the initial state"
+            ),
         };
         say!(
-            "model: {} free DOFs, assembled in {:.1} s; now {work} (sparse Cholesky ordered by {})",
+            "model: {} free DOFs, assembled in {:.1} s; now {work}",
             dofs.n_free(),
             started.elapsed().as_secs_f64(),
-            model.fill_order.name()
         );
     }
     let (dynamics, model) = if keep_model {

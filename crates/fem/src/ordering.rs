@@ -129,7 +129,7 @@ impl FillOrder {
         match (self.dissection.is_some(), self.compare, self.chosen.get()) {
             (false, _, _) | (true, true, Some(false)) => "AMD",
             (true, false, _) | (true, true, Some(true)) => "nested dissection",
-            (true, true, None) => "nested dissection, or AMD where its factor is clearly smaller",
+            (true, true, None) => "nested dissection (or AMD, if its factor is clearly smaller)",
         }
     }
 
