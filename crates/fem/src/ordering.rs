@@ -138,8 +138,9 @@ impl FillOrder {
         self.dissection.as_deref().map(Vec::as_slice)
     }
 
-    /// Whether AMD is still to be tried against the dissection: `None`
-    /// when not, else the outcome so far (`Some(None)`: not yet decided).
+    /// Where the comparison with AMD is kept, if the dissection is to be
+    /// compared with AMD: empty until the first analysis, then true when
+    /// the dissection won.
     pub(crate) fn comparison(&self) -> Option<&OnceLock<bool>> {
         (self.dissection.is_some() && self.compare).then_some(&*self.chosen)
     }

@@ -117,20 +117,20 @@ pub fn analyze_symbolic(
     let Some(forward) = order.dissection_order() else {
         return symbolic_in(a, None);
     };
-    match order.comparison().map(|c| c.get().copied()) {
-        // The dissection alone, or the comparison made already.
-        None | Some(Some(true)) => symbolic_in(a, Some(forward)),
-        Some(Some(false)) => symbolic_in(a, None),
+    let Some(chosen) = order.comparison() else {
+        return symbolic_in(a, Some(forward));
+    };
+    match chosen.get() {
+        Some(true) => symbolic_in(a, Some(forward)),
+        Some(false) => symbolic_in(a, None),
         // The first analysis of the run: both, AMD's kept only where its
         // factor is clearly the smaller (`ordering.rs`, AMD_MARGIN).
-        Some(None) => {
+        None => {
             let dissected = symbolic_in(a, Some(forward))?;
             let amd = symbolic_in(a, None)?;
             let dissection_won =
                 dissected.len_val() as f64 <= crate::ordering::AMD_MARGIN * amd.len_val() as f64;
-            if let Some(chosen) = order.comparison() {
-                let _ = chosen.set(dissection_won);
-            }
+            let _ = chosen.set(dissection_won);
             Ok(if dissection_won { dissected } else { amd })
         }
     }
