@@ -29,6 +29,12 @@ fn stickslip(args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// [`stickslip`], which must succeed.
+fn stickslip_ok(args: &[&str]) {
+    let o = stickslip(args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 /// The paper's slab case run to `t_end` into a new scratch directory
 /// `name`: (the directory, the case, the results file).
 fn run_slab(name: &str, t_end: &str) -> (PathBuf, PathBuf, PathBuf) {
@@ -36,7 +42,7 @@ fn run_slab(name: &str, t_end: &str) -> (PathBuf, PathBuf, PathBuf) {
     let h5 = dir.join("slab.h5");
     let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
     let t_end = format!("time.t_end={t_end}");
-    let o = stickslip(&[
+    stickslip_ok(&[
         "run",
         case.to_str().unwrap(),
         "-o",
@@ -45,7 +51,6 @@ fn run_slab(name: &str, t_end: &str) -> (PathBuf, PathBuf, PathBuf) {
         "--set",
         &t_end,
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     (dir, case, h5)
 }
 
@@ -54,8 +59,7 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
     let (dir, case, h5) = run_slab("slab", "0.1");
     let out = h5.to_str().unwrap().to_string();
     let before = std::fs::read(&h5).unwrap();
-    let o = stickslip(&["stress", &out]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    stickslip_ok(&["stress", &out]);
     assert_eq!(
         std::fs::read(&h5).unwrap(),
         before,
@@ -105,8 +109,7 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
     assert_eq!(xml.matches("slab.stress.h5:/stress<").count(), 3 * rows);
     // Again: the same file, not a bigger one.
     let size = std::fs::metadata(dir.join("slab.stress.h5")).unwrap().len();
-    let o = stickslip(&["stress", &out, "--quiet"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    stickslip_ok(&["stress", &out, "--quiet"]);
     assert_eq!(
         std::fs::metadata(dir.join("slab.stress.h5")).unwrap().len(),
         size
@@ -114,7 +117,7 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
 
     // A restart ends the run elsewhere: the stresses are removed, and the
     // command writes them again.
-    let o = stickslip(&[
+    stickslip_ok(&[
         "run",
         case.to_str().unwrap(),
         "--restart",
@@ -123,7 +126,6 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
         "--set",
         "time.t_end=0.12",
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(!dir.join("slab.stress.h5").exists());
     assert!(!std::fs::read_to_string(dir.join("slab.xdmf"))
         .unwrap()
@@ -179,10 +181,9 @@ fn runs_keep_out_while_the_stresses_are_read() {
         assert!(h5.exists(), "{args:?}: the file is still there");
     }
     // probe reads alongside.
-    let o = stickslip(&["probe", &out, "--at", "8,0"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    stickslip_ok(&["probe", &out, "--at", "8,0"]);
     drop(lock);
-    let o = stickslip(&[
+    stickslip_ok(&[
         "run",
         case.to_str().unwrap(),
         "-o",
@@ -190,5 +191,4 @@ fn runs_keep_out_while_the_stresses_are_read() {
         "--force",
         "--quiet",
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
