@@ -38,14 +38,15 @@
 //! of ṙ_K and r̈_K of different rows overlap; the strain and kinetic sums
 //! go in four lanes by row, [`Lanes`]).
 //!
-//! On small systems (one chunk; at most 128 KB of padded slices, at least
+//! On small systems (one chunk; at most 1 MB of padded lines, at least
 //! half filled) K·r comes from [`Sliced`] instead (`sliced.rs`: slices of
-//! eight rows, a column of a slice one 64-byte line, no gathers of x pairs
-//! and no reduction across lanes): `sliced_lab`, the paper-sized Q2 8×2
-//! slab, one K·x 0.63 → 0.47 µs; the paper mesh's explicit step (bench
-//! step, ten alternating runs, 2026-11-24) 1.41 → 1.12 µs median, 1.27 →
-//! 1.06 µs fastest, which also counts the one-chunk sweep's dense R_K
-//! ([`batch_rows`]).
+//! four rows, a pair of columns of a slice one 64-byte line, no gathers
+//! of x pairs): `sliced_lab`, the paper-sized Q2 8×2 slab, one K·x 0.63
+//! → 0.47 µs in slices of eight rows (2026-11-24), 0.38 µs in the pairs
+//! (2026-11-26); the paper mesh's explicit step (bench step, ten
+//! alternating runs, 2026-11-24) 1.41 → 1.12 µs median, 1.27 → 1.06 µs
+//! fastest, which also counts the one-chunk sweep's dense R_K
+//! ([`batch_rows`]); 1.10 → 0.96 µs with the pairs (five alternating runs).
 //!
 //! K·r row by row from [`Compact`] (2×2 blocks with u32 columns, their
 //! values stored, 36 bytes per block, or indexed into a dictionary of the
