@@ -511,6 +511,9 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         ),
         None => println!("contact     none (no friction code runs)"),
     }
+    if let Some(w) = i.contact().and_then(|c| oblique_supports(&p.mesh, c)) {
+        println!("warning     {w}");
+    }
     // The explicit integrator computed it already (by its own K·x);
     // Newmark's did not.
     let crit = i.dt_crit().unwrap_or_else(|| {
@@ -674,6 +677,47 @@ fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
             100.0 * max / size
         )
     })
+}
+
+/// Degrees by which a fixed direction may leave a contact face's normal
+/// before `run` and `check` warn: the friction force such a support takes
+/// and the slip velocity it hides grow as the angle's sine, 1.7% at 1°.
+const OBLIQUE_DEGREES: f64 = 1.0;
+
+/// The contact nodes where a `[[dirichlet]]` condition fixes x or y more
+/// than [`OBLIQUE_DEGREES`] off the face's normal (a support along an axis
+/// on a curved or tilted face), or `None`. The law acts along the tangent
+/// τ (METHOD.md §2), but such a node moves along its free axis only: its
+/// slip velocity is τ's share of that motion and the support takes part
+/// of the friction force, which nothing else reports (nodes whose tangent
+/// is fixed outright carry no friction and are listed by `check`).
+fn oblique_supports(mesh: &Mesh, c: &ContactSurface) -> Option<String> {
+    let limit = OBLIQUE_DEGREES.to_radians().sin();
+    let mut count = 0;
+    let mut worst: Option<(f64, usize, usize)> = None;
+    for n in &c.nodes {
+        for axis in 0..2 {
+            let off = n.tangent[axis].abs();
+            if n.dofs[axis].is_none() && off > limit {
+                count += 1;
+                if worst.is_none_or(|w| off > w.0) {
+                    worst = Some((off, n.node, axis));
+                }
+            }
+        }
+    }
+    let (off, node, axis) = worst?;
+    let [x, y] = mesh.nodes[node];
+    let (fixed, free) = if axis == 0 { ("ux", "y") } else { ("uy", "x") };
+    Some(format!(
+        "{count} of the {} friction nodes of \"{}\" have {fixed} fixed by a [[dirichlet]] condition although the face is not normal \
+         to that axis there (up to {:.1}° off, at ({x}, {y})): friction acts along the face's tangent, but these nodes can move only along {free}, \
+         so the support takes part of the friction force and the slip is the tangent's share of their motion; \
+         support the contact face only where it is straight along x or y, or leave it free and let the [contact] pressure carry the normal load",
+        c.len(),
+        c.group,
+        off.asin().to_degrees()
+    ))
 }
 
 /// "12.3 µs"-style duration.
@@ -1076,6 +1120,12 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         w.append(&record(&integrator, &dofs, &mut full, 0.0, 0))?;
         if !quiet {
             if let Some(w) = large_static_displacement(&mesh, &full.u) {
+                say!("{}: warning: {w}", case.path.display());
+            }
+            if let Some(w) = integrator
+                .contact()
+                .and_then(|c| oblique_supports(&mesh, c))
+            {
                 say!("{}: warning: {w}", case.path.display());
             }
         }

@@ -1699,3 +1699,56 @@ fn check_says_what_a_newmark_step_resolves() {
     let o = check(&case, &[]);
     assert!(!String::from_utf8_lossy(&o.stdout).contains("accuracy    "));
 }
+
+/// A support along y on a curved contact face (the hole of
+/// cases/meshes/hole-q1.msh) holds most of its nodes off their tangent:
+/// `check` and `run` say so (it went without a word); the same support on
+/// the straight bottom face, along its normal, gets no warning.
+#[test]
+fn a_support_oblique_to_a_curved_contact_face_is_reported() {
+    let dir = scratch("oblique");
+    let held = |group: &'static str| {
+        move |t: String| {
+            t.replace("slab-q2-8x2.msh", "hole-q1.msh")
+                .replace(
+                    "[contact]",
+                    &format!("[[dirichlet]]\ngroup = \"{group}\"\nuy = 0.0\n\n[contact]"),
+                )
+                .replace(
+                    "group = \"contact\"\npressure",
+                    &format!("group = \"{group}\"\npressure"),
+                )
+        }
+    };
+    let (oblique, text) = slab_case(&dir, "oblique", held("hole"));
+    assert!(text.contains("group = \"hole\"\npressure"), "{text}");
+    let said = check(&oblique, &[]);
+    let out = String::from_utf8_lossy(&said.stdout).into_owned();
+    assert_eq!(said.status.code(), Some(0), "{}", stderr(&said));
+    assert!(
+        out.contains("warning     ") && out.contains("have uy fixed by a [[dirichlet]] condition"),
+        "{out}"
+    );
+    let o = bin()
+        .arg("run")
+        .arg(&oblique)
+        .arg("-o")
+        .arg(dir.join("a.h5"))
+        .args(["--set", "time.t_end=0.002"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("warning: ") && stderr(&o).contains("uy fixed"),
+        "{}",
+        stderr(&o)
+    );
+    let (normal, _) = slab_case(&dir, "normal", held("contact"));
+    let calm = check(&normal, &[]);
+    assert_eq!(calm.status.code(), Some(0), "{}", stderr(&calm));
+    assert!(
+        !String::from_utf8_lossy(&calm.stdout).contains("warning"),
+        "{}",
+        String::from_utf8_lossy(&calm.stdout)
+    );
+}
