@@ -96,6 +96,9 @@ pub struct Summary {
     /// How the steps formed their products with K
     /// (`Integrator::stiffness_product`).
     pub stiffness_product: String,
+    /// How the run's sparse Cholesky factors were ordered
+    /// (`Integrator::fill_order`).
+    pub fill_order: String,
 }
 
 /// Growing datasets, one row per output step.
@@ -1126,6 +1129,10 @@ impl ResultsWriter {
             solver.delete_attr("stiffness_product")?;
         }
         string_attr(&solver, "stiffness_product", &summary.stiffness_product)?;
+        if solver.attr("fill_order").is_ok() {
+            solver.delete_attr("fill_order")?;
+        }
+        string_attr(&solver, "fill_order", &summary.fill_order)?;
         if self.file.attr("failure").is_ok() {
             self.file.delete_attr("failure")?;
         }
@@ -1267,6 +1274,7 @@ pub(crate) mod tests {
                     dt_crit: Some(0.25),
                     failure: (!c).then(|| "iteration cap hit at step 3".to_string()),
                     stiffness_product: "stencil types".into(),
+                    fill_order: "nested dissection".into(),
                 },
             )
             .unwrap();
@@ -1452,6 +1460,15 @@ pub(crate) mod tests {
                 .unwrap()
                 .as_str(),
             "stencil types"
+        );
+        assert_eq!(
+            solver
+                .attr("fill_order")
+                .unwrap()
+                .read_scalar::<VarLenUnicode>()
+                .unwrap()
+                .as_str(),
+            "nested dissection"
         );
         assert_eq!(
             solver

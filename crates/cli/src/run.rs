@@ -1331,6 +1331,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         dt_crit: integrator.dt_crit(),
         failure: reason.clone(),
         stiffness_product: integrator.stiffness_product().into(),
+        fill_order: integrator.fill_order().into(),
     };
     let steps_run = integrator.steps() - steps_before;
     let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;
@@ -1393,6 +1394,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             "iterations": integrator.total_iterations(),
             "factorizations": integrator.factorizations(),
             "stiffness_product": summary.stiffness_product,
+            "fill_order": summary.fill_order,
             "dt": case.time.dt,
             "dt_crit": integrator.dt_crit(),
             "energy": {

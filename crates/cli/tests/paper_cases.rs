@@ -75,7 +75,7 @@ assert f["contact/s"].shape == (nc,)
 for name in ("kinetic", "strain", "external_work", "dissipated", "total", "balance"):
     assert f["energy/" + name].shape == (t,), name
 assert f["solver/dt"].shape == (t,) and f["solver/iterations"].shape == (t,)
-for a in ("wall_time_s", "steps", "factorizations", "stiffness_product"):
+for a in ("wall_time_s", "steps", "factorizations", "stiffness_product", "fill_order"):
     assert a in f["solver"].attrs, a
 assert f["time"][0] == 0.0 and abs(f["time"][-1] - 0.5) < 1e-12
 assert "contact" in f["mesh/groups"]

@@ -2065,6 +2065,14 @@ impl Integrator {
         }
     }
 
+    /// How the run's sparse Cholesky factors (the initial static solve,
+    /// A₀, M) are ordered: [`FillOrder::name`], "AMD" or "nested
+    /// dissection" once the run has analysed one, the undecided name while
+    /// it has not (a run that factorized nothing).
+    pub fn fill_order(&self) -> &'static str {
+        self.dynamics.fill_order.name()
+    }
+
     /// How the step forms its products with K (and M): "stencil types",
     /// "element classes", "compact blocks", "2x2 blocks" or "assembled
     /// CSR" (the first two within 1e-12 of the assembled K's products, not
