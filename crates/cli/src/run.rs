@@ -687,7 +687,7 @@ const OBLIQUE_DEGREES: f64 = 1.0;
 /// The contact nodes where a `[[dirichlet]]` condition fixes x or y more
 /// than [`OBLIQUE_DEGREES`] off the face's normal (a support along an axis
 /// on a curved or tilted face), or `None`. The law acts along the tangent
-/// τ (METHOD.md §2), but such a node moves along its free axis only: its
+/// τ (METHOD.md §1), but such a node moves along its free axis only: its
 /// slip velocity is τ's share of that motion and the support takes part
 /// of the friction force, which nothing else reports (nodes whose tangent
 /// is fixed outright carry no friction and are listed by `check`).
