@@ -97,8 +97,9 @@ pub struct Summary {
     /// (`Integrator::stiffness_product`).
     pub stiffness_product: String,
     /// How the run's sparse Cholesky factors were ordered
-    /// (`Integrator::fill_order`).
-    pub fill_order: String,
+    /// (`Integrator::fill_order`); `None` keeps what the file holds (a
+    /// restart that factorized nothing).
+    pub fill_order: Option<String>,
 }
 
 /// Growing datasets, one row per output step.
@@ -1129,10 +1130,12 @@ impl ResultsWriter {
             solver.delete_attr("stiffness_product")?;
         }
         string_attr(&solver, "stiffness_product", &summary.stiffness_product)?;
-        if solver.attr("fill_order").is_ok() {
-            solver.delete_attr("fill_order")?;
+        if let Some(order) = &summary.fill_order {
+            if solver.attr("fill_order").is_ok() {
+                solver.delete_attr("fill_order")?;
+            }
+            string_attr(&solver, "fill_order", order)?;
         }
-        string_attr(&solver, "fill_order", &summary.fill_order)?;
         if self.file.attr("failure").is_ok() {
             self.file.delete_attr("failure")?;
         }
@@ -1274,7 +1277,7 @@ pub(crate) mod tests {
                     dt_crit: Some(0.25),
                     failure: (!c).then(|| "iteration cap hit at step 3".to_string()),
                     stiffness_product: "stencil types".into(),
-                    fill_order: "nested dissection".into(),
+                    fill_order: Some("nested dissection".into()),
                 },
             )
             .unwrap();
@@ -1504,6 +1507,41 @@ pub(crate) mod tests {
         );
         drop(f);
         h5py_check(&path, 3, true);
+        std::fs::remove_file(&path).ok();
+    }
+
+    /// A restart that factorized nothing (`fill_order` None) keeps the
+    /// ordering the file holds; one that did writes its own.
+    #[test]
+    fn a_restart_keeps_the_stored_fill_order_unless_it_has_one() {
+        let _guard = h5_lock();
+        let path = scratch("fill-order");
+        write_file(&path, 3, Some(true));
+        let stored = || {
+            File::open(&path)
+                .unwrap()
+                .group("solver")
+                .unwrap()
+                .attr("fill_order")
+                .unwrap()
+                .read_scalar::<VarLenUnicode>()
+                .unwrap()
+                .as_str()
+                .to_string()
+        };
+        let finish_again = |fill_order: Option<&str>| {
+            let w = ResultsWriter::open_append(&path, 3, 6, 3).unwrap();
+            let summary = Summary {
+                steps: 40,
+                fill_order: fill_order.map(Into::into),
+                ..Summary::default()
+            };
+            w.finish(true, &summary).unwrap();
+        };
+        finish_again(None);
+        assert_eq!(stored(), "nested dissection");
+        finish_again(Some("AMD"));
+        assert_eq!(stored(), "AMD");
         std::fs::remove_file(&path).ok();
     }
 

@@ -1331,7 +1331,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         dt_crit: integrator.dt_crit(),
         failure: reason.clone(),
         stiffness_product: integrator.stiffness_product().into(),
-        fill_order: integrator.fill_order().into(),
+        fill_order: integrator.fill_order().map(Into::into),
     };
     let steps_run = integrator.steps() - steps_before;
     let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;

@@ -133,6 +133,14 @@ impl FillOrder {
         }
     }
 
+    /// [`FillOrder::name`] once the ordering is decided ("AMD" or "nested
+    /// dissection"); `None` while the comparison with AMD waits for the
+    /// first analysis.
+    pub fn decided_name(&self) -> Option<&'static str> {
+        let undecided = self.dissection.is_some() && self.compare && self.chosen.get().is_none();
+        (!undecided).then(|| self.name())
+    }
+
     /// The dissection's order, if it is a candidate.
     pub fn dissection_order(&self) -> Option<&[usize]> {
         self.dissection.as_deref().map(Vec::as_slice)
@@ -407,6 +415,7 @@ mod tests {
         let small = FillOrder::choose(&mesh, &dofs);
         assert!(small.dissection_order().is_none());
         assert_eq!(small.name(), "AMD");
+        assert_eq!(small.decided_name(), Some("AMD"));
         // 28 × (16×4) cells: 100,912 free DOFs, the dissection a
         // candidate, kept; and a strip of 5000 × 10 cells (110k DOFs),
         // where AMD's factor is the smaller by more than the margin (1.23×,
@@ -430,6 +439,7 @@ mod tests {
                 Some(&nested_dissection(&mesh, &dofs)[..])
             );
             assert!(order.name().contains("clearly"), "{}", order.name());
+            assert_eq!(order.decided_name(), None);
             let model = Model::with_dofs(&mesh, &material, dofs).unwrap();
             let k = &model.stiffness;
             let values = |order: &FillOrder| analyze_symbolic(k, order).unwrap().len_val();
@@ -451,6 +461,7 @@ mod tests {
                 "AMD"
             };
             assert_eq!(copy.name(), want, "{nd} against AMD's {amd}");
+            assert_eq!(copy.decided_name(), Some(want));
             assert_eq!(values(&copy), kept);
         }
     }

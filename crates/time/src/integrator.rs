@@ -2066,11 +2066,12 @@ impl Integrator {
     }
 
     /// How the run's sparse Cholesky factors (the initial static solve,
-    /// A₀, M) are ordered: [`FillOrder::name`], "AMD" or "nested
-    /// dissection" once the run has analysed one, the undecided name while
-    /// it has not (a run that factorized nothing).
-    pub fn fill_order(&self) -> &'static str {
-        self.dynamics.fill_order.name()
+    /// A₀, M) are ordered, "AMD" or "nested dissection"
+    /// ([`FillOrder::decided_name`]); `None` where the choice waits for a
+    /// factorization the run never made (an explicit restart from 100k
+    /// DOFs).
+    pub fn fill_order(&self) -> Option<&'static str> {
+        self.dynamics.fill_order.decided_name()
     }
 
     /// How the step forms its products with K (and M): "stencil types",
