@@ -423,6 +423,125 @@ mod tests {
         );
     }
 
+    /// A small deterministic generator (xorshift64).
+    struct Rng(u64);
+
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0
+        }
+
+        fn below(&mut self, n: usize) -> usize {
+            (self.next() % n as u64) as usize
+        }
+    }
+
+    /// Random sparse patterns, symmetric and not, n from 2 up, with empty
+    /// rows and lone columns: every structural entry of K lands in exactly
+    /// one lane (the lines rebuilt into K give K, and hold no more nonzero
+    /// lanes than K has entries), every row's place points back at it, and
+    /// the products are exact on small integers and the same bits by `row`,
+    /// the scalar path and AVX-512 on real values.
+    #[test]
+    fn random_patterns_cover_every_entry_once() {
+        use nalgebra_sparse::{CooMatrix, CsrMatrix};
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        for trial in 0..600 {
+            let n = 2 + trial % 41;
+            let symmetric = trial % 3 != 0;
+            let mut dense = vec![0.0f64; n * n];
+            // Some rows (and, if symmetric, their columns) left empty.
+            let empty: Vec<bool> = (0..n).map(|_| rng.below(6) == 0).collect();
+            let per_row = 1 + rng.below(6);
+            for i in 0..n {
+                if empty[i] {
+                    continue;
+                }
+                if rng.below(4) != 0 {
+                    dense[i * n + i] = 1.0 + rng.below(9) as f64;
+                }
+                for _ in 0..rng.below(per_row + 1) {
+                    let j = rng.below(n);
+                    if (symmetric && empty[j]) || dense[i * n + j] != 0.0 {
+                        continue;
+                    }
+                    let v = rng.below(17) as f64 - 8.0;
+                    let v = if v == 0.0 { 3.0 } else { v };
+                    dense[i * n + j] = v;
+                    if symmetric {
+                        dense[j * n + i] = v;
+                    }
+                }
+            }
+            let mut coo = CooMatrix::new(n, n);
+            for i in 0..n {
+                for j in 0..n {
+                    if dense[i * n + j] != 0.0 {
+                        coo.push(i, j, dense[i * n + j]);
+                    }
+                }
+            }
+            let k = CsrMatrix::from(&coo);
+            let s = Sliced::new(&k).expect("applies");
+            let mut rebuilt = vec![0.0f64; n * n];
+            let mut lanes_set = 0;
+            for (sl, rows) in s.rows.iter().enumerate() {
+                let e = s.starts[sl] as usize..s.starts[sl + 1] as usize;
+                assert!(e.len().is_multiple_of(SUMS), "trial {trial}");
+                for (line, &p) in s.lines[e.clone()].iter().zip(&s.cols[e]) {
+                    assert!((p as usize) + 1 < n, "trial {trial}");
+                    for (kk, &r) in rows.iter().enumerate().take(s.lanes[sl] as usize) {
+                        for h in 0..2 {
+                            let v = line.0[2 * kk + h];
+                            if v != 0.0 {
+                                lanes_set += 1;
+                                rebuilt[r as usize * n + p as usize + h] += v;
+                            }
+                        }
+                    }
+                }
+            }
+            assert_eq!(lanes_set, k.nnz(), "trial {trial}: lanes holding entries");
+            assert_eq!(rebuilt, dense, "trial {trial}: K rebuilt from the lines");
+            for i in 0..n {
+                let p = s.place[i] as usize;
+                assert_eq!(s.rows[p / ROWS][p % ROWS] as usize, i, "trial {trial}");
+                assert!(p % ROWS < s.lanes[p / ROWS] as usize, "trial {trial}");
+            }
+            let ints: Vec<f64> = (0..n).map(|_| rng.below(21) as f64 - 10.0).collect();
+            for (x, exact) in [(ints, true), (x_of(n), false)] {
+                let mut y = vec![f64::NAN; n];
+                s.spmv_scalar(&x, &mut y);
+                for i in 0..n {
+                    if exact {
+                        let want: f64 = (0..n).map(|j| dense[i * n + j] * x[j]).sum();
+                        assert_eq!(y[i], want, "trial {trial} row {i}");
+                    }
+                    assert_eq!(
+                        s.row(i, &x).to_bits(),
+                        y[i].to_bits(),
+                        "trial {trial} row {i}"
+                    );
+                }
+                #[cfg(target_arch = "x86_64")]
+                if crate::kernels::avx512() {
+                    let mut z = vec![f64::NAN; n];
+                    // SAFETY: checked above.
+                    #[allow(unsafe_code)]
+                    unsafe {
+                        s.spmv_avx512(&x, &mut z)
+                    };
+                    for i in 0..n {
+                        assert_eq!(z[i].to_bits(), y[i].to_bits(), "trial {trial} row {i}");
+                    }
+                }
+            }
+        }
+    }
+
     /// Timing lab (run by hand): one K x by [`Sliced`] against
     /// [`crate::kernels::Compact`], same run.
     ///
