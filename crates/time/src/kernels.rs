@@ -1777,8 +1777,8 @@ impl RowProduct for Compact {
 }
 
 /// K as the explicit step reads it: the compact form of the assembled K,
-/// its slices of eight rows on small systems ([`Sliced`]), by stencil
-/// types on structured numberings ([`Stencils`]),
+/// its slices of four rows by column pairs on systems of one chunk
+/// ([`Sliced`]), by stencil types on structured numberings ([`Stencils`]),
 /// or matrix-free by element classes when the mesh has them
 /// ([`Classes`]: measured faster on the structured Q2 slabs; the module
 /// documentation gives the figures).
