@@ -720,6 +720,19 @@ fn oblique_supports(mesh: &Mesh, c: &ContactSurface) -> Option<String> {
     ))
 }
 
+/// The `/solver` attribute `fill_order` a run writes: the decided ordering
+/// of its sparse Cholesky factors; where the choice is still open because
+/// the run factorized nothing (explicit, no preload, from 100k free DOFs),
+/// `None` on a restart (the file keeps what the first run wrote) and
+/// "none" on a fresh run, so that every results file has the attribute.
+fn fill_order_attr(decided: Option<&str>, restart: bool) -> Option<String> {
+    match decided {
+        Some(name) => Some(name.to_string()),
+        None if restart => None,
+        None => Some("none".to_string()),
+    }
+}
+
 /// "12.3 µs"-style duration.
 fn human_seconds(s: f64) -> String {
     if s >= 1.0 {
@@ -1331,7 +1344,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         dt_crit: integrator.dt_crit(),
         failure: reason.clone(),
         stiffness_product: integrator.stiffness_product().into(),
-        fill_order: integrator.fill_order().map(Into::into),
+        fill_order: fill_order_attr(integrator.fill_order(), options.restart),
     };
     let steps_run = integrator.steps() - steps_before;
     let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;
@@ -1441,5 +1454,25 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             );
             Ok(Outcome::Failed)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fresh explicit run from 100k free DOFs without a preload
+    /// factorizes nothing, so its ordering stays undecided: it wrote no
+    /// `fill_order` at all and `--json` gave null (docs/results.md promised
+    /// the attribute). Now it writes "none"; a restart keeps the stored one.
+    #[test]
+    fn an_undecided_fill_order_is_none_on_a_fresh_run_and_kept_on_a_restart() {
+        assert_eq!(fill_order_attr(Some("AMD"), false).as_deref(), Some("AMD"));
+        assert_eq!(
+            fill_order_attr(Some("nested dissection"), true).as_deref(),
+            Some("nested dissection")
+        );
+        assert_eq!(fill_order_attr(None, false).as_deref(), Some("none"));
+        assert_eq!(fill_order_attr(None, true), None);
     }
 }

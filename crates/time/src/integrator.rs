@@ -2068,8 +2068,8 @@ impl Integrator {
     /// How the run's sparse Cholesky factors (the initial static solve,
     /// A₀, M) are ordered, "AMD" or "nested dissection"
     /// ([`FillOrder::decided_name`]); `None` where the choice waits for a
-    /// factorization the run never made (an explicit restart from 100k
-    /// DOFs).
+    /// factorization the run never made (an explicit run from 100k DOFs
+    /// without a preload, or any explicit restart from 100k DOFs).
     pub fn fill_order(&self) -> Option<&'static str> {
         self.dynamics.fill_order.decided_name()
     }
