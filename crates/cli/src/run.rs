@@ -693,22 +693,28 @@ const OBLIQUE_DEGREES: f64 = 1.0;
 /// is fixed outright carry no friction and are listed by `check`).
 fn oblique_supports(mesh: &Mesh, c: &ContactSurface) -> Option<String> {
     let limit = OBLIQUE_DEGREES.to_radians().sin();
-    let mut count = 0;
+    // Per axis: a node is a friction node only with one axis free.
+    let mut count = [0usize; 2];
     let mut worst: Option<(f64, usize, usize)> = None;
     for n in &c.nodes {
         for axis in 0..2 {
             let off = n.tangent[axis].abs();
             if n.dofs[axis].is_none() && off > limit {
-                count += 1;
+                count[axis] += 1;
                 if worst.is_none_or(|w| off > w.0) {
                     worst = Some((off, n.node, axis));
                 }
             }
         }
     }
-    let (off, node, axis) = worst?;
+    let (off, node, _) = worst?;
     let [x, y] = mesh.nodes[node];
-    let (fixed, free) = if axis == 0 { ("ux", "y") } else { ("uy", "x") };
+    let (fixed, free) = match count {
+        [_, 0] => ("ux", "y"),
+        [0, _] => ("uy", "x"),
+        _ => ("ux or uy", "the other axis"),
+    };
+    let count = count[0] + count[1];
     Some(format!(
         "{count} of the {} friction nodes of \"{}\" have {fixed} fixed by a [[dirichlet]] condition although the face is not normal \
          to that axis there (up to {:.1}° off, at ({x}, {y})): friction acts along the face's tangent, but these nodes can move only along {free}, \
@@ -1474,5 +1480,47 @@ mod tests {
         );
         assert_eq!(fill_order_attr(None, false).as_deref(), Some("none"));
         assert_eq!(fill_order_attr(None, true), None);
+    }
+
+    /// Nodes of one contact face held along different axes: the warning
+    /// named only the worst node's axis ("3 of the 3 ... have uy fixed"
+    /// where one had ux fixed); it now names both.
+    #[test]
+    fn oblique_supports_name_every_fixed_axis() {
+        use stickslip_contact::ContactNode;
+        let mesh = stickslip_fem::testing::rectangle(
+            stickslip_mesh::CellKind::Quad4,
+            2,
+            1,
+            [0.0, 0.0],
+            [2.0, 1.0],
+        );
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        let node = |node, dofs, tangent| ContactNode {
+            node,
+            dofs,
+            weight: 1.0,
+            tangent,
+            s: 0.0,
+            bound: 1.0,
+        };
+        let held = |dofs: Vec<[Option<usize>; 2]>| {
+            let nodes = dofs
+                .into_iter()
+                .enumerate()
+                .map(|(i, d)| node(i, d, [s, s]))
+                .collect();
+            let c = ContactSurface::from_nodes("arc", nodes, 1.0).unwrap();
+            oblique_supports(&mesh, &c).expect("a warning")
+        };
+        let uy = held(vec![[Some(0), None], [Some(1), None], [Some(2), None]]);
+        assert!(
+            uy.starts_with("3 of the 3") && uy.contains("have uy fixed"),
+            "{uy}"
+        );
+        assert!(uy.contains("only along x"), "{uy}");
+        let mixed = held(vec![[Some(0), None], [None, Some(1)], [Some(2), None]]);
+        assert!(mixed.contains("have ux or uy fixed"), "{mixed}");
+        assert!(mixed.contains("only along the other axis"), "{mixed}");
     }
 }
