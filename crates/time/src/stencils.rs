@@ -60,8 +60,16 @@ const COARSE: f64 = (1u64 << 24) as f64;
 /// 1.00-1.07, Q2 249k 1.11-1.15). With four blocks in lockstep
 /// ([`avx::run_512`], both paths), 2026-11-25: Q1 1M 0.89-0.95, Q2 1M
 /// 0.81-0.89 (three runs); Q1 502k 0.90-0.99, Q2 501k 0.83-0.89; Q1 252k
-/// 0.94-1.00, Q2 249k 1.00-1.01 (two runs): the threshold stays.
-const FUSED_MIN_ROWS: usize = 400_000;
+/// 0.94-1.00, Q2 249k 1.00-1.01 (two runs): the threshold stayed. The
+/// whole step (`bench_step --case cd MESH STEPS 5`, the two thresholds
+/// alternating four times, 2026-11-26 04:10, medians, batches → own
+/// kernel) says otherwise at every size of several chunks: Q1 708×177
+/// (252k rows) 633 → 331 µs, Q2 352×88 (249k) 744 → 485, Q1 352×88 (62k)
+/// 153 → 113, Q2 176×44 (62k) 176 → 126, Q1 128×32 (8,352) 38.8 → 27.7,
+/// Q2 64×16 (8,352) 49.5 → 40.8 µs; on a host busy with a build the same
+/// (0.60-0.75). So every system of more than one chunk takes it (one
+/// chunk forms K r_K whole first, for the friction).
+const FUSED_MIN_ROWS: usize = 0;
 
 /// Groups of one type summed in lockstep ([`Stencils::lockstep`]).
 const LOCKSTEP: usize = 4;
@@ -1282,7 +1290,7 @@ mod tests {
             let k = &model.stiffness;
             let n = k.nrows();
             assert!(n > CHUNK, "{name}: several chunks");
-            // Forced at these sizes (below FUSED_MIN_ROWS).
+            // Forced (whatever FUSED_MIN_ROWS says).
             let fused = Stencils {
                 fused_min_rows: 0,
                 ..Stencils::new(k).unwrap()
