@@ -326,6 +326,21 @@ mod tests {
     use super::*;
     use crate::kernels::tests::{lab_slab, median_time, x_of};
 
+    /// K x by the AVX-512 kernel, where the CPU has it.
+    fn avx512_product(s: &Sliced, x: &[f64]) -> Option<Vec<f64>> {
+        #[cfg(target_arch = "x86_64")]
+        if crate::kernels::avx512() {
+            let mut z = vec![f64::NAN; s.n];
+            // SAFETY: the CPU has AVX-512F (checked).
+            #[allow(unsafe_code)]
+            unsafe {
+                s.spmv_avx512(x, &mut z)
+            };
+            return Some(z);
+        }
+        None
+    }
+
     /// Each row of the product is the row of K times x to rounding, the
     /// scalar and AVX-512 paths give the same bits, and `row` gives the
     /// bits of `spmv` on every row.
@@ -360,14 +375,7 @@ mod tests {
                     .all(|w| ((w[1] - w[0]) as usize).is_multiple_of(SUMS)),
                 "{name}: a slice's lines a multiple of the sums"
             );
-            #[cfg(target_arch = "x86_64")]
-            if crate::kernels::avx512() {
-                let mut z = vec![f64::NAN; n];
-                // SAFETY: checked above.
-                #[allow(unsafe_code)]
-                unsafe {
-                    s.spmv_avx512(&x, &mut z)
-                };
+            if let Some(z) = avx512_product(&s, &x) {
                 assert!(
                     y.iter().zip(&z).all(|(p, q)| p.to_bits() == q.to_bits()),
                     "{name}"
@@ -407,14 +415,7 @@ mod tests {
         for (i, w) in want.iter().enumerate() {
             assert_eq!(s.row(i, &x), *w);
         }
-        #[cfg(target_arch = "x86_64")]
-        if crate::kernels::avx512() {
-            let mut z = [f64::NAN; 4];
-            // SAFETY: checked above.
-            #[allow(unsafe_code)]
-            unsafe {
-                s.spmv_avx512(&x, &mut z)
-            };
+        if let Some(z) = avx512_product(&s, &x) {
             assert_eq!(z, want);
         }
         assert!(
@@ -526,14 +527,7 @@ mod tests {
                         "trial {trial} row {i}"
                     );
                 }
-                #[cfg(target_arch = "x86_64")]
-                if crate::kernels::avx512() {
-                    let mut z = vec![f64::NAN; n];
-                    // SAFETY: checked above.
-                    #[allow(unsafe_code)]
-                    unsafe {
-                        s.spmv_avx512(&x, &mut z)
-                    };
+                if let Some(z) = avx512_product(&s, &x) {
                     for i in 0..n {
                         assert_eq!(z[i].to_bits(), y[i].to_bits(), "trial {trial} row {i}");
                     }
