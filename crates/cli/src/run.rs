@@ -511,9 +511,6 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         ),
         None => println!("contact     none (no friction code runs)"),
     }
-    if let Some(w) = i.contact().and_then(|c| oblique_supports(&p.mesh, c)) {
-        println!("warning     {w}");
-    }
     // The explicit integrator computed it already (by its own K·x);
     // Newmark's did not.
     let crit = i.dt_crit().unwrap_or_else(|| {
@@ -596,7 +593,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     // Remark 4.1 ran in its setup): the run's warning, before the run.
     let mut u = vec![0.0; 2 * p.mesh.nodes.len()];
     p.model.dofs.expand(i.displacement(), &mut u);
-    if let Some(w) = large_static_displacement(&p.mesh, &u) {
+    for w in setup_warnings(&p.mesh, &u, i) {
         println!("warning     {w}");
     }
     Ok(())
@@ -677,6 +674,16 @@ fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
             100.0 * max / size
         )
     })
+}
+
+/// What runs but is likely not meant, in the words `check` prints and a
+/// fresh run says before its first step (one list, so the two cannot
+/// drift apart): `u` is the initial displacement at every node.
+fn setup_warnings(mesh: &Mesh, u: &[f64], integrator: &Integrator) -> Vec<String> {
+    large_static_displacement(mesh, u)
+        .into_iter()
+        .chain(integrator.contact().and_then(|c| oblique_supports(mesh, c)))
+        .collect()
 }
 
 /// Degrees by which a fixed direction may leave a contact face's normal
@@ -1138,13 +1145,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             .with_context(|| format!("cannot create the results file {}", out.display()))?;
         w.append(&record(&integrator, &dofs, &mut full, 0.0, 0))?;
         if !quiet {
-            if let Some(w) = large_static_displacement(&mesh, &full.u) {
-                say!("{}: warning: {w}", case.path.display());
-            }
-            if let Some(w) = integrator
-                .contact()
-                .and_then(|c| oblique_supports(&mesh, c))
-            {
+            for w in setup_warnings(&mesh, &full.u, &integrator) {
                 say!("{}: warning: {w}", case.path.display());
             }
         }
