@@ -10,6 +10,7 @@ use std::process::{Command, ExitCode};
 mod bench_fem;
 mod bench_mesh;
 mod bench_output;
+mod bench_run;
 mod bench_step;
 mod meshes;
 mod python;
@@ -42,6 +43,8 @@ usage: cargo xtask <command> [args]
                     the STREAM bandwidth and one forward+back solve
   bench fem         assembly and Cholesky on the Q2 slab ladder against
                     scikit-fem and scipy's splu (--refine 8,16,32,64 --no-peer)
+  bench run         whole `stickslip run` processes on the slab ladder, both
+                    schemes [--rounds N] [--max-dofs N] [--against EXE]
   bench output      wall time of whole runs (paper slab, a 4k-node slab) with
                     their results written uncompressed, deflated, or not at all
 ";
@@ -74,8 +77,9 @@ fn main() -> ExitCode {
             Some((what, more)) if what == "fem" => bench_fem::run(&root, more),
             Some((what, more)) if what == "step" => bench_step::run(&root, more),
             Some((what, more)) if what == "output" => bench_output::run(&root, more),
+            Some((what, more)) if what == "run" => bench_run::run(&root, more),
             _ => Err(format!(
-                "cargo xtask bench: say what to benchmark (mesh, fem, step, output)\n{USAGE}"
+                "cargo xtask bench: say what to benchmark (mesh, fem, step, output, run)\n{USAGE}"
             )),
         },
         "help" | "--help" | "-h" => {

@@ -1,0 +1,348 @@
+//! `cargo xtask bench run`: whole `stickslip run` processes on the slab
+//! ladder, as a user pays for them: start-up, mesh, setup, steps, output.
+//!
+//! The first rung is the paper's two cases as shipped (mesh, Δt, t_end,
+//! every step written). Each other rung is a mesh of the paper's slab (the committed ones, and larger
+//! ones Gmsh writes into target/bench/run/ from cases/slab.geo), run with
+//! the paper's scene (cases/martins-oden/cd-step-eps1e-4.toml and
+//! newmark-step.toml): central difference for 1,000 steps at 0.9 of the
+//! rung's critical step (from `stickslip check --json`), Newmark for 100
+//! steps (20 from 200k DOFs, none from 1M) at 5x that step; the full fields
+//! written at 11 records of the run (output.every), as a user of a long run
+//! sets it. Each results file is removed after its run.
+//!
+//! With `--against EXE`, every run is also made with that binary (for
+//! instance a build of an earlier commit), interleaved round by round, and
+//! the table gives the ratio of the medians: a change measured run against
+//! run on one machine at one time. `--against-env K=V` (repeatable) makes
+//! the second runs with that environment (with this binary unless
+//! `--against` names another).
+//!
+//!     cargo xtask bench run [--rounds N] [--max-dofs N] [--rungs NAME,...]
+//!         [--against EXE] [--against-env K=V]... [--only cd|newmark]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// (name, mesh file relative to the root or a Gmsh rung, DOFs roughly).
+struct Rung {
+    name: &'static str,
+    /// `None`: a committed mesh; `Some((order, nx, ny, structured))`: Gmsh.
+    gmsh: Option<(u32, u32, u32, bool)>,
+    committed: &'static str,
+    dofs: u64,
+    /// The paper's cases as they are shipped (their Δt, t_end and output).
+    paper: bool,
+}
+
+const RUNGS: [Rung; 8] = [
+    Rung {
+        name: "paper q2-8x2",
+        gmsh: None,
+        committed: "cases/meshes/slab-q2-8x2.msh",
+        dofs: 148,
+        paper: true,
+    },
+    Rung {
+        name: "q2-64x16",
+        gmsh: None,
+        committed: "cases/meshes/slab-q2-64x16.msh",
+        dofs: 8_352,
+        paper: false,
+    },
+    Rung {
+        name: "q1-128x32",
+        gmsh: None,
+        committed: "cases/meshes/slab-q1-128x32.msh",
+        dofs: 8_352,
+        paper: false,
+    },
+    Rung {
+        name: "q1-352x88",
+        gmsh: Some((1, 352, 88, true)),
+        committed: "",
+        dofs: 62_392,
+        paper: false,
+    },
+    Rung {
+        name: "q2-352x88",
+        gmsh: Some((2, 352, 88, true)),
+        committed: "",
+        dofs: 248_688,
+        paper: false,
+    },
+    Rung {
+        name: "q1-708x177",
+        gmsh: Some((1, 708, 177, true)),
+        committed: "",
+        dofs: 251_517,
+        paper: false,
+    },
+    Rung {
+        name: "q1-unstructured-500k",
+        gmsh: Some((1, 1315, 329, false)),
+        committed: "",
+        dofs: 500_000,
+        paper: false,
+    },
+    Rung {
+        name: "q1-1416x354",
+        gmsh: Some((1, 1416, 354, true)),
+        committed: "",
+        dofs: 1_004_298,
+        paper: false,
+    },
+];
+
+/// Runs the ladder and prints the table.
+///
+/// # Errors
+/// Bad arguments, a failing build, mesh or run.
+pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
+    let mut rounds = 3usize;
+    let mut max_dofs = u64::MAX;
+    let mut against: Option<PathBuf> = None;
+    let mut only: Option<String> = None;
+    let mut rungs: Option<Vec<String>> = None;
+    let mut against_env: Vec<(String, String)> = Vec::new();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--rounds" => rounds = crate::integer_arg::<usize>(a, "a number", &mut it)?.max(1),
+            "--max-dofs" => max_dofs = crate::integer_arg(a, "a number of DOFs", &mut it)?,
+            "--against" => {
+                let p = it.next().ok_or("--against needs a stickslip binary")?;
+                against = Some(std::fs::canonicalize(p).map_err(|e| format!("{p}: {e}"))?);
+            }
+            "--against-env" => {
+                let kv = it.next().ok_or("--against-env needs KEY=VALUE")?;
+                let (k, v) = kv
+                    .split_once('=')
+                    .ok_or_else(|| format!("--against-env {kv}: expected KEY=VALUE"))?;
+                against_env.push((k.to_string(), v.to_string()));
+            }
+            "--rungs" => {
+                let list = it.next().ok_or("--rungs needs names, comma-separated")?;
+                rungs = Some(list.split(',').map(str::to_string).collect());
+            }
+            "--only" => only = Some(it.next().ok_or("--only needs cd or newmark")?.clone()),
+            "-h" | "--help" => {
+                println!("cargo xtask bench run [--rounds N] [--max-dofs N] [--rungs NAME,...] [--against EXE] [--against-env K=V]... [--only cd|newmark]");
+                return Ok(());
+            }
+            other => {
+                return Err(format!(
+                    "cargo xtask bench run: unknown argument {other:?}; try --help"
+                ))
+            }
+        }
+    }
+    crate::setup(false)?;
+    crate::run(crate::cargo().current_dir(root).args([
+        "build",
+        "--release",
+        "-q",
+        "-p",
+        "stickslip",
+    ]))?;
+    let exe = root.join("target/release/stickslip");
+    let dir = root.join("target/bench/run");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut exes = vec![exe.clone()];
+    if against.is_some() || !against_env.is_empty() {
+        exes.push(against.clone().unwrap_or_else(|| exe.clone()));
+    }
+    let compared = exes.len() == 2;
+
+    // The runs: (label, case, sets).
+    let mut runs: Vec<(String, &'static str, Vec<String>)> = Vec::new();
+    let chosen = |r: &Rung| rungs.as_ref().is_none_or(|n| n.iter().any(|n| n == r.name));
+    for rung in RUNGS.iter().filter(|r| r.dofs <= max_dofs && chosen(r)) {
+        let mesh = match rung.gmsh {
+            None => root.join(rung.committed),
+            Some(g) => gmsh_mesh(root, &dir, rung.name, g)?,
+        };
+        let dt_crit = dt_crit(&exe, root, &mesh)?;
+        let cd_dt = 0.9 * dt_crit;
+        let mesh_set = format!("mesh.file={}", mesh.display());
+        if only.as_deref() != Some("newmark") {
+            let steps = 1000.0;
+            runs.push((
+                format!("{} cd", rung.name),
+                "cases/martins-oden/cd-step-eps1e-4.toml",
+                if rung.paper {
+                    Vec::new()
+                } else {
+                    vec![
+                        mesh_set.clone(),
+                        format!("time.dt={cd_dt:e}"),
+                        format!("time.t_end={:e}", steps * cd_dt),
+                        "output.every=100".into(),
+                    ]
+                },
+            ));
+        }
+        let nm_steps = match rung.dofs {
+            d if d >= 1_000_000 => 0.0,
+            d if d >= 200_000 => 20.0,
+            _ => 100.0,
+        };
+        if nm_steps > 0.0 && only.as_deref() != Some("cd") {
+            let dt = 5.0 * cd_dt;
+            runs.push((
+                format!("{} newmark", rung.name),
+                "cases/martins-oden/newmark-step.toml",
+                if rung.paper {
+                    Vec::new()
+                } else {
+                    vec![
+                        mesh_set,
+                        format!("time.dt={dt:e}"),
+                        format!("time.t_end={:e}", nm_steps * dt),
+                        format!("output.every={}", (nm_steps as u64 / 10).max(1)),
+                    ]
+                },
+            ));
+        }
+    }
+    // times[run][exe]
+    let mut times = vec![vec![Vec::new(); exes.len()]; runs.len()];
+    for round in 0..rounds {
+        eprintln!("bench run: round {} of {rounds}", round + 1);
+        for (r, (label, case, sets)) in runs.iter().enumerate() {
+            for (e, exe) in exes.iter().enumerate() {
+                let out = dir.join(format!("r{r}-e{e}.h5"));
+                let mut cmd = Command::new(exe);
+                if e == 1 {
+                    cmd.envs(against_env.iter().map(|(k, v)| (k, v)));
+                }
+                cmd.current_dir(root)
+                    .args(["run", "--quiet", "--force", "-o"])
+                    .arg(&out)
+                    .arg(case);
+                for kv in sets {
+                    cmd.args(["--set", kv]);
+                }
+                let t = Instant::now();
+                let o = cmd
+                    .output()
+                    .map_err(|e| format!("cannot start {}: {e}", exe.display()))?;
+                let secs = t.elapsed().as_secs_f64();
+                if !o.status.success() {
+                    return Err(format!(
+                        "{label} ({}) failed: {}",
+                        exe.display(),
+                        String::from_utf8_lossy(&o.stderr)
+                    ));
+                }
+                times[r][e].push(secs);
+                for ext in ["h5", "xdmf"] {
+                    let _ = std::fs::remove_file(out.with_extension(ext));
+                }
+            }
+        }
+    }
+    let median = |t: &mut Vec<f64>| {
+        t.sort_by(f64::total_cmp);
+        t[t.len() / 2]
+    };
+    let mut csv = String::from("run,median_s,fastest_s,rounds");
+    if compared {
+        csv.push_str(",against_median_s,ratio");
+    }
+    csv.push('\n');
+    println!("\nwall time of whole `stickslip run` processes (release), medians of {rounds} interleaved rounds:\n");
+    print!("{:<32} {:>10} {:>10}", "run", "median s", "fastest");
+    if compared {
+        print!(" {:>12} {:>8}", "against s", "ratio");
+        println!(
+            "\n(against: {} {})",
+            exes[1].display(),
+            against_env
+                .iter()
+                .map(|(k, v)| format!("{k}={v}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+    } else {
+        println!();
+    }
+    for (r, (label, _, _)) in runs.iter().enumerate() {
+        let m = median(&mut times[r][0]);
+        let fastest = times[r][0][0];
+        print!("{label:<32} {m:>10.4} {fastest:>10.4}");
+        csv.push_str(&format!("{label},{m:.5},{fastest:.5},{rounds}"));
+        if compared {
+            let ma = median(&mut times[r][1]);
+            print!(" {ma:>12.4} {:>8.3}", m / ma);
+            csv.push_str(&format!(",{ma:.5},{:.4}", m / ma));
+        }
+        println!();
+        csv.push('\n');
+    }
+    let path = root.join("target/bench/run.csv");
+    std::fs::write(&path, csv).map_err(|e| format!("{}: {e}", path.display()))?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
+/// The rung's mesh, written by Gmsh from cases/slab.geo unless it is there.
+fn gmsh_mesh(
+    root: &Path,
+    dir: &Path,
+    name: &str,
+    (order, nx, ny, structured): (u32, u32, u32, bool),
+) -> Result<PathBuf, String> {
+    let out = dir.join(format!("{name}.msh"));
+    if out.is_file() {
+        return Ok(out);
+    }
+    crate::python::ensure_python_modules(&[("gmsh", "gmsh")])?;
+    eprintln!("bench run: meshing {name} with Gmsh");
+    let script = format!(
+        "import gmsh, sys\n\
+         gmsh.initialize(['', '-setnumber', 'nx', '{nx}', '-setnumber', 'ny', '{ny}', '-setnumber', 'structured', '{s}'])\n\
+         gmsh.option.setNumber('General.Terminal', 0)\n\
+         gmsh.open(sys.argv[1])\n\
+         gmsh.model.mesh.generate(2)\n\
+         gmsh.model.mesh.setOrder({order})\n\
+         gmsh.option.setNumber('Mesh.Binary', 1)\n\
+         gmsh.write(sys.argv[2])\n\
+         gmsh.finalize()\n",
+        s = u8::from(structured)
+    );
+    let status = Command::new(crate::python::python())
+        .args(["-c", &script])
+        .arg(root.join("cases/slab.geo"))
+        .arg(&out)
+        .status()
+        .map_err(|e| format!("cannot start python: {e}"))?;
+    if !status.success() {
+        return Err(format!("Gmsh failed on {name} ({status})"));
+    }
+    Ok(out)
+}
+
+/// The central-difference critical step of the paper's scene on `mesh`,
+/// as `stickslip check` prints it ("dt_crit     1.234567e-3 (...").
+fn dt_crit(exe: &Path, root: &Path, mesh: &Path) -> Result<f64, String> {
+    let o = Command::new(exe)
+        .current_dir(root)
+        .args(["check", "cases/martins-oden/cd-step-eps1e-4.toml"])
+        .args(["--set", &format!("mesh.file={}", mesh.display())])
+        .args(["--set", "time.allow_unstable=true"])
+        .output()
+        .map_err(|e| format!("cannot start {}: {e}", exe.display()))?;
+    let text = String::from_utf8_lossy(&o.stdout);
+    text.lines()
+        .find_map(|l| l.strip_prefix("dt_crit"))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .ok_or_else(|| {
+            format!(
+                "stickslip check printed no dt_crit:\n{text}{}",
+                String::from_utf8_lossy(&o.stderr)
+            )
+        })
+}
