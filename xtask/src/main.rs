@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
+mod bench_advise;
 mod bench_fem;
 mod bench_mesh;
 mod bench_output;
@@ -44,6 +45,8 @@ usage: cargo xtask <command> [args]
                     scikit-fem and scipy's splu (--refine 8,16,32,64 --no-peer)
   bench output      wall time of whole runs (paper slab, a 4k-node slab) with
                     their results written uncompressed, deflated, or not at all
+  bench advise      wall time of advise's pick against the cheapest configuration of
+                    the chart meeting the same tolerance [--rounds N] [--tol T]...
 ";
 
 fn main() -> ExitCode {
@@ -74,6 +77,7 @@ fn main() -> ExitCode {
             Some((what, more)) if what == "fem" => bench_fem::run(&root, more),
             Some((what, more)) if what == "step" => bench_step::run(&root, more),
             Some((what, more)) if what == "output" => bench_output::run(&root, more),
+            Some((what, more)) if what == "advise" => bench_advise::run(&root, more),
             _ => Err(format!(
                 "cargo xtask bench: say what to benchmark (mesh, fem, step, output)\n{USAGE}"
             )),
@@ -140,6 +144,18 @@ fn describe(cmd: &Command) -> String {
 
 pub(crate) fn cargo() -> Command {
     Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+}
+
+/// The release `stickslip` (HDF5 installed and the binary built first, if
+/// need be) and a bench's scratch directory target/bench/NAME.
+pub(crate) fn release_stickslip(root: &Path, name: &str) -> Result<(PathBuf, PathBuf), String> {
+    setup(false)?;
+    run(cargo()
+        .current_dir(root)
+        .args(["build", "--release", "-q", "-p", "stickslip"]))?;
+    let dir = root.join("target/bench").join(name);
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    Ok((root.join("target/release/stickslip"), dir))
 }
 
 /// HDF5's C library and headers, found the way hdf5-metno-sys finds them
