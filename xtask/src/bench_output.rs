@@ -57,17 +57,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
             }
         }
     }
-    crate::setup(false)?;
-    crate::run(crate::cargo().current_dir(root).args([
-        "build",
-        "--release",
-        "-q",
-        "-p",
-        "stickslip",
-    ]))?;
-    let exe = root.join("target/release/stickslip");
-    let dir = root.join("target/bench/output");
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let (exe, dir) = crate::release_stickslip(root, "output")?;
     // times[case][setting]; sizes likewise.
     let mut times = vec![vec![Vec::new(); SETTINGS.len()]; CASES.len()];
     let mut sizes = vec![vec![0u64; SETTINGS.len()]; CASES.len()];

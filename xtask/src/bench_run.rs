@@ -138,17 +138,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
             }
         }
     }
-    crate::setup(false)?;
-    crate::run(crate::cargo().current_dir(root).args([
-        "build",
-        "--release",
-        "-q",
-        "-p",
-        "stickslip",
-    ]))?;
-    let exe = root.join("target/release/stickslip");
-    let dir = root.join("target/bench/run");
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let (exe, dir) = crate::release_stickslip(root, "run")?;
     let mut exes = vec![exe.clone()];
     if against.is_some() || !against_env.is_empty() {
         exes.push(against.clone().unwrap_or_else(|| exe.clone()));

@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
+mod bench_advise;
 mod bench_fem;
 mod bench_mesh;
 mod bench_output;
@@ -23,10 +24,10 @@ usage: cargo xtask <command> [args]
   demo              install what is missing (HDF5), build, and run the paper's
                     slab (central difference, eps = 1e-4) into target/demo/slab.h5;
                     more arguments go to `stickslip run` (-o OUT.h5, --set K=V)
-  test              install what is missing (HDF5, Python modules), then run the whole
-                    test suite (what .ci/run and CI run)
+  test              install what is missing (HDF5, Python modules, ParaView), then run
+                    the whole test suite (what .ci/run and CI run)
   setup             only install what is missing: libhdf5-dev, and h5py, numpy,
-                    gmsh, matplotlib, meshio for the tests
+                    gmsh, matplotlib, meshio and Debian's paraview for the tests
   verify            the proof of correctness: closed forms, convergence rates,
                     the paper's experiments, committed reference runs
                     [--quick] [--bless] [--only SUITE]
@@ -47,6 +48,8 @@ usage: cargo xtask <command> [args]
                     schemes [--rounds N] [--max-dofs N] [--against EXE]
   bench output      wall time of whole runs (paper slab, a 4k-node slab) with
                     their results written uncompressed, deflated, or not at all
+  bench advise      wall time of advise's pick against the cheapest configuration of
+                    the chart meeting the same tolerance [--rounds N] [--tol T]...
 ";
 
 fn main() -> ExitCode {
@@ -78,8 +81,9 @@ fn main() -> ExitCode {
             Some((what, more)) if what == "step" => bench_step::run(&root, more),
             Some((what, more)) if what == "output" => bench_output::run(&root, more),
             Some((what, more)) if what == "run" => bench_run::run(&root, more),
+            Some((what, more)) if what == "advise" => bench_advise::run(&root, more),
             _ => Err(format!(
-                "cargo xtask bench: say what to benchmark (mesh, fem, step, output, run)\n{USAGE}"
+                "cargo xtask bench: say what to benchmark (mesh, fem, step, output, run, advise)\n{USAGE}"
             )),
         },
         "help" | "--help" | "-h" => {
@@ -146,6 +150,18 @@ pub(crate) fn cargo() -> Command {
     Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
 }
 
+/// The release `stickslip` (HDF5 installed and the binary built first, if
+/// need be) and a bench's scratch directory target/bench/NAME.
+pub(crate) fn release_stickslip(root: &Path, name: &str) -> Result<(PathBuf, PathBuf), String> {
+    setup(false)?;
+    run(cargo()
+        .current_dir(root)
+        .args(["build", "--release", "-q", "-p", "stickslip"]))?;
+    let dir = root.join("target/bench").join(name);
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    Ok((root.join("target/release/stickslip"), dir))
+}
+
 /// HDF5's C library and headers, found the way hdf5-metno-sys finds them
 /// (pkg-config), or Debian's serial header path.
 fn hdf5_present() -> bool {
@@ -157,44 +173,25 @@ fn hdf5_present() -> bool {
     pkg || Path::new("/usr/include/hdf5/serial/hdf5.h").exists()
 }
 
-/// Installs libhdf5-dev (and h5py/numpy for the tests' Python checks)
-/// when missing, saying so.
-pub(crate) fn setup(python_too: bool) -> Result<(), String> {
+/// Installs libhdf5-dev when missing, and for the tests (`for_tests`)
+/// the Python modules and ParaView's pvpython they read results with,
+/// saying so.
+pub(crate) fn setup(for_tests: bool) -> Result<(), String> {
+    let mut apt = Apt::default();
     if hdf5_present() {
         eprintln!("setup: HDF5 development files found");
     } else {
         eprintln!(
             "setup: HDF5 is missing; installing Debian's libhdf5-dev and hdf5-tools (about 20 s)"
         );
-        let sudo = if is_root() { None } else { Some("sudo") };
-        let apt = |args: &[&str]| {
-            let mut c = match sudo {
-                Some(s) => {
-                    let mut c = Command::new(s);
-                    c.arg("apt-get");
-                    c
-                }
-                None => Command::new("apt-get"),
-            };
-            c.args(args).env("DEBIAN_FRONTEND", "noninteractive");
-            c
-        };
-        run(&mut apt(&["update", "-q"]))?;
-        run(&mut apt(&[
-            "install",
-            "-y",
-            "-q",
-            "libhdf5-dev",
-            "hdf5-tools",
-            "pkg-config",
-        ]))?;
+        apt.install(&["libhdf5-dev", "hdf5-tools", "pkg-config"])?;
         if !hdf5_present() {
             return Err(
                 "libhdf5-dev was installed but HDF5 is still not found by pkg-config".into(),
             );
         }
     }
-    if python_too {
+    if for_tests {
         // What the end-to-end tests and examples read results and make
         // meshes and pictures with, as users do.
         python::ensure_python_modules(&[
@@ -204,8 +201,58 @@ pub(crate) fn setup(python_too: bool) -> Result<(), String> {
             ("matplotlib", "matplotlib"),
             ("meshio", "meshio"),
         ])?;
+        // The XDMF test opens the results in ParaView, as users do; under
+        // CI it fails without it.
+        if pvpython_present() {
+            eprintln!("setup: ParaView's pvpython found");
+        } else {
+            eprintln!(
+                "setup: pvpython is missing; installing Debian's paraview for the XDMF test \
+                 (about 250 MB to download, 1.4 GB on disk; a few minutes)"
+            );
+            apt.install(&["paraview"])?;
+            if !pvpython_present() {
+                return Err("paraview was installed but `pvpython --version` still fails".into());
+            }
+        }
     }
     Ok(())
+}
+
+fn pvpython_present() -> bool {
+    Command::new("pvpython")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// Debian's apt-get, through sudo unless root; the package lists are
+/// updated once, before the first install.
+#[derive(Default)]
+struct Apt {
+    updated: bool,
+}
+
+impl Apt {
+    fn command(args: &[&str]) -> Command {
+        let mut c = if is_root() {
+            Command::new("apt-get")
+        } else {
+            let mut c = Command::new("sudo");
+            c.arg("apt-get");
+            c
+        };
+        c.args(args).env("DEBIAN_FRONTEND", "noninteractive");
+        c
+    }
+
+    fn install(&mut self, packages: &[&str]) -> Result<(), String> {
+        if !self.updated {
+            run(&mut Self::command(&["update", "-q"]))?;
+            self.updated = true;
+        }
+        run(Self::command(&["install", "-y", "-q"]).args(packages))
+    }
 }
 
 fn is_root() -> bool {
