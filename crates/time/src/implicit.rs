@@ -3,7 +3,7 @@
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{ContactSurface, SlipState, StepSystem};
-use stickslip_fem::{FillOrder, SolverError, SparseCholesky};
+use stickslip_linalg::{FillOrder, SolverError, SparseCholesky};
 
 use crate::linalg::csr_index;
 

@@ -2,7 +2,8 @@
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{iterate, ContactSurface, IterationFailure, IterationOptions, SlipState};
-use stickslip_fem::{ElementClasses, FillOrder, Model, SolverError, SparseCholesky};
+use stickslip_fem::{ElementClasses, Model};
+use stickslip_linalg::{FillOrder, SolverError, SparseCholesky};
 
 use crate::history::History;
 use crate::implicit::{DiagonalStep, ImplicitOperator, ImplicitStep};

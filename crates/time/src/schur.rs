@@ -41,9 +41,9 @@ use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{ContactNode, ContactSurface, SlipState, StepSystem};
-use stickslip_fem::{analyze_symbolic, csc_view, ContactOperator, FillOrder, SolverError};
+use stickslip_linalg::{analyze_symbolic, csc_view, FillOrder, PathOperator, SolverError};
 
-use stickslip_fem::Supernodal;
+use stickslip_linalg::Supernodal;
 
 use crate::small_solve::{minus_columns, BlockInverse};
 
@@ -104,7 +104,7 @@ struct Entry {
     z: Vec<f64>,
     /// W = L⁻¹Pᵀ on its paths (`Supernodal::schur_complement`), when the
     /// step goes through it rather than through solves on the reach.
-    paths: Option<ContactOperator>,
+    paths: Option<PathOperator>,
     /// The solve by inverted supernode blocks, for small factors
     /// (`small_solve.rs`).
     small: Option<BlockInverse>,
@@ -600,13 +600,12 @@ impl SchurOperator {
         let entry = &self.entries[self.current];
         if let Some(op) = &entry.paths {
             // p = Wᵀ(L⁻¹b); `finish` corrects and back-solves.
-            self.sn
-                .begin_step_paths(&entry.l_values, op, b, &mut self.p);
+            self.sn.begin_paths(&entry.l_values, op, b, &mut self.p);
             return;
         }
         if entry.z.is_empty() {
             // The split step: v₀ at the contact DOFs only; `finish` solves.
-            self.sn.begin_step(&self.entries[self.current].l_values, b);
+            self.sn.begin_reach(&self.entries[self.current].l_values, b);
             for (p, node) in self.p.iter_mut().zip(&self.nodes) {
                 let mut sum = 0.0;
                 for (d, t) in node.dofs.iter().zip(node.tangent) {
@@ -640,7 +639,7 @@ impl SchurOperator {
             return;
         }
         if let Some(op) = &entry.paths {
-            self.sn.finish_step_paths(&entry.l_values, op, &self.f, v);
+            self.sn.finish_paths(&entry.l_values, op, &self.f, v);
             return;
         }
         if entry.z.is_empty() {
@@ -652,7 +651,7 @@ impl SchurOperator {
                     }
                 }
             }
-            self.sn.finish_step(&entry.l_values, &self.correction, v);
+            self.sn.finish_reach(&entry.l_values, &self.correction, v);
         } else {
             // A node with f = 0 costs nothing.
             minus_columns(&mut v[..n], &entry.z, &self.f);

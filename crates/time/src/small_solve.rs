@@ -31,7 +31,7 @@
 //! bits (T is an explicit inverse), which is why the tests compare with
 //! the matrix and with that solve to a tolerance.
 
-use stickslip_fem::Supernodal;
+use stickslip_linalg::Supernodal;
 
 /// Factors up to this many values stored (2 MB; F and Fᵀ, or F alone
 /// beyond [`TRANSPOSED_MAX_VALUES`]) are solved by inverted blocks.
@@ -740,7 +740,8 @@ mod tests {
     use faer::{Par, Side, Spec};
     use nalgebra_sparse::CsrMatrix;
     use stickslip_fem::testing::{plain_spmv, rectangle};
-    use stickslip_fem::{analyze_symbolic, csc_view, Hypothesis, Material, Model};
+    use stickslip_fem::{Hypothesis, Material, Model};
+    use stickslip_linalg::{analyze_symbolic, csc_view};
     use stickslip_mesh::CellKind;
 
     /// A₀ of the paper's Newmark step on a slab without every `drop`-th

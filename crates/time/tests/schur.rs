@@ -195,7 +195,7 @@ fn every_schur_step_equals_the_direct_step_from_the_same_state() {
 #[test]
 fn nested_dissection_gives_the_runs_of_amd() {
     use stickslip_fem::ordering::nested_dissection;
-    use stickslip_fem::FillOrder;
+    use stickslip_linalg::FillOrder;
     for mesh in ["slab-q2-8x2.msh", "slab-q1-32x8.msh"] {
         let amd = paper_slab(mesh, 1e-4, History::Step);
         let mut nd = paper_slab(mesh, 1e-4, History::Step);
