@@ -58,8 +58,65 @@ pub fn sum_chunks<const S: usize>(
             body(c, rows(c), p);
         }
     }
+    add_in_order(partials)
+}
+
+/// Runs `body(c, y chunk, sums)` over the chunks of `y`, each with its own
+/// `S` partial sums, and returns them added in chunk order.
+pub fn each_chunk_summed<const S: usize>(
+    y: &mut [f64],
+    partials: &mut [[f64; S]],
+    body: impl Fn(usize, &mut [f64], &mut [f64; S]) + Sync,
+) -> [f64; S] {
+    let n = y.len();
+    let partials = &mut partials[..chunks(n)];
+    if parallel(n) {
+        y.par_chunks_mut(CHUNK)
+            .zip(partials.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (y, p))| body(c, y, p));
+    } else {
+        for (c, (y, p)) in y.chunks_mut(CHUNK).zip(partials.iter_mut()).enumerate() {
+            body(c, y, p);
+        }
+    }
+    add_in_order(partials)
+}
+
+/// Runs `body(c, y chunk, z chunk, sums)` over the same chunks of two
+/// vectors, each chunk with its own `S` partial sums, and returns them
+/// added in chunk order.
+pub fn each_chunk_pair<const S: usize>(
+    y: &mut [f64],
+    z: &mut [f64],
+    partials: &mut [[f64; S]],
+    body: impl Fn(usize, &mut [f64], &mut [f64], &mut [f64; S]) + Sync,
+) -> [f64; S] {
+    let n = y.len();
+    let partials = &mut partials[..chunks(n)];
+    if parallel(n) {
+        y.par_chunks_mut(CHUNK)
+            .zip(z.par_chunks_mut(CHUNK))
+            .zip(partials.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, ((y, z), p))| body(c, y, z, p));
+    } else {
+        for (c, ((y, z), p)) in y
+            .chunks_mut(CHUNK)
+            .zip(z.chunks_mut(CHUNK))
+            .zip(partials.iter_mut())
+            .enumerate()
+        {
+            body(c, y, z, p);
+        }
+    }
+    add_in_order(partials)
+}
+
+/// The chunks' partial sums added in chunk order.
+fn add_in_order<const S: usize>(partials: &[[f64; S]]) -> [f64; S] {
     let mut total = [0.0; S];
-    for p in partials.iter() {
+    for p in partials {
         for (t, v) in total.iter_mut().zip(p) {
             *t += v;
         }

@@ -14,7 +14,7 @@
 
 use stickslip_contact::{ContactSurface, SlipState};
 
-use crate::kernels::RowProduct;
+use stickslip_linalg::Product;
 
 /// The constants of one contact node for one Δt.
 #[derive(Clone, Copy, Debug)]
@@ -91,14 +91,14 @@ impl NodalFriction {
         self.scale = Some(scale.to_bits());
     }
 
-    /// K x at the contact nodes' free DOFs, in one call of
-    /// [`RowProduct::rows_at`] (the rows' own sums, vector-wide where they
-    /// follow on: before, one [`RowProduct::row`] per DOF, a search and a
-    /// node's two sums each time, was 6% of the Q2 1M slab's step on one
-    /// thread). `b`'s k-th call in [`NodalFriction::velocities`] is for
-    /// `self.products()[k]`. [`NodalFriction::prepare`] first.
-    pub(crate) fn form_products(&mut self, k: &impl RowProduct, x: &[f64]) {
-        k.rows_at(&self.dofs, x, &mut self.ku);
+    /// K x at the contact nodes' free DOFs (`b`'s k-th call in
+    /// [`NodalFriction::velocities`] is for `self.products()[k]`), with the
+    /// bits the product's batches give them. [`NodalFriction::prepare`]
+    /// first.
+    pub(crate) fn form_products(&mut self, k: &Product, x: &[f64]) {
+        for (o, &i) in self.ku.iter_mut().zip(&self.dofs) {
+            *o = k.row(i, x);
+        }
     }
 
     /// What [`NodalFriction::form_products`] formed.
