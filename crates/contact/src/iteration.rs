@@ -91,12 +91,7 @@ pub fn iterate<S: StepSystem>(
         surface.classify(velocity, scratch);
         if options.remark_4_2 {
             for (new, old) in scratch.iter_mut().zip(classes.iter()) {
-                let reversed = matches!(
-                    (*old, *new),
-                    (SlipState::SlipPositive, SlipState::SlipNegative)
-                        | (SlipState::SlipNegative, SlipState::SlipPositive)
-                );
-                if reversed {
+                if new.reverses(*old) {
                     *new = SlipState::Stuck;
                 }
             }

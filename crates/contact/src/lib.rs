@@ -14,8 +14,10 @@
 
 mod iteration;
 mod law;
+mod ledger;
 mod surface;
 
 pub use iteration::{iterate, IterationFailure, IterationOptions, IterationReport, StepSystem};
 pub use law::{FrictionLaw, SlipState};
+pub use ledger::stick_events;
 pub use surface::{ContactError, ContactNode, ContactSurface};

@@ -1,7 +1,9 @@
 //! The Newmark family in velocity form with friction (paper §4.1-4.2).
 
 use nalgebra_sparse::CsrMatrix;
-use stickslip_contact::{iterate, ContactSurface, IterationFailure, IterationOptions, SlipState};
+use stickslip_contact::{
+    iterate, stick_events, ContactSurface, IterationFailure, IterationOptions, SlipState,
+};
 use stickslip_fem::{ElementClasses, FillOrder, Model, SolverError, SparseCholesky};
 
 use crate::history::History;
@@ -1867,48 +1869,29 @@ impl Integrator {
 
     /// Friction dissipation of the step and the number of nodes that went
     /// from slip to stick, from the new velocity (before the state is
-    /// overwritten); fills `forces_new`. The increment at a node is the
-    /// trapezoidal ½Δt(ṙ_K + ṙ_{K−1})·τ: equal to (r_K − r_{K−1})·τ for
-    /// Newmark ¼, ½ (so the balance closes to round-off) and, with φ_ε odd
-    /// and increasing, never negative for any scheme.
+    /// overwritten); fills `forces_new` (`ContactSurface::step_dissipation`).
     fn friction_ledger(&mut self, dt: f64) -> (f64, usize) {
         let Some(c) = &self.contact else {
             return (0.0, 0);
         };
-        let mut dissipated = 0.0;
-        if let Some(m) = &mut self.modal {
+        let dissipated = if let Some(m) = &mut self.modal {
             // The nodes' tangential velocities are the iteration's (u = p
             // − S f at convergence), not formed from q̇.
             m.contact_v_new.copy_from_slice(&self.nodal_velocity);
-            for (((node, f_new), f_old), (u_new, u)) in c
-                .nodes
-                .iter()
-                .zip(self.forces_new.iter_mut())
-                .zip(&self.forces)
-                .zip(m.contact_v_new.iter().zip(&m.contact_v))
-            {
-                *f_new = node.force_scale() * c.law.phi(*u_new);
-                dissipated += 0.5 * (*f_new + f_old) * (0.5 * dt * (u_new + u));
-            }
+            c.step_dissipation_tangential(
+                &m.contact_v_new,
+                &m.contact_v,
+                dt,
+                &self.forces,
+                &mut self.forces_new,
+            )
         } else {
-            c.nodal_forces(&self.v_new, &mut self.forces_new);
-            for ((node, f_new), f_old) in c.nodes.iter().zip(&self.forces_new).zip(&self.forces) {
-                let mut increment = 0.0;
-                for k in 0..2 {
-                    if let Some(i) = node.dofs[k] {
-                        increment += node.tangent[k] * (0.5 * dt * (self.v_new[i] + self.v[i]));
-                    }
-                }
-                dissipated += 0.5 * (f_new + f_old) * increment;
-            }
-        }
-        let stick_events = self
-            .scratch_classes
-            .iter()
-            .zip(&self.classes)
-            .filter(|(new, old)| new.is_stuck() && !old.is_stuck())
-            .count();
-        (dissipated, stick_events)
+            c.step_dissipation(&self.v_new, &self.v, dt, &self.forces, &mut self.forces_new)
+        };
+        (
+            dissipated,
+            stick_events(&self.classes, &self.scratch_classes),
+        )
     }
 
     // ---- read access for observers ----
