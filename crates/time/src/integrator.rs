@@ -2,12 +2,13 @@
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{
-    iterate, stick_events, ContactSurface, IterationFailure, IterationOptions, SlipState,
+    iterate, stick_events, ContactSurface, DiagonalStep, IterationFailure, IterationOptions,
+    SlipState,
 };
 use stickslip_fem::{ElementClasses, FillOrder, Model, SolverError, SparseCholesky};
 
 use crate::history::History;
-use crate::implicit::{DiagonalStep, ImplicitOperator, ImplicitStep};
+use crate::implicit::{ImplicitOperator, ImplicitStep};
 use crate::kernels::{self, Lanes, RowProduct};
 use crate::linalg::{
     self, dot, load_minus_k_plus_m, quadratic_form, row_chunks, same_pattern, spmv, two_forms,
@@ -1393,7 +1394,7 @@ impl Integrator {
                     }
                     let (ku, at_dofs) = (&self.b, self.nodal.products());
                     let (friction, slots) = (&mut self.friction, &self.friction_slots);
-                    self.nodal.velocities(
+                    self.nodal.closed_form().velocities(
                         |i, n| {
                             let ku = if one_chunk { ku[i] } else { at_dofs[n] };
                             kernels::rhs_entry(&data, i, ku)
@@ -1473,6 +1474,7 @@ impl Integrator {
                                 .prepare(contact, &self.dynamics.lumped_mass, scale);
                             let (b, v_new) = (&self.b, &mut self.v_new);
                             self.nodal
+                                .closed_form()
                                 .velocities(|i, _| b[i], |_, _, i, v| v_new[i] = v);
                             contact.classify(&self.v_new, &mut self.scratch_classes);
                             1
@@ -1513,8 +1515,8 @@ impl Integrator {
         }
         let (dissipated, stick_events) = match (&self.contact, swept) {
             // The closed-form friction's nodes: classes, forces and the
-            // ledger in one pass (`NodalFriction::ledger`).
-            (Some(_), Some(_)) => self.nodal.ledger(
+            // ledger in one pass (`NodalClosedForm::ledger`).
+            (Some(_), Some(_)) => self.nodal.closed_form().ledger(
                 &self.v_new,
                 &self.v,
                 dt,
