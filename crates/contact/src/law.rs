@@ -180,4 +180,99 @@ mod tests {
             }
         }
     }
+
+    /// φ_ε(v) → sign(v) for v ≠ 0 as ε → 0: exactly ±1 once ε < |v|, the
+    /// definition of METHOD.md §2 (no rounding enters the slip branch).
+    #[test]
+    fn phi_tends_to_the_sign() {
+        for v in [-3.0, -1e-3, -1e-9, 2e-12, 1e-6, 0.5, 40.0] {
+            for k in 0..=40 {
+                let eps = 10f64.powi(-k / 2);
+                let phi = FrictionLaw { eps }.phi(v);
+                if eps < v.abs() {
+                    assert_eq!(phi, v.signum(), "v = {v}, ε = {eps}");
+                } else {
+                    // Still on the viscous branch: |φ| ≤ 1 and of v's sign.
+                    assert!(phi.abs() <= 1.0 && phi * v > 0.0, "v = {v}, ε = {eps}");
+                }
+            }
+            assert_eq!(FrictionLaw { eps: 1e-20 }.phi(v), v.signum(), "v = {v}");
+        }
+        // φ_ε(0) = 0 for every ε: the limit of v/|v| does not exist there.
+        assert_eq!(FrictionLaw { eps: 1e-12 }.phi(0.0), 0.0);
+    }
+
+    /// ψ_ε(s) → |s| with 0 ≤ |s| − ψ_ε(s) ≤ ε/2, an exact bound: from
+    /// METHOD.md §2's two branches, |s| − ψ_ε = ε/2 for |s| > ε and
+    /// |s|(1 − |s|/(2ε)) ∈ [0, ε/2] for |s| ≤ ε, ε/2 at |s| = ε. Tolerance:
+    /// four ulps of max(|s|, ε), the rounding of one subtraction and one
+    /// quotient.
+    #[test]
+    fn psi_tends_to_the_absolute_value_within_half_eps() {
+        let samples: [f64; 8] = [0.0, 1e-12, 3e-7, -2e-4, 0.01, -0.7, 1.0, 25.0];
+        for k in 0..=24 {
+            let eps = 10f64.powi(-k / 2) * if k % 2 == 0 { 1.0 } else { 0.3 };
+            let law = FrictionLaw { eps };
+            for &s in &samples {
+                let gap = s.abs() - law.psi(s);
+                let ulps = 4.0 * f64::EPSILON * s.abs().max(eps);
+                assert!(gap >= -ulps, "s = {s}, ε = {eps}: ψ above |s| by {gap}");
+                assert!(
+                    gap <= 0.5 * eps + ulps,
+                    "s = {s}, ε = {eps}: |s| − ψ = {gap} > ε/2"
+                );
+                if s.abs() > eps {
+                    // The bound is exact on the slip branch.
+                    assert!((gap - 0.5 * eps).abs() <= ulps, "s = {s}, ε = {eps}");
+                }
+            }
+            // ... and attained at s = ε (both branches meet there).
+            assert!((eps - law.psi(eps) - 0.5 * eps).abs() <= 4.0 * f64::EPSILON * eps);
+        }
+    }
+
+    /// The nodal closed form's stuck set is |p| ≤ ε(1 + c/ε) = ε + c, which
+    /// shrinks to the true Coulomb stuck set |p| ≤ c as ε → 0; and its root
+    /// tends to the Coulomb nodal solution t = 0 for |p| ≤ c, t = p − c
+    /// sign(p) otherwise (the root of t + c ∂|t| ∋ p, written here), with
+    /// |t − t₀| ≤ ε: the stuck root is p/(1 + c/ε), at most ε in size, and
+    /// the slip root is exactly the Coulomb one.
+    #[test]
+    fn nodal_solution_tends_to_coulombs() {
+        let coulomb = |p: f64, c: f64| {
+            if p.abs() <= c {
+                0.0
+            } else {
+                p - c * p.signum()
+            }
+        };
+        let c = 0.8;
+        for &p in &[
+            -2.0, -0.8000001, -0.8, -0.3, 0.0, 1e-9, 0.5, 0.79999, 0.8000001, 3.0,
+        ] {
+            for k in 0..=30 {
+                let eps = 10f64.powi(-k / 2);
+                let law = FrictionLaw { eps };
+                let t = law.solve_nodal(p, c);
+                let stuck = law.classify(t).is_stuck();
+                // Stuck set: |p| ≤ ε + c up to the rounding of p/(1 + c/ε).
+                let edge = eps + c;
+                if p.abs() < edge * (1.0 - 1e-12) {
+                    assert!(stuck, "p = {p}, ε = {eps}: t = {t} not stuck");
+                } else if p.abs() > edge * (1.0 + 1e-12) {
+                    assert!(!stuck, "p = {p}, ε = {eps}: t = {t} stuck");
+                }
+                let t0 = coulomb(p, c);
+                assert!(
+                    (t - t0).abs() <= eps * (1.0 + 1e-12) + 4.0 * f64::EPSILON * p.abs(),
+                    "p = {p}, ε = {eps}: {t} vs Coulomb {t0}"
+                );
+            }
+            // At ε = 1e-15 the stuck set is Coulomb's, |p| ≤ c, widened by
+            // ε (p = ±c, at its edge, stays stuck: c/(1 + c/ε) < ε).
+            let law = FrictionLaw { eps: 1e-15 };
+            let t = law.solve_nodal(p, c);
+            assert_eq!(law.classify(t).is_stuck(), p.abs() <= c + 1e-15, "p = {p}");
+        }
+    }
 }

@@ -217,7 +217,7 @@ impl StepSystem for DiagonalStep<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stick_events;
+    use crate::{iterate, stick_events, IterationOptions};
 
     /// A test contact node: weight and bound vary with j.
     fn node(j: usize, dofs: [Option<usize>; 2], tangent: [f64; 2]) -> ContactNode {
@@ -228,6 +228,32 @@ mod tests {
             tangent,
             s: j as f64,
             bound: 2.0 + j as f64,
+        }
+    }
+
+    /// A small deterministic generator (SplitMix64), so the random cases
+    /// are the same on every run.
+    struct Random(u64);
+
+    impl Random {
+        fn next(&mut self) -> u64 {
+            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        }
+        /// Uniform in [0, 1).
+        fn unit(&mut self) -> f64 {
+            (self.next() >> 11) as f64 / (1u64 << 53) as f64
+        }
+        /// Uniform in [lo, hi).
+        fn range(&mut self, lo: f64, hi: f64) -> f64 {
+            lo + (hi - lo) * self.unit()
+        }
+        /// 10^x for x uniform in [lo, hi).
+        fn log(&mut self, lo: f64, hi: f64) -> f64 {
+            10f64.powf(self.range(lo, hi))
         }
     }
 
@@ -387,6 +413,141 @@ mod tests {
         assert!(
             stuck > 0 && slip_pos > 0 && slip_neg > 0,
             "{stuck} {slip_pos} {slip_neg}"
+        );
+    }
+
+    /// The closed form against the iteration of §5 on the same diagonal
+    /// system ([`DiagonalStep`]), on random surfaces: weights, bounds,
+    /// tangents at any angle (a node with one component fixed among them),
+    /// lumped masses, Δt, ε over 1e-6..1 and right-hand sides from deep in
+    /// the stuck set to far beyond the slip bound, the iteration started
+    /// from random classes. The regularized step has one solution
+    /// (METHOD.md §5), so the two agree up to rounding: both form ṙ_i as
+    /// b_i/d_i minus a friction term of size at most w g/d_i, in a handful
+    /// of operations each (products by stored reciprocals against
+    /// quotients and Sherman-Morrison), so 64 ulps of |b_i|/d_i + w g/d_i
+    /// bounds their difference with room to spare. The closed form also
+    /// satisfies the nodal equation D ṙ + w g φ_ε(τ·ṙ) τ = b, to the
+    /// residual of a ṙ off by that tolerance (D + (w g/ε) ττᵀ times it on
+    /// a stuck node, where φ_ε has slope 1/ε).
+    #[test]
+    fn closed_form_is_what_the_iteration_converges_to() {
+        let mut rng = Random(0x5EED_CAFE);
+        let (mut stuck, mut slipping) = (0, 0);
+        for case in 0..400 {
+            let n_nodes = 1 + (rng.next() % 6) as usize;
+            let mut nodes = Vec::new();
+            let mut n_dofs = 0;
+            for j in 0..n_nodes {
+                let angle = rng.range(-std::f64::consts::PI, std::f64::consts::PI);
+                let tangent = [angle.cos(), angle.sin()];
+                // One node in five has a component fixed (a roller), the
+                // other one along the tangent by at least 0.2.
+                let dofs = if rng.next().is_multiple_of(5) && tangent[0].abs() > 0.2 {
+                    n_dofs += 1;
+                    [Some(n_dofs - 1), None]
+                } else {
+                    n_dofs += 2;
+                    [Some(n_dofs - 2), Some(n_dofs - 1)]
+                };
+                nodes.push(ContactNode {
+                    node: j,
+                    dofs,
+                    weight: rng.log(-2.0, 0.0),
+                    tangent,
+                    s: j as f64,
+                    bound: rng.log(-1.0, 2.0),
+                });
+            }
+            let eps = rng.log(-6.0, 0.0);
+            let surface = ContactSurface::from_nodes("random", nodes, eps).unwrap();
+            let mass: Vec<f64> = (0..n_dofs).map(|_| rng.log(-3.0, 0.0)).collect();
+            let dt = rng.log(-5.0, -2.0);
+            let scale = 1.0 / (0.5 * dt);
+            let diagonal: Vec<f64> = mass.iter().map(|m| m * scale).collect();
+            // |b| against w g: ratios from 1e-8 (deeply stuck) to 1e3.
+            let amp = rng.log(-8.0, 3.0);
+            let wg_max = surface
+                .nodes
+                .iter()
+                .map(ContactNode::force_scale)
+                .fold(0.0, f64::max);
+            let b: Vec<f64> = (0..n_dofs)
+                .map(|_| amp * wg_max * rng.range(-1.0, 1.0))
+                .collect();
+
+            let mut closed = NodalClosedForm::default();
+            closed.prepare(&surface, &mass, scale);
+            let mut direct = vec![f64::NAN; n_dofs];
+            closed.velocities(|i, _| b[i], |_, _, i, v| direct[i] = v);
+
+            let mut classes: Vec<SlipState> = (0..n_nodes)
+                .map(|_| match rng.next() % 3 {
+                    0 => SlipState::Stuck,
+                    1 => SlipState::SlipPositive,
+                    _ => SlipState::SlipNegative,
+                })
+                .collect();
+            let mut scratch = classes.clone();
+            let mut iterated = vec![0.0; n_dofs];
+            let mut system = DiagonalStep {
+                diagonal: &diagonal,
+                b: &b,
+            };
+            iterate(
+                &surface,
+                &mut system,
+                &mut classes,
+                &mut scratch,
+                &mut iterated,
+                IterationOptions::default(),
+            )
+            .unwrap_or_else(|e| panic!("case {case}: {e:?}"));
+
+            for (n, class) in surface.nodes.iter().zip(&classes) {
+                match class {
+                    SlipState::Stuck => stuck += 1,
+                    _ => slipping += 1,
+                }
+                let tol = n.dofs.map(|d| {
+                    d.map_or(0.0, |i| {
+                        64.0 * f64::EPSILON * (b[i].abs() + n.force_scale()) / diagonal[i]
+                    })
+                });
+                for c in 0..2 {
+                    let Some(i) = n.dofs[c] else { continue };
+                    let gap = (direct[i] - iterated[i]).abs();
+                    assert!(
+                        gap <= tol[c],
+                        "case {case}, dof {i}: closed form {} vs iterated {}",
+                        direct[i],
+                        iterated[i]
+                    );
+                }
+                // The residual of ṙ off by tol: (D + k ττᵀ) tol with k the
+                // stuck damping w g/ε (φ_ε's slope there), 0 slipping.
+                let k = if class.is_stuck() {
+                    n.stuck_damping(&surface.law)
+                } else {
+                    0.0
+                };
+                let spread = n.tangent[0].abs() * tol[0] + n.tangent[1].abs() * tol[1];
+                let f = n.force(&surface.law, n.tangential(&direct));
+                for c in 0..2 {
+                    let Some(i) = n.dofs[c] else { continue };
+                    let residual = diagonal[i] * direct[i] + f * n.tangent[c] - b[i];
+                    let bound = diagonal[i] * tol[c] + k * n.tangent[c].abs() * spread;
+                    assert!(
+                        residual.abs() <= bound,
+                        "case {case}, dof {i}: residual {residual} > {bound}"
+                    );
+                }
+            }
+        }
+        // Both branches of the law, many times each.
+        assert!(
+            stuck > 100 && slipping > 100,
+            "{stuck} stuck, {slipping} slipping"
         );
     }
 }
