@@ -3,7 +3,7 @@
 //! §4), K·x by stencil types where the mesh has them; stable below
 //! Δt_crit = 2/ω_max.
 
-use stickslip_contact::{iterate, ContactSurface, SlipState, StepSystem};
+use stickslip_contact::{iterate, ContactSurface, DiagonalStep, SlipState};
 use stickslip_linalg::chunks;
 use stickslip_linalg::{csr, Product, Stencils};
 
@@ -147,7 +147,7 @@ impl CentralDifference {
                 &mut self.friction,
                 &self.friction_slots,
             );
-            self.nodal.velocities(
+            self.nodal.closed_form().velocities(
                 |i, k| data.rhs(i, ku[k]),
                 |j, c, _, v| {
                     if let Some(slot) = slots[j][c] {
@@ -286,7 +286,7 @@ impl Stepper for CentralDifference {
             return Err(self.non_finite(step, t_new));
         }
         let (dissipated, stick_events) = if run.contact.is_some() {
-            self.nodal.ledger(
+            self.nodal.closed_form().ledger(
                 &state.v_new,
                 &state.v,
                 dt,
@@ -352,52 +352,5 @@ impl CentralDifference {
             t,
             hint: format!(" below the critical step Δt_crit = {:.4e}", self.dt_crit),
         }
-    }
-}
-
-/// The explicit step's system with a diagonal operator d (lumped mass over
-/// γΔt): solved node by node, stuck nodes by Sherman-Morrison on their 2×2
-/// block d + k ττᵀ. The iterated friction, to check the closed form.
-pub(crate) struct DiagonalStep<'a> {
-    pub diagonal: &'a [f64],
-    pub b: &'a [f64],
-}
-
-impl StepSystem for DiagonalStep<'_> {
-    type Error = std::convert::Infallible;
-
-    fn solve(
-        &mut self,
-        surface: &ContactSurface,
-        classes: &[SlipState],
-        velocity: &mut [f64],
-    ) -> Result<(), Self::Error> {
-        velocity.copy_from_slice(self.b);
-        surface.subtract_slip_forces(classes, velocity);
-        for (v, d) in velocity.iter_mut().zip(self.diagonal) {
-            *v /= d;
-        }
-        for (n, c) in surface.nodes.iter().zip(classes) {
-            if !c.is_stuck() {
-                continue;
-            }
-            let k = n.force_scale() / surface.law.eps;
-            // (D + k ττᵀ)⁻¹ r = D⁻¹r − D⁻¹τ k (τᵀD⁻¹r) / (1 + k τᵀD⁻¹τ).
-            let mut t_dinv_r = 0.0;
-            let mut t_dinv_t = 0.0;
-            for a in 0..2 {
-                if let Some(i) = n.dofs[a] {
-                    t_dinv_r += n.tangent[a] * velocity[i];
-                    t_dinv_t += n.tangent[a] * n.tangent[a] / self.diagonal[i];
-                }
-            }
-            let factor = k * t_dinv_r / (1.0 + k * t_dinv_t);
-            for a in 0..2 {
-                if let Some(i) = n.dofs[a] {
-                    velocity[i] -= factor * n.tangent[a] / self.diagonal[i];
-                }
-            }
-        }
-        Ok(())
     }
 }

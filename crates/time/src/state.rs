@@ -244,15 +244,6 @@ impl State {
         }
     }
 
-    /// Nodes that went from slip to stick in the step being formed.
-    pub fn stick_events(&self) -> usize {
-        self.classes_new
-            .iter()
-            .zip(&self.classes)
-            .filter(|(new, old)| new.is_stuck() && !old.is_stuck())
-            .count()
-    }
-
     /// The checkpoint of this state, the scheme's factorization count
     /// beside it.
     pub fn checkpoint(&self, factorizations: u64) -> Checkpoint {

@@ -106,21 +106,12 @@ impl DirectOperator {
         }
         self.work.values_mut().copy_from_slice(self.a0.values());
         if let Some(surface) = surface {
-            let values = self.work.values_mut();
-            for ((n, c), e) in surface.nodes.iter().zip(classes).zip(&self.entries) {
-                if !c.is_stuck() {
-                    continue;
+            let (values, entries) = (self.work.values_mut(), &self.entries);
+            surface.add_damping(classes, |j, a, b, value| {
+                if let Some(p) = entries[j][2 * a + b] {
+                    values[p] += value;
                 }
-                // Stuck: the damping w g/ε ττᵀ (METHOD.md §3).
-                let k = n.force_scale() / surface.law.eps;
-                for a in 0..2 {
-                    for b in 0..2 {
-                        if let Some(p) = e[2 * a + b] {
-                            values[p] += k * n.tangent[a] * n.tangent[b];
-                        }
-                    }
-                }
-            }
+            });
             for (k, c) in self.key_stuck.iter_mut().zip(classes) {
                 *k = c.is_stuck();
             }

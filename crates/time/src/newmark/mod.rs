@@ -9,7 +9,7 @@ mod direct;
 mod schur;
 
 use nalgebra_sparse::CsrMatrix;
-use stickslip_contact::{iterate, ContactSurface, SlipState};
+use stickslip_contact::{iterate, stick_events, ContactSurface, SlipState};
 use stickslip_linalg::chunks;
 use stickslip_linalg::csr::{load_minus_k_plus_m, same_pattern, two_forms};
 
@@ -310,21 +310,15 @@ impl Stepper for Newmark {
 }
 
 /// Friction dissipation of the step and the number of nodes that went
-/// from slip to stick, from the new velocity; fills `forces_new`. The
-/// increment at a node is the trapezoidal ½Δt(ṙ_K + ṙ_{K−1})·τ: equal to
-/// (r_K − r_{K−1})·τ for Newmark ¼, ½ (so the balance closes to
-/// round-off) and, with φ_ε odd and increasing, never negative.
+/// from slip to stick, from the new velocity; fills `forces_new`
+/// (`ContactSurface::step_dissipation`).
 fn friction_ledger(c: &ContactSurface, state: &mut State, dt: f64) -> (f64, usize) {
-    c.nodal_forces(&state.v_new, &mut state.forces_new);
-    let mut dissipated = 0.0;
-    for ((node, f_new), f_old) in c.nodes.iter().zip(&state.forces_new).zip(&state.forces) {
-        let mut increment = 0.0;
-        for k in 0..2 {
-            if let Some(i) = node.dofs[k] {
-                increment += node.tangent[k] * (0.5 * dt * (state.v_new[i] + state.v[i]));
-            }
-        }
-        dissipated += 0.5 * (f_new + f_old) * increment;
-    }
-    (dissipated, state.stick_events())
+    let dissipated = c.step_dissipation(
+        &state.v_new,
+        &state.v,
+        dt,
+        &state.forces,
+        &mut state.forces_new,
+    );
+    (dissipated, stick_events(&state.classes, &state.classes_new))
 }

@@ -109,7 +109,6 @@ pub(crate) struct SchurOperator {
     /// The same nodes as unit nodes on the n_c nodal unknowns, for the
     /// iteration.
     pub reduced: Option<ContactSurface>,
-    eps: f64,
     dense: DenseFactor,
     /// p = P v₀.
     p: Vec<f64>,
@@ -145,25 +144,9 @@ impl SchurOperator {
             .collect();
         sn.set_reach(&contact_dofs);
         let n_c = nodes.len();
-        let reduced = match contact {
-            Some(c) if n_c > 0 => {
-                let unit: Vec<ContactNode> = c
-                    .nodes
-                    .iter()
-                    .enumerate()
-                    .map(|(j, node)| ContactNode {
-                        dofs: [Some(j), None],
-                        tangent: [1.0, 0.0],
-                        ..*node
-                    })
-                    .collect();
-                Some(
-                    ContactSurface::from_nodes(&c.group, unit, c.law.eps)
-                        .map_err(|e| SolverError::Analysis(e.to_string()))?,
-                )
-            }
-            _ => None,
-        };
+        let reduced = contact
+            .filter(|_| n_c > 0)
+            .map(ContactSurface::on_tangential_unknowns);
         let dense = DenseFactor {
             entry_id: u64::MAX,
             stuck: vec![false; n_c],
@@ -193,7 +176,6 @@ impl SchurOperator {
             clock: 0,
             next_id: 0,
             use_paths,
-            eps: contact.map_or(1.0, |c| c.law.eps),
             nodes,
             reduced,
             dense,
@@ -402,18 +384,20 @@ impl SchurOperator {
         self.sn.finish_reach(&entry.l_values, &self.correction, v);
     }
 
-    /// f for `classes` into self.f and u = p − S f into `u`.
-    fn nodal_solve(&mut self, classes: &[SlipState], u: &mut [f64]) -> Result<(), SolverError> {
+    /// f for `classes` into self.f and u = p − S f into `u`, on `reduced`
+    /// (the nodes as unit nodes on the n_c unknowns).
+    fn nodal_solve(
+        &mut self,
+        reduced: &ContactSurface,
+        classes: &[SlipState],
+        u: &mut [f64],
+    ) -> Result<(), SolverError> {
         let n_c = self.nodes.len();
         let entry = &self.entries[self.current];
         let s = &entry.s;
-        // Slip forces F_J = w g sign.
-        for ((f, node), c) in self.f.iter_mut().zip(&self.nodes).zip(classes) {
-            *f = if c.is_stuck() {
-                0.0
-            } else {
-                node.force_scale() * c.sign()
-            };
+        // Slip forces F_J = w g sign (0 on stuck nodes, set below).
+        for ((f, node), c) in self.f.iter_mut().zip(&reduced.nodes).zip(classes) {
+            *f = node.slip_force(*c);
         }
         let d = &mut self.dense;
         let same = d.valid
@@ -423,11 +407,11 @@ impl SchurOperator {
             d.valid = false;
             d.index.clear();
             d.w.clear();
-            for (j, (node, c)) in self.nodes.iter().zip(classes).enumerate() {
+            for (j, (node, c)) in reduced.nodes.iter().zip(classes).enumerate() {
                 d.stuck[j] = c.is_stuck();
                 if c.is_stuck() {
                     d.index.push(j);
-                    d.w.push((node.force_scale() / self.eps).sqrt());
+                    d.w.push(node.stuck_damping(&reduced.law).sqrt());
                 }
             }
             let m = d.index.len();
@@ -526,10 +510,10 @@ impl StepSystem for NodalStep<'_> {
 
     fn solve(
         &mut self,
-        _surface: &ContactSurface,
+        surface: &ContactSurface,
         classes: &[SlipState],
         velocity: &mut [f64],
     ) -> Result<(), SolverError> {
-        self.op.nodal_solve(classes, velocity)
+        self.op.nodal_solve(surface, classes, velocity)
     }
 }
