@@ -15,8 +15,8 @@ use std::time::Instant;
 use anyhow::Context;
 use stickslip_contact::{ContactSurface, IterationOptions};
 use stickslip_fem::{
-    body_force_load, traction_load, Dirichlet, DofMap, ElementClasses, Hypothesis as FemHypothesis,
-    Material, Model, NodeOrder, Traction,
+    body_force_load, traction_load, Dirichlet, DofMap, Hypothesis as FemHypothesis, Material,
+    Model, NodeOrder, Traction,
 };
 use stickslip_mesh::Mesh;
 use stickslip_time::{
@@ -419,24 +419,8 @@ fn build(
         allow_unstable: case.time.allow_unstable,
         explicit_friction: ExplicitFriction::ClosedForm,
         initial_velocity: None,
-        // The state is read at every record: the modal step of small
-        // systems pays 3n² for each read, so with a record at every step
-        // the factor's step costs less (the paper's Newmark case, 20,000
-        // steps end to end: 24.4 µs a step by the factor, 26.5 µs modal),
-        // from every second step on the modal one.
-        reads_every: Some(case.output.every.max(1) as u64),
+        implicit_solver: ImplicitSolver::Schur,
         restoring,
-    };
-    // The explicit step forms K·x by stencil types where the mesh's
-    // numbering repeats its node rows (structured meshes numbered row by
-    // row), else from element classes where the mesh has them (structured
-    // Q2 meshes), else from a compact copy of the assembled K
-    // (stickslip-time's kernels.rs picks).
-    let classes = match (scheme, &material) {
-        (Scheme::CentralDifference, Some(material)) => {
-            ElementClasses::new(&mesh, material, &model.dofs)
-        }
-        _ => None,
     };
     let dofs = model.dofs.clone();
     if progress && dofs.n_free() >= SETUP_NOTE_DOFS {
@@ -461,7 +445,6 @@ fn build(
     } else {
         (Dynamics::from_model_owned(model), None)
     };
-    let dynamics = dynamics.with_element_classes(classes);
     let integrator = Integrator::new(dynamics, contact, loads, settings).map_err(|e| {
         let key = match e {
             TimeError::Unstable { .. } => "time.dt",
@@ -543,13 +526,6 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
             p.model.fill_order.name(),
             p.model.stiffness.nnz(),
             i.stiffness_product()
-        );
-    } else if i.implicit_solver() == ImplicitSolver::Modal {
-        let n_c = i.contact().map_or(0, |c| c.len());
-        println!(
-            "solver      implicit Newmark in the {n} modes of (K, M) (dense eigensolver once; up to {} DOFs): A₀ diagonal, no K·x per step; friction on the {n_c} contact unknowns by the Schur complement",
-            stickslip_time::MODAL_MAX_DOFS,
-            n = p.model.stiffness.nrows(),
         );
     } else {
         let n_c = i.contact().map_or(0, |c| c.len());
@@ -1067,24 +1043,9 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             )));
         }
         initial_mechanical = cp.initial_mechanical;
-        // The stored run's solver (modal iff its checkpoint holds the modal
-        // state), whatever output.every is now: a restart continues bit
-        // for bit.
-        let modal = !cp.modal.is_empty();
-        if modal != (integrator.implicit_solver() == ImplicitSolver::Modal) {
-            let solver = if modal {
-                ImplicitSolver::Modal
-            } else {
-                ImplicitSolver::Schur
-            };
-            integrator
-                .set_implicit_solver(solver)
-                .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
-        }
         // A state stored in another node order (a file of a version
         // before the node orders, or STICKSLIP_DOF_ORDER changed) is read
-        // into this run's numbering; the modal state, whose modes depend
-        // on the numbering, is then formed again from it.
+        // into this run's numbering.
         let remapped;
         let n_free = dofs.n_free();
         let lengths_fit = [&cp.displacement, &cp.velocity, &cp.acceleration]
@@ -1107,7 +1068,6 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
                 displacement: to_ours(&cp.displacement),
                 velocity: to_ours(&cp.velocity),
                 acceleration: to_ours(&cp.acceleration),
-                modal: Vec::new(),
                 ..cp.clone()
             };
             &remapped

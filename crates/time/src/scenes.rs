@@ -372,7 +372,6 @@ pub mod sdof {
             consistent_mass: scalar(1.0),
             lumped_mass: vec![1.0],
             constant_load: vec![0.0],
-            element_classes: None,
             stencils: true,
             fill_order: Default::default(),
         };
