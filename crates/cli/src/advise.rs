@@ -53,9 +53,9 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use crate::case::{self, Case, Scheme as CaseScheme, StickReduction};
-use crate::error::InputError;
 use crate::run::prepare;
+use stickslip_case::InputError;
+use stickslip_case::{self as case, Case, Scheme as CaseScheme, StickReduction};
 
 /// The output the tolerance is on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

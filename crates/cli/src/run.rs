@@ -43,10 +43,10 @@ macro_rules! say_out {
     }};
 }
 
-use crate::case::{self, Case};
-use crate::error::InputError;
 use crate::output::{self, CheckpointExtra, Header, Record, ResultsWriter, Summary};
 use crate::xdmf::XdmfInfo;
+use stickslip_case::InputError;
+use stickslip_case::{self as case, Case};
 
 /// How a run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -315,7 +315,7 @@ fn build(
         }
     }
     let Some(model) = model.filter(|_| groups_ok && problems.is_empty()) else {
-        return Err(input(crate::error::listed(problems)));
+        return Err(input(stickslip_case::listed(problems)));
     };
 
     let n_full = 2 * mesh.nodes.len();
@@ -394,7 +394,7 @@ fn build(
         }
     }
     if !problems.is_empty() {
-        return Err(input(crate::error::listed(problems)));
+        return Err(input(stickslip_case::listed(problems)));
     }
     let scheme = match case.time.scheme {
         case::Scheme::CentralDifference => Scheme::CentralDifference,
@@ -1141,8 +1141,12 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             contact_nodes: &contact_nodes,
             contact_s: &contact_s,
         };
-        let mut w = ResultsWriter::create_with(out, &header, case.output.compression)
-            .with_context(|| format!("cannot create the results file {}", out.display()))?;
+        let mut w = ResultsWriter::create_with(
+            out,
+            &header,
+            case.output.deflate_level().unwrap_or(output::DEFLATE_LEVEL),
+        )
+        .with_context(|| format!("cannot create the results file {}", out.display()))?;
         w.append(&record(&integrator, &dofs, &mut full, 0.0, 0))?;
         if !quiet {
             for w in setup_warnings(&mesh, &full.u, &integrator) {

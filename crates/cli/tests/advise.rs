@@ -22,7 +22,7 @@
 use std::path::{Path, PathBuf};
 
 use stickslip::advise::{self, Method, Quantity};
-use stickslip::case;
+use stickslip_case as case;
 
 const TOLS: [f64; 3] = [3e-2, 2e-2, 1e-2];
 const AT: [f64; 2] = [8.0, 1.0];

@@ -233,9 +233,9 @@ fn mutated_case_texts_never_panic() {
             .map(|_| sets_pool[rng.below(sets_pool.len())].to_string())
             .collect();
         let r = catch_unwind(AssertUnwindSafe(|| {
-            let r = stickslip::case::load_str(path, &text, &sets);
+            let r = stickslip_case::load_str(path, &text, &sets);
             if k % 8 == 0 {
-                let _ = stickslip::case::restart_changes(&text, seed_str(seed));
+                let _ = stickslip_case::restart_changes(&text, seed_str(seed));
             }
             r
         }));
