@@ -1,14 +1,18 @@
-//! The case file of stickslip: its schema, reading and validation.
+//! The case file of stickslip, and the one path from a case to a model.
 //!
 //! * [`load`]: a case file (with `--set` overrides) read and validated into
 //!   a [`Case`], every problem reported at once with its file and line, as
 //!   an [`InputError`];
 //! * the schema ([`schema`]): the types serde fills, the key list the
 //!   key-by-key check walks generated from them;
-//! * [`restart_changes`]: what a restart would change of a stored run.
+//! * [`restart_changes`]: what a restart would change of a stored run;
+//! * [`assemble`] and [`prepare`]: mesh, DOF map, model, loads, contact
+//!   surface, settings and the integrator built from a case, the problems
+//!   only the mesh reveals reported as [`InputError`]s too.
 //!
 //! Nothing here touches a terminal or a results file.
 
+mod build;
 mod error;
 mod keys;
 mod load;
@@ -17,6 +21,7 @@ mod restart;
 pub mod schema;
 mod set;
 
+pub use build::{assemble, prepare, Prepared, Running, Scene};
 pub use error::{listed, InputError, SHOWN};
 pub use load::{load, load_str, parse_str};
 pub use restart::restart_changes;

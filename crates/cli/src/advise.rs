@@ -53,9 +53,8 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use crate::run::prepare;
 use stickslip_case::InputError;
-use stickslip_case::{self as case, Case, Scheme as CaseScheme, StickReduction};
+use stickslip_case::{self as case, prepare, Case, Prepared, Scheme as CaseScheme, StickReduction};
 
 /// The output the tolerance is on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -476,7 +475,7 @@ fn nearest(
 
 fn probe_of(
     case: &Case,
-    p: &crate::run::Prepared,
+    p: &Prepared,
     q: Quantity,
     at: Option<[f64; 2]>,
 ) -> anyhow::Result<(Probe, Option<[f64; 2]>)> {
@@ -549,7 +548,7 @@ fn probe_of(
 /// Input problems as [`InputError`]; a step that fails.
 pub fn run_traced(case: &Case, q: Quantity, at: Option<[f64; 2]>) -> anyhow::Result<Trace> {
     let start = Instant::now();
-    let mut p = prepare(case, false)?;
+    let mut p = prepare(case)?;
     let (probe, _) = probe_of(case, &p, q, at)?;
     let n_c = p.integrator.contact().map_or(0, |c| c.len());
     let mut stress = vec![0.0; n_c];
@@ -799,14 +798,11 @@ pub fn read_ladder(
             case.time.t_end / 50.0,
             eps_of(case),
         );
-        let p = prepare(&c, false).map_err(|e| {
-            let msg = match e.downcast_ref::<InputError>() {
-                Some(i) => i.0.clone(),
-                None => format!("{e:#}"),
-            };
+        let p = prepare(&c).map_err(|e| {
             input(format!(
-                "{}mesh.ladder entry {text:?}: {msg}",
-                case.at("mesh.ladder")
+                "{}mesh.ladder entry {text:?}: {}",
+                case.at("mesh.ladder"),
+                e.0
             ))
         })?;
         let b = p.mesh.bbox();

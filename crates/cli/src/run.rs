@@ -1,8 +1,8 @@
 //! `stickslip run` and `stickslip check`: from a validated case to a model,
 //! an integrator and the HDF5 results, step by step.
 //!
-//! Everything that can be refused is refused in [`prepare`], before any
-//! time step, as an [`InputError`] (exit code 2). Once stepping starts,
+//! Everything that can be refused is refused before any time step (the
+//! model is built by `stickslip-case`), as an [`InputError`] (exit code 2). Once stepping starts,
 //! every completed output step is in the file; a failure marks the file
 //! `complete = false`, records the reason and returns [`Outcome::Failed`].
 
@@ -13,16 +13,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
-use stickslip_contact::{ContactSurface, IterationOptions};
-use stickslip_fem::{
-    body_force_load, traction_load, Dirichlet, DofMap, ElementClasses, Hypothesis as FemHypothesis,
-    Material, Model, NodeOrder, Traction,
-};
+use stickslip_case::{Prepared, Running, Scene};
+use stickslip_contact::ContactSurface;
+use stickslip_fem::{DofMap, NodeOrder};
 use stickslip_mesh::Mesh;
-use stickslip_time::{
-    Dynamics, ExplicitFriction, History, ImplicitSolver, Integrator, Load, MassKind, Scheme,
-    Settings, StickReduction, TimeError,
-};
+use stickslip_time::{ImplicitSolver, Integrator, Scheme};
 
 /// `eprintln!` that does not panic when stderr is closed: a run's
 /// messages must not end it (`stickslip run ... 2>&1 | head` closes the
@@ -62,31 +57,6 @@ pub enum Outcome {
     Interrupted,
 }
 
-/// A case turned into the objects that run it, with the model kept for
-/// inspection (`check`, `advise`).
-#[derive(Debug)]
-pub struct Prepared {
-    /// The mesh.
-    pub mesh: Mesh,
-    /// K, M, lumped M, DOF map.
-    pub model: Model,
-    /// The integrator at t = 0 (initial state computed).
-    pub integrator: Integrator,
-}
-
-/// A case turned into the objects that run it, for `run`: K and M have
-/// moved into the integrator (a copy left in a model would be held for the
-/// whole run, 24 bytes per stored entry of K beside the step's own data).
-#[derive(Debug)]
-pub struct Running {
-    /// The mesh.
-    pub mesh: Mesh,
-    /// The DOF map of the integrator's free DOFs.
-    pub dofs: DofMap,
-    /// The integrator at t = 0 (initial state computed).
-    pub integrator: Integrator,
-}
-
 /// Free DOFs from which a run or check says when the model is assembled
 /// (its setup then takes seconds: 12 s at 1.1M DOFs).
 const SETUP_NOTE_DOFS: usize = 200_000;
@@ -98,379 +68,52 @@ fn input(msg: impl Into<String>) -> anyhow::Error {
     anyhow::Error::new(InputError(msg.into()))
 }
 
-fn history(h: &case::History) -> History {
-    match h {
-        case::History::Constant => History::Constant,
-        case::History::Step => History::Step,
-        case::History::Sin { omega } => History::Sin { omega: *omega },
-        case::History::Table(points) => {
-            History::Table(points.iter().map(|p| (p[0], p[1])).collect())
-        }
+/// A case's model and integrator ([`stickslip_case::assemble`]), the
+/// model kept (`check`); with `progress`, [`setup_note`].
+fn prepare(case: &Case, progress: bool) -> Result<Prepared, InputError> {
+    let started = Instant::now();
+    let scene = stickslip_case::assemble(case)?;
+    if progress {
+        setup_note(&scene, started);
     }
-}
-
-/// Checks a group the case names against the mesh: it exists (else the
-/// message lists the mesh's groups) and, when `dim` is given, has that
-/// dimension.
-fn check_group(
-    mesh: &Mesh,
-    case: &Case,
-    key: &str,
-    name: &str,
-    dim: Option<u8>,
-    purpose: &str,
-    problems: &mut Vec<String>,
-) -> bool {
-    match mesh.group(name) {
-        Err(e) if matches!(e.kind, stickslip_mesh::MeshErrorKind::AmbiguousGroup { .. }) => {
-            problems.push(format!(
-                "{}{key} = {name:?}: in {}: {e}",
-                case.at(key),
-                case.mesh.file.display()
-            ));
-            false
-        }
-        Err(_) => {
-            let have: Vec<String> = mesh
-                .groups
-                .iter()
-                .map(|g| format!("{:?} (dim {})", g.name, g.dim))
-                .collect();
-            problems.push(format!(
-                "{}{key} = {name:?}: the mesh {} has no physical group {name:?}; it has: {}; \
-                 use one of those, or add the group in Gmsh (Physical Curve/Surface)",
-                case.at(key),
-                case.mesh.file.display(),
-                if have.is_empty() {
-                    "none".to_string()
-                } else {
-                    have.join(", ")
-                }
-            ));
-            false
-        }
-        Ok(g) => match dim {
-            Some(d) if g.dim != d => {
-                problems.push(format!(
-                    "{}{key} = {name:?}: {purpose} needs a group of boundary lines (dimension {d}), \
-                     but {name:?} has dimension {}; name the boundary edges in Gmsh with a Physical Curve",
-                    case.at(key),
-                    g.dim
-                ));
-                false
-            }
-            // A line inside the body (Gmsh's `Line{..} In Surface{..}`):
-            // a load or friction there would act inside the body.
-            Some(_) if mesh.interior_edges(g) > 0 => {
-                problems.push(format!(
-                    "{}{key} = {name:?}: {purpose} must be on the boundary, but {} of the group's {} edges \
-                     lie inside the body (each a side of two cells, as an embedded curve's are); name the \
-                     boundary edges instead",
-                    case.at(key),
-                    mesh.interior_edges(g),
-                    g.edges.len()
-                ));
-                false
-            }
-            _ => true,
-        },
-    }
-}
-
-/// Builds mesh, model, loads, contact surface and integrator. Every problem
-/// with the input is collected (groups the mesh lacks, groups of the wrong
-/// dimension, free rigid-body motions, Δt above the critical step, ...) and
-/// reported together as one [`InputError`], each naming the case file and
-/// line. `progress`: a line on stderr once a large model is assembled
-/// ([`SETUP_NOTE_DOFS`]).
-///
-/// # Errors
-/// Input problems (exit 2) as [`InputError`]; nothing else is expected.
-pub fn prepare(case: &Case, progress: bool) -> anyhow::Result<Prepared> {
-    let (mesh, _, model, integrator) = build(case, false, true, progress)?;
-    Ok(Prepared {
-        mesh,
-        model: model.expect("kept when asked"),
-        integrator,
-    })
+    scene.prepared(case)
 }
 
 /// [`prepare`] for a run, which will [`Integrator::restore`] a checkpoint
-/// when `restoring` (no initial static solve: the checkpoint has the state).
-/// K and M move into the integrator.
-///
-/// # Errors
-/// As [`prepare`].
-pub fn prepare_run(case: &Case, restoring: bool, progress: bool) -> anyhow::Result<Running> {
-    let (mesh, dofs, _, integrator) = build(case, restoring, false, progress)?;
-    Ok(Running {
-        mesh,
-        dofs,
-        integrator,
-    })
+/// when `restoring` (no initial static solve: the checkpoint has the
+/// state). K and M move into the integrator.
+fn prepare_run(case: &Case, restoring: bool, progress: bool) -> Result<Running, InputError> {
+    let started = Instant::now();
+    let mut scene = stickslip_case::assemble(case)?;
+    scene.settings.restoring = restoring;
+    if progress {
+        setup_note(&scene, started);
+    }
+    scene.running(case)
 }
 
-/// [`prepare`] and [`prepare_run`]: the model is returned when
-/// `keep_model`, else its matrices move into the integrator. With
-/// `progress`, a model of [`SETUP_NOTE_DOFS`] free DOFs or more gets a line
-/// on stderr before the integrator's setup (its factorizations take
-/// seconds there, with nothing else on the screen).
-fn build(
-    case: &Case,
-    restoring: bool,
-    keep_model: bool,
-    progress: bool,
-) -> anyhow::Result<(Mesh, DofMap, Option<Model>, Integrator)> {
-    let started = Instant::now();
-    let mesh = Mesh::from_file(&case.mesh.file)
-        .map_err(|e| input(format!("{}{e}", case.at("mesh.file"))))?;
-    let mut problems = Vec::new();
-
-    // Groups first: everything after needs them.
-    let mut groups_ok = true;
-    for (i, d) in case.dirichlet.iter().enumerate() {
-        groups_ok &= check_group(
-            &mesh,
-            case,
-            &format!("dirichlet.{i}.group"),
-            &d.group,
-            None,
-            "a Dirichlet condition",
-            &mut problems,
-        );
+/// A line on stderr before the integrator's setup where the model has
+/// [`SETUP_NOTE_DOFS`] free DOFs or more: its factorizations take seconds
+/// there, with nothing else on the screen.
+fn setup_note(scene: &Scene, started: Instant) {
+    let n_free = scene.model.dofs.n_free();
+    if n_free < SETUP_NOTE_DOFS {
+        return;
     }
-    let dirichlet_ok = groups_ok;
-    for (i, t) in case.traction.iter().enumerate() {
-        groups_ok &= check_group(
-            &mesh,
-            case,
-            &format!("traction.{i}.group"),
-            &t.group,
-            Some(1),
-            "a traction",
-            &mut problems,
-        );
-    }
-    if let Some(c) = &case.contact {
-        groups_ok &= check_group(
-            &mesh,
-            case,
-            "contact.group",
-            &c.group,
-            Some(1),
-            "the contact surface",
-            &mut problems,
-        );
-    }
-
-    let hypothesis = match case.material.hypothesis {
-        case::Hypothesis::PlaneStrain => FemHypothesis::PlaneStrain,
-        case::Hypothesis::PlaneStress => FemHypothesis::PlaneStress,
+    let order = scene.model.fill_order.name();
+    let work = match (scene.settings.scheme, scene.settings.restoring) {
+        (Scheme::CentralDifference, true) => "the step's operators".to_string(),
+        (Scheme::CentralDifference, false) => format!(
+            "the initial state (a static solve by sparse Cholesky, ordered by {order}, when loads act before t = 0) and the step's operators"
+        ),
+        (Scheme::Newmark { .. }, _) => format!(
+            "the factor of the step's operator (sparse Cholesky, ordered by {order}) and the initial state"
+        ),
     };
-    let material = match Material::new(
-        case.material.e,
-        case.material.nu,
-        case.material.rho,
-        hypothesis,
-    ) {
-        Ok(m) => Some(m),
-        Err(e) => {
-            problems.push(format!("{}[material]: {e}", case.at("material.E")));
-            None
-        }
-    };
-    let mut conditions = Vec::new();
-    for d in &case.dirichlet {
-        for (component, value) in [(0, d.ux), (1, d.uy)] {
-            if let Some(value) = value {
-                conditions.push(Dirichlet {
-                    group: d.group.clone(),
-                    component,
-                    value,
-                });
-            }
-        }
-    }
-    let dirichlet_at = case.at("dirichlet.0.group");
-    let model = match (&material, dirichlet_ok) {
-        (Some(material), true) => match Model::new(&mesh, material, &conditions) {
-            Ok(m) => Some(m),
-            Err(e) => {
-                problems.push(format!("{dirichlet_at}[[dirichlet]]: {e}"));
-                None
-            }
-        },
-        _ => None,
-    };
-    if let Some(m) = &model {
-        // The initial static solve (Remark 4.1) is frictionless: the
-        // supports alone must hold the body (DofMap checks each connected part).
-        let free = m.dofs.free_rigid_motions();
-        if !free.is_empty() {
-            problems.push(format!(
-                "{dirichlet_at}the supports leave a rigid-body motion free for the initial static solve: {}; \
-                 add [[dirichlet]] conditions that prevent it (e.g. uy = 0 on a bottom or top group and ux = 0 on an end)",
-                free.join(", ")
-            ));
-        }
-    }
-    let Some(model) = model.filter(|_| groups_ok && problems.is_empty()) else {
-        return Err(input(stickslip_case::listed(problems)));
-    };
-
-    let n_full = 2 * mesh.nodes.len();
-    let n_free = model.dofs.n_free();
-    let mut full = vec![0.0; n_full];
-    let mut loads = Vec::new();
-    let restrict = |full: &[f64]| {
-        let mut free = vec![0.0; n_free];
-        model.dofs.restrict(full, &mut free);
-        free
-    };
-    for (i, t) in case.traction.iter().enumerate() {
-        full.iter_mut().for_each(|x| *x = 0.0);
-        let traction = match (t.t, t.pressure) {
-            (Some(v), None) => Traction::Vector(v),
-            (None, Some(p)) => Traction::Pressure(p),
-            _ => {
-                problems.push(format!(
-                    "{}[[traction]] on {:?}: give exactly one of t or pressure",
-                    case.at(&format!("traction.{i}.group")),
-                    t.group
-                ));
-                continue;
-            }
-        };
-        match traction_load(&mesh, &t.group, traction, &mut full) {
-            Ok(()) => loads.push(Load {
-                vector: restrict(&full),
-                history: history(&t.history),
-            }),
-            Err(e) => problems.push(format!(
-                "{}[[traction]]: {e}",
-                case.at(&format!("traction.{i}.group"))
-            )),
-        }
-    }
-    if let Some(f) = case.body_force {
-        full.iter_mut().for_each(|x| *x = 0.0);
-        body_force_load(&mesh, f, &mut full);
-        loads.push(Load {
-            vector: restrict(&full),
-            history: History::Constant,
-        });
-    }
-    let mut iteration = IterationOptions::default();
-    let mut contact = None;
-    if let Some(c) = &case.contact {
-        // The prescribed normal traction on Γ_C is a load like any other,
-        // present before t = 0 (it makes the initial static state).
-        full.iter_mut().for_each(|x| *x = 0.0);
-        match traction_load(&mesh, &c.group, Traction::Pressure(c.pressure), &mut full) {
-            Ok(()) => loads.push(Load {
-                vector: restrict(&full),
-                history: History::Constant,
-            }),
-            Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
-        }
-        iteration = IterationOptions {
-            remark_4_2: c.remark_4_2,
-            max_iterations: c.max_iterations,
-        };
-        match ContactSurface::from_group(&mesh, &model.dofs, &c.group, c.pressure, c.mu, c.eps) {
-            // Every node's tangential DOF held: the friction the case asks
-            // for could act nowhere (before, it was dropped silently, and
-            // the file had no /contact).
-            Ok(s) if s.is_empty() => problems.push(format!(
-                "{}[contact]: no node of group \"{}\" can slide: [[dirichlet]] conditions hold the tangential \
-                 motion of all its {} nodes, so friction would act nowhere; remove the [[dirichlet]] on the \
-                 contact surface's tangential direction, or remove [contact] for a run without friction",
-                case.at("contact.group"),
-                c.group,
-                s.excluded.len()
-            )),
-            Ok(s) => contact = Some(s),
-            Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
-        }
-    }
-    if !problems.is_empty() {
-        return Err(input(stickslip_case::listed(problems)));
-    }
-    let scheme = match case.time.scheme {
-        case::Scheme::CentralDifference => Scheme::CentralDifference,
-        case::Scheme::Newmark => Scheme::Newmark {
-            beta: case.time.beta,
-            gamma: case.time.gamma,
-        },
-    };
-    let settings = Settings {
-        scheme,
-        mass: case.time.mass.map(|m| match m {
-            case::MassKind::Consistent => MassKind::Consistent,
-            case::MassKind::Lumped => MassKind::Lumped,
-        }),
-        dt: case.time.dt,
-        t_end: case.time.t_end,
-        stick_reduction: case.time.stick_reduction.as_ref().map(|r| StickReduction {
-            dt: r.dt,
-            steps: r.steps,
-        }),
-        iteration,
-        allow_unstable: case.time.allow_unstable,
-        explicit_friction: ExplicitFriction::ClosedForm,
-        initial_velocity: None,
-        // The state is read at every record: the modal step of small
-        // systems pays 3n² for each read, so with a record at every step
-        // the factor's step costs less (the paper's Newmark case, 20,000
-        // steps end to end: 24.4 µs a step by the factor, 26.5 µs modal),
-        // from every second step on the modal one.
-        reads_every: Some(case.output.every.max(1) as u64),
-        restoring,
-    };
-    // The explicit step forms K·x by stencil types where the mesh's
-    // numbering repeats its node rows (structured meshes numbered row by
-    // row), else from element classes where the mesh has them (structured
-    // Q2 meshes), else from a compact copy of the assembled K
-    // (stickslip-time's kernels.rs picks).
-    let classes = match (scheme, &material) {
-        (Scheme::CentralDifference, Some(material)) => {
-            ElementClasses::new(&mesh, material, &model.dofs)
-        }
-        _ => None,
-    };
-    let dofs = model.dofs.clone();
-    if progress && dofs.n_free() >= SETUP_NOTE_DOFS {
-        let order = model.fill_order.name();
-        let work = match (scheme, restoring) {
-            (Scheme::CentralDifference, true) => "the step's operators".to_string(),
-            (Scheme::CentralDifference, false) => format!(
-                "the initial state (a static solve by sparse Cholesky, ordered by {order}, when loads act before t = 0) and the step's operators"
-            ),
-            (Scheme::Newmark { .. }, _) => format!(
-                "the factor of the step's operator (sparse Cholesky, ordered by {order}) and the initial state"
-            ),
-        };
-        say!(
-            "model: {} free DOFs, assembled in {:.1} s; now {work}",
-            dofs.n_free(),
-            started.elapsed().as_secs_f64(),
-        );
-    }
-    let (dynamics, model) = if keep_model {
-        (Dynamics::from_model(&model), Some(model))
-    } else {
-        (Dynamics::from_model_owned(model), None)
-    };
-    let dynamics = dynamics.with_element_classes(classes);
-    let integrator = Integrator::new(dynamics, contact, loads, settings).map_err(|e| {
-        let key = match e {
-            TimeError::Unstable { .. } => "time.dt",
-            TimeError::Static(_) => "dirichlet.0.group",
-            _ => "time.scheme",
-        };
-        input(format!("{}[time]: {e}", case.at(key)))
-    })?;
-    Ok((mesh, dofs, model, integrator))
+    say!(
+        "model: {n_free} free DOFs, assembled in {:.1} s; now {work}",
+        started.elapsed().as_secs_f64(),
+    );
 }
 
 /// `stickslip check`: validate, print the model size, Δt_crit and solver.
