@@ -8,7 +8,10 @@
 //! * [`restart_changes`]: what a restart would change of a stored run;
 //! * [`assemble`] and [`prepare`]: mesh, DOF map, model, loads, contact
 //!   surface, settings and the integrator built from a case, the problems
-//!   only the mesh reveals reported as [`InputError`]s too.
+//!   only the mesh reveals reported as [`InputError`]s too;
+//! * [`Method`] and the pilot runner ([`pilot`]): a case run to t_end under
+//!   one of the methods `stickslip advise` and the studies compare,
+//!   recording chosen outputs, timed.
 //!
 //! Nothing here touches a terminal or a results file.
 
@@ -17,6 +20,8 @@ mod error;
 mod keys;
 mod load;
 mod locate;
+mod method;
+pub mod pilot;
 mod restart;
 pub mod schema;
 mod set;
@@ -24,6 +29,7 @@ mod set;
 pub use build::{assemble, prepare, Prepared, Running, Scene};
 pub use error::{listed, InputError, SHOWN};
 pub use load::{load, load_str, parse_str};
+pub use method::{Method, PAPER_REDUCTION};
 pub use restart::restart_changes;
 pub use schema::{
     Case, ContactSection, DirichletSection, History, Hypothesis, MassKind, MaterialSection,
