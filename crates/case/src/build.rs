@@ -143,7 +143,7 @@ fn history(h: &History) -> TimeHistory {
 
 /// The time crate's settings of a case; `reads_every` is the output
 /// interval, since the caller reads the state at every record.
-fn settings(case: &Case) -> Settings {
+pub fn settings(case: &Case) -> Settings {
     let scheme = match case.time.scheme {
         Scheme::CentralDifference => TimeScheme::CentralDifference,
         Scheme::Newmark => TimeScheme::Newmark {

@@ -26,7 +26,7 @@ mod restart;
 pub mod schema;
 mod set;
 
-pub use build::{assemble, prepare, Prepared, Running, Scene};
+pub use build::{assemble, prepare, settings, Prepared, Running, Scene};
 pub use error::{listed, InputError, SHOWN};
 pub use load::{load, load_str, parse_str};
 pub use method::{Method, PAPER_REDUCTION};
