@@ -13,7 +13,8 @@
 //!   one of the methods `stickslip advise` and the studies compare,
 //!   recording chosen outputs, timed.
 //!
-//! Nothing here touches a terminal or a results file.
+//! Nothing here touches a terminal or a results file: the binary
+//! (`stickslip`), `verify` and `study` use the same reader and builder.
 
 mod build;
 mod error;
