@@ -14,11 +14,31 @@
 //! arguments: a `stickslip_case::InputError`); 1 a run that failed after it
 //! started; 130 interrupted.
 
+/// `eprintln!` that does not panic when stderr is closed: a run's
+/// messages must not end it (`stickslip run ... 2>&1 | head` closes the
+/// pipe while the run goes on, and a panic there lost the steps since the
+/// last flush).
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), $($t)*);
+    }};
+}
+
+/// [`say!`] on stdout.
+macro_rules! say_out {
+    ($($t:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
 pub mod advise;
 pub mod mesh_cmd;
 pub mod output;
 pub mod probe;
 pub mod results_file;
 pub mod run;
+mod start;
 pub mod stress_cmd;
 pub mod xdmf;

@@ -2,9 +2,11 @@
 //! an integrator and the HDF5 results, step by step.
 //!
 //! Everything that can be refused is refused before any time step (the
-//! model is built by `stickslip-case`), as an [`InputError`] (exit code 2). Once stepping starts,
-//! every completed output step is in the file; a failure marks the file
-//! `complete = false`, records the reason and returns [`Outcome::Failed`].
+//! model is built by `stickslip-case`), as an [`InputError`] (exit code
+//! 2). Once stepping starts, every completed output step is in the file; a
+//! failure marks the file `complete = false`, records the reason and
+//! returns [`Outcome::Failed`]. Where a run starts (a new file, or a
+//! restart's checkpoint) is `start.rs`.
 
 use std::io::IsTerminal;
 use std::path::Path;
@@ -13,35 +15,15 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
-use stickslip_case::{Prepared, Running, Scene};
+use stickslip_case::{self as case, Case, InputError, Prepared, Running, Scene};
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{DofMap, NodeOrder};
 use stickslip_mesh::Mesh;
 use stickslip_time::{ImplicitSolver, Integrator, Scheme};
 
-/// `eprintln!` that does not panic when stderr is closed: a run's
-/// messages must not end it (`stickslip run ... 2>&1 | head` closes the
-/// pipe while the run goes on, and a panic there lost the steps since the
-/// last flush).
-macro_rules! say {
-    ($($t:tt)*) => {{
-        use std::io::Write;
-        let _ = writeln!(std::io::stderr(), $($t)*);
-    }};
-}
-
-/// [`say!`] on stdout.
-macro_rules! say_out {
-    ($($t:tt)*) => {{
-        use std::io::Write;
-        let _ = writeln!(std::io::stdout(), $($t)*);
-    }};
-}
-
-use crate::output::{self, CheckpointExtra, Header, Record, ResultsWriter, Summary};
+use crate::output::{self, CheckpointExtra, Record, ResultsWriter, Summary};
+use crate::start;
 use crate::xdmf::XdmfInfo;
-use stickslip_case::InputError;
-use stickslip_case::{self as case, Case};
 
 /// How a run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -64,7 +46,7 @@ const SETUP_NOTE_DOFS: usize = 200_000;
 /// Seconds between progress lines where stderr is not a terminal.
 const PROGRESS_LOG_SECS: u64 = 60;
 
-fn input(msg: impl Into<String>) -> anyhow::Error {
+pub(crate) fn input(msg: impl Into<String>) -> anyhow::Error {
     anyhow::Error::new(InputError(msg.into()))
 }
 
@@ -322,7 +304,7 @@ fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
 /// What runs but is likely not meant, in the words `check` prints and a
 /// fresh run says before its first step (one list, so the two cannot
 /// drift apart): `u` is the initial displacement at every node.
-fn setup_warnings(mesh: &Mesh, u: &[f64], integrator: &Integrator) -> Vec<String> {
+pub(crate) fn setup_warnings(mesh: &Mesh, u: &[f64], integrator: &Integrator) -> Vec<String> {
     large_static_displacement(mesh, u)
         .into_iter()
         .chain(integrator.contact().and_then(|c| oblique_supports(mesh, c)))
@@ -417,8 +399,8 @@ fn human_bytes(b: f64) -> String {
 }
 
 /// Full-length (2 × nodes) copies of the free-DOF state for output.
-struct FullState {
-    u: Vec<f64>,
+pub(crate) struct FullState {
+    pub(crate) u: Vec<f64>,
     v: Vec<f64>,
     a: Vec<f64>,
     stress: Vec<f64>,
@@ -426,7 +408,21 @@ struct FullState {
     state: Vec<i8>,
 }
 
-fn record<'a>(
+impl FullState {
+    /// Buffers for `nodes` mesh nodes and `n_c` contact nodes.
+    pub(crate) fn new(nodes: usize, n_c: usize) -> FullState {
+        FullState {
+            u: vec![0.0; 2 * nodes],
+            v: vec![0.0; 2 * nodes],
+            a: vec![0.0; 2 * nodes],
+            stress: vec![0.0; n_c],
+            slip: vec![0.0; n_c],
+            state: vec![0; n_c],
+        }
+    }
+}
+
+pub(crate) fn record<'a>(
     i: &Integrator,
     dofs: &DofMap,
     s: &'a mut FullState,
@@ -606,24 +602,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         dofs,
         mut integrator,
     } = prepare_run(case, options.restart, !quiet)?;
-    let (contact_nodes, contact_s): (Vec<usize>, Vec<f64>) = integrator
-        .contact()
-        .map(|c| c.nodes.iter().map(|n| (n.node, n.s)).unzip())
-        .unwrap_or_default();
-    let n_c = contact_nodes.len();
-    let n_full = 2 * mesh.nodes.len();
-    let mut full = FullState {
-        u: vec![0.0; n_full],
-        v: vec![0.0; n_full],
-        a: vec![0.0; n_full],
-        stress: vec![0.0; n_c],
-        slip: vec![0.0; n_c],
-        state: vec![0; n_c],
-    };
-    // E₀ for the blow-up test: kinetic + strain at t = 0.
-    let node_order = dofs.node_order();
-    let e0 = integrator.energy();
-    let mut initial_mechanical = e0.kinetic + e0.strain;
+    let n_c = integrator.contact().map_or(0, |c| c.len());
     // A signal during the setup: stop before the file is touched (with
     // --force the old results would otherwise be gone for a run of one
     // step).
@@ -673,442 +652,460 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     } else {
         crate::results_file::claim(out)?
     };
-    let (mut writer, wall_before, mut max_balance, mut times) = if options.restart {
-        let stored = output::read_checkpoint(out)
-            .map_err(|e| input(format!("--restart {}: {e:#}", out.display())))?;
-        let changes = case::restart_changes(&stored.case_source, &case.source)
-            .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
-        if !changes.is_empty() {
-            return Err(input(format!(
-                "{}: --restart {}: the case changes what the stored run computed:\n  {}\n\
-                 a restart may change only time.t_end, output.*, title and mesh.ladder; undo those changes, or start a new run with -o NEW.h5",
-                case.path.display(),
-                out.display(),
-                changes.join("\n  ")
-            )));
-        }
-        if let Some(change) = output::stored_mesh_change(out, &mesh)
-            .map_err(|e| input(format!("--restart {}: {e:#}", out.display())))?
-        {
-            return Err(input(format!(
-                "{}: --restart {}: {} has changed since the run began ({change}); restart with \
-                 the mesh the run began on, or start a new run with -o NEW.h5",
-                case.path.display(),
-                out.display(),
-                case.mesh.file.display()
-            )));
-        }
-        let cp = &stored.checkpoint;
-        if case.time.t_end < cp.t {
-            return Err(input(format!(
-                "{}time.t_end = {} is before the checkpoint's t = {} in {}; give a t_end >= {}",
-                case.at("time.t_end"),
-                case.time.t_end,
-                cp.t,
-                out.display(),
-                cp.t
-            )));
-        }
-        initial_mechanical = cp.initial_mechanical;
-        // The stored run's solver (modal iff its checkpoint holds the modal
-        // state), whatever output.every is now: a restart continues bit
-        // for bit.
-        let modal = !cp.modal.is_empty();
-        if modal != (integrator.implicit_solver() == ImplicitSolver::Modal) {
-            let solver = if modal {
-                ImplicitSolver::Modal
-            } else {
-                ImplicitSolver::Schur
-            };
-            integrator
-                .set_implicit_solver(solver)
-                .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
-        }
-        // A state stored in another node order (a file of a version
-        // before the node orders, or STICKSLIP_DOF_ORDER changed) is read
-        // into this run's numbering; the modal state, whose modes depend
-        // on the numbering, is then formed again from it.
-        let remapped;
-        let n_free = dofs.n_free();
-        let lengths_fit = [&cp.displacement, &cp.velocity, &cp.acceleration]
-            .iter()
-            .all(|x| x.len() == n_free);
-        // (Other lengths: `restore` says what is wrong.)
-        let cp = if stored.extra.node_order != node_order.code() && lengths_fit {
-            let theirs = NodeOrder::from_code(stored.extra.node_order)
-                .and_then(|order| dofs.renumbered(&mesh, order))
-                .ok_or_else(|| {
-                    input(format!(
-                        "--restart {}: its state's node_order {} does not apply to {} (a newer version's order, or a structured grid's on a mesh that is none); restart with the version and the mesh the run started from",
-                        out.display(),
-                        stored.extra.node_order,
-                        case.mesh.file.display()
-                    ))
-                })?;
-            let to_ours = |x: &[f64]| dofs.from_numbering(&theirs, x);
-            remapped = stickslip_time::Checkpoint {
-                displacement: to_ours(&cp.displacement),
-                velocity: to_ours(&cp.velocity),
-                acceleration: to_ours(&cp.acceleration),
-                modal: Vec::new(),
-                ..cp.clone()
-            };
-            &remapped
-        } else {
-            cp
-        };
-        integrator
-            .restore(cp)
-            .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
-        let mut w = ResultsWriter::open_append(out, stored.extra.rows, mesh.nodes.len(), n_c)?;
-        w.set_case(&case.source)?;
-        if !quiet {
-            say!(
-                "restart: continuing {} from step {}, t = {} ({} records kept)",
-                out.display(),
-                cp.steps,
-                cp.t,
-                stored.extra.rows
-            );
-        }
-        (
-            w,
-            stored.extra.wall_time_s,
-            stored.extra.max_balance,
-            stored.times,
-        )
+    let mut full = FullState::new(mesh.nodes.len(), n_c);
+    let opened = if options.restart {
+        start::resume(case, out, quiet, &mesh, &dofs, &mut integrator)?
     } else {
-        let header = Header {
-            case_source: &case.source,
-            mesh: &mesh,
-            contact_nodes: &contact_nodes,
-            contact_s: &contact_s,
-        };
-        let mut w = ResultsWriter::create_with(
-            out,
-            &header,
-            case.output.deflate_level().unwrap_or(output::DEFLATE_LEVEL),
-        )
-        .with_context(|| format!("cannot create the results file {}", out.display()))?;
-        w.append(&record(&integrator, &dofs, &mut full, 0.0, 0))?;
-        if !quiet {
-            for w in setup_warnings(&mesh, &full.u, &integrator) {
-                say!("{}: warning: {w}", case.path.display());
-            }
-        }
-        (w, 0.0, 0.0, vec![integrator.time()])
+        start::fresh(case, out, quiet, &mesh, &dofs, &integrator, &mut full)?
     };
-    writer.auto_flush = false;
-    writer.flush_every_steps = case.output.flush_every.max(1);
-    writer.flush_every_secs = case.output.flush_seconds;
-    let extra = |rows: usize, max_balance: f64| CheckpointExtra {
-        rows,
-        wall_time_s: wall_before + started.elapsed().as_secs_f64(),
-        max_balance,
-        node_order: node_order.code(),
+    let mut session = Session {
+        case,
+        out,
+        options,
+        mesh: &mesh,
+        dofs: &dofs,
+        integrator,
+        writer: opened.writer,
+        full,
+        times: opened.times,
+        max_balance: opened.max_balance,
+        wall_before: opened.wall_before,
+        initial_mechanical: opened.initial_mechanical,
+        started,
+        xdmf_path: out.with_extension("xdmf"),
     };
-    let xdmf_path = out.with_extension("xdmf");
-    let xdmf = |times: &[f64]| {
-        let info = XdmfInfo {
-            n_nodes: mesh.nodes.len(),
-            kind: mesh.kind,
-            n_cells: mesh.n_cells(),
-            times,
-            stress: None,
-        };
-        crate::xdmf::write_xdmf(out, &xdmf_path, &info)
-            .with_context(|| format!("cannot write {}", xdmf_path.display()))
-    };
+    session.writer.auto_flush = false;
+    session.writer.flush_every_steps = case.output.flush_every.max(1);
+    session.writer.flush_every_secs = case.output.flush_seconds;
     // A state to continue from exists from the start (the initial state, or
     // the restored one).
-    writer.write_checkpoint(&integrator.checkpoint(), &extra(writer.rows(), max_balance))?;
-    xdmf(&times)?;
-    let mut last_xdmf = Instant::now();
-    // How long the last rewrite took: the next waits ten times that (and at
-    // least flush_seconds), so the rewrites, each O(rows), stay under a
-    // tenth of the run however many rows (at a fixed interval they took 42%
-    // of a run of 320k rows).
-    let mut xdmf_secs = 0.0_f64;
-
-    let every = case.output.every.max(1) as u64;
-    let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
-        let bar = indicatif::ProgressBar::new(1000);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:30} {percent:>3}% {msg}, ETA {eta}",
-            )
-            .expect("valid template"),
-        );
-        bar
-    });
-    // Where stderr is a log, not a terminal: a line a minute instead of
-    // the bar, so a batch job's log shows a long run moving.
-    let log_progress = !quiet && !std::io::stderr().is_terminal();
-    let mut last_log = Instant::now();
+    session.checkpoint(None)?;
+    session.write_xdmf()?;
     let setup_s = started.elapsed().as_secs_f64();
-    let stepping = Instant::now();
-    if log_progress {
+    let mut progress = Progress::new(quiet, &session.integrator);
+    if progress.log {
+        let i = &session.integrator;
         say!(
             "setup done in {setup_s:.1} s; stepping from t = {} to t_end = {} (about {} steps), a progress line a minute",
-            integrator.time(),
-            integrator.t_end(),
-            ((integrator.t_end() - integrator.time()) / case.time.dt).ceil()
+            i.time(),
+            i.t_end(),
+            ((i.t_end() - i.time()) / case.time.dt).ceil()
         );
     }
-    let t_end = integrator.t_end();
-    // A restart starts where its checkpoint was: the share done and the
-    // time left count from there.
-    let t_start = integrator.time();
-    let steps_before = integrator.steps();
-    let mut failure: Option<String> = None;
-    let mut interrupted: Option<&'static str> = None;
-    // The state before the last step (and the rows then): that step is
-    // shortened to land on t_end, so a restart with a later t_end must redo
-    // it at full length to match a run that never stopped.
-    let mut before_last: Option<(stickslip_time::Checkpoint, usize)> = None;
-    while !integrator.done() {
-        let near_end = integrator.t_end() - integrator.time() <= case.time.dt * (1.0 + 1e-6);
-        let before = near_end.then(|| (integrator.checkpoint(), writer.rows()));
-        match integrator.step() {
-            Ok(info) => {
-                max_balance = max_balance.max(integrator.energy().balance.abs());
-                writer.count_step();
-                let write = integrator.steps() % every == 0 || integrator.done();
-                let mut rec = |writer: &mut ResultsWriter, full: &mut FullState| {
-                    times.push(integrator.time());
-                    writer.append(&record(
-                        &integrator,
-                        &dofs,
-                        full,
-                        info.dt,
-                        info.iterations as u32,
-                    ))
-                };
-                if write {
-                    // HDF5 writes a chunk of rows as it fills: the room for
-                    // it is checked before, as before a flush.
-                    if writer.append_writes() {
-                        if let Some(e) = disk_nearly_full(&writer, &dofs, out, &integrator) {
-                            failure = Some(e);
-                            break;
-                        }
-                    }
-                    rec(&mut writer, &mut full)?;
+    let stepping = Instant::now();
+    let ending = session.step_to_end(&mut progress)?;
+    progress.finish();
+    session.conclude(ending, setup_s, stepping, progress.steps_before)
+}
+
+/// How the stepping ended.
+struct Ending {
+    /// Why the run stopped early, if it failed.
+    failure: Option<String>,
+    /// The signal that stopped it, if one did.
+    interrupted: Option<&'static str>,
+    /// The state before the last step (and the rows then): that step is
+    /// shortened to land on t_end, so a restart with a later t_end must
+    /// redo it at full length to match a run that never stopped.
+    before_last: Option<(stickslip_time::Checkpoint, usize)>,
+}
+
+/// What a run shows while it steps: a bar on a terminal, else (a log) a
+/// line a minute, so that a batch job's log shows a long run moving.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    log: bool,
+    last_log: Instant,
+    /// Where this run started (a restart: at its checkpoint), so that the
+    /// share done and the time left count from there.
+    t_start: f64,
+    steps_before: u64,
+}
+
+impl Progress {
+    fn new(quiet: bool, integrator: &Integrator) -> Progress {
+        let terminal = std::io::stderr().is_terminal();
+        let bar = (!quiet && terminal).then(|| {
+            let bar = indicatif::ProgressBar::new(1000);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{spinner} [{elapsed_precise}] {bar:30} {percent:>3}% {msg}, ETA {eta}",
+                )
+                .expect("valid template"),
+            );
+            bar
+        });
+        Progress {
+            bar,
+            log: !quiet && !terminal,
+            last_log: Instant::now(),
+            t_start: integrator.time(),
+            steps_before: integrator.steps(),
+        }
+    }
+
+    /// After every step: the bar.
+    fn stepped(&self, i: &Integrator, started: Instant) {
+        if let Some(bar) = &self.bar {
+            let t_end = i.t_end();
+            let rate =
+                (i.steps() - self.steps_before) as f64 / started.elapsed().as_secs_f64().max(1e-9);
+            bar.set_position((1000.0 * i.time() / t_end) as u64);
+            bar.set_message(format!(
+                "t = {:.4e} of {t_end}, step {}, {rate:.0} steps/s",
+                i.time(),
+                i.steps()
+            ));
+        }
+    }
+
+    /// After a flush: the log's line, once a minute.
+    fn flushed(&mut self, i: &Integrator, started: Instant) {
+        if self.log && self.last_log.elapsed().as_secs() >= PROGRESS_LOG_SECS {
+            self.last_log = Instant::now();
+            let t_end = i.t_end();
+            let wall = started.elapsed().as_secs_f64();
+            let done = (i.time() - self.t_start) / (t_end - self.t_start).max(1e-300);
+            say!(
+                "progress: t = {:.6e} of {t_end} ({:.1}%), step {}, {:.0} s elapsed, about {:.0} s left",
+                i.time(),
+                100.0 * done,
+                i.steps(),
+                wall,
+                wall * (1.0 - done) / done.max(1e-12)
+            );
+        }
+    }
+
+    fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// A run in progress: the integrator, the file it writes and what the
+/// stepping keeps from step to step.
+struct Session<'a> {
+    case: &'a Case,
+    out: &'a Path,
+    options: &'a RunOptions,
+    mesh: &'a Mesh,
+    dofs: &'a DofMap,
+    integrator: Integrator,
+    writer: ResultsWriter,
+    full: FullState,
+    /// Times of the records written.
+    times: Vec<f64>,
+    max_balance: f64,
+    wall_before: f64,
+    initial_mechanical: f64,
+    started: Instant,
+    xdmf_path: std::path::PathBuf,
+}
+
+impl Session<'_> {
+    /// Writes `cp` (or the current state) as the file's checkpoint, with
+    /// `rows` records (or all so far).
+    fn checkpoint(
+        &mut self,
+        at: Option<(stickslip_time::Checkpoint, usize)>,
+    ) -> anyhow::Result<()> {
+        let (cp, rows) = at.unwrap_or_else(|| (self.integrator.checkpoint(), self.writer.rows()));
+        let extra = CheckpointExtra {
+            rows,
+            wall_time_s: self.wall_before + self.started.elapsed().as_secs_f64(),
+            max_balance: self.max_balance,
+            node_order: self.dofs.node_order().code(),
+        };
+        self.writer.write_checkpoint(&cp, &extra)
+    }
+
+    /// The ParaView side file, listing every record so far.
+    fn write_xdmf(&self) -> anyhow::Result<()> {
+        write_xdmf(self.out, &self.xdmf_path, self.mesh, &self.times)
+    }
+
+    /// Appends the current state as a record.
+    fn append(&mut self, dt: f64, iterations: u32) -> anyhow::Result<()> {
+        self.times.push(self.integrator.time());
+        self.writer.append(&record(
+            &self.integrator,
+            self.dofs,
+            &mut self.full,
+            dt,
+            iterations,
+        ))
+    }
+
+    /// The failure of a run whose disk has less room than its next write
+    /// may take, if it has.
+    fn disk_nearly_full(&self) -> Option<String> {
+        disk_nearly_full(&self.writer, self.dofs, self.out, &self.integrator)
+    }
+
+    /// Steps to t_end (or a failure, a signal), writing every
+    /// `output.every`-th step, flushing and checkpointing when due.
+    fn step_to_end(&mut self, progress: &mut Progress) -> anyhow::Result<Ending> {
+        let every = self.case.output.every.max(1) as u64;
+        let mut last_xdmf = Instant::now();
+        // How long the last rewrite took: the next waits ten times that (and at
+        // least flush_seconds), so the rewrites, each O(rows), stay under a
+        // tenth of the run however many rows (at a fixed interval they took 42%
+        // of a run of 320k rows).
+        let mut xdmf_secs = 0.0_f64;
+        let mut ending = Ending {
+            failure: None,
+            interrupted: None,
+            before_last: None,
+        };
+        while !self.integrator.done() {
+            let i = &self.integrator;
+            let near_end = i.t_end() - i.time() <= self.case.time.dt * (1.0 + 1e-6);
+            let before = near_end.then(|| (i.checkpoint(), self.writer.rows()));
+            let info = match self.integrator.step() {
+                Ok(info) => info,
+                Err(e) => {
+                    ending.failure = Some(e.to_string());
+                    break;
                 }
-                if integrator.is_explicit() {
-                    if let Some(bound) = blow_up(&integrator, initial_mechanical) {
-                        if !write {
-                            rec(&mut writer, &mut full)?;
-                        }
-                        let e = integrator.energy();
-                        let crit = integrator.dt_crit().unwrap_or(f64::NAN);
-                        failure = Some(format!(
-                            "step {} (t = {:.6e}): energy blow-up: kinetic + strain = {:.3e} exceeds {BLOW_UP_FACTOR} x (initial + |work| + dissipated) = {bound:.3e}; \
-                             central difference is unstable at time.dt = {:e}, above its critical step dt_crit = {crit:.6e}: \
-                             use time.dt < {crit:.4e} (e.g. {:.4e}) and remove time.allow_unstable",
-                            integrator.steps(),
-                            integrator.time(),
-                            e.kinetic + e.strain,
-                            case.time.dt,
-                            0.9 * crit
-                        ));
+            };
+            self.max_balance = self.max_balance.max(self.integrator.energy().balance.abs());
+            self.writer.count_step();
+            let write = self.integrator.steps().is_multiple_of(every) || self.integrator.done();
+            if write {
+                // HDF5 writes a chunk of rows as it fills: the room for
+                // it is checked before, as before a flush.
+                if self.writer.append_writes() {
+                    if let Some(e) = self.disk_nearly_full() {
+                        ending.failure = Some(e);
                         break;
                     }
                 }
-                if integrator.done() {
-                    before_last = before;
+                self.append(info.dt, info.iterations as u32)?;
+            }
+            if self.integrator.is_explicit() {
+                if let Some(bound) = blow_up(&self.integrator, self.initial_mechanical) {
+                    if !write {
+                        self.append(info.dt, info.iterations as u32)?;
+                    }
+                    ending.failure = Some(blow_up_failure(&self.integrator, bound, self.case));
                     break;
-                }
-                if let Some(sig) = options.stop.received() {
-                    interrupted = Some(sig);
-                    break;
-                }
-                if writer.flush_due() {
-                    if let Some(e) = disk_nearly_full(&writer, &dofs, out, &integrator) {
-                        failure = Some(e);
-                        break;
-                    }
-                    writer.write_checkpoint(
-                        &integrator.checkpoint(),
-                        &extra(writer.rows(), max_balance),
-                    )?;
-                    // The XML lists every row: rewrite it at most every
-                    // flush_seconds, and ten times as seldom as it takes.
-                    let wait = case.output.flush_seconds.max(10.0 * xdmf_secs);
-                    if last_xdmf.elapsed().as_secs_f64() >= wait {
-                        let t = Instant::now();
-                        xdmf(&times)?;
-                        xdmf_secs = t.elapsed().as_secs_f64();
-                        last_xdmf = Instant::now();
-                    }
-                    if log_progress && last_log.elapsed().as_secs() >= PROGRESS_LOG_SECS {
-                        last_log = Instant::now();
-                        let wall = started.elapsed().as_secs_f64();
-                        let done = (integrator.time() - t_start) / (t_end - t_start).max(1e-300);
-                        say!(
-                            "progress: t = {:.6e} of {t_end} ({:.1}%), step {}, {:.0} s elapsed, about {:.0} s left",
-                            integrator.time(),
-                            100.0 * done,
-                            integrator.steps(),
-                            wall,
-                            wall * (1.0 - done) / done.max(1e-12)
-                        );
-                    }
-                }
-                if let Some(bar) = &bar {
-                    let rate = (integrator.steps() - steps_before) as f64
-                        / started.elapsed().as_secs_f64().max(1e-9);
-                    bar.set_position((1000.0 * integrator.time() / t_end) as u64);
-                    bar.set_message(format!(
-                        "t = {:.4e} of {t_end}, step {}, {rate:.0} steps/s",
-                        integrator.time(),
-                        integrator.steps()
-                    ));
                 }
             }
-            Err(e) => {
-                failure = Some(e.to_string());
+            if self.integrator.done() {
+                ending.before_last = before;
                 break;
             }
+            if let Some(sig) = self.options.stop.received() {
+                ending.interrupted = Some(sig);
+                break;
+            }
+            if self.writer.flush_due() {
+                if let Some(e) = self.disk_nearly_full() {
+                    ending.failure = Some(e);
+                    break;
+                }
+                self.checkpoint(None)?;
+                // The XML lists every row: rewrite it at most every
+                // flush_seconds, and ten times as seldom as it takes.
+                let wait = self.case.output.flush_seconds.max(10.0 * xdmf_secs);
+                if last_xdmf.elapsed().as_secs_f64() >= wait {
+                    let t = Instant::now();
+                    self.write_xdmf()?;
+                    xdmf_secs = t.elapsed().as_secs_f64();
+                    last_xdmf = Instant::now();
+                }
+                progress.flushed(&self.integrator, self.started);
+            }
+            progress.stepped(&self.integrator, self.started);
         }
+        Ok(ending)
     }
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
-    let complete = failure.is_none() && interrupted.is_none();
-    if complete || interrupted.is_some() {
-        // A failed run keeps the checkpoint of its last flush: the state at
-        // the failure is not one to continue from.
-        let (cp, rows) = before_last.unwrap_or_else(|| (integrator.checkpoint(), writer.rows()));
-        writer.write_checkpoint(&cp, &extra(rows, max_balance))?;
-    }
-    let reason = match (&failure, interrupted) {
-        (Some(f), _) => Some(f.clone()),
-        (None, Some(sig)) => Some(format!(
-            "interrupted by {sig} at step {}, t = {}; continue with --restart (and the run's --set overrides, if any)",
-            integrator.steps(),
-            integrator.time()
-        )),
-        _ => None,
-    };
-    let summary = Summary {
-        wall_time_s: wall_before + started.elapsed().as_secs_f64(),
-        steps: integrator.steps(),
-        factorizations: integrator.factorizations(),
-        dt_crit: integrator.dt_crit(),
-        failure: reason.clone(),
-        stiffness_product: integrator.stiffness_product().into(),
-        fill_order: fill_order_attr(integrator.fill_order(), options.restart),
-    };
-    let steps_run = integrator.steps() - steps_before;
-    let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;
-    let rows = writer.rows();
-    writer.finish(complete, &summary)?;
-    xdmf(&times)?;
-    let e = integrator.energy();
-    let status = if complete {
-        "complete"
-    } else if interrupted.is_some() {
-        "interrupted"
-    } else {
-        "failed"
-    };
-    if !quiet {
-        say!(
-            "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations, K by {}) in {:.3} s (setup {setup_s:.3} s, {} a step with output)",
-            match status {
-                "complete" => "done:",
-                "interrupted" => "interrupted:",
-                _ => "stopped:",
-            },
-            integrator.steps(),
-            integrator.time(),
-            integrator.total_iterations(),
-            integrator.factorizations(),
-            summary.stiffness_product,
-            summary.wall_time_s,
-            human_seconds(step_s)
-        );
-        // Newmark's γ > ½ dissipates by design, outside the ledger.
-        let damped = if case.time.scheme == case::Scheme::Newmark && case.time.gamma > 0.5 {
-            format!(
-                " (Newmark gamma = {} > 1/2 damps numerically; the balance holds that loss)",
-                case.time.gamma
-            )
-        } else {
-            String::new()
+
+    /// Closes the file (the last checkpoint, the summary, the side file)
+    /// and says how the run ended.
+    fn conclude(
+        mut self,
+        ending: Ending,
+        setup_s: f64,
+        stepping: Instant,
+        steps_before: u64,
+    ) -> anyhow::Result<Outcome> {
+        let Ending {
+            failure,
+            interrupted,
+            before_last,
+        } = ending;
+        let complete = failure.is_none() && interrupted.is_none();
+        if complete || interrupted.is_some() {
+            // A failed run keeps the checkpoint of its last flush: the state at
+            // the failure is not one to continue from.
+            self.checkpoint(before_last)?;
+        }
+        let i = &self.integrator;
+        let reason = match (&failure, interrupted) {
+            (Some(f), _) => Some(f.clone()),
+            (None, Some(sig)) => Some(format!(
+                "interrupted by {sig} at step {}, t = {}; continue with --restart (and the run's --set overrides, if any)",
+                i.steps(),
+                i.time()
+            )),
+            _ => None,
         };
-        say!(
-            "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}); largest |balance| {:.3e}{damped}",
-            e.total, e.kinetic, e.strain, e.external_work, e.dissipated, max_balance
-        );
-        say!("results: {} ({rows} records)", out.display());
-    }
-    if options.json {
-        let j = serde_json::json!({
-            "status": status,
-            "case": case.path.display().to_string(),
-            "output": out.display().to_string(),
-            "xdmf": xdmf_path.display().to_string(),
-            "complete": complete,
-            "steps": integrator.steps(),
-            "t": integrator.time(),
-            "t_end": t_end,
-            "records": rows,
-            "wall_time_s": summary.wall_time_s,
-            "setup_s": setup_s,
-            "step_s": step_s,
-            "iterations": integrator.total_iterations(),
-            "factorizations": integrator.factorizations(),
-            "stiffness_product": summary.stiffness_product,
-            "fill_order": summary.fill_order,
-            "dt": case.time.dt,
-            "dt_crit": integrator.dt_crit(),
-            "energy": {
-                "kinetic": e.kinetic,
-                "strain": e.strain,
-                "external_work": e.external_work,
-                "dissipated": e.dissipated,
-                "total": e.total,
-                "balance": e.balance,
-                "max_abs_balance": max_balance,
-            },
-            "failure": reason,
-            "restarted": options.restart,
-        });
-        say_out!("{j}");
-    }
-    if let Some(sig) = interrupted {
-        say!(
-            "interrupted by {sig}: stopped after step {}, t = {} of t_end = {t_end}; {} holds {rows} records (up to t = {}) and a checkpoint (complete = false)",
-            integrator.steps(),
-            integrator.time(),
-            out.display(),
-            times.last().copied().unwrap_or(0.0)
-        );
-        let sets: String = options
-            .sets
-            .iter()
-            .map(|s| format!(" --set {}", shell_word(s)))
-            .collect();
-        say!(
-            "continue with: stickslip run {} --restart {}{sets}",
-            shell_word(&case.path.display().to_string()),
-            shell_word(&out.display().to_string())
-        );
-        return Ok(Outcome::Interrupted);
-    }
-    match failure {
-        None => Ok(Outcome::Complete),
-        Some(e) => {
-            say!("error: {}: {e}", case.path.display());
+        let summary = Summary {
+            wall_time_s: self.wall_before + self.started.elapsed().as_secs_f64(),
+            steps: i.steps(),
+            factorizations: i.factorizations(),
+            dt_crit: i.dt_crit(),
+            failure: reason.clone(),
+            stiffness_product: i.stiffness_product().into(),
+            fill_order: fill_order_attr(i.fill_order(), self.options.restart),
+        };
+        let steps_run = i.steps() - steps_before;
+        let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;
+        let rows = self.writer.rows();
+        self.writer.finish(complete, &summary)?;
+        write_xdmf(self.out, &self.xdmf_path, self.mesh, &self.times)?;
+        let status = if complete {
+            "complete"
+        } else if interrupted.is_some() {
+            "interrupted"
+        } else {
+            "failed"
+        };
+        let (case, out, i) = (self.case, self.out, &self.integrator);
+        let e = i.energy();
+        if !self.options.quiet {
             say!(
-                "error: {} keeps every step completed before the failure ({rows} records, complete = false, reason in its failure attribute)",
-                out.display()
+                "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations, K by {}) in {:.3} s (setup {setup_s:.3} s, {} a step with output)",
+                match status {
+                    "complete" => "done:",
+                    "interrupted" => "interrupted:",
+                    _ => "stopped:",
+                },
+                i.steps(),
+                i.time(),
+                i.total_iterations(),
+                i.factorizations(),
+                summary.stiffness_product,
+                summary.wall_time_s,
+                human_seconds(step_s)
             );
-            Ok(Outcome::Failed)
+            // Newmark's γ > ½ dissipates by design, outside the ledger.
+            let damped = if case.time.scheme == case::Scheme::Newmark && case.time.gamma > 0.5 {
+                format!(
+                    " (Newmark gamma = {} > 1/2 damps numerically; the balance holds that loss)",
+                    case.time.gamma
+                )
+            } else {
+                String::new()
+            };
+            say!(
+                "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}); largest |balance| {:.3e}{damped}",
+                e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
+            );
+            say!("results: {} ({rows} records)", out.display());
+        }
+        if self.options.json {
+            let j = serde_json::json!({
+                "status": status,
+                "case": case.path.display().to_string(),
+                "output": out.display().to_string(),
+                "xdmf": self.xdmf_path.display().to_string(),
+                "complete": complete,
+                "steps": i.steps(),
+                "t": i.time(),
+                "t_end": i.t_end(),
+                "records": rows,
+                "wall_time_s": summary.wall_time_s,
+                "setup_s": setup_s,
+                "step_s": step_s,
+                "iterations": i.total_iterations(),
+                "factorizations": i.factorizations(),
+                "stiffness_product": summary.stiffness_product,
+                "fill_order": summary.fill_order,
+                "dt": case.time.dt,
+                "dt_crit": i.dt_crit(),
+                "energy": {
+                    "kinetic": e.kinetic,
+                    "strain": e.strain,
+                    "external_work": e.external_work,
+                    "dissipated": e.dissipated,
+                    "total": e.total,
+                    "balance": e.balance,
+                    "max_abs_balance": self.max_balance,
+                },
+                "failure": reason,
+                "restarted": self.options.restart,
+            });
+            say_out!("{j}");
+        }
+        if let Some(sig) = interrupted {
+            say!(
+                "interrupted by {sig}: stopped after step {}, t = {} of t_end = {}; {} holds {rows} records (up to t = {}) and a checkpoint (complete = false)",
+                i.steps(),
+                i.time(),
+                i.t_end(),
+                out.display(),
+                self.times.last().copied().unwrap_or(0.0)
+            );
+            let sets: String = self
+                .options
+                .sets
+                .iter()
+                .map(|s| format!(" --set {}", shell_word(s)))
+                .collect();
+            say!(
+                "continue with: stickslip run {} --restart {}{sets}",
+                shell_word(&case.path.display().to_string()),
+                shell_word(&out.display().to_string())
+            );
+            return Ok(Outcome::Interrupted);
+        }
+        match failure {
+            None => Ok(Outcome::Complete),
+            Some(e) => {
+                say!("error: {}: {e}", case.path.display());
+                say!(
+                    "error: {} keeps every step completed before the failure ({rows} records, complete = false, reason in its failure attribute)",
+                    out.display()
+                );
+                Ok(Outcome::Failed)
+            }
         }
     }
+}
+
+/// The ParaView side file `path` of the results file `out`, listing the
+/// records at `times`.
+fn write_xdmf(out: &Path, path: &Path, mesh: &Mesh, times: &[f64]) -> anyhow::Result<()> {
+    let info = XdmfInfo {
+        n_nodes: mesh.nodes.len(),
+        kind: mesh.kind,
+        n_cells: mesh.n_cells(),
+        times,
+        stress: None,
+    };
+    crate::xdmf::write_xdmf(out, path, &info)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// The failure message of an explicit run whose energy blew up
+/// ([`blow_up`] gave `bound`).
+fn blow_up_failure(i: &Integrator, bound: f64, case: &Case) -> String {
+    let e = i.energy();
+    let crit = i.dt_crit().unwrap_or(f64::NAN);
+    format!(
+        "step {} (t = {:.6e}): energy blow-up: kinetic + strain = {:.3e} exceeds {BLOW_UP_FACTOR} x (initial + |work| + dissipated) = {bound:.3e}; \
+         central difference is unstable at time.dt = {:e}, above its critical step dt_crit = {crit:.6e}: \
+         use time.dt < {crit:.4e} (e.g. {:.4e}) and remove time.allow_unstable",
+        i.steps(),
+        i.time(),
+        e.kinetic + e.strain,
+        case.time.dt,
+        0.9 * crit
+    )
 }
 
 #[cfg(test)]
