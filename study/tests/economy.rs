@@ -3,7 +3,7 @@
 
 use std::collections::BTreeSet;
 
-use stickslip_study::run::{Method, REDUCTION};
+use stickslip_case::{Method, PAPER_REDUCTION as REDUCTION};
 use stickslip_study::slab::{self, read_mesh, LoadKind, Slab};
 use stickslip_time::{ImplicitSolver, Integrator};
 
