@@ -17,7 +17,6 @@
 
 mod assembly;
 pub mod boundary;
-pub mod classes;
 pub mod dofs;
 pub mod element;
 mod error;
@@ -33,7 +32,6 @@ pub mod testing;
 
 pub use assembly::{free_dof_pattern, node_adjacency};
 pub use boundary::{boundary_quadrature, BoundaryNode};
-pub use classes::ElementClasses;
 pub use dofs::{Dirichlet, DofMap, NodeOrder};
 pub use error::FemError;
 pub use loads::{
