@@ -16,6 +16,8 @@
 //! Nothing here touches a terminal or a results file: the binary
 //! (`stickslip`), `verify` and `study` use the same reader and builder.
 
+#![forbid(unsafe_code)]
+
 mod build;
 mod error;
 mod keys;

@@ -18,6 +18,8 @@
 //! Nodal quadrature on Γ_C means friction couples no two nodes, so a node's
 //! friction lives on its own two DOFs only; every routine here is per node.
 
+#![forbid(unsafe_code)]
+
 mod iteration;
 mod law;
 mod ledger;

@@ -15,6 +15,8 @@
 //! knows nothing of friction or time stepping; boundaries are reached by
 //! physical group name only.
 
+#![forbid(unsafe_code)]
+
 mod assembly;
 pub mod boundary;
 pub mod dofs;

@@ -10,6 +10,8 @@
 //! matrices (nalgebra-sparse CSR with both triangles stored) and vectors.
 //! Every product and sum gives the same bits on one thread and on many.
 
+#![forbid(unsafe_code)]
+
 mod cholesky;
 pub mod chunks;
 pub mod csr;

@@ -18,6 +18,8 @@
 //! code runs; the explicit scheme solves no linear system; the implicit
 //! operator A₀ is analysed once and factorized once per distinct Δt.
 
+#![forbid(unsafe_code)]
+
 mod central_difference;
 mod dynamics;
 mod history;
