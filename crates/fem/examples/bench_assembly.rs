@@ -12,11 +12,11 @@
 use std::io::Write as _;
 use std::time::Instant;
 
-use stickslip_fem::testing::slab;
 use stickslip_fem::{
     free_dof_pattern, static_solve, traction_load, Dirichlet, Hypothesis, Material, Model, Traction,
 };
 use stickslip_mesh::CellKind;
+use stickslip_testkit::slab;
 
 fn peak_rss_mb() -> f64 {
     let s = std::fs::read_to_string("/proc/self/status").unwrap_or_default();

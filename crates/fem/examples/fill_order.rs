@@ -6,17 +6,17 @@
 //!     cargo run --release -p stickslip-fem --example fill_order -- MESH...
 //!
 //! MESH: a .msh file, or `q1-R` / `q2-R`, the slab built in code at
-//! refinement R (`testing::slab`, numbered row by row).
+//! refinement R (`stickslip_testkit::slab`, numbered row by row).
 
 use std::time::Instant;
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::{Par, Side};
 use stickslip_fem::ordering::nested_dissection;
-use stickslip_fem::testing::slab;
 use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
 use stickslip_linalg::{analyze_symbolic, csc_view, FillOrder};
 use stickslip_mesh::{CellKind, Mesh};
+use stickslip_testkit::slab;
 
 /// Ordering + symbolic (s), factor values, numeric factorization (s).
 fn factorize(model: &Model, order: &FillOrder, ordering_s: f64) -> (f64, usize, f64) {

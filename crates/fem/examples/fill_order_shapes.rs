@@ -7,10 +7,10 @@
 //!     cargo run --release -p stickslip-fem --example fill_order_shapes
 
 use stickslip_fem::ordering::{nested_dissection, DISSECTION_MIN_DOFS};
-use stickslip_fem::testing::{add_point_group, rectangle};
 use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
 use stickslip_linalg::{analyze_symbolic, FillOrder};
 use stickslip_mesh::{CellKind, Mesh};
+use stickslip_testkit::{add_point_group, rectangle};
 
 /// The cells of an `nx × ny` grid of `kind` on unit squares that `keep`
 /// keeps, with a point group "clamp" of the kept nodes `clamp` selects and

@@ -2,11 +2,11 @@
 //! groups, bad Dirichlet conditions. Each message must name the problem and
 //! what to do.
 
-use stickslip_fem::testing::{add_point_group, rectangle, slab};
 use stickslip_fem::{
     static_solve, traction_load, Dirichlet, DofMap, FemError, Hypothesis, Material, Model, Traction,
 };
 use stickslip_mesh::{CellKind, Mesh};
+use stickslip_testkit::{add_point_group, rectangle, slab};
 
 fn mat() -> Material {
     Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap()
@@ -132,10 +132,7 @@ fn unknown_groups_are_refused_listing_the_mesh_groups() {
     let expect = |e: FemError, purpose: &str| {
         let msg = e.to_string();
         assert!(msg.contains("\"suport\"") && msg.contains(purpose), "{msg}");
-        assert!(
-            msg.contains("contact, load, support, left, domain"),
-            "{msg}"
-        );
+        assert!(msg.contains("contact, load, support, left, body"), "{msg}");
     };
     expect(
         DofMap::new(&mesh, &[Dirichlet::new("suport", 1, 0.0)]).unwrap_err(),
@@ -150,7 +147,7 @@ fn unknown_groups_are_refused_listing_the_mesh_groups() {
         traction_load(&mesh, "suport", Traction::Pressure(1.0), &mut full).unwrap_err(),
         "a traction",
     );
-    let e = traction_load(&mesh, "domain", Traction::Pressure(1.0), &mut full).unwrap_err();
+    let e = traction_load(&mesh, "body", Traction::Pressure(1.0), &mut full).unwrap_err();
     assert!(
         matches!(e, FemError::WrongGroupDimension { dim: 2, .. }),
         "{e}"

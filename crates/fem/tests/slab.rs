@@ -1,19 +1,12 @@
 //! The paper's slab (BENCHMARK.md) on the committed Gmsh meshes: the static
 //! state under F_n = 300 alone, and the contact-face nodal quadrature.
 
-use std::path::PathBuf;
-
 use stickslip_fem::{
     boundary_quadrature, gauss_point_stresses, nodal_stresses, static_solve, traction_load,
     Dirichlet, Hypothesis, Material, Model, Traction,
 };
 use stickslip_mesh::Mesh;
-
-fn mesh_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../cases/meshes")
-        .join(name)
-}
+use stickslip_testkit::read_mesh;
 
 /// ρ = 1, E = 1000, ν = 0.3, plane strain (METHOD.md §7).
 fn slab_material() -> Material {
@@ -55,7 +48,7 @@ fn slab_static_state_is_the_closed_form_uniform_state_on_committed_meshes() {
         "slab-unstructured-q1.msh",
         "slab-unstructured-q2.msh",
     ] {
-        let mesh = Mesh::from_file(mesh_path(name)).unwrap_or_else(|e| panic!("{e}"));
+        let mesh = read_mesh(name).unwrap_or_else(|e| panic!("{e}"));
         let u = static_state(&mesh);
         let mut worst = 0.0f64;
         for (v, p) in mesh.nodes.iter().enumerate() {
@@ -103,7 +96,7 @@ fn contact_face_nodal_quadrature_on_committed_meshes() {
         ("slab-q2-8x2.msh", 1.0 / 6.0, 1.0 / 3.0),
         ("slab-q1-16x4.msh", 0.25, 0.5),
     ] {
-        let mesh = Mesh::from_file(mesh_path(name)).unwrap();
+        let mesh = read_mesh(name).unwrap();
         let bq = boundary_quadrature(&mesh, "contact").unwrap();
         assert_eq!(bq.len(), 17, "{name}");
         let find = |x: f64| {

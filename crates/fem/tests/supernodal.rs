@@ -5,10 +5,10 @@ use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::sparse::SparseColMatRef;
 use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
-use stickslip_fem::testing::{on_threads, plain_spmv, rectangle};
 use stickslip_fem::{Hypothesis, Material, Model};
 use stickslip_linalg::*;
 use stickslip_mesh::CellKind;
+use stickslip_testkit::{on_threads, plain_spmv, rectangle};
 
 fn operator(kind: CellKind, nx: usize, ny: usize) -> CsrMatrix<f64> {
     let mesh = rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
