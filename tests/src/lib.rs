@@ -13,7 +13,8 @@
 //!   convergence test and verify's rates suite;
 //! * [`reference`]: the plain sparse product and runs on a pool of a
 //!   chosen number of threads, what the bit-for-bit tests compare against;
-//! * [`paths`]: the workspace's folders, found from this crate's.
+//! * [`paths`]: the workspace's folders, found from this crate's, and a
+//!   scratch directory per test.
 //!
 //! A library's unit tests (`#[cfg(test)]` in its `src/`) cannot use the
 //! kit when the kit depends on that library (they would see two copies of
@@ -28,6 +29,6 @@ pub mod sdof;
 pub mod wave;
 
 pub use grid::{add_point_group, map_nodes, rectangle, slab, structured_slab};
-pub use paths::{meshes_dir, read_mesh, workspace_root};
+pub use paths::{meshes_dir, read_mesh, scratch, workspace_root};
 pub use reference::{on_threads, plain_spmv};
 pub use scene::{paper_slab, SceneError, Slab};
