@@ -31,4 +31,4 @@ pub mod wave;
 pub use grid::{add_point_group, map_nodes, rectangle, slab, structured_slab};
 pub use paths::{meshes_dir, read_mesh, scratch, workspace_root};
 pub use reference::{on_threads, plain_spmv};
-pub use scene::{paper_slab, SceneError, Slab};
+pub use scene::{paper_material, paper_slab, paper_supports, SceneError, Slab};

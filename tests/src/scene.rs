@@ -27,6 +27,21 @@ pub const G: f64 = MU * PRESSURE;
 /// End traction t_x at θ = 1 (compressive).
 pub const END_LOAD: f64 = -150.0;
 
+/// The slab's material (BENCHMARK.md): E = 1000, ν = 0.3, ρ = 1, plane
+/// strain.
+pub fn paper_material() -> Material {
+    Material::new(E, NU, 1.0, Hypothesis::PlaneStrain).expect("the paper's material is valid")
+}
+
+/// The slab's supports (BENCHMARK.md): rollers on top ("support",
+/// u_y = 0), the left end ("left") held in x.
+pub fn paper_supports() -> [Dirichlet; 2] {
+    [
+        Dirichlet::new("support", 1, 0.0),
+        Dirichlet::new("left", 0, 0.0),
+    ]
+}
+
 /// Why a scene could not be built or run.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
@@ -141,10 +156,6 @@ impl Slab {
         theta: History,
     ) -> Result<Slab, SceneError> {
         let material = Material::new(E, nu, 1.0, Hypothesis::PlaneStrain)?;
-        let conditions = [
-            Dirichlet::new("support", 1, 0.0),
-            Dirichlet::new("left", 0, 0.0),
-        ];
         let mut tractions = Vec::new();
         if pressure != 0.0 {
             tractions.push(("contact", Traction::Pressure(pressure), History::Constant));
@@ -153,7 +164,7 @@ impl Slab {
             tractions.push(("load", Traction::Vector([end_load, 0.0]), theta));
         }
         let friction = mu.map(|mu| ("contact", pressure, mu, eps));
-        Slab::assemble(mesh, &material, &conditions, &tractions, friction)
+        Slab::assemble(mesh, &material, &paper_supports(), &tractions, friction)
     }
 
     /// The paper's slab: ν = 0.3, F_n = 300, μ = 0.3 (or no friction

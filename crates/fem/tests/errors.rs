@@ -6,14 +6,10 @@ use stickslip_fem::{
     static_solve, traction_load, Dirichlet, DofMap, FemError, Hypothesis, Material, Model, Traction,
 };
 use stickslip_mesh::{CellKind, Mesh};
-use stickslip_testkit::{add_point_group, rectangle, slab};
-
-fn mat() -> Material {
-    Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap()
-}
+use stickslip_testkit::{add_point_group, paper_material, paper_supports, rectangle, slab};
 
 fn solve_err(mesh: &Mesh, bcs: &[Dirichlet]) -> FemError {
-    let model = Model::new(mesh, &mat(), bcs).unwrap();
+    let model = Model::new(mesh, &paper_material(), bcs).unwrap();
     static_solve(&model, &vec![0.0; model.dofs.n_free()]).unwrap_err()
 }
 
@@ -66,15 +62,7 @@ fn singular_supports_name_the_free_rigid_body_motions() {
         }
     );
     // The paper's supports are enough.
-    let model = Model::new(
-        &mesh,
-        &mat(),
-        &[
-            Dirichlet::new("support", 1, 0.0),
-            Dirichlet::new("left", 0, 0.0),
-        ],
-    )
-    .unwrap();
+    let model = Model::new(&mesh, &paper_material(), &paper_supports()).unwrap();
     assert!(model.dofs.free_rigid_motions().is_empty());
 }
 
@@ -139,7 +127,12 @@ fn unknown_groups_are_refused_listing_the_mesh_groups() {
         "a Dirichlet condition",
     );
     expect(
-        Model::new(&mesh, &mat(), &[Dirichlet::new("suport", 1, 0.0)]).unwrap_err(),
+        Model::new(
+            &mesh,
+            &paper_material(),
+            &[Dirichlet::new("suport", 1, 0.0)],
+        )
+        .unwrap_err(),
         "a Dirichlet condition",
     );
     let mut full = vec![0.0; 2 * mesh.nodes.len()];

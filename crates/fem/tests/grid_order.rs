@@ -5,9 +5,9 @@
 //! order is the mesh-order model with its rows and columns permuted, bit
 //! for bit.
 
-use stickslip_fem::{Dirichlet, DofMap, Hypothesis, Material, Model, NodeOrder};
+use stickslip_fem::{Dirichlet, DofMap, Model, NodeOrder};
 use stickslip_mesh::{CellKind, Mesh};
-use stickslip_testkit::{read_mesh, rectangle};
+use stickslip_testkit::{paper_material, read_mesh, rectangle};
 
 /// The paper's supports: rollers on `top`, x held on `left`.
 fn supports(top: &str) -> Vec<Dirichlet> {
@@ -159,7 +159,7 @@ fn a_model_in_another_order_is_the_mesh_order_model_permuted_bit_for_bit() {
 
 fn permuted_model(file: &str, order: NodeOrder) {
     let mesh = read_mesh(file).unwrap();
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let material = paper_material();
     let dofs = DofMap::new(&mesh, &supports("support")).unwrap();
     let (dm, dg) = (
         dofs.renumbered(&mesh, NodeOrder::Mesh).unwrap(),

@@ -3,21 +3,14 @@
 //! as good as AMD on a grid, and `choose` keeps the smaller factor.
 
 use stickslip_fem::ordering::{choose, nested_dissection, DISSECTION_MIN_DOFS, FILL_ORDER_ENV};
-use stickslip_fem::{Dirichlet, DofMap, Hypothesis, Material, Model, NodeOrder};
+use stickslip_fem::{Dirichlet, DofMap, Model, NodeOrder};
 use stickslip_linalg::{analyze_symbolic, FillOrder};
 use stickslip_mesh::{CellKind, Mesh};
-use stickslip_testkit::{add_point_group, rectangle, slab};
+use stickslip_testkit::{add_point_group, paper_material, paper_supports, rectangle, slab};
 
 fn slab_dofs(kind: CellKind, refine: usize) -> (Mesh, DofMap) {
     let mesh = slab(kind, refine);
-    let dofs = DofMap::new(
-        &mesh,
-        &[
-            Dirichlet::new("support", 1, 0.0),
-            Dirichlet::new("left", 0, 0.0),
-        ],
-    )
-    .unwrap();
+    let dofs = DofMap::new(&mesh, &paper_supports()).unwrap();
     (mesh, dofs)
 }
 
@@ -123,7 +116,7 @@ fn the_last_dofs_are_the_middle_line() {
 /// numbering of the DOFs (reverse Cuthill–McKee's here).
 #[test]
 fn dissection_fill_is_amd_s_on_a_grid_whatever_the_numbering() {
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let material = paper_material();
     for kind in [CellKind::Quad4, CellKind::Quad9] {
         let (mesh, grid) = slab_dofs(kind, 28);
         assert_eq!(grid.node_order(), NodeOrder::Grid);
@@ -173,7 +166,7 @@ fn amd_on_small_meshes_the_smaller_factor_on_large_ones() {
         ],
     )
     .unwrap();
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let material = paper_material();
     for (mesh, dofs, amd_wins) in [(slab, slab_dofs, false), (strip, strip_dofs, true)] {
         assert!(dofs.n_free() >= DISSECTION_MIN_DOFS);
         let order = choose(&mesh, &dofs);

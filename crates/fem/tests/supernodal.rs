@@ -5,14 +5,14 @@ use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::sparse::SparseColMatRef;
 use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
-use stickslip_fem::{Hypothesis, Material, Model};
+use stickslip_fem::Model;
 use stickslip_linalg::*;
 use stickslip_mesh::CellKind;
-use stickslip_testkit::{on_threads, plain_spmv, rectangle};
+use stickslip_testkit::{on_threads, paper_material, plain_spmv, rectangle};
 
 fn operator(kind: CellKind, nx: usize, ny: usize) -> CsrMatrix<f64> {
     let mesh = rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let material = paper_material();
     let model = Model::new(&mesh, &material, &[]).unwrap();
     // A₀ of the paper's Newmark step: (β/γ)Δt K + M/(γΔt), Δt = 1e-3.
     model.combined(0.5e-3, 1.0 / 0.5e-3)

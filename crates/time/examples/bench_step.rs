@@ -23,16 +23,11 @@ use std::process::Command;
 use std::time::Instant;
 
 use stickslip_contact::ContactSurface;
-use stickslip_fem::{Hypothesis, Material, Model};
+use stickslip_fem::Model;
 use stickslip_mesh::Mesh;
-use stickslip_testkit::{meshes_dir, structured_slab, workspace_root, Slab};
+use stickslip_testkit::{meshes_dir, paper_material, structured_slab, workspace_root, Slab};
 use stickslip_time::stability::critical_step;
 use stickslip_time::{Dynamics, History, Integrator, Load, Scheme, Settings};
-
-/// The paper's slab material (BENCHMARK.md).
-fn slab_material() -> Material {
-    Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap()
-}
 
 fn mesh_named(name: &str) -> Mesh {
     // "gen-q1-NXxNY" / "gen-q2-NXxNY" are built here; others are files.
@@ -194,7 +189,7 @@ fn dump_mesh(dir: &std::path::Path, mesh: &Mesh, model: &Model) {
     let free =
         (0..model.dofs.n_full()).map(|d| model.dofs.free_of_full(d).map_or(-1, |f| f as i64));
     write_le(&dir.join("free.i64"), free.map(i64::to_le_bytes));
-    let m = slab_material();
+    let m = paper_material();
     let order = if per == 9 { 2 } else { 1 };
     std::fs::write(
         dir.join("mesh.json"),
