@@ -11,8 +11,9 @@
 //!   the 1-D wave (d'Alembert) and the single-DOF friction oscillator;
 //! * [`manufactured`]: the static manufactured solution of the fem
 //!   convergence test and verify's rates suite;
-//! * [`reference`]: the plain sparse product and runs on a pool of a
-//!   chosen number of threads, what the bit-for-bit tests compare against;
+//! * [`reference`](mod@reference): the plain sparse product and runs on
+//!   a pool of a chosen number of threads, what the bit-for-bit tests
+//!   compare against, and a vector for them to act on;
 //! * [`paths`]: the workspace's folders, found from this crate's, and a
 //!   scratch directory per test.
 //!
@@ -30,5 +31,5 @@ pub mod wave;
 
 pub use grid::{add_point_group, map_nodes, rectangle, slab, structured_slab};
 pub use paths::{meshes_dir, read_mesh, scratch, workspace_root};
-pub use reference::{on_threads, plain_spmv};
+pub use reference::{on_threads, plain_spmv, spread};
 pub use scene::{paper_material, paper_slab, paper_supports, SceneError, Slab};

@@ -1,5 +1,6 @@
 //! What the bit-for-bit tests compare against: the plain sparse product
-//! and a run on a thread pool of a chosen size.
+//! and a run on a thread pool of a chosen size; and the vector they
+//! multiply.
 
 use nalgebra_sparse::CsrMatrix;
 
@@ -11,6 +12,14 @@ pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
         .build()
         .expect("a thread pool")
         .install(f)
+}
+
+/// n values in [−1, 1), the same on every run, with no pattern along the
+/// rows (7919 is prime): a vector for products and solves to act on.
+pub fn spread(n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| ((i * 7919) % 1000) as f64 / 500.0 - 1.0)
+        .collect()
 }
 
 /// A x as plain row sums in storage order: the reference the tests hold the

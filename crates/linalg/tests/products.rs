@@ -6,7 +6,7 @@ use nalgebra_sparse::{CooMatrix, CsrMatrix};
 use stickslip_linalg::chunks::{chunks, partials, sum_chunks, CHUNK};
 use stickslip_linalg::csr::{index, load_minus_k_plus_m, quadratic_form, spmv, two_forms};
 use stickslip_linalg::{Stencils, TOLERANCE};
-use stickslip_testkit::{on_threads, plain_spmv};
+use stickslip_testkit::{on_threads, plain_spmv, spread};
 
 /// The chunked sum of a long vector is the same on one thread and on
 /// two, and within rounding of the plain sum.
@@ -134,12 +134,6 @@ fn grid(nx: usize, ny: usize, wobble: f64, fixed: bool) -> CsrMatrix<f64> {
     CsrMatrix::from(&coo)
 }
 
-fn vector(n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| ((i * 7919) % 1000) as f64 / 500.0 - 1.0)
-        .collect()
-}
-
 /// Within TOLERANCE · max|K| · Σ|x| of the assembled product, row by
 /// row, on a grid with rounding-sized wobble and a fixed DOF; few types.
 #[test]
@@ -149,7 +143,7 @@ fn product_within_the_tolerance_of_the_assembled_one() {
         let s = Stencils::new(&a).expect("a structured grid has few stencils");
         assert!(s.types() < 40, "{} types", s.types());
         let n = a.nrows();
-        let x = vector(n);
+        let x = spread(n);
         let mut y = vec![0.0; n];
         s.spmv(&x, &mut y);
         let max = a.values().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
@@ -173,7 +167,7 @@ fn rows_have_the_same_bits_every_way() {
     let s = Stencils::new(&a).unwrap();
     let n = a.nrows();
     assert!(chunks(n) > 2);
-    let x = vector(n);
+    let x = spread(n);
     let on = |threads: usize| {
         on_threads(threads, || {
             let mut y = vec![0.0; n];
