@@ -1,19 +1,20 @@
 //! The paper's slab (BENCHMARK.md) on the committed meshes: top rollers,
 //! left end held in x, pressure on Γ_C with friction, compressive end
-//! traction t_x = −150·θ(t). The scene is `stickslip_time::scenes::Slab`
-//! (shared with the time crate's tests and `verify`); this module adds the
-//! studies' two load histories and errors as text.
+//! traction t_x = −150·θ(t). The scene is the test kit's `Slab`
+//! (`stickslip-testkit`, shared with the time crate's tests and `verify`);
+//! this module adds the studies' two load histories and errors as text.
 
 use stickslip_mesh::Mesh;
-pub use stickslip_time::scenes::{meshes_dir, Slab, END_LOAD, G, MU, PRESSURE};
-use stickslip_time::{scenes, History};
+pub use stickslip_testkit::meshes_dir;
+pub use stickslip_testkit::scene::{Slab, END_LOAD, G, MU, PRESSURE};
+use stickslip_time::History;
 
 /// Reads a committed mesh by file name.
 ///
 /// # Errors
 /// The file is missing or unreadable (names it).
 pub fn read_mesh(name: &str) -> Result<Mesh, String> {
-    scenes::read_mesh(name).map_err(|e| e.to_string())
+    stickslip_testkit::read_mesh(name).map_err(|e| e.to_string())
 }
 
 /// The load history θ(t) of the paper's two experiments.

@@ -116,9 +116,8 @@ fn remark_4_2_leaves_no_failed_steps() {
 /// kernels), every other field exactly.
 #[test]
 fn committed_tables_are_what_the_study_writes() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let out = std::env::temp_dir().join(format!("stickslip-stability-{}", std::process::id()));
-    std::fs::create_dir_all(&out).unwrap();
+    let root = stickslip_testkit::workspace_root();
+    let out = stickslip_testkit::scratch("stability");
     stickslip_study::stability::main(&out, false).unwrap();
     let mut problems = Vec::new();
     for name in [

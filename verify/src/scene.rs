@@ -2,7 +2,7 @@
 //! stickslip-case (the reader and builder of `stickslip run`), a fault
 //! injected into what it built where asked, and a run recorder that keeps
 //! the time histories the checks and figures use. The single-DOF friction
-//! oscillator is `stickslip_time::scenes::sdof`.
+//! oscillator is the test kit's `stickslip_testkit::sdof`.
 
 use std::path::{Path, PathBuf};
 

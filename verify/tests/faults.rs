@@ -3,17 +3,9 @@
 //! and a failing row must name the cause. The clean build must pass the
 //! same suites (against the committed references in cases/reference/).
 
-use std::path::{Path, PathBuf};
-
+use stickslip_testkit::workspace_root as root;
 use stickslip_verify::suites::{paper, reference};
 use stickslip_verify::{run_cases, Fault, Report, Row};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
 
 fn failures(fault: Option<Fault>) -> Vec<Row> {
     let runs = run_cases(&root(), fault, &[]).expect("the case files read");

@@ -560,8 +560,7 @@ mod tests {
 
     /// A directory with a mesh file placeholder, so mesh.file exists.
     fn scratch(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("stickslip-case-{}-{name}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
+        let d = stickslip_testkit::scratch(&format!("case-{name}"));
         std::fs::write(d.join("m.msh"), "").unwrap();
         d
     }

@@ -2,16 +2,16 @@
 //! is the run the case describes, and a method written into a case is
 //! that method.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use stickslip_case::pilot::{Pilot, Probe};
 use stickslip_case::{Method, Scheme, PAPER_REDUCTION};
+use stickslip_testkit::{meshes_dir, workspace_root};
 
 fn paper_case() -> (stickslip_case::Case, PathBuf) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let path = root.join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let path = workspace_root().join("cases/martins-oden/cd-step-eps1e-4.toml");
     let case = stickslip_case::load(&path, &[]).expect("the paper's case loads");
-    (case, root.join("cases/meshes"))
+    (case, meshes_dir())
 }
 
 /// The paper's slab, central difference, Δt = 1e-3 to 0.5: 500 steps, 501

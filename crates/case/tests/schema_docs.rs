@@ -5,7 +5,6 @@
 //! (`stickslip_case::schema`), not from a list written beside them.
 
 use std::collections::BTreeSet;
-use std::path::Path;
 
 use stickslip_case::schema::{key_paths, Kind, ROOT};
 
@@ -72,7 +71,7 @@ fn keys_of(table: &toml::Table, schema: &[(&str, Kind)], prefix: &str, out: &mut
 
 #[test]
 fn the_documented_keys_are_the_schema() {
-    let page = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/case-file.md");
+    let page = stickslip_testkit::workspace_root().join("docs/case-file.md");
     let text = std::fs::read_to_string(&page).expect("docs/case-file.md");
     let mut documented = BTreeSet::new();
     let mut read = 0;

@@ -1126,7 +1126,7 @@ mod tests {
     #[test]
     fn oblique_supports_name_every_fixed_axis() {
         use stickslip_contact::ContactNode;
-        let mesh = stickslip_fem::testing::rectangle(
+        let mesh = stickslip_testkit::rectangle(
             stickslip_mesh::CellKind::Quad4,
             2,
             1,

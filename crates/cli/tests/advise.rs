@@ -16,18 +16,15 @@
 //! differences of neighbouring refinements; advise measures each pilot
 //! against its finest pilot run instead (see crates/cli/src/advise.rs).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use stickslip::advise::{self, Quantity};
 use stickslip_case::pilot::Trace;
 use stickslip_case::{self as case, Method};
+use stickslip_testkit::{scratch, workspace_root as root};
 
 const TOLS: [f64; 3] = [3e-2, 2e-2, 1e-2];
 const AT: [f64; 2] = [8.0, 1.0];
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
 
 /// One `dt` row of the chart's CSV (step load).
 #[derive(Clone, Debug)]
@@ -151,8 +148,7 @@ fn advise_picks_meet_the_tolerance() {
 
 #[test]
 fn advise_command_writes_a_case_that_loads_and_keeps_comments() {
-    let dir = std::env::temp_dir().join(format!("stickslip-advise-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("advise");
     let out = dir.join("adjusted.toml");
     std::fs::remove_file(&out).ok();
     let case_path = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
@@ -198,8 +194,7 @@ fn advise_command_writes_a_case_that_loads_and_keeps_comments() {
 
 #[test]
 fn advise_never_writes_over_a_file() {
-    let dir = std::env::temp_dir().join(format!("stickslip-advise-over-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("advise-over");
     let out = dir.join("mine.toml");
     std::fs::write(&out, "mine").unwrap();
     let st = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
@@ -253,8 +248,7 @@ fn advise_never_writes_over_a_file() {
 /// nearest node).
 #[test]
 fn advise_refuses_a_ladder_of_two_bodies_and_a_point_off_the_body() {
-    let dir = std::env::temp_dir().join(format!("stickslip-advise-bodies-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("advise-bodies");
     let meshes = root().join("cases/meshes");
     let text = std::fs::read_to_string(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
         .unwrap()

@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use stickslip_testkit::{meshes_dir, scratch};
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_stickslip"))
 }
@@ -18,17 +20,10 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-/// A scratch directory per test.
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-case-{name}"));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
 /// tests/data/slab.toml with the mesh path made absolute, after `edit`,
 /// written to a scratch directory. Returns the case path and its text.
 fn case_with(name: &str, edit: impl Fn(String) -> String) -> (PathBuf, String) {
-    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../cases/meshes/slab-q2-8x2.msh");
+    let mesh = meshes_dir().join("slab-q2-8x2.msh");
     let text = std::fs::read_to_string(data("slab.toml")).unwrap().replace(
         "../../../../cases/meshes/slab-q2-8x2.msh",
         &mesh.display().to_string().replace('\\', "/"),

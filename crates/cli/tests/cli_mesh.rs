@@ -9,12 +9,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use stickslip_testkit::workspace_root as root;
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_stickslip"))
-}
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
 fn data(name: &str) -> PathBuf {

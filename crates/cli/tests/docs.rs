@@ -3,15 +3,10 @@
 //! accepts (unknown keys are refused, every value validated), with its
 //! mesh path, written relative to the repository root, made absolute.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
-}
+use stickslip_testkit::{scratch, workspace_root as root};
 
 /// (file, first line, text) of every ```toml block of a Markdown file.
 fn toml_blocks(path: &Path) -> Vec<(String, usize, String)> {
@@ -54,8 +49,7 @@ fn every_documented_case_passes_check() {
         "expected the case-file reference's examples, found {} toml blocks",
         blocks.len()
     );
-    let dir = std::env::temp_dir().join(format!("stickslip-docs-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("docs");
     for (k, (file, line, body)) in blocks.iter().enumerate() {
         // [mesh] file is relative to the repository root in the docs.
         let mut doc: toml::Table = body

@@ -10,12 +10,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
-}
+use stickslip_testkit::{scratch, workspace_root as root};
 
 /// Runs examples/DIR/run.py into a fresh out dir; returns (stdout, out dir),
 /// or None when the Python modules are missing outside CI.
@@ -33,8 +28,7 @@ fn run_example(dir: &str) -> Option<(String, PathBuf)> {
         eprintln!("skipped examples/{dir}: gmsh, h5py, numpy or matplotlib is not installed");
         return None;
     }
-    let out = std::env::temp_dir().join(format!("stickslip-example-{}-{dir}", std::process::id()));
-    std::fs::create_dir_all(&out).unwrap();
+    let out = scratch(&format!("example-{dir}"));
     let o = Command::new("python3")
         .arg(root().join("examples").join(dir).join("run.py"))
         .arg("--out")

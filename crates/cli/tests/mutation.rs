@@ -25,6 +25,7 @@ use std::time::Instant;
 
 use stickslip_case::{Case, History};
 use stickslip_mesh::{Location, Mesh};
+use stickslip_testkit::workspace_root as root;
 
 /// xorshift64* (Vigna 2016): reproducible, no dependency.
 struct Rng(u64);
@@ -38,10 +39,6 @@ impl Rng {
     fn below(&mut self, n: usize) -> usize {
         (self.next() % n.max(1) as u64) as usize
     }
-}
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
 const CASE_TOKENS: &[&str] = &[

@@ -6,24 +6,13 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
-}
+use stickslip_testkit::{scratch, workspace_root as root};
 
 fn stickslip(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_stickslip"))
         .args(args)
         .output()
         .expect("binary runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("stickslip-e2e-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 /// Runs a Python snippet with h5py. Without h5py the check cannot run:

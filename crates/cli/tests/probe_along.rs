@@ -11,12 +11,7 @@ use std::process::Command;
 use hdf5::types::VarLenUnicode;
 use ndarray::{Array1, Array2, Array3};
 use stickslip::probe::{along, along_command, AlongArgs, Field};
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("stickslip-along-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use stickslip_testkit::{scratch, workspace_root as root};
 
 /// Node index of grid point (gx, gy) of the 4 x 4 fixture grid: a fixed
 /// permutation (5 is coprime with 16), so index order is not geometric order.
@@ -236,13 +231,6 @@ fn fixture_orders_follow_the_boundary_with_the_body_on_the_left() {
     .0;
     assert!(e.contains("--times"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
-}
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
 }
 
 fn run_slab(dir: &Path) -> PathBuf {

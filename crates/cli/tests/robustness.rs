@@ -14,27 +14,14 @@ use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use hdf5::types::{FloatSize, IntSize, TypeDescriptor, VarLenUnicode};
+use stickslip_testkit::{scratch, workspace_root as root};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_stickslip"))
 }
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
-}
-
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("robust-{name}"));
-    std::fs::remove_dir_all(&d).ok();
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 /// tests/data/slab.toml (t_end = 0.05, dt = 1e-3, central difference) with

@@ -6,21 +6,11 @@
 //! against `probe --along` (the same nodal average, formed independently of
 //! this command's loop).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Command, Output};
 
 use stickslip::probe::{along, Field};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("stress-{name}"));
-    std::fs::remove_dir_all(&d).ok();
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use stickslip_testkit::{scratch, workspace_root as root};
 
 fn stickslip(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_stickslip"))

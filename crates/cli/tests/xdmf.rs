@@ -14,19 +14,7 @@ use std::process::Command;
 
 use stickslip::xdmf;
 use stickslip_mesh::CellKind;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("stickslip-xdmf-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use stickslip_testkit::{scratch, workspace_root as root};
 
 /// Runs a paper case into `dir/NAME.h5` and returns that path.
 fn run_case(case: &str, dir: &Path, name: &str, sets: &[&str]) -> PathBuf {

@@ -12,11 +12,9 @@
 use std::io::Write as _;
 use std::time::Instant;
 
-use stickslip_fem::testing::slab;
-use stickslip_fem::{
-    free_dof_pattern, static_solve, traction_load, Dirichlet, Hypothesis, Material, Model, Traction,
-};
+use stickslip_fem::{free_dof_pattern, static_solve, traction_load, Model, Traction};
 use stickslip_mesh::CellKind;
+use stickslip_testkit::{paper_material, paper_supports, slab};
 
 fn peak_rss_mb() -> f64 {
     let s = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
@@ -48,11 +46,8 @@ fn main() {
             .unwrap();
     }
     let mesh = slab(kind, refine);
-    let mat = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
-    let bcs = [
-        Dirichlet::new("support", 1, 0.0),
-        Dirichlet::new("left", 0, 0.0),
-    ];
+    let mat = paper_material();
+    let bcs = paper_supports();
 
     let t = Instant::now();
     let dofs = stickslip_fem::DofMap::new(&mesh, &bcs).unwrap();

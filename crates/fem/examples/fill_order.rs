@@ -6,17 +6,17 @@
 //!     cargo run --release -p stickslip-fem --example fill_order -- MESH...
 //!
 //! MESH: a .msh file, or `q1-R` / `q2-R`, the slab built in code at
-//! refinement R (`testing::slab`, numbered row by row).
+//! refinement R (`stickslip_testkit::slab`, numbered row by row).
 
 use std::time::Instant;
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::{Par, Side};
 use stickslip_fem::ordering::nested_dissection;
-use stickslip_fem::testing::slab;
-use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
+use stickslip_fem::Model;
 use stickslip_linalg::{analyze_symbolic, csc_view, FillOrder};
 use stickslip_mesh::{CellKind, Mesh};
+use stickslip_testkit::{paper_material, paper_supports, slab};
 
 /// Ordering + symbolic (s), factor values, numeric factorization (s).
 fn factorize(model: &Model, order: &FillOrder, ordering_s: f64) -> (f64, usize, f64) {
@@ -50,11 +50,8 @@ fn main() {
         );
         std::process::exit(2);
     }
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
-    let supports = [
-        Dirichlet::new("support", 1, 0.0),
-        Dirichlet::new("left", 0, 0.0),
-    ];
+    let material = paper_material();
+    let supports = paper_supports();
     println!(
         "mesh,dofs,nd_values,amd_values,nd_numeric_s,amd_numeric_s,nd_analysis_s,amd_analysis_s"
     );

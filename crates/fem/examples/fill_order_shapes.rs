@@ -7,10 +7,10 @@
 //!     cargo run --release -p stickslip-fem --example fill_order_shapes
 
 use stickslip_fem::ordering::{nested_dissection, DISSECTION_MIN_DOFS};
-use stickslip_fem::testing::{add_point_group, rectangle};
-use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
+use stickslip_fem::{Dirichlet, Model};
 use stickslip_linalg::{analyze_symbolic, FillOrder};
 use stickslip_mesh::{CellKind, Mesh};
+use stickslip_testkit::{add_point_group, paper_material, rectangle};
 
 /// The cells of an `nx × ny` grid of `kind` on unit squares that `keep`
 /// keeps, with a point group "clamp" of the kept nodes `clamp` selects and
@@ -47,7 +47,7 @@ fn shape(
 }
 
 fn main() {
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let material = paper_material();
     let clamp = [
         Dirichlet::new("clamp", 0, 0.0),
         Dirichlet::new("clamp", 1, 0.0),

@@ -30,7 +30,6 @@ pub mod ordering;
 pub mod quadrature;
 pub mod reference;
 pub mod statics;
-pub mod testing;
 
 pub use assembly::{free_dof_pattern, node_adjacency};
 pub use boundary::{boundary_quadrature, BoundaryNode};

@@ -1,8 +1,8 @@
 //! Boundary nodal quadrature: weights, tangents, normals, chain order.
 
-use stickslip_fem::testing::{map_nodes, rectangle, slab};
 use stickslip_fem::{boundary_quadrature, FemError};
 use stickslip_mesh::{CellKind, Group};
+use stickslip_testkit::{map_nodes, rectangle, slab};
 
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-13

@@ -10,7 +10,7 @@
 //! traction σ(u)·n is applied, and the body force is f = −div σ(u), both by
 //! hand (the derivation is checked by finite differences below). The
 //! solution, the mesh and the error integrals live in
-//! `stickslip_fem::testing::manufactured`, shared with `cargo xtask verify`.
+//! `stickslip_testkit::manufactured`, shared with `cargo xtask verify`.
 //!
 //! Expected: the theory's rates (Ciarlet; METHOD.md §2-3) — L2 error
 //! O(h^(k+1)) and H1 error O(h^k) for degree k — i.e. 2 and 1 for Q1, 3 and 2
@@ -23,8 +23,8 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use stickslip_fem::testing::manufactured::{body_force, errors, stress};
 use stickslip_mesh::CellKind;
+use stickslip_testkit::manufactured::{body_force, errors, stress};
 
 #[test]
 fn hand_derived_body_force_matches_finite_differences_of_the_stress() {

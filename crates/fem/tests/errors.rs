@@ -2,18 +2,14 @@
 //! groups, bad Dirichlet conditions. Each message must name the problem and
 //! what to do.
 
-use stickslip_fem::testing::{add_point_group, rectangle, slab};
 use stickslip_fem::{
     static_solve, traction_load, Dirichlet, DofMap, FemError, Hypothesis, Material, Model, Traction,
 };
 use stickslip_mesh::{CellKind, Mesh};
-
-fn mat() -> Material {
-    Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap()
-}
+use stickslip_testkit::{add_point_group, paper_material, paper_supports, rectangle, slab};
 
 fn solve_err(mesh: &Mesh, bcs: &[Dirichlet]) -> FemError {
-    let model = Model::new(mesh, &mat(), bcs).unwrap();
+    let model = Model::new(mesh, &paper_material(), bcs).unwrap();
     static_solve(&model, &vec![0.0; model.dofs.n_free()]).unwrap_err()
 }
 
@@ -66,15 +62,7 @@ fn singular_supports_name_the_free_rigid_body_motions() {
         }
     );
     // The paper's supports are enough.
-    let model = Model::new(
-        &mesh,
-        &mat(),
-        &[
-            Dirichlet::new("support", 1, 0.0),
-            Dirichlet::new("left", 0, 0.0),
-        ],
-    )
-    .unwrap();
+    let model = Model::new(&mesh, &paper_material(), &paper_supports()).unwrap();
     assert!(model.dofs.free_rigid_motions().is_empty());
 }
 
@@ -132,17 +120,19 @@ fn unknown_groups_are_refused_listing_the_mesh_groups() {
     let expect = |e: FemError, purpose: &str| {
         let msg = e.to_string();
         assert!(msg.contains("\"suport\"") && msg.contains(purpose), "{msg}");
-        assert!(
-            msg.contains("contact, load, support, left, domain"),
-            "{msg}"
-        );
+        assert!(msg.contains("contact, load, support, left, body"), "{msg}");
     };
     expect(
         DofMap::new(&mesh, &[Dirichlet::new("suport", 1, 0.0)]).unwrap_err(),
         "a Dirichlet condition",
     );
     expect(
-        Model::new(&mesh, &mat(), &[Dirichlet::new("suport", 1, 0.0)]).unwrap_err(),
+        Model::new(
+            &mesh,
+            &paper_material(),
+            &[Dirichlet::new("suport", 1, 0.0)],
+        )
+        .unwrap_err(),
         "a Dirichlet condition",
     );
     let mut full = vec![0.0; 2 * mesh.nodes.len()];
@@ -150,7 +140,7 @@ fn unknown_groups_are_refused_listing_the_mesh_groups() {
         traction_load(&mesh, "suport", Traction::Pressure(1.0), &mut full).unwrap_err(),
         "a traction",
     );
-    let e = traction_load(&mesh, "domain", Traction::Pressure(1.0), &mut full).unwrap_err();
+    let e = traction_load(&mesh, "body", Traction::Pressure(1.0), &mut full).unwrap_err();
     assert!(
         matches!(e, FemError::WrongGroupDimension { dim: 2, .. }),
         "{e}"

@@ -5,18 +5,9 @@
 //! order is the mesh-order model with its rows and columns permuted, bit
 //! for bit.
 
-use std::path::PathBuf;
-
-use stickslip_fem::testing::rectangle;
-use stickslip_fem::{Dirichlet, DofMap, Hypothesis, Material, Model, NodeOrder};
+use stickslip_fem::{Dirichlet, DofMap, Model, NodeOrder};
 use stickslip_mesh::{CellKind, Mesh};
-
-fn committed(name: &str) -> Mesh {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../cases/meshes")
-        .join(name);
-    Mesh::from_file(&path).unwrap()
-}
+use stickslip_testkit::{paper_material, read_mesh, rectangle};
 
 /// The paper's supports: rollers on `top`, x held on `left`.
 fn supports(top: &str) -> Vec<Dirichlet> {
@@ -39,7 +30,7 @@ fn gmsh_slabs_in_grid_order_are_numbered_as_the_generator_numbers_them() {
         ("slab-q1-32x8.msh", CellKind::Quad4, 32, 8),
         ("slab-q2-32x8.msh", CellKind::Quad9, 32, 8),
     ] {
-        let gmsh = committed(file);
+        let gmsh = read_mesh(file).unwrap();
         let made = DofMap::new(&gmsh, &supports("support")).unwrap();
         let mine = made.renumbered(&gmsh, NodeOrder::Mesh).unwrap();
         let grid = mine.renumbered(&gmsh, NodeOrder::Grid).expect("a grid");
@@ -73,7 +64,7 @@ fn gmsh_slabs_in_grid_order_are_numbered_as_the_generator_numbers_them() {
 fn grid_order_takes_gmsh_rounding_and_declines_meshes_that_are_no_grid() {
     // Gmsh's transfinite nodes (not snapped) sit up to about 1e-11 off their
     // grid lines on an 8 x 1 slab: the same numbering.
-    let exact = committed("slab-q2-32x8.msh");
+    let exact = read_mesh("slab-q2-32x8.msh").unwrap();
     let mut noisy = exact.clone();
     for (i, p) in noisy.nodes.iter_mut().enumerate() {
         let w = ((i as f64) * 0.618_033_988_75).fract() - 0.5;
@@ -91,7 +82,7 @@ fn grid_order_takes_gmsh_rounding_and_declines_meshes_that_are_no_grid() {
     // Unstructured meshes are no grid: they get the band.
     let keep = std::env::var("STICKSLIP_DOF_ORDER").as_deref() == Ok("mesh");
     for file in ["hole-q1.msh", "hole-q2.msh", "slab-unstructured-q1.msh"] {
-        let mesh = committed(file);
+        let mesh = read_mesh(file).unwrap();
         let d = edge_fixed(&mesh);
         let expected = if keep {
             NodeOrder::Mesh
@@ -134,7 +125,7 @@ fn reverse_cuthill_mckee_narrows_gmsh_unstructured_meshes() {
         "slab-unstructured-q1.msh",
         "slab-unstructured-q2.msh",
     ] {
-        let mesh = committed(file);
+        let mesh = read_mesh(file).unwrap();
         let d = edge_fixed(&mesh);
         let (m, b) = (
             d.renumbered(&mesh, NodeOrder::Mesh).unwrap(),
@@ -167,8 +158,8 @@ fn a_model_in_another_order_is_the_mesh_order_model_permuted_bit_for_bit() {
 }
 
 fn permuted_model(file: &str, order: NodeOrder) {
-    let mesh = committed(file);
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let mesh = read_mesh(file).unwrap();
+    let material = paper_material();
     let dofs = DofMap::new(&mesh, &supports("support")).unwrap();
     let (dm, dg) = (
         dofs.renumbered(&mesh, NodeOrder::Mesh).unwrap(),
@@ -220,7 +211,7 @@ fn every_grid_is_numbered_in_grid_order_unless_the_environment_says_mesh() {
         NodeOrder::Grid
     };
     for file in ["slab-q2-8x2.msh", "slab-q1-16x4.msh", "slab-q2-64x16.msh"] {
-        let mesh = committed(file);
+        let mesh = read_mesh(file).unwrap();
         let d = DofMap::new(&mesh, &supports("support")).unwrap();
         assert_eq!(d.node_order(), expected, "{file}");
     }

@@ -1,9 +1,9 @@
 //! Assembled operators: rigid-body modes, mass totals, HRZ ratios, shared
 //! pattern, `combine`, and thread-count independence.
 
-use stickslip_fem::testing::{map_nodes, on_threads, plain_spmv, rectangle};
 use stickslip_fem::{Hypothesis, Material, Model};
 use stickslip_mesh::{CellKind, Mesh};
+use stickslip_testkit::{map_nodes, on_threads, plain_spmv, rectangle};
 
 fn material() -> Material {
     Material::new(1000.0, 0.3, 2.5, Hypothesis::PlaneStrain).unwrap()

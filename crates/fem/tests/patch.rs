@@ -3,12 +3,12 @@
 //! stress (the isoparametric space contains the linear fields, and the full
 //! Gauss rule integrates ∫∇N_a dA exactly because adj(J)·∇̂N is polynomial).
 
-use stickslip_fem::testing::{add_point_group, map_nodes, rectangle};
 use stickslip_fem::{
     gauss_point_stresses, nodal_stresses, static_solve, stress_at_node, traction_load_with,
     von_mises, Dirichlet, Hypothesis, Material, Model,
 };
 use stickslip_mesh::{CellKind, Mesh};
+use stickslip_testkit::{add_point_group, map_nodes, rectangle};
 
 /// The linear field u = a + B x (a generic choice, all entries non-zero).
 fn linear(p: [f64; 2]) -> [f64; 2] {

@@ -1,37 +1,17 @@
 //! The paper's slab (BENCHMARK.md) on the committed Gmsh meshes: the static
 //! state under F_n = 300 alone, and the contact-face nodal quadrature.
 
-use std::path::PathBuf;
-
 use stickslip_fem::{
-    boundary_quadrature, gauss_point_stresses, nodal_stresses, static_solve, traction_load,
-    Dirichlet, Hypothesis, Material, Model, Traction,
+    boundary_quadrature, gauss_point_stresses, nodal_stresses, static_solve, traction_load, Model,
+    Traction,
 };
 use stickslip_mesh::Mesh;
-
-fn mesh_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../cases/meshes")
-        .join(name)
-}
-
-/// ρ = 1, E = 1000, ν = 0.3, plane strain (METHOD.md §7).
-fn slab_material() -> Material {
-    Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap()
-}
+use stickslip_testkit::{paper_material, paper_supports, read_mesh};
 
 /// Supports of BENCHMARK.md: rollers u_y = 0 on `support` (top), u_x = 0 on
 /// `left`; pressure 300 on `contact` (bottom) pushing up.
 fn static_state(mesh: &Mesh) -> Vec<f64> {
-    let model = Model::new(
-        mesh,
-        &slab_material(),
-        &[
-            Dirichlet::new("support", 1, 0.0),
-            Dirichlet::new("left", 0, 0.0),
-        ],
-    )
-    .unwrap();
+    let model = Model::new(mesh, &paper_material(), &paper_supports()).unwrap();
     let mut full = vec![0.0; 2 * mesh.nodes.len()];
     traction_load(mesh, "contact", Traction::Pressure(300.0), &mut full).unwrap();
     let mut free = vec![0.0; model.dofs.n_free()];
@@ -55,7 +35,7 @@ fn slab_static_state_is_the_closed_form_uniform_state_on_committed_meshes() {
         "slab-unstructured-q1.msh",
         "slab-unstructured-q2.msh",
     ] {
-        let mesh = Mesh::from_file(mesh_path(name)).unwrap_or_else(|e| panic!("{e}"));
+        let mesh = read_mesh(name).unwrap_or_else(|e| panic!("{e}"));
         let u = static_state(&mesh);
         let mut worst = 0.0f64;
         for (v, p) in mesh.nodes.iter().enumerate() {
@@ -72,7 +52,7 @@ fn slab_static_state_is_the_closed_form_uniform_state_on_committed_meshes() {
             .position(|p| (p[0] - 8.0).abs() < 1e-12 && p[1].abs() < 1e-12)
             .unwrap();
         assert!((u[2 * corner] - 0.936).abs() < 1e-10);
-        let mat = slab_material();
+        let mat = paper_material();
         for s in gauss_point_stresses(&mesh, &mat, &u) {
             let e = [s.stress[0], s.stress[1] + 300.0, s.stress[2]];
             assert!(
@@ -103,7 +83,7 @@ fn contact_face_nodal_quadrature_on_committed_meshes() {
         ("slab-q2-8x2.msh", 1.0 / 6.0, 1.0 / 3.0),
         ("slab-q1-16x4.msh", 0.25, 0.5),
     ] {
-        let mesh = Mesh::from_file(mesh_path(name)).unwrap();
+        let mesh = read_mesh(name).unwrap();
         let bq = boundary_quadrature(&mesh, "contact").unwrap();
         assert_eq!(bq.len(), 17, "{name}");
         let find = |x: f64| {

@@ -5,14 +5,14 @@ use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::sparse::SparseColMatRef;
 use faer::{Conj, MatMut, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
-use stickslip_fem::testing::{on_threads, plain_spmv, rectangle};
-use stickslip_fem::{Hypothesis, Material, Model};
+use stickslip_fem::Model;
 use stickslip_linalg::*;
 use stickslip_mesh::CellKind;
+use stickslip_testkit::{on_threads, paper_material, plain_spmv, rectangle, spread};
 
 fn operator(kind: CellKind, nx: usize, ny: usize) -> CsrMatrix<f64> {
     let mesh = rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let material = paper_material();
     let model = Model::new(&mesh, &material, &[]).unwrap();
     // A₀ of the paper's Newmark step: (β/γ)Δt K + M/(γΔt), Δt = 1e-3.
     model.combined(0.5e-3, 1.0 / 0.5e-3)
@@ -67,12 +67,6 @@ fn residual(a: &CsrMatrix<f64>, x: &[f64], b: &[f64]) -> f64 {
     worst
 }
 
-fn rhs(n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| ((i * 7919) % 1000) as f64 / 500.0 - 1.0)
-        .collect()
-}
-
 /// The solve satisfies A x = b (residual against the matrix, not
 /// against faer) and agrees with faer's solve, Q1 and Q2.
 #[test]
@@ -81,7 +75,7 @@ fn solves_like_faer() {
         let a = operator(kind, nx, ny);
         let f = factor(&a);
         let mut sn = Supernodal::new(&f.symbolic).expect("forced supernodal");
-        let b = rhs(a.nrows());
+        let b = spread(a.nrows());
         let mut x = b.clone();
         sn.solve(&f.l, &mut x);
         assert!(residual(&a, &x, &b) < 1e-12, "{kind:?}");
@@ -108,7 +102,7 @@ fn split_step_matches_two_solves() {
     let dofs: Vec<usize> = (0..=24).map(|i| 2 * i).collect();
     sn.set_reach(&dofs);
     assert!(sn.reach_len() < f.l.len(), "the reach is part of the tree");
-    let b = rhs(n);
+    let b = spread(n);
     let perm = sn.permuted_indices();
     sn.begin_reach(&f.l, &b);
     let mut full = b.clone();
@@ -135,7 +129,7 @@ fn split_solve_is_right_and_thread_independent() {
     let a = operator(CellKind::Quad4, 40, 10);
     let n = a.nrows();
     let f = factor(&a);
-    let b = rhs(n);
+    let b = spread(n);
     let dofs: Vec<usize> = (0..=40).map(|i| 2 * i).collect();
     let run = |threads: usize| {
         on_threads(threads, || {
@@ -220,7 +214,7 @@ fn schur_complement_matches_full_solves() {
     let g = &op.s;
     let p = rows.len();
     // The step through W: p = P A⁻¹ b, then x = A⁻¹(b − Pᵀf).
-    let b = rhs(n);
+    let b = spread(n);
     let mut pv = vec![0.0; p];
     sn.begin_paths(&f.l, &op, &b, &mut pv);
     let mut full = b.clone();

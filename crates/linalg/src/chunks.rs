@@ -128,32 +128,3 @@ fn add_in_order<const S: usize>(partials: &[[f64; S]]) -> [f64; S] {
 pub fn partials<const S: usize>(n: usize) -> Vec<[f64; S]> {
     vec![[0.0; S]; chunks(n)]
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The chunked sum of a long vector is the same on one thread and on
-    /// two, and within rounding of the plain sum.
-    #[test]
-    fn sums_do_not_depend_on_the_threads() {
-        let n = 5 * CHUNK + 17;
-        let x: Vec<f64> = (0..n)
-            .map(|i| ((i * 7919) % 1000) as f64 * 1e-3 - 0.4)
-            .collect();
-        let sum = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
-                let mut p = partials::<1>(n);
-                sum_chunks(n, &mut p, |_, rows, s| s[0] = rows.map(|i| x[i]).sum())[0]
-            })
-        };
-        let (one, two) = (sum(1), sum(2));
-        assert_eq!(one.to_bits(), two.to_bits());
-        let plain: f64 = x.iter().sum();
-        assert!((one - plain).abs() <= 1e-12 * n as f64);
-    }
-}

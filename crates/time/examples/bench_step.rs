@@ -23,59 +23,18 @@ use std::process::Command;
 use std::time::Instant;
 
 use stickslip_contact::ContactSurface;
-use stickslip_fem::{traction_load, Dirichlet, Hypothesis, Material, Model, Traction};
+use stickslip_fem::Model;
 use stickslip_mesh::Mesh;
+use stickslip_testkit::{meshes_dir, paper_material, structured_slab, workspace_root, Slab};
 use stickslip_time::stability::critical_step;
 use stickslip_time::{Dynamics, History, Integrator, Load, Scheme, Settings};
-
-/// The paper's slab material (BENCHMARK.md).
-fn slab_material() -> Material {
-    Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap()
-}
-
-/// The paper's slab problem (BENCHMARK.md) on `mesh`.
-fn problem(mesh: &Mesh) -> (Model, ContactSurface, Vec<Load>) {
-    let material = slab_material();
-    let conditions = vec![
-        Dirichlet::new("support", 1, 0.0),
-        Dirichlet::new("left", 0, 0.0),
-    ];
-    let model = Model::new(mesh, &material, &conditions).unwrap();
-    let n_full = 2 * mesh.nodes.len();
-    let restrict = |full: &[f64]| {
-        let mut free = vec![0.0; model.dofs.n_free()];
-        model.dofs.restrict(full, &mut free);
-        free
-    };
-    let mut p = vec![0.0; n_full];
-    traction_load(mesh, "contact", Traction::Pressure(300.0), &mut p).unwrap();
-    let mut e = vec![0.0; n_full];
-    traction_load(mesh, "load", Traction::Vector([-150.0, 0.0]), &mut e).unwrap();
-    let loads = vec![
-        Load {
-            vector: restrict(&p),
-            history: History::Constant,
-        },
-        Load {
-            vector: restrict(&e),
-            history: History::Step,
-        },
-    ];
-    let contact =
-        ContactSurface::from_group(mesh, &model.dofs, "contact", 300.0, 0.3, 1e-4).unwrap();
-    (model, contact, loads)
-}
 
 fn mesh_named(name: &str) -> Mesh {
     // "gen-q1-NXxNY" / "gen-q2-NXxNY" are built here; others are files.
     if let Some(rest) = name.strip_prefix("gen-") {
         let (order, size) = rest.split_once('-').expect("gen-qK-NXxNY");
         let (nx, ny) = size.split_once('x').expect("NXxNY");
-        return stickslip_time::scenes::structured_slab(
-            nx.parse().unwrap(),
-            ny.parse().unwrap(),
-            order == "q2",
-        );
+        return structured_slab(nx.parse().unwrap(), ny.parse().unwrap(), order == "q2");
     }
     // A path to a .msh file (e.g. a Gmsh slab from generate.py
     // --bench-out); "gmsh-qK-NXxNY[-fileorder]": the Gmsh slab `cargo
@@ -86,9 +45,7 @@ fn mesh_named(name: &str) -> Mesh {
     } else if let Some(rest) = name.strip_prefix("gmsh-") {
         gmsh_file(rest.trim_end_matches("-fileorder"))
     } else {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../../cases/meshes")
-            .join(format!("{name}.msh"))
+        meshes_dir().join(format!("{name}.msh"))
     };
     Mesh::from_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
@@ -97,8 +54,8 @@ fn mesh_named(name: &str) -> Mesh {
 /// (generate.py --bench-out target/bench/gmsh: Gmsh's numbering and
 /// coordinates, not snapped).
 fn gmsh_file(size: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../target/bench/gmsh")
+    workspace_root()
+        .join("target/bench/gmsh")
         .join(format!("slab-{size}-bin.msh"))
 }
 
@@ -232,7 +189,7 @@ fn dump_mesh(dir: &std::path::Path, mesh: &Mesh, model: &Model) {
     let free =
         (0..model.dofs.n_full()).map(|d| model.dofs.free_of_full(d).map_or(-1, |f| f as i64));
     write_le(&dir.join("free.i64"), free.map(i64::to_le_bytes));
-    let m = slab_material();
+    let m = paper_material();
     let order = if per == 9 { 2 } else { 1 };
     std::fs::write(
         dir.join("mesh.json"),
@@ -296,8 +253,13 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     // runtime (about 3 MB), which the run's own figure leaves out.
     let rss_base = status_bytes("VmRSS:");
     let t_setup = Instant::now();
-    let mesh = mesh_named(name);
-    let (model, contact, loads) = problem(&mesh);
+    let Slab {
+        mesh,
+        model,
+        contact,
+        loads,
+    } = Slab::paper(mesh_named(name), 1e-4, History::Step, true).unwrap();
+    let contact = contact.expect("the paper's slab has friction");
     let explicit = scheme == "cd";
     if let Some(dir) = &dump {
         dump_mesh(dir, &mesh, &model);
@@ -797,7 +759,7 @@ fn main() {
         );
     }
     let exe = std::env::current_exe().unwrap();
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let root = workspace_root();
     let dir = root.join("target/bench");
     let mut rows = Vec::new();
     for (scheme, name, dofs, steps, repeats) in ladder {

@@ -27,7 +27,6 @@ mod initial;
 mod integrator;
 mod newmark;
 mod nodal;
-pub mod scenes;
 mod settings;
 pub mod stability;
 mod state;

@@ -3,8 +3,7 @@
 //! one factorization. Summing Δt step by step drifted and, past 1e5 steps,
 //! added a sliver of a last step (Δt ≈ 1e-10) and a second factorization.
 
-mod common;
-use common::*;
+use stickslip_testkit::paper_slab;
 use stickslip_time::{History, Scheme, Settings, StickReduction};
 
 const NEWMARK: Scheme = Scheme::Newmark {

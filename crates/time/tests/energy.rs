@@ -2,8 +2,7 @@
 //! rule) conserves E = ½ṙᵀMṙ + ½rᵀKr − rᵀR exactly for a constant load;
 //! central difference keeps it within a band that shrinks as Δt².
 
-mod common;
-use common::*;
+use stickslip_testkit::{read_mesh, Slab};
 use stickslip_time::{History, Scheme, Settings};
 
 /// Largest |E_K − E_0| of the frictionless slab (pressure and end load on,

@@ -4,12 +4,11 @@
 //! meanwhile; steps are counted after a warm-up that builds the thread pool
 //! and the factors of every Δt the counted steps use.
 
-mod common;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use common::*;
 use stickslip_linalg::chunks::{CHUNK, PARALLEL_MIN};
+use stickslip_testkit::{paper_slab, Slab};
 use stickslip_time::{History, ImplicitSolver, Integrator, Scheme, Settings, StickReduction};
 
 struct Counting;
@@ -64,7 +63,7 @@ fn steps_allocate_nothing() {
     // Explicit: the paper's mesh (sequential passes) and a mesh of at
     // least PARALLEL_MIN whole chunks of DOFs, whose passes run on the
     // thread pool (CHUNK).
-    let threaded = stickslip_time::scenes::structured_slab(192, 48, false);
+    let threaded = stickslip_testkit::structured_slab(192, 48, false);
     for (mesh, s) in [
         (
             "slab-q2-8x2.msh",

@@ -2,9 +2,8 @@
 //! properties Martins & Oden report, and checks of this implementation
 //! against itself (explicit closed form vs iteration, Remark 4.2).
 
-mod common;
-use common::*;
 use stickslip_contact::IterationOptions;
+use stickslip_testkit::paper_slab;
 use stickslip_time::{ExplicitFriction, History, Integrator, Scheme, Settings, TimeError};
 
 const NEWMARK: Scheme = Scheme::Newmark {

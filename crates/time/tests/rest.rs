@@ -2,8 +2,7 @@
 //! −0 in floating point, which the results file kept and scripts printed
 //! as "-0.000".
 
-mod common;
-use common::*;
+use stickslip_testkit::paper_slab;
 use stickslip_time::{History, Scheme, Settings};
 
 #[test]

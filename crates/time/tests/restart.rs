@@ -3,8 +3,7 @@
 //! the uninterrupted run (the restart contract of the cli). Expected values
 //! come from the uninterrupted run of the same case, not from constants.
 
-mod common;
-use common::*;
+use stickslip_testkit::paper_slab;
 use stickslip_time::{Checkpoint, History, Integrator, Scheme, Settings, StickReduction};
 
 const NEWMARK: Scheme = Scheme::Newmark {

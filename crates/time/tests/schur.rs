@@ -13,10 +13,9 @@
 //! run by round-off amplification alone; the per-step comparison measures
 //! the solver, and the whole-run classes must still agree.
 
-mod common;
 use std::collections::BTreeSet;
 
-use common::*;
+use stickslip_testkit::{paper_slab, Slab};
 use stickslip_time::{History, ImplicitSolver, Integrator, Scheme, Settings, StickReduction};
 
 fn cases() -> Vec<(&'static str, Scheme, Option<StickReduction>)> {

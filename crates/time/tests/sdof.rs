@@ -9,16 +9,16 @@
 //! at 0.03; P = 5 slips forward to 0.08, back to 0.04 and sticks; P = 0.8
 //! never moves.
 //!
-//! The closed form and the oscillator are `stickslip_time::scenes::sdof`
+//! The closed form and the oscillator are `stickslip_testkit::sdof`
 //! (shared with `cargo xtask verify`); the first test checks the closed form
 //! against the statement above.
 
-use stickslip_time::scenes::sdof::closed_form;
+use stickslip_testkit::sdof::closed_form;
 use stickslip_time::Scheme;
 
 /// Largest |x − x_exact| over the run, and x(1).
 fn max_error(p: f64, eps: f64, scheme: Scheme, dt: f64) -> (f64, f64) {
-    stickslip_time::scenes::sdof::max_error(p, eps, scheme, dt).unwrap()
+    stickslip_testkit::sdof::max_error(p, eps, scheme, dt).unwrap()
 }
 
 const SCHEMES: [Scheme; 2] = [

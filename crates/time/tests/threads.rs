@@ -2,11 +2,8 @@
 //! thread and on several (issue 7): the work is split into fixed chunks and
 //! sums are added in chunk order, whatever the number of threads.
 
-mod common;
-use common::*;
-use stickslip_fem::testing::on_threads;
 use stickslip_linalg::chunks::{CHUNK, PARALLEL_MIN};
-use stickslip_time::scenes::structured_slab;
+use stickslip_testkit::{on_threads, structured_slab, Slab};
 use stickslip_time::{History, Integrator, Scheme, Settings};
 
 fn run(s: &Slab, threads: usize, steps: usize) -> Integrator {

@@ -4,12 +4,12 @@
 //! the end displacement: a triangle wave between 0 and −2pL/E with period
 //! 4L/c, u(L, t) = −(p c/E)·t for t ≤ 2L/c, then back to 0 at 4L/c.
 
-use stickslip_time::scenes::{read_mesh, wave};
+use stickslip_testkit::{read_mesh, wave};
 use stickslip_time::Scheme;
 
 /// Relative L2-in-time error of u_x(L, 0) over one period against
-/// d'Alembert (`scenes::wave::exact_end_displacement`, the closed form
-/// above; the scene is `scenes::wave::scene`).
+/// d'Alembert (`wave::exact_end_displacement`, the closed form
+/// above; the scene is `wave::scene`).
 fn wave_error(mesh_file: &str, scheme: Scheme, dt: f64) -> f64 {
     wave::end_error(read_mesh(mesh_file).unwrap(), scheme, dt).unwrap()
 }

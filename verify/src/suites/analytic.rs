@@ -3,10 +3,10 @@
 
 use std::path::Path;
 
-use stickslip_fem::testing::{add_point_group, map_nodes, rectangle};
 use stickslip_fem::{static_solve, Dirichlet, Hypothesis, Material, Model};
 use stickslip_mesh::{CellKind, Mesh};
-use stickslip_time::scenes::{sdof, wave, Slab};
+use stickslip_testkit::{add_point_group, map_nodes, rectangle};
+use stickslip_testkit::{sdof, wave, Slab};
 use stickslip_time::{History, Scheme};
 
 use crate::report::Report;
@@ -53,7 +53,7 @@ fn coulomb_oscillator(opts: &Options, r: &mut Report) {
 }
 
 /// Largest relative L2-in-time error of u_x(L, 0) over one period against
-/// d'Alembert's triangle wave (`stickslip_time::scenes::wave`: ν = 0 makes
+/// d'Alembert's triangle wave (`stickslip_testkit::wave`: ν = 0 makes
 /// plane strain uniaxial, a bar with c = √(E/ρ); the end moves as
 /// −(p c/E)·t up to 2L/c, then back).
 fn wave_error(root: &Path, mesh_file: &str, scheme: Scheme, dt: f64) -> Result<f64, String> {

@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use stickslip_case::Scene;
-use stickslip_fem::testing::manufactured;
 use stickslip_mesh::CellKind;
-use stickslip_time::scenes::sdof;
+use stickslip_testkit::manufactured;
+use stickslip_testkit::sdof;
 use stickslip_time::Scheme;
 
 use crate::report::{num, Report};
@@ -40,7 +40,7 @@ pub fn run(root: &Path, opts: &Options, r: &mut Report) {
 }
 
 // ---- h: the manufactured solution of crates/fem/tests/convergence.rs ----
-// (stickslip_fem::testing::manufactured: a smooth u on the unit square with
+// (stickslip_testkit::manufactured: a smooth u on the unit square with
 // curved interior, clamped on x = 0 and y = 0, traction on x = 1 and y = 1.)
 
 /// (L2 error, H1-seminorm error) on an n × n mesh.

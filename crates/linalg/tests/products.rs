@@ -1,0 +1,197 @@
+//! The products and sums of the fixed chunks (chunks.rs, csr.rs,
+//! stencils.rs) against the plain sums over the stored entries, and the
+//! same bits on one thread and on two.
+
+use nalgebra_sparse::{CooMatrix, CsrMatrix};
+use stickslip_linalg::chunks::{chunks, partials, sum_chunks, CHUNK};
+use stickslip_linalg::csr::{index, load_minus_k_plus_m, quadratic_form, spmv, two_forms};
+use stickslip_linalg::{Stencils, TOLERANCE};
+use stickslip_testkit::{on_threads, plain_spmv, spread};
+
+/// The chunked sum of a long vector is the same on one thread and on
+/// two, and within rounding of the plain sum.
+#[test]
+fn sums_do_not_depend_on_the_threads() {
+    let n = 5 * CHUNK + 17;
+    let x: Vec<f64> = (0..n)
+        .map(|i| ((i * 7919) % 1000) as f64 * 1e-3 - 0.4)
+        .collect();
+    let sum = |threads: usize| {
+        on_threads(threads, || {
+            let mut p = partials::<1>(n);
+            sum_chunks(n, &mut p, |_, rows, s| s[0] = rows.map(|i| x[i]).sum())[0]
+        })
+    };
+    let (one, two) = (sum(1), sum(2));
+    assert_eq!(one.to_bits(), two.to_bits());
+    let plain: f64 = x.iter().sum();
+    assert!((one - plain).abs() <= 1e-12 * n as f64);
+}
+
+/// A symmetric matrix with a few entries per row, long enough for
+/// several chunks.
+fn banded(n: usize) -> CsrMatrix<f64> {
+    let mut coo = CooMatrix::new(n, n);
+    for i in 0..n {
+        coo.push(i, i, 4.0 + (i % 7) as f64);
+        for d in [1, 5, 93] {
+            if i + d < n {
+                let v = -0.25 * d as f64;
+                coo.push(i, i + d, v);
+                coo.push(i + d, i, v);
+            }
+        }
+    }
+    CsrMatrix::from(&coo)
+}
+
+/// The products against a plain sum over the stored entries.
+#[test]
+fn products_and_forms_against_plain_sums() {
+    let n = 3 * CHUNK + 101;
+    let a = banded(n);
+    let x: Vec<f64> = (0..n).map(|i| ((i * 31) % 17) as f64 - 8.0).collect();
+    let y: Vec<f64> = (0..n).map(|i| ((i * 13) % 11) as f64 * 0.5).collect();
+    let plain = plain_spmv(&a, &x);
+    let mut ax = vec![0.0; n];
+    spmv(&a, &x, &mut ax);
+    for (p, q) in plain.iter().zip(&ax) {
+        // Small integers and halves: every sum is exact.
+        assert_eq!(p, q);
+    }
+    let mut partials = partials(n);
+    let xax: f64 = x.iter().zip(&plain).map(|(a, b)| a * b).sum();
+    assert!((quadratic_form(&a, &x, &mut partials) - xax).abs() <= 1e-12 * xax.abs());
+    let (f1, f2) = two_forms(&a, &x, &a, &y, &mut partials);
+    assert_eq!(
+        f1.to_bits(),
+        quadratic_form(&a, &x, &mut partials).to_bits()
+    );
+    assert_eq!(
+        f2.to_bits(),
+        quadratic_form(&a, &y, &mut partials).to_bits()
+    );
+    let l = vec![1.5; n];
+    let mut out = vec![0.0; n];
+    load_minus_k_plus_m(&l, &a, &x, &a, &y, &mut out);
+    let mut ay = vec![0.0; n];
+    spmv(&a, &y, &mut ay);
+    for i in 0..n {
+        assert_eq!(out[i].to_bits(), (l[i] - ax[i] + ay[i]).to_bits());
+    }
+    assert_eq!(index(&a, 0, 5), Some(2));
+    assert_eq!(index(&a, 0, 2), None);
+}
+
+/// A grid of nx × ny nodes, two DOFs each, numbered node by node, row
+/// by row, coupled to their 8 neighbours by 2×2 blocks as a Q1
+/// stiffness couples them; `wobble` perturbs every value by up to that
+/// relative amount (the rounding of a mesh's coordinates), `fixed`
+/// removes the x DOF of the first node (a support: single DOFs).
+fn grid(nx: usize, ny: usize, wobble: f64, fixed: bool) -> CsrMatrix<f64> {
+    let node = |i: usize, j: usize| j * nx + i;
+    let all = 2 * nx * ny;
+    let skip = usize::from(fixed);
+    let mut coo = CooMatrix::new(all - skip, all - skip);
+    let mut k = 0u64;
+    let mut jitter = || {
+        k = k
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        1.0 + wobble * ((k >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+    };
+    for j in 0..ny {
+        for i in 0..nx {
+            for dj in -1i64..=1 {
+                for di in -1i64..=1 {
+                    let (ii, jj) = (i as i64 + di, j as i64 + dj);
+                    if ii < 0 || jj < 0 || ii >= nx as i64 || jj >= ny as i64 {
+                        continue;
+                    }
+                    let (a, b) = (node(i, j), node(ii as usize, jj as usize));
+                    for p in 0..2 {
+                        for q in 0..2 {
+                            let (r, c) = (2 * a + p, 2 * b + q);
+                            if r < skip || c < skip {
+                                continue;
+                            }
+                            let base = if a == b {
+                                if p == q {
+                                    8.0
+                                } else {
+                                    0.5
+                                }
+                            } else {
+                                -1.0 - 0.25 * (p + q) as f64 - 0.1 * (di + 2 * dj) as f64
+                            };
+                            coo.push(r - skip, c - skip, base * jitter());
+                        }
+                    }
+                }
+            }
+        }
+    }
+    CsrMatrix::from(&coo)
+}
+
+/// Within TOLERANCE · max|K| · Σ|x| of the assembled product, row by
+/// row, on a grid with rounding-sized wobble and a fixed DOF; few types.
+#[test]
+fn product_within_the_tolerance_of_the_assembled_one() {
+    for fixed in [false, true] {
+        let a = grid(300, 40, 1e-13, fixed);
+        let s = Stencils::new(&a).expect("a structured grid has few stencils");
+        assert!(s.types() < 40, "{} types", s.types());
+        let n = a.nrows();
+        let x = spread(n);
+        let mut y = vec![0.0; n];
+        s.spmv(&x, &mut y);
+        let max = a.values().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let want = plain_spmv(&a, &x);
+        for (i, r) in a.row_iter().enumerate() {
+            let scale: f64 = r.col_indices().iter().map(|&j| x[j].abs()).sum();
+            assert!(
+                (y[i] - want[i]).abs() <= 2.0 * TOLERANCE * max * scale,
+                "row {i}: {} against {}",
+                y[i],
+                want[i]
+            );
+        }
+    }
+}
+
+/// Batches, single rows, one thread and two: the same bits.
+#[test]
+fn rows_have_the_same_bits_every_way() {
+    let a = grid(200, 60, 1e-13, true);
+    let s = Stencils::new(&a).unwrap();
+    let n = a.nrows();
+    assert!(chunks(n) > 2);
+    let x = spread(n);
+    let on = |threads: usize| {
+        on_threads(threads, || {
+            let mut y = vec![0.0; n];
+            s.spmv(&x, &mut y);
+            y
+        })
+    };
+    let (one, two) = (on(1), on(2));
+    let mut batched = vec![f64::NAN; n];
+    for c in 0..chunks(n) {
+        s.batches(c, &x, |r0, ku| {
+            batched[r0..r0 + ku.len()].copy_from_slice(ku)
+        });
+    }
+    for i in 0..n {
+        assert_eq!(one[i].to_bits(), two[i].to_bits(), "row {i}");
+        assert_eq!(one[i].to_bits(), batched[i].to_bits(), "row {i}");
+        assert_eq!(one[i].to_bits(), s.row(i, &x).to_bits(), "row {i}");
+    }
+}
+
+/// Values that differ by more than the tolerance make types of their
+/// own: a wobble of 1e-6 leaves too many for the types to pay.
+#[test]
+fn declines_what_has_no_structure() {
+    assert!(Stencils::new(&grid(100, 20, 1e-6, false)).is_none());
+}
