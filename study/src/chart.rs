@@ -1,7 +1,6 @@
-//! The work-precision study (issue 6, deliverable 1): every combination of
-//! element order, mesh, method and Δt (and an ε ladder at a fixed
-//! discretization) run on the paper's slab, timed (median of repeats) and
-//! compared with a converged reference.
+//! The work-precision study: every combination of element order, mesh, method
+//! and Δt (and an ε ladder at a fixed discretization) run on the paper's slab,
+//! timed (median of repeats) and compared with a converged reference.
 //!
 //! Errors, all against the reference sampled on the same uniform grid of
 //! [`SAMPLES`] times in [0, 0.5] (linear interpolation between steps):
@@ -212,7 +211,7 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// The full study (about 10 minutes on a loaded 2-core machine).
+    /// The full study (minutes of runs on a 2-core machine).
     pub fn full() -> Plan {
         Plan {
             loads: vec![LoadKind::Step, LoadKind::Sin],

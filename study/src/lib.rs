@@ -1,9 +1,9 @@
-//! Measured studies of the solver on the paper's slab (issue 6): the
-//! work-precision chart (error against wall time over element order, mesh,
-//! scheme, Δt and ε) and the stability map (the explicit critical step, the
-//! ringing after sticking, the stick/slip iteration with and without
-//! Remark 4.2). Everything runs the integrators in-process; results go to
-//! CSV files and PNG/SVG charts in docs/.
+//! Measured studies of the solver on the paper's slab: the work-precision
+//! chart (error against wall time over element order, mesh, scheme, Δt and ε)
+//! and the stability map (the explicit critical step, the ringing after
+//! sticking, the stick/slip iteration with and without Remark 4.2). Everything
+//! runs the integrators in-process; results go to CSV files and PNG/SVG charts
+//! in docs/.
 
 pub mod chart;
 pub mod plot;

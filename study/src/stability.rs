@@ -1,4 +1,4 @@
-//! The stability map (issue 6, deliverable 2), each row a measured fact:
+//! The stability map, each row a measured fact:
 //!
 //! * central difference at Δt/Δt_crit ∈ {0.5, 0.9, 0.99, 1.01, 1.1, 2}:
 //!   stable or not by energy growth, and the observed threshold (bisected)

@@ -1,5 +1,5 @@
-//! Solver economy (issue 6, deliverable 4), measured with the time crate's
-//! counters on the paper's slab: work done is what the scene needs.
+//! Solver economy, measured with the time crate's counters on the paper's
+//! slab: work done is what the scene needs.
 
 use std::collections::BTreeSet;
 

@@ -1,7 +1,7 @@
-//! The qualitative facts of the stability map (issue 6, deliverable 2),
-//! on the paper's meshes: central difference unstable above and stable
-//! below the estimated Δt_crit; the ringing after sticking removed by the
-//! step reduction of Remark 4.3; no iteration failures with Remark 4.2.
+//! The qualitative facts of the stability map, on the paper's meshes: central
+//! difference unstable above and stable below the estimated Δt_crit; the
+//! ringing after sticking removed by the step reduction of Remark 4.3; no
+//! iteration failures with Remark 4.2.
 
 use stickslip_case::Method;
 use stickslip_study::run::TRAPEZOIDAL;
@@ -28,7 +28,7 @@ fn central_difference_is_stable_below_and_unstable_above_the_estimate() {
                     g.growth
                 );
             }
-            // The issue's requirement: the observed threshold within 2% of
+            // The map's requirement: the observed threshold within 2% of
             // the Lanczos estimate of 2/ω_max.
             let observed = threshold(&s, 0.9, 1.1, 1e-3, STABILITY_STEPS).unwrap();
             assert!(

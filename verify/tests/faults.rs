@@ -1,7 +1,7 @@
-//! The verify tool catches a broken build: each defect of issue 5's
-//! acceptance is injected through the library API into the paper cases,
-//! and a failing row must name the cause. The clean build must pass the
-//! same suites (against the committed references in cases/reference/).
+//! The verify tool catches a broken build: each defect it must catch is
+//! injected through the library API into the paper cases, and a failing row
+//! must name the cause. The clean build must pass the same suites (against the
+//! committed references in cases/reference/).
 
 use stickslip_testkit::workspace_root as root;
 use stickslip_verify::suites::{paper, reference};

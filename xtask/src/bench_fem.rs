@@ -1,6 +1,6 @@
-//! `cargo xtask bench fem`: assembly and Cholesky on the Q2 slab ladder
-//! (issue 3, Performance), with scikit-fem's assembly of the same K and
-//! scipy's SuperLU on the very matrix stickslip assembled as peer figures.
+//! `cargo xtask bench fem`: assembly and Cholesky on the Q2 slab ladder, with
+//! scikit-fem's assembly of the same K and scipy's SuperLU on the very matrix
+//! stickslip assembled as peer figures.
 //!
 //! Each rung runs `crates/fem/examples/bench_assembly.rs` in its own process
 //! (so its peak RSS is the rung's), dumping K and the load to

@@ -1,6 +1,6 @@
 //! `cargo xtask bench mesh`: the .msh reader's speed and memory on a ~1M-node
-//! Q1 slab (issue 2, Performance), with Gmsh's own load time of the same
-//! files (`gmsh.open` from Python) as the peer figure.
+//! Q1 slab, with Gmsh's own load time of the same files (`gmsh.open` from
+//! Python) as the peer figure.
 //!
 //! Steps: make sure `gmsh` imports (pip-install it if not); write the slab
 //! (default 1000 x 999 cells = 1,001,000 nodes) to `target/bench-meshes/` in

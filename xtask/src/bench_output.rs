@@ -1,12 +1,12 @@
 //! `cargo xtask bench output`: what a whole run costs, as a user running a
-//! parameter sweep sees it (issue 7: the cost per run), and how much of it
-//! is the results file: the release `stickslip run` on the paper's case
-//! (central difference, 500 steps) and on a 4,257-node Newmark slab (100
-//! steps), every step written, with deflate off (the default) and at levels
-//! 1 and 4, and with only the last step written (the run without its
-//! output). Wall time of the process, median and fastest of the rounds
-//! (configurations interleaved), and the file's size; a CSV into
-//! docs/bench-output.csv (the README quotes it).
+//! parameter sweep sees it (the cost per run), and how much of it is the
+//! results file: the release `stickslip run` on the paper's case (central
+//! difference, 500 steps) and on a 4,257-node Newmark slab (100 steps), every
+//! step written, with deflate off (the default) and at levels 1 and 4, and
+//! with only the last step written (the run without its output). Wall time of
+//! the process, median and fastest of the rounds (configurations interleaved),
+//! and the file's size; a CSV into docs/bench-output.csv (the README quotes
+//! it).
 //!
 //!     cargo xtask bench output [--rounds N]
 

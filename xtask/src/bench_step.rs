@@ -1,21 +1,20 @@
 //! `cargo xtask bench step`: time per step of central difference and of
-//! implicit Newmark (Schur path) on the slab ladder (issue 7, deliverable
-//! 3), with the figures it is compared with measured in the same run: STREAM
-//! triad bandwidth and the bytes an explicit step moves; one forward+back
-//! solve for Newmark; the scipy peer (bench/peer.py, numpy + scipy, its K
-//! and M assembled by scikit-fem, installed with pip if missing) on the
-//! paper's 85-node mesh and the rungs of ≥ 100k DOFs, its matrices checked
-//! against ours (1e-10) and its state against ours (1e-8) before it is timed;
-//! peak memory against what the run must hold.
+//! implicit Newmark (Schur path) on the slab ladder, with the figures it is
+//! compared with measured in the same run: STREAM triad bandwidth and the
+//! bytes an explicit step moves; one forward+back solve for Newmark; the scipy
+//! peer (bench/peer.py, numpy + scipy, its K and M assembled by scikit-fem,
+//! installed with pip if missing) on the paper's 85-node mesh and the rungs of
+//! ≥ 100k DOFs, its matrices checked against ours (1e-10) and its state
+//! against ours (1e-8) before it is timed; peak memory against what the run
+//! must hold.
 //!
 //! Runs `crates/time/examples/bench_step.rs` in the release profile (what
-//! `cargo install` builds; the dev profile keeps debug assertions and
-//! overflow checks: the paper mesh's explicit step 3.2 µs there, 2.0 µs
-//! here, the large rungs equal within the noise), which times each rung in its
-//! own process (so its peak RSS is the rung's), prints one row per rung and
-//! writes target/bench/step.csv; a full run (no --quick, no --max-dofs)
-//! with the peer also copies it to docs/bench-step.csv, the table the
-//! README quotes. Figures are printed, not asserted.
+//! `cargo install` builds; the dev profile keeps debug assertions and overflow
+//! checks, which slow the small rungs' steps: docs/performance.md), which
+//! times each rung in its own process (so its peak RSS is the rung's), prints
+//! one row per rung and writes target/bench/step.csv; a full run (no --quick,
+//! no --max-dofs) with the peer also copies it to docs/bench-step.csv, the
+//! table the README quotes. Figures are printed, not asserted.
 //!
 //!     cargo xtask bench step [--quick] [--max-dofs N] [--no-peer]
 

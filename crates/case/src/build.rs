@@ -404,8 +404,8 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
         }
         match ContactSurface::from_group(&mesh, &model.dofs, &c.group, c.pressure, c.mu, c.eps) {
             // Every node's tangential DOF held: the friction the case asks
-            // for could act nowhere (before, it was dropped silently, and
-            // the file had no /contact).
+            // for could act nowhere, and a run without it is not the run
+            // the case describes.
             Ok(s) if s.is_empty() => problems.push(format!(
                 "{}[contact]: no node of group \"{}\" can slide: [[dirichlet]] conditions hold the tangential \
                  motion of all its {} nodes, so friction would act nowhere; remove the [[dirichlet]] on the \

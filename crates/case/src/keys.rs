@@ -92,7 +92,7 @@ fn is_number(v: &Value) -> bool {
 }
 
 /// Magnitudes a case's numbers may have (or 0): beyond them products such
-/// as E·h² or ρ·h²/Δt² overflow or underflow, and the run failed with a
+/// as E·h² or ρ·h²/Δt² overflow or underflow, and the run would fail with a
 /// wrong diagnosis (E = 1e308: "a rigid-body motion left free"; ρ =
 /// 1e-300: "use time.dt < 0").
 const MODERATE: std::ops::RangeInclusive<f64> = 1e-100..=1e100;

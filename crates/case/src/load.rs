@@ -34,7 +34,7 @@ use crate::set::apply_set;
 /// `file:line:col: what; what to do` (or `--set KEY=VALUE: ...`).
 pub fn load(path: &Path, sets: &[String]) -> Result<Case, InputError> {
     let file = path.display().to_string();
-    // A device or FIFO would be read forever (`check /dev/zero` hung).
+    // A device or FIFO would be read forever (`check /dev/zero` would hang).
     if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
         return Err(InputError(format!(
             "{file}: not a regular file (a device, FIFO or socket); give the case's .toml file"
@@ -215,8 +215,8 @@ pub fn parse_str(text: &str) -> Result<Case, InputError> {
     load_str(Path::new("case.toml"), text, &[])
 }
 
-/// Most steps a case may ask for: 1e12 steps of the paper's 85-node mesh
-/// (about 1 µs each) take twelve days.
+/// Most steps a case may ask for: 1e12 steps take days even on the paper's
+/// 85-node mesh.
 const MAX_STEPS: f64 = 1e12;
 
 /// Checks every value of the case serde read, collecting every problem,
@@ -422,7 +422,7 @@ fn complete(
         "time.t_end",
         format!("time.t_end = {t_end} must be a finite number > 0"),
     );
-    // A run that cannot end (1e300 steps passed `check` and ran on).
+    // A run that cannot end (1e300 steps would pass `check` and run on).
     // Blamed on t_end, or on dt where only dt came from --set.
     let steps = t_end / dt;
     let by_set = |key: &str| span(key).is_some_and(|s| loc.set_by_override(&s));

@@ -268,8 +268,8 @@ impl Schema for History {
     const KIND: Kind = Kind::Any;
 }
 
-/// A table's rows, each exactly [t, f] (serde's [f64; 2] took [t, f, x]
-/// and dropped x).
+/// A table's rows, each exactly [t, f] (serde's [f64; 2] takes [t, f, x]
+/// and drops x).
 fn table_points<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
     let rows = Vec::<Vec<f64>>::deserialize(d)?;
     rows.iter()

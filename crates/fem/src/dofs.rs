@@ -15,21 +15,14 @@
 //! slab's boundary nodes first, its interior column by column and a Q2
 //! mesh's mid-edge and centre nodes cell by cell, so that node rows of K
 //! do not repeat at fixed column offsets, which is what the explicit
-//! step's fastest products need (`stickslip-time`'s stencil types).
-//! bench_step, Gmsh's Q2 slabs, explicit step in the file's order against
-//! the grid's, 2026-11-24: 249k DOFs 4.47 against 1.05 ms (medians of
-//! five), 33k DOFs 238 against 191 µs, 8,352 DOFs 80.8 against 65.7 µs
-//! (medians of three); the paper's 85-node mesh 1.004 against 0.962 µs
-//! (medians of five). AMD orders Gmsh's numbering worse too: Newmark's
-//! factor of A₀ on that 249k-DOF slab has 38.5M entries from the file's
-//! order against 24.6M from the grid's (step 88.3 against 56.0 ms,
-//! medians of three); systems that large are now ordered by nested
-//! dissection, which does not depend on the numbering (`ordering.rs`). Gmsh's unstructured quad meshes come with a node's
-//! neighbours a median 17,832 numbers away (on a 71k-node slab), so that
-//! K·x gathers x from all over memory: on a 285k-node unstructured slab
-//! (569k DOFs) the explicit step took 7.47 ms in the file's order against
-//! 5.95 ms in reverse Cuthill–McKee's (medians of three alternating runs,
-//! 2026-11-24; an earlier three read 6.28 against 5.16 ms).
+//! step's fastest products need (`stickslip-linalg`'s stencil types): in
+//! the file's order the explicit step is slower at every size, several
+//! times slower on large slabs. Gmsh's unstructured quad meshes
+//! come with a node's neighbours far apart in the numbering, so that K·x
+//! gathers x from all over memory; reverse Cuthill–McKee keeps them near.
+//! The factors do not depend on this order where they are ordered by
+//! nested dissection (`ordering.rs`). The measurements are in
+//! docs/performance.md.
 
 use stickslip_mesh::Mesh;
 
@@ -76,14 +69,11 @@ pub enum NodeOrder {
     /// as one row or column). Only where every (row, column) of the grid
     /// holds exactly one node.
     ///
-    /// Tried and not kept: a Q2 row's even columns before its odd ones,
-    /// so that the explicit product's two-node units pair nodes of one
-    /// kind (corner with corner, mid-edge with mid-edge) and carry no +0
-    /// terms: 20% fewer unit blocks (1M-DOF Q2 slab, 2.48M → 1.98M per
-    /// K·x), but K·x took 0.96 of the time and the fused sweep 1.11-1.12
-    /// (alternating in one process, 2 threads, two runs, 2026-11-25): the
-    /// product is not bound by its multiply-adds, and the split rows
-    /// double the x lines a row reads.
+    /// A row's nodes go in column order, also on Q2 meshes: taking a Q2
+    /// row's even columns before its odd ones would spare the product
+    /// some multiply-adds by zero, but the product is not bound by them,
+    /// and the split row doubles the lines of x it reads
+    /// (docs/performance.md).
     Grid,
     /// Reverse Cuthill–McKee on the node adjacency (each connected part
     /// from a pseudo-peripheral node of least degree, neighbours by

@@ -8,63 +8,39 @@
 //! share are the separator and are numbered after both halves, and each
 //! half is split again down to single cells. The separator is the line of
 //! nodes between two rows of cells, one node wide for Q1 and Q2 alike.
-//! Measured against AMD (faer's symbolic and numeric factorization of K,
-//! `Par::Seq`, 2026-11-26; `cases/hole.geo` meshed by Gmsh with lc_hole =
-//! lc/2, the slabs built in code):
-//!
-//! | mesh                   | DOFs  | factor values, ND / AMD | numeric factorization | ordering + symbolic |
-//! |------------------------|-------|-------------------------|-----------------------|---------------------|
-//! | hole Q1, lc 0.0196     | 61k   | 6.11M / 6.25M           | 0.061 / 0.065 s       | 0.028 / 0.039 s     |
-//! | hole Q1, lc 0.0098     | 238k  | 28.7M / 32.6M           | 0.46 / 0.61 s         | 0.13 / 0.27 s       |
-//! | hole Q2, lc 0.0196     | 243k  | 29.5M / 35.9M           | 0.52 / 0.71 s         | 0.15 / 0.31 s       |
-//! | hole Q1, lc 0.0045     | 1.12M | 164M / 196M             | 3.55 / 5.26 s         | 0.91 / 1.64 s       |
-//! | hole Q2, lc 0.009      | 1.13M | 165M / 233M             | 3.67 / 6.90 s         | 0.72 / 1.78 s       |
-//! | slab Q2, row by row    | 62k   | 5.21M / 5.08M           | 0.052 / 0.051 s       | 0.020 / 0.045 s     |
-//! | slab Q1, row by row    | 249k  | 25.1M / 24.6M           | 0.38 / 0.37 s         | 0.10 / 0.20 s       |
-//! | slab Q2, row by row    | 993k  | 115M / 121M             | 2.24 / 2.41 s         | 0.52 / 1.40 s       |
-//!
-//! On unstructured meshes from 238k DOFs the dissection has 12-29% fewer
-//! values and factorizes 1.3-1.9× faster; on grids numbered row by row its
-//! fill is within 5% of AMD's either way. Its supernodes are larger, and
-//! the Newmark step is as fast or faster even on the grids (`bench_step
-//! --case newmark MESH 10 3`, `STICKSLIP_FILL_ORDER` = nd against amd, two
-//! alternating runs each): slab Q2 352×88 (249k DOFs) 43.6-46.1 against
-//! 50.9-51.7 ms, slab Q1 708×177 (251k) 45.8-49.0 against 49.1-50.1 ms,
-//! Gmsh's `hole.geo` Q1 at 238k 44.0-45.8 against 49.7-50.3 ms and Q2 at
-//! 243k 51.3-51.8 against 57.5-59.9 ms, with setups of 2.7-3.0 against
-//! 3.7-4.4 s on those two (the dissection alone; with AMD's analysis
-//! beside it, below, the Q2 mesh's setup read 3.44-3.52 against 4.71-4.83
-//! s and its step 51.8-56.7 against 61.8-62.0 ms, two alternating runs on
-//! a busier host). Below [`DISSECTION_MIN_DOFS`] AMD stays (the
-//! slab Q2 16×4, 552 DOFs: 18.1k factor values against AMD's 16.0k; the
-//! paper's Q2 8×2, 148 DOFs: 3.3k against 3.5k).
+//! Against AMD (faer's symbolic and numeric factorization of K), the
+//! dissection's factor has fewer values and factorizes faster on
+//! unstructured meshes of a few hundred thousand DOFs and more; on grids
+//! numbered row by row its fill is AMD's within a few per cent either way,
+//! and its larger supernodes make the Newmark step's solves as fast or
+//! faster. Below [`DISSECTION_MIN_DOFS`] AMD stays: there the dissection
+//! gains little or nothing. The figures are in docs/performance.md; `cargo
+//! run --release -p stickslip-fem --example fill_order -- MESH...` prints
+//! them for any mesh.
 //!
 //! Not every mesh above [`DISSECTION_MIN_DOFS`] gains: on non-convex
 //! domains and long thin strips the dissection's factor is larger than
-//! AMD's (a comb of 114k DOFs 1.28-1.37×, strips of 500:1 1.23-1.28×,
-//! 200:1 1.11×: `cargo run --release -p stickslip-fem --example
+//! AMD's (`cargo run --release -p stickslip-fem --example
 //! fill_order_shapes`). So from [`DISSECTION_MIN_DOFS`] the first
 //! factorization of a run analyses its pattern in both orders and keeps
 //! the dissection unless AMD's factor has [`stickslip_linalg::AMD_MARGIN`] fewer values
 //! ([`choose`]); K, A₀ and M share the pattern, and the later
 //! factorizations reuse the choice. The price is AMD's analysis beside the
-//! dissection's (1.5 s at 1.12M DOFs, where the dissection saves 1.7 s of
-//! factorization; 0.3 s at 250k).
+//! dissection's, which on large meshes costs less than the dissection
+//! saves of the factorization.
 //!
-//! Tried and not kept: leaves of 2, 4 or 16 cells in any order (up to 31%
-//! more fill than AMD on the Q2 slab of 249k DOFs with 16; 2 and 4 never
-//! better than single cells); separators of nodes (one side's nodes
-//! touching the other, by the node graph): equal on Q1, 10% more fill
-//! than AMD on the Q2 mesh of 1.13M DOFs, where the median cuts through
-//! cells whose nodes couple two node rows apart.
+//! Leaves are single cells and separators the nodes two halves of cells
+//! share: larger leaves, and separators taken on the node graph, gave more
+//! fill (docs/performance.md).
 
 use stickslip_linalg::FillOrder;
 use stickslip_mesh::Mesh;
 
 use crate::dofs::DofMap;
 
-/// Free DOFs from which the factors are ordered by nested dissection (the
-/// table above: at 61-62k the two are within 3% either way).
+/// Free DOFs from which the factors are ordered by nested dissection: at
+/// about 60k DOFs the two orderings' factors are within a few per cent of
+/// each other either way (docs/performance.md).
 pub const DISSECTION_MIN_DOFS: usize = 100_000;
 
 /// Environment variable that overrides the choice, for comparisons:

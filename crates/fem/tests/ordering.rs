@@ -112,7 +112,7 @@ fn the_last_dofs_are_the_middle_line() {
 
 /// The dissection's quality where AMD is at its best, a grid numbered
 /// row by row: within 5% of AMD's factor values (1.003 for Q1 and 1.028
-/// for Q2 at 101k DOFs, 2026-11-26), and the same factor whatever the
+/// for Q2 at these 101k DOFs), and the same factor whatever the
 /// numbering of the DOFs (reverse Cuthill–McKee's here).
 #[test]
 fn dissection_fill_is_amd_s_on_a_grid_whatever_the_numbering() {

@@ -114,8 +114,8 @@ fn stress_error(mesh: &Mesh, u: &[f64]) -> f64 {
     worst
 }
 
-/// Expected: the imposed linear field itself at every interior node (1e-12,
-/// issue 3; displacements are O(0.1)), and σ = D ε of that field at every
+/// Expected: the imposed linear field itself at every interior node (1e-12:
+/// rounding, displacements are O(0.1)), and σ = D ε of that field at every
 /// Gauss point and node (relative 1e-11: stresses are derivatives, so the
 /// nodal rounding is amplified by 1/h).
 #[test]

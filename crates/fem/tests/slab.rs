@@ -24,7 +24,7 @@ fn static_state(mesh: &Mesh) -> Vec<f64> {
 /// 0.117 and ε_yy = (1−ν²)σ_yy/E = −0.273, i.e. u_x = 0.117·x (u_x = 0 at
 /// x = 0) and u_y = 0.273·(1 − y) (u_y = 0 at y = 1). Linear fields are in
 /// the Q1/Q2 spaces, so the FE solution is exact to rounding: 1e-10 at every
-/// node (issue 3). The unstructured meshes are included: exactness does not
+/// node. The unstructured meshes are included: exactness does not
 /// need a regular grid.
 #[test]
 fn slab_static_state_is_the_closed_form_uniform_state_on_committed_meshes() {

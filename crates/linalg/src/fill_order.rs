@@ -8,9 +8,8 @@ use std::sync::{Arc, OnceLock};
 
 /// The dissection is kept unless its factor has more than this many times
 /// AMD's values: at about equal values its supernodes are larger and its
-/// solves faster (the Q2 352×88 slab: 24.62M values against AMD's 24.60M,
-/// Newmark's solve 27.3-28.7 against 35.8-36.5 ms in the runs above), and
-/// the meshes where AMD wins (comb, strips) are 1.11-1.37×.
+/// solves faster, and where AMD wins (non-convex domains, long thin
+/// strips) it wins by more than this margin (docs/performance.md).
 pub const AMD_MARGIN: f64 = 1.1;
 
 /// The ordering the factorizations of a model's matrices use: faer's AMD,

@@ -1,5 +1,5 @@
-//! Read-speed and memory benchmark of the .msh reader (issue 2, Performance),
-//! driven by `cargo xtask bench mesh`, usable alone:
+//! Read-speed and memory benchmark of the .msh reader, driven by `cargo
+//! xtask bench mesh`, usable alone:
 //!
 //! ```text
 //! cargo run -p stickslip-mesh --example bench_read -- FILE.msh [RUNS]

@@ -159,7 +159,8 @@ impl Mesh {
             return Mesh::from_bytes(&bytes).map_err(|e| e.with_path(path));
         }
         // Streamed through a window of 1 MiB: the file's bytes are never
-        // all resident next to the mesh (peak memory target of issue 2).
+        // all resident next to the mesh (the reader's peak-memory target,
+        // below twice the mesh).
         msh::read_file(path, file, meta.len(), msh::CHUNK).map_err(|e| e.with_path(path))
     }
 

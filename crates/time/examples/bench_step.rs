@@ -1,15 +1,14 @@
-//! Time per step of both schemes on the slab ladder (issue 7, deliverable 3)
-//! with what it is compared with in the same run: STREAM triad bandwidth
-//! against the bytes one explicit step moves; for Newmark the time of one
-//! forward+back solve with the factor of A₀; the scipy peer (bench/peer.py,
-//! `--peer`) on the paper's 85-node mesh and the generated rungs of ≥ 100k
-//! DOFs, which reads the problem this process dumps (target/bench/peer/),
-//! assembles K and M on the dumped mesh with scikit-fem and checks them
-//! against ours (≤ 1e-10), checks its state after a few steps against ours
-//! (≤ 1e-8) and times its own steps; peak memory: VmHWM of the whole process (`peak_rss`) and of
-//! the run after setup (`peak_run`, VmHWM reset through clear_refs), each
-//! over what the run must hold (`matrix_bytes` + `factor_bytes` +
-//! `vector_bytes`).
+//! Time per step of both schemes on the slab ladder with what it is compared
+//! with in the same run: STREAM triad bandwidth against the bytes one explicit
+//! step moves; for Newmark the time of one forward+back solve with the factor
+//! of A₀; the scipy peer (bench/peer.py, `--peer`) on the paper's 85-node mesh
+//! and the generated rungs of ≥ 100k DOFs, which reads the problem this
+//! process dumps (target/bench/peer/), assembles K and M on the dumped mesh
+//! with scikit-fem and checks them against ours (≤ 1e-10), checks its state
+//! after a few steps against ours (≤ 1e-8) and times its own steps; peak
+//! memory: VmHWM of the whole process (`peak_rss`) and of the run after setup
+//! (`peak_run`, VmHWM reset through clear_refs), each over what the run must
+//! hold (`matrix_bytes` + `factor_bytes` + `vector_bytes`).
 //!
 //!     cargo run -p stickslip-time --example bench_step [-- --quick] [-- --max-dofs N] [-- --peer]
 //!
@@ -94,7 +93,7 @@ fn reset_peak_rss() -> bool {
 }
 
 /// Streams `v` as little-endian f64 through a small buffer (not a
-/// whole-file buffer: 63 MB for K's columns at 249k DOFs).
+/// whole-file buffer, tens of MB for K's columns from 250k DOFs).
 fn write_f64(path: &std::path::Path, v: &[f64]) {
     write_le(path, v.iter().map(|x| x.to_le_bytes()));
 }
@@ -219,14 +218,13 @@ fn triad(a: &mut [f64], b: &[f64], c: &[f64]) -> f64 {
     bw
 }
 
-/// The explicit step against STREAM in the same moments: `blocks` times
-/// the best of three triads over 20M entries, then `steps` steps. This
-/// host's STREAM switches between two levels with its other tenants' work
-/// (about 37 and 55 GB/s on 2026-11-24), while our step's bandwidth hardly
-/// moves (26-29 GB/s on the Q1 1M slab in both): a single STREAM figure
-/// decides the percentage. Returns the highest triad (what the memory
-/// delivers when the host lets it: the `stream_bw` the percentage is taken
-/// of), the median triad and the median over the blocks of the step's
+/// The explicit step against STREAM in the same moments: `blocks` times the
+/// best of three triads over 20M entries, then `steps` steps. A shared host's
+/// STREAM switches between levels with its other tenants' work while our
+/// step's bandwidth hardly moves (docs/performance.md), so a single STREAM
+/// figure would decide the percentage. Returns the highest triad (what the
+/// memory delivers when the host lets it: the `stream_bw` the percentage is
+/// taken of), the median triad and the median over the blocks of the step's
 /// bandwidth over the triad just before it.
 fn paired_stream(i: &mut Integrator, bytes: f64, steps: usize, blocks: usize) -> (f64, f64, f64) {
     let n = 20_000_000;
@@ -250,7 +248,7 @@ fn paired_stream(i: &mut Integrator, bytes: f64, steps: usize, blocks: usize) ->
 /// and the state after a few steps for bench/peer.py.
 fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option<PathBuf>) {
     // The process before any of the run's data: code, libraries, the
-    // runtime (about 3 MB), which the run's own figure leaves out.
+    // runtime, which the run's own figure leaves out.
     let rss_base = status_bytes("VmRSS:");
     let t_setup = Instant::now();
     let Slab {
@@ -352,9 +350,8 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         )
         .unwrap();
         // The timed run is another process, without the dump: a process
-        // that had written it sometimes held 13.5 MB more at the run's start
-        // (gen-q2-352x88: peak_run_over_need 1.64-1.67 in half of the runs,
-        // 1.25-1.26 in the others and in every run without it, 2026-11-24).
+        // that has written it may start the run holding several MB more,
+        // which its peak would count (docs/performance.md).
         return;
     }
     // Warm-up: the thread pool and the factor of the normal Δt.
@@ -451,9 +448,10 @@ fn text<'a>(row: &'a str, key: &str) -> Option<&'a str> {
         .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
 }
 
-/// Issue 7's targets against this run's rows, each with its figures and a
-/// verdict for this run alone (one run meeting a target does not make it
-/// met on a shared host: the README weighs the runs).
+/// The bench's targets (README, "Speed per step") against this run's
+/// rows, each with its figures and a verdict for this run alone (one run
+/// meeting a target does not make it met on a shared host: the README
+/// weighs the runs).
 fn print_targets(rows: &[String]) {
     let verdict = |ok: bool| if ok { "met" } else { "NOT met" };
     let of = |scheme: &str| {
@@ -463,7 +461,7 @@ fn print_targets(rows: &[String]) {
     };
     let (cd, newmark) = (of("cd"), of("newmark"));
     let dofs = |r: &&String| field(r, "dofs").unwrap_or(0.0);
-    println!("issue 7's targets in this run:");
+    println!("targets in this run:");
     // The largest explicit rungs (the 1M slabs), against the run's highest
     // triad.
     let largest = cd.iter().map(dofs).fold(0.0, f64::max);
@@ -716,9 +714,9 @@ fn main() {
         "slab-q1-128x32",
         "slab-q2-64x16",
     ] {
-        // At least ~0.1 s per repeat: a repeat of a few ms measured the
-        // paper mesh's explicit step at 3.1 µs, a long one at 2.0 µs (the
-        // core's clock and caches settle); the peer runs as many steps.
+        // At least ~0.1 s per repeat: a repeat of a few ms overstates the
+        // paper mesh's explicit step while the core's clock and caches
+        // settle (docs/performance.md); the peer runs as many steps.
         let (cd, newmark) = if m == "slab-q2-8x2" || m == "slab-q1-32x8" {
             (50_000, 5_000)
         } else {
@@ -819,10 +817,10 @@ fn main() {
         let mut row = line.trim_start_matches("RESULT ").to_string();
         if let Some(d) = &peer_dir {
             row.push_str(&run_peer(&root, d, &row, scheme, steps, repeats));
-            // The paper mesh's step is about 1 µs, and the host's other
-            // work slows it by up to a third for seconds at a time: there
-            // ours and the peer's are also timed in alternating pairs,
-            // and the ratio given per pair.
+            // The paper mesh's step is so short that the host's other work
+            // slows whole repeats of it for seconds at a time: there ours
+            // and the peer's are also timed in alternating pairs, and the
+            // ratio given per pair.
             if let (Some(ours), Some(theirs)) = (field(&row, "step"), field(&row, "peer_step")) {
                 if field(&row, "dofs").unwrap_or(f64::INFINITY) < 1000.0 {
                     let mut ratios = vec![theirs / ours];
@@ -857,8 +855,7 @@ fn main() {
     }
     // The highest triad of the whole run, what the memory delivered when
     // the host let it: a rung's own nine blocks may all fall in a busy
-    // spell (2026-11-24 23:37: the 1M rungs saw 35 GB/s at most, other
-    // rungs of the run up to 56.9), so each explicit rung's bandwidth is
+    // spell (docs/performance.md), so each explicit rung's bandwidth is
     // also given as a share of this.
     let run_max = rows
         .iter()

@@ -1,5 +1,5 @@
 //! The explicit scheme's threaded passes give bit-identical runs on one
-//! thread and on several (issue 7): the work is split into fixed chunks and
+//! thread and on several: the work is split into fixed chunks and
 //! sums are added in chunk order, whatever the number of threads.
 
 use stickslip_linalg::chunks::{CHUNK, PARALLEL_MIN};
@@ -27,7 +27,7 @@ fn run(s: &Slab, threads: usize, steps: usize) -> Integrator {
 fn one_thread_and_several_give_the_same_bits() {
     // At least PARALLEL_MIN whole chunks of free DOFs (CHUNK), so
     // that the passes go parallel with more than one thread (the committed
-    // 128×32 slabs, 8,352 DOFs, no longer do).
+    // 128×32 slabs, 8,352 DOFs, are below it).
     for (nx, ny, q2) in [(192, 48, false), (96, 24, true)] {
         let mesh = format!("{} {nx}x{ny}", if q2 { "Q2" } else { "Q1" });
         let s = Slab::paper(structured_slab(nx, ny, q2), 1e-4, History::Step, true).unwrap();

@@ -899,8 +899,9 @@ impl Builder {
 #[inline(always)]
 fn corner_sign(a: [f64; 2], b: [f64; 2], a2: f64, b2: f64, sign: &mut i8) -> Option<()> {
     let det = a[0] * b[1] - a[1] * b[0];
-    // |det| > TOL |a| |b|, squared to save two square roots per corner
-    // (glibc's hypot was a fifth of the read time).
+    // |det| > TOL |a| |b|, squared to save two square roots per corner:
+    // hypot on every corner is a large share of the read
+    // (docs/performance.md).
     let scale2 = a2 * b2;
     let bound2 = JACOBIAN_TOL * JACOBIAN_TOL * scale2;
     let clear = if bound2 >= f64::MIN_POSITIVE && scale2.is_finite() {

@@ -1,16 +1,17 @@
 //! A position in the input with the two ways of reading MSH data:
 //! whitespace-separated ASCII tokens and little-endian binary fields.
 //!
-//! The input is seen through a window of 1 MiB that is refilled as the
-//! reader moves on ([`Source`]), so a file is never resident as a whole: the
-//! memory target of issue 2 (peak below twice the `Mesh`) leaves no room for
-//! the file's bytes next to the mesh. Positions are absolute byte offsets in
-//! the input. Nothing here allocates per token; every read is bounds-checked
-//! and turns running out of input into [`MeshErrorKind::Truncated`]. Errors
-//! carry a byte position that [`Cursor::error`] turns into a line number
-//! (ASCII files) or keeps as a byte offset (binary files); lines are counted
-//! only on the error path (re-reading the file when the window has moved
-//! past the position), which keeps the hot loops free of bookkeeping.
+//! The input is seen through a window of 1 MiB that is refilled as the reader
+//! moves on ([`Source`]), so a file is never resident as a whole: the reader's
+//! memory target (peak below twice the `Mesh`, `cargo xtask bench mesh`)
+//! leaves no room for the file's bytes next to the mesh. Positions are
+//! absolute byte offsets in the input. Nothing here allocates per token; every
+//! read is bounds-checked and turns running out of input into
+//! [`MeshErrorKind::Truncated`]. Errors carry a byte position that
+//! [`Cursor::error`] turns into a line number (ASCII files) or keeps as a byte
+//! offset (binary files); lines are counted only on the error path (re-reading
+//! the file when the window has moved past the position), which keeps the hot
+//! loops free of bookkeeping.
 
 use std::fs::File;
 use std::io::{self, Read};
@@ -21,8 +22,8 @@ use crate::{Location, MeshError, MeshErrorKind};
 pub(crate) type Result<T> = std::result::Result<T, MeshError>;
 
 /// Window size: refills (a copy of the unread tail and a `read`) are rare,
-/// and the window is small next to a mesh worth streaming. 256 KiB, 1 MiB
-/// and 4 MiB measured the same CPU time on the 1M-node benchmark.
+/// and the window is small next to a mesh worth streaming; the read's time
+/// hardly depends on it (docs/performance.md).
 pub(crate) const CHUNK: usize = 1 << 20;
 
 /// Where the bytes come from.

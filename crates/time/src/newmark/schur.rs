@@ -78,7 +78,7 @@ struct DenseFactor {
     /// The factor, column-major n_s × n_s in the first n_s² values.
     l: Vec<f64>,
     /// 1 / the factor's diagonal (the solves multiply: a division's
-    /// latency per column was most of their chains).
+    /// latency per column would be most of their chains).
     inv_diag: Vec<f64>,
     /// Lᵀ column-major (L by rows), for the back solve by columns.
     lt: Vec<f64>,
@@ -460,9 +460,8 @@ impl SchurOperator {
             // L Lᵀ y = rhs by plain loops: at n_s ≤ n_c (16 on the paper
             // mesh) faer's dispatch cost more than the 2·n_s² operations.
             // Both by columns: a column's updates are independent, so a
-            // step waits on one multiplication, where the back solve by
-            // rows summed each row in a chain (the paper mesh's nodal
-            // solve: 9.7% → 6.7% of its Newmark step, perf, about 0.15 µs).
+            // step waits on one multiplication, where a back solve by rows
+            // sums each row in a chain (docs/performance.md).
             let (l, lt) = (&d.l[..m * m], &d.lt[..m * m]);
             for j in 0..m {
                 let col = &l[j * m..(j + 1) * m];
