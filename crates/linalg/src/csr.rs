@@ -7,7 +7,7 @@ use crate::chunks::{each_chunk, sum_chunks, CHUNK};
 
 /// Σ_k vals[k]·x[cols[k]] over one row, in four interleaved partial sums
 /// (one chain of additions waits on the adder's latency).
-#[inline]
+#[inline(always)]
 pub(crate) fn row_dot(vals: &[f64], cols: &[usize], x: &[f64]) -> f64 {
     let split = vals.len() - vals.len() % 4;
     let mut acc = [0.0; 4];
@@ -28,7 +28,7 @@ pub(crate) fn row_dot(vals: &[f64], cols: &[usize], x: &[f64]) -> f64 {
 }
 
 /// Row i of A times x, by [`row_dot`].
-#[inline]
+#[inline(always)]
 pub fn row(a: &CsrMatrix<f64>, i: usize, x: &[f64]) -> f64 {
     let (p, q) = (a.row_offsets()[i], a.row_offsets()[i + 1]);
     row_dot(&a.values()[p..q], &a.col_indices()[p..q], x)
@@ -37,10 +37,27 @@ pub fn row(a: &CsrMatrix<f64>, i: usize, x: &[f64]) -> f64 {
 /// y = A x.
 pub fn spmv(a: &CsrMatrix<f64>, x: &[f64], y: &mut [f64]) {
     each_chunk(y, |c, y| {
-        for (k, yi) in y.iter_mut().enumerate() {
-            *yi = row(a, c * CHUNK + k, x);
-        }
+        crate::simd::vectorized(Rows { a, c, x, y });
     });
+}
+
+/// Rows of chunk c of A x, as a dispatched kernel.
+struct Rows<'a> {
+    a: &'a CsrMatrix<f64>,
+    c: usize,
+    x: &'a [f64],
+    y: &'a mut [f64],
+}
+
+impl crate::simd::Kernel for Rows<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run(self) {
+        for (k, yi) in self.y.iter_mut().enumerate() {
+            *yi = row(self.a, self.c * CHUNK + k, self.x);
+        }
+    }
 }
 
 /// Row sums of two matrices on one pattern, each with [`row_dot`]'s bits.

@@ -17,6 +17,7 @@ pub mod chunks;
 pub mod csr;
 mod fill_order;
 mod product;
+pub mod simd;
 mod stencils;
 mod supernodal;
 

@@ -5,6 +5,7 @@ use nalgebra_sparse::CsrMatrix;
 
 use crate::chunks::CHUNK;
 use crate::csr;
+use crate::simd::Batches;
 use crate::stencils::{Stencils, BATCH};
 
 /// The product a step streams K from: every row's value is the same
@@ -43,13 +44,13 @@ impl Product {
         }
     }
 
-    /// Calls `f(first row, K x on the batch's rows)` for consecutive batches
-    /// of at most [`BATCH`] rows covering chunk `c` (of
-    /// [`crate::chunks::CHUNK`] rows), in order.
-    #[inline]
-    pub fn batches(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, &[f64])) {
+    /// Hands `to` K x on consecutive batches of at most [`BATCH`] rows
+    /// covering chunk `c` (of [`crate::chunks::CHUNK`] rows), in order
+    /// (call inside a [`crate::simd::Kernel`]).
+    #[inline(always)]
+    pub fn batches(&self, c: usize, x: &[f64], to: &mut impl Batches) {
         match self {
-            Product::Stencils(s) => s.batches(c, x, f),
+            Product::Stencils(s) => s.batches(c, x, to),
             Product::Csr(k) => {
                 let end = ((c + 1) * CHUNK).min(k.nrows());
                 let mut buf = [0.0; BATCH];
@@ -59,7 +60,7 @@ impl Product {
                     for (o, i) in buf.iter_mut().zip(r0..r1) {
                         *o = csr::row(k, i, x);
                     }
-                    f(r0, &buf[..r1 - r0]);
+                    to.batch(r0, &buf[..r1 - r0]);
                     r0 = r1;
                 }
             }

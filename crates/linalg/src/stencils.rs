@@ -23,6 +23,7 @@ use std::collections::HashMap;
 use nalgebra_sparse::CsrMatrix;
 
 use crate::chunks::{chunks, each_chunk, CHUNK};
+use crate::simd::{Batches, Kernel};
 
 /// Block values within this fraction of max |K_ij| of a type's are the
 /// type's. The committed slabs spread by about 1e-13; Gmsh's transfinite
@@ -157,37 +158,71 @@ impl Stencils {
         8 * self.types.len() + 36 * self.values.len()
     }
 
-    /// The sums of group g's rows (the second is 0 for a single row), each
-    /// in two partial sums, its blocks' first columns' terms and their
-    /// second columns', added at the end: four independent chains of
-    /// additions instead of two.
-    #[inline]
+    /// The sums of group g's rows (the second is 0 for a single row).
+    #[inline(always)]
     fn group_sums(&self, g: usize, x: &[f64]) -> [f64; 2] {
-        let r = self.group_rows[g] as isize;
-        let t = self.types[g] as usize;
-        let b = self.type_blocks[t] as usize..self.type_blocks[t + 1] as usize;
-        let mut s = [[0.0; 2]; 2];
-        for (&o, v) in self.offsets[b.clone()].iter().zip(&self.values[b]) {
-            let c = (r + o as isize) as usize;
-            let xs = &x[c..c + 2];
-            s[0][0] += v[0] * xs[0];
-            s[0][1] += v[1] * xs[0];
-            s[1][0] += v[2] * xs[1];
-            s[1][1] += v[3] * xs[1];
-        }
-        [s[0][0] + s[1][0], s[0][1] + s[1][1]]
+        self.lockstep::<1>(self.types[g], [self.group_rows[g] as usize], x)[0]
     }
 
-    /// K x on the rows of groups g0..g1 into `out` (from g0's first row).
-    #[inline]
+    /// Q groups of type t whose first rows are `rows`, in lockstep: each
+    /// block's values are loaded once for all. Each row is summed in two
+    /// partial sums, its own column's terms (the block's first column for
+    /// a group's first row, the second for its second) and the other
+    /// column's, added at the end: the same terms in the same order
+    /// whatever Q, so the same bits, and 4Q independent chains of
+    /// additions. Four consecutive groups read one contiguous run of x
+    /// per block, which the compiler keeps in vector registers.
+    #[inline(always)]
+    fn lockstep<const Q: usize>(&self, t: u32, rows: [usize; Q], x: &[f64]) -> [[f64; 2]; Q] {
+        let b = self.type_blocks[t as usize] as usize..self.type_blocks[t as usize + 1] as usize;
+        let (mut own, mut other) = ([[0.0; 2]; Q], [[0.0; 2]; Q]);
+        for (&o, v) in self.offsets[b.clone()].iter().zip(&self.values[b]) {
+            for q in 0..Q {
+                let c = (rows[q] as isize + o as isize) as usize;
+                let xs = &x[c..c + 2];
+                own[q][0] += v[0] * xs[0];
+                own[q][1] += v[3] * xs[1];
+                other[q][0] += v[2] * xs[1];
+                other[q][1] += v[1] * xs[0];
+            }
+        }
+        std::array::from_fn(|q| [own[q][0] + other[q][0], own[q][1] + other[q][1]])
+    }
+
+    /// K x on the rows of groups g0..g1 into `out` (from g0's first row):
+    /// four alike node pairs on consecutive rows in lockstep (a structured
+    /// Q1 node row), or two pairs of alike pairs alternating (a Q2 node
+    /// row, corner and mid-side nodes in turn), else a group at a time.
+    #[inline(always)]
     fn groups_into(&self, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
         let base = self.group_rows[g0] as usize;
-        for g in g0..g1 {
-            let (r0, r1) = (self.group_rows[g] as usize, self.group_rows[g + 1] as usize);
-            let s = self.group_sums(g, x);
-            out[r0 - base] = s[0];
-            if r1 - r0 == 2 {
-                out[r0 + 1 - base] = s[1];
+        let rows = |g: usize| self.group_rows[g] as usize;
+        let mut g = g0;
+        while g < g1 {
+            let r = rows(g);
+            let pairs = g + 4 <= g1 && (1..=4).all(|q| rows(g + q) == r + 2 * q);
+            let t = &self.types;
+            if pairs && t[g] == t[g + 1] && t[g] == t[g + 2] && t[g] == t[g + 3] {
+                let s = self.lockstep::<4>(t[g], [r, r + 2, r + 4, r + 6], x);
+                for (q, s) in s.iter().enumerate() {
+                    out[r + 2 * q - base..r + 2 * q + 2 - base].copy_from_slice(s);
+                }
+                g += 4;
+            } else if pairs && t[g] == t[g + 2] && t[g + 1] == t[g + 3] {
+                let a = self.lockstep::<2>(t[g], [r, r + 4], x);
+                let b = self.lockstep::<2>(t[g + 1], [r + 2, r + 6], x);
+                for (q, s) in [a[0], b[0], a[1], b[1]].iter().enumerate() {
+                    out[r + 2 * q - base..r + 2 * q + 2 - base].copy_from_slice(s);
+                }
+                g += 4;
+            } else {
+                let (r0, r1) = (r, rows(g + 1));
+                let s = self.group_sums(g, x);
+                out[r0 - base] = s[0];
+                if r1 - r0 == 2 {
+                    out[r0 + 1 - base] = s[1];
+                }
+                g += 1;
             }
         }
     }
@@ -199,14 +234,20 @@ impl Stencils {
                 self.chunk_groups[c] as usize,
                 self.chunk_groups[c + 1] as usize,
             );
-            self.groups_into(g0, g1, x, y);
+            crate::simd::vectorized(Groups {
+                k: self,
+                g: g0..g1,
+                x,
+                out: y,
+            });
         });
     }
 
-    /// Calls `f(first row, K x on the batch's rows)` for consecutive
-    /// batches of at most [`BATCH`] rows covering chunk `c`, in order.
-    #[inline]
-    pub fn batches(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, &[f64])) {
+    /// Hands `to` K x on consecutive batches of at most [`BATCH`] rows
+    /// covering chunk `c`, in order (call inside a
+    /// [`crate::simd::Kernel`]).
+    #[inline(always)]
+    pub fn batches(&self, c: usize, x: &[f64], to: &mut impl Batches) {
         let (g0, g1) = (
             self.chunk_groups[c] as usize,
             self.chunk_groups[c + 1] as usize,
@@ -218,7 +259,7 @@ impl Stencils {
             let (ra, rb) = (self.group_rows[g] as usize, self.group_rows[gb] as usize);
             let out = &mut buf[..rb - ra];
             self.groups_into(g, gb, x, out);
-            f(ra, out);
+            to.batch(ra, out);
             g = gb;
         }
     }
@@ -227,6 +268,24 @@ impl Stencils {
     pub fn row(&self, i: usize, x: &[f64]) -> f64 {
         let g = self.group_rows.partition_point(|&r| r as usize <= i) - 1;
         self.group_sums(g, x)[i - self.group_rows[g] as usize]
+    }
+}
+
+/// K x on groups `g` into `out`, as a dispatched kernel.
+struct Groups<'a> {
+    k: &'a Stencils,
+    g: std::ops::Range<usize>,
+    x: &'a [f64],
+    out: &'a mut [f64],
+}
+
+impl Kernel for Groups<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run(self) {
+        self.k
+            .groups_into(self.g.start, self.g.end, self.x, self.out);
     }
 }
 

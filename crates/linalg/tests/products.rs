@@ -178,7 +178,7 @@ fn rows_have_the_same_bits_every_way() {
     let (one, two) = (on(1), on(2));
     let mut batched = vec![f64::NAN; n];
     for c in 0..chunks(n) {
-        s.batches(c, &x, |r0, ku| {
+        s.batches(c, &x, &mut |r0: usize, ku: &[f64]| {
             batched[r0..r0 + ku.len()].copy_from_slice(ku)
         });
     }

@@ -11,6 +11,7 @@
 //! `stickslip_linalg::chunks`: the same bits on any number of threads.
 
 use stickslip_linalg::chunks::{each_chunk, each_chunk_pair, CHUNK};
+use stickslip_linalg::simd::{vectorized, Batches, Kernel};
 use stickslip_linalg::Product;
 
 /// The loads on the rows where the constant load or any load vector is
@@ -165,6 +166,7 @@ impl Lanes {
         self.0 = lanes;
     }
 
+    #[inline(always)]
     fn total(self) -> f64 {
         (self.0[0] + self.0[1]) + (self.0[2] + self.0[3])
     }
@@ -175,7 +177,8 @@ impl Lanes {
 /// ṙ_K) sorted by DOF) — then r̈_K into `a_new` and the sums. K r_K comes
 /// in batches that stay in L1 ([`Product::batches`]), and each batch's
 /// rows go in loops over the batch: no dependence between rows, so their
-/// divisions overlap.
+/// divisions overlap. Each chunk is a dispatched kernel
+/// (`stickslip_linalg::simd`).
 pub(crate) fn sweep(
     k: &Product,
     s: &StepData,
@@ -186,39 +189,93 @@ pub(crate) fn sweep(
 ) -> Sums {
     let [kinetic, not_finite, strain] = each_chunk_pair(v_new, a_new, partials, |c, vn, an, p| {
         let start = c * CHUNK;
-        let mut f = friction.partition_point(|f| f.0 < start);
-        let (mut strain, mut kinetic) = (Lanes::default(), Lanes::default());
-        let mut finite = true;
-        k.batches(c, s.r_new, |r0, ku| {
-            let rows = r0..r0 + ku.len();
-            let (m, rn) = (&s.mass[rows.clone()], &s.r_new[rows.clone()]);
-            let (v, a) = (&s.v[rows.clone()], &s.a[rows.clone()]);
-            let vn = &mut vn[r0 - start..r0 - start + ku.len()];
-            let an = &mut an[r0 - start..r0 - start + ku.len()];
-            for j in 0..ku.len() {
-                vn[j] = s.rhs(r0 + j, ku[j]) / (m[j] * s.scale);
-            }
-            while f < friction.len() && friction[f].0 < rows.end {
-                vn[friction[f].0 - r0] = friction[f].1;
-                f += 1;
-            }
-            for j in 0..ku.len() {
-                an[j] = (vn[j] - v[j]) * s.scale - s.ratio * a[j];
-                // `&`, not `&&`: no branch, so the loop stays vectorized.
-                finite &= rn[j].is_finite() & vn[j].is_finite();
-            }
-            strain.add_pairs(r0, rn, ku, |r, u| r * u);
-            kinetic.add_pairs(r0, m, vn, |m, v| m * v * v);
+        *p = vectorized(Chunk {
+            k,
+            c,
+            x: s.r_new,
+            rows: ChunkRows {
+                s,
+                friction,
+                next: friction.partition_point(|f| f.0 < start),
+                start,
+                vn,
+                an,
+                strain: Lanes::default(),
+                kinetic: Lanes::default(),
+                finite: true,
+            },
         });
-        *p = [
-            kinetic.total(),
-            if finite { 0.0 } else { 1.0 },
-            strain.total(),
-        ];
     });
     Sums {
         strain: 0.5 * strain,
         kinetic: 0.5 * kinetic,
         finite: not_finite == 0.0,
+    }
+}
+
+/// One chunk of the sweep, as a dispatched kernel.
+struct Chunk<'a, 'b> {
+    k: &'a Product,
+    c: usize,
+    x: &'a [f64],
+    rows: ChunkRows<'a, 'b>,
+}
+
+impl Kernel for Chunk<'_, '_> {
+    type Output = [f64; 3];
+
+    #[inline(always)]
+    fn run(mut self) -> [f64; 3] {
+        self.k.batches(self.c, self.x, &mut self.rows);
+        let r = self.rows;
+        [
+            r.kinetic.total(),
+            if r.finite { 0.0 } else { 1.0 },
+            r.strain.total(),
+        ]
+    }
+}
+
+/// The per-row work of a chunk of the sweep and its running sums.
+struct ChunkRows<'a, 'b> {
+    s: &'a StepData<'a>,
+    friction: &'a [(usize, f64)],
+    /// The next entry of `friction` at or after the rows to come.
+    next: usize,
+    start: usize,
+    vn: &'b mut [f64],
+    an: &'b mut [f64],
+    strain: Lanes,
+    kinetic: Lanes,
+    finite: bool,
+}
+
+impl Batches for ChunkRows<'_, '_> {
+    #[inline(always)]
+    fn batch(&mut self, r0: usize, ku: &[f64]) {
+        let s = self.s;
+        let n = ku.len();
+        let rows = r0..r0 + n;
+        let (m, rn) = (&s.mass[rows.clone()], &s.r_new[rows.clone()]);
+        let (v, a) = (&s.v[rows.clone()], &s.a[rows.clone()]);
+        let vn = &mut self.vn[r0 - self.start..r0 - self.start + n];
+        let an = &mut self.an[r0 - self.start..r0 - self.start + n];
+        for j in 0..n {
+            vn[j] = s.rhs(r0 + j, ku[j]) / (m[j] * s.scale);
+        }
+        while self.next < self.friction.len() && self.friction[self.next].0 < rows.end {
+            let (i, vi) = self.friction[self.next];
+            vn[i - r0] = vi;
+            self.next += 1;
+        }
+        let mut finite = self.finite;
+        for j in 0..n {
+            an[j] = (vn[j] - v[j]) * s.scale - s.ratio * a[j];
+            // `&`, not `&&`: no branch, so the loop stays vectorized.
+            finite &= rn[j].is_finite() & vn[j].is_finite();
+        }
+        self.finite = finite;
+        self.strain.add_pairs(r0, rn, ku, |r, u| r * u);
+        self.kinetic.add_pairs(r0, m, vn, |m, v| m * v * v);
     }
 }
