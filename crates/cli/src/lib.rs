@@ -21,4 +21,5 @@ pub mod probe;
 pub mod results_file;
 pub mod run;
 pub mod stress_cmd;
+pub mod views;
 pub mod xdmf;

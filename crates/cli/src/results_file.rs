@@ -172,6 +172,13 @@ impl RunLock {
             .write(true)
             .open(path)
             .map_err(|e| {
+                if e.kind() == std::io::ErrorKind::NotFound {
+                    return InputError(format!(
+                        "--restart {}: no such file; give the OUT.h5 of the run to continue \
+                         (`stickslip run CASE -o OUT.h5` starts a new one)",
+                        path.display()
+                    ));
+                }
                 InputError(format!(
                     "cannot open {} for writing: {e}; a restart appends to the file, so it must be writable \
                      (check its permissions)",
@@ -248,7 +255,14 @@ pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
     // An XDMF half written when a run was killed, and the stresses of the
     // old run (`stickslip stress`), which the new one does not have (best
     // effort).
-    for stale in ["xdmf.part", "stress.h5", "stress.h5.part"] {
+    for stale in [
+        "xdmf.part",
+        "stress.h5",
+        "stress.h5.part",
+        "views.h5",
+        "contact.xdmf",
+        "contact.xdmf.part",
+    ] {
         let _ = std::fs::remove_file(out.with_extension(stale));
     }
     for path in [out.to_path_buf(), out.with_extension("xdmf")] {

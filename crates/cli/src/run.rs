@@ -46,7 +46,6 @@ macro_rules! say_out {
 use crate::case::{self, Case};
 use crate::error::InputError;
 use crate::output::{self, CheckpointExtra, Header, Record, ResultsWriter, Summary};
-use crate::xdmf::XdmfInfo;
 
 /// How a run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -1160,17 +1159,16 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         max_balance,
         node_order: node_order.code(),
     };
-    let xdmf_path = out.with_extension("xdmf");
+    let xdmf_path = crate::xdmf::xdmf_path(out);
+    let contact_line = integrator
+        .contact()
+        .map(|c| crate::views::ContactLine::new(&mesh, &c.group, &contact_nodes));
+    let layout = crate::views::Layout {
+        n_nodes: mesh.nodes.len(),
+        contact: contact_line.as_ref(),
+    };
     let xdmf = |times: &[f64]| {
-        let info = XdmfInfo {
-            n_nodes: mesh.nodes.len(),
-            kind: mesh.kind,
-            n_cells: mesh.n_cells(),
-            times,
-            stress: None,
-        };
-        crate::xdmf::write_xdmf(out, &xdmf_path, &info)
-            .with_context(|| format!("cannot write {}", xdmf_path.display()))
+        crate::xdmf::write_companions(out, &layout, (mesh.kind, mesh.n_cells()), times)
     };
     // A state to continue from exists from the start (the initial state, or
     // the restored one).

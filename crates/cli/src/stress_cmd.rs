@@ -8,7 +8,9 @@
 //! stores, as `stickslip probe --field sxx` does at one node: at each node
 //! the average of its cells' σ = D ε there (`stickslip_fem::nodal_stresses`),
 //! into `OUT.stress.h5`: `/stress` [n_out, n_nodes, 3] (σ_xx, σ_yy, σ_xy)
-//! and `/von_mises` [n_out, n_nodes]; and lists them in `OUT.xdmf`. The
+//! and `/von_mises` [n_out, n_nodes], with a view of each record's
+//! σ_xx, σ_yy, σ_xy and von Mises under `/views`; and lists those in
+//! `OUT.xdmf`. The
 //! results file is only read: a full disk or a kill leaves it as it was
 //! (the stress file is written beside and renamed into place). A new run
 //! or a `--restart` on OUT.h5 removes OUT.stress.h5 (it would end where
@@ -96,12 +98,19 @@ pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
     std::fs::rename(&part, &target)
         .with_context(|| format!("cannot rename {} to {}", part.display(), target.display()))?;
     drop((u, f));
-    let xdmf_path = path.with_extension("xdmf");
+    let xdmf_path = crate::xdmf::xdmf_path(path);
     let stress_name = target
         .file_name()
         .and_then(|n| n.to_str())
         .unwrap_or("stress.h5")
         .to_string();
+    // The body's views, in case the run's are gone (the contact's are
+    // left as they are).
+    let layout = crate::views::Layout {
+        n_nodes,
+        contact: None,
+    };
+    crate::views::update(path, &layout, rows)?;
     let info = crate::xdmf::XdmfInfo {
         n_nodes,
         kind: mesh.kind,
@@ -109,7 +118,7 @@ pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
         times: &times[..rows],
         stress: Some(&stress_name),
     };
-    crate::xdmf::write_xdmf(path, &xdmf_path, &info)
+    crate::xdmf::write_xdmf(path, &info)
         .with_context(|| format!("cannot write {}", xdmf_path.display()))?;
     Ok((rows, n_nodes))
 }
@@ -172,6 +181,19 @@ fn write_stresses(
                 k + 1,
                 started.elapsed().as_secs_f64()
             );
+        }
+    }
+    // One view per record and scalar for the XDMF readers (the views file
+    // of the run is left to the run): "." is this file, whatever its name.
+    let views = g.create_group("views")?;
+    for (c, name) in crate::xdmf::STRESS_VIEWS.iter().enumerate() {
+        let v = views.create_group(name)?;
+        for k in 0..rows {
+            if c < 3 {
+                crate::views::column_view(&v, ".", "stress", (n_nodes, 3), k, c)?;
+            } else {
+                crate::views::row_view::<f64>(&v, ".", "von_mises", n_nodes, k)?;
+            }
         }
     }
     g.flush()?;
