@@ -50,7 +50,8 @@ A second Ctrl-C while the first is being handled exits at once (the file keeps e
         /// Overwrite an existing results file.
         #[arg(long)]
         force: bool,
-        /// No progress (a bar on a terminal, a line a minute in a log) and no summary.
+        /// No progress (a bar on a terminal, a line a minute in a log) and no
+        /// summary; warnings are still printed (and kept in the results file).
         #[arg(short, long)]
         quiet: bool,
         /// Print the closing summary as one JSON object on stdout.

@@ -857,6 +857,38 @@ impl ResultsWriter {
         string_attr(&self.file, "case", source)
     }
 
+    /// Stores the run's warnings (what runs but is likely not meant) as the
+    /// root attribute `warnings`, one string each, replacing any before.
+    pub fn set_warnings(&mut self, warnings: &[String]) -> Result<()> {
+        if self.file.attr("warnings").is_ok() {
+            self.file.delete_attr("warnings")?;
+        }
+        let v = warnings
+            .iter()
+            .map(|w| {
+                w.replace('\0', " ")
+                    .parse::<VarLenUnicode>()
+                    .map_err(|e| anyhow::anyhow!("attribute warnings: {e:?}"))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        self.file
+            .new_attr::<VarLenUnicode>()
+            .shape(v.len())
+            .create("warnings")?
+            .write_raw(&v)?;
+        Ok(())
+    }
+
+    /// The warnings the file stores (none where it has no `warnings`
+    /// attribute, as files of earlier versions).
+    pub fn warnings(&self) -> Vec<String> {
+        self.file
+            .attr("warnings")
+            .and_then(|a| a.read_raw::<VarLenUnicode>())
+            .map(|v| v.iter().map(|w| w.as_str().to_string()).collect())
+            .unwrap_or_default()
+    }
+
     /// True when [`ResultsWriter::flush_every_steps`] rows or
     /// [`ResultsWriter::flush_every_secs`] seconds have gone by since the
     /// last flush.

@@ -679,8 +679,10 @@ fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
 /// fresh run says before its first step (one list, so the two cannot
 /// drift apart): `u` is the initial displacement at every node.
 fn setup_warnings(mesh: &Mesh, u: &[f64], integrator: &Integrator) -> Vec<String> {
-    large_static_displacement(mesh, u)
+    stickslip_mesh::degenerate_cells(mesh, stickslip_mesh::DEGENERATE_RATIO)
+        .map(|d| d.to_string())
         .into_iter()
+        .chain(large_static_displacement(mesh, u))
         .chain(integrator.contact().and_then(|c| oblique_supports(mesh, c)))
         .collect()
 }
@@ -1143,11 +1145,13 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         let mut w = ResultsWriter::create_with(out, &header, case.output.compression)
             .with_context(|| format!("cannot create the results file {}", out.display()))?;
         w.append(&record(&integrator, &dofs, &mut full, 0.0, 0))?;
-        if !quiet {
-            for w in setup_warnings(&mesh, &full.u, &integrator) {
-                say!("{}: warning: {w}", case.path.display());
-            }
+        // Kept in the file and printed with --quiet too: quiet silences
+        // progress, not what the user should know.
+        let warnings = setup_warnings(&mesh, &full.u, &integrator);
+        for w in &warnings {
+            say!("{}: warning: {w}", case.path.display());
         }
+        w.set_warnings(&warnings)?;
         (w, 0.0, 0.0, vec![integrator.time()])
     };
     writer.auto_flush = false;
@@ -1354,6 +1358,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     let steps_run = integrator.steps() - steps_before;
     let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;
     let rows = writer.rows();
+    let warnings = writer.warnings();
     writer.finish(complete, &summary)?;
     xdmf(&times)?;
     let e = integrator.energy();
@@ -1401,6 +1406,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
             "case": case.path.display().to_string(),
             "output": out.display().to_string(),
             "xdmf": xdmf_path.display().to_string(),
+            "warnings": warnings,
             "complete": complete,
             "steps": integrator.steps(),
             "t": integrator.time(),
