@@ -8,7 +8,8 @@ use std::path::Path;
 use crate::error::InputError;
 
 /// Refuses an output path `run` must not write (exit code 2), before
-/// anything is read: an existing OUT.h5 or OUT.xdmf without `force`, an
+/// anything is read: an existing OUT.h5, OUT.xdmf, OUT.contact.xdmf or
+/// OUT.views.h5 without `force`, an
 /// empty name, a directory, the case file itself, a missing directory, or
 /// a file another process has open (HDF5 locks files it writes: a second
 /// run with `--force` would truncate the first run's file and then fail on
@@ -84,8 +85,13 @@ pub fn check_output(out: &Path, inputs: &[&Path], force: bool) -> Result<(), Inp
             )));
         }
     }
-    let xdmf = out.with_extension("xdmf");
-    for path in [out, xdmf.as_path()] {
+    // The files a run writes beside OUT.h5 for the viewers are its too.
+    let beside = [
+        crate::xdmf::xdmf_path(out),
+        crate::xdmf::contact_xdmf_path(out),
+        crate::views::views_path(out),
+    ];
+    for path in std::iter::once(out).chain(beside.iter().map(|p| p.as_path())) {
         if !path.exists() {
             continue;
         }

@@ -1479,11 +1479,11 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
         .arg(&case)
         .arg("-o")
         .arg(&out)
-        // 501 records of 4.4 kB and 2.6 kB of XDMF each: they fit the
-        // 4 MB when the run starts (a run whose records cannot fit is
-        // refused before it starts), but not with the room each write
-        // keeps.
-        .args(["--quiet", "--set", "time.t_end=0.5"])
+        // 351 records of 4.4 kB, and 5.6 kB each of XDMF and views beside
+        // them: they fit the 4 MB when the run starts (a run whose
+        // records cannot fit is refused before it starts), but not with
+        // the room each write keeps.
+        .args(["--quiet", "--set", "time.t_end=0.35"])
         .output()
         .unwrap();
     let read = hdf5::File::open(&out).map(|f| {
