@@ -15,7 +15,7 @@ fuzz_target!(|data: &[u8]| {
     let (case, sets) = text.split_once('\0').unwrap_or((text, ""));
     let sets: Vec<String> = sets.lines().take(8).map(str::to_string).collect();
     let path = std::path::Path::new("fuzz/case.toml");
-    let _ = stickslip::case::load_str(path, case, &sets);
-    let _ = stickslip::case::restart_changes(case, case);
-    let _ = stickslip::case::restart_changes(case, "title = \"x\"\n");
+    let _ = stickslip_case::load_str(path, case, &sets);
+    let _ = stickslip_case::restart_changes(case, case);
+    let _ = stickslip_case::restart_changes(case, "title = \"x\"\n");
 });

@@ -14,11 +14,12 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use stickslip_mesh::Mesh;
+use stickslip_case::pilot::{self, relative_l2, sample, Trace};
+use stickslip_case::{Case, Method};
 
 use crate::plot::{self, Marker, Panel, Series, COLORS};
-use crate::run::{label, relative_l2, sample, timed_run, Method, Trace};
-use crate::slab::{self, read_mesh, LoadKind};
+use crate::run::{configured, paper_case, timed_run, SIGMA_7_0, UX_8_0, UX_8_1};
+use crate::slab::LoadKind;
 
 /// End time of every run (the paper's plots end at 0.5).
 pub const T_END: f64 = 0.5;
@@ -77,21 +78,15 @@ pub const MEASURES: [(&str, &str); 4] = [
     ),
 ];
 
-fn grid() -> Vec<f64> {
-    (0..SAMPLES)
-        .map(|k| T_END * k as f64 / (SAMPLES - 1) as f64)
-        .collect()
-}
-
 impl Reference {
     /// Samples a trace.
     pub fn from_trace(load: LoadKind, tr: &Trace) -> Reference {
-        let grid = grid();
+        let grid = pilot::grid(T_END, SAMPLES);
         Reference {
             load,
-            ux81: sample(&tr.t, &tr.ux81, &grid),
-            ux85: sample(&tr.t, &tr.ux85, &grid),
-            sigma71: sample(&tr.t, &tr.sigma71, &grid),
+            ux81: sample(&tr.t, &tr.values[UX_8_0], &grid),
+            ux85: sample(&tr.t, &tr.values[UX_8_1], &grid),
+            sigma71: sample(&tr.t, &tr.values[SIGMA_7_0], &grid),
             grid,
             energy0: tr.energy0,
             energy_end: tr.energy_end,
@@ -102,9 +97,9 @@ impl Reference {
     pub fn errors(&self, tr: &Trace) -> Errors {
         let s = |y: &[f64]| sample(&tr.t, y, &self.grid);
         Errors {
-            ux81: relative_l2(&s(&tr.ux81), &self.ux81, self.ux81[0]),
-            ux85: relative_l2(&s(&tr.ux85), &self.ux85, self.ux85[0]),
-            sigma71: relative_l2(&s(&tr.sigma71), &self.sigma71, 0.0),
+            ux81: relative_l2(&s(&tr.values[UX_8_0]), &self.ux81, self.ux81[0]),
+            ux85: relative_l2(&s(&tr.values[UX_8_1]), &self.ux85, self.ux85[0]),
+            sigma71: relative_l2(&s(&tr.values[SIGMA_7_0]), &self.sigma71, 0.0),
             energy: (tr.energy_end - self.energy_end).abs()
                 / (self.energy_end - self.energy0).abs(),
         }
@@ -267,29 +262,30 @@ impl Plan {
 /// stress does not ring after sticking.
 pub const REFERENCE_METHOD: Method = Method::TrapezoidalReduced;
 
-struct Meshes(Vec<(&'static str, Mesh, f64)>);
+/// The committed meshes' Δt_crit (central difference, lumped mass), each
+/// computed once.
+struct Meshes(Vec<(&'static str, f64)>);
 
 impl Meshes {
-    /// The mesh and its Δt_crit (central difference, lumped mass).
-    fn get(&mut self, name: &'static str) -> Result<(&Mesh, f64), String> {
-        if let Some(k) = self.0.iter().position(|m| m.0 == name) {
-            return Ok((&self.0[k].1, self.0[k].2));
+    /// Δt_crit of the mesh `name` in `case`.
+    fn crit(&mut self, case: &Case, name: &'static str) -> Result<f64, String> {
+        if let Some(&(_, crit)) = self.0.iter().find(|m| m.0 == name) {
+            return Ok(crit);
         }
-        let mesh = read_mesh(name)?;
-        let slab = slab::paper(&mesh, EPS, LoadKind::Step, true)?;
-        let crit = stickslip_time::stability::critical_step(
-            &slab.model.stiffness,
-            &slab.model.lumped_mass,
-        );
-        self.0.push((name, mesh, crit));
-        let last = self.0.last().expect("just pushed");
-        Ok((&last.1, last.2))
+        // A Newmark set-up refuses no Δt: the model is all that is needed.
+        let c = configured(case, name, Method::Trapezoidal, T_END / 50.0, EPS, T_END);
+        let p = stickslip_case::prepare(&c).map_err(|e| e.to_string())?;
+        let crit =
+            stickslip_time::stability::critical_step(&p.model.stiffness, &p.model.lumped_mass);
+        self.0.push((name, crit));
+        Ok(crit)
     }
 }
 
 #[allow(clippy::too_many_arguments)]
 fn measure(
     meshes: &mut Meshes,
+    case: &Case,
     reference: &Reference,
     study: &'static str,
     order: u8,
@@ -299,14 +295,14 @@ fn measure(
     eps: f64,
     repeats: usize,
 ) -> Result<Row, String> {
-    let (mesh, crit) = meshes.get(mesh_name)?;
-    let settings = method.settings(dt, T_END);
+    let crit = meshes.crit(case, mesh_name)?;
+    let c = configured(case, mesh_name, method, dt, eps, T_END);
     let mut times = Vec::with_capacity(repeats);
     let mut first = None;
     for _ in 0..repeats.max(1) {
-        let (tr, secs) = timed_run(mesh, eps, reference.load, settings.clone())
+        let tr = timed_run(&c)
             .map_err(|e| format!("{mesh_name} {} Δt = {dt:e} ε = {eps:e}: {e}", method.name()))?;
-        times.push(secs);
+        times.push(tr.secs);
         first.get_or_insert(tr);
     }
     times.sort_by(f64::total_cmp);
@@ -344,8 +340,15 @@ pub fn study(plan: &Plan, mut progress: impl FnMut(&Row)) -> Result<Vec<Row>, St
     let (ref_mesh, ref_dt, coarser) = plan.reference;
     let order_of = |name: &str| if name.contains("-q1-") { 1 } else { 2 };
     for &load in &plan.loads {
-        let (mesh, _) = meshes.get(ref_mesh)?;
-        let (tr, secs) = timed_run(mesh, EPS, load, REFERENCE_METHOD.settings(ref_dt, T_END))?;
+        let case = paper_case(load)?;
+        let tr = timed_run(&configured(
+            &case,
+            ref_mesh,
+            REFERENCE_METHOD,
+            ref_dt,
+            EPS,
+            T_END,
+        ))?;
         let reference = Reference::from_trace(load, &tr);
         let row = Row {
             study: "reference",
@@ -360,7 +363,7 @@ pub fn study(plan: &Plan, mut progress: impl FnMut(&Row)) -> Result<Vec<Row>, St
             steps: tr.steps,
             iterations: tr.iterations,
             factorizations: tr.factorizations,
-            times: vec![secs],
+            times: vec![tr.secs],
             errors: reference.errors(&tr),
             energy_end: tr.energy_end,
         };
@@ -369,7 +372,7 @@ pub fn study(plan: &Plan, mut progress: impl FnMut(&Row)) -> Result<Vec<Row>, St
         // Convergence of the reference: the same method at 2Δt on the same
         // mesh, at Δt on the next-coarser mesh, and central difference at
         // Δt_crit/4 on the same mesh (another scheme, another mass).
-        let (_, crit) = meshes.get(ref_mesh)?;
+        let crit = meshes.crit(&case, ref_mesh)?;
         for (m, method, dt) in [
             (ref_mesh, REFERENCE_METHOD, 2.0 * ref_dt),
             (coarser, REFERENCE_METHOD, ref_dt),
@@ -377,6 +380,7 @@ pub fn study(plan: &Plan, mut progress: impl FnMut(&Row)) -> Result<Vec<Row>, St
         ] {
             let row = measure(
                 &mut meshes,
+                &case,
                 &reference,
                 "refcheck",
                 order_of(m),
@@ -390,7 +394,7 @@ pub fn study(plan: &Plan, mut progress: impl FnMut(&Row)) -> Result<Vec<Row>, St
             rows.push(row);
         }
         for &(order, m) in &plan.meshes {
-            let (_, crit) = meshes.get(m)?;
+            let crit = meshes.crit(&case, m)?;
             for method in Method::ALL {
                 let dts: Vec<f64> = if method == Method::CentralDifference {
                     plan.cd_fractions.iter().map(|f| f * crit).collect()
@@ -400,6 +404,7 @@ pub fn study(plan: &Plan, mut progress: impl FnMut(&Row)) -> Result<Vec<Row>, St
                 for dt in dts {
                     let row = measure(
                         &mut meshes,
+                        &case,
                         &reference,
                         "dt",
                         order,
@@ -415,7 +420,7 @@ pub fn study(plan: &Plan, mut progress: impl FnMut(&Row)) -> Result<Vec<Row>, St
             }
         }
         let (order, m) = plan.eps_mesh;
-        let (_, crit) = meshes.get(m)?;
+        let crit = meshes.crit(&case, m)?;
         for &eps in &plan.eps {
             for (method, dt) in [
                 (Method::CentralDifference, plan.cd_fractions[0] * crit),
@@ -423,6 +428,7 @@ pub fn study(plan: &Plan, mut progress: impl FnMut(&Row)) -> Result<Vec<Row>, St
             ] {
                 let row = measure(
                     &mut meshes,
+                    &case,
                     &reference,
                     "eps",
                     order,
@@ -488,7 +494,7 @@ pub fn panels(rows: &[Row], loads: &[LoadKind]) -> Vec<Panel> {
                         .collect();
                     all.extend(pts.iter().copied());
                     series.push(Series {
-                        label: format!("{} Q{order}", label(*method)),
+                        label: format!("{} Q{order}", method.label()),
                         color: COLORS[mi],
                         marker: marker(*method),
                         filled: order == 2,
@@ -504,7 +510,7 @@ pub fn panels(rows: &[Row], loads: &[LoadKind]) -> Vec<Panel> {
                     .map(|r| (r.time(), r.errors.as_array()[k]))
                     .collect();
                 series.push(Series {
-                    label: format!("ε ladder, {}", label(method)),
+                    label: format!("ε ladder, {}", method.label()),
                     color: COLORS[5],
                     marker: marker(method),
                     filled: false,

@@ -35,6 +35,13 @@ impl LoadKind {
             },
         }
     }
+    /// The paper's case file of this history (cases/martins-oden).
+    pub fn case_file(self) -> &'static str {
+        match self {
+            LoadKind::Step => "cd-step-eps1e-4.toml",
+            LoadKind::Sin => "cd-sin-eps1e-4.toml",
+        }
+    }
     /// Short name for tables.
     pub fn name(self) -> &'static str {
         match self {

@@ -12,12 +12,13 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use stickslip_case::Method;
 use stickslip_contact::IterationOptions;
 use stickslip_mesh::Mesh;
 use stickslip_time::{ExplicitFriction, Integrator, Scheme, Settings, TimeError};
 
 use crate::plot::{self, Marker, Panel, Series, COLORS};
-use crate::run::{label, Method, TRAPEZOIDAL};
+use crate::run::TRAPEZOIDAL;
 use crate::slab::{self, read_mesh, LoadKind, Slab, G};
 
 /// The Δt/Δt_crit ratios of the map.
@@ -519,7 +520,7 @@ pub fn main(out: &Path, quick: bool) -> Result<(), String> {
             .iter()
             .enumerate()
             .map(|(k, m)| Series {
-                label: format!("{} (Δt = {:.0e})", label(*m), paper_dt(*m)),
+                label: format!("{} (Δt = {:.0e})", m.label(), paper_dt(*m)),
                 color: COLORS[k],
                 marker: [
                     Marker::Circle,

@@ -3,9 +3,9 @@
 
 use std::collections::BTreeSet;
 
-use stickslip_study::run::{Method, REDUCTION};
+use stickslip_case::{Method, PAPER_REDUCTION as REDUCTION};
 use stickslip_study::slab::{self, read_mesh, LoadKind, Slab};
-use stickslip_time::{ImplicitSolver, Integrator, MODAL_MAX_DOFS};
+use stickslip_time::{ImplicitSolver, Integrator};
 
 fn slab(mesh: &str, friction: bool) -> Slab {
     slab::paper(&read_mesh(mesh).unwrap(), 1e-4, LoadKind::Step, friction).unwrap()
@@ -54,10 +54,8 @@ fn a_scene_without_a_contact_group_runs_no_friction_code() {
 
 #[test]
 fn an_implicit_run_factorizes_once_per_distinct_dt() {
-    // The Schur-complement path (the default, issue 7; on systems of up to
-    // MODAL_MAX_DOFS in the modes, where a "factorization" is A₀'s n
-    // reciprocals) factorizes A₀ once per distinct Δt and never for a
-    // change of the stuck set; the
+    // The Schur-complement path (the default) factorizes A₀ once per
+    // distinct Δt and never for a change of the stuck set; the
     // reduction of Remark 4.3 alternates the normal and the reduced step,
     // both kept (the last step may be a third, shortened Δt).
     for mesh in ["slab-q2-8x2.msh", "slab-q1-32x8.msh"] {
@@ -69,12 +67,7 @@ fn an_implicit_run_factorizes_once_per_distinct_dt() {
         ] {
             let mut i = s.integrator(method.settings(5e-3, 0.5)).unwrap();
             assert!(!i.is_explicit());
-            let default = if s.model.stiffness.nrows() <= MODAL_MAX_DOFS {
-                ImplicitSolver::Modal
-            } else {
-                ImplicitSolver::Schur
-            };
-            assert_eq!(i.implicit_solver(), default, "{mesh}");
+            assert_eq!(i.implicit_solver(), ImplicitSolver::Schur, "{mesh}");
             let (dts, changes) = run(&mut i);
             assert_eq!(
                 i.factorizations(),
@@ -101,10 +94,9 @@ fn the_direct_path_refactorizes_only_when_dt_or_the_stuck_set_changes() {
     // change of (Δt, stuck set) and per stick/slip iteration that changes
     // the classes, never one per step while both stay put.
     let s = slab("slab-q2-8x2.msh", true);
-    let mut i = s
-        .integrator(Method::Trapezoidal.settings(5e-3, 0.5))
-        .unwrap();
-    i.set_implicit_solver(ImplicitSolver::Direct).unwrap();
+    let mut settings = Method::Trapezoidal.settings(5e-3, 0.5);
+    settings.implicit_solver = ImplicitSolver::Direct;
+    let mut i = s.integrator(settings).unwrap();
     let (_, changes) = run(&mut i);
     assert!(i.factorizations() >= 1);
     // Each step's iteration solves once per class set it tries: the extra

@@ -3,7 +3,8 @@
 //! below the estimated Δt_crit; the ringing after sticking removed by the
 //! step reduction of Remark 4.3; no iteration failures with Remark 4.2.
 
-use stickslip_study::run::{Method, TRAPEZOIDAL};
+use stickslip_case::Method;
+use stickslip_study::run::TRAPEZOIDAL;
 use stickslip_study::slab::{self, read_mesh, LoadKind};
 use stickslip_study::stability::{growth, iteration_run, ringing, threshold, STABILITY_STEPS};
 use stickslip_time::Scheme;

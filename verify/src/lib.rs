@@ -6,9 +6,11 @@
 //! (`rates`), the properties Martins & Oden report for their experiments
 //! (`paper`), and committed reference runs of every paper case
 //! (`reference`) — the table they print, and the plots. It runs the
-//! integrators in-process through the library crates (no HDF5, no CLI), so
-//! a defect can be injected through the public API ([`Fault`]) to show that
-//! a check catches it.
+//! integrators in-process through the library crates (no HDF5, no CLI);
+//! the paper's cases are read and built by stickslip-case, the reader and
+//! builder of `stickslip run`, so the checks see what users run, and a
+//! defect can be injected into what it built ([`Fault`]) to show that a
+//! check catches it.
 
 pub mod figures;
 pub mod plotting;
@@ -19,7 +21,7 @@ pub mod suites;
 use std::path::{Path, PathBuf};
 
 pub use report::{Report, Row};
-pub use scene::{Case, Fault, Scene, Trace};
+pub use scene::{Fault, PaperCase, Trace};
 use stickslip_time::Scheme;
 
 /// Newmark ¼, ½ (average acceleration).
@@ -50,7 +52,7 @@ pub const SUITES: [&str; 4] = ["analytic", "rates", "paper", "reference"];
 #[derive(Debug)]
 pub struct Run {
     /// The case.
-    pub case: Case,
+    pub case: PaperCase,
     /// Its time histories (with the error that stopped it early, if any).
     pub trace: Trace,
 }
@@ -65,18 +67,18 @@ pub fn cases_dir(root: &Path) -> PathBuf {
 /// # Errors
 /// An unreadable case directory or case file.
 pub fn run_cases(root: &Path, fault: Option<Fault>, only: &[String]) -> Result<Vec<Run>, String> {
-    let cases = Case::read_dir(&cases_dir(root))?;
+    let cases = PaperCase::read_dir(&cases_dir(root))?;
     let mut runs = Vec::new();
     for case in cases {
         if !only.is_empty() && !only.iter().any(|o| case.name.contains(o.as_str())) {
             continue;
         }
-        let trace = match Scene::from_case(&case) {
+        let trace = match case.scene() {
             Ok(mut s) => {
                 if let Some(f) = fault {
-                    s.inject(f);
+                    f.inject(&mut s);
                 }
-                s.run()
+                scene::run(&s)
             }
             Err(e) => Trace {
                 error: Some(e),

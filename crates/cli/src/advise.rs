@@ -53,9 +53,11 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use crate::case::{self, Case, Scheme as CaseScheme, StickReduction};
-use crate::error::InputError;
-use crate::run::prepare;
+use stickslip_case::pilot::{self, relative_l2, sample, Trace};
+use stickslip_case::InputError;
+use stickslip_case::{
+    self as case, prepare, Case, Method, Prepared, Scheme as CaseScheme, PAPER_REDUCTION,
+};
 
 /// The output the tolerance is on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -283,27 +285,6 @@ pub fn continue_errors_above(
     (e, p)
 }
 
-pub use stickslip_time::scenes::Method;
-
-/// Longer name of a method for the report.
-pub fn label(method: Method) -> &'static str {
-    match method {
-        Method::CentralDifference => "central difference",
-        Method::Trapezoidal => "Newmark beta 1/4, gamma 1/2",
-        Method::TrapezoidalReduced => {
-            "Newmark beta 1/4, gamma 1/2 with step reduction (Remark 4.3)"
-        }
-        Method::Damped => "Newmark beta 0.3025, gamma 0.6",
-    }
-}
-
-/// The paper's Remark 4.3 (Δt = 1e-7 for 10 steps after sticking), used
-/// when the case gives no `time.stick_reduction` of its own.
-pub const PAPER_REDUCTION: StickReduction = StickReduction {
-    dt: stickslip_time::scenes::PAPER_REDUCTION.dt,
-    steps: stickslip_time::scenes::PAPER_REDUCTION.steps,
-};
-
 /// Central-difference Δt as fractions of Δt_crit (as in the chart).
 pub const CD_FRACTIONS: [f64; 3] = [0.9, 0.45, 0.225];
 /// Newmark Δt = t_end / these.
@@ -409,52 +390,8 @@ pub struct LadderMesh {
     pub node_at: Option<[f64; 2]>,
 }
 
-/// What a run of one configuration recorded.
-#[derive(Clone, Debug, Default)]
-pub struct Trace {
-    /// Times (t = 0 and each step).
-    pub t: Vec<f64>,
-    /// The quantity at those times (empty for the energy).
-    pub y: Vec<f64>,
-    /// Total energy at t = 0.
-    pub energy0: f64,
-    /// Total energy at t_end.
-    pub energy_end: f64,
-    /// Steps taken.
-    pub steps: u64,
-    /// Free DOFs.
-    pub dofs: usize,
-    /// Stored entries of K: the work of one K·r, the deterministic part of a step's cost.
-    pub nnz: usize,
-    /// Wall time (model assembly included), seconds.
-    pub secs: f64,
-}
-
 fn input(msg: impl Into<String>) -> anyhow::Error {
     anyhow::Error::new(InputError(msg.into()))
-}
-
-/// The case with one configuration applied (mesh, method, Δt, ε).
-pub fn configured(case: &Case, mesh: &Path, method: Method, dt: f64, eps: f64) -> Case {
-    let mut c = case.clone();
-    c.mesh.file = mesh.to_path_buf();
-    c.time.dt = dt;
-    c.time.mass = None;
-    c.time.allow_unstable = false;
-    match method.newmark() {
-        None => c.time.scheme = CaseScheme::CentralDifference,
-        Some((beta, gamma)) => {
-            c.time.scheme = CaseScheme::Newmark;
-            c.time.beta = beta;
-            c.time.gamma = gamma;
-        }
-    }
-    c.time.stick_reduction = (method == Method::TrapezoidalReduced)
-        .then(|| case.time.stick_reduction.unwrap_or(PAPER_REDUCTION));
-    if let Some(contact) = &mut c.contact {
-        contact.eps = eps;
-    }
-    c
 }
 
 /// Where the quantity is read in one prepared model.
@@ -476,7 +413,7 @@ fn nearest(
 
 fn probe_of(
     case: &Case,
-    p: &crate::run::Prepared,
+    p: &Prepared,
     q: Quantity,
     at: Option<[f64; 2]>,
 ) -> anyhow::Result<(Probe, Option<[f64; 2]>)> {
@@ -543,90 +480,35 @@ fn probe_of(
 }
 
 /// Runs `case` (already configured) to t_end recording `q` at the node
-/// nearest `at`; the time includes building the model.
+/// nearest `at` (nothing but the energies for [`Quantity::Energy`]); the
+/// time includes building the model.
 ///
 /// # Errors
 /// Input problems as [`InputError`]; a step that fails.
 pub fn run_traced(case: &Case, q: Quantity, at: Option<[f64; 2]>) -> anyhow::Result<Trace> {
-    let start = Instant::now();
-    let mut p = prepare(case, false)?;
-    let (probe, _) = probe_of(case, &p, q, at)?;
-    let n_c = p.integrator.contact().map_or(0, |c| c.len());
-    let mut stress = vec![0.0; n_c];
-    let mut tr = Trace {
-        dofs: p.model.dofs.n_free(),
-        nnz: p.model.stiffness.nnz(),
-        energy0: p.integrator.energy().total,
-        ..Trace::default()
+    let pilot = pilot::Pilot::new(case)?;
+    let probes: Vec<pilot::Probe> = match probe_of(case, &pilot.prepared, q, at)?.0 {
+        Probe::Dof(d) => vec![pilot::Probe::Dof(d)],
+        Probe::Contact(k) => vec![pilot::Probe::Contact(k)],
+        Probe::Energy => Vec::new(),
     };
-    let hint = ((case.time.t_end / case.time.dt) as usize + 2).min(1 << 22);
-    tr.t.reserve(hint);
-    tr.y.reserve(hint);
-    let i = &mut p.integrator;
-    let mut record = |i: &stickslip_time::Integrator, tr: &mut Trace| {
-        let y = match probe {
-            Probe::Dof(d) => i.displacement()[d],
-            Probe::Contact(k) => {
-                i.friction_stress(&mut stress);
-                stress[k]
-            }
-            Probe::Energy => return,
-        };
-        tr.t.push(i.time());
-        tr.y.push(y);
-    };
-    record(i, &mut tr);
-    while !i.done() {
-        i.step().map_err(|e| {
-            anyhow::anyhow!(
-                "{} on {} ({}, dt = {:e}): step {} failed: {e}",
-                case.path.display(),
-                case.mesh.file.display(),
-                match case.time.scheme {
-                    CaseScheme::CentralDifference => "central difference".to_string(),
-                    CaseScheme::Newmark =>
-                        format!("newmark {}/{}", case.time.beta, case.time.gamma),
-                },
-                case.time.dt,
-                i.steps() + 1
-            )
-        })?;
-        record(i, &mut tr);
-    }
-    tr.energy_end = i.energy().total;
-    tr.steps = i.steps();
-    tr.secs = start.elapsed().as_secs_f64();
-    Ok(tr)
-}
-
-/// Linear interpolation of (t, y) at the sorted times `grid`.
-pub fn sample(t: &[f64], y: &[f64], grid: &[f64]) -> Vec<f64> {
-    let mut out = Vec::with_capacity(grid.len());
-    let mut k = 0;
-    for &g in grid {
-        if t.len() < 2 {
-            out.push(y.first().copied().unwrap_or(0.0));
-            continue;
-        }
-        while k + 2 < t.len() && t[k + 1] < g {
-            k += 1;
-        }
-        let (t0, t1) = (t[k], t[k + 1]);
-        let s = if t1 > t0 {
-            ((g - t0) / (t1 - t0)).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
-        out.push(y[k] + s * (y[k + 1] - y[k]));
-    }
-    out
+    pilot.run(&probes).map_err(|e| {
+        anyhow::anyhow!(
+            "{} on {} ({}, dt = {:e}): {e}",
+            case.path.display(),
+            case.mesh.file.display(),
+            match case.time.scheme {
+                CaseScheme::CentralDifference => "central difference".to_string(),
+                CaseScheme::Newmark => format!("newmark {}/{}", case.time.beta, case.time.gamma),
+            },
+            case.time.dt,
+        )
+    })
 }
 
 /// The uniform grid of [`SAMPLES`] times on [0, t_end].
 pub fn grid(t_end: f64) -> Vec<f64> {
-    (0..SAMPLES)
-        .map(|k| t_end * k as f64 / (SAMPLES - 1) as f64)
-        .collect()
+    pilot::grid(t_end, SAMPLES)
 }
 
 /// The error measure of `a` against `b` (docs/work-precision.csv's):
@@ -638,16 +520,14 @@ pub fn distance(q: Quantity, a: &Trace, b: &Trace, grid: &[f64]) -> f64 {
     if q == Quantity::Energy {
         return (a.energy_end - b.energy_end).abs() / (b.energy_end - b.energy0).abs();
     }
-    let sa = sample(&a.t, &a.y, grid);
-    let sb = sample(&b.t, &b.y, grid);
+    let sa = sample(&a.t, &a.values[0], grid);
+    let sb = sample(&b.t, &b.values[0], grid);
     let offset = if q == Quantity::FrictionStress {
         0.0
     } else {
         sb[0]
     };
-    let num: f64 = sa.iter().zip(&sb).map(|(x, y)| (x - y).powi(2)).sum();
-    let den: f64 = sb.iter().map(|y| (y - offset).powi(2)).sum();
-    (num / den).sqrt()
+    relative_l2(&sa, &sb, offset)
 }
 
 /// One pilot run, for the report.
@@ -707,7 +587,7 @@ impl Pilots<'_> {
         {
             return Ok(k);
         }
-        let c = configured(self.case, &self.ladder[m].path, method, dt, eps);
+        let c = method.configure(self.case, &self.ladder[m].path, dt, eps);
         let tr = run_traced(&c, self.q, self.at).with_context(|| {
             format!(
                 "pilot run on {} ({}, dt = {dt:.4e}, eps = {eps:e})",
@@ -792,21 +672,12 @@ pub fn read_ladder(
             )));
         }
         // A Newmark set-up never refuses a Δt; the static solve checks the supports.
-        let c = configured(
-            case,
-            path,
-            Method::Trapezoidal,
-            case.time.t_end / 50.0,
-            eps_of(case),
-        );
-        let p = prepare(&c, false).map_err(|e| {
-            let msg = match e.downcast_ref::<InputError>() {
-                Some(i) => i.0.clone(),
-                None => format!("{e:#}"),
-            };
+        let c = Method::Trapezoidal.configure(case, path, case.time.t_end / 50.0, eps_of(case));
+        let p = prepare(&c).map_err(|e| {
             input(format!(
-                "{}mesh.ladder entry {text:?}: {msg}",
-                case.at("mesh.ladder")
+                "{}mesh.ladder entry {text:?}: {}",
+                case.at("mesh.ladder"),
+                e.0
             ))
         })?;
         let b = p.mesh.bbox();
@@ -1457,7 +1328,7 @@ fn describe(c: &Candidate, ladder: &[LadderMesh]) -> String {
         c.order,
         c.mesh,
         c.dofs,
-        label(c.method),
+        c.method.label(),
         c.dt,
         c.eps
     )

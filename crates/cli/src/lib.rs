@@ -1,25 +1,45 @@
-//! The `stickslip` command's library: case files ([`case`]), the HDF5
-//! results and checkpoints ([`output`]), runs and checks ([`run`]), the
-//! `mesh` report ([`mesh_cmd`]), the `probe` reader ([`probe`]), the
-//! results file's protection ([`results_file`]) and the `advise` command
-//! ([`advise`]: the cheapest configuration for a tolerance).
+//! The `stickslip` command's library: the HDF5 results and checkpoints
+//! ([`output`]), runs and checks ([`run`]), the `mesh` report
+//! ([`mesh_cmd`]), the `probe` reader ([`probe`]), the results file's
+//! protection ([`results_file`]) and the `advise` command ([`advise`]: the
+//! cheapest configuration for a tolerance). Case files are read by
+//! `stickslip-case`.
 //!
-//! This crate owns everything that touches files other than meshes and the
+//! This crate owns everything that touches the results files and the
 //! terminal; the numerics live in the library crates below it. It is a
 //! library as well as the binary (`main.rs`, the command line) so that the
-//! fuzz targets and tests can call the case reader directly.
+//! tests can call its parts directly.
 //!
 //! Exit codes (used by `main.rs`): 0 success; 2 bad input (case, mesh,
-//! arguments); 1 a run that failed after it started; 130 interrupted.
+//! arguments: a `stickslip_case::InputError`); 1 a run that failed after it
+//! started; 130 interrupted.
+
+/// `eprintln!` that does not panic when stderr is closed: a run's
+/// messages must not end it (`stickslip run ... 2>&1 | head` closes the
+/// pipe while the run goes on, and a panic there lost the steps since the
+/// last flush).
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), $($t)*);
+    }};
+}
+
+/// [`say!`] on stdout.
+macro_rules! say_out {
+    ($($t:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
 
 pub mod advise;
-pub mod case;
-pub mod error;
 pub mod mesh_cmd;
 pub mod output;
 pub mod probe;
 pub mod results_file;
 pub mod run;
+mod start;
 pub mod stress_cmd;
 pub mod views;
 pub mod xdmf;

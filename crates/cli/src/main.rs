@@ -14,8 +14,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use stickslip::error::InputError;
-use stickslip::{advise, case, mesh_cmd, probe, run};
+use stickslip::{advise, mesh_cmd, probe, run};
+use stickslip_case as case;
+use stickslip_case::InputError;
 
 #[derive(Debug, Parser)]
 #[command(

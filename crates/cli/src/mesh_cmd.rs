@@ -8,7 +8,7 @@ use std::path::Path;
 use serde_json::json;
 use stickslip_mesh::Mesh;
 
-use crate::error::InputError;
+use stickslip_case::InputError;
 
 /// Reads `path` and returns the report to print (a table, or one JSON object).
 ///

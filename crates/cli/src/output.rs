@@ -522,13 +522,6 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         },
         total_iterations: get_scalar(&g, "total_iterations")?,
         factorizations: get_scalar(&g, "factorizations")?,
-        // Absent in files of versions before the modal step: the restart
-        // then projects the physical state.
-        modal: if g.link_exists("modal") {
-            get_vector(&g, "modal")?
-        } else {
-            Vec::new()
-        },
     };
     let extra = CheckpointExtra {
         rows: get_scalar::<u64>(&g, "rows")? as usize,
@@ -996,7 +989,6 @@ impl ResultsWriter {
         put_vector(&g, "acceleration", &cp.acceleration)?;
         put_vector(&g, "forces", &cp.forces)?;
         put_vector(&g, "classes", &cp.classes)?;
-        put_vector(&g, "modal", &cp.modal)?;
         let e = &cp.energy;
         put_vector(
             &g,

@@ -9,7 +9,7 @@ use std::path::Path;
 use hdf5::File;
 use ndarray::s;
 
-use crate::error::InputError;
+use stickslip_case::InputError;
 
 /// A field that can be probed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use crate::error::InputError;
+use stickslip_case::InputError;
 
 /// Refuses an output path `run` must not write (exit code 2), before
 /// anything is read: an existing OUT.h5, OUT.xdmf, OUT.contact.xdmf or

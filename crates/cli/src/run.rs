@@ -1,10 +1,12 @@
 //! `stickslip run` and `stickslip check`: from a validated case to a model,
 //! an integrator and the HDF5 results, step by step.
 //!
-//! Everything that can be refused is refused in [`prepare`], before any
-//! time step, as an [`InputError`] (exit code 2). Once stepping starts,
-//! every completed output step is in the file; a failure marks the file
-//! `complete = false`, records the reason and returns [`Outcome::Failed`].
+//! Everything that can be refused is refused before any time step (the
+//! model is built by `stickslip-case`), as an [`InputError`] (exit code
+//! 2). Once stepping starts, every completed output step is in the file; a
+//! failure marks the file `complete = false`, records the reason and
+//! returns [`Outcome::Failed`]. Where a run starts (a new file, or a
+//! restart's checkpoint) is `start.rs`.
 
 use std::io::IsTerminal;
 use std::path::Path;
@@ -12,40 +14,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::Context;
-use stickslip_contact::{ContactSurface, IterationOptions};
-use stickslip_fem::{
-    body_force_load, traction_load, Dirichlet, DofMap, ElementClasses, Hypothesis as FemHypothesis,
-    Material, Model, NodeOrder, Traction,
-};
+use stickslip_case::{self as case, Case, InputError, Prepared, Running, Scene};
+use stickslip_contact::ContactSurface;
+use stickslip_fem::{DofMap, NodeOrder};
 use stickslip_mesh::Mesh;
-use stickslip_time::{
-    Dynamics, ExplicitFriction, History, ImplicitSolver, Integrator, Load, MassKind, Scheme,
-    Settings, StickReduction, TimeError,
-};
+use stickslip_time::{ImplicitSolver, Integrator, Scheme};
 
-/// `eprintln!` that does not panic when stderr is closed: a run's
-/// messages must not end it (`stickslip run ... 2>&1 | head` closes the
-/// pipe while the run goes on, and a panic there lost the steps since the
-/// last flush).
-macro_rules! say {
-    ($($t:tt)*) => {{
-        use std::io::Write;
-        let _ = writeln!(std::io::stderr(), $($t)*);
-    }};
-}
-
-/// [`say!`] on stdout.
-macro_rules! say_out {
-    ($($t:tt)*) => {{
-        use std::io::Write;
-        let _ = writeln!(std::io::stdout(), $($t)*);
-    }};
-}
-
-use crate::case::{self, Case};
-use crate::error::InputError;
-use crate::output::{self, CheckpointExtra, Header, Record, ResultsWriter, Summary};
+use crate::output::{self, CheckpointExtra, Record, ResultsWriter, Summary};
+use crate::start;
 
 /// How a run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -61,31 +37,6 @@ pub enum Outcome {
     Interrupted,
 }
 
-/// A case turned into the objects that run it, with the model kept for
-/// inspection (`check`, `advise`).
-#[derive(Debug)]
-pub struct Prepared {
-    /// The mesh.
-    pub mesh: Mesh,
-    /// K, M, lumped M, DOF map.
-    pub model: Model,
-    /// The integrator at t = 0 (initial state computed).
-    pub integrator: Integrator,
-}
-
-/// A case turned into the objects that run it, for `run`: K and M have
-/// moved into the integrator (a copy left in a model would be held for the
-/// whole run, 24 bytes per stored entry of K beside the step's own data).
-#[derive(Debug)]
-pub struct Running {
-    /// The mesh.
-    pub mesh: Mesh,
-    /// The DOF map of the integrator's free DOFs.
-    pub dofs: DofMap,
-    /// The integrator at t = 0 (initial state computed).
-    pub integrator: Integrator,
-}
-
 /// Free DOFs from which a run or check says when the model is assembled
 /// (its setup then takes seconds: 12 s at 1.1M DOFs).
 const SETUP_NOTE_DOFS: usize = 200_000;
@@ -93,383 +44,56 @@ const SETUP_NOTE_DOFS: usize = 200_000;
 /// Seconds between progress lines where stderr is not a terminal.
 const PROGRESS_LOG_SECS: u64 = 60;
 
-fn input(msg: impl Into<String>) -> anyhow::Error {
+pub(crate) fn input(msg: impl Into<String>) -> anyhow::Error {
     anyhow::Error::new(InputError(msg.into()))
 }
 
-fn history(h: &case::History) -> History {
-    match h {
-        case::History::Constant => History::Constant,
-        case::History::Step => History::Step,
-        case::History::Sin { omega } => History::Sin { omega: *omega },
-        case::History::Table(points) => {
-            History::Table(points.iter().map(|p| (p[0], p[1])).collect())
-        }
+/// A case's model and integrator ([`stickslip_case::assemble`]), the
+/// model kept (`check`); with `progress`, [`setup_note`].
+fn prepare(case: &Case, progress: bool) -> Result<Prepared, InputError> {
+    let started = Instant::now();
+    let scene = stickslip_case::assemble(case)?;
+    if progress {
+        setup_note(&scene, started);
     }
-}
-
-/// Checks a group the case names against the mesh: it exists (else the
-/// message lists the mesh's groups) and, when `dim` is given, has that
-/// dimension.
-fn check_group(
-    mesh: &Mesh,
-    case: &Case,
-    key: &str,
-    name: &str,
-    dim: Option<u8>,
-    purpose: &str,
-    problems: &mut Vec<String>,
-) -> bool {
-    match mesh.group(name) {
-        Err(e) if matches!(e.kind, stickslip_mesh::MeshErrorKind::AmbiguousGroup { .. }) => {
-            problems.push(format!(
-                "{}{key} = {name:?}: in {}: {e}",
-                case.at(key),
-                case.mesh.file.display()
-            ));
-            false
-        }
-        Err(_) => {
-            let have: Vec<String> = mesh
-                .groups
-                .iter()
-                .map(|g| format!("{:?} (dim {})", g.name, g.dim))
-                .collect();
-            problems.push(format!(
-                "{}{key} = {name:?}: the mesh {} has no physical group {name:?}; it has: {}; \
-                 use one of those, or add the group in Gmsh (Physical Curve/Surface)",
-                case.at(key),
-                case.mesh.file.display(),
-                if have.is_empty() {
-                    "none".to_string()
-                } else {
-                    have.join(", ")
-                }
-            ));
-            false
-        }
-        Ok(g) => match dim {
-            Some(d) if g.dim != d => {
-                problems.push(format!(
-                    "{}{key} = {name:?}: {purpose} needs a group of boundary lines (dimension {d}), \
-                     but {name:?} has dimension {}; name the boundary edges in Gmsh with a Physical Curve",
-                    case.at(key),
-                    g.dim
-                ));
-                false
-            }
-            // A line inside the body (Gmsh's `Line{..} In Surface{..}`):
-            // a load or friction there would act inside the body.
-            Some(_) if mesh.interior_edges(g) > 0 => {
-                problems.push(format!(
-                    "{}{key} = {name:?}: {purpose} must be on the boundary, but {} of the group's {} edges \
-                     lie inside the body (each a side of two cells, as an embedded curve's are); name the \
-                     boundary edges instead",
-                    case.at(key),
-                    mesh.interior_edges(g),
-                    g.edges.len()
-                ));
-                false
-            }
-            _ => true,
-        },
-    }
-}
-
-/// Builds mesh, model, loads, contact surface and integrator. Every problem
-/// with the input is collected (groups the mesh lacks, groups of the wrong
-/// dimension, free rigid-body motions, Δt above the critical step, ...) and
-/// reported together as one [`InputError`], each naming the case file and
-/// line. `progress`: a line on stderr once a large model is assembled
-/// ([`SETUP_NOTE_DOFS`]).
-///
-/// # Errors
-/// Input problems (exit 2) as [`InputError`]; nothing else is expected.
-pub fn prepare(case: &Case, progress: bool) -> anyhow::Result<Prepared> {
-    let (mesh, _, model, integrator) = build(case, false, true, progress)?;
-    Ok(Prepared {
-        mesh,
-        model: model.expect("kept when asked"),
-        integrator,
-    })
+    scene.prepared(case)
 }
 
 /// [`prepare`] for a run, which will [`Integrator::restore`] a checkpoint
-/// when `restoring` (no initial static solve: the checkpoint has the state).
-/// K and M move into the integrator.
-///
-/// # Errors
-/// As [`prepare`].
-pub fn prepare_run(case: &Case, restoring: bool, progress: bool) -> anyhow::Result<Running> {
-    let (mesh, dofs, _, integrator) = build(case, restoring, false, progress)?;
-    Ok(Running {
-        mesh,
-        dofs,
-        integrator,
-    })
+/// when `restoring` (no initial static solve: the checkpoint has the
+/// state). K and M move into the integrator.
+fn prepare_run(case: &Case, restoring: bool, progress: bool) -> Result<Running, InputError> {
+    let started = Instant::now();
+    let mut scene = stickslip_case::assemble(case)?;
+    scene.settings.restoring = restoring;
+    if progress {
+        setup_note(&scene, started);
+    }
+    scene.running(case)
 }
 
-/// [`prepare`] and [`prepare_run`]: the model is returned when
-/// `keep_model`, else its matrices move into the integrator. With
-/// `progress`, a model of [`SETUP_NOTE_DOFS`] free DOFs or more gets a line
-/// on stderr before the integrator's setup (its factorizations take
-/// seconds there, with nothing else on the screen).
-fn build(
-    case: &Case,
-    restoring: bool,
-    keep_model: bool,
-    progress: bool,
-) -> anyhow::Result<(Mesh, DofMap, Option<Model>, Integrator)> {
-    let started = Instant::now();
-    let mesh = Mesh::from_file(&case.mesh.file)
-        .map_err(|e| input(format!("{}{e}", case.at("mesh.file"))))?;
-    let mut problems = Vec::new();
-
-    // Groups first: everything after needs them.
-    let mut groups_ok = true;
-    for (i, d) in case.dirichlet.iter().enumerate() {
-        groups_ok &= check_group(
-            &mesh,
-            case,
-            &format!("dirichlet.{i}.group"),
-            &d.group,
-            None,
-            "a Dirichlet condition",
-            &mut problems,
-        );
+/// A line on stderr before the integrator's setup where the model has
+/// [`SETUP_NOTE_DOFS`] free DOFs or more: its factorizations take seconds
+/// there, with nothing else on the screen.
+fn setup_note(scene: &Scene, started: Instant) {
+    let n_free = scene.model.dofs.n_free();
+    if n_free < SETUP_NOTE_DOFS {
+        return;
     }
-    let dirichlet_ok = groups_ok;
-    for (i, t) in case.traction.iter().enumerate() {
-        groups_ok &= check_group(
-            &mesh,
-            case,
-            &format!("traction.{i}.group"),
-            &t.group,
-            Some(1),
-            "a traction",
-            &mut problems,
-        );
-    }
-    if let Some(c) = &case.contact {
-        groups_ok &= check_group(
-            &mesh,
-            case,
-            "contact.group",
-            &c.group,
-            Some(1),
-            "the contact surface",
-            &mut problems,
-        );
-    }
-
-    let hypothesis = match case.material.hypothesis {
-        case::Hypothesis::PlaneStrain => FemHypothesis::PlaneStrain,
-        case::Hypothesis::PlaneStress => FemHypothesis::PlaneStress,
+    let order = scene.model.fill_order.name();
+    let work = match (scene.settings.scheme, scene.settings.restoring) {
+        (Scheme::CentralDifference, true) => "the step's operators".to_string(),
+        (Scheme::CentralDifference, false) => format!(
+            "the initial state (a static solve by sparse Cholesky, ordered by {order}, when loads act before t = 0) and the step's operators"
+        ),
+        (Scheme::Newmark { .. }, _) => format!(
+            "the factor of the step's operator (sparse Cholesky, ordered by {order}) and the initial state"
+        ),
     };
-    let material = match Material::new(
-        case.material.e,
-        case.material.nu,
-        case.material.rho,
-        hypothesis,
-    ) {
-        Ok(m) => Some(m),
-        Err(e) => {
-            problems.push(format!("{}[material]: {e}", case.at("material.E")));
-            None
-        }
-    };
-    let mut conditions = Vec::new();
-    for d in &case.dirichlet {
-        for (component, value) in [(0, d.ux), (1, d.uy)] {
-            if let Some(value) = value {
-                conditions.push(Dirichlet {
-                    group: d.group.clone(),
-                    component,
-                    value,
-                });
-            }
-        }
-    }
-    let dirichlet_at = case.at("dirichlet.0.group");
-    let model = match (&material, dirichlet_ok) {
-        (Some(material), true) => match Model::new(&mesh, material, &conditions) {
-            Ok(m) => Some(m),
-            Err(e) => {
-                problems.push(format!("{dirichlet_at}[[dirichlet]]: {e}"));
-                None
-            }
-        },
-        _ => None,
-    };
-    if let Some(m) = &model {
-        // The initial static solve (Remark 4.1) is frictionless: the
-        // supports alone must hold the body (DofMap checks each connected part).
-        let free = m.dofs.free_rigid_motions();
-        if !free.is_empty() {
-            problems.push(format!(
-                "{dirichlet_at}the supports leave a rigid-body motion free for the initial static solve: {}; \
-                 add [[dirichlet]] conditions that prevent it (e.g. uy = 0 on a bottom or top group and ux = 0 on an end)",
-                free.join(", ")
-            ));
-        }
-    }
-    let Some(model) = model.filter(|_| groups_ok && problems.is_empty()) else {
-        return Err(input(crate::error::listed(problems)));
-    };
-
-    let n_full = 2 * mesh.nodes.len();
-    let n_free = model.dofs.n_free();
-    let mut full = vec![0.0; n_full];
-    let mut loads = Vec::new();
-    let restrict = |full: &[f64]| {
-        let mut free = vec![0.0; n_free];
-        model.dofs.restrict(full, &mut free);
-        free
-    };
-    for (i, t) in case.traction.iter().enumerate() {
-        full.iter_mut().for_each(|x| *x = 0.0);
-        let traction = match (t.t, t.pressure) {
-            (Some(v), None) => Traction::Vector(v),
-            (None, Some(p)) => Traction::Pressure(p),
-            _ => {
-                problems.push(format!(
-                    "{}[[traction]] on {:?}: give exactly one of t or pressure",
-                    case.at(&format!("traction.{i}.group")),
-                    t.group
-                ));
-                continue;
-            }
-        };
-        match traction_load(&mesh, &t.group, traction, &mut full) {
-            Ok(()) => loads.push(Load {
-                vector: restrict(&full),
-                history: history(&t.history),
-            }),
-            Err(e) => problems.push(format!(
-                "{}[[traction]]: {e}",
-                case.at(&format!("traction.{i}.group"))
-            )),
-        }
-    }
-    if let Some(f) = case.body_force {
-        full.iter_mut().for_each(|x| *x = 0.0);
-        body_force_load(&mesh, f, &mut full);
-        loads.push(Load {
-            vector: restrict(&full),
-            history: History::Constant,
-        });
-    }
-    let mut iteration = IterationOptions::default();
-    let mut contact = None;
-    if let Some(c) = &case.contact {
-        // The prescribed normal traction on Γ_C is a load like any other,
-        // present before t = 0 (it makes the initial static state).
-        full.iter_mut().for_each(|x| *x = 0.0);
-        match traction_load(&mesh, &c.group, Traction::Pressure(c.pressure), &mut full) {
-            Ok(()) => loads.push(Load {
-                vector: restrict(&full),
-                history: History::Constant,
-            }),
-            Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
-        }
-        iteration = IterationOptions {
-            remark_4_2: c.remark_4_2,
-            max_iterations: c.max_iterations,
-        };
-        match ContactSurface::from_group(&mesh, &model.dofs, &c.group, c.pressure, c.mu, c.eps) {
-            // Every node's tangential DOF held: the friction the case asks
-            // for could act nowhere (before, it was dropped silently, and
-            // the file had no /contact).
-            Ok(s) if s.is_empty() => problems.push(format!(
-                "{}[contact]: no node of group \"{}\" can slide: [[dirichlet]] conditions hold the tangential \
-                 motion of all its {} nodes, so friction would act nowhere; remove the [[dirichlet]] on the \
-                 contact surface's tangential direction, or remove [contact] for a run without friction",
-                case.at("contact.group"),
-                c.group,
-                s.excluded.len()
-            )),
-            Ok(s) => contact = Some(s),
-            Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
-        }
-    }
-    if !problems.is_empty() {
-        return Err(input(crate::error::listed(problems)));
-    }
-    let scheme = match case.time.scheme {
-        case::Scheme::CentralDifference => Scheme::CentralDifference,
-        case::Scheme::Newmark => Scheme::Newmark {
-            beta: case.time.beta,
-            gamma: case.time.gamma,
-        },
-    };
-    let settings = Settings {
-        scheme,
-        mass: case.time.mass.map(|m| match m {
-            case::MassKind::Consistent => MassKind::Consistent,
-            case::MassKind::Lumped => MassKind::Lumped,
-        }),
-        dt: case.time.dt,
-        t_end: case.time.t_end,
-        stick_reduction: case.time.stick_reduction.as_ref().map(|r| StickReduction {
-            dt: r.dt,
-            steps: r.steps,
-        }),
-        iteration,
-        allow_unstable: case.time.allow_unstable,
-        explicit_friction: ExplicitFriction::ClosedForm,
-        initial_velocity: None,
-        // The state is read at every record: the modal step of small
-        // systems pays 3n² for each read, so with a record at every step
-        // the factor's step costs less (the paper's Newmark case, 20,000
-        // steps end to end: 24.4 µs a step by the factor, 26.5 µs modal),
-        // from every second step on the modal one.
-        reads_every: Some(case.output.every.max(1) as u64),
-        restoring,
-    };
-    // The explicit step forms K·x by stencil types where the mesh's
-    // numbering repeats its node rows (structured meshes numbered row by
-    // row), else from element classes where the mesh has them (structured
-    // Q2 meshes), else from a compact copy of the assembled K
-    // (stickslip-time's kernels.rs picks).
-    let classes = match (scheme, &material) {
-        (Scheme::CentralDifference, Some(material)) => {
-            ElementClasses::new(&mesh, material, &model.dofs)
-        }
-        _ => None,
-    };
-    let dofs = model.dofs.clone();
-    if progress && dofs.n_free() >= SETUP_NOTE_DOFS {
-        let order = model.fill_order.name();
-        let work = match (scheme, restoring) {
-            (Scheme::CentralDifference, true) => "the step's operators".to_string(),
-            (Scheme::CentralDifference, false) => format!(
-                "the initial state (a static solve by sparse Cholesky, ordered by {order}, when loads act before t = 0) and the step's operators"
-            ),
-            (Scheme::Newmark { .. }, _) => format!(
-                "the factor of the step's operator (sparse Cholesky, ordered by {order}) and the initial state"
-            ),
-        };
-        say!(
-            "model: {} free DOFs, assembled in {:.1} s; now {work}",
-            dofs.n_free(),
-            started.elapsed().as_secs_f64(),
-        );
-    }
-    let (dynamics, model) = if keep_model {
-        (Dynamics::from_model(&model), Some(model))
-    } else {
-        (Dynamics::from_model_owned(model), None)
-    };
-    let dynamics = dynamics.with_element_classes(classes);
-    let integrator = Integrator::new(dynamics, contact, loads, settings).map_err(|e| {
-        let key = match e {
-            TimeError::Unstable { .. } => "time.dt",
-            TimeError::Static(_) => "dirichlet.0.group",
-            _ => "time.scheme",
-        };
-        input(format!("{}[time]: {e}", case.at(key)))
-    })?;
-    Ok((mesh, dofs, model, integrator))
+    say!(
+        "model: {n_free} free DOFs, assembled in {:.1} s; now {work}",
+        started.elapsed().as_secs_f64(),
+    );
 }
 
 /// `stickslip check`: validate, print the model size, Δt_crit and solver.
@@ -542,13 +166,6 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
             p.model.fill_order.name(),
             p.model.stiffness.nnz(),
             i.stiffness_product()
-        );
-    } else if i.implicit_solver() == ImplicitSolver::Modal {
-        let n_c = i.contact().map_or(0, |c| c.len());
-        println!(
-            "solver      implicit Newmark in the {n} modes of (K, M) (dense eigensolver once; up to {} DOFs): A₀ diagonal, no K·x per step; friction on the {n_c} contact unknowns by the Schur complement",
-            stickslip_time::MODAL_MAX_DOFS,
-            n = p.model.stiffness.nrows(),
         );
     } else {
         let n_c = i.contact().map_or(0, |c| c.len());
@@ -678,7 +295,7 @@ fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
 /// What runs but is likely not meant, in the words `check` prints and a
 /// fresh run says before its first step (one list, so the two cannot
 /// drift apart): `u` is the initial displacement at every node.
-fn setup_warnings(mesh: &Mesh, u: &[f64], integrator: &Integrator) -> Vec<String> {
+pub(crate) fn setup_warnings(mesh: &Mesh, u: &[f64], integrator: &Integrator) -> Vec<String> {
     stickslip_mesh::degenerate_cells(mesh, stickslip_mesh::DEGENERATE_RATIO)
         .map(|d| d.to_string())
         .into_iter()
@@ -775,8 +392,8 @@ fn human_bytes(b: f64) -> String {
 }
 
 /// Full-length (2 × nodes) copies of the free-DOF state for output.
-struct FullState {
-    u: Vec<f64>,
+pub(crate) struct FullState {
+    pub(crate) u: Vec<f64>,
     v: Vec<f64>,
     a: Vec<f64>,
     stress: Vec<f64>,
@@ -784,7 +401,21 @@ struct FullState {
     state: Vec<i8>,
 }
 
-fn record<'a>(
+impl FullState {
+    /// Buffers for `nodes` mesh nodes and `n_c` contact nodes.
+    pub(crate) fn new(nodes: usize, n_c: usize) -> FullState {
+        FullState {
+            u: vec![0.0; 2 * nodes],
+            v: vec![0.0; 2 * nodes],
+            a: vec![0.0; 2 * nodes],
+            stress: vec![0.0; n_c],
+            slip: vec![0.0; n_c],
+            state: vec![0; n_c],
+        }
+    }
+}
+
+pub(crate) fn record<'a>(
     i: &Integrator,
     dofs: &DofMap,
     s: &'a mut FullState,
@@ -964,24 +595,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         dofs,
         mut integrator,
     } = prepare_run(case, options.restart, !quiet)?;
-    let (contact_nodes, contact_s): (Vec<usize>, Vec<f64>) = integrator
-        .contact()
-        .map(|c| c.nodes.iter().map(|n| (n.node, n.s)).unzip())
-        .unwrap_or_default();
-    let n_c = contact_nodes.len();
-    let n_full = 2 * mesh.nodes.len();
-    let mut full = FullState {
-        u: vec![0.0; n_full],
-        v: vec![0.0; n_full],
-        a: vec![0.0; n_full],
-        stress: vec![0.0; n_c],
-        slip: vec![0.0; n_c],
-        state: vec![0; n_c],
-    };
-    // E₀ for the blow-up test: kinetic + strain at t = 0.
-    let node_order = dofs.node_order();
-    let e0 = integrator.energy();
-    let mut initial_mechanical = e0.kinetic + e0.strain;
+    let n_c = integrator.contact().map_or(0, |c| c.len());
     // A signal during the setup: stop before the file is touched (with
     // --force the old results would otherwise be gone for a run of one
     // step).
@@ -1031,441 +645,475 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     } else {
         crate::results_file::claim(out)?
     };
-    let (mut writer, wall_before, mut max_balance, mut times) = if options.restart {
-        let stored = output::read_checkpoint(out)
-            .map_err(|e| input(format!("--restart {}: {e:#}", out.display())))?;
-        let changes = case::restart_changes(&stored.case_source, &case.source)
-            .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
-        if !changes.is_empty() {
-            return Err(input(format!(
-                "{}: --restart {}: the case changes what the stored run computed:\n  {}\n\
-                 a restart may change only time.t_end, output.*, title and mesh.ladder; undo those changes, or start a new run with -o NEW.h5",
-                case.path.display(),
-                out.display(),
-                changes.join("\n  ")
-            )));
-        }
-        if let Some(change) = output::stored_mesh_change(out, &mesh)
-            .map_err(|e| input(format!("--restart {}: {e:#}", out.display())))?
-        {
-            return Err(input(format!(
-                "{}: --restart {}: {} has changed since the run began ({change}); restart with \
-                 the mesh the run began on, or start a new run with -o NEW.h5",
-                case.path.display(),
-                out.display(),
-                case.mesh.file.display()
-            )));
-        }
-        let cp = &stored.checkpoint;
-        if case.time.t_end < cp.t {
-            return Err(input(format!(
-                "{}time.t_end = {} is before the checkpoint's t = {} in {}; give a t_end >= {}",
-                case.at("time.t_end"),
-                case.time.t_end,
-                cp.t,
-                out.display(),
-                cp.t
-            )));
-        }
-        initial_mechanical = cp.initial_mechanical;
-        // The stored run's solver (modal iff its checkpoint holds the modal
-        // state), whatever output.every is now: a restart continues bit
-        // for bit.
-        let modal = !cp.modal.is_empty();
-        if modal != (integrator.implicit_solver() == ImplicitSolver::Modal) {
-            let solver = if modal {
-                ImplicitSolver::Modal
-            } else {
-                ImplicitSolver::Schur
-            };
-            integrator
-                .set_implicit_solver(solver)
-                .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
-        }
-        // A state stored in another node order (a file of a version
-        // before the node orders, or STICKSLIP_DOF_ORDER changed) is read
-        // into this run's numbering; the modal state, whose modes depend
-        // on the numbering, is then formed again from it.
-        let remapped;
-        let n_free = dofs.n_free();
-        let lengths_fit = [&cp.displacement, &cp.velocity, &cp.acceleration]
-            .iter()
-            .all(|x| x.len() == n_free);
-        // (Other lengths: `restore` says what is wrong.)
-        let cp = if stored.extra.node_order != node_order.code() && lengths_fit {
-            let theirs = NodeOrder::from_code(stored.extra.node_order)
-                .and_then(|order| dofs.renumbered(&mesh, order))
-                .ok_or_else(|| {
-                    input(format!(
-                        "--restart {}: its state's node_order {} does not apply to {} (a newer version's order, or a structured grid's on a mesh that is none); restart with the version and the mesh the run started from",
-                        out.display(),
-                        stored.extra.node_order,
-                        case.mesh.file.display()
-                    ))
-                })?;
-            let to_ours = |x: &[f64]| dofs.from_numbering(&theirs, x);
-            remapped = stickslip_time::Checkpoint {
-                displacement: to_ours(&cp.displacement),
-                velocity: to_ours(&cp.velocity),
-                acceleration: to_ours(&cp.acceleration),
-                modal: Vec::new(),
-                ..cp.clone()
-            };
-            &remapped
-        } else {
-            cp
-        };
-        integrator
-            .restore(cp)
-            .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
-        let mut w = ResultsWriter::open_append(out, stored.extra.rows, mesh.nodes.len(), n_c)?;
-        w.set_case(&case.source)?;
-        if !quiet {
-            say!(
-                "restart: continuing {} from step {}, t = {} ({} records kept)",
-                out.display(),
-                cp.steps,
-                cp.t,
-                stored.extra.rows
-            );
-        }
-        (
-            w,
-            stored.extra.wall_time_s,
-            stored.extra.max_balance,
-            stored.times,
-        )
+    let mut full = FullState::new(mesh.nodes.len(), n_c);
+    let opened = if options.restart {
+        start::resume(case, out, quiet, &mesh, &dofs, &mut integrator)?
     } else {
-        let header = Header {
-            case_source: &case.source,
-            mesh: &mesh,
-            contact_nodes: &contact_nodes,
-            contact_s: &contact_s,
-        };
-        let mut w = ResultsWriter::create_with(out, &header, case.output.compression)
-            .with_context(|| format!("cannot create the results file {}", out.display()))?;
-        w.append(&record(&integrator, &dofs, &mut full, 0.0, 0))?;
-        // Kept in the file and printed with --quiet too: quiet silences
-        // progress, not what the user should know.
-        let warnings = setup_warnings(&mesh, &full.u, &integrator);
-        for w in &warnings {
-            say!("{}: warning: {w}", case.path.display());
-        }
-        w.set_warnings(&warnings)?;
-        (w, 0.0, 0.0, vec![integrator.time()])
+        start::fresh(case, out, &mesh, &dofs, &integrator, &mut full)?
     };
-    writer.auto_flush = false;
-    writer.flush_every_steps = case.output.flush_every.max(1);
-    writer.flush_every_secs = case.output.flush_seconds;
-    let extra = |rows: usize, max_balance: f64| CheckpointExtra {
-        rows,
-        wall_time_s: wall_before + started.elapsed().as_secs_f64(),
-        max_balance,
-        node_order: node_order.code(),
+    let contact_line = session_contact_line(&mesh, &integrator);
+    let mut session = Session {
+        case,
+        out,
+        options,
+        mesh: &mesh,
+        dofs: &dofs,
+        integrator,
+        writer: opened.writer,
+        full,
+        times: opened.times,
+        max_balance: opened.max_balance,
+        wall_before: opened.wall_before,
+        initial_mechanical: opened.initial_mechanical,
+        started,
+        xdmf_path: crate::xdmf::xdmf_path(out),
+        contact_line,
     };
-    let xdmf_path = crate::xdmf::xdmf_path(out);
-    let contact_line = integrator
-        .contact()
-        .map(|c| crate::views::ContactLine::new(&mesh, &c.group, &contact_nodes));
-    let layout = crate::views::Layout {
-        n_nodes: mesh.nodes.len(),
-        contact: contact_line.as_ref(),
-    };
-    let xdmf = |times: &[f64]| {
-        crate::xdmf::write_companions(out, &layout, (mesh.kind, mesh.n_cells()), times)
-    };
+    session.writer.auto_flush = false;
+    session.writer.flush_every_steps = case.output.flush_every.max(1);
+    session.writer.flush_every_secs = case.output.flush_seconds;
     // A state to continue from exists from the start (the initial state, or
     // the restored one).
-    writer.write_checkpoint(&integrator.checkpoint(), &extra(writer.rows(), max_balance))?;
-    xdmf(&times)?;
-    let mut last_xdmf = Instant::now();
-    // How long the last rewrite took: the next waits ten times that (and at
-    // least flush_seconds), so the rewrites, each O(rows), stay under a
-    // tenth of the run however many rows (at a fixed interval they took 42%
-    // of a run of 320k rows).
-    let mut xdmf_secs = 0.0_f64;
-
-    let every = case.output.every.max(1) as u64;
-    let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
-        let bar = indicatif::ProgressBar::new(1000);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:30} {percent:>3}% {msg}, ETA {eta}",
-            )
-            .expect("valid template"),
-        );
-        bar
-    });
-    // Where stderr is a log, not a terminal: a line a minute instead of
-    // the bar, so a batch job's log shows a long run moving.
-    let log_progress = !quiet && !std::io::stderr().is_terminal();
-    let mut last_log = Instant::now();
+    session.checkpoint(None)?;
+    session.write_xdmf()?;
     let setup_s = started.elapsed().as_secs_f64();
-    let stepping = Instant::now();
-    if log_progress {
+    let mut progress = Progress::new(quiet, &session.integrator);
+    if progress.log {
+        let i = &session.integrator;
         say!(
             "setup done in {setup_s:.1} s; stepping from t = {} to t_end = {} (about {} steps), a progress line a minute",
-            integrator.time(),
-            integrator.t_end(),
-            ((integrator.t_end() - integrator.time()) / case.time.dt).ceil()
+            i.time(),
+            i.t_end(),
+            ((i.t_end() - i.time()) / case.time.dt).ceil()
         );
     }
-    let t_end = integrator.t_end();
-    // A restart starts where its checkpoint was: the share done and the
-    // time left count from there.
-    let t_start = integrator.time();
-    let steps_before = integrator.steps();
-    let mut failure: Option<String> = None;
-    let mut interrupted: Option<&'static str> = None;
-    // The state before the last step (and the rows then): that step is
-    // shortened to land on t_end, so a restart with a later t_end must redo
-    // it at full length to match a run that never stopped.
-    let mut before_last: Option<(stickslip_time::Checkpoint, usize)> = None;
-    while !integrator.done() {
-        let near_end = integrator.t_end() - integrator.time() <= case.time.dt * (1.0 + 1e-6);
-        let before = near_end.then(|| (integrator.checkpoint(), writer.rows()));
-        match integrator.step() {
-            Ok(info) => {
-                max_balance = max_balance.max(integrator.energy().balance.abs());
-                writer.count_step();
-                let write = integrator.steps() % every == 0 || integrator.done();
-                let mut rec = |writer: &mut ResultsWriter, full: &mut FullState| {
-                    times.push(integrator.time());
-                    writer.append(&record(
-                        &integrator,
-                        &dofs,
-                        full,
-                        info.dt,
-                        info.iterations as u32,
-                    ))
-                };
-                if write {
-                    // HDF5 writes a chunk of rows as it fills: the room for
-                    // it is checked before, as before a flush.
-                    if writer.append_writes() {
-                        if let Some(e) = disk_nearly_full(&writer, &dofs, out, &integrator) {
-                            failure = Some(e);
-                            break;
-                        }
-                    }
-                    rec(&mut writer, &mut full)?;
+    let stepping = Instant::now();
+    let ending = session.step_to_end(&mut progress)?;
+    progress.finish();
+    session.conclude(ending, setup_s, stepping, progress.steps_before)
+}
+
+/// How the stepping ended.
+struct Ending {
+    /// Why the run stopped early, if it failed.
+    failure: Option<String>,
+    /// The signal that stopped it, if one did.
+    interrupted: Option<&'static str>,
+    /// The state before the last step (and the rows then): that step is
+    /// shortened to land on t_end, so a restart with a later t_end must
+    /// redo it at full length to match a run that never stopped.
+    before_last: Option<(stickslip_time::Checkpoint, usize)>,
+}
+
+/// What a run shows while it steps: a bar on a terminal, else (a log) a
+/// line a minute, so that a batch job's log shows a long run moving.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    log: bool,
+    last_log: Instant,
+    /// Where this run started (a restart: at its checkpoint), so that the
+    /// share done and the time left count from there.
+    t_start: f64,
+    steps_before: u64,
+}
+
+impl Progress {
+    fn new(quiet: bool, integrator: &Integrator) -> Progress {
+        let terminal = std::io::stderr().is_terminal();
+        let bar = (!quiet && terminal).then(|| {
+            let bar = indicatif::ProgressBar::new(1000);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{spinner} [{elapsed_precise}] {bar:30} {percent:>3}% {msg}, ETA {eta}",
+                )
+                .expect("valid template"),
+            );
+            bar
+        });
+        Progress {
+            bar,
+            log: !quiet && !terminal,
+            last_log: Instant::now(),
+            t_start: integrator.time(),
+            steps_before: integrator.steps(),
+        }
+    }
+
+    /// After every step: the bar.
+    fn stepped(&self, i: &Integrator, started: Instant) {
+        if let Some(bar) = &self.bar {
+            let t_end = i.t_end();
+            let rate =
+                (i.steps() - self.steps_before) as f64 / started.elapsed().as_secs_f64().max(1e-9);
+            bar.set_position((1000.0 * i.time() / t_end) as u64);
+            bar.set_message(format!(
+                "t = {:.4e} of {t_end}, step {}, {rate:.0} steps/s",
+                i.time(),
+                i.steps()
+            ));
+        }
+    }
+
+    /// After a flush: the log's line, once a minute.
+    fn flushed(&mut self, i: &Integrator, started: Instant) {
+        if self.log && self.last_log.elapsed().as_secs() >= PROGRESS_LOG_SECS {
+            self.last_log = Instant::now();
+            let t_end = i.t_end();
+            let wall = started.elapsed().as_secs_f64();
+            let done = (i.time() - self.t_start) / (t_end - self.t_start).max(1e-300);
+            say!(
+                "progress: t = {:.6e} of {t_end} ({:.1}%), step {}, {:.0} s elapsed, about {:.0} s left",
+                i.time(),
+                100.0 * done,
+                i.steps(),
+                wall,
+                wall * (1.0 - done) / done.max(1e-12)
+            );
+        }
+    }
+
+    fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// A run in progress: the integrator, the file it writes and what the
+/// stepping keeps from step to step.
+struct Session<'a> {
+    case: &'a Case,
+    out: &'a Path,
+    options: &'a RunOptions,
+    mesh: &'a Mesh,
+    dofs: &'a DofMap,
+    integrator: Integrator,
+    writer: ResultsWriter,
+    full: FullState,
+    /// Times of the records written.
+    times: Vec<f64>,
+    max_balance: f64,
+    wall_before: f64,
+    initial_mechanical: f64,
+    started: Instant,
+    xdmf_path: std::path::PathBuf,
+    /// The contact surface as the viewers' line cells, if the case has one.
+    contact_line: Option<crate::views::ContactLine>,
+}
+
+impl Session<'_> {
+    /// Writes `cp` (or the current state) as the file's checkpoint, with
+    /// `rows` records (or all so far).
+    fn checkpoint(
+        &mut self,
+        at: Option<(stickslip_time::Checkpoint, usize)>,
+    ) -> anyhow::Result<()> {
+        let (cp, rows) = at.unwrap_or_else(|| (self.integrator.checkpoint(), self.writer.rows()));
+        let extra = CheckpointExtra {
+            rows,
+            wall_time_s: self.wall_before + self.started.elapsed().as_secs_f64(),
+            max_balance: self.max_balance,
+            node_order: self.dofs.node_order().code(),
+        };
+        self.writer.write_checkpoint(&cp, &extra)
+    }
+
+    /// The viewers' files beside the results, listing every record so far.
+    fn write_xdmf(&self) -> anyhow::Result<()> {
+        write_xdmf(self.out, self.mesh, self.contact_line.as_ref(), &self.times)
+    }
+
+    /// Appends the current state as a record.
+    fn append(&mut self, dt: f64, iterations: u32) -> anyhow::Result<()> {
+        self.times.push(self.integrator.time());
+        self.writer.append(&record(
+            &self.integrator,
+            self.dofs,
+            &mut self.full,
+            dt,
+            iterations,
+        ))
+    }
+
+    /// The failure of a run whose disk has less room than its next write
+    /// may take, if it has.
+    fn disk_nearly_full(&self) -> Option<String> {
+        disk_nearly_full(&self.writer, self.dofs, self.out, &self.integrator)
+    }
+
+    /// Steps to t_end (or a failure, a signal), writing every
+    /// `output.every`-th step, flushing and checkpointing when due.
+    fn step_to_end(&mut self, progress: &mut Progress) -> anyhow::Result<Ending> {
+        let every = self.case.output.every.max(1) as u64;
+        let mut last_xdmf = Instant::now();
+        // How long the last rewrite took: the next waits ten times that (and at
+        // least flush_seconds), so the rewrites, each O(rows), stay under a
+        // tenth of the run however many rows (at a fixed interval they took 42%
+        // of a run of 320k rows).
+        let mut xdmf_secs = 0.0_f64;
+        let mut ending = Ending {
+            failure: None,
+            interrupted: None,
+            before_last: None,
+        };
+        while !self.integrator.done() {
+            let i = &self.integrator;
+            let near_end = i.t_end() - i.time() <= self.case.time.dt * (1.0 + 1e-6);
+            let before = near_end.then(|| (i.checkpoint(), self.writer.rows()));
+            let info = match self.integrator.step() {
+                Ok(info) => info,
+                Err(e) => {
+                    ending.failure = Some(e.to_string());
+                    break;
                 }
-                if integrator.is_explicit() {
-                    if let Some(bound) = blow_up(&integrator, initial_mechanical) {
-                        if !write {
-                            rec(&mut writer, &mut full)?;
-                        }
-                        let e = integrator.energy();
-                        let crit = integrator.dt_crit().unwrap_or(f64::NAN);
-                        failure = Some(format!(
-                            "step {} (t = {:.6e}): energy blow-up: kinetic + strain = {:.3e} exceeds {BLOW_UP_FACTOR} x (initial + |work| + dissipated) = {bound:.3e}; \
-                             central difference is unstable at time.dt = {:e}, above its critical step dt_crit = {crit:.6e}: \
-                             use time.dt < {crit:.4e} (e.g. {:.4e}) and remove time.allow_unstable",
-                            integrator.steps(),
-                            integrator.time(),
-                            e.kinetic + e.strain,
-                            case.time.dt,
-                            0.9 * crit
-                        ));
+            };
+            self.max_balance = self.max_balance.max(self.integrator.energy().balance.abs());
+            self.writer.count_step();
+            let write = self.integrator.steps().is_multiple_of(every) || self.integrator.done();
+            if write {
+                // HDF5 writes a chunk of rows as it fills: the room for
+                // it is checked before, as before a flush.
+                if self.writer.append_writes() {
+                    if let Some(e) = self.disk_nearly_full() {
+                        ending.failure = Some(e);
                         break;
                     }
                 }
-                if integrator.done() {
-                    before_last = before;
+                self.append(info.dt, info.iterations as u32)?;
+            }
+            if self.integrator.is_explicit() {
+                if let Some(bound) = blow_up(&self.integrator, self.initial_mechanical) {
+                    if !write {
+                        self.append(info.dt, info.iterations as u32)?;
+                    }
+                    ending.failure = Some(blow_up_failure(&self.integrator, bound, self.case));
                     break;
-                }
-                if let Some(sig) = options.stop.received() {
-                    interrupted = Some(sig);
-                    break;
-                }
-                if writer.flush_due() {
-                    if let Some(e) = disk_nearly_full(&writer, &dofs, out, &integrator) {
-                        failure = Some(e);
-                        break;
-                    }
-                    writer.write_checkpoint(
-                        &integrator.checkpoint(),
-                        &extra(writer.rows(), max_balance),
-                    )?;
-                    // The XML lists every row: rewrite it at most every
-                    // flush_seconds, and ten times as seldom as it takes.
-                    let wait = case.output.flush_seconds.max(10.0 * xdmf_secs);
-                    if last_xdmf.elapsed().as_secs_f64() >= wait {
-                        let t = Instant::now();
-                        xdmf(&times)?;
-                        xdmf_secs = t.elapsed().as_secs_f64();
-                        last_xdmf = Instant::now();
-                    }
-                    if log_progress && last_log.elapsed().as_secs() >= PROGRESS_LOG_SECS {
-                        last_log = Instant::now();
-                        let wall = started.elapsed().as_secs_f64();
-                        let done = (integrator.time() - t_start) / (t_end - t_start).max(1e-300);
-                        say!(
-                            "progress: t = {:.6e} of {t_end} ({:.1}%), step {}, {:.0} s elapsed, about {:.0} s left",
-                            integrator.time(),
-                            100.0 * done,
-                            integrator.steps(),
-                            wall,
-                            wall * (1.0 - done) / done.max(1e-12)
-                        );
-                    }
-                }
-                if let Some(bar) = &bar {
-                    let rate = (integrator.steps() - steps_before) as f64
-                        / started.elapsed().as_secs_f64().max(1e-9);
-                    bar.set_position((1000.0 * integrator.time() / t_end) as u64);
-                    bar.set_message(format!(
-                        "t = {:.4e} of {t_end}, step {}, {rate:.0} steps/s",
-                        integrator.time(),
-                        integrator.steps()
-                    ));
                 }
             }
-            Err(e) => {
-                failure = Some(e.to_string());
+            if self.integrator.done() {
+                ending.before_last = before;
                 break;
             }
+            if let Some(sig) = self.options.stop.received() {
+                ending.interrupted = Some(sig);
+                break;
+            }
+            if self.writer.flush_due() {
+                if let Some(e) = self.disk_nearly_full() {
+                    ending.failure = Some(e);
+                    break;
+                }
+                self.checkpoint(None)?;
+                // The XML lists every row: rewrite it at most every
+                // flush_seconds, and ten times as seldom as it takes.
+                let wait = self.case.output.flush_seconds.max(10.0 * xdmf_secs);
+                if last_xdmf.elapsed().as_secs_f64() >= wait {
+                    let t = Instant::now();
+                    self.write_xdmf()?;
+                    xdmf_secs = t.elapsed().as_secs_f64();
+                    last_xdmf = Instant::now();
+                }
+                progress.flushed(&self.integrator, self.started);
+            }
+            progress.stepped(&self.integrator, self.started);
         }
+        Ok(ending)
     }
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
-    let complete = failure.is_none() && interrupted.is_none();
-    if complete || interrupted.is_some() {
-        // A failed run keeps the checkpoint of its last flush: the state at
-        // the failure is not one to continue from.
-        let (cp, rows) = before_last.unwrap_or_else(|| (integrator.checkpoint(), writer.rows()));
-        writer.write_checkpoint(&cp, &extra(rows, max_balance))?;
-    }
-    let reason = match (&failure, interrupted) {
-        (Some(f), _) => Some(f.clone()),
-        (None, Some(sig)) => Some(format!(
-            "interrupted by {sig} at step {}, t = {}; continue with --restart (and the run's --set overrides, if any)",
-            integrator.steps(),
-            integrator.time()
-        )),
-        _ => None,
-    };
-    let summary = Summary {
-        wall_time_s: wall_before + started.elapsed().as_secs_f64(),
-        steps: integrator.steps(),
-        factorizations: integrator.factorizations(),
-        dt_crit: integrator.dt_crit(),
-        failure: reason.clone(),
-        stiffness_product: integrator.stiffness_product().into(),
-        fill_order: fill_order_attr(integrator.fill_order(), options.restart),
-    };
-    let steps_run = integrator.steps() - steps_before;
-    let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;
-    let rows = writer.rows();
-    let warnings = writer.warnings();
-    writer.finish(complete, &summary)?;
-    xdmf(&times)?;
-    let e = integrator.energy();
-    let status = if complete {
-        "complete"
-    } else if interrupted.is_some() {
-        "interrupted"
-    } else {
-        "failed"
-    };
-    if !quiet {
-        say!(
-            "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations, K by {}) in {:.3} s (setup {setup_s:.3} s, {} a step with output)",
-            match status {
-                "complete" => "done:",
-                "interrupted" => "interrupted:",
-                _ => "stopped:",
-            },
-            integrator.steps(),
-            integrator.time(),
-            integrator.total_iterations(),
-            integrator.factorizations(),
-            summary.stiffness_product,
-            summary.wall_time_s,
-            human_seconds(step_s)
-        );
-        // Newmark's γ > ½ dissipates by design, outside the ledger.
-        let damped = if case.time.scheme == case::Scheme::Newmark && case.time.gamma > 0.5 {
-            format!(
-                " (Newmark gamma = {} > 1/2 damps numerically; the balance holds that loss)",
-                case.time.gamma
-            )
-        } else {
-            String::new()
+
+    /// Closes the file (the last checkpoint, the summary, the side file)
+    /// and says how the run ended.
+    fn conclude(
+        mut self,
+        ending: Ending,
+        setup_s: f64,
+        stepping: Instant,
+        steps_before: u64,
+    ) -> anyhow::Result<Outcome> {
+        let Ending {
+            failure,
+            interrupted,
+            before_last,
+        } = ending;
+        let complete = failure.is_none() && interrupted.is_none();
+        if complete || interrupted.is_some() {
+            // A failed run keeps the checkpoint of its last flush: the state at
+            // the failure is not one to continue from.
+            self.checkpoint(before_last)?;
+        }
+        let i = &self.integrator;
+        let reason = match (&failure, interrupted) {
+            (Some(f), _) => Some(f.clone()),
+            (None, Some(sig)) => Some(format!(
+                "interrupted by {sig} at step {}, t = {}; continue with --restart (and the run's --set overrides, if any)",
+                i.steps(),
+                i.time()
+            )),
+            _ => None,
         };
-        say!(
-            "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}); largest |balance| {:.3e}{damped}",
-            e.total, e.kinetic, e.strain, e.external_work, e.dissipated, max_balance
-        );
-        say!("results: {} ({rows} records)", out.display());
-    }
-    if options.json {
-        let j = serde_json::json!({
-            "status": status,
-            "case": case.path.display().to_string(),
-            "output": out.display().to_string(),
-            "xdmf": xdmf_path.display().to_string(),
-            "warnings": warnings,
-            "complete": complete,
-            "steps": integrator.steps(),
-            "t": integrator.time(),
-            "t_end": t_end,
-            "records": rows,
-            "wall_time_s": summary.wall_time_s,
-            "setup_s": setup_s,
-            "step_s": step_s,
-            "iterations": integrator.total_iterations(),
-            "factorizations": integrator.factorizations(),
-            "stiffness_product": summary.stiffness_product,
-            "fill_order": summary.fill_order,
-            "dt": case.time.dt,
-            "dt_crit": integrator.dt_crit(),
-            "energy": {
-                "kinetic": e.kinetic,
-                "strain": e.strain,
-                "external_work": e.external_work,
-                "dissipated": e.dissipated,
-                "total": e.total,
-                "balance": e.balance,
-                "max_abs_balance": max_balance,
-            },
-            "failure": reason,
-            "restarted": options.restart,
-        });
-        say_out!("{j}");
-    }
-    if let Some(sig) = interrupted {
-        say!(
-            "interrupted by {sig}: stopped after step {}, t = {} of t_end = {t_end}; {} holds {rows} records (up to t = {}) and a checkpoint (complete = false)",
-            integrator.steps(),
-            integrator.time(),
-            out.display(),
-            times.last().copied().unwrap_or(0.0)
-        );
-        let sets: String = options
-            .sets
-            .iter()
-            .map(|s| format!(" --set {}", shell_word(s)))
-            .collect();
-        say!(
-            "continue with: stickslip run {} --restart {}{sets}",
-            shell_word(&case.path.display().to_string()),
-            shell_word(&out.display().to_string())
-        );
-        return Ok(Outcome::Interrupted);
-    }
-    match failure {
-        None => Ok(Outcome::Complete),
-        Some(e) => {
-            say!("error: {}: {e}", case.path.display());
+        let summary = Summary {
+            wall_time_s: self.wall_before + self.started.elapsed().as_secs_f64(),
+            steps: i.steps(),
+            factorizations: i.factorizations(),
+            dt_crit: i.dt_crit(),
+            failure: reason.clone(),
+            stiffness_product: i.stiffness_product().into(),
+            fill_order: fill_order_attr(i.fill_order(), self.options.restart),
+        };
+        let steps_run = i.steps() - steps_before;
+        let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;
+        let rows = self.writer.rows();
+        let warnings = self.writer.warnings();
+        self.writer.finish(complete, &summary)?;
+        write_xdmf(self.out, self.mesh, self.contact_line.as_ref(), &self.times)?;
+        let status = if complete {
+            "complete"
+        } else if interrupted.is_some() {
+            "interrupted"
+        } else {
+            "failed"
+        };
+        let (case, out, i) = (self.case, self.out, &self.integrator);
+        let e = i.energy();
+        if !self.options.quiet {
             say!(
-                "error: {} keeps every step completed before the failure ({rows} records, complete = false, reason in its failure attribute)",
-                out.display()
+                "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations, K by {}) in {:.3} s (setup {setup_s:.3} s, {} a step with output)",
+                match status {
+                    "complete" => "done:",
+                    "interrupted" => "interrupted:",
+                    _ => "stopped:",
+                },
+                i.steps(),
+                i.time(),
+                i.total_iterations(),
+                i.factorizations(),
+                summary.stiffness_product,
+                summary.wall_time_s,
+                human_seconds(step_s)
             );
-            Ok(Outcome::Failed)
+            // Newmark's γ > ½ dissipates by design, outside the ledger.
+            let damped = if case.time.scheme == case::Scheme::Newmark && case.time.gamma > 0.5 {
+                format!(
+                    " (Newmark gamma = {} > 1/2 damps numerically; the balance holds that loss)",
+                    case.time.gamma
+                )
+            } else {
+                String::new()
+            };
+            say!(
+                "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}); largest |balance| {:.3e}{damped}",
+                e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
+            );
+            say!("results: {} ({rows} records)", out.display());
+        }
+        if self.options.json {
+            let j = serde_json::json!({
+                "status": status,
+                "case": case.path.display().to_string(),
+                "output": out.display().to_string(),
+                "xdmf": self.xdmf_path.display().to_string(),
+                "warnings": warnings,
+                "complete": complete,
+                "steps": i.steps(),
+                "t": i.time(),
+                "t_end": i.t_end(),
+                "records": rows,
+                "wall_time_s": summary.wall_time_s,
+                "setup_s": setup_s,
+                "step_s": step_s,
+                "iterations": i.total_iterations(),
+                "factorizations": i.factorizations(),
+                "stiffness_product": summary.stiffness_product,
+                "fill_order": summary.fill_order,
+                "dt": case.time.dt,
+                "dt_crit": i.dt_crit(),
+                "energy": {
+                    "kinetic": e.kinetic,
+                    "strain": e.strain,
+                    "external_work": e.external_work,
+                    "dissipated": e.dissipated,
+                    "total": e.total,
+                    "balance": e.balance,
+                    "max_abs_balance": self.max_balance,
+                },
+                "failure": reason,
+                "restarted": self.options.restart,
+            });
+            say_out!("{j}");
+        }
+        if let Some(sig) = interrupted {
+            say!(
+                "interrupted by {sig}: stopped after step {}, t = {} of t_end = {}; {} holds {rows} records (up to t = {}) and a checkpoint (complete = false)",
+                i.steps(),
+                i.time(),
+                i.t_end(),
+                out.display(),
+                self.times.last().copied().unwrap_or(0.0)
+            );
+            let sets: String = self
+                .options
+                .sets
+                .iter()
+                .map(|s| format!(" --set {}", shell_word(s)))
+                .collect();
+            say!(
+                "continue with: stickslip run {} --restart {}{sets}",
+                shell_word(&case.path.display().to_string()),
+                shell_word(&out.display().to_string())
+            );
+            return Ok(Outcome::Interrupted);
+        }
+        match failure {
+            None => Ok(Outcome::Complete),
+            Some(e) => {
+                say!("error: {}: {e}", case.path.display());
+                say!(
+                    "error: {} keeps every step completed before the failure ({rows} records, complete = false, reason in its failure attribute)",
+                    out.display()
+                );
+                Ok(Outcome::Failed)
+            }
         }
     }
+}
+
+/// The viewers' files beside the results file `out`, listing the records
+/// at `times`.
+fn write_xdmf(
+    out: &Path,
+    mesh: &Mesh,
+    contact: Option<&crate::views::ContactLine>,
+    times: &[f64],
+) -> anyhow::Result<()> {
+    let layout = crate::views::Layout {
+        n_nodes: mesh.nodes.len(),
+        contact,
+    };
+    crate::xdmf::write_companions(out, &layout, (mesh.kind, mesh.n_cells()), times)
+}
+
+/// The contact surface of `integrator` as line cells for the viewers.
+fn session_contact_line(mesh: &Mesh, integrator: &Integrator) -> Option<crate::views::ContactLine> {
+    integrator.contact().map(|c| {
+        let nodes: Vec<usize> = c.nodes.iter().map(|n| n.node).collect();
+        crate::views::ContactLine::new(mesh, &c.group, &nodes)
+    })
+}
+
+/// The failure message of an explicit run whose energy blew up
+/// ([`blow_up`] gave `bound`).
+fn blow_up_failure(i: &Integrator, bound: f64, case: &Case) -> String {
+    let e = i.energy();
+    let crit = i.dt_crit().unwrap_or(f64::NAN);
+    format!(
+        "step {} (t = {:.6e}): energy blow-up: kinetic + strain = {:.3e} exceeds {BLOW_UP_FACTOR} x (initial + |work| + dissipated) = {bound:.3e}; \
+         central difference is unstable at time.dt = {:e}, above its critical step dt_crit = {crit:.6e}: \
+         use time.dt < {crit:.4e} (e.g. {:.4e}) and remove time.allow_unstable",
+        i.steps(),
+        i.time(),
+        e.kinetic + e.strain,
+        case.time.dt,
+        0.9 * crit
+    )
 }
 
 #[cfg(test)]

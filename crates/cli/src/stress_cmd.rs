@@ -23,7 +23,7 @@ use anyhow::Context;
 use hdf5::File;
 use ndarray::{s, Array1, Array2};
 
-use crate::error::InputError;
+use stickslip_case::InputError;
 
 /// Writes the stress datasets of the results file `path` and rewrites its
 /// XDMF; returns the records and nodes written.

@@ -18,8 +18,9 @@
 
 use std::path::{Path, PathBuf};
 
-use stickslip::advise::{self, Method, Quantity};
-use stickslip::case;
+use stickslip::advise::{self, Quantity};
+use stickslip_case::pilot::Trace;
+use stickslip_case::{self as case, Method};
 
 const TOLS: [f64; 3] = [3e-2, 2e-2, 1e-2];
 const AT: [f64; 2] = [8.0, 1.0];
@@ -86,7 +87,7 @@ fn advise_picks_meet_the_tolerance() {
         .expect("estimates");
     eprintln!("pilots: {} runs, {:.2} s", est.pilots.len(), est.seconds);
     let rows = csv_rows();
-    let mut reference: Option<advise::Trace> = None;
+    let mut reference: Option<Trace> = None;
     let grid = advise::grid(case.time.t_end);
     let mut failures = Vec::new();
     for tol in TOLS {
@@ -109,19 +110,17 @@ fn advise_picks_meet_the_tolerance() {
             Some(r) => r.err_ux_8_1,
             None => {
                 let reference = reference.get_or_insert_with(|| {
-                    let c = advise::configured(
+                    let c = Method::TrapezoidalReduced.configure(
                         &case,
                         &meshes.join("slab-q2-64x16.msh"),
-                        Method::TrapezoidalReduced,
                         2e-4,
                         1e-4,
                     );
                     advise::run_traced(&c, Quantity::Ux, Some(AT)).expect("reference")
                 });
-                let c = advise::configured(
+                let c = pick.method.configure(
                     &case,
                     &est.ladder[pick.mesh_index].path,
-                    pick.method,
                     pick.dt,
                     pick.eps,
                 );

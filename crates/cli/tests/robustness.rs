@@ -821,11 +821,9 @@ fn restart_in_a_step_reduction_is_bit_identical_newmark() {
     // Newmark 1/4, 1/2 with Remark 4.3's reduction (dt 5e-3 cut to 1e-7 for
     // 10 steps after sticking). The short run ends half a reduced step
     // after a reduced step, so its checkpoint (taken before its shortened
-    // last step) has the reduction counter running. Written every step the
-    // paper mesh's run goes through the factor, every second step through
-    // its modes (`stiffness_product` = "modes"; the checkpoint then
-    // carries the modal state).
-    for (every, product) in [("1", "2x2 blocks"), ("2", "modes")] {
+    // last step) has the reduction counter running; written every step and
+    // every second step.
+    for (every, product) in [("1", "assembled CSR"), ("2", "assembled CSR")] {
         let dir = scratch(&format!("restart-nm-{every}"));
         let case = paper_case(&dir, "newmark-step-reduced.toml");
         let every = format!("output.every={every}");

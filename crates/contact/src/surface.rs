@@ -59,6 +59,50 @@ impl ContactNode {
     pub fn force_scale(&self) -> f64 {
         self.weight * self.bound
     }
+
+    /// The damping coefficient w_J g_J/ε of the node when stuck: C gains
+    /// it times τ_J τ_Jᵀ (METHOD.md §3).
+    #[inline]
+    pub fn stuck_damping(&self, law: &FrictionLaw) -> f64 {
+        law.stuck_damping(self.force_scale())
+    }
+
+    /// The constant slip force w_J g_J sign(v_TJ) along τ_J that F gains
+    /// for a node of class `class` (0 when stuck; METHOD.md §3).
+    #[inline]
+    pub fn slip_force(&self, class: SlipState) -> f64 {
+        self.force_scale() * class.sign()
+    }
+
+    /// The nodal friction force f_J = w_J g_J φ_ε(v_T) along τ_J at
+    /// tangential velocity `v_t` (paper eq. (4.5)).
+    #[inline]
+    pub fn force(&self, law: &FrictionLaw, v_t: f64) -> f64 {
+        self.class_and_force(law, v_t).1
+    }
+
+    /// The node's class at tangential velocity `v_t` and its force
+    /// [`ContactNode::force`].
+    #[inline]
+    pub fn class_and_force(&self, law: &FrictionLaw, v_t: f64) -> (SlipState, f64) {
+        let (class, phi) = law.class_and_phi(v_t);
+        (class, self.force_scale() * phi)
+    }
+
+    /// The node's tangential velocity at free-DOF velocity `v_new` and its
+    /// tangential displacement over a step of `dt` from `v` to `v_new` by
+    /// the trapezoid rule, (τ·ṙ_K, τ·½Δt(ṙ_K + ṙ_{K−1})), in one pass.
+    #[inline]
+    pub fn motion(&self, v_new: &[f64], v: &[f64], dt: f64) -> (f64, f64) {
+        let (mut v_t, mut increment) = (0.0, 0.0);
+        for c in 0..2 {
+            if let Some(d) = self.dofs[c] {
+                v_t += self.tangent[c] * v_new[d];
+                increment += self.tangent[c] * (0.5 * dt * (v_new[d] + v[d]));
+            }
+        }
+        (v_t, increment)
+    }
 }
 
 /// The friction surface: the nodes of one named line group that carry
@@ -176,7 +220,7 @@ impl ContactSurface {
     /// (the friction force vector is J = Σ f_J τ_J, paper eq. (4.5)).
     pub fn nodal_forces(&self, velocity: &[f64], out: &mut [f64]) {
         for (n, f) in self.nodes.iter().zip(out.iter_mut()) {
-            *f = n.force_scale() * self.law.phi(n.tangential(velocity));
+            *f = n.force(&self.law, n.tangential(velocity));
         }
     }
 
@@ -194,21 +238,23 @@ impl ContactSurface {
         -node.bound * self.law.phi(v_t) + 0.0
     }
 
-    /// Adds the damping of stuck nodes, w g/ε ττᵀ, through `add(i, j, value)`
-    /// on free DOFs (METHOD.md §3, C of J = C ṙ + F).
-    pub fn add_damping(&self, classes: &[SlipState], mut add: impl FnMut(usize, usize, f64)) {
-        for (n, c) in self.nodes.iter().zip(classes) {
+    /// Adds the damping of stuck nodes, w g/ε ττᵀ (METHOD.md §3, C of
+    /// J = C ṙ + F), through `add(j, a, b, value)` for node j's components
+    /// a, b where both are free.
+    pub fn add_damping(
+        &self,
+        classes: &[SlipState],
+        mut add: impl FnMut(usize, usize, usize, f64),
+    ) {
+        for (j, (n, c)) in self.nodes.iter().zip(classes).enumerate() {
             if !c.is_stuck() {
                 continue;
             }
-            let k = n.force_scale() / self.law.eps;
+            let k = n.stuck_damping(&self.law);
             for a in 0..2 {
                 for b in 0..2 {
-                    if let (Some(i), Some(j)) = (n.dofs[a], n.dofs[b]) {
-                        let v = k * n.tangent[a] * n.tangent[b];
-                        if v != 0.0 {
-                            add(i, j, v);
-                        }
+                    if n.dofs[a].is_some() && n.dofs[b].is_some() {
+                        add(j, a, b, k * n.tangent[a] * n.tangent[b]);
                     }
                 }
             }
@@ -222,12 +268,35 @@ impl ContactSurface {
             if c.is_stuck() {
                 continue;
             }
-            let f = n.force_scale() * c.sign();
+            let f = n.slip_force(*c);
             for a in 0..2 {
                 if let Some(i) = n.dofs[a] {
                     rhs[i] -= f * n.tangent[a];
                 }
             }
+        }
+    }
+
+    /// The same nodes as unit nodes on n_c unknowns, one per node (node J's
+    /// only DOF is J, its tangent x): the surface on which an iteration
+    /// over the nodes' tangential velocities runs (the Schur complement
+    /// step), with the same weights, bounds and law.
+    pub fn on_tangential_unknowns(&self) -> ContactSurface {
+        let nodes = self
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(j, node)| ContactNode {
+                dofs: [Some(j), None],
+                tangent: [1.0, 0.0],
+                ..*node
+            })
+            .collect();
+        ContactSurface {
+            group: self.group.clone(),
+            nodes,
+            excluded: Vec::new(),
+            law: self.law,
         }
     }
 }

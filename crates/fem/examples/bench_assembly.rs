@@ -14,8 +14,7 @@ use std::time::Instant;
 
 use stickslip_fem::testing::slab;
 use stickslip_fem::{
-    free_dof_pattern, static_solve, traction_load, Dirichlet, FillOrder, Hypothesis, Material,
-    Model, SparseCholesky, Traction,
+    free_dof_pattern, static_solve, traction_load, Dirichlet, Hypothesis, Material, Model, Traction,
 };
 use stickslip_mesh::CellKind;
 
@@ -68,7 +67,7 @@ fn main() {
     let model = Model::new(&mesh, &mat, &bcs).unwrap();
     let model_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let order = FillOrder::choose(&mesh, &model.dofs);
+    let order = stickslip_fem::ordering::choose(&mesh, &model.dofs);
     let order_s = t.elapsed().as_secs_f64();
     assert_eq!(
         order.dissection_order(),
@@ -89,7 +88,8 @@ fn main() {
     model.dofs.restrict(&full, &mut load);
 
     let t = Instant::now();
-    let mut chol = SparseCholesky::analyze(&model.stiffness, &model.fill_order).unwrap();
+    let mut chol =
+        stickslip_linalg::SparseCholesky::analyze(&model.stiffness, &model.fill_order).unwrap();
     let symbolic_s = order_s + t.elapsed().as_secs_f64();
     let t = Instant::now();
     chol.factorize(&model.stiffness).unwrap();

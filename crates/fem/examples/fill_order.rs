@@ -14,9 +14,8 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::{Par, Side};
 use stickslip_fem::ordering::nested_dissection;
 use stickslip_fem::testing::slab;
-use stickslip_fem::{
-    analyze_symbolic, csc_view, Dirichlet, FillOrder, Hypothesis, Material, Model,
-};
+use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
+use stickslip_linalg::{analyze_symbolic, csc_view, FillOrder};
 use stickslip_mesh::{CellKind, Mesh};
 
 /// Ordering + symbolic (s), factor values, numeric factorization (s).

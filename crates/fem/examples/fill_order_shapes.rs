@@ -8,7 +8,8 @@
 
 use stickslip_fem::ordering::{nested_dissection, DISSECTION_MIN_DOFS};
 use stickslip_fem::testing::{add_point_group, rectangle};
-use stickslip_fem::{analyze_symbolic, Dirichlet, FillOrder, Hypothesis, Material, Model};
+use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
+use stickslip_linalg::{analyze_symbolic, FillOrder};
 use stickslip_mesh::{CellKind, Mesh};
 
 /// The cells of an `nx × ny` grid of `kind` on unit squares that `keep`

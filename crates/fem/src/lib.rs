@@ -9,14 +9,16 @@
 //! into `nalgebra-sparse` CSR with a pattern built once and values filled in
 //! place ([`Model`], K and M sharing one pattern), consistent loads
 //! ([`traction_load`], [`body_force_load`]), nodal quadrature on boundary
-//! lines ([`boundary_quadrature`], on which `contact` builds), the sparse
-//! Cholesky ([`SparseCholesky`]), the static solve and stress recovery. It
+//! lines ([`boundary_quadrature`], on which `contact` builds), the nested
+//! dissection that orders its factors ([`ordering`]), the static solve and
+//! stress recovery (the sparse Cholesky is `stickslip-linalg`'s). It
 //! knows nothing of friction or time stepping; boundaries are reached by
 //! physical group name only.
 
+#![forbid(unsafe_code)]
+
 mod assembly;
 pub mod boundary;
-pub mod classes;
 pub mod dofs;
 pub mod element;
 mod error;
@@ -27,14 +29,11 @@ pub mod model;
 pub mod ordering;
 pub mod quadrature;
 pub mod reference;
-mod solver;
 pub mod statics;
-mod supernodal;
 pub mod testing;
 
 pub use assembly::{free_dof_pattern, node_adjacency};
 pub use boundary::{boundary_quadrature, BoundaryNode};
-pub use classes::ElementClasses;
 pub use dofs::{Dirichlet, DofMap, NodeOrder};
 pub use error::FemError;
 pub use loads::{
@@ -42,12 +41,9 @@ pub use loads::{
 };
 pub use material::{Hypothesis, Material};
 pub use model::Model;
-pub use ordering::FillOrder;
-pub use solver::{analyze_symbolic, csc_view, SolverError, SparseCholesky};
 pub use statics::{
     gauss_point_stresses, nodal_stresses, static_solve, stress_at_node, von_mises, GaussPointStress,
 };
-pub use supernodal::{ContactOperator, Supernodal};
 
 /// The physical group `name` of `mesh`, wanted for `purpose`.
 pub(crate) fn find_group<'m>(

@@ -9,7 +9,7 @@ use crate::assembly::{assemble, free_dof_pattern, Assembly};
 use crate::dofs::{Dirichlet, DofMap};
 use crate::error::FemError;
 use crate::material::Material;
-use crate::ordering::FillOrder;
+use stickslip_linalg::FillOrder;
 
 /// K, M and lumped M of a mesh and material under Dirichlet conditions,
 /// restricted to the free DOFs.
@@ -78,7 +78,7 @@ impl Model {
             .expect("one value per pattern entry");
         let mass = CsrMatrix::try_from_pattern_and_values(pattern, m)
             .expect("one value per pattern entry");
-        let fill_order = FillOrder::choose(mesh, &dofs);
+        let fill_order = crate::ordering::choose(mesh, &dofs);
         Ok(Model {
             fill_order,
             dofs,

@@ -45,8 +45,8 @@
 //! 200:1 1.11×: `cargo run --release -p stickslip-fem --example
 //! fill_order_shapes`). So from [`DISSECTION_MIN_DOFS`] the first
 //! factorization of a run analyses its pattern in both orders and keeps
-//! the dissection unless AMD's factor has [`AMD_MARGIN`] fewer values
-//! ([`FillOrder::choose`]); K, A₀ and M share the pattern, and the later
+//! the dissection unless AMD's factor has [`stickslip_linalg::AMD_MARGIN`] fewer values
+//! ([`choose`]); K, A₀ and M share the pattern, and the later
 //! factorizations reuse the choice. The price is AMD's analysis beside the
 //! dissection's (1.5 s at 1.12M DOFs, where the dissection saves 1.7 s of
 //! factorization; 0.3 s at 250k).
@@ -58,8 +58,7 @@
 //! than AMD on the Q2 mesh of 1.13M DOFs, where the median cuts through
 //! cells whose nodes couple two node rows apart.
 
-use std::sync::{Arc, OnceLock};
-
+use stickslip_linalg::FillOrder;
 use stickslip_mesh::Mesh;
 
 use crate::dofs::DofMap;
@@ -68,89 +67,20 @@ use crate::dofs::DofMap;
 /// table above: at 61-62k the two are within 3% either way).
 pub const DISSECTION_MIN_DOFS: usize = 100_000;
 
-/// The dissection is kept unless its factor has more than this many times
-/// AMD's values: at about equal values its supernodes are larger and its
-/// solves faster (the Q2 352×88 slab: 24.62M values against AMD's 24.60M,
-/// Newmark's solve 27.3-28.7 against 35.8-36.5 ms in the runs above), and
-/// the meshes where AMD wins (comb, strips) are 1.11-1.37×.
-pub const AMD_MARGIN: f64 = 1.1;
-
 /// Environment variable that overrides the choice, for comparisons:
 /// `amd` or `nd` (as [`crate::dofs::ORDER_ENV`] keeps the file's node
 /// order); any other value, or none, chooses by size.
 pub const FILL_ORDER_ENV: &str = "STICKSLIP_FILL_ORDER";
 
-/// The ordering the factorizations of a model's matrices use: faer's AMD,
-/// a nested dissection, or (from [`DISSECTION_MIN_DOFS`]) the dissection
-/// unless AMD's factor is smaller by [`AMD_MARGIN`], decided at the first
-/// analysis ([`crate::analyze_symbolic`]) and shared by every clone.
-#[derive(Clone, Debug, Default)]
-pub struct FillOrder {
-    /// The dissection's elimination order of the free DOFs, if a candidate.
-    dissection: Option<Arc<Vec<usize>>>,
-    /// Whether AMD is to be tried beside it.
-    compare: bool,
-    /// The comparison's outcome, once made: true when the dissection won.
-    chosen: Arc<OnceLock<bool>>,
-}
-
-impl FillOrder {
-    /// faer's AMD.
-    pub fn amd() -> FillOrder {
-        FillOrder::default()
-    }
-
-    /// The nested dissection `order`, whatever its factor.
-    pub fn dissection(order: Vec<usize>) -> FillOrder {
-        FillOrder {
-            dissection: Some(Arc::new(order)),
-            ..FillOrder::default()
-        }
-    }
-
-    /// AMD below [`DISSECTION_MIN_DOFS`] free DOFs, else the dissection or
-    /// AMD by their factors ([`AMD_MARGIN`]), unless [`FILL_ORDER_ENV`]
-    /// says which.
-    pub fn choose(mesh: &Mesh, dofs: &DofMap) -> FillOrder {
-        match std::env::var(FILL_ORDER_ENV).as_deref() {
-            Ok("amd") => FillOrder::amd(),
-            Ok("nd") => FillOrder::dissection(nested_dissection(mesh, dofs)),
-            _ if dofs.n_free() < DISSECTION_MIN_DOFS => FillOrder::amd(),
-            _ => FillOrder {
-                compare: true,
-                ..FillOrder::dissection(nested_dissection(mesh, dofs))
-            },
-        }
-    }
-
-    /// "AMD" or "nested dissection" (what the factors use, once decided),
-    /// for messages.
-    pub fn name(&self) -> &'static str {
-        match (self.dissection.is_some(), self.compare, self.chosen.get()) {
-            (false, _, _) | (true, true, Some(false)) => "AMD",
-            (true, false, _) | (true, true, Some(true)) => "nested dissection",
-            (true, true, None) => "nested dissection (or AMD, if its factor is clearly smaller)",
-        }
-    }
-
-    /// [`FillOrder::name`] once the ordering is decided ("AMD" or "nested
-    /// dissection"); `None` while the comparison with AMD waits for the
-    /// first analysis.
-    pub fn decided_name(&self) -> Option<&'static str> {
-        let undecided = self.dissection.is_some() && self.compare && self.chosen.get().is_none();
-        (!undecided).then(|| self.name())
-    }
-
-    /// The dissection's order, if it is a candidate.
-    pub fn dissection_order(&self) -> Option<&[usize]> {
-        self.dissection.as_deref().map(Vec::as_slice)
-    }
-
-    /// Where the comparison with AMD is kept, if the dissection is to be
-    /// compared with AMD: empty until the first analysis, then true when
-    /// the dissection won.
-    pub(crate) fn comparison(&self) -> Option<&OnceLock<bool>> {
-        (self.dissection.is_some() && self.compare).then_some(&*self.chosen)
+/// The ordering of the model's factors: AMD below [`DISSECTION_MIN_DOFS`]
+/// free DOFs, else the dissection or AMD by their factors
+/// ([`stickslip_linalg::AMD_MARGIN`]), unless [`FILL_ORDER_ENV`] says which.
+pub fn choose(mesh: &Mesh, dofs: &DofMap) -> FillOrder {
+    match std::env::var(FILL_ORDER_ENV).as_deref() {
+        Ok("amd") => FillOrder::amd(),
+        Ok("nd") => FillOrder::dissection(nested_dissection(mesh, dofs)),
+        _ if dofs.n_free() < DISSECTION_MIN_DOFS => FillOrder::amd(),
+        _ => FillOrder::dissection_unless_amd(nested_dissection(mesh, dofs)),
     }
 }
 
@@ -378,7 +308,8 @@ mod tests {
     /// numbering of the DOFs (reverse Cuthill–McKee's here).
     #[test]
     fn dissection_fill_is_amd_s_on_a_grid_whatever_the_numbering() {
-        use crate::{analyze_symbolic, Hypothesis, Material, Model, NodeOrder};
+        use crate::{Hypothesis, Material, Model, NodeOrder};
+        use stickslip_linalg::analyze_symbolic;
         let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
         for kind in [CellKind::Quad4, CellKind::Quad9] {
             let (mesh, grid) = slab_dofs(kind, 28);
@@ -407,12 +338,13 @@ mod tests {
 
     #[test]
     fn amd_on_small_meshes_the_smaller_factor_on_large_ones() {
-        use crate::{analyze_symbolic, Hypothesis, Material, Model};
+        use crate::{Hypothesis, Material, Model};
+        use stickslip_linalg::analyze_symbolic;
         if std::env::var_os(FILL_ORDER_ENV).is_some() {
             return;
         }
         let (mesh, dofs) = slab_dofs(CellKind::Quad4, 4);
-        let small = FillOrder::choose(&mesh, &dofs);
+        let small = choose(&mesh, &dofs);
         assert!(small.dissection_order().is_none());
         assert_eq!(small.name(), "AMD");
         assert_eq!(small.decided_name(), Some("AMD"));
@@ -433,7 +365,7 @@ mod tests {
         let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
         for (mesh, dofs, amd_wins) in [(slab, slab_dofs, false), (strip, strip_dofs, true)] {
             assert!(dofs.n_free() >= DISSECTION_MIN_DOFS);
-            let order = FillOrder::choose(&mesh, &dofs);
+            let order = choose(&mesh, &dofs);
             assert_eq!(
                 order.dissection_order(),
                 Some(&nested_dissection(&mesh, &dofs)[..])
@@ -449,7 +381,7 @@ mod tests {
                 )),
                 values(&FillOrder::amd()),
             );
-            let dissection_kept = nd as f64 <= AMD_MARGIN * amd as f64;
+            let dissection_kept = nd as f64 <= stickslip_linalg::AMD_MARGIN * amd as f64;
             assert_eq!(!dissection_kept, amd_wins, "AMD {amd}, the dissection {nd}");
             let kept = if dissection_kept { nd } else { amd };
             // A clone shares the decision.

@@ -10,7 +10,7 @@ use crate::material::Material;
 use crate::model::Model;
 use crate::quadrature::square_rule;
 use crate::reference::cell_nodes;
-use crate::solver::{SolverError, SparseCholesky};
+use stickslip_linalg::{SolverError, SparseCholesky};
 
 /// Solves `K u_f = load_free + dirichlet_load` and returns the FULL
 /// displacement (interleaved, prescribed values filled in).

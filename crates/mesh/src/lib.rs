@@ -11,6 +11,8 @@
 //! ([`Mesh::group`]); Gmsh's node tags are kept ([`Mesh::node_tags`]) but all
 //! indices in this crate's API are dense and 0-based.
 
+#![forbid(unsafe_code)]
+
 use std::collections::BTreeMap;
 
 mod basis;

@@ -23,9 +23,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use stickslip_contact::ContactSurface;
-use stickslip_fem::{
-    traction_load, Dirichlet, ElementClasses, Hypothesis, Material, Model, SparseCholesky, Traction,
-};
+use stickslip_fem::{traction_load, Dirichlet, Hypothesis, Material, Model, Traction};
 use stickslip_mesh::Mesh;
 use stickslip_time::stability::critical_step;
 use stickslip_time::{Dynamics, History, Integrator, Load, Scheme, Settings};
@@ -301,14 +299,6 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     let mesh = mesh_named(name);
     let (model, contact, loads) = problem(&mesh);
     let explicit = scheme == "cd";
-    // The explicit step forms K·x from element classes where the mesh has
-    // them (structured Q2: kernels.rs), else streams the assembled K
-    // (always with STICKSLIP_NO_CLASSES set: the comparison).
-    let classes = if explicit && std::env::var_os("STICKSLIP_NO_CLASSES").is_none() {
-        ElementClasses::new(&mesh, &slab_material(), &model.dofs)
-    } else {
-        None
-    };
     if let Some(dir) = &dump {
         dump_mesh(dir, &mesh, &model);
     }
@@ -329,7 +319,7 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         // same ordering, the model's, and faer supernodal Cholesky as the
         // step's).
         let a0 = model.combined(0.5 * newmark_dt, 1.0 / (0.5 * newmark_dt));
-        let mut chol = SparseCholesky::analyze(&a0, &model.fill_order).unwrap();
+        let mut chol = stickslip_linalg::SparseCholesky::analyze(&a0, &model.fill_order).unwrap();
         chol.factorize(&a0).unwrap();
         let mut x = vec![1.0; n];
         let mut times = Vec::new();
@@ -353,7 +343,6 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
     // STICKSLIP_NO_STENCILS set: K (and M) as the mesh allows without
     // stencil types (the comparison).
     let dynamics = Dynamics::from_model_owned(model)
-        .with_element_classes(classes)
         .with_stencils(std::env::var_os("STICKSLIP_NO_STENCILS").is_none());
     let settings = if explicit {
         Settings::new(Scheme::CentralDifference, dt, 1e9)
@@ -445,20 +434,12 @@ fn run_case(scheme: &str, name: &str, steps: usize, repeats: usize, dump: Option
         peak / need
     );
     let extra = if explicit {
-        // Bytes a step must move (kernels.rs): K as the step reads it;
-        // vectors: the sweep reads r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K and
-        // the next step's predictor (7); the loads at their rows only
-        // (Integrator::explicit_bytes_per_step).
+        // Bytes a step must move (Integrator::explicit_bytes_per_step).
         let bytes = i.explicit_bytes_per_step() as f64;
         let (bw, bw_median, paired) = pool.install(|| paired_stream(&mut i, bytes, steps, 9));
-        let (dict, blocks) = i.explicit_dictionary().unwrap_or((0, 0));
-        let classes = i.explicit_classes().unwrap_or(0);
         let stencils = i.explicit_stencils().unwrap_or(0);
-        // The share of the steps swept in place (several chunks; the first
-        // step of each Δt forms its predictor apart).
-        let in_place = i.in_place_steps() as f64 / i.steps().max(1) as f64;
         format!(
-            "dict_blocks={dict} of_blocks={blocks} element_classes={classes} stencil_types={stencils} bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1} stream_bw_median={bw_median:.4e} pct_stream_paired={:.1} in_place={in_place:.3}",
+            "stencil_types={stencils} bytes_per_step={bytes:.0} stream_bw={bw:.4e} step_bw={:.4e} pct_stream={:.1} stream_bw_median={bw_median:.4e} pct_stream_paired={:.1}",
             bytes / per_step.0,
             100.0 * bytes / per_step.0 / bw,
             100.0 * paired

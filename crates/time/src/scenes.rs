@@ -11,7 +11,7 @@ use stickslip_contact::{ContactError, ContactSurface};
 use stickslip_fem::{traction_load, Dirichlet, FemError, Hypothesis, Material, Model, Traction};
 use stickslip_mesh::{CellKind, Mesh, MeshError};
 
-use crate::{Dynamics, History, Integrator, Load, Scheme, Settings, StickReduction, TimeError};
+use crate::{Dynamics, History, Integrator, Load, Settings, TimeError};
 
 /// E of the slab (BENCHMARK.md).
 pub const E: f64 = 1000.0;
@@ -372,7 +372,6 @@ pub mod sdof {
             consistent_mass: scalar(1.0),
             lumped_mass: vec![1.0],
             constant_load: vec![0.0],
-            element_classes: None,
             stencils: true,
             fill_order: Default::default(),
         };
@@ -409,69 +408,6 @@ pub mod sdof {
             err = err.max((i.displacement()[0] - closed_form(p, i.time())).abs());
         }
         Ok((err, i.displacement()[0]))
-    }
-}
-
-/// Remark 4.3 as the paper did it: Δt = 1e-7 for 10 steps after sticking.
-pub const PAPER_REDUCTION: StickReduction = StickReduction {
-    dt: 1e-7,
-    steps: 10,
-};
-
-/// The time-stepping methods the studies compare and `stickslip advise`
-/// chooses from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    /// Central difference, lumped mass, closed-form nodal friction.
-    CentralDifference,
-    /// Newmark ¼/½ (trapezoidal rule), consistent mass.
-    Trapezoidal,
-    /// Newmark ¼/½ with the step reduction of Remark 4.3.
-    TrapezoidalReduced,
-    /// Newmark 0.3025/0.6 (numerical damping).
-    Damped,
-}
-
-impl Method {
-    /// All of them, in table order.
-    pub const ALL: [Method; 4] = [
-        Method::CentralDifference,
-        Method::Trapezoidal,
-        Method::TrapezoidalReduced,
-        Method::Damped,
-    ];
-
-    /// Short name (tables, legends, docs/work-precision.csv).
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::CentralDifference => "cd",
-            Method::Trapezoidal => "nm-0.25-0.5",
-            Method::TrapezoidalReduced => "nm-0.25-0.5-reduced",
-            Method::Damped => "nm-0.3025-0.6",
-        }
-    }
-
-    /// (β, γ) of the Newmark methods; `None` for central difference.
-    pub fn newmark(self) -> Option<(f64, f64)> {
-        match self {
-            Method::CentralDifference => None,
-            Method::Trapezoidal | Method::TrapezoidalReduced => Some((0.25, 0.5)),
-            Method::Damped => Some((0.3025, 0.6)),
-        }
-    }
-
-    /// The time crate's settings for this method (the reduced method with
-    /// the paper's Remark 4.3).
-    pub fn settings(self, dt: f64, t_end: f64) -> Settings {
-        let scheme = match self.newmark() {
-            None => Scheme::CentralDifference,
-            Some((beta, gamma)) => Scheme::Newmark { beta, gamma },
-        };
-        let mut s = Settings::new(scheme, dt, t_end);
-        if self == Method::TrapezoidalReduced {
-            s.stick_reduction = Some(PAPER_REDUCTION);
-        }
-        s
     }
 }
 

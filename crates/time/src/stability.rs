@@ -3,8 +3,8 @@
 
 use nalgebra_sparse::CsrMatrix;
 
-use crate::kernels::{each_chunk_pair, each_chunk_summed, partials, total, CHUNK};
-use crate::linalg::{dot, spmv};
+use stickslip_linalg::chunks::{each_chunk_pair, each_chunk_summed, partials, CHUNK};
+use stickslip_linalg::csr::{dot, spmv};
 
 /// Largest eigenvalue of M⁻¹K for a diagonal (lumped) mass, by Lanczos on
 /// the symmetric M^{-1/2} K M^{-1/2}.
@@ -23,12 +23,11 @@ pub fn largest_eigenvalue(
 }
 
 /// [`largest_eigenvalue`] with y = K x formed by `product` (the explicit
-/// step's own K·x: `Integrator::new`).
+/// step's own K·x).
 ///
 /// A step is the product and three passes over the vectors, threaded by
-/// the explicit step's fixed chunks with their sums added in chunk order
-/// (`kernels::each_chunk_summed`: the same bits on any number of
-/// threads): with x = M^{-1/2} q and y = K x, α = yᵀx; w = M^{-1/2} y −
+/// fixed chunks with their sums added in chunk order
+/// (`stickslip_linalg::chunks`: the same bits on any number of threads): with x = M^{-1/2} q and y = K x, α = yᵀx; w = M^{-1/2} y −
 /// α q − β q_prev and β² = wᵀw; then q_prev, q ← q, w/β and the next x.
 /// (α = yᵀx is qᵀM^{-1/2} K M^{-1/2} q, one pass before w exists.)
 pub fn largest_eigenvalue_with(
@@ -50,18 +49,17 @@ pub fn largest_eigenvalue_with(
     let mut x: Vec<f64> = q.iter().zip(&scale).map(|(q, s)| q * s).collect();
     let mut q_prev = vec![0.0; n];
     let mut y = vec![0.0; n];
-    let mut partials = partials(n);
+    let mut partials = partials::<1>(n);
     let (mut alphas, mut betas) = (Vec::new(), Vec::new());
     let mut beta_prev = 0.0;
     let mut last = 0.0;
     for step in 0..max_steps.min(n) {
         product(&x, &mut y);
-        each_chunk_summed(&mut y, &mut partials, |c, y, p| {
+        let [alpha] = each_chunk_summed(&mut y, &mut partials, |c, y, p| {
             p[0] = dot(y, &x[c * CHUNK..c * CHUNK + y.len()]);
         });
-        let alpha = total(&partials, 0);
         // y becomes w in place.
-        each_chunk_summed(&mut y, &mut partials, |c, w, p| {
+        let [beta_squared] = each_chunk_summed(&mut y, &mut partials, |c, w, p| {
             let r = c * CHUNK..c * CHUNK + w.len();
             let (q, qp, s) = (&q[r.clone()], &q_prev[r.clone()], &scale[r]);
             let mut sum = 0.0;
@@ -71,7 +69,7 @@ pub fn largest_eigenvalue_with(
             }
             p[0] = sum;
         });
-        let beta = total(&partials, 0).sqrt();
+        let beta = beta_squared.sqrt();
         alphas.push(alpha);
         if step % 5 == 4 || beta <= 1e-14 * alpha.abs() || step + 1 == max_steps.min(n) {
             let top = tridiagonal_max_eigenvalue(&alphas, &betas);
@@ -191,40 +189,5 @@ mod tests {
         let m4 = vec![4.0; n];
         let ratio = critical_step(&k, &m4) / critical_step(&k, &m);
         assert!((ratio - 2.0).abs() < 1e-6, "ratio {ratio}");
-    }
-
-    /// The Lanczos passes are threaded by fixed chunks: the same bits on one
-    /// thread and on two (a system of several chunks); and the estimate on
-    /// the explicit step's products (stencil types, compact blocks: within
-    /// 1e-12 of K·x) agrees with the one on the CSR to 1e-12 relative
-    /// (measured 2e-16 to 2e-14 on the slabs of 251k to 1M DOFs).
-    #[test]
-    fn threads_and_products_keep_the_estimate() {
-        use crate::kernels::tests::lab_slab;
-        use crate::kernels::RowProduct;
-        use stickslip_fem::testing::on_threads;
-
-        for name in ["q1-192x48", "q2-96x24"] {
-            let (_, _, model) = lab_slab(name);
-            let (k, m) = (&model.stiffness, &model.lumped_mass);
-            assert!(m.len() > 2 * CHUNK, "{name}: {} DOFs", m.len());
-            let one = on_threads(1, || critical_step(k, m));
-            let two = on_threads(2, || critical_step(k, m));
-            assert_eq!(one.to_bits(), two.to_bits(), "{name}");
-            let stencils = crate::kernels::Stencils::new(k).expect("structured");
-            let compact = crate::kernels::Compact::new(k).expect("square");
-            for (product, dt) in [
-                (
-                    "stencils",
-                    critical_step_with(|x, y| RowProduct::spmv(&stencils, x, y), m),
-                ),
-                ("compact", critical_step_with(|x, y| compact.spmv(x, y), m)),
-            ] {
-                assert!(
-                    (dt - one).abs() <= 1e-12 * one,
-                    "{name} {product}: {dt:e} against {one:e}"
-                );
-            }
-        }
     }
 }

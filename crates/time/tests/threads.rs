@@ -5,8 +5,9 @@
 mod common;
 use common::*;
 use stickslip_fem::testing::on_threads;
+use stickslip_linalg::chunks::{CHUNK, PARALLEL_MIN};
 use stickslip_time::scenes::structured_slab;
-use stickslip_time::{History, Integrator, Scheme, Settings, CHUNK, PARALLEL_MIN};
+use stickslip_time::{History, Integrator, Scheme, Settings};
 
 fn run(s: &Slab, threads: usize, steps: usize) -> Integrator {
     on_threads(threads, || {

@@ -1,10 +1,10 @@
 //! The paper's experiments (every case in cases/martins-oden/): the numbers
 //! and behaviours Martins & Oden report, checked on our runs.
 
-use stickslip_time::{MassKind, Scheme, Settings};
+use stickslip_time::{MassKind, Scheme};
 
 use crate::report::{num, Report};
-use crate::scene::{Case, Scene, Trace};
+use crate::scene::{PaperCase, Trace};
 use crate::Run;
 
 /// Friction bound μ F_n = 0.3 × 300 (BENCHMARK.md).
@@ -60,12 +60,11 @@ pub fn run(runs: &[Run], r: &mut Report) {
     // mass; the consistent mass must be refused, not silently used.
     if let Some(run) = runs
         .iter()
-        .find(|x| x.case.settings.scheme == Scheme::CentralDifference)
+        .find(|x| x.case.settings().scheme == Scheme::CentralDifference)
     {
-        let refused = Scene::from_case(&run.case).map(|scene| {
-            let mut s: Settings = scene.settings.clone();
-            s.mass = Some(MassKind::Consistent);
-            stickslip_time::Integrator::new(scene.dynamics, scene.contact, scene.loads, s).is_err()
+        let refused = run.case.scene().map(|mut scene| {
+            scene.settings.mass = Some(MassKind::Consistent);
+            scene.integrator().is_err()
         });
         r.holds(
             &run.case.name,
@@ -77,7 +76,7 @@ pub fn run(runs: &[Run], r: &mut Report) {
     }
 }
 
-fn check_case(case: &Case, trace: &Trace, r: &mut Report) {
+fn check_case(case: &PaperCase, trace: &Trace, r: &mut Report) {
     let name = case.name.as_str();
     if let Some(e) = &trace.error {
         r.holds(
@@ -101,7 +100,7 @@ fn check_case(case: &Case, trace: &Trace, r: &mut Report) {
     );
     // §4.3: the paper pairs central difference with the lumped mass and
     // Newmark with the consistent one.
-    let want = if case.settings.scheme == Scheme::CentralDifference {
+    let want = if case.settings().scheme == Scheme::CentralDifference {
         MassKind::Lumped
     } else {
         MassKind::Consistent
@@ -114,10 +113,10 @@ fn check_case(case: &Case, trace: &Trace, r: &mut Report) {
         trace.mass == Some(want),
     );
     let step = case.is_step();
-    let (beta, gamma) = case.settings.scheme.parameters();
+    let (beta, gamma) = case.settings().scheme.parameters();
     let trapezoidal = beta == 0.25 && gamma == 0.5;
-    let cd = case.settings.scheme == Scheme::CentralDifference;
-    let eps = case.contact.3;
+    let cd = case.settings().scheme == Scheme::CentralDifference;
+    let eps = case.eps();
 
     // E(0) from the closed-form static state u_x = 0.117x, u_y = 0.273(1−y):
     // ½rᵀKr − rᵀR_p = −½·300·8·0.273 = −327.6, and with H(0) = 1 the end
@@ -226,14 +225,14 @@ fn check_case(case: &Case, trace: &Trace, r: &mut Report) {
         );
     }
     if !cd && step {
-        let ringing_expected = trapezoidal && case.settings.stick_reduction.is_none();
+        let ringing_expected = trapezoidal && case.settings().stick_reduction.is_none();
         match ringing(trace) {
             Some((ts, a)) => {
                 let q = format!("σ_T(81) ringing amplitude after stick (t={})", num(ts));
                 if ringing_expected {
                     r.at_least(name, &q, a, RINGING, "Remark 4.3, Fig. 11: rings");
                 } else {
-                    let why = if case.settings.stick_reduction.is_some() {
+                    let why = if case.settings().stick_reduction.is_some() {
                         "Remark 4.3, Fig. 12: cured by reduction"
                     } else {
                         "Figs. 14-15: damped by γ = 0.6"

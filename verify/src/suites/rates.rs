@@ -4,13 +4,14 @@
 
 use std::path::Path;
 
+use stickslip_case::Scene;
 use stickslip_fem::testing::manufactured;
 use stickslip_mesh::CellKind;
 use stickslip_time::scenes::sdof;
-use stickslip_time::{Integrator, Scheme};
+use stickslip_time::Scheme;
 
 use crate::report::{num, Report};
-use crate::scene::{Case, Scene};
+use crate::scene::{self, PaperCase};
 use crate::suites::analytic::SCHEMES;
 use crate::{Options, NEWMARK};
 
@@ -94,13 +95,12 @@ fn h_rates(opts: &Options, r: &mut Report) {
 
 // ---- Δt: the frictionless slab under the smooth end load −150·sin(8πt) ----
 
-/// max-norm difference of the displacement at t_end between a run at `dt`
-/// and one at `dt_ref`, same scheme.
-fn final_state(scene: &Scene, scheme: Scheme, dt: f64, t_end: f64) -> Result<Vec<f64>, String> {
-    let mut s = stickslip_time::Settings::new(scheme, dt, t_end);
-    s.mass = None;
-    let mut i = Integrator::new(scene.dynamics.clone(), None, scene.loads.clone(), s)
-        .map_err(|e| e.to_string())?;
+/// The displacement at t_end of the scene without its friction surface,
+/// run with `scheme` at `dt`.
+fn final_state(scene: &mut Scene, scheme: Scheme, dt: f64, t_end: f64) -> Result<Vec<f64>, String> {
+    scene.contact = None;
+    scene.settings = stickslip_time::Settings::new(scheme, dt, t_end);
+    let mut i = scene.integrator().map_err(|e| e.to_string())?;
     while !i.done() {
         i.step().map_err(|e| e.to_string())?;
     }
@@ -109,7 +109,7 @@ fn final_state(scene: &Scene, scheme: Scheme, dt: f64, t_end: f64) -> Result<Vec
 
 fn dt_rates(root: &Path, opts: &Options, r: &mut Report) {
     let case_file = root.join("cases/martins-oden/cd-sin-eps1e-4.toml");
-    let scene = match Case::read(&case_file).and_then(|c| Scene::from_case(&c)) {
+    let mut scene = match PaperCase::read(&case_file).and_then(|c| c.scene()) {
         Ok(s) => s,
         Err(e) => {
             r.holds("Δt rates", "scene", e, "builds", false);
@@ -144,10 +144,10 @@ fn dt_rates(root: &Path, opts: &Options, r: &mut Report) {
         let dts = if opts.quick { &dts[1..] } else { dts };
         let case = format!("frictionless slab sin {name}");
         let result = (|| -> Result<Vec<f64>, String> {
-            let reference = final_state(&scene, scheme, dt_ref, t_end)?;
+            let reference = final_state(&mut scene, scheme, dt_ref, t_end)?;
             dts.iter()
                 .map(|&dt| {
-                    let u = final_state(&scene, scheme, dt, t_end)?;
+                    let u = final_state(&mut scene, scheme, dt, t_end)?;
                     Ok(u.iter()
                         .zip(&reference)
                         .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())))
@@ -220,13 +220,13 @@ fn eps_rates(root: &Path, opts: &Options, r: &mut Report) {
     let case_file = root.join("cases/martins-oden/cd-step-eps1e-4.toml");
     let case = "slab CD H(t)";
     let result = (|| -> Result<(Vec<f64>, Vec<f64>), String> {
-        let c = Case::read(&case_file)?;
+        let c = PaperCase::read(&case_file)?;
         let history = |eps: f64| -> Result<Vec<f64>, String> {
-            let mut scene = Scene::from_case(&c)?;
+            let mut scene = c.scene()?;
             if let Some(s) = &mut scene.contact {
                 s.law.eps = eps;
             }
-            let t = scene.run();
+            let t = scene::run(&scene);
             t.error.map_or(Ok(t.ux81), Err)
         };
         let reference = history(1e-6)?;

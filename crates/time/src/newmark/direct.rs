@@ -1,15 +1,17 @@
-//! The implicit Newmark step: the operator (β/γ)ΔtK + M/(γΔt) + C and its
-//! factorization, kept until Δt or the stuck set changes (METHOD.md §4-5).
+//! The implicit Newmark step solved directly: the operator (β/γ)ΔtK +
+//! M/(γΔt) + C and its factorization, kept until Δt or the stuck set
+//! changes (METHOD.md §4-5). The reference the Schur path is checked
+//! against.
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{ContactSurface, SlipState, StepSystem};
-use stickslip_fem::{FillOrder, SolverError, SparseCholesky};
+use stickslip_linalg::{FillOrder, SolverError, SparseCholesky};
 
-use crate::linalg::csr_index;
+use stickslip_linalg::csr::index as csr_index;
 
 /// The implicit operator and its factorization for the current (Δt, stuck
 /// set); `factorizations` counts numeric factorizations over the run.
-pub(crate) struct ImplicitOperator {
+pub(crate) struct DirectOperator {
     /// A₀ = c_K K + c_M M for the current Δt (values only change).
     a0: CsrMatrix<f64>,
     /// A₀ + C for the current stuck set: what is factorized.
@@ -23,13 +25,13 @@ pub(crate) struct ImplicitOperator {
     pub factorizations: u64,
 }
 
-impl ImplicitOperator {
+impl DirectOperator {
     /// Analyses the pattern of K (which M shares) once for the run.
     pub fn new(
         stiffness: &CsrMatrix<f64>,
         order: &FillOrder,
         contact: Option<&ContactSurface>,
-    ) -> Result<ImplicitOperator, SolverError> {
+    ) -> Result<DirectOperator, SolverError> {
         let cholesky = SparseCholesky::analyze(stiffness, order)?;
         let entries = contact
             .map(|s| {
@@ -49,7 +51,7 @@ impl ImplicitOperator {
                     .collect()
             })
             .unwrap_or_default();
-        Ok(ImplicitOperator {
+        Ok(DirectOperator {
             a0: stiffness.clone(),
             work: stiffness.clone(),
             cholesky,
@@ -104,21 +106,12 @@ impl ImplicitOperator {
         }
         self.work.values_mut().copy_from_slice(self.a0.values());
         if let Some(surface) = surface {
-            let values = self.work.values_mut();
-            for ((n, c), e) in surface.nodes.iter().zip(classes).zip(&self.entries) {
-                if !c.is_stuck() {
-                    continue;
+            let (values, entries) = (self.work.values_mut(), &self.entries);
+            surface.add_damping(classes, |j, a, b, value| {
+                if let Some(p) = entries[j][2 * a + b] {
+                    values[p] += value;
                 }
-                // Stuck: the damping w g/ε ττᵀ (METHOD.md §3).
-                let k = n.force_scale() / surface.law.eps;
-                for a in 0..2 {
-                    for b in 0..2 {
-                        if let Some(p) = e[2 * a + b] {
-                            values[p] += k * n.tangent[a] * n.tangent[b];
-                        }
-                    }
-                }
-            }
+            });
             for (k, c) in self.key_stuck.iter_mut().zip(classes) {
                 *k = c.is_stuck();
             }
@@ -142,7 +135,7 @@ impl ImplicitOperator {
 /// One step's linear system for the stick/slip iteration: b is the
 /// right-hand side without friction (R̂_K of METHOD.md §4).
 pub(crate) struct ImplicitStep<'a> {
-    pub operator: &'a mut ImplicitOperator,
+    pub operator: &'a mut DirectOperator,
     pub b: &'a [f64],
 }
 
@@ -159,53 +152,6 @@ impl StepSystem for ImplicitStep<'_> {
         velocity.copy_from_slice(self.b);
         surface.subtract_slip_forces(classes, velocity);
         self.operator.cholesky.solve_in_place(velocity);
-        Ok(())
-    }
-}
-
-/// The explicit step's system with a diagonal operator d (lumped mass over
-/// γΔt): solved node by node, stuck nodes by Sherman-Morrison on their 2×2
-/// block d + k ττᵀ. Used to check the closed form against the iteration.
-pub(crate) struct DiagonalStep<'a> {
-    pub diagonal: &'a [f64],
-    pub b: &'a [f64],
-}
-
-impl StepSystem for DiagonalStep<'_> {
-    type Error = std::convert::Infallible;
-
-    fn solve(
-        &mut self,
-        surface: &ContactSurface,
-        classes: &[SlipState],
-        velocity: &mut [f64],
-    ) -> Result<(), Self::Error> {
-        velocity.copy_from_slice(self.b);
-        surface.subtract_slip_forces(classes, velocity);
-        for (v, d) in velocity.iter_mut().zip(self.diagonal) {
-            *v /= d;
-        }
-        for (n, c) in surface.nodes.iter().zip(classes) {
-            if !c.is_stuck() {
-                continue;
-            }
-            let k = n.force_scale() / surface.law.eps;
-            // (D + k ττᵀ)⁻¹ r = D⁻¹r − D⁻¹τ k (τᵀD⁻¹r) / (1 + k τᵀD⁻¹τ).
-            let mut t_dinv_r = 0.0;
-            let mut t_dinv_t = 0.0;
-            for a in 0..2 {
-                if let Some(i) = n.dofs[a] {
-                    t_dinv_r += n.tangent[a] * velocity[i];
-                    t_dinv_t += n.tangent[a] * n.tangent[a] / self.diagonal[i];
-                }
-            }
-            let factor = k * t_dinv_r / (1.0 + k * t_dinv_t);
-            for a in 0..2 {
-                if let Some(i) = n.dofs[a] {
-                    velocity[i] -= factor * n.tangent[a] / self.diagonal[i];
-                }
-            }
-        }
         Ok(())
     }
 }

@@ -1,25 +1,15 @@
-//! The one error type that means "the user's input is wrong" (exit code 2).
+//! The one error type that means "the user's input is wrong".
 //!
 //! Anything the user can fix by editing a case file, a mesh or the command
-//! line is an [`InputError`]; `main` maps it to exit code 2 and any other
-//! failure of a started run to exit code 1. `run.rs` constructs it too (e.g. a
-//! group the mesh does not have), so `main` finds it with
-//! `anyhow::Error::downcast_ref::<InputError>()`.
-
-use std::fmt;
+//! line is an [`InputError`]: reading a case, building its model and the
+//! binary's own checks all return it, and the binary maps it to exit code 2
+//! (any other failure of a started run is exit code 1).
 
 /// Bad input: the message names the file, the line where there is one, what
 /// is wrong and what to do. Several problems are separated by newlines.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
 pub struct InputError(pub String);
-
-impl fmt::Display for InputError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for InputError {}
 
 /// Problems listed at once, at most this many (thousands of tables with one
 /// mistake each would bury the first).

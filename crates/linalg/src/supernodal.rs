@@ -1,27 +1,24 @@
-//! Forward and back substitution with faer's supernodal LLᵀ factor, written
-//! for one right-hand side (the implicit step's and the static solve's;
-//! issue 7, deliverable 1).
+//! Forward and back substitution with faer's supernodal LLᵀ factor, for
+//! one right-hand side.
 //!
 //! faer's own solve handles a block of right-hand sides through its
 //! general triangular-solve and matmul kernels; for one column its
-//! per-supernode dispatch and temporaries cost more than the arithmetic
-//! (measured in the module's `lab` test: see [`Supernodal`]). Here each
-//! supernode is a column-major (k + m) × k block, the k × k diagonal
-//! triangle above the m rows of its pattern, and the loops run straight
-//! over its columns: the forward solve pushes L_bot x_top into the pattern
-//! rows (a contiguous axpy per column, then one scatter), the back solve
-//! gathers the pattern rows once and takes contiguous dot products.
+//! per-supernode dispatch and temporaries cost more than the arithmetic.
+//! Here each supernode is a column-major (k + m) × k block, the k × k
+//! diagonal triangle above the m rows of its pattern, and the loops run
+//! straight over its columns: the forward solve pushes L_bot x_top into the
+//! pattern rows (a contiguous axpy per column, then one scatter), the back
+//! solve gathers the pattern rows once and takes contiguous dot products.
 //!
-//! The step also needs solves that touch only part of the tree: the
-//! velocities at the contact DOFs of A₀⁻¹b, and A₀⁻¹Pᵀf whose right-hand
-//! side lives on the contact DOFs. Both only involve the supernodes on the
-//! paths from the contact DOFs' supernodes to the root (a column's solution
-//! in the back solve depends only on its ancestors; a forward push from a
-//! supernode only reaches its ancestors), the *reach* set. So a step costs
-//! one full forward solve, one back solve restricted to the reach, the
-//! nodal iteration, one forward solve restricted to the reach, and one full
-//! back solve: one solve's worth of passes over the factor plus twice the
-//! reach's share of it.
+//! Solves restricted to a few rows P of the system: (A⁻¹b) at those rows,
+//! and A⁻¹Pᵀf whose right-hand side lives on them, involve only the
+//! supernodes on the paths from their supernodes to the root (a column's
+//! solution in the back solve depends only on its ancestors; a forward push
+//! from a supernode only reaches its ancestors), the *reach*. A solve
+//! with a correction on those rows then costs one full forward solve, the
+//! reach's share twice, and one full back solve ([`Supernodal::begin_reach`],
+//! [`Supernodal::finish_reach`]), or with the rows' paths stored
+//! ([`PathOperator`]) one pass over W instead of the reach's solves.
 
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use rayon::prelude::*;
@@ -33,7 +30,7 @@ use rayon::prelude::*;
 /// of L, and p = Wᵀy, the correction W f replace the two solves restricted
 /// to the reach.
 #[derive(Clone, Debug, Default)]
-pub struct ContactOperator {
+pub struct PathOperator {
     /// S = P A⁻¹ Pᵀ, column-major.
     pub s: Vec<f64>,
     w_ptr: Vec<usize>,
@@ -41,7 +38,7 @@ pub struct ContactOperator {
     w_val: Vec<f64>,
 }
 
-impl ContactOperator {
+impl PathOperator {
     /// Stored values of W.
     pub fn w_len(&self) -> usize {
         self.w_val.len()
@@ -124,9 +121,6 @@ pub struct Supernodal {
     w: Vec<f64>,
     tmp: Vec<f64>,
     scratch: [BinScratch; 2],
-    /// How far ahead the solves ask for L ([`prefetch_block`]; 0: not at
-    /// all, which only the timing lab sets).
-    prefetch: usize,
 }
 
 impl std::fmt::Debug for Supernodal {
@@ -191,7 +185,6 @@ impl Supernodal {
             Some(p) => p.arrays().0.iter().map(|&i| i as u32).collect(),
             None => (0..n as u32).collect(),
         };
-        let val_ptr_total = val_ptr[ns];
         let max_pattern = (0..ns)
             .map(|s| row_ptr[s + 1] - row_ptr[s])
             .max()
@@ -219,11 +212,6 @@ impl Supernodal {
             w: vec![0.0; n],
             tmp: vec![0.0; max_pattern],
             scratch: Default::default(),
-            prefetch: if val_ptr_total >= PREFETCH_MIN_VALUES {
-                PREFETCH
-            } else {
-                0
-            },
         };
         this.split_tree(split_min);
         this.reach = Plan {
@@ -397,7 +385,7 @@ impl Supernodal {
             }
         }
         self.reach_cols = next as usize;
-        // `finish_step_paths` keeps two sums on the reach in `w`.
+        // `finish_paths` keeps two sums on the reach in `w`.
         let len = self.n.max(2 * self.reach_cols);
         self.w.resize(len, 0.0);
     }
@@ -412,7 +400,7 @@ impl Supernodal {
     /// values are read once per group and the inner loops run over the
     /// group), groups in parallel; a column's arithmetic is the same on any
     /// thread.
-    pub fn schur_complement(&self, l: &[f64], rows: &[Vec<(usize, f64)>]) -> ContactOperator {
+    pub fn schur_complement(&self, l: &[f64], rows: &[Vec<(usize, f64)>]) -> PathOperator {
         let p = rows.len();
         let groups: Vec<usize> = (0..p).step_by(GROUP).collect();
         let columns: Vec<(Vec<f64>, Vec<PathColumn>)> = groups
@@ -463,7 +451,7 @@ impl Supernodal {
                 },
             )
             .collect();
-        let mut op = ContactOperator {
+        let mut op = PathOperator {
             s: Vec::with_capacity(p * p),
             w_ptr: vec![0],
             w_idx: Vec::new(),
@@ -482,11 +470,11 @@ impl Supernodal {
         op
     }
 
-    /// The step's start with a [`ContactOperator`]: the forward solve
+    /// A restricted solve's start with a [`PathOperator`]: the forward solve
     /// y = L⁻¹(Perm b) into the internal vector and p_j = W_jᵀ y = (P A⁻¹ b)_j
     /// (one pass over W instead of a back solve over the reach; the rows
     /// in parallel, each its own sum).
-    pub fn begin_step_paths(&mut self, l: &[f64], op: &ContactOperator, b: &[f64], p: &mut [f64]) {
+    pub fn begin_paths(&mut self, l: &[f64], op: &PathOperator, b: &[f64], p: &mut [f64]) {
         let mut xp = std::mem::take(&mut self.xp);
         permute_in(&self.fwd, b, &mut xp);
         self.forward(l, false, &mut xp);
@@ -512,10 +500,10 @@ impl Supernodal {
         self.xp = xp;
     }
 
-    /// The step's end: x = A⁻¹(b − Pᵀf) = Perm⁻¹ L⁻ᵀ(y − W f). W f in two
+    /// A restricted solve's end: x = A⁻¹(b − Pᵀf) = Perm⁻¹ L⁻ᵀ(y − W f). W f in two
     /// halves of its columns at once, each into its own sums on the reach,
     /// added in a fixed order (the same bits on one thread and on two).
-    pub fn finish_step_paths(&mut self, l: &[f64], op: &ContactOperator, f: &[f64], x: &mut [f64]) {
+    pub fn finish_paths(&mut self, l: &[f64], op: &PathOperator, f: &[f64], x: &mut [f64]) {
         let mut xp = std::mem::take(&mut self.xp);
         let half = f.len() / 2;
         let mut acc = std::mem::take(&mut self.w);
@@ -678,6 +666,11 @@ impl Supernodal {
         }
     }
 
+    /// Columns inside the reach.
+    pub fn reach_columns(&self) -> usize {
+        self.reach_cols
+    }
+
     /// Values of L inside the reach (for the cost figures).
     pub fn reach_len(&self) -> usize {
         self.reach_len
@@ -701,7 +694,7 @@ impl Supernodal {
     /// Forward solve L y = P b into the internal vector, and the back solve
     /// restricted to the reach: afterwards [`Supernodal::reach_value`] gives
     /// (A⁻¹b) at the DOFs given to [`Supernodal::set_reach`].
-    pub fn begin_step(&mut self, l: &[f64], b: &[f64]) {
+    pub fn begin_reach(&mut self, l: &[f64], b: &[f64]) {
         let mut xp = std::mem::take(&mut self.xp);
         permute_in(&self.fwd, b, &mut xp);
         self.forward(l, false, &mut xp);
@@ -712,7 +705,7 @@ impl Supernodal {
         self.xr = xr;
     }
 
-    /// (A⁻¹b) at the permuted index i after [`Supernodal::begin_step`].
+    /// (A⁻¹b) at the permuted index i after [`Supernodal::begin_reach`].
     pub fn reach_value(&self, permuted: usize) -> f64 {
         self.xr[permuted]
     }
@@ -726,9 +719,9 @@ impl Supernodal {
         inv
     }
 
-    /// Finishes the step: x = A⁻¹(b − c) with c nonzero only at DOFs given
+    /// Finishes a restricted solve: x = A⁻¹(b − c) with c nonzero only at DOFs given
     /// to [`Supernodal::set_reach`], as (permuted index, value).
-    pub fn finish_step(&mut self, l: &[f64], c: &[(usize, f64)], x: &mut [f64]) {
+    pub fn finish_reach(&mut self, l: &[f64], c: &[(usize, f64)], x: &mut [f64]) {
         let mut buffer = std::mem::take(&mut self.w);
         let w = &mut buffer[..self.n];
         w.fill(0.0);
@@ -767,7 +760,6 @@ impl Supernodal {
         let plan = if reach { &self.reach } else { &self.full };
         for &s in &plan.top {
             let s = s as usize;
-            prefetch_block(l, &self.val_ptr, s, true, self.prefetch);
             let (c0, c1) = (self.begin[s], self.begin[s + 1]);
             let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
             let tmp = &mut self.tmp[..pattern.len()];
@@ -814,7 +806,6 @@ impl Supernodal {
         sc.acc.fill(0.0);
         for &s in list {
             let s = s as usize;
-            prefetch_block(l, &self.val_ptr, s, true, self.prefetch);
             let c0 = self.slot[self.begin[s]] as usize;
             let k = self.begin[s + 1] - self.begin[s];
             let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
@@ -841,7 +832,6 @@ impl Supernodal {
         let plan = if reach { &self.reach } else { &self.full };
         for &s in plan.top.iter().rev() {
             let s = s as usize;
-            prefetch_block(l, &self.val_ptr, s, false, self.prefetch);
             let (c0, c1) = (self.begin[s], self.begin[s + 1]);
             let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
             let tmp = &mut self.tmp[..pattern.len()];
@@ -869,7 +859,6 @@ impl Supernodal {
         }
         for &s in list.iter().rev() {
             let s = s as usize;
-            prefetch_block(l, &self.val_ptr, s, false, self.prefetch);
             let c0 = self.slot[self.begin[s]] as usize;
             let k = self.begin[s + 1] - self.begin[s];
             let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
@@ -890,55 +879,6 @@ impl Supernodal {
         }
     }
 }
-
-/// Asks for the lines of L `distance` values ([`PREFETCH`]) past supernode s's block
-/// (`ahead`: the forward solve, which visits the blocks in the order they
-/// are stored) or before it (the back solve, which visits them in reverse),
-/// each line once over a pass, so that L streams in ahead of the columns'
-/// axpys and dots. The hardware's prefetchers alone left the solve waiting
-/// on L's lines: the loads of the dot products held most of the samples.
-#[inline(always)]
-fn prefetch_block(l: &[f64], val_ptr: &[usize], s: usize, ahead: bool, distance: usize) {
-    #[cfg(target_arch = "x86_64")]
-    if distance > 0 {
-        let (a, b) = (val_ptr[s], val_ptr[s + 1]);
-        let (a, b) = if ahead {
-            ((a + distance).min(l.len()), (b + distance).min(l.len()))
-        } else {
-            (a.saturating_sub(distance), b.saturating_sub(distance))
-        };
-        let mut i = a & !7;
-        while i < b {
-            // SAFETY: i < b <= l.len(): an address inside `l` (a prefetch
-            // reads nothing into the program either way).
-            #[allow(unsafe_code)]
-            unsafe {
-                std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-                    l.as_ptr().add(i).cast(),
-                );
-            }
-            i += 8;
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (l, val_ptr, s, ahead, distance);
-}
-
-/// How far ahead of the solve [`prefetch_block`] asks for L, in values (16
-/// KB). `prefetch_lab`, one solve on the Q2 352×88 slab's operator (29.3M
-/// values), 2026-11-25, distances 0 / 1024 / 2048 / 4096 alternating in one
-/// process, three runs, medians of 15: one thread 70.9-72.0 / 60.2-60.6 /
-/// 60.1-61.1 / 60.5-61.0 ms, two threads 40.8-46.5 / 35.8-38.0 / 36.1-36.8
-/// / 36.3-42.0 ms.
-const PREFETCH: usize = 2048;
-
-/// Factors from this many values (32 MB, the size of this machine's L3)
-/// prefetch; a smaller one stays in the caches from one solve to the
-/// next, where the prefetches only add instructions: on the 8,352-DOF Q1
-/// slab (L 3.9 MB) the bench's Newmark solve took 0.42-0.58 against
-/// 0.39-0.54 ms without (three alternating runs), while at 62k DOFs (L
-/// about 40 MB) it gained.
-const PREFETCH_MIN_VALUES: usize = 1 << 22;
 
 fn permute_in(fwd: &[u32], b: &[f64], xp: &mut [f64]) {
     for (y, &f) in xp.iter_mut().zip(fwd) {
@@ -1015,380 +955,4 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
         s += x * y;
     }
     s
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::testing::{on_threads, plain_spmv, rectangle};
-    use crate::{Hypothesis, Material, Model};
-    use faer::dyn_stack::{MemBuffer, MemStack};
-    use faer::sparse::linalg::cholesky::LltRef;
-    use faer::sparse::SparseColMatRef;
-    use faer::{Conj, MatMut, Par, Side, Spec};
-    use nalgebra_sparse::CsrMatrix;
-    use stickslip_mesh::CellKind;
-
-    fn operator(kind: CellKind, nx: usize, ny: usize) -> CsrMatrix<f64> {
-        let mesh = rectangle(kind, nx, ny, [0.0, 0.0], [8.0, 1.0]);
-        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
-        let model = Model::new(&mesh, &material, &[]).unwrap();
-        // A₀ of the paper's Newmark step: (β/γ)Δt K + M/(γΔt), Δt = 1e-3.
-        model.combined(0.5e-3, 1.0 / 0.5e-3)
-    }
-
-    fn as_csc(a: &CsrMatrix<f64>) -> SparseColMatRef<'_, usize, f64> {
-        crate::csc_view(a, a.values())
-    }
-
-    struct Factor {
-        symbolic: SymbolicCholesky<usize>,
-        l: Vec<f64>,
-    }
-
-    fn factor(a: &CsrMatrix<f64>) -> Factor {
-        let symbolic = crate::analyze_symbolic(a, &crate::FillOrder::default()).unwrap();
-        let mut l = vec![0.0; symbolic.len_val()];
-        let mut scratch = MemBuffer::new(
-            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
-        );
-        symbolic
-            .factorize_numeric_llt(
-                &mut l,
-                as_csc(a),
-                Side::Lower,
-                Default::default(),
-                Par::Seq,
-                MemStack::new(&mut scratch),
-                Spec::default(),
-            )
-            .unwrap();
-        Factor { symbolic, l }
-    }
-
-    fn faer_solve(f: &Factor, x: &mut [f64]) {
-        let n = x.len();
-        let mut scratch = MemBuffer::new(f.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
-        LltRef::<'_, usize, f64>::new(&f.symbolic, &f.l).solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(x, n, 1),
-            Par::Seq,
-            MemStack::new(&mut scratch),
-        );
-    }
-
-    fn residual(a: &CsrMatrix<f64>, x: &[f64], b: &[f64]) -> f64 {
-        let mut worst: f64 = 0.0;
-        let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for (ax, bi) in plain_spmv(a, x).iter().zip(b) {
-            worst = worst.max((ax - bi).abs() / scale);
-        }
-        worst
-    }
-
-    fn rhs(n: usize) -> Vec<f64> {
-        (0..n)
-            .map(|i| ((i * 7919) % 1000) as f64 / 500.0 - 1.0)
-            .collect()
-    }
-
-    /// The solve satisfies A x = b (residual against the matrix, not
-    /// against faer) and agrees with faer's solve, Q1 and Q2.
-    #[test]
-    fn solves_like_faer() {
-        for (kind, nx, ny) in [(CellKind::Quad4, 24, 6), (CellKind::Quad9, 8, 2)] {
-            let a = operator(kind, nx, ny);
-            let f = factor(&a);
-            let mut sn = Supernodal::new(&f.symbolic).expect("forced supernodal");
-            let b = rhs(a.nrows());
-            let mut x = b.clone();
-            sn.solve(&f.l, &mut x);
-            assert!(residual(&a, &x, &b) < 1e-12, "{kind:?}");
-            let mut y = b.clone();
-            faer_solve(&f, &mut y);
-            let d = x
-                .iter()
-                .zip(&y)
-                .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
-            let s = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            assert!(d <= 1e-12 * s, "{kind:?}: {d} against {s}");
-        }
-    }
-
-    /// The split step (forward, back on the reach, forward on the reach,
-    /// back) gives A⁻¹b at the reach DOFs and A⁻¹(b − c) in the end.
-    #[test]
-    fn split_step_matches_two_solves() {
-        let a = operator(CellKind::Quad4, 24, 6);
-        let n = a.nrows();
-        let f = factor(&a);
-        let mut sn = Supernodal::new(&f.symbolic).unwrap();
-        // The bottom edge's x DOFs (nodes 0..=24 of the rectangle): DOF 2i.
-        let dofs: Vec<usize> = (0..=24).map(|i| 2 * i).collect();
-        sn.set_reach(&dofs);
-        assert!(sn.reach_len() < f.l.len(), "the reach is part of the tree");
-        let b = rhs(n);
-        let perm = sn.permuted_indices();
-        sn.begin_step(&f.l, &b);
-        let mut full = b.clone();
-        faer_solve(&f, &mut full);
-        for &d in &dofs {
-            let v = sn.reach_value(perm[d]);
-            assert!((v - full[d]).abs() <= 1e-12 * full[d].abs().max(1.0), "{d}");
-        }
-        let c: Vec<(usize, f64)> = dofs.iter().map(|&d| (perm[d], 0.1 * d as f64)).collect();
-        let mut x = vec![0.0; n];
-        sn.finish_step(&f.l, &c, &mut x);
-        let mut bc = b.clone();
-        for &d in &dofs {
-            bc[d] -= 0.1 * d as f64;
-        }
-        assert!(residual(&a, &x, &bc) < 1e-12);
-    }
-
-    /// The two-group solve (forced on a small factor) solves A x = b, and
-    /// gives the same bits on one thread and on two: the groups' arithmetic
-    /// does not depend on the thread count.
-    #[test]
-    fn split_solve_is_right_and_thread_independent() {
-        let a = operator(CellKind::Quad4, 40, 10);
-        let n = a.nrows();
-        let f = factor(&a);
-        let b = rhs(n);
-        let dofs: Vec<usize> = (0..=40).map(|i| 2 * i).collect();
-        let run = |threads: usize| {
-            on_threads(threads, || {
-                let mut sn = Supernodal::with_split_min(&f.symbolic, 0).unwrap();
-                assert!(sn.is_split(), "the tree splits");
-                sn.set_reach(&dofs);
-                let mut x = b.clone();
-                sn.solve(&f.l, &mut x);
-                let perm = sn.permuted_indices();
-                sn.begin_step(&f.l, &b);
-                let at: Vec<f64> = dofs.iter().map(|&d| sn.reach_value(perm[d])).collect();
-                let c: Vec<(usize, f64)> = dofs.iter().map(|&d| (perm[d], 0.5)).collect();
-                let mut y = vec![0.0; n];
-                sn.finish_step(&f.l, &c, &mut y);
-                // The step through W: p, then the corrected solution.
-                let rows: Vec<Vec<(usize, f64)>> =
-                    dofs.iter().map(|&d| vec![(perm[d], 1.0)]).collect();
-                let op = sn.schur_complement(&f.l, &rows);
-                let mut p = vec![0.0; rows.len()];
-                sn.begin_step_paths(&f.l, &op, &b, &mut p);
-                let mut z = vec![0.0; n];
-                sn.finish_step_paths(&f.l, &op, &vec![0.5; rows.len()], &mut z);
-                (x, at, y, (op.s, p, z))
-            })
-        };
-        let (x1, at1, y1, w1) = run(1);
-        let (x2, at2, y2, w2) = run(2);
-        assert!(
-            residual(&a, &w1.2, &{
-                let mut bc = b.clone();
-                for &d in &dofs {
-                    bc[d] -= 0.5;
-                }
-                bc
-            }) < 1e-12
-        );
-        for (k, &d) in dofs.iter().enumerate() {
-            assert!((w1.1[k] - x1[d]).abs() <= 1e-12 * x1[d].abs().max(1.0));
-        }
-        assert!(residual(&a, &x1, &b) < 1e-12);
-        for (k, &d) in dofs.iter().enumerate() {
-            assert!((at1[k] - x1[d]).abs() <= 1e-12 * x1[d].abs().max(1.0));
-        }
-        let mut bc = b.clone();
-        for &d in &dofs {
-            bc[d] -= 0.5;
-        }
-        assert!(residual(&a, &y1, &bc) < 1e-12);
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(&x1), bits(&x2));
-        assert_eq!(bits(&at1), bits(&at2));
-        assert_eq!(bits(&y1), bits(&y2));
-        assert_eq!(bits(&w1.0), bits(&w2.0), "S");
-        assert_eq!(bits(&w1.1), bits(&w2.1), "p through W");
-        assert_eq!(bits(&w1.2), bits(&w2.2), "x through W");
-    }
-
-    /// G = P A⁻¹ Pᵀ on the reach equals P applied to full solves.
-    #[test]
-    fn schur_complement_matches_full_solves() {
-        let a = operator(CellKind::Quad4, 24, 6);
-        let n = a.nrows();
-        let f = factor(&a);
-        let mut sn = Supernodal::new(&f.symbolic).unwrap();
-        let perm = sn.permuted_indices();
-        // Rows of P: 11 "nodes", some with two DOFs (a tangent (0.6, 0.8)).
-        let rows: Vec<Vec<(usize, f64)>> = (0..11)
-            .map(|i| {
-                if i % 2 == 0 {
-                    vec![(2 * i, 0.6), (2 * i + 1, 0.8)]
-                } else {
-                    vec![(2 * i, 1.0)]
-                }
-            })
-            .collect();
-        let dofs: Vec<usize> = rows.iter().flatten().map(|&(d, _)| d).collect();
-        sn.set_reach(&dofs);
-        let permuted: Vec<Vec<(usize, f64)>> = rows
-            .iter()
-            .map(|r| r.iter().map(|&(d, v)| (perm[d], v)).collect())
-            .collect();
-        let op = sn.schur_complement(&f.l, &permuted);
-        let g = &op.s;
-        let p = rows.len();
-        // The step through W: p = P A⁻¹ b, then x = A⁻¹(b − Pᵀf).
-        let b = rhs(n);
-        let mut pv = vec![0.0; p];
-        sn.begin_step_paths(&f.l, &op, &b, &mut pv);
-        let mut full = b.clone();
-        faer_solve(&f, &mut full);
-        for (j, row) in rows.iter().enumerate() {
-            let want: f64 = row.iter().map(|&(d, v)| v * full[d]).sum();
-            assert!(
-                (pv[j] - want).abs() <= 1e-12 * want.abs().max(1.0),
-                "p[{j}]"
-            );
-        }
-        let fv: Vec<f64> = (0..p).map(|j| 0.3 * j as f64 - 1.0).collect();
-        let mut x = vec![0.0; n];
-        sn.finish_step_paths(&f.l, &op, &fv, &mut x);
-        let mut bc = b.clone();
-        for (row, fj) in rows.iter().zip(&fv) {
-            for &(d, v) in row {
-                bc[d] -= v * fj;
-            }
-        }
-        assert!(residual(&a, &x, &bc) < 1e-12);
-        assert!(op.w_len() < sn.reach_cols * p, "W is sparse");
-        for j in 0..p {
-            let mut x = vec![0.0; n];
-            for &(d, v) in &rows[j] {
-                x[d] = v;
-            }
-            faer_solve(&f, &mut x);
-            for i in 0..p {
-                let want: f64 = rows[i].iter().map(|&(d, v)| v * x[d]).sum();
-                assert!(
-                    (g[j * p + i] - want).abs() <= 1e-12 * want.abs().max(1e-3),
-                    "G[{i}, {j}] = {} against {want}",
-                    g[j * p + i]
-                );
-            }
-        }
-    }
-
-    /// Timing lab (run by hand): one solve on the Q2 352×88 slab's
-    /// operator on one and on two threads, with [`prefetch_block`]'s
-    /// distances alternating in one process (0: none), median (fastest)
-    /// of 15 solves each.
-    ///
-    ///     cargo test --release -p stickslip-fem --lib prefetch_lab -- --ignored --nocapture
-    #[test]
-    #[ignore = "timing lab, run by hand"]
-    fn prefetch_lab() {
-        let a = operator(CellKind::Quad9, 352, 88);
-        let n = a.nrows();
-        let f = factor(&a);
-        let b = rhs(n);
-        for threads in [1, 2] {
-            crate::testing::on_threads(threads, || {
-                let mut sn = Supernodal::new(&f.symbolic).unwrap();
-                let mut x = b.clone();
-                let distances = [0, 1024, 2048, 4096];
-                let mut t: Vec<Vec<f64>> = vec![Vec::new(); distances.len()];
-                for _ in 0..15 {
-                    for (d, t) in distances.iter().zip(&mut t) {
-                        sn.prefetch = *d;
-                        x.copy_from_slice(&b);
-                        let s = std::time::Instant::now();
-                        sn.solve(&f.l, &mut x);
-                        t.push(s.elapsed().as_secs_f64());
-                    }
-                }
-                print!("{threads} thread(s), L {} values:", f.l.len());
-                for (d, t) in distances.iter().zip(&mut t) {
-                    t.sort_by(f64::total_cmp);
-                    print!("  {d}: {:.2} ({:.2})", t[7] * 1e3, t[0] * 1e3);
-                }
-                println!(" ms");
-            });
-        }
-    }
-
-    /// Timing lab (run by hand): one solve with faer's and with this
-    /// module's loops on the Q1 slab of 252k DOFs, and the reach's share.
-    ///
-    ///     cargo test -p stickslip-fem --lib supernodal_lab -- --ignored --nocapture
-    #[test]
-    #[ignore = "timing lab, run by hand"]
-    fn supernodal_lab() {
-        for (kind, nx, ny) in [(CellKind::Quad4, 708, 177), (CellKind::Quad9, 352, 88)] {
-            let a = operator(kind, nx, ny);
-            let n = a.nrows();
-            let f = factor(&a);
-            let mut sn = Supernodal::new(&f.symbolic).unwrap();
-            let dofs: Vec<usize> = (0..=nx * if kind == CellKind::Quad9 { 2 } else { 1 })
-                .map(|i| 2 * i)
-                .collect();
-            sn.set_reach(&dofs);
-            let b = rhs(n);
-            let time = |f: &mut dyn FnMut()| {
-                let mut t = Vec::new();
-                for _ in 0..7 {
-                    let s = std::time::Instant::now();
-                    f();
-                    t.push(s.elapsed().as_secs_f64());
-                }
-                t.sort_by(f64::total_cmp);
-                t[3]
-            };
-            let mut x = b.clone();
-            let t_faer = time(&mut || {
-                x.copy_from_slice(&b);
-                faer_solve(&f, &mut x);
-            });
-            let t_ours = time(&mut || {
-                x.copy_from_slice(&b);
-                sn.solve(&f.l, &mut x);
-            });
-            let perm = sn.permuted_indices();
-            let c: Vec<(usize, f64)> = dofs.iter().map(|&d| (perm[d], 1.0)).collect();
-            let t_split = time(&mut || {
-                sn.begin_step(&f.l, &b);
-                sn.finish_step(&f.l, &c, &mut x);
-            });
-            let rows: Vec<Vec<(usize, f64)>> = dofs.iter().map(|&d| vec![(perm[d], 1.0)]).collect();
-            let t_op = std::time::Instant::now();
-            let op = sn.schur_complement(&f.l, &rows);
-            let t_op = t_op.elapsed().as_secs_f64();
-            let mut pv = vec![0.0; rows.len()];
-            let fv = vec![1.0; rows.len()];
-            let t_paths = time(&mut || {
-                sn.begin_step_paths(&f.l, &op, &b, &mut pv);
-                sn.finish_step_paths(&f.l, &op, &fv, &mut x);
-            });
-            println!(
-                "  W: {} values ({:.1}% of L, reach {:.1}%), S and W built in {:.2} s; step through W {:.2} ms",
-                op.w_len(),
-                100.0 * op.w_len() as f64 / f.l.len() as f64,
-                100.0 * sn.reach_len() as f64 / f.l.len() as f64,
-                t_op,
-                t_paths * 1e3
-            );
-            println!(
-                "{kind:?} n={n} L={} ({:.0} MB) supernodes={} split={} reach {:.1}% of L: faer {:.2} ms, ours {:.2} ms, split step {:.2} ms",
-                f.l.len(),
-                f.l.len() as f64 * 8e-6,
-                sn.supernodes(),
-                sn.is_split(),
-                100.0 * sn.reach_len() as f64 / f.l.len() as f64,
-                t_faer * 1e3,
-                t_ours * 1e3,
-                t_split * 1e3
-            );
-        }
-    }
 }

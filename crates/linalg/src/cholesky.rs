@@ -1,15 +1,13 @@
 //! Sparse symmetric positive definite solves with faer's Cholesky.
 //!
-//! The implicit Newmark operator (β/γ)ΔtK + M/(γΔt) + C keeps one sparsity
-//! pattern for a whole run, so the fill-reducing ordering and the symbolic
-//! factorization are computed once ([`SparseCholesky::analyze`]) and every
-//! change of Δt or of the stick/slip classes only redoes the numeric part
-//! ([`SparseCholesky::factorize`]). Measured choice: DEPENDENCIES.md §3 (AMD +
-//! supernodal, about 80× faster than an unordered simplicial Cholesky; from
-//! 100k free DOFs a nested dissection of the mesh's cells unless AMD's
-//! factor is clearly smaller, [`crate::FillOrder`]). The factor is always
-//! supernodal and solved by [`Supernodal`]'s loops (2.7× faster than faer's
-//! one-column solve at 250k DOFs; `supernodal.rs`).
+//! The operators factorized here keep one sparsity pattern over many
+//! factorizations (a run's K, its A₀ for every Δt), so the fill-reducing
+//! ordering and the symbolic factorization are computed once
+//! ([`SparseCholesky::analyze`]) and a change of values only redoes the
+//! numeric part ([`SparseCholesky::factorize`]). AMD and supernodal (the
+//! measured choice: DEPENDENCIES.md §3), or the caller's nested dissection
+//! ([`crate::FillOrder`]). The factor is always supernodal and solved by
+//! [`Supernodal`]'s loops.
 
 use std::cell::RefCell;
 
@@ -124,12 +122,12 @@ pub fn analyze_symbolic(
         Some(true) => symbolic_in(a, Some(forward)),
         Some(false) => symbolic_in(a, None),
         // The first analysis of the run: both, AMD's kept only where its
-        // factor is clearly the smaller (`ordering.rs`, AMD_MARGIN).
+        // factor is clearly the smaller (`fill_order.rs`, AMD_MARGIN).
         None => {
             let dissected = symbolic_in(a, Some(forward))?;
             let amd = symbolic_in(a, None)?;
             let dissection_won =
-                dissected.len_val() as f64 <= crate::ordering::AMD_MARGIN * amd.len_val() as f64;
+                dissected.len_val() as f64 <= crate::AMD_MARGIN * amd.len_val() as f64;
             let _ = chosen.set(dissection_won);
             Ok(if dissection_won { dissected } else { amd })
         }
@@ -318,7 +316,13 @@ mod tests {
         chol.factorize(&a).unwrap();
         let mut x = b.clone();
         chol.solve_in_place(&mut x);
-        for (i, ax) in crate::testing::plain_spmv(&a, &x).iter().enumerate() {
+        for (i, row) in a.row_iter().enumerate() {
+            let ax: f64 = row
+                .col_indices()
+                .iter()
+                .zip(row.values())
+                .map(|(&j, v)| v * x[j])
+                .sum();
             assert!((ax - b[i]).abs() < 1e-12, "residual at row {i}");
         }
     }

@@ -1,0 +1,431 @@
+//! From a validated case to what runs it: the mesh, the model (DOF map, K,
+//! M, lumped M), the loads, the contact surface, the settings and the
+//! integrator. Every problem the mesh reveals (a group it lacks, a group of
+//! the wrong dimension, a free rigid-body motion, Δt above the critical
+//! step, ...) is an [`InputError`] naming the case file and the line of the
+//! key concerned, all of them reported together where they are found in
+//! one pass.
+
+use stickslip_contact::{ContactSurface, IterationOptions};
+use stickslip_fem::{
+    body_force_load, traction_load, Dirichlet, DofMap, Hypothesis as FemHypothesis, Material,
+    Model, Traction,
+};
+use stickslip_mesh::Mesh;
+use stickslip_time::{
+    Dynamics, ExplicitFriction, History as TimeHistory, ImplicitSolver, Integrator, Load,
+    MassKind as TimeMass, Scheme as TimeScheme, Settings, StickReduction as TimeReduction,
+    TimeError,
+};
+
+use crate::error::{listed, InputError};
+use crate::schema::{Case, History, Hypothesis, MassKind, Scheme};
+
+/// A case assembled: everything the integrator is built from, each part
+/// open to change before it is (`verify` injects its faults here).
+#[derive(Debug)]
+pub struct Scene {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// K, M, lumped M, DOF map.
+    pub model: Model,
+    /// The friction surface, if the case has one.
+    pub contact: Option<ContactSurface>,
+    /// The tractions in case order, then the body force, then the contact
+    /// pressure, each restricted to the free DOFs.
+    pub loads: Vec<Load>,
+    /// Scheme, Δt, mass, iteration, step reduction.
+    pub settings: Settings,
+}
+
+/// A case turned into the objects that run it, with the model kept for
+/// inspection (`check`, `advise`, the pilots).
+#[derive(Debug)]
+pub struct Prepared {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// K, M, lumped M, DOF map.
+    pub model: Model,
+    /// The integrator at t = 0 (initial state computed).
+    pub integrator: Integrator,
+}
+
+/// A case turned into the objects that run it, for a run: K and M have
+/// moved into the integrator (a copy left in a model would be held for the
+/// whole run, 24 bytes per stored entry of K beside the step's own data).
+#[derive(Debug)]
+pub struct Running {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// The DOF map of the integrator's free DOFs.
+    pub dofs: DofMap,
+    /// The integrator at t = 0 (initial state computed).
+    pub integrator: Integrator,
+}
+
+/// [`assemble`] and the integrator, the model kept.
+///
+/// # Errors
+/// Every input problem found, as one [`InputError`].
+pub fn prepare(case: &Case) -> Result<Prepared, InputError> {
+    assemble(case)?.prepared(case)
+}
+
+impl Scene {
+    /// The integrator of this scene, its K and M copied (the scene can
+    /// build another).
+    ///
+    /// # Errors
+    /// The settings refused (Δt above the critical step, a mass the scheme
+    /// cannot take), or the initial static solve failed.
+    pub fn integrator(&self) -> Result<Integrator, TimeError> {
+        let dynamics = Dynamics::from_model(&self.model);
+        Integrator::new(
+            dynamics,
+            self.contact.clone(),
+            self.loads.clone(),
+            self.settings.clone(),
+        )
+    }
+
+    /// The integrator, the model kept.
+    ///
+    /// # Errors
+    /// As [`Scene::integrator`], located in `case`.
+    pub fn prepared(self, case: &Case) -> Result<Prepared, InputError> {
+        let dynamics = Dynamics::from_model(&self.model);
+        let integrator = Integrator::new(dynamics, self.contact, self.loads, self.settings)
+            .map_err(|e| refused(case, e))?;
+        Ok(Prepared {
+            mesh: self.mesh,
+            model: self.model,
+            integrator,
+        })
+    }
+
+    /// The integrator, K and M moved into it.
+    ///
+    /// # Errors
+    /// As [`Scene::prepared`].
+    pub fn running(self, case: &Case) -> Result<Running, InputError> {
+        let dofs = self.model.dofs.clone();
+        let dynamics = Dynamics::from_model_owned(self.model);
+        let integrator = Integrator::new(dynamics, self.contact, self.loads, self.settings)
+            .map_err(|e| refused(case, e))?;
+        Ok(Running {
+            mesh: self.mesh,
+            dofs,
+            integrator,
+        })
+    }
+}
+
+/// The integrator's refusal, at the key it concerns.
+fn refused(case: &Case, e: TimeError) -> InputError {
+    let key = match e {
+        TimeError::Unstable { .. } => "time.dt",
+        TimeError::Static(_) => "dirichlet.0.group",
+        _ => "time.scheme",
+    };
+    InputError(format!("{}[time]: {e}", case.at(key)))
+}
+
+/// The time crate's copy of a load history.
+fn history(h: &History) -> TimeHistory {
+    match h {
+        History::Constant => TimeHistory::Constant,
+        History::Step => TimeHistory::Step,
+        History::Sin { omega } => TimeHistory::Sin { omega: *omega },
+        History::Table(points) => TimeHistory::Table(points.iter().map(|p| (p[0], p[1])).collect()),
+    }
+}
+
+/// The time crate's settings of a case.
+pub fn settings(case: &Case) -> Settings {
+    let scheme = match case.time.scheme {
+        Scheme::CentralDifference => TimeScheme::CentralDifference,
+        Scheme::Newmark => TimeScheme::Newmark {
+            beta: case.time.beta,
+            gamma: case.time.gamma,
+        },
+    };
+    Settings {
+        scheme,
+        mass: case.time.mass.map(|m| match m {
+            MassKind::Consistent => TimeMass::Consistent,
+            MassKind::Lumped => TimeMass::Lumped,
+        }),
+        dt: case.time.dt,
+        t_end: case.time.t_end,
+        stick_reduction: case.time.stick_reduction.as_ref().map(|r| TimeReduction {
+            dt: r.dt,
+            steps: r.steps,
+        }),
+        iteration: case
+            .contact
+            .as_ref()
+            .map_or_else(IterationOptions::default, |c| IterationOptions {
+                remark_4_2: c.remark_4_2,
+                max_iterations: c.max_iterations,
+            }),
+        allow_unstable: case.time.allow_unstable,
+        explicit_friction: ExplicitFriction::ClosedForm,
+        initial_velocity: None,
+        implicit_solver: ImplicitSolver::Schur,
+        restoring: false,
+    }
+}
+
+/// Checks a group the case names against the mesh: it exists (else the
+/// message lists the mesh's groups) and, when `dim` is given, has that
+/// dimension.
+fn check_group(
+    mesh: &Mesh,
+    case: &Case,
+    key: &str,
+    name: &str,
+    dim: Option<u8>,
+    purpose: &str,
+    problems: &mut Vec<String>,
+) -> bool {
+    match mesh.group(name) {
+        Err(e) if matches!(e.kind, stickslip_mesh::MeshErrorKind::AmbiguousGroup { .. }) => {
+            problems.push(format!(
+                "{}{key} = {name:?}: in {}: {e}",
+                case.at(key),
+                case.mesh.file.display()
+            ));
+            false
+        }
+        Err(_) => {
+            let have: Vec<String> = mesh
+                .groups
+                .iter()
+                .map(|g| format!("{:?} (dim {})", g.name, g.dim))
+                .collect();
+            problems.push(format!(
+                "{}{key} = {name:?}: the mesh {} has no physical group {name:?}; it has: {}; \
+                 use one of those, or add the group in Gmsh (Physical Curve/Surface)",
+                case.at(key),
+                case.mesh.file.display(),
+                if have.is_empty() {
+                    "none".to_string()
+                } else {
+                    have.join(", ")
+                }
+            ));
+            false
+        }
+        Ok(g) => match dim {
+            Some(d) if g.dim != d => {
+                problems.push(format!(
+                    "{}{key} = {name:?}: {purpose} needs a group of boundary lines (dimension {d}), \
+                     but {name:?} has dimension {}; name the boundary edges in Gmsh with a Physical Curve",
+                    case.at(key),
+                    g.dim
+                ));
+                false
+            }
+            // A line inside the body (Gmsh's `Line{..} In Surface{..}`):
+            // a load or friction there would act inside the body.
+            Some(_) if mesh.interior_edges(g) > 0 => {
+                problems.push(format!(
+                    "{}{key} = {name:?}: {purpose} must be on the boundary, but {} of the group's {} edges \
+                     lie inside the body (each a side of two cells, as an embedded curve's are); name the \
+                     boundary edges instead",
+                    case.at(key),
+                    mesh.interior_edges(g),
+                    g.edges.len()
+                ));
+                false
+            }
+            _ => true,
+        },
+    }
+}
+
+/// Reads the mesh and builds the model, the loads, the contact surface,
+/// and the settings. The
+/// integrator is not built yet: [`Scene::prepared`], [`Scene::running`].
+///
+/// # Errors
+/// Every input problem found, as one [`InputError`].
+pub fn assemble(case: &Case) -> Result<Scene, InputError> {
+    let mesh = Mesh::from_file(&case.mesh.file)
+        .map_err(|e| InputError(format!("{}{e}", case.at("mesh.file"))))?;
+    let mut problems = Vec::new();
+
+    // Groups first: everything after needs them.
+    let mut groups_ok = true;
+    for (i, d) in case.dirichlet.iter().enumerate() {
+        groups_ok &= check_group(
+            &mesh,
+            case,
+            &format!("dirichlet.{i}.group"),
+            &d.group,
+            None,
+            "a Dirichlet condition",
+            &mut problems,
+        );
+    }
+    let dirichlet_ok = groups_ok;
+    for (i, t) in case.traction.iter().enumerate() {
+        groups_ok &= check_group(
+            &mesh,
+            case,
+            &format!("traction.{i}.group"),
+            &t.group,
+            Some(1),
+            "a traction",
+            &mut problems,
+        );
+    }
+    if let Some(c) = &case.contact {
+        groups_ok &= check_group(
+            &mesh,
+            case,
+            "contact.group",
+            &c.group,
+            Some(1),
+            "the contact surface",
+            &mut problems,
+        );
+    }
+
+    let hypothesis = match case.material.hypothesis {
+        Hypothesis::PlaneStrain => FemHypothesis::PlaneStrain,
+        Hypothesis::PlaneStress => FemHypothesis::PlaneStress,
+    };
+    let material = match Material::new(
+        case.material.e,
+        case.material.nu,
+        case.material.rho,
+        hypothesis,
+    ) {
+        Ok(m) => Some(m),
+        Err(e) => {
+            problems.push(format!("{}[material]: {e}", case.at("material.E")));
+            None
+        }
+    };
+    let mut conditions = Vec::new();
+    for d in &case.dirichlet {
+        for (component, value) in [(0, d.ux), (1, d.uy)] {
+            if let Some(value) = value {
+                conditions.push(Dirichlet {
+                    group: d.group.clone(),
+                    component,
+                    value,
+                });
+            }
+        }
+    }
+    let dirichlet_at = case.at("dirichlet.0.group");
+    let model = match (&material, dirichlet_ok) {
+        (Some(material), true) => match Model::new(&mesh, material, &conditions) {
+            Ok(m) => Some(m),
+            Err(e) => {
+                problems.push(format!("{dirichlet_at}[[dirichlet]]: {e}"));
+                None
+            }
+        },
+        _ => None,
+    };
+    if let Some(m) = &model {
+        // The initial static solve (Remark 4.1) is frictionless: the
+        // supports alone must hold the body (DofMap checks each connected part).
+        let free = m.dofs.free_rigid_motions();
+        if !free.is_empty() {
+            problems.push(format!(
+                "{dirichlet_at}the supports leave a rigid-body motion free for the initial static solve: {}; \
+                 add [[dirichlet]] conditions that prevent it (e.g. uy = 0 on a bottom or top group and ux = 0 on an end)",
+                free.join(", ")
+            ));
+        }
+    }
+    let (Some(model), Some(_)) = (model.filter(|_| groups_ok && problems.is_empty()), material)
+    else {
+        return Err(InputError(listed(problems)));
+    };
+
+    let n_full = 2 * mesh.nodes.len();
+    let n_free = model.dofs.n_free();
+    let mut full = vec![0.0; n_full];
+    let mut loads = Vec::new();
+    let restrict = |full: &[f64]| {
+        let mut free = vec![0.0; n_free];
+        model.dofs.restrict(full, &mut free);
+        free
+    };
+    for (i, t) in case.traction.iter().enumerate() {
+        full.iter_mut().for_each(|x| *x = 0.0);
+        let traction = match (t.t, t.pressure) {
+            (Some(v), None) => Traction::Vector(v),
+            (None, Some(p)) => Traction::Pressure(p),
+            _ => {
+                problems.push(format!(
+                    "{}[[traction]] on {:?}: give exactly one of t or pressure",
+                    case.at(&format!("traction.{i}.group")),
+                    t.group
+                ));
+                continue;
+            }
+        };
+        match traction_load(&mesh, &t.group, traction, &mut full) {
+            Ok(()) => loads.push(Load {
+                vector: restrict(&full),
+                history: history(&t.history),
+            }),
+            Err(e) => problems.push(format!(
+                "{}[[traction]]: {e}",
+                case.at(&format!("traction.{i}.group"))
+            )),
+        }
+    }
+    if let Some(f) = case.body_force {
+        full.iter_mut().for_each(|x| *x = 0.0);
+        body_force_load(&mesh, f, &mut full);
+        loads.push(Load {
+            vector: restrict(&full),
+            history: TimeHistory::Constant,
+        });
+    }
+    let mut contact = None;
+    if let Some(c) = &case.contact {
+        // The prescribed normal traction on Γ_C is a load like any other,
+        // present before t = 0 (it makes the initial static state, METHOD.md §3).
+        full.iter_mut().for_each(|x| *x = 0.0);
+        match traction_load(&mesh, &c.group, Traction::Pressure(c.pressure), &mut full) {
+            Ok(()) => loads.push(Load {
+                vector: restrict(&full),
+                history: TimeHistory::Constant,
+            }),
+            Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
+        }
+        match ContactSurface::from_group(&mesh, &model.dofs, &c.group, c.pressure, c.mu, c.eps) {
+            // Every node's tangential DOF held: the friction the case asks
+            // for could act nowhere (before, it was dropped silently, and
+            // the file had no /contact).
+            Ok(s) if s.is_empty() => problems.push(format!(
+                "{}[contact]: no node of group \"{}\" can slide: [[dirichlet]] conditions hold the tangential \
+                 motion of all its {} nodes, so friction would act nowhere; remove the [[dirichlet]] on the \
+                 contact surface's tangential direction, or remove [contact] for a run without friction",
+                case.at("contact.group"),
+                c.group,
+                s.excluded.len()
+            )),
+            Ok(s) => contact = Some(s),
+            Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
+        }
+    }
+    if !problems.is_empty() {
+        return Err(InputError(listed(problems)));
+    }
+    Ok(Scene {
+        mesh,
+        model,
+        contact,
+        loads,
+        settings: settings(case),
+    })
+}

@@ -1,0 +1,972 @@
+//! Reading a case: TOML in, a validated [`Case`] out (DESIGN.md "Case file").
+//!
+//! Loading goes in five steps, so that every message can name the file and
+//! the line the user has to edit:
+//! 1. parse the text with `toml_edit` (syntax errors, original lines);
+//! 2. apply the `--set KEY=VALUE` overrides to that document, which keeps the
+//!    rest of the text (and its comments) as written; the result is
+//!    [`Case::source`], the case as run;
+//! 3. check every key against the schema (`keys.rs`): unknown keys (with
+//!    the nearest valid key suggested) and values of the wrong type are
+//!    all collected, then removed so that step 4 can still look at the rest;
+//! 4. deserialize with serde into the schema's types (`deny_unknown_fields`);
+//! 5. validate every value, collecting all problems before reporting, each
+//!    at the place of its value in the text.
+//!
+//! Lines of the final text are mapped back to the user's file by a line diff;
+//! a problem on a line that `--set` changed is reported against that `--set`.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::Path;
+
+use crate::error::{listed, InputError};
+use crate::keys::{check_table, dotted, remove_path, seg_name, value_spans};
+use crate::locate::{line_col, Locator};
+use crate::schema::{Case, History, MassKind, Scheme, ROOT};
+use crate::set::apply_set;
+
+/// Reads, overrides (`--set KEY=VALUE`, VALUE parsed as TOML, else taken as a
+/// string) and validates a case file.
+///
+/// # Errors
+/// An [`InputError`] listing every problem found, each as
+/// `file:line:col: what; what to do` (or `--set KEY=VALUE: ...`).
+pub fn load(path: &Path, sets: &[String]) -> Result<Case, InputError> {
+    let file = path.display().to_string();
+    // A device or FIFO would be read forever (`check /dev/zero` hung).
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        return Err(InputError(format!(
+            "{file}: not a regular file (a device, FIFO or socket); give the case's .toml file"
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(|e| {
+        InputError(format!(
+            "{file}: cannot read the case file: {e}; check the path"
+        ))
+    })?;
+    if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        return Err(InputError(format!(
+            "{file}: UTF-16 text (it starts with a UTF-16 byte-order mark); TOML files are UTF-8: \
+             save it as UTF-8 in your editor (e.g. `iconv -f utf-16 -t utf-8`)"
+        )));
+    }
+    let original = String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let text = &e.as_bytes()[..at];
+        let line = text.iter().filter(|&&b| b == b'\n').count() + 1;
+        let col = text.iter().rev().take_while(|&&b| b != b'\n').count() + 1;
+        InputError(format!(
+            "{file}:{line}:{col}: not UTF-8 text (byte {at}); TOML files are UTF-8: save it as \
+             UTF-8 in your editor (e.g. `iconv -f latin1 -t utf-8`)"
+        ))
+    })?;
+    load_str(path, &original, sets)
+}
+
+/// [`load`] on text already in memory (`path` names it and anchors relative paths).
+///
+/// # Errors
+/// As [`load`].
+pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, InputError> {
+    let file = path.display().to_string();
+    let mut doc: toml_edit::DocumentMut = original.parse().map_err(|e: toml_edit::TomlError| {
+        let at = e.span().map(|s| line_col(original, s.start));
+        InputError(format!(
+            "{}: invalid TOML: {}; fix the syntax there",
+            at.map_or(file.clone(), |(l, c)| format!("{file}:{l}:{c}")),
+            e.message().trim_end()
+        ))
+    })?;
+    for s in sets {
+        apply_set(&mut doc, s).map_err(|m| InputError(format!("--set {s}: {m}")))?;
+    }
+    let source = if sets.is_empty() {
+        original.to_string()
+    } else {
+        doc.to_string()
+    };
+    // Step 3: every key against the schema, all problems at once; keys that
+    // are unknown or of the wrong type are then removed so that serde and
+    // the value checks can still report on the rest.
+    let loc = Locator::new(&file, original, &source, sets, false);
+    let mut problems = Vec::new();
+    let mut removals = Vec::new();
+    let mut typed = Vec::new();
+    match toml_edit::Document::parse(source.as_str()) {
+        Ok(spanned) => check_table(
+            spanned.as_table(),
+            &mut Vec::new(),
+            ROOT,
+            &mut |span, msg| problems.push(format!("{}: {msg}", loc.at(span))),
+            &mut removals,
+            &mut typed,
+        ),
+        Err(e) => {
+            // Only --set can make the text unparsable here (the original parsed).
+            return Err(InputError(format!(
+                "{}: the case after --set is not valid TOML: {}; check the --set values",
+                file,
+                e.message().trim_end()
+            )));
+        }
+    }
+    // Lines whose value was replaced: later problems there are artefacts.
+    let quiet_lines: Vec<String> = typed
+        .iter()
+        .filter_map(|(_, _, span)| {
+            let at = loc.at(span.clone());
+            at.rsplit_once(':').map(|(l, _)| format!("{l}:"))
+        })
+        .filter(|l| !l.starts_with("--set"))
+        .collect();
+    let cleaned = if removals.is_empty() && typed.is_empty() {
+        None
+    } else {
+        let mut doc: toml_edit::DocumentMut =
+            source.parse().map_err(|e: toml_edit::TomlError| {
+                InputError(format!("{file}: {}", e.message().trim_end()))
+            })?;
+        for r in &removals {
+            remove_path(doc.as_table_mut(), r, None);
+        }
+        for (r, with, _) in &typed {
+            remove_path(doc.as_table_mut(), r, with.as_ref());
+            if with.is_none() {
+                removals.push(r.clone());
+            }
+        }
+        Some(doc.to_string())
+    };
+    let text = cleaned.as_deref().unwrap_or(&source);
+    let loc_text = Locator::new(&file, original, text, sets, cleaned.is_some());
+
+    match toml::from_str::<Case>(text) {
+        Err(e) => {
+            let msg = e.message().trim_end().to_string();
+            // A required key removed above for its type is already reported.
+            let removed_leaf = |m: &str| {
+                removals.iter().any(|r| {
+                    r.last()
+                        .is_some_and(|k| m.contains(&format!("`{}`", seg_name(k))))
+                })
+            };
+            if !(msg.starts_with("missing field") && removed_leaf(&msg)) {
+                let hint = if msg.starts_with("unknown field") {
+                    "; check the spelling (docs/case-file.md lists the keys)"
+                } else if msg.starts_with("missing field") {
+                    "; add it (docs/case-file.md lists the keys)"
+                } else if msg.starts_with("wanted string or table")
+                    || msg.starts_with("wanted exactly 1 element")
+                {
+                    // Only a traction's history is a string or a one-key table.
+                    " (a traction's history); write history = \"step\", \
+                     history = { sin = { omega = 25.13 } } or history = { table = [[0.0, 0.0], [0.1, 1.0]] }"
+                } else if msg.contains("variant") {
+                    "; use one of the values listed"
+                } else if msg.starts_with("invalid type") || msg.starts_with("invalid length") {
+                    "; numbers go without quotes, text in quotes, vectors as [x, y]"
+                } else {
+                    ""
+                };
+                problems.push(format!("{}: {msg}{hint}", loc_text.at(e.span())));
+            }
+        }
+        Ok(case) => {
+            // Where each value is, in the text serde read.
+            let mut spans = BTreeMap::new();
+            if let Ok(doc) = toml_edit::Document::parse(text) {
+                value_spans(doc.as_table(), "", &mut spans);
+            }
+            match complete(case, path, source.clone(), &spans, &loc_text) {
+                Ok(case) if problems.is_empty() => return Ok(case),
+                Ok(_) => {}
+                Err(bad) => {
+                    // A key given a placeholder (its type was wrong, which
+                    // is reported): what the checks say of the placeholder
+                    // is no problem of the user's, also where the value came
+                    // from --set (no line of the file to quiet).
+                    let placeholders: Vec<String> =
+                        typed.iter().map(|(p, _, _)| dotted(p)).collect();
+                    // ": key " also matches "[section]: key ".
+                    let of_placeholder = |p: &str| {
+                        placeholders.iter().any(|k| {
+                            [" ", ":"]
+                                .iter()
+                                .any(|end| p.contains(&format!(": {k}{end}")))
+                        })
+                    };
+                    problems.extend(bad.into_iter().filter(|p| {
+                        !quiet_lines.iter().any(|l| p.starts_with(l.as_str())) && !of_placeholder(p)
+                    }));
+                }
+            }
+        }
+    }
+    Err(InputError(listed(problems)))
+}
+
+/// [`load_str`] on text alone, named `case.toml` in the current directory
+/// (for fuzzing and property tests: any text gives a case or an error).
+///
+/// # Errors
+/// As [`load`].
+pub fn parse_str(text: &str) -> Result<Case, InputError> {
+    load_str(Path::new("case.toml"), text, &[])
+}
+
+/// Most steps a case may ask for: 1e12 steps of the paper's 85-node mesh
+/// (about 1 µs each) take twelve days.
+const MAX_STEPS: f64 = 1e12;
+
+/// Checks every value of the case serde read, collecting every problem,
+/// and completes it: paths resolved against the case file's directory,
+/// `output.file` defaulted, where each key is. `spans`: each value's
+/// place in the text serde read, by dotted key.
+fn complete(
+    mut case: Case,
+    path: &Path,
+    source: String,
+    spans: &BTreeMap<String, Range<usize>>,
+    loc: &Locator,
+) -> Result<Case, Vec<String>> {
+    let mut bad = Vec::new();
+    let span = |key: &str| spans.get(key).cloned();
+    let mut check = |ok: bool, key: &str, msg: String| {
+        if !ok {
+            bad.push(format!("{}: {msg}", loc.at(span(key))));
+        }
+    };
+    let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
+
+    // [mesh]
+    let mesh_file = base.join(&case.mesh.file);
+    check(
+        mesh_file.is_file(),
+        "mesh.file",
+        if mesh_file.is_dir() {
+            format!(
+                "mesh.file: {} is a directory; give the .msh file in it",
+                mesh_file.display()
+            )
+        } else if mesh_file.exists() {
+            format!(
+                "mesh.file: {} is not a regular file (a device, FIFO or socket); give the .msh file",
+                mesh_file.display()
+            )
+        } else {
+            format!(
+                "mesh.file: {} does not exist (paths are relative to the case file's directory); \
+                 check the name, or make the mesh with Gmsh",
+                mesh_file.display()
+            )
+        },
+    );
+
+    // mesh.ladder: at least one entry. Whether its files exist is checked
+    // by `advise`, which reads them; a run does not, and must not fail on them.
+    if spans.contains_key("mesh.ladder") {
+        check(
+            !case.mesh.ladder.is_empty(),
+            "mesh.ladder",
+            "mesh.ladder is empty; list the meshes coarse to fine, e.g. [\"a.msh\", \"b.msh\"], or remove the key".into(),
+        );
+    }
+
+    // [material]
+    let m = &case.material;
+    let (e, nu, rho) = (m.e, m.nu, m.rho);
+    check(
+        e > 0.0 && e.is_finite(),
+        "material.E",
+        format!("material.E = {e} must be a finite number > 0; give Young's modulus"),
+    );
+    check(
+        rho > 0.0 && rho.is_finite(),
+        "material.rho",
+        format!("material.rho = {rho} must be a finite number > 0; give the mass density"),
+    );
+    check(
+        nu > -1.0 && nu < 0.5,
+        "material.nu",
+        format!("material.nu = {nu} must lie in (-1, 0.5); 0.5 (incompressible) cannot be modelled with displacements only"),
+    );
+
+    // [[dirichlet]]
+    for (i, d) in case.dirichlet.iter().enumerate() {
+        let group = format!("dirichlet.{i}.group");
+        check(
+            d.ux.is_some() || d.uy.is_some(),
+            &group,
+            format!(
+                "dirichlet.{} (group {:?}) fixes neither ux nor uy; add ux = .. and/or uy = ..",
+                i, d.group
+            ),
+        );
+        let finite = d.ux.is_none_or(f64::is_finite) && d.uy.is_none_or(f64::is_finite);
+        check(
+            finite,
+            &group,
+            format!(
+                "dirichlet.{i} (group {:?}): {}: give finite numbers",
+                d.group,
+                [("ux", d.ux), ("uy", d.uy)]
+                    .iter()
+                    .filter_map(|(k, v)| v.map(|v| format!("{k} = {v}")))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        );
+    }
+
+    // A component of a group prescribed twice: even with equal values it is
+    // a copy-paste slip the user should see (different values would also
+    // contradict each other).
+    let mut seen: BTreeMap<(&str, usize), usize> = BTreeMap::new();
+    for (i, d) in case.dirichlet.iter().enumerate() {
+        for (comp, given) in [(0, d.ux.is_some()), (1, d.uy.is_some())] {
+            if !given {
+                continue;
+            }
+            if let Some(first) = seen.insert((d.group.as_str(), comp), i) {
+                let c = if comp == 0 { "ux" } else { "uy" };
+                check(
+                    false,
+                    &format!("dirichlet.{i}.group"),
+                    format!(
+                        "dirichlet.{} (group {:?}) sets {c} again, already set by dirichlet.{} ({}); give each component of a group once",
+                        i,
+                        d.group,
+                        first,
+                        loc.at(span(&format!("dirichlet.{first}.group")))
+                    ),
+                );
+            }
+        }
+    }
+
+    // [[traction]]
+    for (i, t) in case.traction.iter().enumerate() {
+        let what = format!("traction.{i} (group {:?})", t.group);
+        let group = format!("traction.{i}.group");
+        check(
+            t.t.is_some() != t.pressure.is_some(),
+            &group,
+            format!(
+                "{what} must give exactly one of t = [tx, ty] and pressure = p; it gives {}",
+                if t.t.is_some() { "both" } else { "neither" }
+            ),
+        );
+        let finite = t.t.is_none_or(|v| v.iter().all(|x| x.is_finite()))
+            && t.pressure.is_none_or(f64::is_finite);
+        check(
+            finite,
+            &group,
+            format!("{what}: t and pressure must be finite numbers"),
+        );
+        let history = format!("traction.{i}.history");
+        match &t.history {
+            History::Sin { omega } => check(
+                omega.is_finite(),
+                &history,
+                format!("{what}: history sin omega = {omega} must be a finite number"),
+            ),
+            History::Table(p) => {
+                let increasing = p.windows(2).all(|w| w[1][0] > w[0][0]);
+                let finite = p.iter().flatten().all(|x| x.is_finite());
+                check(
+                    !p.is_empty() && increasing && finite,
+                    &history,
+                    format!("{what}: history table needs at least one [t, f] pair, finite values and strictly increasing times; e.g. {{ table = [[0.0, 0.0], [0.1, 1.0]] }}"),
+                );
+            }
+            History::Constant | History::Step => {}
+        }
+    }
+
+    if let Some(b) = &case.body_force {
+        check(
+            b.iter().all(|x| x.is_finite()),
+            "body_force",
+            "body_force must be finite numbers".into(),
+        );
+    }
+
+    // [contact]
+    if let Some(c) = &case.contact {
+        let (p, mu, eps) = (c.pressure, c.mu, c.eps);
+        check(p >= 0.0 && p.is_finite(), "contact.pressure", format!("contact.pressure = {p} must be >= 0 and finite (it presses the body onto the surface; g = mu * pressure)"));
+        check(
+            mu >= 0.0 && mu.is_finite(),
+            "contact.mu",
+            format!("contact.mu = {mu} must be >= 0 and finite; use 0 for frictionless contact"),
+        );
+        check(eps > 0.0 && eps.is_finite(), "contact.eps", format!("contact.eps = {eps} must be > 0 and finite (the friction law's regularization; the paper uses 1e-4 to 1)"));
+        check(
+            c.max_iterations > 0,
+            "contact.max_iterations",
+            "contact.max_iterations must be >= 1 (default 100)".into(),
+        );
+    }
+
+    // [time]
+    let tm = &case.time;
+    let (dt, t_end) = (tm.dt, tm.t_end);
+    check(
+        dt > 0.0 && dt.is_finite(),
+        "time.dt",
+        format!("time.dt = {dt} must be a finite number > 0"),
+    );
+    check(
+        t_end > 0.0 && t_end.is_finite(),
+        "time.t_end",
+        format!("time.t_end = {t_end} must be a finite number > 0"),
+    );
+    // A run that cannot end (1e300 steps passed `check` and ran on).
+    // Blamed on t_end, or on dt where only dt came from --set.
+    let steps = t_end / dt;
+    let by_set = |key: &str| span(key).is_some_and(|s| loc.set_by_override(&s));
+    let blamed = if by_set("time.dt") && !by_set("time.t_end") {
+        "time.dt"
+    } else {
+        "time.t_end"
+    };
+    check(
+        steps.is_nan() || steps <= MAX_STEPS,
+        blamed,
+        format!(
+            "time.t_end / time.dt = {t_end:e} / {dt:e} = {steps:.3e} steps, more than {MAX_STEPS:e}: \
+             a run that would not end in years; check the two values (their units, a missing minus \
+             sign in an exponent)"
+        ),
+    );
+    let (beta, gamma) = (tm.beta, tm.gamma);
+    if tm.scheme == Scheme::Newmark {
+        // Unconditional stability of Newmark's method: 2β ≥ γ ≥ ½ (Hughes, The
+        // Finite Element Method, §9.1).
+        let key = ["time.gamma", "time.beta"]
+            .into_iter()
+            .find(|k| spans.contains_key(*k))
+            .unwrap_or("time.scheme");
+        check(
+            gamma >= 0.5 && 2.0 * beta >= gamma,
+            key,
+            format!("newmark with beta = {beta}, gamma = {gamma} is not unconditionally stable (needs 2*beta >= gamma >= 0.5); use e.g. beta = 0.25, gamma = 0.5 (trapezoidal) or beta = 0.3025, gamma = 0.6 (damped)"),
+        );
+    }
+    if tm.scheme == Scheme::CentralDifference {
+        // Newmark's parameters on an explicit run would be ignored
+        // silently: say so (a Newmark case switched by --set keeps them).
+        for key in ["beta", "gamma"] {
+            let dotted = format!("time.{key}");
+            if spans.contains_key(&dotted) {
+                check(
+                    false,
+                    &dotted,
+                    format!(
+                        "time.{key} is a Newmark parameter; scheme = \"central_difference\" has none: \
+                         remove it, or use scheme = \"newmark\""
+                    ),
+                );
+            }
+        }
+    }
+    if let (Scheme::CentralDifference, Some(m)) = (tm.scheme, tm.mass) {
+        check(
+            m == MassKind::Lumped,
+            "time.mass",
+            "central_difference needs mass = \"lumped\" (with a consistent mass it is no longer explicit); remove the key or use scheme = \"newmark\"".into(),
+        );
+    }
+    if let Some(r) = &tm.stick_reduction {
+        check(
+            r.dt > 0.0 && r.dt <= dt,
+            "time.stick_reduction.dt",
+            format!(
+                "time.stick_reduction.dt = {} must be > 0 and <= time.dt = {dt}",
+                r.dt
+            ),
+        );
+        check(
+            r.steps > 0,
+            "time.stick_reduction.steps",
+            "time.stick_reduction.steps must be >= 1; remove stick_reduction to turn the reduction off".into(),
+        );
+    }
+
+    // [output]
+    let o = &case.output;
+    check(
+        o.every > 0,
+        "output.every",
+        "output.every must be >= 1 (1 writes every step)".into(),
+    );
+    check(
+        o.flush_every > 0,
+        "output.flush_every",
+        "output.flush_every must be >= 1 (steps between flushes of the results file; default 100)"
+            .into(),
+    );
+    check(
+        o.flush_seconds > 0.0 && !o.flush_seconds.is_nan(),
+        "output.flush_seconds",
+        format!(
+            "output.flush_seconds = {} must be > 0 (seconds between flushes; default 5)",
+            o.flush_seconds
+        ),
+    );
+    if let Some(c) = o.compression {
+        check(
+            c <= 9,
+            "output.compression",
+            format!("output.compression = {c} must be 0 (none) to 9 (deflate level; default 0)"),
+        );
+    }
+
+    if !bad.is_empty() {
+        return Err(bad);
+    }
+    case.output.file = if spans.contains_key("output.file") {
+        base.join(&case.output.file)
+    } else {
+        let stem = path
+            .file_stem()
+            .map_or("results".into(), |s| s.to_string_lossy().into_owned());
+        base.join(format!("{stem}.h5"))
+    };
+    case.mesh.file = mesh_file;
+    case.mesh.ladder_text = case
+        .mesh
+        .ladder
+        .iter()
+        .map(|f| f.display().to_string())
+        .collect();
+    case.mesh.ladder = case.mesh.ladder.iter().map(|f| base.join(f)).collect();
+    case.path = path.to_path_buf();
+    case.source = source;
+    case.locations = spans
+        .iter()
+        .map(|(k, s)| (k.clone(), loc.at(Some(s.clone()))))
+        .collect();
+    Ok(case)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    use crate::{restart_changes, DirichletSection, Hypothesis, MaterialSection};
+
+    /// A directory with a mesh file placeholder, so mesh.file exists.
+    fn scratch(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("stickslip-case-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::write(d.join("m.msh"), "").unwrap();
+        d
+    }
+
+    const GOOD: &str = r#"title = "slab"
+[mesh]
+file = "m.msh"
+[material]
+E = 1000
+nu = 0.3
+rho = 1.0
+[[dirichlet]]
+group = "support"
+uy = 0.0
+[[dirichlet]]
+group = "left"
+ux = 0.0
+[[traction]]
+group = "load"
+t = [-150.0, 0.0]   # compressive
+[contact]
+group = "contact"
+pressure = 300.0
+mu = 0.3
+eps = 1e-4
+[time]
+scheme = "central_difference"
+dt = 1e-3
+t_end = 0.5
+"#;
+
+    fn load_text(name: &str, text: &str, sets: &[&str]) -> Result<Case, InputError> {
+        let d = scratch(name);
+        let p = d.join("case.toml");
+        std::fs::write(&p, text).unwrap();
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        load(&p, &sets)
+    }
+
+    /// The 1-based line of the first line of `text` containing `needle`:
+    /// expected locations come from the test's own text, not the code.
+    fn line_of(text: &str, needle: &str) -> usize {
+        text.lines()
+            .position(|l| l.contains(needle))
+            .expect("needle in text")
+            + 1
+    }
+
+    #[test]
+    fn mesh_ladder_is_read_resolved_and_checked() {
+        let text = GOOD.replace(
+            "file = \"m.msh\"",
+            "file = \"m.msh\"\nladder = [\"m.msh\", \"m.msh\"]  # coarse to fine",
+        );
+        let c = load_text("ladder", &text, &[]).unwrap();
+        let dir = c.path.parent().unwrap().to_path_buf();
+        assert_eq!(c.mesh.ladder, vec![dir.join("m.msh"), dir.join("m.msh")]);
+        assert_eq!(c.mesh.ladder_text, vec!["m.msh", "m.msh"]);
+        assert!(load_text("ladder-none", GOOD, &[])
+            .unwrap()
+            .mesh
+            .ladder
+            .is_empty());
+        // A missing file does not stop a run (advise checks the files); an
+        // empty list and a wrong type are refused, named at their line.
+        let missing = text.replace("[\"m.msh\", \"m.msh\"]", "[\"m.msh\", \"nope.msh\"]");
+        assert!(load_text("ladder-missing", &missing, &[]).is_ok());
+        let line = line_of(&missing, "ladder");
+        let empty = text.replace("[\"m.msh\", \"m.msh\"]", "[]");
+        let e = load_text("ladder-empty", &empty, &[]).unwrap_err().0;
+        assert!(e.contains("mesh.ladder is empty"), "{e}");
+        let wrong = text.replace("[\"m.msh\", \"m.msh\"]", "\"m.msh\"");
+        let e = load_text("ladder-type", &wrong, &[]).unwrap_err().0;
+        assert!(
+            e.contains("mesh.ladder: expected a list of mesh files"),
+            "{e}"
+        );
+        assert!(e.contains(&format!("case.toml:{line}:")), "{e}");
+        // A typo is caught by the unknown-key machinery with a suggestion.
+        let typo = text.replace("ladder =", "ladders =");
+        let e = load_text("ladder-typo", &typo, &[]).unwrap_err().0;
+        assert!(e.contains("did you mean `ladder`?"), "{e}");
+        // A restart may add or change the ladder: advise reads it, a run does not.
+        assert!(restart_changes(GOOD, &text).unwrap().is_empty());
+    }
+
+    #[test]
+    fn good_case_and_defaults() {
+        let c = load_text("good", GOOD, &[]).unwrap();
+        let dir = c.path.parent().unwrap().to_path_buf();
+        assert_eq!(c.title.as_deref(), Some("slab"));
+        assert_eq!(c.mesh.file, dir.join("m.msh"));
+        assert_eq!(
+            c.material,
+            MaterialSection {
+                e: 1000.0,
+                nu: 0.3,
+                rho: 1.0,
+                hypothesis: Hypothesis::PlaneStrain
+            }
+        );
+        assert_eq!(c.dirichlet.len(), 2);
+        assert_eq!(
+            c.dirichlet[1],
+            DirichletSection {
+                group: "left".into(),
+                ux: Some(0.0),
+                uy: None
+            }
+        );
+        assert_eq!(c.traction[0].t, Some([-150.0, 0.0]));
+        assert_eq!(
+            c.traction[0].history,
+            History::Step,
+            "DESIGN.md: history defaults to step"
+        );
+        let k = c.contact.unwrap();
+        assert!(k.remark_4_2);
+        assert_eq!(k.max_iterations, 100);
+        assert_eq!(c.time.scheme, Scheme::CentralDifference);
+        assert_eq!((c.time.beta, c.time.gamma), (0.25, 0.5));
+        assert_eq!(c.time.mass, None);
+        assert!(!c.time.allow_unstable);
+        assert_eq!(
+            c.output.file,
+            dir.join("case.h5"),
+            "default output is <case stem>.h5 beside the case"
+        );
+        assert_eq!(c.output.every, 1);
+        assert_eq!(c.source, GOOD);
+    }
+
+    #[test]
+    fn unknown_key_names_file_line_and_key() {
+        let text = GOOD.replace("eps = 1e-4", "eps = 1e-4\nepsilon = 2");
+        let e = load_text("unknown", &text, &[]).unwrap_err().0;
+        let l = line_of(&text, "epsilon");
+        assert!(
+            e.contains(&format!("case.toml:{l}:1: unknown field `epsilon`")),
+            "{e}"
+        );
+    }
+
+    /// A key in the wrong table is sent to the table the schema has it in,
+    /// a list of tables and a nested table included.
+    #[test]
+    fn misplaced_keys_name_their_table() {
+        let text = GOOD.replace("t_end = 0.5", "t_end = 0.5\nsteps = 3\nux = 0.0");
+        let e = load_text("misplaced", &text, &[]).unwrap_err().0;
+        assert!(
+            e.contains("`steps` belongs in [time.stick_reduction]; move it there"),
+            "{e}"
+        );
+        assert!(
+            e.contains("`ux` belongs in [[dirichlet]]; move it there"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn syntax_error_has_line() {
+        let text = GOOD.replace("mu = 0.3", "mu = = 0.3");
+        let e = load_text("syntax", &text, &[]).unwrap_err().0;
+        let l = line_of(&text, "mu = =");
+        assert!(
+            e.contains(&format!("case.toml:{l}:")) && e.contains("invalid TOML"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn all_value_problems_are_reported_together() {
+        let text = GOOD
+            .replace("E = 1000", "E = -1")
+            .replace("nu = 0.3", "nu = 0.5")
+            .replace("rho = 1.0", "rho = 0")
+            .replace("mu = 0.3", "mu = -0.1")
+            .replace("eps = 1e-4", "eps = 0.0")
+            .replace("dt = 1e-3", "dt = -1e-3")
+            .replace(
+                "t_end = 0.5",
+                "t_end = 0\nmass = \"consistent\"\nstick_reduction = { dt = 1e-2, steps = 3 }",
+            )
+            .replace("file = \"m.msh\"", "file = \"missing.msh\"")
+            .replace("uy = 0.0", "")
+            .replace(
+                "t = [-150.0, 0.0]   # compressive",
+                "t = [-150.0, 0.0]\npressure = 2.0",
+            )
+            + "[output]\nevery = 0\n";
+        let e = load_text("many", &text, &[]).unwrap_err().0;
+        let expect = [
+            ("E = -1", "material.E"),
+            ("nu = 0.5", "material.nu"),
+            ("rho = 0", "material.rho"),
+            ("mu = -0.1", "contact.mu"),
+            ("eps = 0.0", "contact.eps"),
+            ("dt = -1e-3", "time.dt"),
+            ("t_end = 0", "time.t_end"),
+            ("mass = ", "central_difference needs mass = \"lumped\""),
+            ("stick_reduction", "time.stick_reduction.dt"),
+            ("missing.msh", "does not exist"),
+            ("group = \"support\"", "fixes neither ux nor uy"),
+            ("group = \"load\"", "exactly one of t"),
+            ("every = 0", "output.every"),
+        ];
+        for (needle, what) in expect {
+            let l = line_of(&text, needle);
+            assert!(
+                e.lines()
+                    .any(|m| m.contains(&format!("case.toml:{l}:")) && m.contains(what)),
+                "no '{what}' at line {l} in:\n{e}"
+            );
+        }
+        assert_eq!(
+            e.lines().count(),
+            expect.len(),
+            "one line per problem:\n{e}"
+        );
+    }
+
+    #[test]
+    fn newmark_stability_condition() {
+        // 2β ≥ γ ≥ ½ (textbook unconditional stability): (0.3025, 0.6) passes,
+        // (0.25, 0.4) and (0.2, 0.5) fail.
+        let nm = GOOD.replace("\"central_difference\"", "\"newmark\"");
+        let ok = load_text("nm-ok", &nm, &["time.beta=0.3025", "time.gamma=0.6"]).unwrap();
+        assert_eq!((ok.time.beta, ok.time.gamma), (0.3025, 0.6));
+        for (b, g) in [(0.25, 0.4), (0.2, 0.5)] {
+            let text = nm.replace("dt = 1e-3", &format!("dt = 1e-3\nbeta = {b}\ngamma = {g}"));
+            let e = load_text("nm-bad", &text, &[]).unwrap_err().0;
+            assert!(e.contains("not unconditionally stable"), "{e}");
+            assert!(
+                e.contains(&format!("case.toml:{}:", line_of(&text, "gamma ="))),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
+    fn table_rows_cd_parameters_and_an_empty_file_are_reported_where_they_are() {
+        let with = |rows: &str| {
+            GOOD.replace(
+                "t = [-150.0, 0.0]   # compressive",
+                &format!("t = [-150.0, 0.0]\nhistory = {{ table = {rows} }}"),
+            )
+        };
+        assert!(load_text("rows-ok", &with("[[0.0, 0.0], [0.1, 1.0]]"), &[]).is_ok());
+        // serde's [f64; 2] took a third number and dropped it.
+        let text = with("[[0.0, 0.0], [0.1, 1.0, 99.0]]");
+        let e = load_text("rows-3", &text, &[]).unwrap_err().0;
+        assert!(e.contains("table row 2 has 3 numbers"), "{e}");
+        assert!(
+            e.contains(&format!("case.toml:{}:", line_of(&text, "history ="))),
+            "{e}"
+        );
+        // Newmark's parameters on a central-difference run were ignored.
+        let text = GOOD.replace("dt = 1e-3", "dt = 1e-3\nbeta = 0.3");
+        let e = load_text("cd-beta", &text, &[]).unwrap_err().0;
+        assert!(e.contains("time.beta is a Newmark parameter"), "{e}");
+        assert!(
+            e.contains(&format!("case.toml:{}:", line_of(&text, "beta ="))),
+            "{e}"
+        );
+        // No --set to blame in an empty file.
+        let e = load_text("empty", "", &[]).unwrap_err().0;
+        assert!(e.contains("case.toml: missing field `mesh`"), "{e}");
+        assert!(!e.contains("--set"), "{e}");
+    }
+
+    #[test]
+    fn set_replaces_inserts_and_keeps_lines() {
+        let c = load_text(
+            "set",
+            GOOD,
+            &[
+                "time.dt=5e-4",
+                "time.scheme=newmark",
+                "contact.remark_4_2=false",
+                "dirichlet.0.uy=0.5",
+                "output.every=10",
+            ],
+        )
+        .unwrap();
+        assert_eq!(c.time.dt, 5e-4);
+        assert_eq!(c.time.scheme, Scheme::Newmark);
+        assert!(!c.contact.as_ref().unwrap().remark_4_2);
+        assert_eq!(c.dirichlet[0].uy, Some(0.5));
+        assert_eq!(c.output.every, 10);
+        // The source is the case as run, and still carries the user's comment.
+        let again = load_str(&c.path, &c.source, &[]).unwrap();
+        assert_eq!(again.time, c.time);
+        assert!(c.source.contains("# compressive"));
+        // A problem on a line --set did not touch keeps its original line even
+        // though --set inserted a line before it.
+        let text = GOOD.replace("t_end = 0.5", "t_end = -0.5");
+        let e = load_text("set-shift", &text, &["contact.remark_4_2=false"])
+            .unwrap_err()
+            .0;
+        assert!(
+            e.contains(&format!("case.toml:{}:", line_of(&text, "t_end"))),
+            "{e}"
+        );
+    }
+
+    /// Too many steps is blamed on the value that came from --set: a tiny
+    /// dt given by --set named t_end's line of the file.
+    #[test]
+    fn endless_runs_blame_the_set_value() {
+        let e = load_text("set-dt", GOOD, &["time.dt=1e-14"]).unwrap_err().0;
+        assert!(
+            e.contains("--set time.dt=1e-14") && e.contains("more than 1e12"),
+            "{e}"
+        );
+        let e = load_text("set-t-end", GOOD, &["time.t_end=1e20"])
+            .unwrap_err()
+            .0;
+        assert!(
+            e.contains("--set time.t_end=1e20") && e.contains("more than 1e12"),
+            "{e}"
+        );
+        // Neither set: t_end's line of the file.
+        let text = GOOD.replace("t_end = 0.5", "t_end = 1e20");
+        let e = load_text("file-t-end", &text, &[]).unwrap_err().0;
+        assert!(
+            e.contains(&format!("case.toml:{}:", line_of(&text, "t_end"))),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn set_problems_name_the_set() {
+        let e = load_text("set-bad", GOOD, &["contact.eps=0"])
+            .unwrap_err()
+            .0;
+        assert!(
+            e.contains("--set contact.eps=0") && e.contains("contact.eps = 0 must be > 0"),
+            "{e}"
+        );
+        let e = load_text("set-typo", GOOD, &["time.dtt=1"]).unwrap_err().0;
+        assert!(
+            e.contains("--set time.dtt=1") && e.contains("unknown field `dtt`"),
+            "{e}"
+        );
+        let e = load_text("set-idx", GOOD, &["dirichlet.5.uy=0"])
+            .unwrap_err()
+            .0;
+        assert!(e.contains("dirichlet has 2 entries"), "{e}");
+        let e = load_text("set-noeq", GOOD, &["time.dt"]).unwrap_err().0;
+        assert!(e.contains("expected KEY=VALUE"), "{e}");
+    }
+
+    #[test]
+    fn history_forms_and_values() {
+        let text = GOOD.replace(
+            "t = [-150.0, 0.0]   # compressive",
+            "t = [-150.0, 0.0]\nhistory = { table = [[0.0, 0.0], [0.1, 1.0], [0.3, 0.0]] }",
+        );
+        let h = load_text("hist", &text, &[]).unwrap().traction[0]
+            .history
+            .clone();
+        // Piecewise linear through the given points, constant beyond the ends.
+        for (t, f) in [
+            (-1.0, 0.0),
+            (0.0, 0.0),
+            (0.05, 0.5),
+            (0.1, 1.0),
+            (0.2, 0.5),
+            (0.3, 0.0),
+            (9.0, 0.0),
+        ] {
+            assert!(
+                (h.value(t) - f).abs() < 1e-15,
+                "table({t}) = {} != {f}",
+                h.value(t)
+            );
+        }
+        let c = load_text(
+            "hist-sin",
+            GOOD,
+            &["traction.0.history={ sin = { omega = 25.132741 } }"],
+        )
+        .unwrap();
+        let h = &c.traction[0].history;
+        assert_eq!(*h, History::Sin { omega: 25.132741 });
+        assert!((h.value(1.0 / 16.0) - (25.132741f64 / 16.0).sin()).abs() < 1e-15);
+        // H(t): H(0) = 1 (load on at t = 0), off before; constant is always on.
+        assert_eq!(
+            (History::Step.value(0.0), History::Step.value(-1e-12)),
+            (1.0, 0.0)
+        );
+        assert_eq!(History::Constant.value(-1.0), 1.0);
+        let bad = GOOD.replace(
+            "t = [-150.0, 0.0]   # compressive",
+            "t = [-150.0, 0.0]\nhistory = { table = [[0.2, 0.0], [0.1, 1.0]] }",
+        );
+        let e = load_text("hist-bad", &bad, &[]).unwrap_err().0;
+        assert!(
+            e.contains("strictly increasing")
+                && e.contains(&format!("case.toml:{}:", line_of(&bad, "history"))),
+            "{e}"
+        );
+        let e = load_text("hist-ramp", GOOD, &["traction.0.history=ramp"])
+            .unwrap_err()
+            .0;
+        assert!(e.contains("unknown variant `ramp`"), "{e}");
+    }
+}

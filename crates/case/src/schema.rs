@@ -1,0 +1,522 @@
+//! The case schema (DESIGN.md "Case file"), declared once: the types serde
+//! fills are the types the rest of the code reads, and the key list that
+//! the key-by-key check walks ([`Section::KEYS`]) is generated from the
+//! same declarations by [`section!`], each key's [`Kind`] taken from its
+//! field's Rust type ([`Schema`]). docs/case-file.md is tested against
+//! [`key_paths`].
+//!
+//! Values read as written (relative paths, defaults) are completed by
+//! loading (`load.rs`): paths resolved against the case file's directory,
+//! `output.file` defaulted from the case's name.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::Deserialize;
+
+/// What a key's value must be.
+#[derive(Clone, Copy, Debug)]
+pub enum Kind {
+    /// A string.
+    Str,
+    /// A string naming one of an enumeration's values; the value given is
+    /// a valid one, put in place of a value of the wrong type so that the
+    /// rest of the case can still be checked.
+    Variant(&'static str),
+    /// A number (integer or float).
+    Num,
+    /// A whole number >= 0.
+    Int,
+    /// true or false.
+    Bool,
+    /// [x, y], two numbers.
+    Vec2,
+    /// A list of strings (`mesh.ladder`).
+    StrList,
+    /// A table with these keys.
+    Table(&'static [(&'static str, Kind)]),
+    /// A list of tables with these keys (`[[name]]`).
+    Tables(&'static [(&'static str, Kind)]),
+    /// Anything (checked by serde: `history`).
+    Any,
+}
+
+/// The [`Kind`] of a field's Rust type: what its TOML value must be.
+pub trait Schema {
+    /// The kind.
+    const KIND: Kind;
+}
+
+/// A table of the case file: its keys and their kinds, in declaration order.
+pub trait Section {
+    /// The keys.
+    const KEYS: &'static [(&'static str, Kind)];
+}
+
+macro_rules! kind {
+    ($kind:expr => $($t:ty),+) => {
+        $(impl Schema for $t {
+            const KIND: Kind = $kind;
+        })+
+    };
+}
+kind!(Kind::Str => String, PathBuf);
+kind!(Kind::Num => f64);
+kind!(Kind::Int => usize, u64);
+kind!(Kind::Bool => bool);
+kind!(Kind::Vec2 => [f64; 2]);
+kind!(Kind::StrList => Vec<PathBuf>);
+
+impl<T: Schema> Schema for Option<T> {
+    const KIND: Kind = T::KIND;
+}
+
+impl<T: Section> Schema for Vec<T> {
+    const KIND: Kind = Kind::Tables(T::KEYS);
+}
+
+/// Declares a table of the case file: a struct that serde fills (unknown
+/// keys refused), each field given with its TOML key, and its
+/// [`Section::KEYS`]. Fields after `derived` are no keys: loading fills
+/// them.
+macro_rules! section {
+    (
+        $(#[$attr:meta])*
+        pub struct $name:ident {
+            $(
+                $(#[$fattr:meta])*
+                $key:literal $field:ident: $ty:ty,
+            )*
+        }
+        $(derived {
+            $(
+                $(#[$dattr:meta])*
+                $dfield:ident: $dty:ty,
+            )*
+        })?
+    ) => {
+        $(#[$attr])*
+        #[derive(Clone, Debug, PartialEq, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            $(
+                $(#[$fattr])*
+                #[serde(rename = $key)]
+                pub $field: $ty,
+            )*
+            $($(
+                $(#[$dattr])*
+                #[serde(skip)]
+                pub $dfield: $dty,
+            )*)?
+        }
+
+        impl Section for $name {
+            const KEYS: &'static [(&'static str, Kind)] =
+                &[$(($key, <$ty as Schema>::KIND)),*];
+        }
+
+        impl Schema for $name {
+            const KIND: Kind = Kind::Table(<$name as Section>::KEYS);
+        }
+    };
+}
+
+section! {
+    /// A validated case: everything a run needs besides the mesh itself.
+    pub struct Case {
+        /// Free-text title.
+        "title" title: Option<String>,
+        /// The mesh.
+        "mesh" mesh: MeshSection,
+        /// Linear elastic material.
+        "material" material: MaterialSection,
+        /// Prescribed displacements, one entry per group.
+        #[serde(default)]
+        "dirichlet" dirichlet: Vec<DirichletSection>,
+        /// Prescribed tractions, one entry per group.
+        #[serde(default)]
+        "traction" traction: Vec<TractionSection>,
+        /// Constant body force per unit volume (bx, by), if any.
+        "body_force" body_force: Option<[f64; 2]>,
+        /// The frictional contact surface, if any.
+        "contact" contact: Option<ContactSection>,
+        /// Time integration.
+        "time" time: TimeSection,
+        /// Results file.
+        #[serde(default)]
+        "output" output: OutputSection,
+    }
+    derived {
+        /// The case file as given on the command line.
+        path: PathBuf,
+        /// The TOML text as run (after `--set`), stored in the results file.
+        source: String,
+        /// Where each key is in the user's text: dotted key (`contact.group`,
+        /// `dirichlet.0.group`, `time.dt`, ...) → `file:line:col` (or
+        /// `--set ..`), for the problems only the mesh reveals.
+        locations: BTreeMap<String, String>,
+    }
+}
+
+impl Case {
+    /// `file:line:col: ` of a dotted key for a message, or `file: ` when its
+    /// place is not known.
+    pub fn at(&self, key: &str) -> String {
+        match self.locations.get(key) {
+            Some(l) => format!("{l}: "),
+            None => format!("{}: ", self.path.display()),
+        }
+    }
+}
+
+section! {
+    /// `[mesh]`.
+    pub struct MeshSection {
+        /// The `.msh` file, resolved against the case file's directory.
+        "file" file: PathBuf,
+        /// Meshes of the same geometry and group names, coarse to fine,
+        /// resolved against the case file's directory (empty when the key
+        /// is absent). Only `stickslip advise` reads it; a run uses `file`.
+        #[serde(default)]
+        "ladder" ladder: Vec<PathBuf>,
+    }
+    derived {
+        /// The ladder entries as written in the case file (for `advise --write`).
+        ladder_text: Vec<String>,
+    }
+}
+
+/// Plane strain or plane stress.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Hypothesis {
+    /// ε_zz = 0 (the paper's slab).
+    #[default]
+    PlaneStrain,
+    /// σ_zz = 0.
+    PlaneStress,
+}
+
+impl Schema for Hypothesis {
+    const KIND: Kind = Kind::Variant("plane_strain");
+}
+
+section! {
+    /// `[material]`.
+    pub struct MaterialSection {
+        /// Young's modulus.
+        "E" e: f64,
+        /// Poisson's ratio.
+        "nu" nu: f64,
+        /// Mass density.
+        "rho" rho: f64,
+        /// Plane strain (default) or plane stress.
+        #[serde(default)]
+        "hypothesis" hypothesis: Hypothesis,
+    }
+}
+
+section! {
+    /// One `[[dirichlet]]` table: a component left out stays free.
+    pub struct DirichletSection {
+        /// Physical group name.
+        "group" group: String,
+        /// Prescribed u_x.
+        "ux" ux: Option<f64>,
+        /// Prescribed u_y.
+        "uy" uy: Option<f64>,
+    }
+}
+
+section! {
+    /// One `[[traction]]` table: exactly one of `t` and `pressure` is set.
+    pub struct TractionSection {
+        /// Physical group name (a line group).
+        "group" group: String,
+        /// Traction vector (t_x, t_y).
+        "t" t: Option<[f64; 2]>,
+        /// Normal pressure (positive pushes into the body).
+        "pressure" pressure: Option<f64>,
+        /// Time factor multiplying the load.
+        #[serde(default)]
+        "history" history: History,
+    }
+}
+
+/// Time factor of a load. TOML: `"constant"`, `"step"`,
+/// `{ sin = { omega = .. } }` or `{ table = [[t0, f0], ..] }`; default `"step"`.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum History {
+    /// 1 for all t, t < 0 included: part of the initial static state.
+    Constant,
+    /// Heaviside H(t) with H(0) = 1: on from t = 0, not in the static state.
+    #[default]
+    Step,
+    /// sin(ω t).
+    Sin {
+        /// Angular frequency ω (rad per unit time).
+        omega: f64,
+    },
+    /// Piecewise linear through (t_i, f_i), constant beyond the ends.
+    #[serde(deserialize_with = "table_points")]
+    Table(Vec<[f64; 2]>),
+}
+
+impl Schema for History {
+    const KIND: Kind = Kind::Any;
+}
+
+/// A table's rows, each exactly [t, f] (serde's [f64; 2] took [t, f, x]
+/// and dropped x).
+fn table_points<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    let rows = Vec::<Vec<f64>>::deserialize(d)?;
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| match r[..] {
+            [t, f] => Ok([t, f]),
+            _ => Err(serde::de::Error::custom(format!(
+                "table row {} has {} numbers; each row is [t, f]",
+                i + 1,
+                r.len()
+            ))),
+        })
+        .collect()
+}
+
+impl History {
+    /// The factor at time `t` (the builder hands the history to the time
+    /// crate, which evaluates its own copy; this one documents and tests
+    /// the schema).
+    pub fn value(&self, t: f64) -> f64 {
+        match self {
+            History::Constant => 1.0,
+            History::Step => {
+                if t >= 0.0 {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            History::Sin { omega } => (omega * t).sin(),
+            History::Table(p) => {
+                let (Some(first), Some(last)) = (p.first(), p.last()) else {
+                    return 0.0;
+                };
+                if t <= first[0] {
+                    return first[1];
+                }
+                if t >= last[0] {
+                    return last[1];
+                }
+                // First point with t_i > t; validation guarantees increasing t_i.
+                let i = p.partition_point(|q| q[0] <= t);
+                let (a, b) = (p[i - 1], p[i]);
+                a[1] + (b[1] - a[1]) * (t - a[0]) / (b[0] - a[0])
+            }
+        }
+    }
+}
+
+fn default_remark_4_2() -> bool {
+    true
+}
+
+fn default_max_iterations() -> usize {
+    100
+}
+
+section! {
+    /// `[contact]`: the regularized Coulomb friction surface (METHOD.md).
+    pub struct ContactSection {
+        /// Line group on which friction acts.
+        "group" group: String,
+        /// Prescribed normal pressure F_n (friction bound g = μ F_n).
+        "pressure" pressure: f64,
+        /// Coulomb coefficient μ.
+        "mu" mu: f64,
+        /// Regularization ε of the friction law.
+        "eps" eps: f64,
+        /// The paper's Remark 4.2 rule in the iteration (default true).
+        #[serde(default = "default_remark_4_2")]
+        "remark_4_2" remark_4_2: bool,
+        /// Iteration cap per step (default 100).
+        #[serde(default = "default_max_iterations")]
+        "max_iterations" max_iterations: usize,
+    }
+}
+
+/// Time integration scheme.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Scheme {
+    /// Explicit, lumped mass (β = 0, γ = ½).
+    CentralDifference,
+    /// Implicit Newmark (β, γ).
+    Newmark,
+}
+
+impl Schema for Scheme {
+    const KIND: Kind = Kind::Variant("central_difference");
+}
+
+/// Mass matrix kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MassKind {
+    /// Consistent mass.
+    Consistent,
+    /// HRZ-lumped (diagonal) mass.
+    Lumped,
+}
+
+impl Schema for MassKind {
+    const KIND: Kind = Kind::Variant("lumped");
+}
+
+section! {
+    /// Remark 4.3 step reduction after a slip-to-stick transition.
+    #[derive(Copy)]
+    pub struct StickReduction {
+        /// The reduced step.
+        "dt" dt: f64,
+        /// How many reduced steps follow each sticking event.
+        "steps" steps: usize,
+    }
+}
+
+fn default_beta() -> f64 {
+    0.25
+}
+
+fn default_gamma() -> f64 {
+    0.5
+}
+
+section! {
+    /// `[time]`.
+    pub struct TimeSection {
+        /// Central difference or Newmark.
+        "scheme" scheme: Scheme,
+        /// Newmark β (default 0.25; refused for central difference).
+        #[serde(default = "default_beta")]
+        "beta" beta: f64,
+        /// Newmark γ (default 0.5; refused for central difference).
+        #[serde(default = "default_gamma")]
+        "gamma" gamma: f64,
+        /// Mass override; `None` = the scheme's default (lumped for central
+        /// difference, consistent for Newmark).
+        "mass" mass: Option<MassKind>,
+        /// Time step.
+        "dt" dt: f64,
+        /// End time.
+        "t_end" t_end: f64,
+        /// Remark 4.3 step reduction, if asked for.
+        "stick_reduction" stick_reduction: Option<StickReduction>,
+        /// Run an explicit scheme above Δt_crit anyway.
+        #[serde(default)]
+        "allow_unstable" allow_unstable: bool,
+    }
+}
+
+fn default_every() -> usize {
+    1
+}
+
+fn default_flush_every() -> usize {
+    100
+}
+
+fn default_flush_seconds() -> f64 {
+    5.0
+}
+
+section! {
+    /// `[output]`.
+    pub struct OutputSection {
+        /// Results file, resolved against the case file's directory
+        /// (default `<case stem>.h5` next to the case file).
+        #[serde(default)]
+        "file" file: PathBuf,
+        /// Write every `every`-th step (default 1).
+        #[serde(default = "default_every")]
+        "every" every: usize,
+        /// Flush the file (and rewrite the checkpoint) at least every this
+        /// many steps (default 100).
+        #[serde(default = "default_flush_every")]
+        "flush_every" flush_every: usize,
+        /// ... and at least every this many seconds (default 5).
+        #[serde(default = "default_flush_seconds")]
+        "flush_seconds" flush_seconds: f64,
+        /// Deflate level of the growing datasets, 0 to 9 (`None`: the
+        /// results writer's default); wider as read, so that a level out of
+        /// range is reported with its value.
+        "compression" compression: Option<u64>,
+    }
+}
+
+impl Default for OutputSection {
+    fn default() -> Self {
+        OutputSection {
+            file: PathBuf::new(),
+            every: default_every(),
+            flush_every: default_flush_every(),
+            flush_seconds: default_flush_seconds(),
+            compression: None,
+        }
+    }
+}
+
+impl OutputSection {
+    /// The deflate level asked for, if any (validated to 0..=9 when the
+    /// case was loaded).
+    pub fn deflate_level(&self) -> Option<u8> {
+        self.compression.map(|c| c.min(9) as u8)
+    }
+}
+
+/// The keys of the whole case file.
+pub const ROOT: &[(&str, Kind)] = <Case as Section>::KEYS;
+
+/// Visits every key of `keys` and below, depth first in declaration
+/// order, with its dotted path (no list indices) and kind.
+fn walk(keys: &'static [(&'static str, Kind)], prefix: &str, visit: &mut dyn FnMut(&str, &Kind)) {
+    for (key, kind) in keys {
+        let name = if prefix.is_empty() {
+            key.to_string()
+        } else {
+            format!("{prefix}.{key}")
+        };
+        visit(&name, kind);
+        if let Kind::Table(sub) | Kind::Tables(sub) = kind {
+            walk(sub, &name, visit);
+        }
+    }
+}
+
+/// Every table of the schema with its name, in the order of the schema
+/// (`mesh`, `[dirichlet]` for a list of tables, `time.stick_reduction`),
+/// to say where a misplaced key belongs.
+pub fn sections() -> Vec<(String, &'static [(&'static str, Kind)])> {
+    let mut out = Vec::new();
+    walk(ROOT, "", &mut |name, kind| match kind {
+        Kind::Table(sub) => out.push((name.to_string(), *sub)),
+        Kind::Tables(sub) => out.push((format!("[{name}]"), *sub)),
+        _ => {}
+    });
+    out
+}
+
+/// Every key a case may have, as a dotted path without list indices
+/// (`time.stick_reduction.dt`, `dirichlet.group`); tables are listed by
+/// their keys only.
+pub fn key_paths() -> Vec<String> {
+    let mut out = Vec::new();
+    walk(ROOT, "", &mut |name, kind| {
+        if !matches!(kind, Kind::Table(_) | Kind::Tables(_)) {
+            out.push(name.to_string());
+        }
+    });
+    out
+}

@@ -1,0 +1,95 @@
+//! `--set KEY=VALUE`: one case value overridden by its dotted path, in
+//! the document as written (toml_edit keeps the rest of the text and its
+//! comments), so that the case as run can be stored and read again.
+
+use toml_edit::{Item, TableLike, Value};
+
+/// Applies one `KEY=VALUE` to the document. Keys are dotted paths; a number
+/// after an array of tables picks an entry (`dirichlet.0.uy=0`). A missing
+/// leaf key is added (serde then rejects it if it is not a case key).
+pub(crate) fn apply_set(doc: &mut toml_edit::DocumentMut, set: &str) -> Result<(), String> {
+    let (key, val) = set
+        .split_once('=')
+        .ok_or_else(|| "expected KEY=VALUE, e.g. --set time.dt=5e-4".to_string())?;
+    let key = key.trim();
+    let segs: Vec<&str> = key.split('.').map(str::trim).collect();
+    if segs.iter().any(|s| s.is_empty()) {
+        return Err(format!(
+            "{key:?} is not a dotted key path; write e.g. time.dt"
+        ));
+    }
+    let val = val.trim();
+    let mut value: Value = val.parse().unwrap_or_else(|_| Value::from(val));
+    value.decor_mut().clear();
+    set_in(doc.as_table_mut(), &segs, value, key)
+}
+
+fn set_in(t: &mut dyn TableLike, segs: &[&str], mut value: Value, key: &str) -> Result<(), String> {
+    let (k, rest) = segs.split_first().expect("non-empty path");
+    if rest.is_empty() {
+        match t.get_mut(k) {
+            Some(Item::Value(old)) => {
+                // Keep the spacing and any trailing comment of the line.
+                *value.decor_mut() = old.decor().clone();
+                *old = value;
+            }
+            Some(Item::None) | None => {
+                t.insert(k, Item::Value(value));
+            }
+            Some(_) => {
+                return Err(format!(
+                    "{key} is a table; set one of its keys, e.g. {key}.NAME=VALUE"
+                ))
+            }
+        }
+        return Ok(());
+    }
+    if t.get(k).is_none() {
+        // A section the file does not have yet (e.g. --set contact.mu=0.3).
+        t.insert(k, Item::Value(Value::InlineTable(Default::default())));
+    }
+    match t.get_mut(k).expect("just inserted") {
+        Item::Table(tt) => set_in(tt, rest, value, key),
+        Item::Value(Value::InlineTable(tt)) => set_in(tt, rest, value, key),
+        Item::ArrayOfTables(a) => {
+            let n = a.len();
+            let (i, rest) = index(rest, k, n, key)?;
+            set_in(a.get_mut(i).expect("index checked"), rest, value, key)
+        }
+        Item::Value(Value::Array(a)) => {
+            let n = a.len();
+            let (i, rest) = index(rest, k, n, key)?;
+            match a.get_mut(i).expect("index checked") {
+                Value::InlineTable(tt) => set_in(tt, rest, value, key),
+                _ => Err(format!(
+                    "{k}.{i} is a value, not a table; set {k} as a whole"
+                )),
+            }
+        }
+        _ => Err(format!("{k} holds a value, not a table; set {k} itself")),
+    }
+}
+
+fn index<'a>(
+    rest: &'a [&'a str],
+    k: &str,
+    n: usize,
+    key: &str,
+) -> Result<(usize, &'a [&'a str]), String> {
+    let (i, rest) = rest.split_first().expect("caller checked");
+    let i: usize = i.parse().map_err(|_| {
+        format!("{k} is a list of {n} tables; pick one by number from 0, e.g. {k}.0.KEY=VALUE")
+    })?;
+    if i >= n {
+        return Err(format!(
+            "{k} has {n} entries (0..{}); {key} names entry {i}",
+            n.saturating_sub(1)
+        ));
+    }
+    if rest.is_empty() {
+        return Err(format!(
+            "{key} names a whole table; set one of its keys, e.g. {key}.NAME=VALUE"
+        ));
+    }
+    Ok((i, rest))
+}

@@ -1,0 +1,173 @@
+//! Where a run starts: a new results file holding the case, the mesh and
+//! the initial state, or a stored run continued from its checkpoint
+//! (`run --restart`), checked against the case and the mesh and restored
+//! into the integrator.
+
+use std::path::Path;
+
+use anyhow::Context;
+use stickslip_case::{self as case, Case};
+use stickslip_fem::{DofMap, NodeOrder};
+use stickslip_mesh::Mesh;
+use stickslip_time::Integrator;
+
+use crate::output::{self, Header, ResultsWriter};
+use crate::run::{input, record, setup_warnings, FullState};
+
+/// The results file a run writes to, opened, and what it carries over.
+pub(crate) struct Opened {
+    pub(crate) writer: ResultsWriter,
+    /// Wall time of the runs before (a restart's).
+    pub(crate) wall_before: f64,
+    /// Largest |energy balance| so far.
+    pub(crate) max_balance: f64,
+    /// Times of the records written.
+    pub(crate) times: Vec<f64>,
+    /// Kinetic + strain energy at t = 0, for the blow-up test.
+    pub(crate) initial_mechanical: f64,
+}
+
+/// A fresh run's file: created with the case, the mesh and the contact
+/// nodes, its first record the initial state; the setup warnings said.
+pub(crate) fn fresh(
+    case: &Case,
+    out: &Path,
+    mesh: &Mesh,
+    dofs: &DofMap,
+    integrator: &Integrator,
+    full: &mut FullState,
+) -> anyhow::Result<Opened> {
+    let (contact_nodes, contact_s): (Vec<usize>, Vec<f64>) = integrator
+        .contact()
+        .map(|c| c.nodes.iter().map(|n| (n.node, n.s)).unzip())
+        .unwrap_or_default();
+    let header = Header {
+        case_source: &case.source,
+        mesh,
+        contact_nodes: &contact_nodes,
+        contact_s: &contact_s,
+    };
+    let mut writer = ResultsWriter::create_with(
+        out,
+        &header,
+        case.output.deflate_level().unwrap_or(output::DEFLATE_LEVEL),
+    )
+    .with_context(|| format!("cannot create the results file {}", out.display()))?;
+    writer.append(&record(integrator, dofs, full, 0.0, 0))?;
+    // Kept in the file and printed with --quiet too: quiet silences
+    // progress, not what the user should know.
+    let warnings = setup_warnings(mesh, &full.u, integrator);
+    for w in &warnings {
+        say!("{}: warning: {w}", case.path.display());
+    }
+    writer.set_warnings(&warnings)?;
+    let e0 = integrator.energy();
+    Ok(Opened {
+        writer,
+        wall_before: 0.0,
+        max_balance: 0.0,
+        times: vec![integrator.time()],
+        initial_mechanical: e0.kinetic + e0.strain,
+    })
+}
+
+/// A restart's file: its checkpoint read and checked against the case
+/// and the mesh, restored into `integrator` (in this run's node order and
+/// with the stored run's solver), the file opened to append.
+pub(crate) fn resume(
+    case: &Case,
+    out: &Path,
+    quiet: bool,
+    mesh: &Mesh,
+    dofs: &DofMap,
+    integrator: &mut Integrator,
+) -> anyhow::Result<Opened> {
+    let stored = output::read_checkpoint(out)
+        .map_err(|e| input(format!("--restart {}: {e:#}", out.display())))?;
+    let changes = case::restart_changes(&stored.case_source, &case.source)
+        .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
+    if !changes.is_empty() {
+        return Err(input(format!(
+            "{}: --restart {}: the case changes what the stored run computed:\n  {}\n\
+             a restart may change only time.t_end, output.*, title and mesh.ladder; undo those changes, or start a new run with -o NEW.h5",
+            case.path.display(),
+            out.display(),
+            changes.join("\n  ")
+        )));
+    }
+    if let Some(change) = output::stored_mesh_change(out, mesh)
+        .map_err(|e| input(format!("--restart {}: {e:#}", out.display())))?
+    {
+        return Err(input(format!(
+            "{}: --restart {}: {} has changed since the run began ({change}); restart with \
+             the mesh the run began on, or start a new run with -o NEW.h5",
+            case.path.display(),
+            out.display(),
+            case.mesh.file.display()
+        )));
+    }
+    let cp = &stored.checkpoint;
+    if case.time.t_end < cp.t {
+        return Err(input(format!(
+            "{}time.t_end = {} is before the checkpoint's t = {} in {}; give a t_end >= {}",
+            case.at("time.t_end"),
+            case.time.t_end,
+            cp.t,
+            out.display(),
+            cp.t
+        )));
+    }
+    // A state stored in another node order (a file of a version
+    // before the node orders, or STICKSLIP_DOF_ORDER changed) is read
+    // into this run's numbering.
+    let remapped;
+    let n_free = dofs.n_free();
+    let lengths_fit = [&cp.displacement, &cp.velocity, &cp.acceleration]
+        .iter()
+        .all(|x| x.len() == n_free);
+    // (Other lengths: `restore` says what is wrong.)
+    let cp = if stored.extra.node_order != dofs.node_order().code() && lengths_fit {
+        let theirs = NodeOrder::from_code(stored.extra.node_order)
+            .and_then(|order| dofs.renumbered(mesh, order))
+            .ok_or_else(|| {
+                input(format!(
+                    "--restart {}: its state's node_order {} does not apply to {} (a newer version's order, or a structured grid's on a mesh that is none); restart with the version and the mesh the run started from",
+                    out.display(),
+                    stored.extra.node_order,
+                    case.mesh.file.display()
+                ))
+            })?;
+        let to_ours = |x: &[f64]| dofs.from_numbering(&theirs, x);
+        remapped = stickslip_time::Checkpoint {
+            displacement: to_ours(&cp.displacement),
+            velocity: to_ours(&cp.velocity),
+            acceleration: to_ours(&cp.acceleration),
+            ..cp.clone()
+        };
+        &remapped
+    } else {
+        cp
+    };
+    integrator
+        .restore(cp)
+        .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
+    let n_c = integrator.contact().map_or(0, |c| c.len());
+    let mut writer = ResultsWriter::open_append(out, stored.extra.rows, mesh.nodes.len(), n_c)?;
+    writer.set_case(&case.source)?;
+    if !quiet {
+        say!(
+            "restart: continuing {} from step {}, t = {} ({} records kept)",
+            out.display(),
+            cp.steps,
+            cp.t,
+            stored.extra.rows
+        );
+    }
+    Ok(Opened {
+        writer,
+        wall_before: stored.extra.wall_time_s,
+        max_balance: stored.extra.max_balance,
+        times: stored.times,
+        initial_mechanical: stored.checkpoint.initial_mechanical,
+    })
+}

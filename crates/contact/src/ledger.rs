@@ -1,0 +1,74 @@
+//! Friction's share of a step's energy ledger (METHOD.md §6): the nodal
+//! forces at the new velocity, the work they dissipate over the step, and
+//! the slip → stick events that Remark 4.3's step reduction follows.
+
+use crate::law::SlipState;
+use crate::surface::ContactSurface;
+
+impl ContactSurface {
+    /// The forces f_J = w_J g_J φ_ε(v_TJ) of free-DOF velocity `v_new` into
+    /// `forces`; returns the work friction dissipated over a step of `dt`
+    /// from `v` to `v_new`, Σ_J ½(f_J + f_J,old) Δs_J with Δs_J the
+    /// trapezoidal increment τ_J·½Δt(ṙ_K + ṙ_{K−1})
+    /// ([`ContactNode::motion`](crate::ContactNode::motion)). Δs_J is
+    /// (r_K − r_{K−1})·τ_J for Newmark ¼, ½, so the energy balance closes
+    /// to round-off there; with φ_ε odd and increasing the sum is never
+    /// negative for any scheme.
+    pub fn step_dissipation(
+        &self,
+        v_new: &[f64],
+        v: &[f64],
+        dt: f64,
+        forces_old: &[f64],
+        forces: &mut [f64],
+    ) -> f64 {
+        let mut dissipated = 0.0;
+        for ((n, f), f_old) in self.nodes.iter().zip(forces.iter_mut()).zip(forces_old) {
+            let (v_t, increment) = n.motion(v_new, v, dt);
+            *f = n.force(&self.law, v_t);
+            dissipated += work(*f, *f_old, increment);
+        }
+        dissipated
+    }
+
+    /// [`ContactSurface::step_dissipation`] with the nodes' tangential
+    /// velocities given (`u_new`, `u`: one per node), as a step that solves
+    /// for them forms them (the modal step).
+    pub fn step_dissipation_tangential(
+        &self,
+        u_new: &[f64],
+        u: &[f64],
+        dt: f64,
+        forces_old: &[f64],
+        forces: &mut [f64],
+    ) -> f64 {
+        let mut dissipated = 0.0;
+        for (((n, f), f_old), (u_new, u)) in self
+            .nodes
+            .iter()
+            .zip(forces.iter_mut())
+            .zip(forces_old)
+            .zip(u_new.iter().zip(u))
+        {
+            *f = n.force(&self.law, *u_new);
+            dissipated += work(*f, *f_old, 0.5 * dt * (u_new + u));
+        }
+        dissipated
+    }
+}
+
+/// The work of a nodal force going from `f_old` to `f` over the tangential
+/// increment `increment`, by the trapezoid rule.
+#[inline]
+pub(crate) fn work(f: f64, f_old: f64, increment: f64) -> f64 {
+    0.5 * (f + f_old) * increment
+}
+
+/// Nodes stuck in `new` that were slipping in `old`: the step's slip → stick
+/// events.
+pub fn stick_events(old: &[SlipState], new: &[SlipState]) -> usize {
+    new.iter()
+        .zip(old)
+        .filter(|(new, old)| new.sticks_after(**old))
+        .count()
+}

@@ -1,0 +1,27 @@
+//! Sparse linear algebra for the solver: products with K and M in fixed
+//! chunks of rows ([`chunks`], [`csr`], and by stencil types on structured
+//! meshes, [`Stencils`], behind the explicit step's [`Product`]), the sparse
+//! Cholesky factorization of symmetric positive definite operators (faer's
+//! symbolic and numeric factorization, ordered by AMD or by a caller's
+//! nested dissection), its one-column solves on the supernodal factor, and
+//! solves restricted to a few rows ([`Supernodal`], [`PathOperator`]).
+//!
+//! It knows nothing of meshes, elements, friction or time stepping: only
+//! matrices (nalgebra-sparse CSR with both triangles stored) and vectors.
+//! Every product and sum gives the same bits on one thread and on many.
+
+#![forbid(unsafe_code)]
+
+mod cholesky;
+pub mod chunks;
+pub mod csr;
+mod fill_order;
+mod product;
+mod stencils;
+mod supernodal;
+
+pub use cholesky::{analyze_symbolic, csc_view, SolverError, SparseCholesky};
+pub use fill_order::{FillOrder, AMD_MARGIN};
+pub use product::Product;
+pub use stencils::{Stencils, BATCH, TOLERANCE};
+pub use supernodal::{PathOperator, Supernodal};

@@ -1,0 +1,92 @@
+//! K·x for the explicit step: by stencil types where the matrix has them
+//! (structured meshes), else from the assembled CSR.
+
+use nalgebra_sparse::CsrMatrix;
+
+use crate::chunks::CHUNK;
+use crate::csr;
+use crate::stencils::{Stencils, BATCH};
+
+/// The product a step streams K from: every row's value is the same
+/// whichever batch, chunk or thread computes it.
+#[derive(Clone, Debug)]
+pub enum Product {
+    /// Stencil types ([`Stencils`]): within 1e-10 · max |K_ij| · Σ|x_j| of
+    /// the assembled product, not its bits.
+    Stencils(Stencils),
+    /// The assembled matrix.
+    Csr(CsrMatrix<f64>),
+}
+
+impl Product {
+    /// The fastest form `k` allows (stencil types, else the CSR itself).
+    pub fn new(k: CsrMatrix<f64>) -> Product {
+        match Stencils::new(&k) {
+            Some(s) => Product::Stencils(s),
+            None => Product::Csr(k),
+        }
+    }
+
+    /// Rows.
+    pub fn n(&self) -> usize {
+        match self {
+            Product::Stencils(s) => s.n(),
+            Product::Csr(k) => k.nrows(),
+        }
+    }
+
+    /// y = K x.
+    pub fn spmv(&self, x: &[f64], y: &mut [f64]) {
+        match self {
+            Product::Stencils(s) => s.spmv(x, y),
+            Product::Csr(k) => csr::spmv(k, x, y),
+        }
+    }
+
+    /// Calls `f(first row, K x on the batch's rows)` for consecutive batches
+    /// of at most [`BATCH`] rows covering chunk `c` (of
+    /// [`crate::chunks::CHUNK`] rows), in order.
+    #[inline]
+    pub fn batches(&self, c: usize, x: &[f64], mut f: impl FnMut(usize, &[f64])) {
+        match self {
+            Product::Stencils(s) => s.batches(c, x, f),
+            Product::Csr(k) => {
+                let end = ((c + 1) * CHUNK).min(k.nrows());
+                let mut buf = [0.0; BATCH];
+                let mut r0 = c * CHUNK;
+                while r0 < end {
+                    let r1 = (r0 + BATCH).min(end);
+                    for (o, i) in buf.iter_mut().zip(r0..r1) {
+                        *o = csr::row(k, i, x);
+                    }
+                    f(r0, &buf[..r1 - r0]);
+                    r0 = r1;
+                }
+            }
+        }
+    }
+
+    /// (K x)_i, with the bits the batches give it.
+    pub fn row(&self, i: usize, x: &[f64]) -> f64 {
+        match self {
+            Product::Stencils(s) => s.row(i, x),
+            Product::Csr(k) => csr::row(k, i, x),
+        }
+    }
+
+    /// Bytes one product streams from the operator's data.
+    pub fn bytes(&self) -> usize {
+        match self {
+            Product::Stencils(s) => s.bytes(),
+            Product::Csr(k) => 16 * k.nnz() + 8 * (k.nrows() + 1),
+        }
+    }
+
+    /// "stencil types" or "assembled CSR", for messages and the results.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Product::Stencils(_) => "stencil types",
+            Product::Csr(_) => "assembled CSR",
+        }
+    }
+}

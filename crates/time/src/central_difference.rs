@@ -1,0 +1,356 @@
+//! Central difference (β = 0, γ = ½) with the lumped mass: every step
+//! explicit, the friction solved node by node in closed form (METHOD.md
+//! §4), K·x by stencil types where the mesh has them; stable below
+//! Δt_crit = 2/ω_max.
+
+use stickslip_contact::{iterate, ContactSurface, DiagonalStep, SlipState};
+use stickslip_linalg::chunks;
+use stickslip_linalg::{csr, Product, Stencils};
+
+use crate::dynamics::{Dynamics, Loads};
+use crate::initial::{initial_state, Mass};
+use crate::nodal::NodalFriction;
+use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError};
+use crate::stability::critical_step_with;
+use crate::state::{State, StepEnergies, StepInfo};
+use crate::stepper::{Run, Stepper};
+use crate::sweep::{predict, sweep, Partials, SparseLoads, StepData, Sums};
+
+/// γ of central difference.
+const GAMMA: f64 = 0.5;
+
+/// The explicit stepper.
+pub(crate) struct CentralDifference {
+    /// K as the step reads it.
+    product: Product,
+    mass: Vec<f64>,
+    dt_crit: f64,
+    /// The constant load and the loads on their nonzero rows.
+    sparse_loads: SparseLoads,
+    /// θ_l(t) of each load for the step being taken.
+    thetas: Vec<f64>,
+    partials: Partials,
+    /// The closed-form nodal friction's constants for the last Δt.
+    nodal: NodalFriction,
+    /// (DOF, ṙ_K) at the contact DOFs, sorted by DOF: the friction's
+    /// velocities handed to the sweep.
+    friction: Vec<(usize, f64)>,
+    /// Per contact node and component, its entry of `friction`.
+    friction_slots: Vec<[Option<usize>; 2]>,
+    /// The iterated friction's R̂_K and diagonal ([`ExplicitFriction::Iterate`]).
+    b: Vec<f64>,
+    diagonal: Vec<f64>,
+    iter_scratch: Vec<SlipState>,
+}
+
+/// Builds the stepper and the initial state. The critical step is
+/// estimated first, on the step's own product, so that a Δt above it is
+/// refused before any factorization.
+///
+/// # Errors
+/// Δt above the critical step (unless allowed), or a singular static
+/// problem.
+pub(crate) fn start(
+    dynamics: Dynamics,
+    contact: Option<&ContactSurface>,
+    loads: &Loads,
+    settings: &Settings,
+) -> Result<(Box<dyn Stepper>, State), TimeError> {
+    let Dynamics {
+        stiffness: k,
+        lumped_mass: mass,
+        fill_order,
+        stencils,
+        ..
+    } = dynamics;
+    let types = if stencils { Stencils::new(&k) } else { None };
+    let dt_crit = critical_step_with(
+        |x, y| match &types {
+            Some(s) => s.spmv(x, y),
+            None => csr::spmv(&k, x, y),
+        },
+        &mass,
+    );
+    if settings.dt > dt_crit && !settings.allow_unstable {
+        return Err(TimeError::Unstable {
+            dt: settings.dt,
+            dt_crit,
+        });
+    }
+    let state = initial_state(
+        &k,
+        Mass::Lumped(&mass),
+        &fill_order,
+        contact,
+        loads,
+        settings,
+    )?;
+    let product = match types {
+        Some(s) => Product::Stencils(s),
+        None => Product::Csr(k),
+    };
+    let n = mass.len();
+    let vectors: Vec<&[f64]> = loads.loads.iter().map(|l| &l.vector[..]).collect();
+    let (mut friction, mut friction_slots) = (Vec::new(), Vec::new());
+    if let Some(c) = contact {
+        let mut dofs: Vec<usize> = c.nodes.iter().flat_map(|n| n.dofs).flatten().collect();
+        dofs.sort_unstable();
+        dofs.dedup();
+        friction_slots = c
+            .nodes
+            .iter()
+            .map(|n| {
+                n.dofs
+                    .map(|d| d.map(|i| dofs.binary_search(&i).expect("listed")))
+            })
+            .collect();
+        friction = dofs.into_iter().map(|i| (i, 0.0)).collect();
+    }
+    let iterated = settings.explicit_friction == ExplicitFriction::Iterate;
+    let n_c = contact.map_or(0, |c| c.len());
+    let stepper = CentralDifference {
+        product,
+        dt_crit,
+        sparse_loads: SparseLoads::new(&loads.constant, &vectors),
+        thetas: vec![0.0; loads.loads.len()],
+        partials: chunks::partials(n),
+        nodal: NodalFriction::default(),
+        friction,
+        friction_slots,
+        b: if iterated { vec![0.0; n] } else { Vec::new() },
+        diagonal: if iterated { vec![0.0; n] } else { Vec::new() },
+        iter_scratch: vec![SlipState::Stuck; n_c],
+        mass,
+    };
+    Ok((Box::new(stepper), state))
+}
+
+impl CentralDifference {
+    /// The friction's velocities at the contact DOFs into `friction`:
+    /// node by node in closed form (from R̂_K there), or by the iteration
+    /// of §5 on the whole diagonal system (the reference; it leaves its
+    /// classes in `classes_new` and its velocities in `v_new`). Returns the
+    /// iterations.
+    fn friction_velocities(
+        &mut self,
+        contact: &ContactSurface,
+        data: &StepData,
+        settings: &Settings,
+        (classes, classes_new, v_new): (&[SlipState], &mut [SlipState], &mut [f64]),
+        (step, t): (u64, f64),
+    ) -> Result<usize, TimeError> {
+        self.nodal.prepare(contact, data.mass, data.scale);
+        if settings.explicit_friction == ExplicitFriction::ClosedForm {
+            self.nodal.form_products(&self.product, data.r_new);
+            let (ku, friction, slots) = (
+                self.nodal.products(),
+                &mut self.friction,
+                &self.friction_slots,
+            );
+            self.nodal.closed_form().velocities(
+                |i, k| data.rhs(i, ku[k]),
+                |j, c, _, v| {
+                    if let Some(slot) = slots[j][c] {
+                        friction[slot].1 = v;
+                    }
+                },
+            );
+            return Ok(1);
+        }
+        self.product.spmv(data.r_new, &mut self.b);
+        for (i, b) in self.b.iter_mut().enumerate() {
+            *b = data.rhs(i, *b);
+        }
+        for (d, m) in self.diagonal.iter_mut().zip(data.mass) {
+            *d = m * data.scale;
+        }
+        let mut system = DiagonalStep {
+            diagonal: &self.diagonal,
+            b: &self.b,
+        };
+        classes_new.copy_from_slice(classes);
+        let report = iterate(
+            contact,
+            &mut system,
+            classes_new,
+            &mut self.iter_scratch,
+            v_new,
+            settings.iteration,
+        )
+        .map_err(|f| {
+            TimeError::from_iteration(f, (step, t, settings.iteration.remark_4_2), |never| {
+                match never {}
+            })
+        })?;
+        for (i, vi) in self.friction.iter_mut() {
+            *vi = v_new[*i];
+        }
+        Ok(report.iterations)
+    }
+
+    /// The step's velocities, accelerations and sums from the predictor
+    /// in `state.r_new` (the outputs apart from `state`, which is read).
+    fn velocities(
+        &mut self,
+        run: &Run,
+        state: &State,
+        scale: f64,
+        at: (u64, f64),
+        outputs: (&mut [f64], &mut [f64], &mut [SlipState]),
+    ) -> Result<(Sums, usize), TimeError> {
+        // The mass is read by the step's data while the friction's parts
+        // are written: moved out for the step.
+        let mass = std::mem::take(&mut self.mass);
+        let result = self.velocities_with(run, state, &mass, scale, at, outputs);
+        self.mass = mass;
+        result
+    }
+
+    fn velocities_with(
+        &mut self,
+        run: &Run,
+        state: &State,
+        mass: &[f64],
+        scale: f64,
+        at: (u64, f64),
+        (v_new, a_new, classes_new): (&mut [f64], &mut [f64], &mut [SlipState]),
+    ) -> Result<(Sums, usize), TimeError> {
+        let data = StepData {
+            load_new: &state.load_new,
+            mass,
+            r_new: &state.r_new,
+            v: &state.v,
+            a: &state.a,
+            cv: scale,
+            ca: 1.0 / GAMMA - 1.0,
+            scale,
+            ratio: (1.0 - GAMMA) / GAMMA,
+        };
+        let mut iterations = 1;
+        if let Some(contact) = &run.contact {
+            iterations = self.friction_velocities(
+                contact,
+                &data,
+                &run.settings,
+                (&state.classes, classes_new, v_new),
+                at,
+            )?;
+        }
+        let sums = sweep(
+            &self.product,
+            &data,
+            &self.friction,
+            v_new,
+            a_new,
+            &mut self.partials,
+        );
+        Ok((sums, iterations))
+    }
+}
+
+impl Stepper for CentralDifference {
+    fn step(&mut self, run: &Run, state: &mut State) -> Result<StepInfo, TimeError> {
+        let settings = &run.settings;
+        let (dt, t_new) = state.next_step(settings);
+        let step = state.steps + 1;
+        for (theta, l) in self.thetas.iter_mut().zip(&run.loads.loads) {
+            *theta = l.history.value(t_new);
+        }
+        if self.thetas.iter().any(|t| !t.is_finite()) {
+            return Err(self.non_finite(step, t_new));
+        }
+        // β = 0: r_K = r + Δt ṙ + ½Δt² r̈ is final (no corrector).
+        let (work, load_dot) = predict(
+            &self.sparse_loads,
+            &self.thetas,
+            [&state.r, &state.v, &state.a],
+            [dt, 0.5 * dt * dt],
+            &state.load,
+            &mut state.load_new,
+            &mut state.r_new,
+        );
+        let scale = 1.0 / (GAMMA * dt);
+        let mut v_new = std::mem::take(&mut state.v_new);
+        let mut a_new = std::mem::take(&mut state.a_new);
+        let mut classes_new = std::mem::take(&mut state.classes_new);
+        let result = self.velocities(
+            run,
+            state,
+            scale,
+            (step, t_new),
+            (&mut v_new, &mut a_new, &mut classes_new),
+        );
+        (state.v_new, state.a_new, state.classes_new) = (v_new, a_new, classes_new);
+        let (sums, iterations) = result?;
+        if !sums.finite {
+            return Err(self.non_finite(step, t_new));
+        }
+        let (dissipated, stick_events) = if run.contact.is_some() {
+            self.nodal.closed_form().ledger(
+                &state.v_new,
+                &state.v,
+                dt,
+                &state.classes,
+                &mut state.classes_new,
+                &state.forces,
+                &mut state.forces_new,
+            )
+        } else {
+            (0.0, 0)
+        };
+        state.commit(dt, t_new, iterations);
+        let energies = StepEnergies {
+            kinetic: sums.kinetic,
+            strain: sums.strain,
+            work,
+            dissipated,
+            load_dot,
+        };
+        Ok(state.close_step(energies, settings, dt, iterations, stick_events))
+    }
+
+    fn dt_crit(&self) -> Option<f64> {
+        Some(self.dt_crit)
+    }
+
+    fn is_explicit(&self) -> bool {
+        true
+    }
+
+    fn mass_kind(&self) -> MassKind {
+        MassKind::Lumped
+    }
+
+    fn stiffness_product(&self) -> &'static str {
+        self.product.name()
+    }
+
+    fn stencil_types(&self) -> Option<usize> {
+        match &self.product {
+            Product::Stencils(s) => Some(s.types()),
+            Product::Csr(_) => None,
+        }
+    }
+
+    fn matrix_bytes(&self) -> usize {
+        self.product.bytes()
+    }
+
+    /// K, and 11 vector streams: the predictor reads r, ṙ, r̈ and writes
+    /// r_K; the sweep reads r_K, m, ṙ, r̈, R_K and writes ṙ_K, r̈_K; and the
+    /// loads at their rows.
+    fn bytes_per_step(&self) -> usize {
+        self.product.bytes() + 8 * 11 * self.mass.len() + self.sparse_loads.bytes()
+    }
+}
+
+impl CentralDifference {
+    /// The step's NaN/infinity error, with the critical step as advice.
+    fn non_finite(&self, step: u64, t: f64) -> TimeError {
+        TimeError::NonFinite {
+            step,
+            t,
+            hint: format!(" below the critical step Δt_crit = {:.4e}", self.dt_crit),
+        }
+    }
+}

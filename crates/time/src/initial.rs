@@ -1,0 +1,100 @@
+//! The initial state of paper Remark 4.1 (METHOD.md §4): r₀ the
+//! frictionless static equilibrium under the loads present at t = 0⁻,
+//! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀, again without friction.
+
+use nalgebra_sparse::CsrMatrix;
+use stickslip_contact::ContactSurface;
+use stickslip_linalg::csr::{dot, quadratic_form, spmv};
+use stickslip_linalg::{chunks, FillOrder, SparseCholesky};
+
+use crate::dynamics::Loads;
+use crate::settings::{Settings, TimeError};
+use crate::state::{Energy, State};
+
+/// The mass a scheme uses, as the initial state needs it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Mass<'a> {
+    /// The HRZ lumped mass, one value per free DOF.
+    Lumped(&'a [f64]),
+    /// The consistent mass.
+    Consistent(&'a CsrMatrix<f64>),
+}
+
+impl Mass<'_> {
+    /// xᵀ M x.
+    pub fn form(&self, x: &[f64], partials: &mut [[f64; 2]]) -> f64 {
+        match self {
+            Mass::Lumped(m) => x.iter().zip(*m).map(|(v, m)| m * v * v).sum(),
+            Mass::Consistent(m) => quadratic_form(m, x, partials),
+        }
+    }
+}
+
+/// The state at t = 0 for a scheme with mass `mass`: Remark 4.1's r₀ (no
+/// factorization where nothing acts before t = 0, or where the state will
+/// come from a checkpoint: r₀ = 0 then), ṙ₀, r̈₀, R(0), the contact
+/// classes and forces at ṙ₀, and the energies.
+///
+/// # Errors
+/// [`TimeError::Static`] when K (or a consistent M) is not positive
+/// definite: a rigid-body motion left free.
+pub(crate) fn initial_state(
+    k: &CsrMatrix<f64>,
+    mass: Mass,
+    fill_order: &FillOrder,
+    contact: Option<&ContactSurface>,
+    loads: &Loads,
+    settings: &Settings,
+) -> Result<State, TimeError> {
+    let n = k.nrows();
+    let mut state = State::new(n, contact.map_or(0, |c| c.len()), settings.dt);
+    let mut r = loads.before_start();
+    if settings.restoring {
+        r.fill(0.0);
+    } else if r.iter().any(|&x| x != 0.0) {
+        let mut solver = SparseCholesky::analyze(k, fill_order).map_err(TimeError::Static)?;
+        solver.factorize(k).map_err(TimeError::Static)?;
+        solver.solve_in_place(&mut r);
+    }
+    state.r = r;
+    if let Some(v0) = &settings.initial_velocity {
+        state.v.copy_from_slice(v0);
+    }
+    loads.at(0.0, &mut state.load);
+    // r̈₀ from M r̈₀ = R(0) − K r₀.
+    let mut rhs = vec![0.0; n];
+    spmv(k, &state.r, &mut rhs);
+    for (x, l) in rhs.iter_mut().zip(&state.load) {
+        *x = l - *x;
+    }
+    match mass {
+        Mass::Lumped(m) => {
+            for ((a, x), m) in state.a.iter_mut().zip(&rhs).zip(m) {
+                *a = x / m;
+            }
+        }
+        Mass::Consistent(m) => {
+            let mut solver = SparseCholesky::analyze(m, fill_order).map_err(TimeError::Static)?;
+            solver.factorize(m).map_err(TimeError::Static)?;
+            state.a.copy_from_slice(&rhs);
+            solver.solve_in_place(&mut state.a);
+        }
+    }
+    if let Some(c) = contact {
+        c.classify(&state.v, &mut state.classes);
+        c.nodal_forces(&state.v, &mut state.forces);
+    }
+    let mut partials = chunks::partials(n);
+    let kinetic = 0.5 * mass.form(&state.v, &mut partials);
+    let strain = 0.5 * quadratic_form(k, &state.r, &mut partials);
+    state.initial_mechanical = kinetic + strain;
+    state.energy = Energy {
+        kinetic,
+        strain,
+        external_work: 0.0,
+        dissipated: 0.0,
+        total: kinetic + strain - dot(&state.r, &state.load),
+        balance: 0.0,
+    };
+    Ok(state)
+}

@@ -1,0 +1,275 @@
+//! What the caller asks of a run: the scheme and its parameters, the step,
+//! the end time, the options; and why a run could not start or a step
+//! failed.
+
+use stickslip_contact::IterationOptions;
+use stickslip_linalg::SolverError;
+
+/// The time-stepping scheme.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Scheme {
+    /// β = 0, γ = ½ with the lumped mass: explicit, Δt < Δt_crit.
+    CentralDifference,
+    /// Newmark (β, γ): unconditionally stable for 2β ≥ γ ≥ ½.
+    Newmark {
+        /// β.
+        beta: f64,
+        /// γ.
+        gamma: f64,
+    },
+}
+
+impl Scheme {
+    /// (β, γ).
+    pub fn parameters(self) -> (f64, f64) {
+        match self {
+            Scheme::CentralDifference => (0.0, 0.5),
+            Scheme::Newmark { beta, gamma } => (beta, gamma),
+        }
+    }
+}
+
+/// Which mass matrix the scheme uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MassKind {
+    /// Consistent mass (the paper's choice for Newmark).
+    Consistent,
+    /// HRZ lumped mass (the paper's choice for central difference).
+    Lumped,
+}
+
+/// How the explicit scheme solves the friction of a step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExplicitFriction {
+    /// Each node's piecewise-linear monotone equation in closed form.
+    ClosedForm,
+    /// The stick/slip iteration of §5 (to check the closed form).
+    Iterate,
+}
+
+/// How implicit steps solve their linear systems.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ImplicitSolver {
+    /// A₀ factorized once per Δt, friction on the contact DOFs through the
+    /// Schur complement (`newmark/schur.rs`), its restricted solves by
+    /// W = L⁻¹Pᵀ or on the factor's paths, whichever reads fewer bytes.
+    #[default]
+    Schur,
+    /// As [`ImplicitSolver::Schur`], always by W.
+    SchurPaths,
+    /// As [`ImplicitSolver::Schur`], always by solves on the paths.
+    SchurReach,
+    /// A₀ + C refactorized whenever Δt or the stuck set changes, the
+    /// iteration on the full system (the reference).
+    Direct,
+}
+
+/// Remark 4.3: after a step in which a node went from slip to stick, the
+/// next `steps` steps use `dt`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StickReduction {
+    /// The reduced step.
+    pub dt: f64,
+    /// How many steps use it after each sticking event.
+    pub steps: usize,
+}
+
+/// Everything about the time discretization.
+#[derive(Clone, Debug)]
+pub struct Settings {
+    /// Scheme.
+    pub scheme: Scheme,
+    /// Mass; `None` = the paper's (lumped for central difference, consistent
+    /// for Newmark).
+    pub mass: Option<MassKind>,
+    /// Normal time step.
+    pub dt: f64,
+    /// End time.
+    pub t_end: f64,
+    /// Step reduction after sticking.
+    pub stick_reduction: Option<StickReduction>,
+    /// Stick/slip iteration settings.
+    pub iteration: IterationOptions,
+    /// Run an explicit scheme above its critical step anyway.
+    pub allow_unstable: bool,
+    /// Closed-form or iterated friction in explicit steps.
+    pub explicit_friction: ExplicitFriction,
+    /// How implicit steps solve.
+    pub implicit_solver: ImplicitSolver,
+    /// ṙ₀ (default zero).
+    pub initial_velocity: Option<Vec<f64>>,
+    /// The state will come from a checkpoint ([`crate::Integrator::restore`]):
+    /// the initial static solve (Remark 4.1), whose factor of K would be
+    /// most of a large restart's setup and peak memory, is skipped and r₀
+    /// left 0 until the restore.
+    pub restoring: bool,
+}
+
+impl Settings {
+    /// Defaults for a scheme, Δt and end time.
+    pub fn new(scheme: Scheme, dt: f64, t_end: f64) -> Settings {
+        Settings {
+            scheme,
+            mass: None,
+            dt,
+            t_end,
+            stick_reduction: None,
+            iteration: IterationOptions::default(),
+            allow_unstable: false,
+            explicit_friction: ExplicitFriction::ClosedForm,
+            implicit_solver: ImplicitSolver::Schur,
+            initial_velocity: None,
+            restoring: false,
+        }
+    }
+
+    /// Checks the settings for a model of `n` free DOFs and returns the
+    /// mass the scheme uses.
+    ///
+    /// # Errors
+    /// [`TimeError::Settings`] naming the setting and what to do.
+    pub(crate) fn check(&self, n: usize) -> Result<MassKind, TimeError> {
+        let bad = |m: String| Err(TimeError::Settings(m));
+        if !(self.dt > 0.0 && self.dt.is_finite()) {
+            return bad(format!(
+                "time.dt = {}: the time step must be positive",
+                self.dt
+            ));
+        }
+        if !(self.t_end > 0.0 && self.t_end.is_finite()) {
+            return bad(format!(
+                "time.t_end = {}: the end time must be positive",
+                self.t_end
+            ));
+        }
+        if let Some(r) = self.stick_reduction {
+            if !(r.dt > 0.0 && r.dt <= self.dt) {
+                return bad(format!(
+                    "time.stick_reduction.dt = {}: the reduced step must be positive and at most time.dt = {}",
+                    r.dt, self.dt
+                ));
+            }
+        }
+        if self.iteration.max_iterations == 0 {
+            return bad("contact.max_iterations must be at least 1".into());
+        }
+        if let Some(v0) = &self.initial_velocity {
+            if v0.len() != n {
+                return bad(format!(
+                    "initial velocity has {} entries, the model {n} free DOFs",
+                    v0.len()
+                ));
+            }
+        }
+        match (self.scheme, self.mass) {
+            (Scheme::CentralDifference, Some(MassKind::Consistent)) => bad(
+                "time.mass = \"consistent\" with central difference would need a linear solve per step; \
+                 central difference uses the lumped mass: remove time.mass or set it to \"lumped\""
+                    .into(),
+            ),
+            (Scheme::CentralDifference, _) => Ok(MassKind::Lumped),
+            (Scheme::Newmark { beta, gamma }, m) => {
+                if !(gamma >= 0.5 && 2.0 * beta >= gamma && beta.is_finite() && gamma.is_finite()) {
+                    return bad(format!(
+                        "Newmark β = {beta}, γ = {gamma} is outside the unconditionally stable range 2β ≥ γ ≥ ½ \
+                         (the paper uses β = 0.25, γ = 0.5 or β = 0.3025, γ = 0.6); for an explicit run use \
+                         time.scheme = \"central_difference\""
+                    ));
+                }
+                Ok(m.unwrap_or(MassKind::Consistent))
+            }
+        }
+    }
+}
+
+/// Why a run could not start or a step failed.
+#[derive(Debug, thiserror::Error)]
+pub enum TimeError {
+    /// A setting out of range; says which and what to do.
+    #[error("{0}")]
+    Settings(String),
+    /// Δt above the explicit scheme's critical step.
+    #[error(
+        "time.dt = {dt:e} is above the critical step of central difference, Δt_crit = {dt_crit:.6e} \
+         (2/ω_max, ω_max² the largest eigenvalue of M⁻¹K): use time.dt < {dt_crit:.4e}, \
+         or set time.allow_unstable = true to run anyway"
+    )]
+    Unstable {
+        /// The step asked for.
+        dt: f64,
+        /// The estimated critical step.
+        dt_crit: f64,
+    },
+    /// The initial static solve failed (rigid-body motion left free).
+    #[error(
+        "the initial static solve failed: {0}; the supports leave a rigid-body motion free: \
+         add Dirichlet conditions that fix translation in x and y and rotation"
+    )]
+    Static(SolverError),
+    /// A factorization failed during the run.
+    #[error("step {step} (t = {t:.6e}): the linear solve failed: {source}")]
+    Solve {
+        /// Step number (1-based).
+        step: u64,
+        /// Time the step was going to.
+        t: f64,
+        /// The solver's error.
+        source: SolverError,
+    },
+    /// The stick/slip iteration did not settle.
+    #[error(
+        "step {step} (t = {t:.6e}): the stick/slip iteration did not converge in {iterations} \
+         iterations ({changing} nodes still changing class); {hint}raise contact.max_iterations, \
+         or reduce time.dt"
+    )]
+    IterationCap {
+        /// Step number (1-based).
+        step: u64,
+        /// Time the step was going to.
+        t: f64,
+        /// Iterations performed.
+        iterations: usize,
+        /// Nodes still changing class.
+        changing: usize,
+        /// "enable Remark 4.2 (…), " where the run had it off, else "".
+        hint: &'static str,
+    },
+    /// NaN or infinity in the state.
+    #[error("step {step} (t = {t:.6e}): the solution is no longer finite; reduce time.dt{hint}")]
+    NonFinite {
+        /// Step number (1-based).
+        step: u64,
+        /// Time reached.
+        t: f64,
+        /// Extra advice (the critical step of an explicit run).
+        hint: String,
+    },
+}
+
+impl TimeError {
+    /// The stick/slip iteration's failure as the step's error: the cap, or
+    /// the failed solve as `solve` maps it.
+    pub(crate) fn from_iteration<E>(
+        failure: stickslip_contact::IterationFailure<E>,
+        (step, t, remark_4_2): (u64, f64, bool),
+        solve: impl FnOnce(E) -> TimeError,
+    ) -> TimeError {
+        match failure {
+            stickslip_contact::IterationFailure::Cap {
+                iterations,
+                changing,
+            } => TimeError::IterationCap {
+                step,
+                t,
+                iterations,
+                changing,
+                hint: if remark_4_2 {
+                    ""
+                } else {
+                    "enable Remark 4.2 (contact.remark_4_2 = true, the default), "
+                },
+            },
+            stickslip_contact::IterationFailure::Solve(e) => solve(e),
+        }
+    }
+}
