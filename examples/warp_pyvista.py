@@ -2,11 +2,13 @@
 display.
 
     cargo xtask demo                                  # writes target/demo/slab.h5
-    stickslip stress target/demo/slab.h5              # optional: colour by von Mises
+    stickslip views target/demo/slab.h5               # writes slab.xdmf for the viewers
+    stickslip stress target/demo/slab.h5              # optional (writes slab.xdmf too): colour by von Mises
     python3 examples/warp_pyvista.py target/demo/slab.h5 --png slab.png [--time 0.25] [--scale 1]
 
-PyVista reads `OUT.xdmf`, the file `stickslip run` writes beside OUT.h5
-(keep OUT.h5, OUT.xdmf and OUT.views.h5 together), at the record nearest
+PyVista reads `OUT.xdmf`, the file `stickslip views` (or `stickslip
+stress`) writes beside OUT.h5 (keep OUT.h5, OUT.xdmf and OUT.views.h5
+together), at the record nearest
 `--time` (default: the last). Warp By Vector moves each node by its
 displacement (times `--scale`), and the mesh is coloured by von Mises
 where `stickslip stress` has run, else by |u|. The undeformed outline is
@@ -28,6 +30,8 @@ parser.add_argument("--scale", type=float, default=1.0, help="displacement magni
 args = parser.parse_args()
 
 xdmf = pathlib.Path(args.results).with_suffix(".xdmf")
+if not xdmf.is_file():
+    raise SystemExit(f"{xdmf} is missing: write it with `stickslip views {args.results}`")
 reader = pv.get_reader(str(xdmf))
 times = np.array(reader.time_values)
 k = len(times) - 1 if args.time is None else int(np.argmin(np.abs(times - args.time)))

@@ -161,7 +161,7 @@ fn open_results(file: &Path) -> Result<File, InputError> {
 /// them would allocate that much (a file that claimed 1e11 rows aborted
 /// probe on an 800 GB allocation). The two grow together; between two
 /// records one may be one row ahead.
-fn read_time(f: &File, name: &str) -> Result<Vec<f64>, InputError> {
+pub(crate) fn read_time(f: &File, name: &str) -> Result<Vec<f64>, InputError> {
     let rows = |ds: &str| {
         f.dataset(ds)
             .map(|d| d.shape().first().copied().unwrap_or(0))
@@ -915,6 +915,7 @@ mod tests {
             mesh: &mesh,
             contact_nodes: &[0, 1, 2],
             contact_s: &[0.0, 1.0, 2.0],
+            contact_lines: &[[0, 1], [1, 2]],
         };
         let mut w = ResultsWriter::create(path, &header).unwrap();
         for k in 0..4 {

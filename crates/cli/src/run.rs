@@ -247,8 +247,7 @@ fn output_size(case: &Case, nodes: usize, contact_nodes: usize) -> (f64, f64) {
     // The node vectors take whole chunks of rows.
     let block = output::vector_chunk_rows(nodes) as f64;
     let rows = (records / block).ceil() * block;
-    let bytes = rows * 48.0 * nodes as f64
-        + records * (17.0 * contact_nodes as f64 + 96.0 + crate::xdmf::BYTES_PER_STEP as f64);
+    let bytes = rows * 48.0 * nodes as f64 + records * (17.0 * contact_nodes as f64 + 96.0);
     (records, bytes)
 }
 
@@ -629,18 +628,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     // ([`crate::results_file::in_use`]).
     let _lock = if options.restart {
         let lock = crate::results_file::RunLock::take(out)?;
-        // `stickslip stress`'s file ends where the earlier run ended.
-        let stress = crate::stress_cmd::stress_path(out);
-        if stress.is_file() {
-            std::fs::remove_file(&stress).ok();
-            if !quiet {
-                say!(
-                    "restart: removed {} (the earlier run's stresses); run `stickslip stress {}` again after this run",
-                    stress.display(),
-                    out.display()
-                );
-            }
-        }
+        forget_companions(out, quiet);
         lock
     } else {
         crate::results_file::claim(out)?
@@ -651,12 +639,10 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     } else {
         start::fresh(case, out, &mesh, &dofs, &integrator, &mut full)?
     };
-    let contact_line = session_contact_line(&mesh, &integrator);
     let mut session = Session {
         case,
         out,
         options,
-        mesh: &mesh,
         dofs: &dofs,
         integrator,
         writer: opened.writer,
@@ -666,8 +652,6 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         wall_before: opened.wall_before,
         initial_mechanical: opened.initial_mechanical,
         started,
-        xdmf_path: crate::xdmf::xdmf_path(out),
-        contact_line,
     };
     session.writer.auto_flush = false;
     session.writer.flush_every_steps = case.output.flush_every.max(1);
@@ -675,7 +659,6 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     // A state to continue from exists from the start (the initial state, or
     // the restored one).
     session.checkpoint(None)?;
-    session.write_xdmf()?;
     let setup_s = started.elapsed().as_secs_f64();
     let mut progress = Progress::new(quiet, &session.integrator);
     if progress.log {
@@ -785,7 +768,6 @@ struct Session<'a> {
     case: &'a Case,
     out: &'a Path,
     options: &'a RunOptions,
-    mesh: &'a Mesh,
     dofs: &'a DofMap,
     integrator: Integrator,
     writer: ResultsWriter,
@@ -796,9 +778,6 @@ struct Session<'a> {
     wall_before: f64,
     initial_mechanical: f64,
     started: Instant,
-    xdmf_path: std::path::PathBuf,
-    /// The contact surface as the viewers' line cells, if the case has one.
-    contact_line: Option<crate::views::ContactLine>,
 }
 
 impl Session<'_> {
@@ -816,11 +795,6 @@ impl Session<'_> {
             node_order: self.dofs.node_order().code(),
         };
         self.writer.write_checkpoint(&cp, &extra)
-    }
-
-    /// The viewers' files beside the results, listing every record so far.
-    fn write_xdmf(&self) -> anyhow::Result<()> {
-        write_xdmf(self.out, self.mesh, self.contact_line.as_ref(), &self.times)
     }
 
     /// Appends the current state as a record.
@@ -845,12 +819,6 @@ impl Session<'_> {
     /// `output.every`-th step, flushing and checkpointing when due.
     fn step_to_end(&mut self, progress: &mut Progress) -> anyhow::Result<Ending> {
         let every = self.case.output.every.max(1) as u64;
-        let mut last_xdmf = Instant::now();
-        // How long the last rewrite took: the next waits ten times that (and at
-        // least flush_seconds), so the rewrites, each O(rows), stay under a
-        // tenth of the run however many rows (at a fixed interval they took 42%
-        // of a run of 320k rows).
-        let mut xdmf_secs = 0.0_f64;
         let mut ending = Ending {
             failure: None,
             interrupted: None,
@@ -904,15 +872,6 @@ impl Session<'_> {
                     break;
                 }
                 self.checkpoint(None)?;
-                // The XML lists every row: rewrite it at most every
-                // flush_seconds, and ten times as seldom as it takes.
-                let wait = self.case.output.flush_seconds.max(10.0 * xdmf_secs);
-                if last_xdmf.elapsed().as_secs_f64() >= wait {
-                    let t = Instant::now();
-                    self.write_xdmf()?;
-                    xdmf_secs = t.elapsed().as_secs_f64();
-                    last_xdmf = Instant::now();
-                }
                 progress.flushed(&self.integrator, self.started);
             }
             progress.stepped(&self.integrator, self.started);
@@ -920,8 +879,8 @@ impl Session<'_> {
         Ok(ending)
     }
 
-    /// Closes the file (the last checkpoint, the summary, the side file)
-    /// and says how the run ended.
+    /// Closes the file (the last checkpoint, the summary) and says how the
+    /// run ended.
     fn conclude(
         mut self,
         ending: Ending,
@@ -964,7 +923,6 @@ impl Session<'_> {
         let rows = self.writer.rows();
         let warnings = self.writer.warnings();
         self.writer.finish(complete, &summary)?;
-        write_xdmf(self.out, self.mesh, self.contact_line.as_ref(), &self.times)?;
         let status = if complete {
             "complete"
         } else if interrupted.is_some() {
@@ -1004,13 +962,18 @@ impl Session<'_> {
                 e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
             );
             say!("results: {} ({rows} records)", out.display());
+            say!(
+                "view: `{}`, then open {} in ParaView (meshio and PyVista read it too)",
+                view_command(out),
+                crate::xdmf::xdmf_path(out).display()
+            );
         }
         if self.options.json {
             let j = serde_json::json!({
                 "status": status,
                 "case": case.path.display().to_string(),
                 "output": out.display().to_string(),
-                "xdmf": self.xdmf_path.display().to_string(),
+                "view_command": view_command(out),
                 "warnings": warnings,
                 "complete": complete,
                 "steps": i.steps(),
@@ -1076,27 +1039,45 @@ impl Session<'_> {
     }
 }
 
-/// The viewers' files beside the results file `out`, listing the records
-/// at `times`.
-fn write_xdmf(
-    out: &Path,
-    mesh: &Mesh,
-    contact: Option<&crate::views::ContactLine>,
-    times: &[f64],
-) -> anyhow::Result<()> {
-    let layout = crate::views::Layout {
-        n_nodes: mesh.nodes.len(),
-        contact,
-    };
-    crate::xdmf::write_companions(out, &layout, (mesh.kind, mesh.n_cells()), times)
+/// The command that writes the viewers' files of `out`, as a user would
+/// type it.
+fn view_command(out: &Path) -> String {
+    format!("stickslip views {}", shell_word(&out.display().to_string()))
 }
 
-/// The contact surface of `integrator` as line cells for the viewers.
-fn session_contact_line(mesh: &Mesh, integrator: &Integrator) -> Option<crate::views::ContactLine> {
-    integrator.contact().map(|c| {
-        let nodes: Vec<usize> = c.nodes.iter().map(|n| n.node).collect();
-        crate::views::ContactLine::new(mesh, &c.group, &nodes)
-    })
+/// Before a restart: removes what `stickslip stress` and `stickslip views`
+/// wrote beside `out` for the earlier run (the stresses end where it
+/// ended, the XML lists its records), saying so. The views file stays: a
+/// view of a row is the same whatever run wrote the row, and `views`
+/// then adds only the new records' views.
+fn forget_companions(out: &Path, quiet: bool) {
+    let stress = crate::stress_cmd::stress_path(out);
+    if stress.is_file() {
+        std::fs::remove_file(&stress).ok();
+        if !quiet {
+            say!(
+                "restart: removed {} (the earlier run's stresses); run `stickslip stress {}` again after this run",
+                stress.display(),
+                out.display()
+            );
+        }
+    }
+    let xml = [
+        crate::xdmf::xdmf_path(out),
+        crate::xdmf::contact_xdmf_path(out),
+    ];
+    let removed: Vec<String> = xml
+        .iter()
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .map(|p| p.display().to_string())
+        .collect();
+    if !removed.is_empty() && !quiet {
+        say!(
+            "restart: removed {} (they list the earlier run's records); run `{}` again after this run",
+            removed.join(" and "),
+            view_command(out)
+        );
+    }
 }
 
 /// The failure message of an explicit run whose energy blew up

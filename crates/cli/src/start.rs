@@ -41,11 +41,16 @@ pub(crate) fn fresh(
         .contact()
         .map(|c| c.nodes.iter().map(|n| (n.node, n.s)).unzip())
         .unwrap_or_default();
+    let contact_lines = integrator
+        .contact()
+        .map(|c| crate::views::contact_lines(mesh, &c.group, &contact_nodes))
+        .unwrap_or_default();
     let header = Header {
         case_source: &case.source,
         mesh,
         contact_nodes: &contact_nodes,
         contact_s: &contact_s,
+        contact_lines: &contact_lines,
     };
     let mut writer = ResultsWriter::create_with(
         out,

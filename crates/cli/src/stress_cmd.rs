@@ -9,8 +9,8 @@
 //! the average of its cells' σ = D ε there (`stickslip_fem::nodal_stresses`),
 //! into `OUT.stress.h5`: `/stress` [n_out, n_nodes, 3] (σ_xx, σ_yy, σ_xy)
 //! and `/von_mises` [n_out, n_nodes], with a view of each record's
-//! σ_xx, σ_yy, σ_xy and von Mises under `/views`; and lists those in
-//! `OUT.xdmf`. The
+//! σ_xx, σ_yy, σ_xy and von Mises under `/views`; and writes the viewers'
+//! files as `stickslip views` does, `OUT.xdmf` listing the stresses. The
 //! results file is only read: a full disk or a kill leaves it as it was
 //! (the stress file is written beside and renamed into place). A new run
 //! or a `--restart` on OUT.h5 removes OUT.stress.h5 (it would end where
@@ -25,39 +25,20 @@ use ndarray::{s, Array1, Array2};
 
 use stickslip_case::InputError;
 
-/// Writes the stress datasets of the results file `path` and rewrites its
-/// XDMF; returns the records and nodes written.
+/// Writes the stress datasets of the results file `path` and the viewers'
+/// files ([`crate::views_cmd::write`]); returns the records and nodes
+/// written, and what the viewers' files hold.
 ///
 /// # Errors
 /// An [`InputError`] for a file that is missing, being written, or not a
 /// results file of `stickslip run`; other errors for HDF5 failures.
-pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
+pub fn command(
+    path: &Path,
+    quiet: bool,
+) -> anyhow::Result<(usize, usize, crate::views_cmd::Written)> {
     let name = path.display().to_string();
-    if !path.is_file() {
-        return Err(InputError(format!(
-            "{name}: no such results file; give the OUT.h5 a `stickslip run` wrote"
-        ))
-        .into());
-    }
-    if crate::results_file::in_use(path) {
-        return Err(InputError(format!(
-            "{name}: a run or a reader has it open; wait for the run to end (or close the reader) and run this again"
-        ))
-        .into());
-    }
     // No run may start on the file while its stresses are formed.
-    let _lock = crate::results_file::RunLock::shared(path)?;
-    let f = File::open(path).map_err(|e| {
-        InputError(format!(
-            "{name}: cannot open it as HDF5: {e}; give a results file written by `stickslip run`"
-        ))
-    })?;
-    if crate::output::text_attr(&f, "program").ok().as_deref() != Some("stickslip") {
-        return Err(InputError(format!(
-            "{name} was not written by `stickslip run` (no program = \"stickslip\" attribute)"
-        ))
-        .into());
-    }
+    let (_lock, f) = crate::results_file::open_finished(path, true)?;
     let (mesh, material) = crate::probe::stored_model(&f, &name)?;
     let n_nodes = mesh.nodes.len();
     let u = f.dataset("displacement")?;
@@ -98,29 +79,8 @@ pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
     std::fs::rename(&part, &target)
         .with_context(|| format!("cannot rename {} to {}", part.display(), target.display()))?;
     drop((u, f));
-    let xdmf_path = crate::xdmf::xdmf_path(path);
-    let stress_name = target
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or("stress.h5")
-        .to_string();
-    // The body's views, in case the run's are gone (the contact's are
-    // left as they are).
-    let layout = crate::views::Layout {
-        n_nodes,
-        contact: None,
-    };
-    crate::views::update(path, &layout, rows)?;
-    let info = crate::xdmf::XdmfInfo {
-        n_nodes,
-        kind: mesh.kind,
-        n_cells: mesh.n_cells(),
-        times: &times[..rows],
-        stress: Some(&stress_name),
-    };
-    crate::xdmf::write_xdmf(path, &info)
-        .with_context(|| format!("cannot write {}", xdmf_path.display()))?;
-    Ok((rows, n_nodes))
+    let written = crate::views_cmd::write(path)?;
+    Ok((rows, n_nodes, written))
 }
 
 /// The stress file of the results file `out`: OUT.stress.h5 beside it.
@@ -183,8 +143,8 @@ fn write_stresses(
             );
         }
     }
-    // One view per record and scalar for the XDMF readers (the views file
-    // of the run is left to the run): "." is this file, whatever its name.
+    // One view per record and scalar for the XDMF readers (in this file,
+    // which goes with the stresses): "." is this file, whatever its name.
     let views = g.create_group("views")?;
     for (c, name) in crate::xdmf::STRESS_VIEWS.iter().enumerate() {
         let v = views.create_group(name)?;

@@ -16,11 +16,16 @@
 //! named by file name only: HDF5 looks for it beside the views file, so
 //! the files move together.
 //!
+//! `stickslip views` writes the file (and `stickslip stress` through it),
+//! not the run: HDF5 creates a dataset, virtual or plain, far more slowly
+//! than a run writes a record, and six views a record made a run of many
+//! cheap records several times slower (docs/performance.md).
+//!
 //! The file only grows: each update adds the views of the records written
 //! since the last one (a view of a row is the same whatever run wrote the
-//! row), so a long run does not rewrite it. A file that cannot be opened
-//! (a run killed while adding views) or that belongs to other sizes is
-//! made anew.
+//! row), so after a restart only the new records' views are made. A file
+//! that cannot be opened (killed while adding views) or that belongs to
+//! other sizes is made anew.
 
 use std::path::{Path, PathBuf};
 
@@ -44,48 +49,45 @@ pub fn views_path(out: &Path) -> PathBuf {
     out.with_extension("views.h5")
 }
 
-/// The contact surface as line cells for the viewers: the friction nodes'
-/// coordinates, in the order of `/contact/nodes`, and the segments between
-/// two of them that are neighbours on a side of the group (indices into
-/// `points`, oriented with the body on the left).
+/// The segments of the contact surface between two friction nodes
+/// `nodes` (mesh indices, as `/contact/nodes`) that are neighbours on a
+/// side of the dimension-1 group `group`, as indices into `nodes`,
+/// oriented as the group's edges (the body on the left): a quad9 side
+/// gives two (corner, mid-side, corner). A segment with a node that
+/// carries no friction (its tangential motion held) is left out, since
+/// the fields have no value there. The run stores them as
+/// `/contact/lines`, since the results file keeps the group's nodes but
+/// not its edges.
+pub fn contact_lines(mesh: &Mesh, group: &str, nodes: &[usize]) -> Vec<[usize; 2]> {
+    let mut index = std::collections::HashMap::with_capacity(nodes.len());
+    for (i, &n) in nodes.iter().enumerate() {
+        index.insert(n, i);
+    }
+    let mut lines = Vec::new();
+    if let Ok(g) = mesh.group(group) {
+        for e in &g.edges {
+            let chain: Vec<usize> = match e.mid {
+                Some(m) => vec![e.nodes[0], m, e.nodes[1]],
+                None => e.nodes.to_vec(),
+            };
+            for w in chain.windows(2) {
+                if let (Some(&a), Some(&b)) = (index.get(&w[0]), index.get(&w[1])) {
+                    lines.push([a, b]);
+                }
+            }
+        }
+    }
+    lines
+}
+
+/// The contact surface as the viewers' line cells: the friction nodes'
+/// coordinates, in the order of `/contact/nodes`, and `/contact/lines`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactLine {
     /// Coordinates of `/contact/nodes`.
     pub points: Vec<[f64; 2]>,
     /// Segments: pairs of indices into `points`.
     pub lines: Vec<[usize; 2]>,
-}
-
-impl ContactLine {
-    /// The line of the friction nodes `nodes` (mesh indices) of the
-    /// dimension-1 group `group`: a quad9 side gives two segments (corner,
-    /// mid-side, corner); a segment with a node that carries no friction
-    /// (its tangential motion held) is left out, since the fields have no
-    /// value there.
-    pub fn new(mesh: &Mesh, group: &str, nodes: &[usize]) -> ContactLine {
-        let mut index = std::collections::HashMap::with_capacity(nodes.len());
-        for (i, &n) in nodes.iter().enumerate() {
-            index.insert(n, i);
-        }
-        let mut lines = Vec::new();
-        if let Ok(g) = mesh.group(group) {
-            for e in &g.edges {
-                let chain: Vec<usize> = match e.mid {
-                    Some(m) => vec![e.nodes[0], m, e.nodes[1]],
-                    None => e.nodes.to_vec(),
-                };
-                for w in chain.windows(2) {
-                    if let (Some(&a), Some(&b)) = (index.get(&w[0]), index.get(&w[1])) {
-                        lines.push([a, b]);
-                    }
-                }
-            }
-        }
-        ContactLine {
-            points: nodes.iter().map(|&n| mesh.nodes[n]).collect(),
-            lines,
-        }
-    }
 }
 
 /// What the views of one results file are views of.
@@ -98,9 +100,7 @@ pub struct Layout<'a> {
 }
 
 /// Makes `OUT.views.h5` hold the views of records `0..rows` of the results
-/// file `out`, adding those it lacks. A layout without a contact line
-/// leaves the contact views of an existing file as they are (`stickslip
-/// stress` knows the body only).
+/// file `out`, adding those it lacks.
 ///
 /// # Errors
 /// `out` without a UTF-8 file name, or HDF5 failing to write the file.
@@ -108,8 +108,7 @@ pub fn update(out: &Path, layout: &Layout, rows: usize) -> anyhow::Result<()> {
     let source = file_name(out)?;
     let path = views_path(out);
     let n_c = layout.contact.map_or(0, |c| c.points.len());
-    let contact = layout.contact.map(|c| c.points.len());
-    let f = match open_matching(&path, source, layout.n_nodes, contact) {
+    let f = match open_matching(&path, source, layout.n_nodes, n_c) {
         Some(f) => f,
         None => create(&path, source, layout)
             .with_context(|| format!("cannot create {}", path.display()))?,
@@ -150,17 +149,13 @@ pub(crate) fn file_name(out: &Path) -> anyhow::Result<&str> {
 }
 
 /// The views file at `path`, open for writing, if it is one of `source`
-/// with these sizes (`n_c`: `None` takes any contact).
-fn open_matching(path: &Path, source: &str, n_nodes: usize, n_c: Option<usize>) -> Option<File> {
+/// with these sizes.
+fn open_matching(path: &Path, source: &str, n_nodes: usize, n_c: usize) -> Option<File> {
     let f = File::open_rw(path).ok()?;
+    let size = |name: &str| f.attr(name).and_then(|a| a.read_scalar::<u64>()).ok();
     let same = crate::output::text_attr(&f, "source").ok().as_deref() == Some(source)
-        && f.attr("n_nodes").and_then(|a| a.read_scalar::<u64>()).ok() == Some(n_nodes as u64)
-        && n_c.is_none_or(|n_c| {
-            f.attr("n_contact")
-                .and_then(|a| a.read_scalar::<u64>())
-                .ok()
-                == Some(n_c as u64)
-        })
+        && size("n_nodes") == Some(n_nodes as u64)
+        && size("n_contact") == Some(n_c as u64)
         && VECTORS.iter().all(|v| f.group(v).is_ok());
     same.then_some(f)
 }
@@ -273,15 +268,11 @@ mod tests {
         let mut nodes = g.nodes.clone();
         // Along the face: x = 0, 1, 2, 3, 4.
         nodes.sort_by(|&a, &b| mesh.nodes[a][0].total_cmp(&mesh.nodes[b][0]));
-        let line = ContactLine::new(&mesh, "contact", &nodes);
-        let xs: Vec<f64> = line.points.iter().map(|p| p[0]).collect();
-        assert_eq!(xs, [0.0, 1.0, 2.0, 3.0, 4.0]);
-        let mut lines = line.lines.clone();
+        let mut lines = contact_lines(&mesh, "contact", &nodes);
         lines.sort();
         assert_eq!(lines, [[0, 1], [1, 2], [2, 3], [3, 4]]);
         // The node at x = 0 held: its segment goes, the others stay.
-        let held = ContactLine::new(&mesh, "contact", &nodes[1..]);
-        let mut lines = held.lines;
+        let mut lines = contact_lines(&mesh, "contact", &nodes[1..]);
         lines.sort();
         assert_eq!(lines, [[0, 1], [1, 2], [2, 3]]);
     }

@@ -45,12 +45,6 @@ pub struct XdmfInfo<'a> {
     pub stress: Option<&'a str>,
 }
 
-/// About the bytes per record of a run beside its results: the XML of
-/// both files (1,150 and 1,377 for the slab's `st.h5`; each character of
-/// a longer file name adds about ten) and six views in `OUT.views.h5`
-/// (3,048 together).
-pub const BYTES_PER_STEP: usize = 5600;
-
 /// The body's XDMF file of the results file `out`: OUT.xdmf beside it.
 pub fn xdmf_path(out: &Path) -> PathBuf {
     out.with_extension("xdmf")
@@ -231,8 +225,8 @@ fn views_name(h5_name: &str) -> String {
 /// them together).
 ///
 /// Call it after the views of every record in `info.times` exist
-/// ([`crate::views::update`]), after the last step is written (and again
-/// after a restart), with the times actually in the file.
+/// ([`crate::views::update`]), with the times actually in the file
+/// ([`crate::views_cmd::write`]).
 ///
 /// # Errors
 /// `out` without a UTF-8 file name (`InvalidInput`), or the write failing.
@@ -258,38 +252,6 @@ pub fn write_contact_xdmf(
     replace(&contact_xdmf_path(out), |w| {
         write_contact(w, name, times, (n_c, n_lines))
     })
-}
-
-/// The views and both XDMF files of the results file `out` for the
-/// records at `times` (a run calls it after a flush and at its end): the
-/// views first, so that the XML never names a view that is not there.
-///
-/// # Errors
-/// As [`crate::views::update`] and [`write_xdmf`], naming the file.
-pub fn write_companions(
-    out: &Path,
-    layout: &crate::views::Layout,
-    (kind, n_cells): (CellKind, usize),
-    times: &[f64],
-) -> anyhow::Result<()> {
-    use anyhow::Context;
-    crate::views::update(out, layout, times.len())?;
-    let info = XdmfInfo {
-        n_nodes: layout.n_nodes,
-        kind,
-        n_cells,
-        times,
-        stress: None,
-    };
-    let path = xdmf_path(out);
-    write_xdmf(out, &info).with_context(|| format!("cannot write {}", path.display()))?;
-    // A surface of one node has no line to show.
-    if let Some(c) = layout.contact.filter(|c| !c.lines.is_empty()) {
-        let path = contact_xdmf_path(out);
-        write_contact_xdmf(out, times, c.points.len(), c.lines.len())
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    Ok(())
 }
 
 /// Writes `path` beside and renames it over: a reader (or a kill -9

@@ -1,12 +1,15 @@
-//! The XDMF companions of a results file (`src/xdmf.rs`, `src/views.rs`)
-//! read back by the tools users open them with, as shipped: ParaView's
-//! three XDMF readers through `pvpython` (Debian's `paraview`), meshio's
-//! `TimeSeriesReader` and PyVista (PyPI). `cargo xtask test` installs
-//! them, and under CI a missing one fails its test.
+//! The XDMF companions of a results file that `stickslip views` writes
+//! (`src/views_cmd.rs`, `src/xdmf.rs`, `src/views.rs`) read back by the
+//! tools users open them with, as shipped: ParaView's three XDMF readers
+//! through `pvpython` (Debian's `paraview`), meshio's `TimeSeriesReader`
+//! and PyVista (PyPI). `cargo xtask test` installs them, and under CI a
+//! missing one fails its test.
 //!
-//! Each test runs a Q1 and a Q2 case of the paper's slab, forms the
-//! stresses (`stickslip stress`), and has its reader read `OUT.xdmf` (the
-//! body) and `OUT.contact.xdmf` (Γ_C as line cells) at every record. The
+//! Each test runs a Q1 and a Q2 case of the paper's slab, writes the
+//! viewers' files (`stickslip views`) and forms the stresses (`stickslip
+//! stress`, which lists them in OUT.xdmf), and has its reader read
+//! `OUT.xdmf` (the body) and `OUT.contact.xdmf` (Γ_C as line cells) at
+//! every record. The
 //! expected values are h5py's reading of OUT.h5 and OUT.stress.h5, and
 //! every array must equal them bit for bit: the XDMF files and the views
 //! hold only references, so any difference is a wrong reference. Node
@@ -22,8 +25,8 @@ fn scratch(name: &str) -> PathBuf {
     common::scratch(&format!("xdmf-{name}"))
 }
 
-/// Runs a paper case into `dir/NAME.h5` and forms its stresses; returns
-/// the results file.
+/// Runs a paper case into `dir/NAME.h5`, writes its viewers' files and
+/// forms its stresses; returns the results file.
 fn run_case(case: &str, dir: &Path, name: &str, sets: &[&str]) -> PathBuf {
     let out = dir.join(format!("{name}.h5"));
     let case = root().join("cases/martins-oden").join(case);
@@ -40,6 +43,7 @@ fn run_case(case: &str, dir: &Path, name: &str, sets: &[&str]) -> PathBuf {
         args.push(s.as_ref());
     }
     stickslip(&args);
+    stickslip(&["views".as_ref(), out.as_os_str(), "--quiet".as_ref()]);
     stickslip(&["stress".as_ref(), out.as_os_str(), "--quiet".as_ref()]);
     out
 }
@@ -389,21 +393,40 @@ fn paraview_readers_read_what_h5py_reads_q1_and_q2() {
     }
 }
 
-/// `stickslip run -o OUT.h5` writes OUT.xdmf, OUT.contact.xdmf and
-/// OUT.views.h5 beside OUT.h5, one grid and one view per record, and a
-/// restart adds the views of its records to the same views file.
+/// `stickslip run -o OUT.h5` writes OUT.h5 only and says how to view it;
+/// `stickslip views OUT.h5` writes OUT.xdmf, OUT.contact.xdmf and
+/// OUT.views.h5 beside it, one grid and one view per record; a restart
+/// removes the XML (it lists the earlier run's records) and keeps the
+/// views, to which `views` adds those of the new records.
 #[test]
-fn run_writes_the_companions_beside_the_h5() {
+fn views_writes_the_companions_beside_the_h5() {
     let dir = scratch("run");
     let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
     let h5 = dir.join("slab.h5");
     let (case, h5s) = (case.to_str().unwrap(), h5.to_str().unwrap());
     let run = |more: [&str; 2], t_end: &str| {
-        let args = ["run", case, more[0], more[1], "--quiet", "--set", t_end];
-        let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
-        stickslip(&args);
+        let o = common::stickslip(&["run", case, more[0], more[1], "--set", t_end]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
     };
-    run(["-o", h5s], "time.t_end=0.01");
+    let said = run(["-o", h5s], "time.t_end=0.01");
+    assert!(
+        said.contains(&format!(
+            "view: `stickslip views {h5s}`, then open {} in ParaView",
+            dir.join("slab.xdmf").display()
+        )),
+        "{said}"
+    );
+    for name in ["slab.xdmf", "slab.contact.xdmf", "slab.views.h5"] {
+        assert!(!dir.join(name).exists(), "{name} written by the run");
+    }
+    let views_cmd = || {
+        let o = common::stickslip(&["views", h5s]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let said = views_cmd();
+    assert!(said.starts_with("views: 11 records in "), "{said}");
     let grids = |name: &str| {
         std::fs::read_to_string(dir.join(name))
             .unwrap()
@@ -420,7 +443,12 @@ fn run_writes_the_companions_beside_the_h5() {
     assert_eq!(grids("slab.xdmf"), 11);
     assert_eq!(grids("slab.contact.xdmf"), 11);
     assert_eq!(views(), (11, 11));
-    run(["--restart", h5s], "time.t_end=0.015");
+    let said = run(["--restart", h5s], "time.t_end=0.015");
+    assert!(said.contains("restart: removed "), "{said}");
+    assert!(!dir.join("slab.xdmf").exists());
+    assert!(!dir.join("slab.contact.xdmf").exists());
+    assert_eq!(views(), (11, 11));
+    views_cmd();
     assert_eq!(grids("slab.xdmf"), 16);
     assert_eq!(grids("slab.contact.xdmf"), 16);
     assert_eq!(views(), (16, 16));
@@ -446,4 +474,110 @@ fn run_writes_the_companions_beside_the_h5() {
             );
         }
     }
+}
+
+/// `stickslip views` refuses, with exit code 2 and what to give instead,
+/// a missing file, a file that is not HDF5 (the case), an XDMF named for
+/// its results file, and an HDF5 file `stickslip run` did not write.
+#[test]
+fn views_refuses_what_is_not_a_results_file() {
+    let dir = scratch("refuse");
+    let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let other = dir.join("other.h5");
+    hdf5::File::create(&other).unwrap();
+    for (bad, says) in [
+        (dir.join("none.h5"), "no such results file"),
+        (case, "cannot open it as HDF5"),
+        (
+            dir.join("slab.xdmf"),
+            "give the results file the XDMF is written for",
+        ),
+        (other, "was not written by `stickslip run`"),
+    ] {
+        let o = common::stickslip(&["views".as_ref(), bad.as_os_str()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{}: {err}", bad.display());
+        assert!(err.contains(says), "{}: {err}", bad.display());
+    }
+}
+
+/// `stickslip views` on a run's file: refused while the run writes it
+/// (exit code 2), and after the run is interrupted (SIGINT) it lists
+/// every record the file holds.
+#[test]
+fn views_waits_for_the_run_and_shows_an_interrupted_one() {
+    let dir = scratch("interrupted");
+    let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let h5 = dir.join("long.h5");
+    // 200,000 steps, a record every 2,000th: seconds of run, few records.
+    let child = Command::new(env!("CARGO_BIN_EXE_stickslip"))
+        .arg("run")
+        .arg(&case)
+        .arg("-o")
+        .arg(&h5)
+        .args([
+            "--quiet",
+            "--set",
+            "time.t_end=200",
+            "--set",
+            "output.every=2000",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while !h5.exists() && t0.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let o = common::stickslip(&["views".as_ref(), h5.as_os_str()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("a run is writing it"), "{err}");
+    assert!(!dir.join("long.xdmf").exists());
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    stickslip(&["views".as_ref(), h5.as_os_str(), "--quiet".as_ref()]);
+    let f = hdf5::File::open(&h5).unwrap();
+    assert!(!f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
+    let rows = f.dataset("time").unwrap().size();
+    assert!(rows >= 2, "{rows} records before the signal");
+    for name in ["long.xdmf", "long.contact.xdmf"] {
+        let xml = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert_eq!(xml.matches("GridType=\"Uniform\"").count(), rows, "{name}");
+    }
+}
+
+/// A results file of a version before `/contact/lines` (made here by
+/// removing it): `views` writes the body's files, removes the contact
+/// surface's (it would list other records) and says why.
+#[test]
+fn views_of_a_file_without_contact_lines_shows_the_body() {
+    let dir = scratch("old");
+    let h5 = run_case("cd-step-eps1e-4.toml", &dir, "old", &["time.t_end=0.005"]);
+    assert!(dir.join("old.contact.xdmf").exists());
+    hdf5::File::open_rw(&h5)
+        .unwrap()
+        .unlink("contact/lines")
+        .unwrap();
+    let o = common::stickslip(&["views".as_ref(), h5.as_os_str(), "--quiet".as_ref()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("has no /contact/lines") && err.contains("old.contact.xdmf is not written"),
+        "{err}"
+    );
+    let xml = std::fs::read_to_string(dir.join("old.xdmf")).unwrap();
+    assert_eq!(xml.matches("GridType=\"Uniform\"").count(), 6);
+    assert!(!dir.join("old.contact.xdmf").exists());
 }
