@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
+mod apt;
 mod bench_advise;
 mod bench_fem;
 mod bench_mesh;
@@ -27,7 +28,8 @@ usage: cargo xtask <command> [args]
   test              install what is missing (HDF5, Python modules, ParaView), then run
                     the whole test suite (what .ci/run and CI run)
   setup             only install what is missing: libhdf5-dev, and h5py, numpy,
-                    gmsh, matplotlib, meshio and Debian's paraview for the tests
+                    gmsh, matplotlib, meshio, pyvista and Debian's paraview for
+                    the tests (and the X/GL libraries gmsh's wheel loads)
   verify            the proof of correctness: closed forms, convergence rates,
                     the paper's experiments, committed reference runs
                     [--quick] [--bless] [--only SUITE]
@@ -177,7 +179,7 @@ fn hdf5_present() -> bool {
 /// the Python modules and ParaView's pvpython they read results with,
 /// saying so.
 pub(crate) fn setup(for_tests: bool) -> Result<(), String> {
-    let mut apt = Apt::default();
+    let mut apt = apt::Apt::default();
     if hdf5_present() {
         eprintln!("setup: HDF5 development files found");
     } else {
@@ -200,9 +202,10 @@ pub(crate) fn setup(for_tests: bool) -> Result<(), String> {
             ("gmsh", "gmsh"),
             ("matplotlib", "matplotlib"),
             ("meshio", "meshio"),
+            ("pyvista", "pyvista"),
         ])?;
-        // The XDMF test opens the results in ParaView, as users do; under
-        // CI it fails without it.
+        // The XDMF tests open the results in ParaView, as users do; under
+        // CI they fail without it.
         if pvpython_present() {
             eprintln!("setup: ParaView's pvpython found");
         } else {
@@ -224,43 +227,6 @@ fn pvpython_present() -> bool {
         .arg("--version")
         .output()
         .is_ok_and(|o| o.status.success())
-}
-
-/// Debian's apt-get, through sudo unless root; the package lists are
-/// updated once, before the first install.
-#[derive(Default)]
-struct Apt {
-    updated: bool,
-}
-
-impl Apt {
-    fn command(args: &[&str]) -> Command {
-        let mut c = if is_root() {
-            Command::new("apt-get")
-        } else {
-            let mut c = Command::new("sudo");
-            c.arg("apt-get");
-            c
-        };
-        c.args(args).env("DEBIAN_FRONTEND", "noninteractive");
-        c
-    }
-
-    fn install(&mut self, packages: &[&str]) -> Result<(), String> {
-        if !self.updated {
-            run(&mut Self::command(&["update", "-q"]))?;
-            self.updated = true;
-        }
-        run(Self::command(&["install", "-y", "-q"]).args(packages))
-    }
-}
-
-fn is_root() -> bool {
-    Command::new("id")
-        .arg("-u")
-        .output()
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
-        .unwrap_or(false)
 }
 
 /// The main job: the paper's slab under a step load, central difference.

@@ -1,8 +1,9 @@
 //! The `stickslip` command's library: the HDF5 results and checkpoints
 //! ([`output`]), runs and checks ([`run`]), the `mesh` report
 //! ([`mesh_cmd`]), the `probe` reader ([`probe`]), the results file's
-//! protection ([`results_file`]) and the `advise` command ([`advise`]: the
-//! cheapest configuration for a tolerance). Case files are read by
+//! protection ([`results_file`]), the `advise` command ([`advise`]: the
+//! cheapest configuration for a tolerance) and the viewers' files
+//! ([`views_cmd`]). Case files are read by
 //! `stickslip-case`.
 //!
 //! This crate owns everything that touches the results files and the
@@ -41,4 +42,6 @@ pub mod results_file;
 pub mod run;
 mod start;
 pub mod stress_cmd;
+pub mod views;
+pub mod views_cmd;
 pub mod xdmf;

@@ -14,7 +14,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use stickslip::{advise, mesh_cmd, probe, run};
+use stickslip::{advise, mesh_cmd, probe, run, views_cmd};
 use stickslip_case as case;
 use stickslip_case::InputError;
 
@@ -23,7 +23,7 @@ use stickslip_case::InputError;
     name = "stickslip",
     version,
     about = "2-D elastodynamics with Coulomb friction (Martins & Oden 1983)",
-    after_help = "Examples:\n  stickslip mesh cases/meshes/slab-q2-8x2.msh\n  stickslip check cases/martins-oden/cd-step-eps1e-4.toml\n  stickslip run cases/martins-oden/cd-step-eps1e-4.toml -o slab.h5 --set time.dt=5e-4\n  stickslip probe slab.h5 --at 8,0 --field ux"
+    after_help = "Examples:\n  stickslip mesh cases/meshes/slab-q2-8x2.msh\n  stickslip check cases/martins-oden/cd-step-eps1e-4.toml\n  stickslip run cases/martins-oden/cd-step-eps1e-4.toml -o slab.h5 --set time.dt=5e-4\n  stickslip views slab.h5\n  stickslip probe slab.h5 --at 8,0 --field ux"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -51,7 +51,8 @@ A second Ctrl-C while the first is being handled exits at once (the file keeps e
         /// Overwrite an existing results file.
         #[arg(long)]
         force: bool,
-        /// No progress (a bar on a terminal, a line a minute in a log) and no summary.
+        /// No progress (a bar on a terminal, a line a minute in a log) and no
+        /// summary; warnings are still printed (and kept in the results file).
         #[arg(short, long)]
         quiet: bool,
         /// Print the closing summary as one JSON object on stdout.
@@ -109,12 +110,25 @@ Exit codes: 0 a configuration meets the tolerance (estimated), 1 none of the lad
         json: bool,
     },
     /// Write a finished run's stress fields (/stress, /von_mises) into OUT.stress.h5 beside its
-    /// results file and list them in its XDMF, for ParaView.
+    /// results file, and the viewers' files as `views` does, OUT.xdmf listing the stresses.
     #[command(after_help = "Example:\n  stickslip stress slab.h5")]
     Stress {
         /// A results file written by `stickslip run` (no run may be writing it).
         file: PathBuf,
         /// No progress lines.
+        #[arg(short, long)]
+        quiet: bool,
+    },
+    /// Write OUT.xdmf, OUT.contact.xdmf and OUT.views.h5 beside a results file, for ParaView,
+    /// meshio and PyVista (the run itself does not: their cost grows with the records).
+    #[command(after_help = "Example:\n  stickslip views slab.h5\n\n\
+Open slab.xdmf in ParaView (any of its XDMF readers) and slab.contact.xdmf for the friction fields along \
+the contact surface; meshio.xdmf.TimeSeriesReader and pyvista.read read them too. Works on a finished, \
+interrupted or failed run's file; run it again after a --restart (it adds the new records).")]
+    Views {
+        /// A results file written by `stickslip run` (no run may be writing it).
+        file: PathBuf,
+        /// No summary line (notes are still printed).
         #[arg(short, long)]
         quiet: bool,
     },
@@ -300,13 +314,28 @@ fn main() -> ExitCode {
             }
         }
         Command::Stress { file, quiet } => match stickslip::stress_cmd::command(&file, quiet) {
-            Ok((rows, nodes)) => {
+            Ok((rows, nodes, written)) => {
                 if !quiet {
                     eprintln!(
                         "stress: {rows} records of {nodes} nodes into {} (/stress, /von_mises), listed in {}",
                         stickslip::stress_cmd::stress_path(&file).display(),
-                        file.with_extension("xdmf").display()
+                        stickslip::xdmf::xdmf_path(&file).display()
                     );
+                }
+                if let Some(note) = &written.note {
+                    eprintln!("stress: note: {note}");
+                }
+                ExitCode::SUCCESS
+            }
+            Err(e) => fail(&e),
+        },
+        Command::Views { file, quiet } => match views_cmd::command(&file) {
+            Ok(written) => {
+                if !quiet {
+                    eprintln!("{}", views_cmd::summary(&file, &written));
+                }
+                if let Some(note) = &written.note {
+                    eprintln!("views: note: {note}");
                 }
                 ExitCode::SUCCESS
             }

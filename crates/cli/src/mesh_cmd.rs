@@ -54,7 +54,16 @@ pub fn to_json(mesh: &Mesh) -> serde_json::Value {
         "bbox": mesh.bbox(),
         "reoriented": mesh.source.reoriented,
         "unused_nodes": mesh.source.unused_nodes,
+        "warnings": warnings(mesh),
     })
+}
+
+/// What in the mesh runs but is likely not meant: nearly degenerate cells.
+fn warnings(mesh: &Mesh) -> Vec<String> {
+    stickslip_mesh::degenerate_cells(mesh, stickslip_mesh::DEGENERATE_RATIO)
+        .map(|d| d.to_string())
+        .into_iter()
+        .collect()
 }
 
 fn to_table(path: &Path, mesh: &Mesh) -> String {
@@ -98,6 +107,9 @@ fn to_table(path: &Path, mesh: &Mesh) -> String {
         "  reoriented   {} cells (given clockwise, turned counter-clockwise)",
         mesh.source.reoriented
     );
+    for w in warnings(mesh) {
+        let _ = writeln!(s, "  warning: {w}");
+    }
     if mesh.groups.is_empty() {
         let _ = writeln!(s, "  no physical groups: name the boundary parts in Gmsh (Physical Curve(\"contact\") = {{..}};)");
         return s;

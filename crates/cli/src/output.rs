@@ -42,6 +42,10 @@ pub struct Header<'a> {
     pub contact_nodes: &'a [usize],
     /// Arc length of each contact node.
     pub contact_s: &'a [f64],
+    /// The contact surface's segments between two neighbouring contact
+    /// nodes (indices into `contact_nodes`, the body on the left), for
+    /// the viewers' line cells (`/contact/lines`).
+    pub contact_lines: &'a [[usize; 2]],
 }
 
 /// One output step. Vectors are full, `2 * n_nodes` long, interleaved
@@ -696,6 +700,10 @@ impl ResultsWriter {
             c.new_dataset_builder()
                 .with_data(&ArrayView1::from(header.contact_s))
                 .create("s")?;
+            let lines = Array2::from_shape_fn((header.contact_lines.len(), 2), |(i, k)| {
+                header.contact_lines[i][k] as i64
+            });
+            c.new_dataset_builder().with_data(&lines).create("lines")?;
             Some(ContactSeries {
                 friction_stress: series_2d::<f64>(&c, "friction_stress", n_c, level)?,
                 slip_velocity: series_2d::<f64>(&c, "slip_velocity", n_c, level)?,
@@ -850,6 +858,38 @@ impl ResultsWriter {
         string_attr(&self.file, "case", source)
     }
 
+    /// Stores the run's warnings (what runs but is likely not meant) as the
+    /// root attribute `warnings`, one string each, replacing any before.
+    pub fn set_warnings(&mut self, warnings: &[String]) -> Result<()> {
+        if self.file.attr("warnings").is_ok() {
+            self.file.delete_attr("warnings")?;
+        }
+        let v = warnings
+            .iter()
+            .map(|w| {
+                w.replace('\0', " ")
+                    .parse::<VarLenUnicode>()
+                    .map_err(|e| anyhow::anyhow!("attribute warnings: {e:?}"))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        self.file
+            .new_attr::<VarLenUnicode>()
+            .shape(v.len())
+            .create("warnings")?
+            .write_raw(&v)?;
+        Ok(())
+    }
+
+    /// The warnings the file stores (none where it has no `warnings`
+    /// attribute, as files of earlier versions).
+    pub fn warnings(&self) -> Vec<String> {
+        self.file
+            .attr("warnings")
+            .and_then(|a| a.read_raw::<VarLenUnicode>())
+            .map(|v| v.iter().map(|w| w.as_str().to_string()).collect())
+            .unwrap_or_default()
+    }
+
     /// True when [`ResultsWriter::flush_every_steps`] rows or
     /// [`ResultsWriter::flush_every_secs`] seconds have gone by since the
     /// last flush.
@@ -870,9 +910,7 @@ impl ResultsWriter {
         // allocated), so the next write may take a chunk of every series.
         let record = (6 * self.n_nodes + 3 * self.n_c + 9) * 8;
         let checkpoint = 5 * n_free * 8;
-        // And the XDMF's next rewrite, made beside the old one.
-        let xdmf = crate::xdmf::BYTES_PER_STEP * (self.rows + self.block_rows);
-        (2 * (self.block_rows * record + checkpoint) + xdmf + (1 << 20)) as u64
+        (2 * (self.block_rows * record + checkpoint) + (1 << 20)) as u64
     }
 
     /// Whether the next [`ResultsWriter::append`] writes its chunk of rows
@@ -1224,6 +1262,7 @@ pub(crate) mod tests {
             mesh: &mesh,
             contact_nodes: &[0, 1, 2],
             contact_s: &[0.0, 1.0, 2.0],
+            contact_lines: &[[0, 1], [1, 2]],
         };
         // Compressed, so that the filters' path is the one read back (the
         // default is none: `default_output_is_unfiltered`).
@@ -1279,16 +1318,17 @@ pub(crate) mod tests {
     /// A header for `mesh` with no case text, with the tiny mesh's contact
     /// line (nodes 0, 1, 2) or none.
     fn test_header(mesh: &Mesh, contact: bool) -> Header<'_> {
-        let (nodes, s): (&[usize], &[f64]) = if contact {
-            (&[0, 1, 2], &[0.0, 1.0, 2.0])
+        let (nodes, s, lines): (&[usize], &[f64], &[[usize; 2]]) = if contact {
+            (&[0, 1, 2], &[0.0, 1.0, 2.0], &[[0, 1], [1, 2]])
         } else {
-            (&[], &[])
+            (&[], &[], &[])
         };
         Header {
             case_source: "",
             mesh,
             contact_nodes: nodes,
             contact_s: s,
+            contact_lines: lines,
         }
     }
 
@@ -1388,6 +1428,16 @@ pub(crate) mod tests {
                 .unwrap()
                 .to_vec(),
             vec![0.0, 1.0, 2.0]
+        );
+        assert_eq!(
+            f.dataset("contact/lines")
+                .unwrap()
+                .read_2d::<i64>()
+                .unwrap()
+                .iter()
+                .copied()
+                .collect::<Vec<_>>(),
+            vec![0, 1, 1, 2]
         );
         let fs = f
             .dataset("contact/friction_stress")

@@ -161,7 +161,7 @@ fn open_results(file: &Path) -> Result<File, InputError> {
 /// them would allocate that much (a file that claimed 1e11 rows aborted
 /// probe on an 800 GB allocation). The two grow together; between two
 /// records one may be one row ahead.
-fn read_time(f: &File, name: &str) -> Result<Vec<f64>, InputError> {
+pub(crate) fn read_time(f: &File, name: &str) -> Result<Vec<f64>, InputError> {
     let rows = |ds: &str| {
         f.dataset(ds)
             .map(|d| d.shape().first().copied().unwrap_or(0))
@@ -473,17 +473,19 @@ pub struct AlongArgs {
 pub struct Along {
     /// Which steps were used for which times (for stderr).
     pub info: String,
-    /// `t_asked,t,step,node,x,y,s,FIELD`, one line per (time, node).
+    /// `t_asked,t,record,node,x,y,s,FIELD`, one line per (time, node):
+    /// `record` is the row of `/time` (0 the initial state), not the
+    /// integrator's step.
     pub csv: String,
     /// The group's nodes in order along it.
     pub nodes: Vec<usize>,
     /// Arc length of each node from the first.
     pub s: Vec<f64>,
-    /// The output step used for each asked time.
-    pub steps: Vec<usize>,
-    /// The time of each of those steps.
+    /// The record (row of `/time`) used for each asked time.
+    pub records: Vec<usize>,
+    /// The time of each of those records.
     pub t: Vec<f64>,
-    /// `values[i][j]`: the field at step `steps[i]`, node `nodes[j]` (NaN for
+    /// `values[i][j]`: the field at record `records[i]`, node `nodes[j]` (NaN for
     /// a contact field at a group node that carries no friction).
     pub values: Vec<Vec<f64>>,
 }
@@ -778,14 +780,14 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
             field.name()
         );
     }
-    let (mut steps, mut t_used, mut values) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut records, mut t_used, mut values) = (Vec::new(), Vec::new(), Vec::new());
     for &ta in &asked {
         let k = (0..t_all.len())
             .min_by(|&a, &b| (t_all[a] - ta).abs().total_cmp(&(t_all[b] - ta).abs()))
             .expect("non-empty");
         let _ = write!(
             info,
-            "t = {ta}: output step {k} at t = {} (nearest; off by {:.3e})",
+            "t = {ta}: record {k} at t = {} (nearest; off by {:.3e})",
             t_all[k],
             (t_all[k] - ta).abs()
         );
@@ -834,7 +836,7 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
                     .collect()
             }
         };
-        steps.push(k);
+        records.push(k);
         t_used.push(t_all[k]);
         values.push(row);
     }
@@ -845,14 +847,14 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
     if !complete {
         info.push_str("(the run did not complete)\n");
     }
-    let mut csv = format!("t_asked,t,step,node,x,y,s,{}\n", field.name());
+    let mut csv = format!("t_asked,t,record,node,x,y,s,{}\n", field.name());
     for (i, &ta) in asked.iter().enumerate() {
         for (j, &v) in order.iter().enumerate() {
             let _ = writeln!(
                 csv,
                 "{ta:e},{:e},{},{v},{:e},{:e},{:e},{:e}",
                 t_used[i],
-                steps[i],
+                records[i],
                 nodes[[v, 0]],
                 nodes[[v, 1]],
                 s[j],
@@ -865,7 +867,7 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
         csv,
         nodes: order,
         s,
-        steps,
+        records,
         t: t_used,
         values,
     })
@@ -913,6 +915,7 @@ mod tests {
             mesh: &mesh,
             contact_nodes: &[0, 1, 2],
             contact_s: &[0.0, 1.0, 2.0],
+            contact_lines: &[[0, 1], [1, 2]],
         };
         let mut w = ResultsWriter::create(path, &header).unwrap();
         for k in 0..4 {

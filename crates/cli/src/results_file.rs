@@ -8,7 +8,8 @@ use std::path::Path;
 use stickslip_case::InputError;
 
 /// Refuses an output path `run` must not write (exit code 2), before
-/// anything is read: an existing OUT.h5 or OUT.xdmf without `force`, an
+/// anything is read: an existing OUT.h5, OUT.xdmf, OUT.contact.xdmf or
+/// OUT.views.h5 without `force`, an
 /// empty name, a directory, the case file itself, a missing directory, or
 /// a file another process has open (HDF5 locks files it writes: a second
 /// run with `--force` would truncate the first run's file and then fail on
@@ -23,7 +24,7 @@ pub fn check_output(out: &Path, inputs: &[&Path], force: bool) -> Result<(), Inp
         .is_some_and(|e| e.eq_ignore_ascii_case("xdmf"))
     {
         return Err(InputError(format!(
-            "-o {name}: -o names the HDF5 results file, and the .xdmf is written beside it \
+            "-o {name}: -o names the HDF5 results file, and `stickslip views` writes the .xdmf beside it \
              under the same name; give -o {}",
             out.with_extension("h5").display()
         )));
@@ -84,8 +85,14 @@ pub fn check_output(out: &Path, inputs: &[&Path], force: bool) -> Result<(), Inp
             )));
         }
     }
-    let xdmf = out.with_extension("xdmf");
-    for path in [out, xdmf.as_path()] {
+    // The viewers' files beside OUT.h5 (`stickslip views`) show its run:
+    // a new run would leave them showing another.
+    let beside = [
+        crate::xdmf::xdmf_path(out),
+        crate::xdmf::contact_xdmf_path(out),
+        crate::views::views_path(out),
+    ];
+    for path in std::iter::once(out).chain(beside.iter().map(|p| p.as_path())) {
         if !path.exists() {
             continue;
         }
@@ -172,6 +179,13 @@ impl RunLock {
             .write(true)
             .open(path)
             .map_err(|e| {
+                if e.kind() == std::io::ErrorKind::NotFound {
+                    return InputError(format!(
+                        "--restart {}: no such file; give the OUT.h5 of the run to continue \
+                         (`stickslip run CASE -o OUT.h5` starts a new one)",
+                        path.display()
+                    ));
+                }
                 InputError(format!(
                     "cannot open {} for writing: {e}; a restart appends to the file, so it must be writable \
                      (check its permissions)",
@@ -206,6 +220,58 @@ impl RunLock {
             _ => Ok(RunLock { _file: f }),
         }
     }
+}
+
+/// Opens the results file `path` for a command that reads it after its
+/// run and writes beside it (`stickslip stress`, `stickslip views`): it
+/// must exist (not be the XDMF beside it), no run may be writing it (nor,
+/// with `readers_too`, a reader hold it open), and it must be HDF5 written
+/// by `stickslip run`. Returns it with a shared lock that keeps runs off it
+/// meanwhile.
+///
+/// # Errors
+/// The [`InputError`] naming the file and what to give instead.
+pub(crate) fn open_finished(
+    path: &Path,
+    readers_too: bool,
+) -> Result<(RunLock, hdf5::File), InputError> {
+    let name = path.display();
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xdmf"))
+    {
+        return Err(InputError(format!(
+            "{name}: give the results file the XDMF is written for, {}",
+            path.with_extension("h5").display()
+        )));
+    }
+    if !path.is_file() {
+        return Err(InputError(format!(
+            "{name}: no such results file; give the OUT.h5 a `stickslip run` wrote"
+        )));
+    }
+    if readers_too && in_use(path) {
+        return Err(InputError(format!(
+            "{name}: a run or a reader has it open; wait for the run to end (or close the reader) and run this again"
+        )));
+    }
+    if being_written(path) {
+        return Err(InputError(format!(
+            "{name}: a run is writing it; wait for the run to end (or stop it with Ctrl-C) and run this again"
+        )));
+    }
+    let lock = RunLock::shared(path)?;
+    let f = hdf5::File::open(path).map_err(|e| {
+        InputError(format!(
+            "{name}: cannot open it as HDF5: {e}; give a results file written by `stickslip run`"
+        ))
+    })?;
+    if crate::output::text_attr(&f, "program").ok().as_deref() != Some("stickslip") {
+        return Err(InputError(format!(
+            "{name} was not written by `stickslip run` (no program = \"stickslip\" attribute)"
+        )));
+    }
+    Ok((lock, f))
 }
 
 /// The message for a results file another process has open.
@@ -245,10 +311,17 @@ fn ofd_lock(f: &std::fs::File, read: bool) -> std::io::Result<()> {
 /// # Errors
 /// The [`InputError`] naming the file and what to do.
 pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
-    // An XDMF half written when a run was killed, and the stresses of the
-    // old run (`stickslip stress`), which the new one does not have (best
-    // effort).
-    for stale in ["xdmf.part", "stress.h5", "stress.h5.part"] {
+    // An XDMF half written when `stickslip views` was killed, and the
+    // stresses and views of the old run (`stickslip stress`, `stickslip
+    // views`), which the new one does not have (best effort).
+    for stale in [
+        "xdmf.part",
+        "stress.h5",
+        "stress.h5.part",
+        "views.h5",
+        "contact.xdmf",
+        "contact.xdmf.part",
+    ] {
         let _ = std::fs::remove_file(out.with_extension(stale));
     }
     for path in [out.to_path_buf(), out.with_extension("xdmf")] {

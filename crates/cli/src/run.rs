@@ -14,7 +14,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::Context;
 use stickslip_case::{self as case, Case, InputError, Prepared, Running, Scene};
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{DofMap, NodeOrder};
@@ -23,7 +22,6 @@ use stickslip_time::{ImplicitSolver, Integrator, Scheme};
 
 use crate::output::{self, CheckpointExtra, Record, ResultsWriter, Summary};
 use crate::start;
-use crate::xdmf::XdmfInfo;
 
 /// How a run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -249,8 +247,7 @@ fn output_size(case: &Case, nodes: usize, contact_nodes: usize) -> (f64, f64) {
     // The node vectors take whole chunks of rows.
     let block = output::vector_chunk_rows(nodes) as f64;
     let rows = (records / block).ceil() * block;
-    let bytes = rows * 48.0 * nodes as f64
-        + records * (17.0 * contact_nodes as f64 + 96.0 + crate::xdmf::BYTES_PER_STEP as f64);
+    let bytes = rows * 48.0 * nodes as f64 + records * (17.0 * contact_nodes as f64 + 96.0);
     (records, bytes)
 }
 
@@ -298,8 +295,10 @@ fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
 /// fresh run says before its first step (one list, so the two cannot
 /// drift apart): `u` is the initial displacement at every node.
 pub(crate) fn setup_warnings(mesh: &Mesh, u: &[f64], integrator: &Integrator) -> Vec<String> {
-    large_static_displacement(mesh, u)
+    stickslip_mesh::degenerate_cells(mesh, stickslip_mesh::DEGENERATE_RATIO)
+        .map(|d| d.to_string())
         .into_iter()
+        .chain(large_static_displacement(mesh, u))
         .chain(integrator.contact().and_then(|c| oblique_supports(mesh, c)))
         .collect()
 }
@@ -629,18 +628,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     // ([`crate::results_file::in_use`]).
     let _lock = if options.restart {
         let lock = crate::results_file::RunLock::take(out)?;
-        // `stickslip stress`'s file ends where the earlier run ended.
-        let stress = crate::stress_cmd::stress_path(out);
-        if stress.is_file() {
-            std::fs::remove_file(&stress).ok();
-            if !quiet {
-                say!(
-                    "restart: removed {} (the earlier run's stresses); run `stickslip stress {}` again after this run",
-                    stress.display(),
-                    out.display()
-                );
-            }
-        }
+        forget_companions(out, quiet);
         lock
     } else {
         crate::results_file::claim(out)?
@@ -649,13 +637,12 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     let opened = if options.restart {
         start::resume(case, out, quiet, &mesh, &dofs, &mut integrator)?
     } else {
-        start::fresh(case, out, quiet, &mesh, &dofs, &integrator, &mut full)?
+        start::fresh(case, out, &mesh, &dofs, &integrator, &mut full)?
     };
     let mut session = Session {
         case,
         out,
         options,
-        mesh: &mesh,
         dofs: &dofs,
         integrator,
         writer: opened.writer,
@@ -665,7 +652,6 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         wall_before: opened.wall_before,
         initial_mechanical: opened.initial_mechanical,
         started,
-        xdmf_path: out.with_extension("xdmf"),
     };
     session.writer.auto_flush = false;
     session.writer.flush_every_steps = case.output.flush_every.max(1);
@@ -673,7 +659,6 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     // A state to continue from exists from the start (the initial state, or
     // the restored one).
     session.checkpoint(None)?;
-    session.write_xdmf()?;
     let setup_s = started.elapsed().as_secs_f64();
     let mut progress = Progress::new(quiet, &session.integrator);
     if progress.log {
@@ -783,7 +768,6 @@ struct Session<'a> {
     case: &'a Case,
     out: &'a Path,
     options: &'a RunOptions,
-    mesh: &'a Mesh,
     dofs: &'a DofMap,
     integrator: Integrator,
     writer: ResultsWriter,
@@ -794,7 +778,6 @@ struct Session<'a> {
     wall_before: f64,
     initial_mechanical: f64,
     started: Instant,
-    xdmf_path: std::path::PathBuf,
 }
 
 impl Session<'_> {
@@ -812,11 +795,6 @@ impl Session<'_> {
             node_order: self.dofs.node_order().code(),
         };
         self.writer.write_checkpoint(&cp, &extra)
-    }
-
-    /// The ParaView side file, listing every record so far.
-    fn write_xdmf(&self) -> anyhow::Result<()> {
-        write_xdmf(self.out, &self.xdmf_path, self.mesh, &self.times)
     }
 
     /// Appends the current state as a record.
@@ -841,12 +819,6 @@ impl Session<'_> {
     /// `output.every`-th step, flushing and checkpointing when due.
     fn step_to_end(&mut self, progress: &mut Progress) -> anyhow::Result<Ending> {
         let every = self.case.output.every.max(1) as u64;
-        let mut last_xdmf = Instant::now();
-        // How long the last rewrite took: the next waits ten times that (and at
-        // least flush_seconds), so the rewrites, each O(rows), stay under a
-        // tenth of the run however many rows (at a fixed interval they took 42%
-        // of a run of 320k rows).
-        let mut xdmf_secs = 0.0_f64;
         let mut ending = Ending {
             failure: None,
             interrupted: None,
@@ -900,15 +872,6 @@ impl Session<'_> {
                     break;
                 }
                 self.checkpoint(None)?;
-                // The XML lists every row: rewrite it at most every
-                // flush_seconds, and ten times as seldom as it takes.
-                let wait = self.case.output.flush_seconds.max(10.0 * xdmf_secs);
-                if last_xdmf.elapsed().as_secs_f64() >= wait {
-                    let t = Instant::now();
-                    self.write_xdmf()?;
-                    xdmf_secs = t.elapsed().as_secs_f64();
-                    last_xdmf = Instant::now();
-                }
                 progress.flushed(&self.integrator, self.started);
             }
             progress.stepped(&self.integrator, self.started);
@@ -916,8 +879,8 @@ impl Session<'_> {
         Ok(ending)
     }
 
-    /// Closes the file (the last checkpoint, the summary, the side file)
-    /// and says how the run ended.
+    /// Closes the file (the last checkpoint, the summary) and says how the
+    /// run ended.
     fn conclude(
         mut self,
         ending: Ending,
@@ -958,8 +921,8 @@ impl Session<'_> {
         let steps_run = i.steps() - steps_before;
         let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;
         let rows = self.writer.rows();
+        let warnings = self.writer.warnings();
         self.writer.finish(complete, &summary)?;
-        write_xdmf(self.out, &self.xdmf_path, self.mesh, &self.times)?;
         let status = if complete {
             "complete"
         } else if interrupted.is_some() {
@@ -999,13 +962,19 @@ impl Session<'_> {
                 e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
             );
             say!("results: {} ({rows} records)", out.display());
+            say!(
+                "view: `{}`, then open {} in ParaView (meshio and PyVista read it too)",
+                view_command(out),
+                crate::xdmf::xdmf_path(out).display()
+            );
         }
         if self.options.json {
             let j = serde_json::json!({
                 "status": status,
                 "case": case.path.display().to_string(),
                 "output": out.display().to_string(),
-                "xdmf": self.xdmf_path.display().to_string(),
+                "view_command": view_command(out),
+                "warnings": warnings,
                 "complete": complete,
                 "steps": i.steps(),
                 "t": i.time(),
@@ -1070,18 +1039,45 @@ impl Session<'_> {
     }
 }
 
-/// The ParaView side file `path` of the results file `out`, listing the
-/// records at `times`.
-fn write_xdmf(out: &Path, path: &Path, mesh: &Mesh, times: &[f64]) -> anyhow::Result<()> {
-    let info = XdmfInfo {
-        n_nodes: mesh.nodes.len(),
-        kind: mesh.kind,
-        n_cells: mesh.n_cells(),
-        times,
-        stress: None,
-    };
-    crate::xdmf::write_xdmf(out, path, &info)
-        .with_context(|| format!("cannot write {}", path.display()))
+/// The command that writes the viewers' files of `out`, as a user would
+/// type it.
+fn view_command(out: &Path) -> String {
+    format!("stickslip views {}", shell_word(&out.display().to_string()))
+}
+
+/// Before a restart: removes what `stickslip stress` and `stickslip views`
+/// wrote beside `out` for the earlier run (the stresses end where it
+/// ended, the XML lists its records), saying so. The views file stays: a
+/// view of a row is the same whatever run wrote the row, and `views`
+/// then adds only the new records' views.
+fn forget_companions(out: &Path, quiet: bool) {
+    let stress = crate::stress_cmd::stress_path(out);
+    if stress.is_file() {
+        std::fs::remove_file(&stress).ok();
+        if !quiet {
+            say!(
+                "restart: removed {} (the earlier run's stresses); run `stickslip stress {}` again after this run",
+                stress.display(),
+                out.display()
+            );
+        }
+    }
+    let xml = [
+        crate::xdmf::xdmf_path(out),
+        crate::xdmf::contact_xdmf_path(out),
+    ];
+    let removed: Vec<String> = xml
+        .iter()
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .map(|p| p.display().to_string())
+        .collect();
+    if !removed.is_empty() && !quiet {
+        say!(
+            "restart: removed {} (they list the earlier run's records); run `{}` again after this run",
+            removed.join(" and "),
+            view_command(out)
+        );
+    }
 }
 
 /// The failure message of an explicit run whose energy blew up

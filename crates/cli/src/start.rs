@@ -32,7 +32,6 @@ pub(crate) struct Opened {
 pub(crate) fn fresh(
     case: &Case,
     out: &Path,
-    quiet: bool,
     mesh: &Mesh,
     dofs: &DofMap,
     integrator: &Integrator,
@@ -42,11 +41,16 @@ pub(crate) fn fresh(
         .contact()
         .map(|c| c.nodes.iter().map(|n| (n.node, n.s)).unzip())
         .unwrap_or_default();
+    let contact_lines = integrator
+        .contact()
+        .map(|c| crate::views::contact_lines(mesh, &c.group, &contact_nodes))
+        .unwrap_or_default();
     let header = Header {
         case_source: &case.source,
         mesh,
         contact_nodes: &contact_nodes,
         contact_s: &contact_s,
+        contact_lines: &contact_lines,
     };
     let mut writer = ResultsWriter::create_with(
         out,
@@ -55,11 +59,13 @@ pub(crate) fn fresh(
     )
     .with_context(|| format!("cannot create the results file {}", out.display()))?;
     writer.append(&record(integrator, dofs, full, 0.0, 0))?;
-    if !quiet {
-        for w in setup_warnings(mesh, &full.u, integrator) {
-            say!("{}: warning: {w}", case.path.display());
-        }
+    // Kept in the file and printed with --quiet too: quiet silences
+    // progress, not what the user should know.
+    let warnings = setup_warnings(mesh, &full.u, integrator);
+    for w in &warnings {
+        say!("{}: warning: {w}", case.path.display());
     }
+    writer.set_warnings(&warnings)?;
     let e0 = integrator.energy();
     Ok(Opened {
         writer,

@@ -8,7 +8,9 @@
 //! stores, as `stickslip probe --field sxx` does at one node: at each node
 //! the average of its cells' σ = D ε there (`stickslip_fem::nodal_stresses`),
 //! into `OUT.stress.h5`: `/stress` [n_out, n_nodes, 3] (σ_xx, σ_yy, σ_xy)
-//! and `/von_mises` [n_out, n_nodes]; and lists them in `OUT.xdmf`. The
+//! and `/von_mises` [n_out, n_nodes], with a view of each record's
+//! σ_xx, σ_yy, σ_xy and von Mises under `/views`; and writes the viewers'
+//! files as `stickslip views` does, `OUT.xdmf` listing the stresses. The
 //! results file is only read: a full disk or a kill leaves it as it was
 //! (the stress file is written beside and renamed into place). A new run
 //! or a `--restart` on OUT.h5 removes OUT.stress.h5 (it would end where
@@ -23,39 +25,20 @@ use ndarray::{s, Array1, Array2};
 
 use stickslip_case::InputError;
 
-/// Writes the stress datasets of the results file `path` and rewrites its
-/// XDMF; returns the records and nodes written.
+/// Writes the stress datasets of the results file `path` and the viewers'
+/// files ([`crate::views_cmd::write`]); returns the records and nodes
+/// written, and what the viewers' files hold.
 ///
 /// # Errors
 /// An [`InputError`] for a file that is missing, being written, or not a
 /// results file of `stickslip run`; other errors for HDF5 failures.
-pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
+pub fn command(
+    path: &Path,
+    quiet: bool,
+) -> anyhow::Result<(usize, usize, crate::views_cmd::Written)> {
     let name = path.display().to_string();
-    if !path.is_file() {
-        return Err(InputError(format!(
-            "{name}: no such results file; give the OUT.h5 a `stickslip run` wrote"
-        ))
-        .into());
-    }
-    if crate::results_file::in_use(path) {
-        return Err(InputError(format!(
-            "{name}: a run or a reader has it open; wait for the run to end (or close the reader) and run this again"
-        ))
-        .into());
-    }
     // No run may start on the file while its stresses are formed.
-    let _lock = crate::results_file::RunLock::shared(path)?;
-    let f = File::open(path).map_err(|e| {
-        InputError(format!(
-            "{name}: cannot open it as HDF5: {e}; give a results file written by `stickslip run`"
-        ))
-    })?;
-    if crate::output::text_attr(&f, "program").ok().as_deref() != Some("stickslip") {
-        return Err(InputError(format!(
-            "{name} was not written by `stickslip run` (no program = \"stickslip\" attribute)"
-        ))
-        .into());
-    }
+    let (_lock, f) = crate::results_file::open_finished(path, true)?;
     let (mesh, material) = crate::probe::stored_model(&f, &name)?;
     let n_nodes = mesh.nodes.len();
     let u = f.dataset("displacement")?;
@@ -96,22 +79,8 @@ pub fn command(path: &Path, quiet: bool) -> anyhow::Result<(usize, usize)> {
     std::fs::rename(&part, &target)
         .with_context(|| format!("cannot rename {} to {}", part.display(), target.display()))?;
     drop((u, f));
-    let xdmf_path = path.with_extension("xdmf");
-    let stress_name = target
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or("stress.h5")
-        .to_string();
-    let info = crate::xdmf::XdmfInfo {
-        n_nodes,
-        kind: mesh.kind,
-        n_cells: mesh.n_cells(),
-        times: &times[..rows],
-        stress: Some(&stress_name),
-    };
-    crate::xdmf::write_xdmf(path, &xdmf_path, &info)
-        .with_context(|| format!("cannot write {}", xdmf_path.display()))?;
-    Ok((rows, n_nodes))
+    let written = crate::views_cmd::write(path)?;
+    Ok((rows, n_nodes, written))
 }
 
 /// The stress file of the results file `out`: OUT.stress.h5 beside it.
@@ -172,6 +141,19 @@ fn write_stresses(
                 k + 1,
                 started.elapsed().as_secs_f64()
             );
+        }
+    }
+    // One view per record and scalar for the XDMF readers (in this file,
+    // which goes with the stresses): "." is this file, whatever its name.
+    let views = g.create_group("views")?;
+    for (c, name) in crate::xdmf::STRESS_VIEWS.iter().enumerate() {
+        let v = views.create_group(name)?;
+        for k in 0..rows {
+            if c < 3 {
+                crate::views::column_view(&v, ".", "stress", (n_nodes, 3), k, c)?;
+            } else {
+                crate::views::row_view::<f64>(&v, ".", "von_mises", n_nodes, k)?;
+            }
         }
     }
     g.flush()?;

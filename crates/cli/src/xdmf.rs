@@ -1,26 +1,31 @@
-//! The XDMF 3 companion of a results file, for ParaView (and meshio).
+//! The XDMF 3 companions of a results file, for ParaView, meshio and
+//! PyVista.
 //!
-//! `OUT.xdmf` holds no numbers, only XML that points into `OUT.h5` (by file
-//! name: the two files sit side by side and move together): a temporal
-//! collection with one uniform grid per output step, each with the mesh
-//! (`/mesh/cells`, `/mesh/nodes`) and the node vectors displacement, velocity
-//! and acceleration, selected from the `[n_out, n_nodes, 2]` datasets by a
-//! HyperSlab (start `k 0 0`, stride `1 1 1`, count `1 n_nodes 2`).
-//!
-//! HyperSlab is the XDMF model's way to address one row of a larger array;
-//! in ParaView (5.11) open the file with the "XDMF Reader" (the "Xdmf3
-//! Reader" variants load the mesh but skip HyperSlab vectors); meshio 5.3
-//! reads the grids and times but needs a HyperSlab rule added
-//! (`tests/xdmf.rs` shows one).
+//! `OUT.xdmf` (the body) and `OUT.contact.xdmf` (the contact surface Γ_C
+//! as line cells) hold no numbers, only XML that points into `OUT.h5` and
+//! `OUT.views.h5` by file name (the files sit side by side and move
+//! together): each a temporal collection with one uniform grid per record.
+//! The body's grid has the mesh (`/mesh/cells`, `/mesh/nodes`) and the
+//! node vectors displacement, velocity and acceleration; the contact
+//! grid has the friction nodes joined by segments, their arc length `s`
+//! and the friction stress, slip velocity and state. Every per-record
+//! array is a whole dataset of `OUT.views.h5` (a view of one row of the
+//! results file, [`crate::views`]), so that no reader needs XDMF's
+//! HyperSlab items: ParaView's three XDMF readers, meshio's
+//! `TimeSeriesReader` and `pyvista.read` read the files as they are.
+//! Two files rather than one grid collection per record: meshio reads one
+//! uniform grid per time and PyVista then gives a plain mesh.
 //!
 //! Cell node order needs no permutation: quad4 corners counter-clockwise and
 //! quad9 as in `stickslip_mesh::GMSH_TO_FEM_QUAD9` are XDMF's (and VTK's)
 //! `Quadrilateral` and `Quadrilateral_9` orders.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use stickslip_mesh::CellKind;
+
+use crate::views::{views_path, CONTACT_FIELDS, VECTORS};
 
 /// What the XML needs to know about a results file: its sizes and times.
 #[derive(Clone, Copy, Debug)]
@@ -31,21 +36,24 @@ pub struct XdmfInfo<'a> {
     pub kind: CellKind,
     /// Rows of `/mesh/cells`.
     pub n_cells: usize,
-    /// `/time`, one entry per output step written so far.
+    /// `/time`, one entry per record written so far.
     pub times: &'a [f64],
-    /// The file name of `stickslip stress`'s `/stress` [n_out, n_nodes, 3]
-    /// and `/von_mises` [n_out, n_nodes], beside the results file: listed
-    /// per step too, σ_xx, σ_yy, σ_xy and von Mises as scalars (ParaView
-    /// would call a 3-vector's third component "Z").
+    /// The file name of `stickslip stress`'s file beside the results file,
+    /// whose views `/views/NAME/K` give σ_xx, σ_yy, σ_xy and von Mises of
+    /// record K as scalars (ParaView would call a 3-vector's third
+    /// component "Z").
     pub stress: Option<&'a str>,
 }
 
-/// About the bytes of XML per step of a run (2,557 for the slab's `st.h5`;
-/// each character of a longer file name adds five).
-pub const BYTES_PER_STEP: usize = 2600;
+/// The body's XDMF file of the results file `out`: OUT.xdmf beside it.
+pub fn xdmf_path(out: &Path) -> PathBuf {
+    out.with_extension("xdmf")
+}
 
-/// The node vectors written per step: (dataset, attribute name).
-const VECTORS: [&str; 3] = ["displacement", "velocity", "acceleration"];
+/// The contact surface's XDMF file of `out`: OUT.contact.xdmf beside it.
+pub fn contact_xdmf_path(out: &Path) -> PathBuf {
+    out.with_extension("contact.xdmf")
+}
 
 /// Escapes the five XML special characters of a file name.
 fn xml_escape(s: &str) -> String {
@@ -63,113 +71,202 @@ fn xml_escape(s: &str) -> String {
     out
 }
 
-/// The XML text for the results file named `h5_name` (a file name, no
-/// directory).
+/// The XML of `OUT.xdmf` for the results file named `h5_name` (a file
+/// name, no directory).
 pub fn xdmf_text(h5_name: &str, info: &XdmfInfo) -> String {
-    let mut x = Vec::with_capacity(1024 + info.times.len() * 1600);
-    write_xml(&mut x, h5_name, info).expect("writing to memory");
+    let mut x = Vec::with_capacity(1024 + info.times.len() * 1400);
+    write_body(&mut x, h5_name, info).expect("writing to memory");
     String::from_utf8(x).expect("the XML is UTF-8")
 }
 
+/// The XML of `OUT.contact.xdmf` for the results file named `h5_name`,
+/// whose contact line has `n_c` nodes and `n_lines` segments.
+pub fn contact_text(h5_name: &str, times: &[f64], n_c: usize, n_lines: usize) -> String {
+    let mut x = Vec::with_capacity(1024 + times.len() * 1400);
+    write_contact(&mut x, h5_name, times, (n_c, n_lines)).expect("writing to memory");
+    String::from_utf8(x).expect("the XML is UTF-8")
+}
+
+/// The opening of a file: one temporal collection named `name`.
+fn open_collection(x: &mut impl Write, name: &str) -> std::io::Result<()> {
+    x.write_all(b"<?xml version=\"1.0\" encoding=\"utf-8\"?>\n")?;
+    x.write_all(b"<Xdmf Version=\"3.0\">\n  <Domain>\n")?;
+    writeln!(
+        x,
+        "    <Grid Name=\"{name}\" GridType=\"Collection\" CollectionType=\"Temporal\">"
+    )
+}
+
+fn close_collection(x: &mut impl Write) -> std::io::Result<()> {
+    x.write_all(b"    </Grid>\n  </Domain>\n</Xdmf>\n")
+}
+
+/// A uniform grid's opening with its time: `{:e}` is Rust's shortest
+/// round-trip form, so the time read back is the f64 in /time, bit for bit.
+fn open_grid(x: &mut impl Write, k: usize, t: f64) -> std::io::Result<()> {
+    write!(
+        x,
+        "      <Grid Name=\"record {k}\" GridType=\"Uniform\">\n        <Time Value=\"{t:e}\"/>\n"
+    )
+}
+
+/// A node-centred attribute whose data is the whole dataset `path`.
+fn attribute(
+    x: &mut impl Write,
+    name: &str,
+    kind: &str,
+    dims: &str,
+    number: (&str, u8),
+    path: &str,
+) -> std::io::Result<()> {
+    let (ty, precision) = number;
+    write!(
+        x,
+        "        <Attribute Name=\"{name}\" AttributeType=\"{kind}\" Center=\"Node\">\n\
+      \x20         <DataItem Dimensions=\"{dims}\" NumberType=\"{ty}\" Precision=\"{precision}\" Format=\"HDF\">{path}</DataItem>\n\
+      \x20       </Attribute>\n"
+    )
+}
+
+/// A topology and an XY geometry, each one dataset.
+fn mesh(
+    x: &mut impl Write,
+    (topology, n_cells, npc): (&str, usize, usize),
+    cells: &str,
+    n: usize,
+    nodes: &str,
+) -> std::io::Result<()> {
+    write!(
+        x,
+        "        <Topology TopologyType=\"{topology}\" NumberOfElements=\"{n_cells}\" NodesPerElement=\"{npc}\">\n\
+      \x20         <DataItem Dimensions=\"{n_cells} {npc}\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">{cells}</DataItem>\n\
+      \x20       </Topology>\n\
+      \x20       <Geometry GeometryType=\"XY\">\n\
+      \x20         <DataItem Dimensions=\"{n} 2\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{nodes}</DataItem>\n\
+      \x20       </Geometry>\n"
+    )
+}
+
 /// [`xdmf_text`] into `x`, grid by grid: a run of a million records has a
-/// text of about 1.8 GB, which is never held whole.
-fn write_xml(x: &mut impl Write, h5_name: &str, info: &XdmfInfo) -> std::io::Result<()> {
+/// text of about 1.3 GB, which is never held whole.
+fn write_body(x: &mut impl Write, h5_name: &str, info: &XdmfInfo) -> std::io::Result<()> {
     let h5 = xml_escape(h5_name);
-    let (n, n_out, n_cells) = (info.n_nodes, info.times.len(), info.n_cells);
-    let npc = info.kind.nodes_per_cell();
+    let views = xml_escape(&views_name(h5_name));
+    let n = info.n_nodes;
     let topology = match info.kind {
         CellKind::Quad4 => "Quadrilateral",
         CellKind::Quad9 => "Quadrilateral_9",
     };
-    x.write_all(b"<?xml version=\"1.0\" encoding=\"utf-8\"?>\n")?;
-    x.write_all(b"<Xdmf Version=\"3.0\">\n")?;
-    x.write_all(b"  <Domain>\n")?;
-    x.write_all(
-        b"    <Grid Name=\"stickslip\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
-    )?;
-    for (k, t) in info.times.iter().enumerate() {
-        // `{:e}` is Rust's shortest round-trip form: the time read back is
-        // the f64 in /time, bit for bit.
-        write!(
-            x,
-            "      <Grid Name=\"step {k}\" GridType=\"Uniform\">\n        <Time Value=\"{t:e}\"/>\n"
-        )?;
-        write!(
-            x,
-            "        <Topology TopologyType=\"{topology}\" NumberOfElements=\"{n_cells}\" NodesPerElement=\"{npc}\">\n\
-          \x20         <DataItem Dimensions=\"{n_cells} {npc}\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">{h5}:/mesh/cells</DataItem>\n\
-          \x20       </Topology>\n\
-          \x20       <Geometry GeometryType=\"XY\">\n\
-          \x20         <DataItem Dimensions=\"{n} 2\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:/mesh/nodes</DataItem>\n\
-          \x20       </Geometry>\n"
-        )?;
+    let cells = (topology, info.n_cells, info.kind.nodes_per_cell());
+    let (cells_path, nodes_path) = (format!("{h5}:/mesh/cells"), format!("{h5}:/mesh/nodes"));
+    let vector_dims = format!("{n} 3");
+    let scalar_dims = n.to_string();
+    let stress = info.stress.map(xml_escape);
+    open_collection(x, "stickslip")?;
+    for (k, &t) in info.times.iter().enumerate() {
+        open_grid(x, k, t)?;
+        mesh(x, cells, &cells_path, n, &nodes_path)?;
         for name in VECTORS {
-            write!(
-                x,
-                "        <Attribute Name=\"{name}\" AttributeType=\"Vector\" Center=\"Node\">\n\
-              \x20         <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 {n} 2\" Type=\"HyperSlab\">\n\
-              \x20           <DataItem Dimensions=\"3 3\" NumberType=\"Int\" Format=\"XML\">{k} 0 0 1 1 1 1 {n} 2</DataItem>\n\
-              \x20           <DataItem Dimensions=\"{n_out} {n} 2\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:/{name}</DataItem>\n\
-              \x20         </DataItem>\n\
-              \x20       </Attribute>\n"
-            )?;
+            let path = format!("{views}:/{name}/{k}");
+            attribute(x, name, "Vector", &vector_dims, ("Float", 8), &path)?;
         }
-        if let Some(file) = info.stress {
-            let file = xml_escape(file);
-            for (name, c) in [("sxx", 0), ("syy", 1), ("sxy", 2)] {
-                write!(
-                    x,
-                    "        <Attribute Name=\"{name}\" AttributeType=\"Scalar\" Center=\"Node\">\n\
-                  \x20         <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 {n} 1\" Type=\"HyperSlab\">\n\
-                  \x20           <DataItem Dimensions=\"3 3\" NumberType=\"Int\" Format=\"XML\">{k} 0 {c} 1 1 1 1 {n} 1</DataItem>\n\
-                  \x20           <DataItem Dimensions=\"{n_out} {n} 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{file}:/stress</DataItem>\n\
-                  \x20         </DataItem>\n\
-                  \x20       </Attribute>\n"
-                )?;
+        if let Some(file) = &stress {
+            for name in STRESS_VIEWS {
+                let path = format!("{file}:/views/{name}/{k}");
+                attribute(x, name, "Scalar", &scalar_dims, ("Float", 8), &path)?;
             }
-            write!(
-                x,
-                "        <Attribute Name=\"von_mises\" AttributeType=\"Scalar\" Center=\"Node\">\n\
-              \x20         <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 {n}\" Type=\"HyperSlab\">\n\
-              \x20           <DataItem Dimensions=\"3 2\" NumberType=\"Int\" Format=\"XML\">{k} 0 1 1 1 {n}</DataItem>\n\
-              \x20           <DataItem Dimensions=\"{n_out} {n}\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">{file}:/von_mises</DataItem>\n\
-              \x20         </DataItem>\n\
-              \x20       </Attribute>\n"
-            )?;
         }
         x.write_all(b"      </Grid>\n")?;
     }
-    x.write_all(b"    </Grid>\n  </Domain>\n</Xdmf>\n")
+    close_collection(x)
 }
 
-/// Writes `xdmf_path`, pointing into `h5_path` by its file name only (the
-/// two files must sit in the same directory; move them together).
+/// The scalars `stickslip stress` gives per record, as its views name
+/// them.
+pub const STRESS_VIEWS: [&str; 4] = ["sxx", "syy", "sxy", "von_mises"];
+
+/// [`contact_text`] into `x`.
+fn write_contact(
+    x: &mut impl Write,
+    h5_name: &str,
+    times: &[f64],
+    (n_c, n_lines): (usize, usize),
+) -> std::io::Result<()> {
+    let h5 = xml_escape(h5_name);
+    let views = xml_escape(&views_name(h5_name));
+    let (lines, points) = (
+        format!("{views}:/contact/lines"),
+        format!("{views}:/contact/points"),
+    );
+    let dims = n_c.to_string();
+    open_collection(x, "contact")?;
+    for (k, &t) in times.iter().enumerate() {
+        open_grid(x, k, t)?;
+        mesh(x, ("Polyline", n_lines, 2), &lines, n_c, &points)?;
+        let s = format!("{h5}:/contact/s");
+        attribute(x, "s", "Scalar", &dims, ("Float", 8), &s)?;
+        for (name, small) in CONTACT_FIELDS {
+            let number = if small { ("Int", 1) } else { ("Float", 8) };
+            let path = format!("{views}:/contact/{name}/{k}");
+            attribute(x, name, "Scalar", &dims, number, &path)?;
+        }
+        x.write_all(b"      </Grid>\n")?;
+    }
+    close_collection(x)
+}
+
+/// The views file's name for the results file named `h5_name`.
+fn views_name(h5_name: &str) -> String {
+    views_path(Path::new(h5_name)).display().to_string()
+}
+
+/// Writes `OUT.xdmf` for the results file `out`, pointing into it and its
+/// views by file name only (the files must sit in the same directory; move
+/// them together).
 ///
-/// Call it after the last step is written (and again after a restart), with
-/// the times actually in the file: the XML declares `times.len()` rows.
+/// Call it after the views of every record in `info.times` exist
+/// ([`crate::views::update`]), with the times actually in the file
+/// ([`crate::views_cmd::write`]).
 ///
 /// # Errors
-/// `h5_path` without a file name (`InvalidInput`), or the write failing.
-pub fn write_xdmf(h5_path: &Path, xdmf_path: &Path, info: &XdmfInfo) -> std::io::Result<()> {
-    let name = h5_path
-        .file_name()
-        .and_then(|n| n.to_str())
-        .ok_or_else(|| {
-            std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                format!(
-                    "{}: the results path has no UTF-8 file name for the XDMF file to refer to",
-                    h5_path.display()
-                ),
-            )
-        })?;
-    // Written beside and renamed over: a reader (or a kill -9 mid-write)
-    // never meets half a file.
-    let tmp = xdmf_path.with_extension("xdmf.part");
+/// `out` without a UTF-8 file name (`InvalidInput`), or the write failing.
+pub fn write_xdmf(out: &Path, info: &XdmfInfo) -> std::io::Result<()> {
+    let name = crate::views::file_name(out)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.to_string()))?;
+    replace(&xdmf_path(out), |w| write_body(w, name, info))
+}
+
+/// Writes `OUT.contact.xdmf` for the results file `out`: the contact line
+/// of `n_c` nodes and `n_lines` segments at `times`, as [`write_xdmf`].
+///
+/// # Errors
+/// As [`write_xdmf`].
+pub fn write_contact_xdmf(
+    out: &Path,
+    times: &[f64],
+    n_c: usize,
+    n_lines: usize,
+) -> std::io::Result<()> {
+    let name = crate::views::file_name(out)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.to_string()))?;
+    replace(&contact_xdmf_path(out), |w| {
+        write_contact(w, name, times, (n_c, n_lines))
+    })
+}
+
+/// Writes `path` beside and renames it over: a reader (or a kill -9
+/// mid-write) never meets half a file.
+fn replace(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".part");
+    let tmp = PathBuf::from(tmp);
     let mut w = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-    write_xml(&mut w, name, info)?;
+    write(&mut w)?;
     w.into_inner().map_err(|e| e.into_error())?;
-    std::fs::rename(&tmp, xdmf_path)
+    std::fs::rename(&tmp, path)
 }
 
 #[cfg(test)]
@@ -180,19 +277,20 @@ mod tests {
         hay.matches(needle).count()
     }
 
+    fn info(times: &[f64]) -> XdmfInfo<'_> {
+        XdmfInfo {
+            n_nodes: 85,
+            kind: CellKind::Quad9,
+            n_cells: 16,
+            times,
+            stress: None,
+        }
+    }
+
     #[test]
-    fn one_grid_per_step_with_its_time_and_hyperslab() {
+    fn one_grid_per_record_with_its_time_and_views() {
         let times = [0.0, 1e-3, 0.5];
-        let x = xdmf_text(
-            "slab.h5",
-            &XdmfInfo {
-                n_nodes: 85,
-                kind: CellKind::Quad9,
-                n_cells: 16,
-                times: &times,
-                stress: None,
-            },
-        );
+        let x = xdmf_text("slab.h5", &info(&times));
         assert_eq!(count(&x, "GridType=\"Uniform\""), 3);
         assert_eq!(count(&x, "CollectionType=\"Temporal\""), 1);
         assert!(x.contains("<Time Value=\"0e0\"/>"), "{x}");
@@ -203,36 +301,67 @@ mod tests {
             count(&x, "NumberOfElements=\"16\" NodesPerElement=\"9\""),
             3
         );
-        assert_eq!(count(&x, "slab.h5:/mesh/nodes"), 3);
-        // Step 2 of each vector: start (2, 0, 0), count (1, 85, 2) of a
-        // [3, 85, 2] dataset.
-        assert_eq!(count(&x, ">2 0 0 1 1 1 1 85 2<"), 3);
-        assert_eq!(count(&x, "Dimensions=\"3 85 2\""), 9);
+        assert_eq!(count(&x, ">slab.h5:/mesh/nodes<"), 3);
+        assert_eq!(count(&x, "HyperSlab"), 0);
+        // Record 2 of each vector: its own view, three components.
         for v in VECTORS {
-            assert_eq!(count(&x, &format!("slab.h5:/{v}<")), 3);
+            assert_eq!(count(&x, &format!(">slab.views.h5:/{v}/2<")), 1, "{v}");
+            assert_eq!(count(&x, &format!("slab.views.h5:/{v}/")), 3, "{v}");
         }
+        assert_eq!(count(&x, "Dimensions=\"85 3\""), 9);
         assert_eq!(count(&x, "<Grid"), count(&x, "</Grid>"));
+        assert_eq!(count(&x, "<DataItem"), count(&x, "</DataItem>"));
+        // Stresses: four scalars per record from the stress file's views.
+        let with = xdmf_text(
+            "slab.h5",
+            &XdmfInfo {
+                stress: Some("slab.stress.h5"),
+                ..info(&times)
+            },
+        );
+        assert_eq!(count(&with, "slab.stress.h5:/views/"), 12);
+        assert!(with.contains(">slab.stress.h5:/views/von_mises/1<"));
+    }
+
+    #[test]
+    fn the_contact_file_has_lines_and_the_friction_fields() {
+        let x = contact_text("slab.h5", &[0.0, 0.25], 16, 15);
+        assert_eq!(count(&x, "GridType=\"Uniform\""), 2);
+        assert_eq!(
+            count(
+                &x,
+                "TopologyType=\"Polyline\" NumberOfElements=\"15\" NodesPerElement=\"2\""
+            ),
+            2
+        );
+        assert_eq!(count(&x, ">slab.views.h5:/contact/points<"), 2);
+        assert_eq!(count(&x, ">slab.h5:/contact/s<"), 2);
+        assert!(x.contains(">slab.views.h5:/contact/friction_stress/1<"));
+        assert!(x.contains(
+            "NumberType=\"Int\" Precision=\"1\" Format=\"HDF\">slab.views.h5:/contact/state/0<"
+        ));
         assert_eq!(count(&x, "<DataItem"), count(&x, "</DataItem>"));
     }
 
     #[test]
-    fn the_file_is_the_text_and_no_part_is_left() {
+    fn the_files_are_the_texts_and_no_part_is_left() {
         let dir = std::env::temp_dir().join(format!("stickslip-xdmf-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let info = XdmfInfo {
-            n_nodes: 85,
-            kind: CellKind::Quad9,
-            n_cells: 16,
-            times: &[0.0, 0.25, 0.5],
-            stress: None,
-        };
-        let path = dir.join("slab.xdmf");
-        write_xdmf(&dir.join("slab.h5"), &path, &info).unwrap();
+        let times = [0.0, 0.25, 0.5];
+        let out = dir.join("slab.h5");
+        write_xdmf(&out, &info(&times)).unwrap();
+        write_contact_xdmf(&out, &times, 16, 15).unwrap();
         assert_eq!(
-            std::fs::read_to_string(&path).unwrap(),
-            xdmf_text("slab.h5", &info)
+            std::fs::read_to_string(dir.join("slab.xdmf")).unwrap(),
+            xdmf_text("slab.h5", &info(&times))
+        );
+        assert_eq!(
+            std::fs::read_to_string(dir.join("slab.contact.xdmf")).unwrap(),
+            contact_text("slab.h5", &times, 16, 15)
         );
         assert!(!dir.join("slab.xdmf.part").exists());
+        assert!(!dir.join("slab.contact.xdmf.part").exists());
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
@@ -251,6 +380,10 @@ mod tests {
             "TopologyType=\"Quadrilateral\" NumberOfElements=\"2\" NodesPerElement=\"4\""
         ));
         assert!(x.contains(">a&amp;b&lt;c&gt;.h5:/mesh/cells<"), "{x}");
+        assert!(
+            x.contains(">a&amp;b&lt;c&gt;.views.h5:/displacement/0<"),
+            "{x}"
+        );
         assert!(!x.contains("a&b"));
     }
 
@@ -258,35 +391,20 @@ mod tests {
     fn refers_to_the_h5_by_file_name_only() {
         let dir = std::env::temp_dir().join(format!("stickslip-xdmf-unit-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let xdmf = dir.join("run.xdmf");
-        write_xdmf(
-            &dir.join("run.h5"),
-            &xdmf,
-            &XdmfInfo {
-                n_nodes: 4,
-                kind: CellKind::Quad4,
-                n_cells: 1,
-                times: &[0.0, 1.0],
-                stress: None,
-            },
-        )
-        .unwrap();
-        let x = std::fs::read_to_string(&xdmf).unwrap();
-        assert!(x.contains(">run.h5:/displacement<"));
+        let small = XdmfInfo {
+            n_nodes: 4,
+            kind: CellKind::Quad4,
+            n_cells: 1,
+            times: &[0.0, 1.0],
+            stress: None,
+        };
+        write_xdmf(&dir.join("run.h5"), &small).unwrap();
+        let x = std::fs::read_to_string(dir.join("run.xdmf")).unwrap();
+        assert!(x.contains(">run.h5:/mesh/nodes<"));
+        assert!(x.contains(">run.views.h5:/displacement/1<"));
         assert!(!x.contains(&dir.display().to_string()));
         std::fs::remove_dir_all(&dir).ok();
-        let e = write_xdmf(
-            Path::new("/"),
-            &xdmf,
-            &XdmfInfo {
-                n_nodes: 4,
-                kind: CellKind::Quad4,
-                n_cells: 1,
-                times: &[],
-                stress: None,
-            },
-        )
-        .unwrap_err();
+        let e = write_xdmf(Path::new("/"), &small).unwrap_err();
         assert_eq!(e.kind(), std::io::ErrorKind::InvalidInput);
     }
 }

@@ -153,3 +153,103 @@ fn example_03_inclined_contact() {
     assert!(number(&out, "max sigma_T * v_T:") <= 0.0, "{out}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// examples/warp_pyvista.py: PyVista reads a run's XDMF, warps the mesh
+/// by the displacement and writes a PNG without a display. Expected
+/// values from the hdf5 crate's reading of the .h5: the last record's
+/// max |u| to 1e-15 relative (numpy's norm and Rust's hypot may round
+/// apart), and the bounding box of nodes + u bit for bit (the script
+/// prints them with 17 digits).
+#[test]
+fn warp_pyvista_draws_the_deformed_slab() {
+    let has = Command::new("python3")
+        .args(["-c", "import pyvista"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !has {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "examples/warp_pyvista.py: pyvista is needed (pip install pyvista; cargo xtask test installs it)"
+        );
+        eprintln!("skipped examples/warp_pyvista.py: pyvista is not installed");
+        return;
+    }
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("example-warp");
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    let h5 = dir.join("slab.h5");
+    let stickslip = |args: &[&std::ffi::OsStr]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_stickslip"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    stickslip(&[
+        "run".as_ref(),
+        case.as_os_str(),
+        "-o".as_ref(),
+        h5.as_os_str(),
+        "--quiet".as_ref(),
+        "--set".as_ref(),
+        "time.t_end=0.1".as_ref(),
+    ]);
+    stickslip(&["stress".as_ref(), h5.as_os_str(), "--quiet".as_ref()]);
+    let png = dir.join("slab.png");
+    let o = Command::new("python3")
+        .arg(root().join("examples/warp_pyvista.py"))
+        .arg(&h5)
+        .arg("--png")
+        .arg(&png)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        o.status.success(),
+        "examples/warp_pyvista.py failed:\n{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_png(&png);
+    assert!(out.contains("coloured by von_mises"), "{out}");
+    let f = hdf5::File::open(&h5).unwrap();
+    let nodes = f.dataset("mesh/nodes").unwrap().read_2d::<f64>().unwrap();
+    let u = f
+        .dataset("displacement")
+        .unwrap()
+        .read::<f64, ndarray::Ix3>()
+        .unwrap();
+    let last = u.shape()[0] - 1;
+    assert!(
+        out.contains(&format!("record {last} of {}", last + 1)),
+        "{out}"
+    );
+    let max_u = (0..nodes.nrows())
+        .map(|i| u[[last, i, 0]].hypot(u[[last, i, 1]]))
+        .fold(0.0, f64::max);
+    let said = number(&out, "max |u| =");
+    assert!(
+        (said - max_u).abs() <= 1e-15 * max_u,
+        "{said} against {max_u}"
+    );
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for i in 0..nodes.nrows() {
+        for c in 0..2 {
+            let x = nodes[[i, c]] + u[[last, i, c]];
+            lo[c] = lo[c].min(x);
+            hi[c] = hi[c].max(x);
+        }
+    }
+    let want = format!(
+        "warped x in [{:?}, {:?}], y in [{:?}, {:?}]",
+        lo[0], hi[0], lo[1], hi[1]
+    );
+    let got = out.lines().find(|l| l.starts_with("warped ")).unwrap();
+    let nums = |s: &str| -> Vec<f64> {
+        s.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e'))
+            .filter_map(|w| w.parse().ok())
+            .collect()
+    };
+    assert_eq!(nums(got), nums(&want), "{got} against {want}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -136,14 +136,14 @@ fn fixture_orders_follow_the_boundary_with_the_body_on_the_left() {
     let a = along(&h5, "bottom", "0.6,-1,2", Field::Ux).unwrap();
     assert_eq!(a.nodes, ids(&[(0, 0), (1, 0), (2, 0), (3, 0)]));
     assert_eq!(a.s, vec![0.0, 1.0, 2.0, 3.0]);
-    assert_eq!(a.steps, vec![1, 0, 2]);
+    assert_eq!(a.records, vec![1, 0, 2]);
     assert_eq!(a.t, vec![0.5, 0.0, 1.0]);
-    for (i, &k) in a.steps.iter().enumerate() {
+    for (i, &k) in a.records.iter().enumerate() {
         let want: Vec<f64> = a.nodes.iter().map(|&n| ux(k, n)).collect();
         assert_eq!(a.values[i], want);
     }
     assert!(
-        a.info.contains("t = 0.6: output step 1 at t = 0.5"),
+        a.info.contains("t = 0.6: record 1 at t = 0.5"),
         "{}",
         a.info
     );
@@ -155,7 +155,7 @@ fn fixture_orders_follow_the_boundary_with_the_body_on_the_left() {
     );
     assert!(a.info.contains("ordered as /contact/nodes"), "{}", a.info);
     let mut lines = a.csv.lines();
-    assert_eq!(lines.next(), Some("t_asked,t,step,node,x,y,s,ux"));
+    assert_eq!(lines.next(), Some("t_asked,t,record,node,x,y,s,ux"));
     assert_eq!(
         lines.next().unwrap(),
         format!("6e-1,5e-1,1,{},0e0,0e0,0e0,{:e}", id(0, 0), ux(1, id(0, 0)))
@@ -280,7 +280,7 @@ fn slab_contact_and_support_quad9() {
     // is held in x (BENCHMARK.md).
     let tail: Vec<i64> = a.nodes[1..].iter().map(|&n| n as i64).collect();
     assert_eq!(tail, contact);
-    for (i, &k) in a.steps.iter().enumerate() {
+    for (i, &k) in a.records.iter().enumerate() {
         assert!((time[k] - [0.05, 0.1][i]).abs() < 1e-9, "step {k}");
         assert!(a.values[i][0].is_nan());
         for j in 1..17 {
@@ -300,7 +300,7 @@ fn slab_contact_and_support_quad9() {
     for (j, &n) in a.nodes.iter().enumerate() {
         assert_eq!(nodes[[n, 1]], 1.0);
         assert!((a.s[j] - (8.0 - nodes[[n, 0]])).abs() < 1e-12);
-        assert_eq!(a.values[0][j], disp[[a.steps[0], n, 0]]);
+        assert_eq!(a.values[0][j], disp[[a.records[0], n, 0]]);
     }
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -328,7 +328,7 @@ fn probe_along_through_the_binary() {
     );
     let want = along(&h5, "contact", "0.1", Field::FrictionStress).unwrap();
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), want.csv);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("output step 100"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("record 100"));
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -943,6 +943,12 @@ fn json_summary_is_one_object_on_stdout() {
     assert_eq!(j["records"], 51);
     assert_eq!(j["t"], 0.05);
     assert_eq!(j["output"], out.display().to_string());
+    // The run writes no viewers' files; it gives the command that does.
+    assert_eq!(
+        j["view_command"],
+        format!("stickslip views {}", out.display())
+    );
+    assert!(!out.with_extension("xdmf").exists());
     assert!(j["energy"]["total"].is_f64() && j["dt_crit"].is_f64());
 }
 
@@ -1464,11 +1470,10 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
         .arg(&case)
         .arg("-o")
         .arg(&out)
-        // 501 records of 4.4 kB and 2.6 kB of XDMF each: they fit the
-        // 4 MB when the run starts (a run whose records cannot fit is
-        // refused before it starts), but not with the room each write
-        // keeps.
-        .args(["--quiet", "--set", "time.t_end=0.5"])
+        // 801 records of 4.5 kB: they fit the 4 MB when the run starts
+        // (a run whose records cannot fit is refused before it starts),
+        // but not with the room each write keeps (1.2 MB here).
+        .args(["--quiet", "--set", "time.t_end=0.8"])
         .output()
         .unwrap();
     let read = hdf5::File::open(&out).map(|f| {

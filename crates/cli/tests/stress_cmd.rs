@@ -1,5 +1,5 @@
 //! `stickslip stress OUT.h5`: a finished run's stress fields into
-//! OUT.stress.h5 and its XDMF; the results file is only read. Expected values: the paper's slab at t = 0 is in its static
+//! OUT.stress.h5, listed in OUT.xdmf; the results file is only read. Expected values: the paper's slab at t = 0 is in its static
 //! state, pressed by F_n = 300 on its bottom and held on its top: σ_yy =
 //! −300 at every node, σ_xx = σ_xy = 0, and plane strain with ν = 0.3 gives
 //! von Mises √(300² + 90² − 300·90) = √71100. Later rows are checked
@@ -96,7 +96,19 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
         let attr = format!("<Attribute Name=\"{name}\" AttributeType=\"Scalar\"");
         assert_eq!(xml.matches(&attr).count(), rows, "{name}");
     }
-    assert_eq!(xml.matches("slab.stress.h5:/stress<").count(), 3 * rows);
+    assert_eq!(xml.matches(">slab.stress.h5:/views/").count(), 4 * rows);
+    // Each record's view is that record's column of /stress.
+    let g = hdf5::File::open(dir.join("slab.stress.h5")).unwrap();
+    let last = format!("views/syy/{}", rows - 1);
+    let syy = g.dataset(&last).unwrap().read_1d::<f64>().unwrap();
+    for v in 0..85 {
+        assert_eq!(
+            syy[v].to_bits(),
+            stress[[rows - 1, v, 1]].to_bits(),
+            "{last}"
+        );
+    }
+    drop(g);
     // Again: the same file, not a bigger one.
     let size = std::fs::metadata(dir.join("slab.stress.h5")).unwrap().len();
     stickslip_ok(&["stress", &out, "--quiet"]);
@@ -117,9 +129,11 @@ fn stress_fields_go_into_the_file_and_its_xdmf() {
         "time.t_end=0.12",
     ]);
     assert!(!dir.join("slab.stress.h5").exists());
-    assert!(!std::fs::read_to_string(dir.join("slab.xdmf"))
-        .unwrap()
-        .contains("von_mises"));
+    assert!(!dir.join("slab.xdmf").exists());
+    // `stickslip views` lists the records without stresses.
+    stickslip_ok(&["views", &out, "--quiet"]);
+    let xml = std::fs::read_to_string(dir.join("slab.xdmf")).unwrap();
+    assert!(!xml.contains("von_mises") && xml.contains(">slab.views.h5:/displacement/120<"));
 
     // Bad input: no file, not a results file.
     for bad in [dir.join("none.h5"), case.clone()] {

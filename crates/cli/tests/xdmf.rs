@@ -1,302 +1,583 @@
-//! The XDMF companion file (`src/xdmf.rs`) read back by the tools users
-//! open it with: meshio (Python) and ParaView's `pvpython` (Debian's
-//! `paraview`; `cargo xtask test` installs both, and under CI a missing one
-//! fails its test). Every array they read must equal the one in the
-//! .h5 (read here with h5py / the hdf5 crate), bit for bit: the XDMF holds
-//! only references, so any difference is a wrong reference.
+//! The XDMF companions of a results file that `stickslip views` writes
+//! (`src/views_cmd.rs`, `src/xdmf.rs`, `src/views.rs`) read back by the
+//! tools users open them with, as shipped: ParaView's three XDMF readers
+//! through `pvpython` (Debian's `paraview`), meshio's `TimeSeriesReader`
+//! and PyVista (PyPI). `cargo xtask test` installs them, and under CI a
+//! missing one fails its test.
 //!
-//! The writer is called directly on the .h5 of a run, so these checks do
-//! not depend on when `run` calls it; one test checks that `run` does
-//! write `OUT.xdmf` beside `OUT.h5`.
+//! Each test runs a Q1 and a Q2 case of the paper's slab, writes the
+//! viewers' files (`stickslip views`) and forms the stresses (`stickslip
+//! stress`, which lists them in OUT.xdmf), and has its reader read
+//! `OUT.xdmf` (the body) and `OUT.contact.xdmf` (Γ_C as line cells) at
+//! every record. The
+//! expected values are h5py's reading of OUT.h5 and OUT.stress.h5, and
+//! every array must equal them bit for bit: the XDMF files and the views
+//! hold only references, so any difference is a wrong reference. Node
+//! vectors come with a third component, which must be 0.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use stickslip::xdmf;
-use stickslip_mesh::CellKind;
-use stickslip_testkit::{scratch, workspace_root as root};
+mod common;
+use common::{root, stickslip_ok as stickslip};
 
-/// Runs a paper case into `dir/NAME.h5` and returns that path.
+fn scratch(name: &str) -> PathBuf {
+    common::scratch(&format!("xdmf-{name}"))
+}
+
+/// Runs a paper case into `dir/NAME.h5`, writes its viewers' files and
+/// forms its stresses; returns the results file.
 fn run_case(case: &str, dir: &Path, name: &str, sets: &[&str]) -> PathBuf {
     let out = dir.join(format!("{name}.h5"));
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_stickslip"));
-    cmd.arg("run")
-        .arg(root().join("cases/martins-oden").join(case))
-        .arg("-o")
-        .arg(&out)
-        .args(["--force", "--quiet"]);
+    let case = root().join("cases/martins-oden").join(case);
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "run".as_ref(),
+        case.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+        "--force".as_ref(),
+        "--quiet".as_ref(),
+    ];
     for s in sets {
-        cmd.args(["--set", s]);
+        args.push("--set".as_ref());
+        args.push(s.as_ref());
     }
-    let o = cmd.output().unwrap();
-    assert!(
-        o.status.success(),
-        "stickslip run {case} failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    stickslip(&args);
+    stickslip(&["views".as_ref(), out.as_os_str(), "--quiet".as_ref()]);
+    stickslip(&["stress".as_ref(), out.as_os_str(), "--quiet".as_ref()]);
     out
 }
 
-/// Sizes and times of a results file, read with the hdf5 crate.
-fn info_of(h5: &Path) -> (usize, CellKind, usize, Vec<f64>) {
-    let f = hdf5::File::open(h5).unwrap();
-    let nodes = f.dataset("mesh/nodes").unwrap().shape();
-    let cells = f.dataset("mesh/cells").unwrap().shape();
-    let kind = match cells[1] {
-        4 => CellKind::Quad4,
-        9 => CellKind::Quad9,
-        n => panic!("{n} nodes per cell"),
-    };
-    let t = f.dataset("time").unwrap().read_raw::<f64>().unwrap();
-    (nodes[0], kind, cells[0], t)
+/// The two cases every reader reads: the paper's 85-node quad9 slab, every
+/// step to t = 0.02 (21 records), and the Q1 16x4 slab (85 nodes, 64
+/// quad4 cells), every 2nd step to t = 0.02 (11 records).
+fn cases(dir: &Path) -> [(PathBuf, &'static str, usize); 2] {
+    [
+        (
+            run_case("cd-step-eps1e-4.toml", dir, "q2", &["time.t_end=0.02"]),
+            "quad9",
+            21,
+        ),
+        (
+            run_case(
+                "cd-step-eps1-q1.toml",
+                dir,
+                "q1",
+                &["time.t_end=0.02", "output.every=2"],
+            ),
+            "quad",
+            11,
+        ),
+    ]
 }
 
-/// Writes `dir/NAME.xdmf` for `dir/NAME.h5` with the writer under test.
-fn write_companion(h5: &Path) -> PathBuf {
-    let (n_nodes, kind, n_cells, times) = info_of(h5);
-    let xdmf = h5.with_extension("xdmf");
-    xdmf::write_xdmf(
-        h5,
-        &xdmf,
-        &xdmf::XdmfInfo {
-            n_nodes,
-            kind,
-            n_cells,
-            times: &times,
-            stress: None,
-        },
-    )
-    .unwrap();
-    xdmf
-}
-
-fn python_has(modules: &str) -> bool {
-    Command::new("python3")
-        .args(["-c", &format!("import {modules}")])
-        .status()
-        .is_ok_and(|s| s.success())
-}
-
-/// meshio 5.3 reads XDMF 3 temporal collections but not HyperSlab data
-/// items (its `_read_data_item` wants a `Format`); the subclass below adds
-/// the HyperSlab rule of the XDMF model (first child: start, stride and
-/// count per dimension; second child: the source) and leaves everything
-/// else (grid discovery, topology names, times, centring) to meshio.
-const MESHIO_CHECK: &str = r#"
+/// Python (with h5py) that compares what a reader read, `got`, with h5py's
+/// reading of the results: `check(tag, h5, part, got)` for part "body"
+/// (OUT.xdmf) or "contact" (OUT.contact.xdmf), where `got` has `time`
+/// (the reader's times), `points`, `cells` (connectivity, one row per
+/// cell) and `arrays` (name → one array per record). Prints one line
+/// "ok TAG PART: R records, A arrays, N points".
+const COMPARE: &str = r#"
 import sys
 import numpy as np
 import h5py
-from meshio.xdmf import TimeSeriesReader
 
-class Reader(TimeSeriesReader):
-    def _read_data_item(self, item):
-        if item.get("ItemType") == "HyperSlab":
-            sel, src = list(item)
-            start, stride, count = self._read_data_item(sel).reshape(3, -1)
-            full = self._read_data_item(src)
-            assert list(full.shape) == [int(d) for d in src.get("Dimensions").split()]
-            idx = tuple(slice(a, a + s * c, s) for a, s, c in zip(start, stride, count))
-            dims = [int(d) for d in item.get("Dimensions").split()]
-            return full[idx].reshape(dims)
-        return super()._read_data_item(item)
+def expected(h5, part):
+    with h5py.File(h5, "r") as f, h5py.File(h5[:-3] + ".stress.h5", "r") as g:
+        time = f["time"][:]
+        nodes = f["mesh/nodes"][:]
+        if part == "body":
+            stress = g["stress"][:]
+            arrays = {v: f[v][:] for v in ["displacement", "velocity", "acceleration"]}
+            for c, name in enumerate(["sxx", "syy", "sxy"]):
+                arrays[name] = stress[:, :, c]
+            arrays["von_mises"] = g["von_mises"][:]
+            return time, nodes, f["mesh/cells"][:], arrays
+        contact = f["contact/nodes"][:]
+        n_c = len(contact)
+        arrays = {v: f["contact/" + v][:] for v in ["friction_stress", "slip_velocity", "state"]}
+        arrays["s"] = np.broadcast_to(f["contact/s"][:], (len(time), n_c))
+        # /contact/nodes follows the straight contact face node by node, and
+        # only its end node is held: each segment joins two neighbours.
+        lines = np.array([[i, i + 1] for i in range(n_c - 1)])
+        return time, nodes[contact], lines, arrays
 
-xdmf, h5, cell_type = sys.argv[1], sys.argv[2], sys.argv[3]
-with h5py.File(h5, "r") as f, Reader(xdmf) as r:
-    points, cells = r.read_points_cells()
-    assert np.array_equal(points, f["mesh/nodes"][:]), "points"
-    assert len(cells) == 1 and cells[0].type == cell_type, [c.type for c in cells]
-    assert np.array_equal(cells[0].data, f["mesh/cells"][:]), "cells"
-    time = f["time"][:]
-    assert r.num_steps == len(time), (r.num_steps, len(time))
-    n = points.shape[0]
-    for k in range(r.num_steps):
-        t, point_data, cell_data = r.read_data(k)
-        assert t == time[k], (k, t, time[k])
-        assert sorted(point_data) == ["acceleration", "displacement", "velocity"], sorted(point_data)
-        for name, v in point_data.items():
-            assert np.array_equal(v.reshape(n, 2), f[name][k]), (name, k)
-    print(f"ok {r.num_steps} steps {n} nodes {cells[0].type}")
+def check(tag, h5, part, got):
+    time, points, cells, arrays = expected(h5, part)
+    assert np.array_equal(np.asarray(got["time"], dtype=float), time), (tag, part, "time", got["time"], time)
+    p = np.asarray(got["points"])
+    assert np.array_equal(p[:, :2], points), (tag, part, "points")
+    assert not p[:, 2:].any(), (tag, part, "z of the points")
+    c = np.asarray(got["cells"])
+    assert np.array_equal(c, cells), (tag, part, "cells", c[:3], cells[:3])
+    assert sorted(got["arrays"]) == sorted(arrays), (tag, part, sorted(got["arrays"]), sorted(arrays))
+    for name, want in arrays.items():
+        rows = got["arrays"][name]
+        assert len(rows) == len(time), (tag, part, name, len(rows))
+        for k, a in enumerate(rows):
+            a = np.asarray(a)
+            if want.ndim == 3:
+                # A node vector: (x, y) as stored, z = 0.
+                assert a.shape == (want.shape[1], 3), (tag, part, name, k, a.shape)
+                assert np.array_equal(a[:, :2], want[k]) and not a[:, 2].any(), (tag, part, name, k)
+            else:
+                assert np.array_equal(a.reshape(-1), want[k]), (tag, part, name, k, a.reshape(-1)[:4], want[k][:4])
+    print(f"ok {tag} {part}: {len(time)} records, {len(arrays)} arrays, {len(points)} points")
 "#;
 
-/// Reads the XDMF with meshio and compares every array with h5py; returns
-/// meshio's summary line, or None (skipped) without meshio/h5py outside CI.
-fn meshio_check(xdmf: &Path, h5: &Path, cell_type: &str) -> Option<String> {
-    if !python_has("meshio, h5py, numpy") {
+/// Whether `program -c "import MODULES"` runs.
+fn imports(program: &str, modules: &str) -> bool {
+    Command::new(program)
+        .args(["-c", &format!("import {modules}")])
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// Whether the reader is here; outside CI a missing one skips its test
+/// (saying so), under CI it fails: the test command installs it.
+fn present(what: &str, ok: bool, install: &str) -> bool {
+    if !ok {
         assert!(
             std::env::var_os("CI").is_none(),
-            "meshio/h5py missing: pip install meshio h5py (cargo xtask test installs them)"
+            "{what} is missing: {install} (cargo xtask test installs it)"
         );
-        eprintln!("skipped: meshio or h5py is not installed (pip install meshio h5py)");
-        return None;
+        eprintln!("skipped: {what} is not installed ({install})");
     }
+    ok
+}
+
+/// Runs `python3 -c COMPARE + script args…` from elsewhere than the files
+/// (they must be found relative to the XDMF) and returns its stdout.
+fn python(script: &str, args: &[&Path]) -> String {
     let o = Command::new("python3")
         .arg("-c")
-        .arg(MESHIO_CHECK)
-        .arg(xdmf)
-        .arg(h5)
-        .arg(cell_type)
-        // From elsewhere: the .h5 must be found relative to the .xdmf.
+        .arg(format!("{COMPARE}\n{script}"))
+        .args(args)
         .current_dir(std::env::temp_dir())
         .output()
         .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
     assert!(
         o.status.success(),
-        "meshio check of {} failed:\n{}{}",
-        xdmf.display(),
-        String::from_utf8_lossy(&o.stdout),
+        "python3 failed:\n{stdout}{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    Some(String::from_utf8_lossy(&o.stdout).trim().to_string())
+    stdout
 }
 
-#[test]
-fn meshio_reads_the_same_arrays_as_h5py_quad9_and_quad4() {
-    let dir = scratch("meshio");
-    // The paper's 85-node quad9 slab, every step to t = 0.05 (51 records).
-    let h5 = run_case("cd-step-eps1e-4.toml", &dir, "q2", &["time.t_end=0.05"]);
-    let x = write_companion(&h5);
-    if let Some(s) = meshio_check(&x, &h5, "quad9") {
-        assert_eq!(s, "ok 51 steps 85 nodes quad9");
-    }
-    // The Q1 16x4 slab (85 nodes too, 64 quad4 cells), every 5th step.
-    let h5 = run_case(
-        "cd-step-eps1-q1.toml",
-        &dir,
-        "q1",
-        &["time.t_end=0.05", "output.every=5"],
-    );
-    let x = write_companion(&h5);
-    if let Some(s) = meshio_check(&x, &h5, "quad") {
-        assert!(s.starts_with("ok ") && s.ends_with(" nodes quad"), "{s}");
-    }
-    // Moving both files together keeps the reference valid.
-    let moved = scratch("meshio-moved");
-    std::fs::rename(&h5, moved.join("q1.h5")).unwrap();
-    std::fs::rename(&x, moved.join("q1.xdmf")).unwrap();
-    meshio_check(&moved.join("q1.xdmf"), &moved.join("q1.h5"), "quad");
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::remove_dir_all(&moved).ok();
+/// The lines a reader's check must print for a case of `records` records.
+fn oks(tag: &str, records: usize) -> [String; 2] {
+    [
+        format!("ok {tag} body: {records} records, 7 arrays, 85 points"),
+        format!("ok {tag} contact: {records} records, 4 arrays, 16 points"),
+    ]
 }
 
-/// ParaView's "XDMF Reader" (vtkXdmfReader), through pvpython: the number
-/// of time steps, their values, the cell type (VTK_BIQUADRATIC_QUAD = 28),
-/// the point count and the displacement at the last step. (ParaView 5.11's
-/// "Xdmf3 Reader" variants do not evaluate HyperSlab data items: they load
-/// the mesh and skip the vectors with "Skipping unrecognized array type".)
-const PVPYTHON_CHECK: &str = r#"
-import sys, json, struct
-from paraview.simple import XDMFReader
-from paraview import servermanager as sm
-r = XDMFReader(FileNames=[sys.argv[1]])
-r.UpdatePipelineInformation()
-times = list(r.TimestepValues)
-r.UpdatePipeline(times[-1])
-d = sm.Fetch(r)
-if d.IsA("vtkMultiBlockDataSet"):
-    d = d.GetBlock(0)
-pd = d.GetPointData()
-# Floats as their IEEE bits, so the JSON round trip cannot round them.
-bits = lambda v: struct.unpack("<q", struct.pack("<d", v))[0]
-disp = pd.GetArray("displacement")
-print(json.dumps({
-    "times": [bits(t) for t in times],
-    "points": d.GetNumberOfPoints(),
-    "cells": d.GetNumberOfCells(),
-    "cell_type": d.GetCellType(0),
-    "arrays": sorted(pd.GetArrayName(i) for i in range(pd.GetNumberOfArrays())),
-    "components": disp.GetNumberOfComponents(),
-    "disp": [[bits(v) for v in disp.GetTuple(i)] for i in range(d.GetNumberOfPoints())],
-    "xy": [[bits(v) for v in d.GetPoint(i)[:2]] for i in range(d.GetNumberOfPoints())],
-}))
+fn assert_oks(stdout: &str, tag: &str, records: usize) {
+    for line in oks(tag, records) {
+        assert!(
+            stdout.lines().any(|l| l == line),
+            "no `{line}` in:\n{stdout}"
+        );
+    }
+}
+
+/// meshio's stock `TimeSeriesReader`, as PyPI ships it.
+const MESHIO: &str = r#"
+from meshio.xdmf import TimeSeriesReader
+tag, cell_type, h5 = sys.argv[1], sys.argv[2], sys.argv[3]
+for part, xdmf, kind in [("body", h5[:-3] + ".xdmf", cell_type), ("contact", h5[:-3] + ".contact.xdmf", "line")]:
+    with TimeSeriesReader(xdmf) as r:
+        points, cells = r.read_points_cells()
+        assert len(cells) == 1 and cells[0].type == kind, [c.type for c in cells]
+        got = {"time": [], "points": points, "cells": cells[0].data, "arrays": {}}
+        for k in range(r.num_steps):
+            t, point_data, cell_data = r.read_data(k)
+            assert not cell_data, cell_data
+            got["time"].append(t)
+            for name, v in point_data.items():
+                got["arrays"].setdefault(name, []).append(v)
+    check(tag, h5, part, got)
 "#;
 
 #[test]
-fn paraview_loads_the_xdmf() {
-    let has_pvpython = Command::new("pvpython")
+fn meshio_reads_what_h5py_reads_q1_and_q2() {
+    if !present(
+        "meshio, h5py or numpy",
+        imports("python3", "meshio, h5py, numpy"),
+        "pip install meshio h5py",
+    ) {
+        return;
+    }
+    let dir = scratch("meshio");
+    for (h5, cell_type, records) in cases(&dir) {
+        let tag = h5.file_stem().unwrap().to_str().unwrap().to_string();
+        let out = python(MESHIO, &[Path::new(&tag), Path::new(cell_type), &h5]);
+        assert_oks(&out, &tag, records);
+    }
+    // Moving the files together keeps every reference valid.
+    let moved = scratch("meshio-moved");
+    for ext in ["h5", "xdmf", "contact.xdmf", "views.h5", "stress.h5"] {
+        std::fs::rename(
+            dir.join(format!("q1.{ext}")),
+            moved.join(format!("q1.{ext}")),
+        )
+        .unwrap();
+    }
+    let out = python(
+        MESHIO,
+        &[Path::new("q1"), Path::new("quad"), &moved.join("q1.h5")],
+    );
+    assert_oks(&out, "q1", 11);
+}
+
+/// PyVista as shipped: `pyvista.read` (the first record) and its reader's
+/// time steps (`pyvista.get_reader`), and Warp By Vector on the
+/// displacement.
+const PYVISTA: &str = r#"
+import pyvista as pv
+tag, cell_type, h5 = sys.argv[1], sys.argv[2], sys.argv[3]
+def cells(grid):
+    return np.array([grid.get_cell(i).point_ids for i in range(grid.n_cells)])
+for part, xdmf in [("body", h5[:-3] + ".xdmf"), ("contact", h5[:-3] + ".contact.xdmf")]:
+    first = pv.read(xdmf)
+    assert isinstance(first, pv.UnstructuredGrid), type(first)
+    r = pv.get_reader(xdmf)
+    got = {"time": list(r.time_values), "points": first.points, "cells": cells(first), "arrays": {}}
+    for t in r.time_values:
+        r.set_active_time_value(t)
+        grid = r.read()
+        for name in grid.point_data.keys():
+            got["arrays"].setdefault(name, []).append(np.array(grid.point_data[name]))
+    for name in first.point_data.keys():
+        assert np.array_equal(first.point_data[name], got["arrays"][name][0]), (name, "pyvista.read")
+    check(tag, h5, part, got)
+    if part == "body":
+        # The warped mesh is the nodes plus the displacement (z = 0 + 0).
+        warped = grid.warp_by_vector("displacement")
+        with h5py.File(h5, "r") as f:
+            want = f["mesh/nodes"][:] + f["displacement"][-1]
+        assert np.array_equal(warped.points[:, :2], want) and not warped.points[:, 2].any(), "warp"
+        print(f"ok {tag} warp")
+"#;
+
+#[test]
+fn pyvista_reads_what_h5py_reads_q1_and_q2() {
+    if !present(
+        "pyvista, h5py or numpy",
+        imports("python3", "pyvista, h5py, numpy"),
+        "pip install pyvista h5py",
+    ) {
+        return;
+    }
+    let dir = scratch("pyvista");
+    for (h5, cell_type, records) in cases(&dir) {
+        let tag = h5.file_stem().unwrap().to_str().unwrap().to_string();
+        let out = python(PYVISTA, &[Path::new(&tag), Path::new(cell_type), &h5]);
+        assert_oks(&out, &tag, records);
+        assert!(out.contains(&format!("ok {tag} warp")), "{out}");
+    }
+}
+
+/// ParaView's readers of .xdmf files (those its File > Open offers:
+/// Xdmf3ReaderS, the one `OpenDataFile` picks, Xdmf3ReaderT and the legacy
+/// XDMF Reader), each at every time step, into an .npz for the h5py
+/// comparison (Debian's pvpython has numpy but no h5py); and Warp By Vector
+/// on the displacement of the last record, as a user would apply it.
+const PVPYTHON: &str = r#"
+import sys
+import numpy as np
+from paraview import servermanager as sm
+from paraview.simple import OpenDataFile, XDMFReader, Xdmf3ReaderS, Xdmf3ReaderT, WarpByVector
+from vtk.numpy_interface import dataset_adapter as dsa
+h5, out = sys.argv[1], sys.argv[2]
+readers = {
+    "XDMF Reader": lambda f: XDMFReader(FileNames=[f]),
+    "Xdmf3ReaderS": lambda f: Xdmf3ReaderS(FileName=[f]),
+    "Xdmf3ReaderT": lambda f: Xdmf3ReaderT(FileName=[f]),
+}
+def grid(src, t):
+    src.UpdatePipeline(t)
+    d = sm.Fetch(src)
+    while d.IsA("vtkMultiBlockDataSet"):
+        d = d.GetBlock(0)
+    return d
+res = {"default": np.array([OpenDataFile(h5[:-3] + ".xdmf").GetXMLName()])}
+for name, make in readers.items():
+    for part, xdmf in [("body", h5[:-3] + ".xdmf"), ("contact", h5[:-3] + ".contact.xdmf")]:
+        key = f"{name}|{part}"
+        r = make(xdmf)
+        r.UpdatePipelineInformation()
+        times = list(r.TimestepValues)
+        res[f"{key}|time"] = np.array(times)
+        for k, t in enumerate(times):
+            d = grid(r, t)
+            w = dsa.WrapDataObject(d)
+            if k == 0:
+                res[f"{key}|points"] = np.array(w.Points)
+                res[f"{key}|cells"] = np.array([[d.GetCell(i).GetPointId(j) for j in range(d.GetCell(i).GetNumberOfPoints())] for i in range(d.GetNumberOfCells())])
+            for a in w.PointData.keys():
+                res[f"{key}|array|{a}|{k}"] = np.array(w.PointData[a])
+        if part == "body":
+            warped = grid(WarpByVector(Input=r, Vectors=["POINTS", "displacement"]), times[-1])
+            res[f"{key}|warped"] = np.array(dsa.WrapDataObject(warped).Points)
+np.savez(out, **res)
+"#;
+
+/// The .npz of [`PVPYTHON`] through [`COMPARE`], one check per reader and
+/// part, and the warped points against h5py's nodes + displacement.
+const PVPYTHON_COMPARE: &str = r#"
+tag, h5, npz = sys.argv[1], sys.argv[2], sys.argv[3]
+z = np.load(npz)
+print("default reader", z["default"][0])
+readers = sorted({k.split("|")[0] for k in z.files if "|" in k})
+for name in readers:
+    for part in ["body", "contact"]:
+        key = f"{name}|{part}"
+        got = {"time": z[f"{key}|time"], "points": z[f"{key}|points"], "cells": z[f"{key}|cells"], "arrays": {}}
+        n = len(got["time"])
+        for a in sorted({k.split("|")[3] for k in z.files if k.startswith(f"{key}|array|")}):
+            got["arrays"][a] = [z[f"{key}|array|{a}|{k}"] for k in range(n)]
+        check(f"{tag} {name}", h5, part, got)
+    with h5py.File(h5, "r") as f:
+        want = f["mesh/nodes"][:] + f["displacement"][-1]
+    w = z[f"{name}|body|warped"]
+    assert np.array_equal(w[:, :2], want) and not w[:, 2].any(), (name, "warp")
+    print(f"ok {tag} {name} warp")
+"#;
+
+#[test]
+fn paraview_readers_read_what_h5py_reads_q1_and_q2() {
+    let has = Command::new("pvpython")
         .arg("--version")
         .output()
         .is_ok_and(|o| o.status.success());
-    if !has_pvpython {
-        // Under CI the test command has installed it: its absence is a
-        // failure, not a pass.
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "pvpython is missing: apt-get install -y paraview (cargo xtask test installs it)"
-        );
-        eprintln!("skipped: pvpython is not installed (apt-get install -y paraview)");
+    if !present("pvpython", has, "apt-get install -y paraview")
+        || !present(
+            "h5py or numpy",
+            imports("python3", "h5py, numpy"),
+            "pip install h5py",
+        )
+    {
         return;
     }
     let dir = scratch("paraview");
-    let h5 = run_case("cd-step-eps1e-4.toml", &dir, "q2", &["time.t_end=0.02"]);
-    let x = write_companion(&h5);
-    let script = dir.join("check.py");
-    std::fs::write(&script, PVPYTHON_CHECK).unwrap();
-    let o = Command::new("pvpython")
-        .arg("--force-offscreen-rendering")
-        .arg(&script)
-        .arg(&x)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success(),
-        "pvpython failed:\n{stdout}{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let line = stdout.lines().last().unwrap_or_default();
-    let j: serde_json::Value =
-        serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {stdout}"));
-
-    let f = hdf5::File::open(&h5).unwrap();
-    let time = f.dataset("time").unwrap().read_raw::<f64>().unwrap();
-    let nodes = f.dataset("mesh/nodes").unwrap().read_2d::<f64>().unwrap();
-    let disp = f
-        .dataset("displacement")
-        .unwrap()
-        .read_dyn::<f64>()
-        .unwrap();
-    let float = |v: &serde_json::Value| f64::from_bits(v.as_i64().unwrap() as u64);
-    let times: Vec<f64> = j["times"].as_array().unwrap().iter().map(float).collect();
-    assert_eq!(times, time, "ParaView's time steps are /time");
-    assert_eq!(j["points"], 85);
-    assert_eq!(j["cells"], 16);
-    assert_eq!(j["cell_type"], 28, "VTK_BIQUADRATIC_QUAD");
-    // VTK vectors have 3 components: the reader pads (x, y) with z = 0.
-    assert_eq!(j["components"], 3);
-    assert_eq!(
-        j["arrays"],
-        serde_json::json!(["acceleration", "displacement", "velocity"])
-    );
-    let last = time.len() - 1;
-    for i in 0..85 {
-        for c in 0..2 {
-            assert_eq!(float(&j["xy"][i][c]), nodes[[i, c]], "node {i}");
-            assert_eq!(
-                float(&j["disp"][i][c]),
-                disp[[last, i, c]],
-                "displacement of node {i} at the last step"
-            );
+    let script = dir.join("read.py");
+    std::fs::write(&script, PVPYTHON).unwrap();
+    for (h5, _, records) in cases(&dir) {
+        let tag = h5.file_stem().unwrap().to_str().unwrap().to_string();
+        let npz = dir.join(format!("{tag}.npz"));
+        let o = Command::new("pvpython")
+            .arg("--force-offscreen-rendering")
+            .arg(&script)
+            .arg(&h5)
+            .arg(&npz)
+            .current_dir(std::env::temp_dir())
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success() && npz.is_file(),
+            "pvpython failed:\n{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let out = python(PVPYTHON_COMPARE, &[Path::new(&tag), &h5, &npz]);
+        assert!(
+            out.contains("default reader Xdmf3ReaderS"),
+            "the reader File > Open picks: {out}"
+        );
+        for reader in ["XDMF Reader", "Xdmf3ReaderS", "Xdmf3ReaderT"] {
+            assert_oks(&out, &format!("{tag} {reader}"), records);
+            assert!(out.contains(&format!("ok {tag} {reader} warp")), "{out}");
         }
-        assert_eq!(float(&j["disp"][i][2]), 0.0);
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
-/// `stickslip run -o OUT.h5` writes `OUT.xdmf` beside it (issue 9). This
-/// fails until run.rs calls `xdmf::write_xdmf` after the last step.
+/// `stickslip run -o OUT.h5` writes OUT.h5 only and says how to view it;
+/// `stickslip views OUT.h5` writes OUT.xdmf, OUT.contact.xdmf and
+/// OUT.views.h5 beside it, one grid and one view per record; a restart
+/// removes the XML (it lists the earlier run's records) and keeps the
+/// views, to which `views` adds those of the new records.
 #[test]
-fn run_writes_the_xdmf_beside_the_h5() {
+fn views_writes_the_companions_beside_the_h5() {
     let dir = scratch("run");
-    let h5 = run_case("cd-step-eps1e-4.toml", &dir, "slab", &["time.t_end=0.01"]);
-    let x = dir.join("slab.xdmf");
+    let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let h5 = dir.join("slab.h5");
+    let (case, h5s) = (case.to_str().unwrap(), h5.to_str().unwrap());
+    let run = |more: [&str; 2], t_end: &str| {
+        let o = common::stickslip(&["run", case, more[0], more[1], "--set", t_end]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let said = run(["-o", h5s], "time.t_end=0.01");
     assert!(
-        x.is_file(),
-        "stickslip run -o {} wrote no {}",
-        h5.display(),
-        x.display()
+        said.contains(&format!(
+            "view: `stickslip views {h5s}`, then open {} in ParaView",
+            dir.join("slab.xdmf").display()
+        )),
+        "{said}"
     );
-    if let Some(s) = meshio_check(&x, &h5, "quad9") {
-        assert_eq!(s, "ok 11 steps 85 nodes quad9");
+    for name in ["slab.xdmf", "slab.contact.xdmf", "slab.views.h5"] {
+        assert!(!dir.join(name).exists(), "{name} written by the run");
     }
-    std::fs::remove_dir_all(&dir).ok();
+    let views_cmd = || {
+        let o = common::stickslip(&["views", h5s]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let said = views_cmd();
+    assert!(said.starts_with("views: 11 records in "), "{said}");
+    let grids = |name: &str| {
+        std::fs::read_to_string(dir.join(name))
+            .unwrap()
+            .matches("GridType=\"Uniform\"")
+            .count()
+    };
+    let views = || {
+        let f = hdf5::File::open(dir.join("slab.views.h5")).unwrap();
+        (
+            f.group("displacement").unwrap().len(),
+            f.group("contact/state").unwrap().len(),
+        )
+    };
+    assert_eq!(grids("slab.xdmf"), 11);
+    assert_eq!(grids("slab.contact.xdmf"), 11);
+    assert_eq!(views(), (11, 11));
+    let said = run(["--restart", h5s], "time.t_end=0.015");
+    assert!(said.contains("restart: removed "), "{said}");
+    assert!(!dir.join("slab.xdmf").exists());
+    assert!(!dir.join("slab.contact.xdmf").exists());
+    assert_eq!(views(), (11, 11));
+    views_cmd();
+    assert_eq!(grids("slab.xdmf"), 16);
+    assert_eq!(grids("slab.contact.xdmf"), 16);
+    assert_eq!(views(), (16, 16));
+    // The views read what the results file holds, first record and last.
+    let f = hdf5::File::open(&h5).unwrap();
+    let u = f
+        .dataset("displacement")
+        .unwrap()
+        .read::<f64, ndarray::Ix3>()
+        .unwrap();
+    let g = hdf5::File::open(dir.join("slab.views.h5")).unwrap();
+    for k in [0, 15] {
+        let v = g
+            .dataset(&format!("displacement/{k}"))
+            .unwrap()
+            .read_2d::<f64>()
+            .unwrap();
+        assert_eq!(v.shape(), [85, 3]);
+        for i in 0..85 {
+            assert_eq!(
+                [v[[i, 0]], v[[i, 1]], v[[i, 2]]],
+                [u[[k, i, 0]], u[[k, i, 1]], 0.0]
+            );
+        }
+    }
+}
+
+/// `stickslip views` refuses, with exit code 2 and what to give instead,
+/// a missing file, a file that is not HDF5 (the case), an XDMF named for
+/// its results file, and an HDF5 file `stickslip run` did not write.
+#[test]
+fn views_refuses_what_is_not_a_results_file() {
+    let dir = scratch("refuse");
+    let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let other = dir.join("other.h5");
+    hdf5::File::create(&other).unwrap();
+    for (bad, says) in [
+        (dir.join("none.h5"), "no such results file"),
+        (case, "cannot open it as HDF5"),
+        (
+            dir.join("slab.xdmf"),
+            "give the results file the XDMF is written for",
+        ),
+        (other, "was not written by `stickslip run`"),
+    ] {
+        let o = common::stickslip(&["views".as_ref(), bad.as_os_str()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{}: {err}", bad.display());
+        assert!(err.contains(says), "{}: {err}", bad.display());
+    }
+}
+
+/// `stickslip views` on a run's file: refused while the run writes it
+/// (exit code 2), and after the run is interrupted (SIGINT) it lists
+/// every record the file holds.
+#[test]
+fn views_waits_for_the_run_and_shows_an_interrupted_one() {
+    let dir = scratch("interrupted");
+    let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let h5 = dir.join("long.h5");
+    // 200,000 steps, a record every 2,000th: seconds of run, few records.
+    let child = Command::new(env!("CARGO_BIN_EXE_stickslip"))
+        .arg("run")
+        .arg(&case)
+        .arg("-o")
+        .arg(&h5)
+        .args([
+            "--quiet",
+            "--set",
+            "time.t_end=200",
+            "--set",
+            "output.every=2000",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while !h5.exists() && t0.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let o = common::stickslip(&["views".as_ref(), h5.as_os_str()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("a run is writing it"), "{err}");
+    assert!(!dir.join("long.xdmf").exists());
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    stickslip(&["views".as_ref(), h5.as_os_str(), "--quiet".as_ref()]);
+    let f = hdf5::File::open(&h5).unwrap();
+    assert!(!f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
+    let rows = f.dataset("time").unwrap().size();
+    assert!(rows >= 2, "{rows} records before the signal");
+    for name in ["long.xdmf", "long.contact.xdmf"] {
+        let xml = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert_eq!(xml.matches("GridType=\"Uniform\"").count(), rows, "{name}");
+    }
+}
+
+/// A results file of a version before `/contact/lines` (made here by
+/// removing it): `views` writes the body's files, removes the contact
+/// surface's (it would list other records) and says why.
+#[test]
+fn views_of_a_file_without_contact_lines_shows_the_body() {
+    let dir = scratch("old");
+    let h5 = run_case("cd-step-eps1e-4.toml", &dir, "old", &["time.t_end=0.005"]);
+    assert!(dir.join("old.contact.xdmf").exists());
+    hdf5::File::open_rw(&h5)
+        .unwrap()
+        .unlink("contact/lines")
+        .unwrap();
+    let o = common::stickslip(&["views".as_ref(), h5.as_os_str(), "--quiet".as_ref()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("has no /contact/lines") && err.contains("old.contact.xdmf is not written"),
+        "{err}"
+    );
+    let xml = std::fs::read_to_string(dir.join("old.xdmf")).unwrap();
+    assert_eq!(xml.matches("GridType=\"Uniform\"").count(), 6);
+    assert!(!dir.join("old.contact.xdmf").exists());
 }

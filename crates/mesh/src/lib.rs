@@ -15,10 +15,13 @@
 
 use std::collections::BTreeMap;
 
+mod basis;
 mod error;
 mod msh;
+mod quality;
 
 pub use error::{Location, MeshError, MeshErrorKind};
+pub use quality::{degenerate_cells, jacobian_ratio, Degenerate, DEGENERATE_RATIO};
 
 /// Node order of a quad9 cell as used everywhere in stickslip (and by VTK /
 /// XDMF `Quadrilateral_9`): the four corners counter-clockwise, then the

@@ -925,41 +925,6 @@ fn corner_sign(a: [f64; 2], b: [f64; 2], a2: f64, b2: f64, sign: &mut i8) -> Opt
     Some(())
 }
 
-/// Fem node index of the quad9 node at (ξ, η) = (a - 1, b - 1), `[a][b]`.
-const QUAD9_GRID: [[usize; 3]; 3] = [[0, 7, 3], [4, 8, 6], [1, 5, 2]];
-
-/// √(3/5), the abscissa of the 3-point Gauss rule the fem crate integrates with.
-const G: f64 = 0.774_596_669_241_483_4;
-
-/// The quadratic Lagrange basis on -1, 0, 1 (`[i][a]`: basis `a` at point
-/// `i`): derivatives at the nodes, values and derivatives at -G, 0, G.
-const D_NODE: [[f64; 3]; 3] = [[-1.5, 2.0, -0.5], [-0.5, 0.0, 0.5], [0.5, -2.0, 1.5]];
-const L_GAUSS: [[f64; 3]; 3] = [
-    [0.5 * G * (G + 1.0), 1.0 - G * G, 0.5 * G * (G - 1.0)],
-    [0.0, 1.0, 0.0],
-    [0.5 * G * (G - 1.0), 1.0 - G * G, 0.5 * G * (G + 1.0)],
-];
-const D_GAUSS: [[f64; 3]; 3] = [
-    [-G - 0.5, 2.0 * G, 0.5 - G],
-    [-0.5, 0.0, 0.5],
-    [G - 0.5, -2.0 * G, G + 0.5],
-];
-
-/// `w[0] v[0] + w[1] v[1] + w[2] v[2]`.
-#[inline(always)]
-fn comb(w: [f64; 3], v: [[f64; 2]; 3]) -> [f64; 2] {
-    [
-        w[0] * v[0][0] + w[1] * v[1][0] + w[2] * v[2][0],
-        w[0] * v[0][1] + w[1] * v[1][1] + w[2] * v[2][1],
-    ]
-}
-
-/// `det [a b] > 0`, false for NaN.
-#[inline(always)]
-fn positive(a: [f64; 2], b: [f64; 2]) -> bool {
-    a[0] * b[1] - a[1] * b[0] > 0.0
-}
-
 /// Whether the Jacobian determinant of a counter-clockwise quad9 is positive
 /// at its 9 nodes and 9 Gauss points. The corner test sees only the
 /// corners; a mid-side or centre node pulled across the cell inverts it
@@ -990,40 +955,10 @@ fn quad9_inside_positive(p: &[[f64; 2]; 9]) -> bool {
     if dev <= 1e-12 * size {
         return true;
     }
-    // Relative to node 0 and scaled to O(1): no overflow at 1e200, no
-    // underflow at 1e-200, whatever the magnitude of the coordinates.
-    let o = p[0];
-    let m = p.iter().fold(0.0f64, |m, q| {
-        m.max((q[0] - o[0]).abs()).max((q[1] - o[1]).abs())
-    });
-    let s = if m > 0.0 && (1.0 / m).is_finite() {
-        1.0 / m
-    } else {
-        1.0
-    };
-    let x: [[[f64; 2]; 3]; 3] =
-        QUAD9_GRID.map(|row| row.map(|k| [(p[k][0] - o[0]) * s, (p[k][1] - o[1]) * s]));
-    let column = |v: &[[[f64; 2]; 3]; 3], j: usize| [v[0][j], v[1][j], v[2][j]];
-    // At the nodes the basis is the identity: one 3-term sum a derivative.
-    for (i, &di) in D_NODE.iter().enumerate() {
-        for (j, &dj) in D_NODE.iter().enumerate() {
-            if !positive(comb(di, column(&x, j)), comb(dj, x[i])) {
-                return false;
-            }
-        }
-    }
-    // At the Gauss points, values and η-derivatives along η first (sum
-    // factorization), then the ξ sums.
-    let along = |w: &[[f64; 3]; 3]| x.map(|row| w.map(|wj| comb(wj, row)));
-    let (pv, qv) = (along(&L_GAUSS), along(&D_GAUSS));
-    for (&li, &di) in L_GAUSS.iter().zip(&D_GAUSS) {
-        for j in 0..3 {
-            if !positive(comb(di, column(&pv, j)), comb(li, column(&qv, j))) {
-                return false;
-            }
-        }
-    }
-    true
+    // False for NaN too.
+    crate::basis::quad9_dets(&crate::basis::quad9_grid(p))
+        .iter()
+        .all(|&d| d > 0.0)
 }
 
 /// Reverses a cell's orientation keeping node 0: corners 0 3 2 1, and for

@@ -1,0 +1,279 @@
+//! `OUT.views.h5`: one dataset per record and field, each a view of one
+//! row of the results file's `[n_out, …]` datasets, for the XDMF files to
+//! point to.
+//!
+//! A view is an HDF5 virtual dataset: it holds no numbers, only the
+//! mapping "row k of `/displacement` in OUT.h5", which the HDF5 library
+//! resolves on read (every reader built on HDF5 ≥ 1.10 does: ParaView,
+//! h5py under meshio, VTK under PyVista). XDMF readers then see plain
+//! datasets, where the XDMF way to address one row of a larger array (a
+//! HyperSlab data item) is read by ParaView's legacy reader only; and the
+//! `[n_out, n, 2]` datasets stay as h5py scripts read them.
+//!
+//! The node vectors are viewed as `[n, 3]` with z = 0 (HDF5's fill value
+//! of the unmapped third column): VTK vectors have three components, and
+//! ParaView's Warp By Vector offers only 3-component arrays. The source is
+//! named by file name only: HDF5 looks for it beside the views file, so
+//! the files move together.
+//!
+//! `stickslip views` writes the file (and `stickslip stress` through it),
+//! not the run: HDF5 creates a dataset, virtual or plain, far more slowly
+//! than a run writes a record, and six views a record made a run of many
+//! cheap records several times slower (docs/performance.md).
+//!
+//! The file only grows: each update adds the views of the records written
+//! since the last one (a view of a row is the same whatever run wrote the
+//! row), so after a restart only the new records' views are made. A file
+//! that cannot be opened (killed while adding views) or that belongs to
+//! other sizes is made anew.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use hdf5::{File, Hyperslab, Selection};
+use ndarray::Array2;
+use stickslip_mesh::Mesh;
+
+/// The body's node vectors, as the results file names them.
+pub const VECTORS: [&str; 3] = ["displacement", "velocity", "acceleration"];
+
+/// The contact fields under `/contact`: (name, stored as i8).
+pub const CONTACT_FIELDS: [(&str, bool); 3] = [
+    ("friction_stress", false),
+    ("slip_velocity", false),
+    ("state", true),
+];
+
+/// The views file of the results file `out`: OUT.views.h5 beside it.
+pub fn views_path(out: &Path) -> PathBuf {
+    out.with_extension("views.h5")
+}
+
+/// The segments of the contact surface between two friction nodes
+/// `nodes` (mesh indices, as `/contact/nodes`) that are neighbours on a
+/// side of the dimension-1 group `group`, as indices into `nodes`,
+/// oriented as the group's edges (the body on the left): a quad9 side
+/// gives two (corner, mid-side, corner). A segment with a node that
+/// carries no friction (its tangential motion held) is left out, since
+/// the fields have no value there. The run stores them as
+/// `/contact/lines`, since the results file keeps the group's nodes but
+/// not its edges.
+pub fn contact_lines(mesh: &Mesh, group: &str, nodes: &[usize]) -> Vec<[usize; 2]> {
+    let mut index = std::collections::HashMap::with_capacity(nodes.len());
+    for (i, &n) in nodes.iter().enumerate() {
+        index.insert(n, i);
+    }
+    let mut lines = Vec::new();
+    if let Ok(g) = mesh.group(group) {
+        for e in &g.edges {
+            let chain: Vec<usize> = match e.mid {
+                Some(m) => vec![e.nodes[0], m, e.nodes[1]],
+                None => e.nodes.to_vec(),
+            };
+            for w in chain.windows(2) {
+                if let (Some(&a), Some(&b)) = (index.get(&w[0]), index.get(&w[1])) {
+                    lines.push([a, b]);
+                }
+            }
+        }
+    }
+    lines
+}
+
+/// The contact surface as the viewers' line cells: the friction nodes'
+/// coordinates, in the order of `/contact/nodes`, and `/contact/lines`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactLine {
+    /// Coordinates of `/contact/nodes`.
+    pub points: Vec<[f64; 2]>,
+    /// Segments: pairs of indices into `points`.
+    pub lines: Vec<[usize; 2]>,
+}
+
+/// What the views of one results file are views of.
+#[derive(Clone, Copy, Debug)]
+pub struct Layout<'a> {
+    /// Rows of `/mesh/nodes`.
+    pub n_nodes: usize,
+    /// The contact surface's line, if the case has friction nodes.
+    pub contact: Option<&'a ContactLine>,
+}
+
+/// Makes `OUT.views.h5` hold the views of records `0..rows` of the results
+/// file `out`, adding those it lacks.
+///
+/// # Errors
+/// `out` without a UTF-8 file name, or HDF5 failing to write the file.
+pub fn update(out: &Path, layout: &Layout, rows: usize) -> anyhow::Result<()> {
+    let source = file_name(out)?;
+    let path = views_path(out);
+    let n_c = layout.contact.map_or(0, |c| c.points.len());
+    let f = match open_matching(&path, source, layout.n_nodes, n_c) {
+        Some(f) => f,
+        None => create(&path, source, layout)
+            .with_context(|| format!("cannot create {}", path.display()))?,
+    };
+    let add = || -> hdf5::Result<()> {
+        for name in VECTORS {
+            let g = f.group(name)?;
+            for k in g.len() as usize..rows {
+                vector_view(&g, source, name, layout.n_nodes, k)?;
+            }
+        }
+        if n_c > 0 && f.group("contact").is_ok() {
+            for (name, small) in CONTACT_FIELDS {
+                let g = f.group(&format!("contact/{name}"))?;
+                let src = format!("contact/{name}");
+                for k in g.len() as usize..rows {
+                    if small {
+                        row_view::<i8>(&g, source, &src, n_c, k)?;
+                    } else {
+                        row_view::<f64>(&g, source, &src, n_c, k)?;
+                    }
+                }
+            }
+        }
+        f.flush()
+    };
+    add().with_context(|| format!("cannot add views to {}", path.display()))
+}
+
+/// `out`'s file name, by which the views and the XML refer to it.
+pub(crate) fn file_name(out: &Path) -> anyhow::Result<&str> {
+    out.file_name().and_then(|n| n.to_str()).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: the results path has no UTF-8 file name for the views and XDMF files to refer to",
+            out.display()
+        )
+    })
+}
+
+/// The views file at `path`, open for writing, if it is one of `source`
+/// with these sizes.
+fn open_matching(path: &Path, source: &str, n_nodes: usize, n_c: usize) -> Option<File> {
+    let f = File::open_rw(path).ok()?;
+    let size = |name: &str| f.attr(name).and_then(|a| a.read_scalar::<u64>()).ok();
+    let same = crate::output::text_attr(&f, "source").ok().as_deref() == Some(source)
+        && size("n_nodes") == Some(n_nodes as u64)
+        && size("n_contact") == Some(n_c as u64)
+        && VECTORS.iter().all(|v| f.group(v).is_ok());
+    same.then_some(f)
+}
+
+/// A new, empty views file for `source` (the contact line's points and
+/// segments written whole: they are the mesh's, not a record's).
+fn create(path: &Path, source: &str, layout: &Layout) -> anyhow::Result<File> {
+    let _ = std::fs::remove_file(path);
+    let f = File::create(path)?;
+    crate::output::string_attr(
+        &f,
+        "about",
+        "views (HDF5 virtual datasets) of one record each of the results file named by `source`, \
+         for OUT.xdmf and OUT.contact.xdmf; /NAME/K is row K of /NAME there, node vectors with z = 0",
+    )?;
+    crate::output::string_attr(&f, "source", source)?;
+    let n_c = layout.contact.map_or(0, |c| c.points.len());
+    f.new_attr::<u64>()
+        .create("n_nodes")?
+        .write_scalar(&(layout.n_nodes as u64))?;
+    f.new_attr::<u64>()
+        .create("n_contact")?
+        .write_scalar(&(n_c as u64))?;
+    for name in VECTORS {
+        f.create_group(name)?;
+    }
+    if let Some(c) = layout.contact.filter(|c| !c.points.is_empty()) {
+        let g = f.create_group("contact")?;
+        let points = Array2::from_shape_fn((c.points.len(), 2), |(i, k)| c.points[i][k]);
+        g.new_dataset_builder()
+            .with_data(&points)
+            .create("points")?;
+        let lines = Array2::from_shape_fn((c.lines.len(), 2), |(i, k)| c.lines[i][k] as i64);
+        g.new_dataset_builder().with_data(&lines).create("lines")?;
+        for (name, _) in CONTACT_FIELDS {
+            g.create_group(name)?;
+        }
+    }
+    Ok(f)
+}
+
+/// The source extent a view of row `k` names: one row more than it needs.
+/// The hdf5 crate stores a selection that covers its whole extent as
+/// "all", and a view of "all" of a one-row extent would read the whole
+/// source once the run has written more rows.
+fn rows_past(k: usize) -> usize {
+    k + 2
+}
+
+/// `g/k`: row k of the `[rows, n, 2]` dataset `src` of `source` as `[n, 3]`.
+fn vector_view(g: &hdf5::Group, source: &str, src: &str, n: usize, k: usize) -> hdf5::Result<()> {
+    let row = Selection::from(Hyperslab::from((k..k + 1, 0..n, 0..2)));
+    let cols = Selection::from(Hyperslab::from((0..n, 0..2)));
+    g.new_dataset::<f64>()
+        .shape((n, 3))
+        .fill_value(0.0)
+        .virtual_map(source, src, (rows_past(k), n, 2), row, (n, 3), cols)
+        .create(k.to_string().as_str())?;
+    Ok(())
+}
+
+/// `g/k`: row k of the `[rows, n]` dataset `src` of `source`.
+pub(crate) fn row_view<T: hdf5::H5Type>(
+    g: &hdf5::Group,
+    source: &str,
+    src: &str,
+    n: usize,
+    k: usize,
+) -> hdf5::Result<()> {
+    let row = Selection::from(Hyperslab::from((k..k + 1, 0..n)));
+    g.new_dataset::<T>()
+        .shape(n)
+        .virtual_map(source, src, (rows_past(k), n), row, n, ..)
+        .create(k.to_string().as_str())?;
+    Ok(())
+}
+
+/// `g/k`: column `c` of row k of the `[rows, n, m]` dataset `src` of
+/// `source`, as `[n]`.
+pub(crate) fn column_view(
+    g: &hdf5::Group,
+    source: &str,
+    src: &str,
+    (n, m): (usize, usize),
+    k: usize,
+    c: usize,
+) -> hdf5::Result<()> {
+    let sel = Selection::from(Hyperslab::from((k..k + 1, 0..n, c..c + 1)));
+    g.new_dataset::<f64>()
+        .shape(n)
+        .virtual_map(source, src, (rows_past(k), n, m), sel, n, ..)
+        .create(k.to_string().as_str())?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quad9_sides_give_two_segments_and_held_nodes_none() {
+        // Two quad9 cells side by side along y = 0; the contact group is
+        // their bottom sides, nodes 0-4-1 and 1-9-10.
+        let text = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n1 1 \"contact\"\n$EndPhysicalNames\n\
+                    $Nodes\n15\n1 0 0 0\n2 2 0 0\n3 2 1 0\n4 0 1 0\n5 1 0 0\n6 2 0.5 0\n7 1 1 0\n8 0 0.5 0\n9 1 0.5 0\n\
+                    10 3 0 0\n11 4 0 0\n12 4 1 0\n13 3 1 0\n14 4 0.5 0\n15 3 0.5 0\n$EndNodes\n\
+                    $Elements\n4\n1 8 2 1 1 1 2 5\n2 8 2 1 1 2 11 10\n3 10 2 0 1 1 2 3 4 5 6 7 8 9\n4 10 2 0 1 2 11 12 3 10 14 13 6 15\n$EndElements\n";
+        let mesh = Mesh::from_bytes(text.as_bytes()).unwrap();
+        let g = mesh.group("contact").unwrap();
+        let mut nodes = g.nodes.clone();
+        // Along the face: x = 0, 1, 2, 3, 4.
+        nodes.sort_by(|&a, &b| mesh.nodes[a][0].total_cmp(&mesh.nodes[b][0]));
+        let mut lines = contact_lines(&mesh, "contact", &nodes);
+        lines.sort();
+        assert_eq!(lines, [[0, 1], [1, 2], [2, 3], [3, 4]]);
+        // The node at x = 0 held: its segment goes, the others stay.
+        let mut lines = contact_lines(&mesh, "contact", &nodes[1..]);
+        lines.sort();
+        assert_eq!(lines, [[0, 1], [1, 2], [2, 3]]);
+    }
+}

@@ -1,0 +1,237 @@
+//! `stickslip views OUT.h5`: the files ParaView, meshio and PyVista open,
+//! written beside a results file: `OUT.xdmf` (the body), `OUT.contact.xdmf`
+//! (Γ_C as line cells) and `OUT.views.h5` (what they point to,
+//! [`crate::views`]), for the records the file holds, of a finished run or
+//! of one interrupted or failed midway. With `OUT.stress.h5` beside it
+//! (`stickslip stress`, which calls [`write`] itself) `OUT.xdmf` lists the
+//! stresses too.
+//!
+//! The run writes none of these: their cost grows with the records, and a
+//! run of many cheap records paid several times its own time for them
+//! (docs/performance.md). The results file is only read; the XML files are
+//! written beside and renamed into place, and the views file only grows,
+//! so running the command again after a restart adds the new records'
+//! views.
+
+use std::path::Path;
+
+use anyhow::Context;
+use hdf5::File;
+use stickslip_case::InputError;
+use stickslip_mesh::CellKind;
+
+use crate::views::{ContactLine, Layout};
+use crate::xdmf::XdmfInfo;
+
+/// About the bytes per record the command writes beside the results:
+/// the XML of both files (1,150 and 1,377 for the slab's `st.h5`; each
+/// character of a longer file name adds about ten) and six views in
+/// `OUT.views.h5` (3,048 together).
+const BYTES_PER_RECORD: usize = 5600;
+
+/// What [`write`] wrote.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Written {
+    /// Records listed.
+    pub records: usize,
+    /// `OUT.contact.xdmf` written (the file has a contact line).
+    pub contact: bool,
+    /// `OUT.xdmf` lists the stresses of `OUT.stress.h5`.
+    pub stress: bool,
+    /// Why the contact surface is not shown, where it has friction nodes.
+    pub note: Option<String>,
+}
+
+/// `stickslip views OUT.h5`: checks that `path` is a results file no run
+/// is writing, then [`write`]s the viewers' files beside it.
+///
+/// # Errors
+/// An [`InputError`] for a file that is missing, being written, or not a
+/// results file of `stickslip run`; other errors for HDF5 or file system
+/// failures.
+pub fn command(path: &Path) -> anyhow::Result<Written> {
+    // No run may start on the file while its views are made.
+    let (_lock, f) = crate::results_file::open_finished(path, false)?;
+    drop(f);
+    write(path)
+}
+
+/// Writes `OUT.views.h5`, `OUT.xdmf` and `OUT.contact.xdmf` for the
+/// records of the results file `out` (the views first, so that the XML
+/// never names a view that is not there). The caller keeps runs off the
+/// file.
+///
+/// # Errors
+/// A file without the datasets a run writes, a disk without room, or HDF5
+/// and file system failures, naming the file.
+pub fn write(out: &Path) -> anyhow::Result<Written> {
+    let name = out.display().to_string();
+    let f = File::open(out).with_context(|| format!("cannot open {name}"))?;
+    let bad = |what: &str| {
+        InputError(format!(
+            "{name}: {what}; give a results file written by `stickslip run`"
+        ))
+    };
+    let shape = |path: &str| {
+        f.dataset(path)
+            .map(|d| d.shape())
+            .map_err(|_| bad(&format!("no /{path}")))
+    };
+    let nodes = shape("mesh/nodes")?;
+    let cells = shape("mesh/cells")?;
+    let kind = match f
+        .group("mesh")
+        .ok()
+        .and_then(|g| crate::output::text_attr(&g, "kind").ok())
+        .as_deref()
+    {
+        Some("quad4") => CellKind::Quad4,
+        Some("quad9") => CellKind::Quad9,
+        other => {
+            return Err(bad(&format!(
+                "/mesh has cell kind {other:?}, not quad4 or quad9"
+            ))
+            .into())
+        }
+    };
+    let n_nodes = nodes.first().copied().unwrap_or(0);
+    let times = crate::probe::read_time(&f, &name)?;
+    // A run killed between writing /time and the vectors: list the
+    // records every dataset holds.
+    let rows = times
+        .len()
+        .min(shape("displacement")?.first().copied().unwrap_or(0));
+    let (contact, note) = contact_line(&f, out)?;
+    let stress = stress_name(out, rows);
+    drop(f);
+
+    let need = (rows * BYTES_PER_RECORD) as u64 + (1 << 20);
+    if let Some(free) = crate::results_file::free_bytes(out) {
+        if free < need {
+            return Err(InputError(format!(
+                "{}: the viewers' files of {rows} records need about {:.1} MB beside it and its disk \
+                 has {:.1} MB free; make room and run this again",
+                name,
+                need as f64 / 1e6,
+                free as f64 / 1e6
+            ))
+            .into());
+        }
+    }
+    let layout = Layout {
+        n_nodes,
+        contact: contact.as_ref(),
+    };
+    crate::views::update(out, &layout, rows)?;
+    let info = XdmfInfo {
+        n_nodes,
+        kind,
+        n_cells: cells.first().copied().unwrap_or(0),
+        times: &times[..rows],
+        stress: stress.as_deref(),
+    };
+    let path = crate::xdmf::xdmf_path(out);
+    crate::xdmf::write_xdmf(out, &info)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    // A surface of one node has no line to show.
+    let line = contact.filter(|c| !c.lines.is_empty());
+    let contact_path = crate::xdmf::contact_xdmf_path(out);
+    match &line {
+        Some(c) => {
+            crate::xdmf::write_contact_xdmf(out, &times[..rows], c.points.len(), c.lines.len())
+                .with_context(|| format!("cannot write {}", contact_path.display()))?
+        }
+        // One of an earlier results file would list other records.
+        None => {
+            let _ = std::fs::remove_file(&contact_path);
+        }
+    }
+    Ok(Written {
+        records: rows,
+        contact: line.is_some(),
+        stress: stress.is_some(),
+        note,
+    })
+}
+
+/// The contact line of the results file `f`: the friction nodes'
+/// coordinates and `/contact/lines`; `None` without friction nodes, and
+/// with a note where the file has them but no lines (a file of a version
+/// before `/contact/lines`).
+fn contact_line(f: &File, out: &Path) -> anyhow::Result<(Option<ContactLine>, Option<String>)> {
+    let name = out.display();
+    let Ok(nodes) = f.dataset("contact/nodes") else {
+        return Ok((None, None));
+    };
+    let nodes = nodes.read_1d::<i64>()?;
+    let Ok(lines) = f.dataset("contact/lines") else {
+        return Ok((
+            None,
+            Some(format!(
+                "{name} has no /contact/lines (a file of an earlier version): {} is not written; \
+                 a new run of the case stores them",
+                crate::xdmf::contact_xdmf_path(out).display()
+            )),
+        ));
+    };
+    let xy = f.dataset("mesh/nodes")?.read_2d::<f64>()?;
+    let n_c = nodes.len();
+    let point = |&n: &i64| {
+        usize::try_from(n)
+            .ok()
+            .filter(|&n| n < xy.nrows())
+            .map(|n| [xy[[n, 0]], xy[[n, 1]]])
+    };
+    let points: Option<Vec<[f64; 2]>> = nodes.iter().map(point).collect();
+    let lines = lines.read_2d::<i64>()?;
+    let index = |v: i64| usize::try_from(v).ok().filter(|&i| i < n_c);
+    let segments: Option<Vec<[usize; 2]>> = lines
+        .rows()
+        .into_iter()
+        .map(|r| Some([index(r[0])?, index(r[1])?]))
+        .collect();
+    match (points, segments, lines.ncols()) {
+        (Some(points), Some(lines), 2) => Ok((Some(ContactLine { points, lines }), None)),
+        _ => Err(InputError(format!(
+            "{name}: /contact/nodes or /contact/lines name nodes that are not there; \
+             give a results file written by `stickslip run`"
+        ))
+        .into()),
+    }
+}
+
+/// The file name of `OUT.stress.h5` beside `out`, if it holds the views of
+/// at least `rows` records (one of fewer would leave records without
+/// stresses; a run or restart removes it anyway).
+fn stress_name(out: &Path, rows: usize) -> Option<String> {
+    let path = crate::stress_cmd::stress_path(out);
+    let g = File::open(&path).ok()?;
+    for v in crate::xdmf::STRESS_VIEWS {
+        if (g.group(&format!("views/{v}")).ok()?.len() as usize) < rows {
+            return None;
+        }
+    }
+    path.file_name()?.to_str().map(str::to_string)
+}
+
+/// The line `stickslip views` closes with: what it wrote for `out` and
+/// how to open it.
+pub fn summary(out: &Path, w: &Written) -> String {
+    let xdmf = crate::xdmf::xdmf_path(out);
+    let mut files = xdmf.display().to_string();
+    if w.contact {
+        files.push_str(&format!(
+            " and {}",
+            crate::xdmf::contact_xdmf_path(out).display()
+        ));
+    }
+    let stress = if w.stress { ", with the stresses" } else { "" };
+    format!(
+        "views: {} records in {files}{stress} (pointing into {} and {}); open {} in ParaView \
+         (any of its XDMF readers), or read it with meshio.xdmf.TimeSeriesReader or pyvista.read",
+        w.records,
+        out.display(),
+        crate::views::views_path(out).display(),
+        xdmf.display()
+    )
+}
