@@ -509,7 +509,8 @@ fn views_waits_for_the_run_and_shows_an_interrupted_one() {
     let dir = scratch("interrupted");
     let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
     let h5 = dir.join("long.h5");
-    // 200,000 steps, a record every 2,000th: seconds of run, few records.
+    // 10⁸ steps, a record every 2,000th: a run that is still going when
+    // it is interrupted, however fast the steps, with few records.
     let child = Command::new(env!("CARGO_BIN_EXE_stickslip"))
         .arg("run")
         .arg(&case)
@@ -518,7 +519,7 @@ fn views_waits_for_the_run_and_shows_an_interrupted_one() {
         .args([
             "--quiet",
             "--set",
-            "time.t_end=200",
+            "time.t_end=100000",
             "--set",
             "output.every=2000",
         ])
