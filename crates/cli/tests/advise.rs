@@ -14,7 +14,7 @@
 //! meeting them have errors 2.96e-2, 1.67e-2 and 8.7e-3. The first is 1.2%
 //! below 3e-2, so that case asks for an estimate sharper than the 1.5× of
 //! differences of neighbouring refinements; advise measures each pilot
-//! against its finest pilot run instead (see crates/cli/src/advise.rs).
+//! against its finest pilot run instead (see crates/cli/src/advise/mod.rs).
 
 use std::path::{Path, PathBuf};
 
