@@ -7,25 +7,9 @@
 //! the ends (`left`, `load`) 2 line3 elements and 5 nodes; bbox [0, 8] × [0, 1].
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_stickslip"))
-}
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::{bin, data, root, stderr};
 
 fn mesh_json(file: &Path) -> serde_json::Value {
     let o = bin().arg("mesh").arg(file).arg("--json").output().unwrap();

@@ -4,21 +4,10 @@
 //! run that fails midway keeps its steps, says `complete = false`, exits 1.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
-}
-
-fn stickslip(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_stickslip"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
+mod common;
+use common::{root, run};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("stickslip-e2e-{}-{name}", std::process::id()));
@@ -93,14 +82,7 @@ fn every_paper_case_runs_and_writes_the_documented_layout() {
             continue;
         }
         let out = dir.join(case.file_stem().unwrap()).with_extension("h5");
-        let run = stickslip(&[
-            "run",
-            case.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--force",
-            "--quiet",
-        ]);
+        let run = run(&case, &out, &["--force", "--quiet"]);
         assert!(
             run.status.success(),
             "{}: {}",
@@ -192,13 +174,7 @@ fn bad_input_is_refused_with_exit_code_2_before_any_work() {
     for (name, edit, word) in cases {
         let case = variant(&dir, name, edit);
         let out = dir.join(format!("{name}.h5"));
-        let run = stickslip(&[
-            "run",
-            case.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--quiet",
-        ]);
+        let run = run(&case, &out, &["--quiet"]);
         let stderr = String::from_utf8_lossy(&run.stderr);
         assert_eq!(run.status.code(), Some(2), "{name}: {stderr}");
         assert!(
@@ -225,13 +201,7 @@ fn a_run_that_fails_midway_keeps_its_steps_and_exits_1() {
         )
     });
     let out = dir.join("cycling.h5");
-    let run = stickslip(&[
-        "run",
-        case.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let run = run(&case, &out, &["--quiet"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("did not converge"), "{stderr}");

@@ -15,20 +15,8 @@ use std::time::{Duration, Instant};
 
 use hdf5::types::{FloatSize, IntSize, TypeDescriptor, VarLenUnicode};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_stickslip"))
-}
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::{bin, check, root, stderr};
 
 fn scratch(name: &str) -> PathBuf {
     let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("robust-{name}"));
@@ -75,25 +63,9 @@ fn line_of(text: &str, needle: &str) -> usize {
         + 1
 }
 
-fn check(case: &Path, sets: &[&str]) -> Output {
-    let mut c = bin();
-    c.arg("check").arg(case);
-    for s in sets {
-        c.args(["--set", s]);
-    }
-    c.output().unwrap()
-}
-
+/// `stickslip run CASE -o OUT --quiet --force ARGS...`.
 fn run(case: &Path, out: &Path, args: &[&str]) -> Output {
-    bin()
-        .arg("run")
-        .arg(case)
-        .arg("-o")
-        .arg(out)
-        .args(["--quiet", "--force"])
-        .args(args)
-        .output()
-        .unwrap()
+    common::run(case, out, &[&["--quiet", "--force"], args].concat())
 }
 
 fn restart(case: &Path, out: &Path, args: &[&str]) -> Output {
