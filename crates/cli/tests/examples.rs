@@ -11,23 +11,20 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::root;
+use common::{python_has, root};
 
 /// Runs examples/DIR/run.py into a fresh out dir and checks that it wrote
 /// the plot `png` there; returns (stdout, out dir), or None when the Python
 /// modules are missing outside CI.
 fn run_example(dir: &str, png: &str) -> Option<(String, PathBuf)> {
-    let has = Command::new("python3")
-        .args(["-c", "import gmsh, h5py, numpy, matplotlib"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has {
-        assert!(
-            std::env::var_os("CI").is_none(),
+    if !python_has(
+        "gmsh, h5py, numpy, matplotlib",
+        &format!(
             "examples/{dir}: python3 with gmsh, h5py, numpy and matplotlib is needed \
              (pip install gmsh h5py numpy matplotlib; cargo xtask test installs them)"
-        );
-        eprintln!("skipped examples/{dir}: gmsh, h5py, numpy or matplotlib is not installed");
+        ),
+        &format!("skipped examples/{dir}: gmsh, h5py, numpy or matplotlib is not installed"),
+    ) {
         return None;
     }
     let out = std::env::temp_dir().join(format!("stickslip-example-{}-{dir}", std::process::id()));

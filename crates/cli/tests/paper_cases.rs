@@ -4,10 +4,9 @@
 //! run that fails midway keeps its steps, says `complete = false`, exits 1.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 mod common;
-use common::{root, run};
+use common::{python, python_has, root, run};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("stickslip-e2e-{}-{name}", std::process::id()));
@@ -18,31 +17,12 @@ fn scratch(name: &str) -> PathBuf {
 /// Runs a Python snippet with h5py. Without h5py the check cannot run:
 /// under CI (where `cargo xtask test` installs h5py) that is a failure.
 fn python_h5py(script: &str, args: &[&str]) -> Option<String> {
-    let has_h5py = Command::new("python3")
-        .args(["-c", "import h5py"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has_h5py {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "h5py is missing; `cargo xtask test` installs it"
-        );
-        eprintln!("skipping the h5py check: h5py is not installed (cargo xtask test installs it)");
-        return None;
-    }
-    let out = Command::new("python3")
-        .arg("-c")
-        .arg(script)
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "python check failed:\n{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
+    let has_h5py = python_has(
+        "h5py",
+        "h5py is missing; `cargo xtask test` installs it",
+        "skipping the h5py check: h5py is not installed (cargo xtask test installs it)",
     );
-    Some(String::from_utf8_lossy(&out.stdout).into_owned())
+    has_h5py.then(|| python(script, args))
 }
 
 const CHECK: &str = r#"

@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 use hdf5::types::{FloatSize, IntSize, TypeDescriptor, VarLenUnicode};
 
 mod common;
-use common::{bin, check, root, stderr};
+use common::{bin, check, python, python_has, root, stderr};
 
 fn scratch(name: &str) -> PathBuf {
     let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("robust-{name}"));
@@ -447,29 +447,13 @@ fn signal(child: &Child, sig: &str) {
 /// Runs a Python snippet with h5py on `path` (skipped when h5py is missing,
 /// except under CI).
 fn h5py(script: &str, path: &Path) -> Option<String> {
-    let has = Command::new("python3")
-        .args(["-c", "import h5py"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has {
-        assert!(std::env::var_os("CI").is_none(), "h5py is missing");
-        eprintln!("skipping the h5py check: h5py is not installed");
-        return None;
-    }
-    let script = script.replace("PY_SLOT", PY_SLOT);
-    let o = Command::new("python3")
-        .arg("-c")
-        .arg(&script)
-        .arg(path)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "h5py: {}{}",
-        String::from_utf8_lossy(&o.stdout),
-        stderr(&o)
+    let has = python_has(
+        "h5py",
+        "h5py is missing",
+        "skipping the h5py check: h5py is not installed",
     );
-    Some(String::from_utf8_lossy(&o.stdout).trim().to_string())
+    let script = script.replace("PY_SLOT", PY_SLOT);
+    has.then(|| python(&script, &[path]).trim().to_string())
 }
 
 const H5PY_INTERRUPTED: &str = r#"

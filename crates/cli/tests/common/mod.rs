@@ -3,6 +3,7 @@
 // Each test file uses a part of this module.
 #![allow(dead_code)]
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -51,6 +52,41 @@ pub fn run(case: &Path, out: &Path, flags: &[&str]) -> Output {
         .args(flags)
         .output()
         .unwrap()
+}
+
+/// Whether python3 imports `modules` (as written after `import`). A check
+/// that needs them cannot run without them: under CI, where `cargo xtask
+/// test` installs them, that is a failure saying `missing`; elsewhere a
+/// skip, said on stderr as `skipped`.
+pub fn python_has(modules: &str, missing: &str, skipped: &str) -> bool {
+    let has = Command::new("python3")
+        .args(["-c", &format!("import {modules}")])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !has {
+        assert!(std::env::var_os("CI").is_none(), "{missing}");
+        eprintln!("{skipped}");
+    }
+    has
+}
+
+/// `python3 -c SCRIPT ARGS...`, which must succeed: what it printed.
+pub fn python<S: AsRef<OsStr>>(script: &str, args: &[S]) -> String {
+    let o = Command::new("python3")
+        .arg("-c")
+        .arg(script)
+        .args(args)
+        .output()
+        .unwrap();
+    succeeded(&o, "python check failed")
+}
+
+/// The stdout of a command that must have succeeded; where it did not,
+/// the failure says `what` and shows all it printed.
+pub fn succeeded(o: &Output, what: &str) -> String {
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(o.status.success(), "{what}:\n{stdout}{}", stderr(o));
+    stdout
 }
 
 /// `stickslip probe RESULTS ARGS...`.
