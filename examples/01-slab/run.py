@@ -28,98 +28,35 @@ How
    node 81 over time, into OUT/slab.png.
 
     python3 examples/01-slab/run.py --out /tmp/slab
-
-The stickslip binary is $STICKSLIP_BIN, else `stickslip` on PATH, else
-`cargo run` in this checkout.
 """
 
-import argparse
 import os
-import shlex
-import shutil
-import subprocess
 import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-
-
-def stickslip():
-    """The command that runs stickslip: $STICKSLIP_BIN, else `stickslip` on
-    PATH, else `cargo run` in this checkout (whatever the current directory)."""
-    exe = os.environ.get("STICKSLIP_BIN")
-    if exe:
-        return shlex.split(exe)
-    if shutil.which("stickslip"):
-        return ["stickslip"]
-    manifest = os.path.join(HERE, "..", "..", "Cargo.toml")
-    if shutil.which("cargo") and os.path.exists(manifest):
-        return ["cargo", "run", "-q", "--manifest-path", manifest, "-p", "stickslip", "--"]
-    sys.exit(
-        "stickslip not found: build it (cargo build --release -p stickslip in the checkout) "
-        "and put it on PATH, or set STICKSLIP_BIN to its path"
-    )
-
-
-def run_stickslip(args):
-    """Runs stickslip; its own message says what went wrong, so no traceback."""
-    cmd = stickslip() + args
-    try:
-        done = subprocess.run(cmd)
-    except OSError as e:
-        sys.exit(f"cannot start {cmd[0]}: {e}; set STICKSLIP_BIN to the stickslip binary")
-    if done.returncode != 0:
-        sys.exit(f"stickslip exited with {done.returncode} (its message is above)")
-
-
-def mesh(geo, msh, order, params):
-    """Meshes a .geo with the gmsh Python module, headless."""
-    import gmsh
-
-    argv = ["gmsh", "-nopopup"]
-    for name, value in params.items():
-        argv += ["-setnumber", name, str(value)]
-    gmsh.initialize(argv, readConfigFiles=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.open(geo)
-        gmsh.model.mesh.generate(2)
-        gmsh.model.mesh.setOrder(order)
-        gmsh.write(msh)
-    finally:
-        gmsh.finalize()
+# examples/common.py, whatever the current directory.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import common  # noqa: E402
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="directory for the mesh, results and PNG")
-    args = ap.parse_args()
-    os.makedirs(args.out, exist_ok=True)
+    here, out = common.setup(__file__, __doc__)
 
-    # 1. Mesh (the case names slab.msh relative to itself: copy it alongside).
-    mesh(os.path.join(HERE, "slab.geo"), os.path.join(args.out, "slab.msh"), 2, {"nx": 8, "ny": 2})
-    case = os.path.join(args.out, "case.toml")
-    with open(os.path.join(HERE, "case.toml")) as src, open(case, "w") as dst:
-        dst.write(src.read())
+    # 1. Mesh.
+    common.mesh(here, out, "slab", 2, nx=8, ny=2)
 
-    # 2. Run.
-    h5 = os.path.join(args.out, "slab.h5")
-    run_stickslip(["run", case, "-o", h5, "--force", "--quiet"])
+    # 2. Run (the case names slab.msh relative to itself: copied alongside).
+    h5 = common.run_case(here, out, "slab")
 
     # 3. Read.
-    import h5py
     import numpy as np
 
-    with h5py.File(h5, "r") as f:
-        nodes = f["mesh/nodes"][:]
-        t = f["time"][:]
-        contact = list(f["contact/nodes"][:])
-        s = f["contact/s"][:]
-        sigma = f["contact/friction_stress"][:]
-        n81 = int(np.argmin(np.hypot(nodes[:, 0] - 8.0, nodes[:, 1])))  # the paper's node 81
-        ux81 = f["displacement"][:, n81, 0]
-        assert bool(f.attrs["complete"]), "the run did not complete"
+    nodes, t, contact, s, sigma, u = common.read(
+        h5, "mesh/nodes", "time", "contact/nodes", "contact/s", "contact/friction_stress", "displacement"
+    )
+    n81 = int(np.argmin(np.hypot(nodes[:, 0] - 8.0, nodes[:, 1])))  # the paper's node 81
+    ux81 = u[:, n81, 0]
     g = 0.3 * 300.0  # mu * F_n, from case.toml
-    j81 = contact.index(n81)
+    j81 = list(contact).index(n81)
     static = 0.3 * (1 + 0.3) * 300.0 / 1000.0 * 8.0  # nu (1 + nu) F_n / E * x at x = 8
     print(f"nodes {len(nodes)}, contact nodes with friction {len(contact)}, output steps {len(t)}")
     print(f"node 81 = mesh node {n81}; initial u_x {ux81[0]:.9f}, closed form {static:.9f}")
@@ -127,29 +64,17 @@ def main():
     print(f"max |sigma_T| / g: {np.abs(sigma).max() / g:.6f}")
 
     # 4. Plot.
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = common.pyplot()
     fig, (a, b, c) = plt.subplots(3, 1, figsize=(6.5, 8))
-    for k in np.searchsorted(t, [0.01, 0.05, 0.1, 0.2, 0.5]):
-        k = min(k, len(t) - 1)
-        a.plot(s, sigma[k] / g, marker=".", label=f"t = {t[k]:.2f}")
-    a.set_xlabel("x along the bottom (s)")
-    a.set_ylabel("sigma_T / g")
     a.set_title("Martins & Oden slab: friction stress on the bottom")
-    a.legend(fontsize=8)
+    common.plot_along(a, s, sigma, g, t, common.at_times(t, [0.01, 0.05, 0.1, 0.2, 0.5]), "x along the bottom (s)")
     b.plot(t, ux81)
     b.set_ylabel("u_x, node 81")
     c.plot(t, sigma[:, j81])
     c.axhline(g, color="gray", lw=0.5)
     c.set_ylabel("sigma_T, node 81")
     c.set_xlabel("t")
-    fig.tight_layout()
-    png = os.path.join(args.out, "slab.png")
-    fig.savefig(png, dpi=110)
-    print(f"wrote {png}")
+    common.save(fig, out, "slab.png")
 
 
 if __name__ == "__main__":

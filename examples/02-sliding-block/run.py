@@ -28,98 +28,34 @@ How
    and sigma_T / g along the base at a few times into OUT/block.png.
 
     python3 examples/02-sliding-block/run.py --out /tmp/block
-
-The stickslip binary is $STICKSLIP_BIN, else `stickslip` on PATH, else
-`cargo run` in this checkout.
 """
 
-import argparse
 import os
-import shlex
-import shutil
-import subprocess
 import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-
-
-def stickslip():
-    """The command that runs stickslip: $STICKSLIP_BIN, else `stickslip` on
-    PATH, else `cargo run` in this checkout (whatever the current directory)."""
-    exe = os.environ.get("STICKSLIP_BIN")
-    if exe:
-        return shlex.split(exe)
-    if shutil.which("stickslip"):
-        return ["stickslip"]
-    manifest = os.path.join(HERE, "..", "..", "Cargo.toml")
-    if shutil.which("cargo") and os.path.exists(manifest):
-        return ["cargo", "run", "-q", "--manifest-path", manifest, "-p", "stickslip", "--"]
-    sys.exit(
-        "stickslip not found: build it (cargo build --release -p stickslip in the checkout) "
-        "and put it on PATH, or set STICKSLIP_BIN to its path"
-    )
-
-
-def run_stickslip(args):
-    """Runs stickslip; its own message says what went wrong, so no traceback."""
-    cmd = stickslip() + args
-    try:
-        done = subprocess.run(cmd)
-    except OSError as e:
-        sys.exit(f"cannot start {cmd[0]}: {e}; set STICKSLIP_BIN to the stickslip binary")
-    if done.returncode != 0:
-        sys.exit(f"stickslip exited with {done.returncode} (its message is above)")
-
-
-def mesh(geo, msh, order, params):
-    """Meshes a .geo with the gmsh Python module, headless."""
-    import gmsh
-
-    argv = ["gmsh", "-nopopup"]
-    for name, value in params.items():
-        argv += ["-setnumber", name, str(value)]
-    gmsh.initialize(argv, readConfigFiles=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.open(geo)
-        gmsh.model.mesh.generate(2)
-        gmsh.model.mesh.setOrder(order)
-        gmsh.write(msh)
-    finally:
-        gmsh.finalize()
+# examples/common.py, whatever the current directory.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import common  # noqa: E402
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="directory for the mesh, results and PNG")
-    args = ap.parse_args()
-    os.makedirs(args.out, exist_ok=True)
+    here, out = common.setup(__file__, __doc__)
 
-    # 1. Mesh. The case refers to block.msh relative to itself, so the case
+    # 1. Mesh.
+    common.mesh(here, out, "block", 1, nx=16, ny=8)
+
+    # 2. Run. The case refers to block.msh relative to itself, so the case
     #    is copied next to the mesh.
-    mesh(os.path.join(HERE, "block.geo"), os.path.join(args.out, "block.msh"), 1, {"nx": 16, "ny": 8})
-    case = os.path.join(args.out, "case.toml")
-    with open(os.path.join(HERE, "case.toml")) as src, open(case, "w") as dst:
-        dst.write(src.read())
-
-    # 2. Run.
-    h5 = os.path.join(args.out, "block.h5")
-    run_stickslip(["run", case, "-o", h5, "--force", "--quiet"])
+    h5 = common.run_case(here, out, "block")
 
     # 3. Read.
-    import h5py
     import numpy as np
 
-    with h5py.File(h5, "r") as f:
-        nodes = f["mesh/nodes"][:]
-        t = f["time"][:]
-        ux = f["displacement"][:, :, 0]
-        contact = f["contact/nodes"][:]
-        s = f["contact/s"][:]
-        sigma = f["contact/friction_stress"][:]
-        v_t = f["contact/slip_velocity"][:]
-        state = f["contact/state"][:]
-        assert bool(f.attrs["complete"]), "the run did not complete"
+    nodes, t, u, contact, s, sigma, v_t, state = common.read(
+        h5, "mesh/nodes", "time", "displacement", "contact/nodes", "contact/s",
+        "contact/friction_stress", "contact/slip_velocity", "contact/state",
+    )
+    ux = u[:, :, 0]
     g = 0.5 * 50.0  # mu * pressure, from case.toml
     corner = int(np.argmin(np.hypot(nodes[:, 0], nodes[:, 1])))  # (0, 0): pushed face, on the base
 
@@ -133,27 +69,16 @@ def main():
     print(f"largest fraction of the base slipping: {slipping.max():.3f} (at t = {t[slipping.argmax()]:.3f})")
 
     # 4. Plot.
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = common.pyplot()
     fig, (a, b) = plt.subplots(2, 1, figsize=(6.5, 6))
     a.plot(t, ux[:, corner])
     a.set_xlabel("t")
     a.set_ylabel("u_x at the pushed corner (0, 0)")
     a.set_title("A block pushed towards a wall along a rough base")
-    for k in np.linspace(1, len(t) - 1, 5).astype(int):
-        b.plot(s, sigma[k] / g, marker=".", label=f"t = {t[k]:.2f}")
+    common.plot_along(b, s, sigma, g, t, np.linspace(1, len(t) - 1, 5).astype(int), "x along the base")
     b.axhline(1.0, color="gray", lw=0.5)
     b.axhline(-1.0, color="gray", lw=0.5)
-    b.set_xlabel("x along the base")
-    b.set_ylabel("sigma_T / g")
-    b.legend(fontsize=8)
-    fig.tight_layout()
-    png = os.path.join(args.out, "block.png")
-    fig.savefig(png, dpi=110)
-    print(f"wrote {png}")
+    common.save(fig, out, "block.png")
 
 
 if __name__ == "__main__":

@@ -27,97 +27,32 @@ How
    mesh with the incline's tangent into OUT/wedge.png.
 
     python3 examples/03-inclined-contact/run.py --out /tmp/wedge
-
-The stickslip binary is $STICKSLIP_BIN, else `stickslip` on PATH, else
-`cargo run` in this checkout.
 """
 
-import argparse
 import os
-import shlex
-import shutil
-import subprocess
 import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-
-
-def stickslip():
-    """The command that runs stickslip: $STICKSLIP_BIN, else `stickslip` on
-    PATH, else `cargo run` in this checkout (whatever the current directory)."""
-    exe = os.environ.get("STICKSLIP_BIN")
-    if exe:
-        return shlex.split(exe)
-    if shutil.which("stickslip"):
-        return ["stickslip"]
-    manifest = os.path.join(HERE, "..", "..", "Cargo.toml")
-    if shutil.which("cargo") and os.path.exists(manifest):
-        return ["cargo", "run", "-q", "--manifest-path", manifest, "-p", "stickslip", "--"]
-    sys.exit(
-        "stickslip not found: build it (cargo build --release -p stickslip in the checkout) "
-        "and put it on PATH, or set STICKSLIP_BIN to its path"
-    )
-
-
-def run_stickslip(args):
-    """Runs stickslip; its own message says what went wrong, so no traceback."""
-    cmd = stickslip() + args
-    try:
-        done = subprocess.run(cmd)
-    except OSError as e:
-        sys.exit(f"cannot start {cmd[0]}: {e}; set STICKSLIP_BIN to the stickslip binary")
-    if done.returncode != 0:
-        sys.exit(f"stickslip exited with {done.returncode} (its message is above)")
-
-
-def mesh(geo, msh, order, params):
-    """Meshes a .geo with the gmsh Python module, headless."""
-    import gmsh
-
-    argv = ["gmsh", "-nopopup"]
-    for name, value in params.items():
-        argv += ["-setnumber", name, str(value)]
-    gmsh.initialize(argv, readConfigFiles=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.open(geo)
-        gmsh.model.mesh.generate(2)
-        gmsh.model.mesh.setOrder(order)
-        gmsh.write(msh)
-    finally:
-        gmsh.finalize()
+# examples/common.py, whatever the current directory.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import common  # noqa: E402
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="directory for the mesh, results and PNG")
-    args = ap.parse_args()
-    os.makedirs(args.out, exist_ok=True)
+    here, out = common.setup(__file__, __doc__)
 
     # 1. Mesh.
-    mesh(os.path.join(HERE, "wedge.geo"), os.path.join(args.out, "wedge.msh"), 2, {})
-    case = os.path.join(args.out, "case.toml")
-    with open(os.path.join(HERE, "case.toml")) as src, open(case, "w") as dst:
-        dst.write(src.read())
+    common.mesh(here, out, "wedge", 2)
 
     # 2. Run.
-    h5 = os.path.join(args.out, "wedge.h5")
-    run_stickslip(["run", case, "-o", h5, "--force", "--quiet"])
+    h5 = common.run_case(here, out, "wedge")
 
     # 3. Read.
-    import h5py
     import numpy as np
 
-    with h5py.File(h5, "r") as f:
-        nodes = f["mesh/nodes"][:]
-        cells = f["mesh/cells"][:]
-        t = f["time"][:]
-        vel = f["velocity"][:]
-        contact = f["contact/nodes"][:]
-        s = f["contact/s"][:]
-        sigma = f["contact/friction_stress"][:]
-        v_t = f["contact/slip_velocity"][:]
-        assert bool(f.attrs["complete"]), "the run did not complete"
+    nodes, cells, t, vel, contact, s, sigma, v_t = common.read(
+        h5, "mesh/nodes", "mesh/cells", "time", "velocity", "contact/nodes", "contact/s",
+        "contact/friction_stress", "contact/slip_velocity",
+    )
     g = 0.3 * 200.0  # mu * pressure, from case.toml
     tau = np.array([4.0, 1.0]) / np.sqrt(17.0)  # the incline, walked with the body on its left
     along = vel[:, contact, :] @ tau  # tau . v at every contact node and step
@@ -129,10 +64,7 @@ def main():
     print(f"max sigma_T * v_T: {(sigma * v_t).max():.3e}")
 
     # 4. Plot.
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = common.pyplot()
     from matplotlib.collections import PolyCollection
 
     fig, (a, b) = plt.subplots(2, 1, figsize=(6.5, 7.5))
@@ -147,16 +79,8 @@ def main():
     a.autoscale()
     a.legend(loc="upper right", fontsize=8)
     a.set_title("A wedge on an inclined rough face")
-    for k in np.searchsorted(t, [0.02, 0.1, 0.25, 0.5]):
-        k = min(k, len(t) - 1)
-        b.plot(s, sigma[k] / g, marker=".", label=f"t = {t[k]:.2f}")
-    b.set_xlabel("s along the incline")
-    b.set_ylabel("sigma_T / g")
-    b.legend(fontsize=8)
-    fig.tight_layout()
-    png = os.path.join(args.out, "wedge.png")
-    fig.savefig(png, dpi=110)
-    print(f"wrote {png}")
+    common.plot_along(b, s, sigma, g, t, common.at_times(t, [0.02, 0.1, 0.25, 0.5]), "s along the incline")
+    common.save(fig, out, "wedge.png")
 
 
 if __name__ == "__main__":

@@ -15,7 +15,6 @@
 
 use std::path::Path;
 use std::process::Command;
-use std::time::Instant;
 
 /// The case and the point of the advise tests and of the chart's errors.
 const CASE: &str = "cases/martins-oden/cd-step-eps1e-4.toml";
@@ -90,32 +89,31 @@ impl Config {
 pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     let mut rounds = 7usize;
     let mut tols = Vec::new();
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--rounds" => rounds = crate::integer_arg::<usize>(a, "a number", &mut it)?.max(1),
-            "--tol" => {
-                let v = it.next().ok_or("--tol needs a relative error, e.g. 2e-2")?;
-                tols.push(
-                    v.parse::<f64>()
-                        .map_err(|_| format!("--tol {v}: not a number"))?,
-                );
+    crate::bench::args(
+        "bench advise",
+        "[--rounds N] [--tol T]...",
+        args,
+        |a, it| {
+            match a {
+                "--rounds" => {
+                    rounds = crate::bench::integer_arg::<usize>(a, "a number", it)?.max(1)
+                }
+                "--tol" => {
+                    let v = it.next().ok_or("--tol needs a relative error, e.g. 2e-2")?;
+                    tols.push(
+                        v.parse::<f64>()
+                            .map_err(|_| format!("--tol {v}: not a number"))?,
+                    );
+                }
+                _ => return Ok(false),
             }
-            "-h" | "--help" => {
-                println!("cargo xtask bench advise [--rounds N] [--tol T]...");
-                return Ok(());
-            }
-            other => {
-                return Err(format!(
-                    "cargo xtask bench advise: unknown argument {other:?}; try --help"
-                ))
-            }
-        }
-    }
+            Ok(true)
+        },
+    )?;
     if tols.is_empty() {
         tols = TOLS.to_vec();
     }
-    let (exe, dir) = crate::release_stickslip(root, "advise")?;
+    let (exe, dir) = crate::bench::release_stickslip(root, "advise")?;
     let csv = root.join("docs/work-precision.csv");
     let rows = std::fs::read_to_string(&csv)
         .map_err(|e| format!("{}: {e}", csv.display()))
@@ -296,20 +294,10 @@ fn csv_rows(text: &str) -> Result<Vec<(Config, f64, f64)>, String> {
 /// One `stickslip run` of the paper case in configuration `c`: the
 /// process's wall time, and the run's own from its `done:` line.
 fn time_run(root: &Path, exe: &Path, out: &Path, c: &Config) -> Result<(f64, Option<f64>), String> {
-    let mut cmd = Command::new(exe);
-    cmd.current_dir(root)
-        .args(["run", "--force", "-o"])
-        .arg(out)
-        .arg(CASE)
-        .args(["--set", "output.every=1000000000"]);
-    for s in c.sets()? {
-        cmd.args(["--set", &s]);
-    }
-    let t = Instant::now();
-    let o = cmd
-        .output()
-        .map_err(|e| format!("cannot start {}: {e}", exe.display()))?;
-    let wall = t.elapsed().as_secs_f64();
+    let mut sets = vec!["output.every=1000000000".to_string()];
+    sets.extend(c.sets()?);
+    let (o, wall) =
+        crate::bench::timed_run(Command::new(exe), root, &["--force"], out, CASE, &sets)?;
     let err = String::from_utf8_lossy(&o.stderr);
     if !o.status.success() {
         return Err(format!("run of {} failed: {err}", c.describe()));

@@ -38,9 +38,9 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     let mut refines = vec![8usize, 16, 32, 64];
     let (mut q1, mut peer) = (false, true);
     let mut splu_max = 600_000usize;
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
+    let usage = "[--refine 8,16,32,64] [--q1] [--no-peer] [--splu-max-dofs N]";
+    crate::bench::args("bench fem", usage, args, |a, it| {
+        match a {
             "--refine" => {
                 let v = it.next().ok_or("--refine needs a list like 8,16,32")?;
                 refines = v
@@ -51,20 +51,13 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                     })
                     .collect::<Result<_, _>>()?;
             }
-            "--splu-max-dofs" => splu_max = crate::integer_arg(a, "a number", &mut it)?,
+            "--splu-max-dofs" => splu_max = crate::bench::integer_arg(a, "a number", it)?,
             "--q1" => q1 = true,
             "--no-peer" => peer = false,
-            "-h" | "--help" => {
-                println!("cargo xtask bench fem [--refine 8,16,32,64] [--q1] [--no-peer] [--splu-max-dofs N]");
-                return Ok(());
-            }
-            other => {
-                return Err(format!(
-                    "cargo xtask bench fem: unknown argument {other:?}; try --help"
-                ))
-            }
+            _ => return Ok(false),
         }
-    }
+        Ok(true)
+    })?;
     if peer {
         python::ensure_python_modules(&[("skfem", "scikit-fem"), ("scipy", "scipy")])?;
     }

@@ -45,16 +45,20 @@ struct Options {
     regenerate: bool,
 }
 
-fn parse_args(args: &[String]) -> Result<Option<Options>, String> {
+fn parse_args(args: &[String]) -> Result<Options, String> {
     let mut o = Options {
         nx: 1000,
         ny: 999,
         regenerate: false,
     };
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "-h" | "--help" => return Ok(None),
+    let usage = format!(
+        "[--nx N] [--ny M] [--regenerate]\n\n\
+         Reads a Q1 slab of N x M cells (default 1000 x 999, ~1M nodes) in MSH 4.1 ASCII and binary\n\
+         with stickslip-mesh (median of {RUST_RUNS}) and with gmsh.open (median of {GMSH_RUNS}).\n\
+         Meshes go to target/bench-meshes/ and are reused unless --regenerate."
+    );
+    crate::bench::args("bench mesh", &usage, args, |a, it| {
+        match a {
             "--regenerate" => o.regenerate = true,
             "--nx" | "--ny" => {
                 let v = it.next().ok_or_else(|| format!("{a} needs a number"))?;
@@ -69,14 +73,11 @@ fn parse_args(args: &[String]) -> Result<Option<Options>, String> {
                     o.ny = n;
                 }
             }
-            other => {
-                return Err(format!(
-                    "cargo xtask bench mesh: unknown argument {other:?}; try --help"
-                ))
-            }
+            _ => return Ok(false),
         }
-    }
-    Ok(Some(o))
+        Ok(true)
+    })?;
+    Ok(o)
 }
 
 /// Key/value pairs of the `RESULT k=v …` line a timing program prints last.
@@ -121,15 +122,7 @@ struct Row {
 /// gmsh missing and not installable, mesh generation failing, the reader
 /// failing on the file, or a timing program not printing its result.
 pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
-    let Some(opt) = parse_args(args)? else {
-        println!(
-            "cargo xtask bench mesh [--nx N] [--ny M] [--regenerate]\n\n\
-             Reads a Q1 slab of N x M cells (default 1000 x 999, ~1M nodes) in MSH 4.1 ASCII and binary\n\
-             with stickslip-mesh (median of {RUST_RUNS}) and with gmsh.open (median of {GMSH_RUNS}).\n\
-             Meshes go to target/bench-meshes/ and are reused unless --regenerate."
-        );
-        return Ok(());
-    };
+    let opt = parse_args(args)?;
     python::ensure_python_modules(&[("gmsh", "gmsh")])?;
 
     let target_dir = std::env::var_os("CARGO_TARGET_DIR")

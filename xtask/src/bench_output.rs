@@ -12,7 +12,6 @@
 
 use std::path::Path;
 use std::process::Command;
-use std::time::Instant;
 
 /// (label, case file, extra `--set`s).
 const CASES: [(&str, &str, &[&str]); 2] = [
@@ -42,22 +41,14 @@ const SETTINGS: [(&str, &[&str]); 4] = [
 /// Bad arguments, a failing build or run.
 pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     let mut rounds = 7usize;
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--rounds" => rounds = crate::integer_arg::<usize>(a, "a number", &mut it)?.max(1),
-            "-h" | "--help" => {
-                println!("cargo xtask bench output [--rounds N]");
-                return Ok(());
-            }
-            other => {
-                return Err(format!(
-                    "cargo xtask bench output: unknown argument {other:?}; try --help"
-                ))
-            }
+    crate::bench::args("bench output", "[--rounds N]", args, |a, it| {
+        match a {
+            "--rounds" => rounds = crate::bench::integer_arg::<usize>(a, "a number", it)?.max(1),
+            _ => return Ok(false),
         }
-    }
-    let (exe, dir) = crate::release_stickslip(root, "output")?;
+        Ok(true)
+    })?;
+    let (exe, dir) = crate::bench::release_stickslip(root, "output")?;
     // times[case][setting]; sizes likewise.
     let mut times = vec![vec![Vec::new(); SETTINGS.len()]; CASES.len()];
     let mut sizes = vec![vec![0u64; SETTINGS.len()]; CASES.len()];
@@ -66,19 +57,10 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         for (c, (_, case, case_sets)) in CASES.iter().enumerate() {
             for (s, (_, sets)) in SETTINGS.iter().enumerate() {
                 let out = dir.join(format!("c{c}-s{s}.h5"));
-                let mut cmd = Command::new(&exe);
-                cmd.current_dir(root)
-                    .args(["run", "--quiet", "--force", "-o"])
-                    .arg(&out)
-                    .arg(case);
-                for kv in case_sets.iter().chain(sets.iter()) {
-                    cmd.args(["--set", kv]);
-                }
-                let t = Instant::now();
-                let o = cmd
-                    .output()
-                    .map_err(|e| format!("cannot start {}: {e}", exe.display()))?;
-                let secs = t.elapsed().as_secs_f64();
+                let all: Vec<&str> = case_sets.iter().chain(sets.iter()).copied().collect();
+                let flags = ["--quiet", "--force"];
+                let (o, secs) =
+                    crate::bench::timed_run(Command::new(&exe), root, &flags, &out, case, &all)?;
                 if !o.status.success() {
                     return Err(format!(
                         "{case} {sets:?} failed: {}",

@@ -23,7 +23,6 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::Instant;
 
 /// (name, mesh file relative to the root or a Gmsh rung, DOFs roughly).
 struct Rung {
@@ -106,11 +105,11 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     let mut only: Option<String> = None;
     let mut rungs: Option<Vec<String>> = None;
     let mut against_env: Vec<(String, String)> = Vec::new();
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--rounds" => rounds = crate::integer_arg::<usize>(a, "a number", &mut it)?.max(1),
-            "--max-dofs" => max_dofs = crate::integer_arg(a, "a number of DOFs", &mut it)?,
+    let usage = "[--rounds N] [--max-dofs N] [--rungs NAME,...] [--against EXE] [--against-env K=V]... [--only cd|newmark]";
+    crate::bench::args("bench run", usage, args, |a, it| {
+        match a {
+            "--rounds" => rounds = crate::bench::integer_arg::<usize>(a, "a number", it)?.max(1),
+            "--max-dofs" => max_dofs = crate::bench::integer_arg(a, "a number of DOFs", it)?,
             "--against" => {
                 let p = it.next().ok_or("--against needs a stickslip binary")?;
                 against = Some(std::fs::canonicalize(p).map_err(|e| format!("{p}: {e}"))?);
@@ -127,18 +126,11 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                 rungs = Some(list.split(',').map(str::to_string).collect());
             }
             "--only" => only = Some(it.next().ok_or("--only needs cd or newmark")?.clone()),
-            "-h" | "--help" => {
-                println!("cargo xtask bench run [--rounds N] [--max-dofs N] [--rungs NAME,...] [--against EXE] [--against-env K=V]... [--only cd|newmark]");
-                return Ok(());
-            }
-            other => {
-                return Err(format!(
-                    "cargo xtask bench run: unknown argument {other:?}; try --help"
-                ))
-            }
+            _ => return Ok(false),
         }
-    }
-    let (exe, dir) = crate::release_stickslip(root, "run")?;
+        Ok(true)
+    })?;
+    let (exe, dir) = crate::bench::release_stickslip(root, "run")?;
     let mut exes = vec![exe.clone()];
     if against.is_some() || !against_env.is_empty() {
         exes.push(against.clone().unwrap_or_else(|| exe.clone()));
@@ -207,18 +199,8 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                 if e == 1 {
                     cmd.envs(against_env.iter().map(|(k, v)| (k, v)));
                 }
-                cmd.current_dir(root)
-                    .args(["run", "--quiet", "--force", "-o"])
-                    .arg(&out)
-                    .arg(case);
-                for kv in sets {
-                    cmd.args(["--set", kv]);
-                }
-                let t = Instant::now();
-                let o = cmd
-                    .output()
-                    .map_err(|e| format!("cannot start {}: {e}", exe.display()))?;
-                let secs = t.elapsed().as_secs_f64();
+                let flags = ["--quiet", "--force"];
+                let (o, secs) = crate::bench::timed_run(cmd, root, &flags, &out, case, sets)?;
                 for ext in ["h5", "xdmf"] {
                     let _ = std::fs::remove_file(out.with_extension(ext));
                 }

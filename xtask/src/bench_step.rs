@@ -30,26 +30,19 @@ use crate::python;
 pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     let mut pass: Vec<String> = Vec::new();
     let mut peer = true;
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--quick" => pass.push(a.clone()),
+    let usage = "[--quick] [--max-dofs N] [--no-peer]";
+    crate::bench::args("bench step", usage, args, |a, it| {
+        match a {
+            "--quick" => pass.push(a.to_string()),
             "--no-peer" => peer = false,
             "--max-dofs" => {
-                let v: u64 = crate::integer_arg(a, "a number of DOFs", &mut it)?;
-                pass.extend([a.clone(), v.to_string()]);
+                let v: u64 = crate::bench::integer_arg(a, "a number of DOFs", it)?;
+                pass.extend([a.to_string(), v.to_string()]);
             }
-            "-h" | "--help" => {
-                println!("cargo xtask bench step [--quick] [--max-dofs N] [--no-peer]");
-                return Ok(());
-            }
-            other => {
-                return Err(format!(
-                    "cargo xtask bench step: unknown argument {other:?}; try --help"
-                ))
-            }
+            _ => return Ok(false),
         }
-    }
+        Ok(true)
+    })?;
     if peer {
         python::ensure_python_modules(&[
             ("numpy", "numpy"),

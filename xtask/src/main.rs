@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
 mod apt;
+mod bench;
 mod bench_advise;
 mod bench_fem;
 mod bench_mesh;
@@ -114,16 +115,25 @@ fn project_root() -> PathBuf {
         .to_path_buf()
 }
 
-/// The integer after the flag `flag` of a bench command: "{flag} needs
-/// {what}" when it is missing, "{flag} {v}: not an integer" when it is not
-/// one.
-pub fn integer_arg<T: std::str::FromStr>(
-    flag: &str,
-    what: &str,
-    it: &mut std::slice::Iter<String>,
-) -> Result<T, String> {
-    let v = it.next().ok_or_else(|| format!("{flag} needs {what}"))?;
-    v.parse().map_err(|_| format!("{flag} {v}: not an integer"))
+/// `cargo run -p PACKAGE -- SUB ARGS` (dev profile) in `root`: a binary of
+/// the workspace that runs the integrators in-process, without HDF5.
+pub(crate) fn cargo_run(
+    root: &Path,
+    package: &str,
+    sub: &str,
+    args: &[String],
+) -> Result<(), String> {
+    let status = cargo()
+        .current_dir(root)
+        .args(["run", "--quiet", "-p", package, "--"])
+        .arg(sub)
+        .args(args)
+        .status();
+    match status {
+        Ok(s) if s.success() => Ok(()),
+        Ok(s) => Err(format!("{package} {sub} failed ({s})")),
+        Err(e) => Err(format!("cannot start cargo run -p {package}: {e}")),
+    }
 }
 
 /// Runs a command, echoing it, and fails with its exit status.
@@ -150,18 +160,6 @@ fn describe(cmd: &Command) -> String {
 
 pub(crate) fn cargo() -> Command {
     Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-}
-
-/// The release `stickslip` (HDF5 installed and the binary built first, if
-/// need be) and a bench's scratch directory target/bench/NAME.
-pub(crate) fn release_stickslip(root: &Path, name: &str) -> Result<(PathBuf, PathBuf), String> {
-    setup(false)?;
-    run(cargo()
-        .current_dir(root)
-        .args(["build", "--release", "-q", "-p", "stickslip"]))?;
-    let dir = root.join("target/bench").join(name);
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    Ok((root.join("target/release/stickslip"), dir))
 }
 
 /// HDF5's C library and headers, found the way hdf5-metno-sys finds them

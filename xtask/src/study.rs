@@ -7,28 +7,11 @@ use std::path::Path;
 /// docs/work-precision.csv, .png and .svg (`--quick`: a smoke test into
 /// target/study-quick/).
 pub fn chart(root: &Path, args: &[String]) -> Result<(), String> {
-    run_study_binary(root, "chart", args)
+    crate::cargo_run(root, "stickslip-study", "chart", args)
 }
 
 /// `cargo xtask stability [--quick] [--out DIR]`: the stability map,
 /// docs/stability-*.csv, .png and .svg.
 pub fn stability(root: &Path, args: &[String]) -> Result<(), String> {
-    run_study_binary(root, "stability", args)
-}
-
-fn run_study_binary(root: &Path, sub: &str, args: &[String]) -> Result<(), String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let mut cmd = std::process::Command::new(cargo);
-    cmd.current_dir(root)
-        .args(["run", "--quiet", "-p", "stickslip-study", "--"])
-        .arg(sub)
-        .args(args);
-    let status = cmd
-        .status()
-        .map_err(|e| format!("cannot start cargo run -p stickslip-study: {e}"))?;
-    if status.success() {
-        Ok(())
-    } else {
-        Err(format!("stickslip-study {sub} failed ({status})"))
-    }
+    crate::cargo_run(root, "stickslip-study", "stability", args)
 }

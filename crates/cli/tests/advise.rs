@@ -14,7 +14,7 @@
 //! meeting them have errors 2.96e-2, 1.67e-2 and 8.7e-3. The first is 1.2%
 //! below 3e-2, so that case asks for an estimate sharper than the 1.5× of
 //! differences of neighbouring refinements; advise measures each pilot
-//! against its finest pilot run instead (see crates/cli/src/advise.rs).
+//! against its finest pilot run instead (see crates/cli/src/advise/mod.rs).
 
 use std::path::Path;
 
@@ -22,6 +22,9 @@ use stickslip::advise::{self, Quantity};
 use stickslip_case::pilot::Trace;
 use stickslip_case::{self as case, Method};
 use stickslip_testkit::{scratch, workspace_root as root};
+
+mod common;
+use common::{bin, succeeded};
 
 const TOLS: [f64; 3] = [3e-2, 2e-2, 1e-2];
 const AT: [f64; 2] = [8.0, 1.0];
@@ -152,7 +155,7 @@ fn advise_command_writes_a_case_that_loads_and_keeps_comments() {
     let out = dir.join("adjusted.toml");
     std::fs::remove_file(&out).ok();
     let case_path = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
-    let st = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
+    let st = bin()
         .args(["advise"])
         .arg(&case_path)
         .args([
@@ -161,12 +164,7 @@ fn advise_command_writes_a_case_that_loads_and_keeps_comments() {
         .arg(&out)
         .output()
         .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
-    let j: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
+    let j: serde_json::Value = serde_json::from_str(&succeeded(&st, "advise --write")).unwrap();
     assert_eq!(j["found"], true);
     let text = std::fs::read_to_string(&out).unwrap();
     // The paper case's comments survive (toml_edit keeps them).
@@ -181,7 +179,7 @@ fn advise_command_writes_a_case_that_loads_and_keeps_comments() {
     ));
     assert!(c.mesh.file.is_file(), "{}", c.mesh.file.display());
     // Bad input exits 2 with a message naming what to do.
-    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
+    let bad = bin()
         .args(["advise"])
         .arg(&case_path)
         .args(["--tol", "1e-2", "--on", "ux"])
@@ -197,7 +195,7 @@ fn advise_never_writes_over_a_file() {
     let dir = scratch("advise-over");
     let out = dir.join("mine.toml");
     std::fs::write(&out, "mine").unwrap();
-    let st = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
+    let st = bin()
         .arg("advise")
         .arg(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
         .args(["--tol", "3e-2", "--on", "ux", "--at", "8,1", "--write"])
@@ -220,7 +218,7 @@ fn advise_never_writes_over_a_file() {
             "--tol 1e308: give a relative error between 0 and 1",
         ),
     ] {
-        let st = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
+        let st = bin()
             .arg("advise")
             .arg(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
             .args(["--on", "ux", "--at", "8,1"])
@@ -232,7 +230,7 @@ fn advise_never_writes_over_a_file() {
         assert!(err.contains(says), "{args:?}: {err}");
     }
     // --at with the energy, which has no point, was silently ignored.
-    let st = std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
+    let st = bin()
         .arg("advise")
         .arg(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
         .args(["--tol", "1e-2", "--on", "energy", "--at", "8,1"])
@@ -256,7 +254,7 @@ fn advise_refuses_a_ladder_of_two_bodies_and_a_point_off_the_body() {
     let case = dir.join("case.toml");
     std::fs::write(&case, &text).unwrap();
     let advise = |case: &Path, at: &str| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_stickslip"))
+        bin()
             .arg("advise")
             .arg(case)
             .args(["--tol", "2e-2", "--on", "ux", "--at", at])

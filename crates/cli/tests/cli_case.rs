@@ -1,24 +1,12 @@
 //! End-to-end tests of `stickslip check`, `run` and `probe` on case files:
 //! bad input exits 2 with `file:line`, a good case runs and can be probed.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
 
-use stickslip_testkit::{meshes_dir, scratch};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_stickslip"))
-}
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::scratch;
+use common::{check, data, probe, run, stderr};
+use stickslip_testkit::meshes_dir;
 
 /// tests/data/slab.toml with the mesh path made absolute, after `edit`,
 /// written to a scratch directory. Returns the case path and its text.
@@ -48,7 +36,7 @@ fn line_of(text: &str, needle: &str) -> usize {
 
 #[test]
 fn check_accepts_the_slab_case() {
-    let o = bin().arg("check").arg(data("slab.toml")).output().unwrap();
+    let o = check(&data("slab.toml"), &[]);
     assert!(
         o.status.success(),
         "exit {:?}: {}",
@@ -117,7 +105,7 @@ fn case_errors_exit_2_with_file_and_line() {
     ];
     for (name, edit, needle, what) in cases {
         let (path, text) = case_with(name, edit);
-        let o = bin().arg("check").arg(&path).output().unwrap();
+        let o = check(&path, &[]);
         let e = stderr(&o);
         assert_eq!(o.status.code(), Some(2), "{name}: {e}");
         let at = format!("{name}.toml:{}:", line_of(&text, needle));
@@ -127,13 +115,7 @@ fn case_errors_exit_2_with_file_and_line() {
         );
         // run refuses it the same way, before creating any output.
         let out = path.with_extension("h5");
-        let o = bin()
-            .arg("run")
-            .arg(&path)
-            .arg("-o")
-            .arg(&out)
-            .output()
-            .unwrap();
+        let o = run(&path, &out, &[]);
         assert_eq!(o.status.code(), Some(2), "{name} run: {}", stderr(&o));
         assert!(!out.exists(), "{name}: no results file for bad input");
     }
@@ -145,7 +127,7 @@ fn several_problems_are_reported_together() {
         t.replace("eps = 1e-4", "eps = -1")
             .replace("\nmu = 0.3", "\nmu = -1")
     });
-    let o = bin().arg("check").arg(&path).output().unwrap();
+    let o = check(&path, &[]);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(2));
     // (The slab's [contact] comment also says "mu = 0.3": only the key line is edited.)
@@ -164,43 +146,24 @@ fn several_problems_are_reported_together() {
 
 #[test]
 fn set_overrides_and_names_itself_in_errors() {
-    let o = bin()
-        .arg("check")
-        .arg(data("slab.toml"))
-        .args(["--set", "contact.eps=-1e-2"])
-        .output()
-        .unwrap();
+    let slab = data("slab.toml");
+    let o = check(&slab, &["contact.eps=-1e-2"]);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(
         e.contains("--set contact.eps=-1e-2") && e.contains("must be > 0"),
         "{e}"
     );
-    let o = bin()
-        .arg("check")
-        .arg(data("slab.toml"))
-        .args(["--set", "time.scheme=newmark", "--set", "time.dt=5e-3"])
-        .output()
-        .unwrap();
+    let o = check(&slab, &["time.scheme=newmark", "time.dt=5e-3"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let o = bin()
-        .arg("check")
-        .arg(data("slab.toml"))
-        .args(["--set", "time.dtt=5e-3"])
-        .output()
-        .unwrap();
+    let o = check(&slab, &["time.dtt=5e-3"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("unknown field `dtt`"), "{}", stderr(&o));
 }
 
 #[test]
 fn missing_group_lists_the_mesh_groups() {
-    let o = bin()
-        .arg("check")
-        .arg(data("slab.toml"))
-        .args(["--set", "contact.group=bottom"])
-        .output()
-        .unwrap();
+    let o = check(&data("slab.toml"), &["contact.group=bottom"]);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(
@@ -214,25 +177,11 @@ fn run_refuses_to_overwrite_without_force() {
     let dir = scratch("overwrite");
     let out = dir.join("exists.h5");
     std::fs::write(&out, b"precious").unwrap();
-    let o = bin()
-        .arg("run")
-        .arg(data("slab.toml"))
-        .arg("-o")
-        .arg(&out)
-        .arg("--quiet")
-        .output()
-        .unwrap();
+    let o = run(&data("slab.toml"), &out, &["--quiet"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("use --force"), "{}", stderr(&o));
     assert_eq!(std::fs::read(&out).unwrap(), b"precious");
-    let o = bin()
-        .arg("run")
-        .arg(data("slab.toml"))
-        .arg("-o")
-        .arg(&out)
-        .args(["--quiet", "--force"])
-        .output()
-        .unwrap();
+    let o = run(&data("slab.toml"), &out, &["--quiet", "--force"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_ne!(std::fs::read(&out).unwrap(), b"precious");
 }
@@ -240,14 +189,7 @@ fn run_refuses_to_overwrite_without_force() {
 #[test]
 fn run_into_a_missing_directory_is_bad_input() {
     let out = scratch("nodir").join("no/such/dir/out.h5");
-    let o = bin()
-        .arg("run")
-        .arg(data("slab.toml"))
-        .arg("-o")
-        .arg(&out)
-        .arg("--quiet")
-        .output()
-        .unwrap();
+    let o = run(&data("slab.toml"), &out, &["--quiet"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("does not exist"), "{}", stderr(&o));
 }
@@ -255,25 +197,13 @@ fn run_into_a_missing_directory_is_bad_input() {
 #[test]
 fn run_then_probe_node_81() {
     let out = scratch("probe").join("slab.h5");
-    let o = bin()
-        .arg("run")
-        .arg(data("slab.toml"))
-        .arg("-o")
-        .arg(&out)
-        .args(["--quiet", "--force"])
-        .output()
-        .unwrap();
+    let o = run(&data("slab.toml"), &out, &["--quiet", "--force"]);
     assert!(o.status.success(), "{}", stderr(&o));
 
     // Node 81 of the paper = (8, 0). BENCHMARK.md: the initial static state is
     // u_x = 0.117 x, so u_x(8, 0) = 0.936 at t = 0, and it decreases under
     // the compressive end load.
-    let o = bin()
-        .arg("probe")
-        .arg(&out)
-        .args(["--at", "8,0", "--field", "ux", "--csv"])
-        .output()
-        .unwrap();
+    let o = probe(&out, &["--at", "8,0", "--field", "ux", "--csv"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
         stderr(&o).contains("at (8, 0)"),
@@ -299,12 +229,7 @@ fn run_then_probe_node_81() {
     assert!(rows.last().unwrap().1 < rows[0].1, "the end moves in -x");
 
     // |σ_T| <= g = μ F_n = 90 (the regularized law never exceeds the bound).
-    let o = bin()
-        .arg("probe")
-        .arg(&out)
-        .args(["--at", "8,0", "--field", "friction_stress"])
-        .output()
-        .unwrap();
+    let o = probe(&out, &["--at", "8,0", "--field", "friction_stress"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8(o.stdout).unwrap();
     let vals: Vec<f64> = text
@@ -319,12 +244,7 @@ fn run_then_probe_node_81() {
     );
 
     // The top-right corner (8, 1) is not on the contact surface.
-    let o = bin()
-        .arg("probe")
-        .arg(&out)
-        .args(["--at", "8,1", "--field", "friction_stress"])
-        .output()
-        .unwrap();
+    let o = probe(&out, &["--at", "8,1", "--field", "friction_stress"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("not a contact node"), "{}", stderr(&o));
 }
@@ -337,7 +257,7 @@ fn check_names_the_explicit_preloads_factorization() {
     let (path, _) = case_with("check-preload", |t| {
         t.replace("history = \"step\"", "history = \"constant\"")
     });
-    let o = bin().arg("check").arg(&path).output().unwrap();
+    let o = check(&path, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout).into_owned();
     let solver = out
@@ -353,7 +273,7 @@ fn check_names_the_explicit_preloads_factorization() {
         let (head, rest) = t.split_once("[contact]").unwrap();
         format!("{head}{}", &rest[rest.find("[time]").unwrap()..])
     });
-    let o = bin().arg("check").arg(&path).output().unwrap();
+    let o = check(&path, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout).into_owned();
     let solver = out.lines().find(|l| l.starts_with("solver")).unwrap();

@@ -7,23 +7,9 @@
 //! the ends (`left`, `load`) 2 line3 elements and 5 nodes; bbox [0, 8] × [0, 1].
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use stickslip_testkit::workspace_root as root;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_stickslip"))
-}
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::{bin, data, root, stderr};
 
 fn mesh_json(file: &Path) -> serde_json::Value {
     let o = bin().arg("mesh").arg(file).arg("--json").output().unwrap();
@@ -45,26 +31,16 @@ fn check_slab_q2_8x2(j: &serde_json::Value, version: &str) {
     assert_eq!(j["boundary_elements"], serde_json::json!({"line3": 20}));
     assert_eq!(j["reoriented"], 0);
     let g = &j["groups"];
-    assert_eq!(
-        g["contact"],
-        serde_json::json!({"dim": 1, "elements": 8, "nodes": 17})
-    );
-    assert_eq!(
-        g["support"],
-        serde_json::json!({"dim": 1, "elements": 8, "nodes": 17})
-    );
-    assert_eq!(
-        g["left"],
-        serde_json::json!({"dim": 1, "elements": 2, "nodes": 5})
-    );
-    assert_eq!(
-        g["load"],
-        serde_json::json!({"dim": 1, "elements": 2, "nodes": 5})
-    );
-    assert_eq!(
-        g["body"],
-        serde_json::json!({"dim": 2, "elements": 16, "nodes": 85})
-    );
+    for (name, dim, elements, nodes) in [
+        ("contact", 1, 8, 17),
+        ("support", 1, 8, 17),
+        ("left", 1, 2, 5),
+        ("load", 1, 2, 5),
+        ("body", 2, 16, 85),
+    ] {
+        let want = serde_json::json!({"dim": dim, "elements": elements, "nodes": nodes});
+        assert_eq!(g[name], want, "group {name}");
+    }
     assert_eq!(
         g.as_object().unwrap().len(),
         5,

@@ -4,9 +4,10 @@
 //! mesh path, written relative to the repository root, made absolute.
 
 use std::path::Path;
-use std::process::Command;
 
-use stickslip_testkit::{scratch, workspace_root as root};
+mod common;
+use common::scratch;
+use common::{check, root, succeeded};
 
 /// (file, first line, text) of every ```toml block of a Markdown file.
 fn toml_blocks(path: &Path) -> Vec<(String, usize, String)> {
@@ -71,17 +72,8 @@ fn every_documented_case_passes_check() {
         );
         let case = dir.join(format!("doc-{k}.toml"));
         std::fs::write(&case, &text).unwrap();
-        let o = Command::new(env!("CARGO_BIN_EXE_stickslip"))
-            .arg("check")
-            .arg(&case)
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{file}:{line}: the documented case fails `stickslip check`:\n{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        );
+        let what = format!("{file}:{line}: the documented case fails `stickslip check`");
+        succeeded(&check(&case, &[]), &what);
     }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -10,22 +10,22 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use stickslip_testkit::{scratch, workspace_root as root};
+mod common;
+use common::scratch;
+use common::{python_has, root};
 
-/// Runs examples/DIR/run.py into a fresh out dir; returns (stdout, out dir),
-/// or None when the Python modules are missing outside CI.
-fn run_example(dir: &str) -> Option<(String, PathBuf)> {
-    let has = Command::new("python3")
-        .args(["-c", "import gmsh, h5py, numpy, matplotlib"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has {
-        assert!(
-            std::env::var_os("CI").is_none(),
+/// Runs examples/DIR/run.py into a fresh out dir and checks that it wrote
+/// the plot `png` there; returns (stdout, out dir), or None when the Python
+/// modules are missing outside CI.
+fn run_example(dir: &str, png: &str) -> Option<(String, PathBuf)> {
+    if !python_has(
+        "gmsh, h5py, numpy, matplotlib",
+        &format!(
             "examples/{dir}: python3 with gmsh, h5py, numpy and matplotlib is needed \
              (pip install gmsh h5py numpy matplotlib; cargo xtask test installs them)"
-        );
-        eprintln!("skipped examples/{dir}: gmsh, h5py, numpy or matplotlib is not installed");
+        ),
+        &format!("skipped examples/{dir}: gmsh, h5py, numpy or matplotlib is not installed"),
+    ) {
         return None;
     }
     let out = scratch(&format!("example-{dir}"));
@@ -43,6 +43,7 @@ fn run_example(dir: &str) -> Option<(String, PathBuf)> {
         "examples/{dir}/run.py failed:\n{stdout}{}",
         String::from_utf8_lossy(&o.stderr)
     );
+    assert_png(&out.join(png));
     Some((stdout, out))
 }
 
@@ -77,10 +78,9 @@ fn example_01_slab() {
         std::fs::read_to_string(root().join("cases/slab.geo")).unwrap(),
         "examples/01-slab/slab.geo has drifted from cases/slab.geo"
     );
-    let Some((out, dir)) = run_example("01-slab") else {
+    let Some((out, dir)) = run_example("01-slab", "slab.png") else {
         return;
     };
-    assert_png(&dir.join("slab.png"));
     // Static state under F_n alone: u_x = nu (1 + nu) F_n / E x = 0.936 at
     // x = 8 (plane strain, sigma_xx = 0); quad9 holds a linear field exactly.
     let line = out.lines().find(|l| l.starts_with("node 81 = ")).unwrap();
@@ -104,10 +104,9 @@ fn example_01_slab() {
 
 #[test]
 fn example_02_sliding_block() {
-    let Some((out, dir)) = run_example("02-sliding-block") else {
+    let Some((out, dir)) = run_example("02-sliding-block", "block.png") else {
         return;
     };
-    assert_png(&dir.join("block.png"));
     // Pushed towards the wall: the pushed face moves in +x.
     assert!(
         number(&out, "final u_x of the pushed corner (0, 0):") > 0.0,
@@ -122,10 +121,9 @@ fn example_02_sliding_block() {
 
 #[test]
 fn example_03_inclined_contact() {
-    let Some((out, dir)) = run_example("03-inclined-contact") else {
+    let Some((out, dir)) = run_example("03-inclined-contact", "wedge.png") else {
         return;
     };
-    assert_png(&dir.join("wedge.png"));
     // The stored slip velocity is the velocity's component along the
     // incline's tangent (4, 1)/sqrt(17): equal up to rounding.
     let line = out

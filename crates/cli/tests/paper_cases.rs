@@ -4,45 +4,20 @@
 //! run that fails midway keeps its steps, says `complete = false`, exits 1.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use stickslip_testkit::{scratch, workspace_root as root};
-
-fn stickslip(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_stickslip"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
+mod common;
+use common::scratch;
+use common::{python, python_has, root, run};
 
 /// Runs a Python snippet with h5py. Without h5py the check cannot run:
 /// under CI (where `cargo xtask test` installs h5py) that is a failure.
 fn python_h5py(script: &str, args: &[&str]) -> Option<String> {
-    let has_h5py = Command::new("python3")
-        .args(["-c", "import h5py"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has_h5py {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "h5py is missing; `cargo xtask test` installs it"
-        );
-        eprintln!("skipping the h5py check: h5py is not installed (cargo xtask test installs it)");
-        return None;
-    }
-    let out = Command::new("python3")
-        .arg("-c")
-        .arg(script)
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "python check failed:\n{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
+    let has_h5py = python_has(
+        "h5py",
+        "h5py is missing; `cargo xtask test` installs it",
+        "skipping the h5py check: h5py is not installed (cargo xtask test installs it)",
     );
-    Some(String::from_utf8_lossy(&out.stdout).into_owned())
+    has_h5py.then(|| python(script, args))
 }
 
 const CHECK: &str = r#"
@@ -82,14 +57,7 @@ fn every_paper_case_runs_and_writes_the_documented_layout() {
             continue;
         }
         let out = dir.join(case.file_stem().unwrap()).with_extension("h5");
-        let run = stickslip(&[
-            "run",
-            case.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--force",
-            "--quiet",
-        ]);
+        let run = run(&case, &out, &["--force", "--quiet"]);
         assert!(
             run.status.success(),
             "{}: {}",
@@ -181,13 +149,7 @@ fn bad_input_is_refused_with_exit_code_2_before_any_work() {
     for (name, edit, word) in cases {
         let case = variant(&dir, name, edit);
         let out = dir.join(format!("{name}.h5"));
-        let run = stickslip(&[
-            "run",
-            case.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--quiet",
-        ]);
+        let run = run(&case, &out, &["--quiet"]);
         let stderr = String::from_utf8_lossy(&run.stderr);
         assert_eq!(run.status.code(), Some(2), "{name}: {stderr}");
         assert!(
@@ -214,13 +176,7 @@ fn a_run_that_fails_midway_keeps_its_steps_and_exits_1() {
         )
     });
     let out = dir.join("cycling.h5");
-    let run = stickslip(&[
-        "run",
-        case.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let run = run(&case, &out, &["--quiet"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("did not converge"), "{stderr}");

@@ -16,13 +16,8 @@ use std::time::{Duration, Instant};
 use hdf5::types::{FloatSize, IntSize, TypeDescriptor, VarLenUnicode};
 use stickslip_testkit::{scratch, workspace_root as root};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_stickslip"))
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::{bin, check, python, python_has, stderr};
 
 /// tests/data/slab.toml (t_end = 0.05, dt = 1e-3, central difference) with
 /// an absolute mesh path, after `edit`, written into `dir`.
@@ -62,25 +57,9 @@ fn line_of(text: &str, needle: &str) -> usize {
         + 1
 }
 
-fn check(case: &Path, sets: &[&str]) -> Output {
-    let mut c = bin();
-    c.arg("check").arg(case);
-    for s in sets {
-        c.args(["--set", s]);
-    }
-    c.output().unwrap()
-}
-
+/// `stickslip run CASE -o OUT --quiet --force ARGS...`.
 fn run(case: &Path, out: &Path, args: &[&str]) -> Output {
-    bin()
-        .arg("run")
-        .arg(case)
-        .arg("-o")
-        .arg(out)
-        .args(["--quiet", "--force"])
-        .args(args)
-        .output()
-        .unwrap()
+    common::run(case, out, &[&["--quiet", "--force"], args].concat())
 }
 
 fn restart(case: &Path, out: &Path, args: &[&str]) -> Output {
@@ -462,29 +441,13 @@ fn signal(child: &Child, sig: &str) {
 /// Runs a Python snippet with h5py on `path` (skipped when h5py is missing,
 /// except under CI).
 fn h5py(script: &str, path: &Path) -> Option<String> {
-    let has = Command::new("python3")
-        .args(["-c", "import h5py"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !has {
-        assert!(std::env::var_os("CI").is_none(), "h5py is missing");
-        eprintln!("skipping the h5py check: h5py is not installed");
-        return None;
-    }
-    let script = script.replace("PY_SLOT", PY_SLOT);
-    let o = Command::new("python3")
-        .arg("-c")
-        .arg(&script)
-        .arg(path)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "h5py: {}{}",
-        String::from_utf8_lossy(&o.stdout),
-        stderr(&o)
+    let has = python_has(
+        "h5py",
+        "h5py is missing",
+        "skipping the h5py check: h5py is not installed",
     );
-    Some(String::from_utf8_lossy(&o.stdout).trim().to_string())
+    let script = script.replace("PY_SLOT", PY_SLOT);
+    has.then(|| python(&script, &[path]).trim().to_string())
 }
 
 const H5PY_INTERRUPTED: &str = r#"

@@ -17,6 +17,37 @@ fn err(s: &str) -> MeshError {
     err_bytes(s.as_bytes())
 }
 
+/// The error of `fixture` with its first line `line` replaced by `by`,
+/// which must be located at the line `at` of the damaged text (the
+/// replaced line where None: where the fix is).
+fn line_err(fixture: &str, line: &str, by: &str, at: Option<&str>) -> MeshError {
+    let t = replace_line(&text(fixture), line, by);
+    err_at_line(&t, at.unwrap_or(by))
+}
+
+/// The error of `t`, which must be located at its first line equal to `at`.
+fn err_at_line(t: &str, at: &str) -> MeshError {
+    let e = err(t);
+    assert_eq!(e.location, Location::Line(line_no(t, at)), "{e}");
+    e
+}
+
+/// The error of damaged binary input, which must be located at byte `at`.
+fn byte_err(b: &[u8], at: usize) -> MeshError {
+    let e = err_bytes(b);
+    assert_eq!(e.location, Location::Byte(at), "{e}");
+    e
+}
+
+/// A count that does not match what follows it.
+fn wrong_count(section: &'static str, what: &'static str, expected: u64) -> K {
+    K::WrongCount {
+        section,
+        what,
+        expected,
+    }
+}
+
 const Q4_22: &str = "slab_q4_v22_ascii.msh";
 const Q4_41: &str = "slab_q4_v41_ascii.msh";
 
@@ -39,17 +70,15 @@ fn truncated_binary() {
     let b = bytes("slab_q4_v22_bin.msh");
     let data = find(&b, b"$Nodes\n15\n") + 10;
     // 5 whole 28-byte node records and 3 bytes: the 15 records do not fit.
-    let e = err_bytes(&b[..data + 28 * 5 + 3]);
+    let e = byte_err(&b[..data + 28 * 5 + 3], data);
     assert!(matches!(e.kind, K::Truncated { .. }), "{e}");
-    assert_eq!(e.location, Location::Byte(data));
 }
 
 // ---- missing $End… ----
 
 #[test]
 fn missing_end_ascii() {
-    let t = replace_line(&text(Q4_22), "$EndNodes", "");
-    let e = err(&t);
+    let e = line_err(Q4_22, "$EndNodes", "", Some("$Elements"));
     assert_eq!(
         e.kind,
         K::MissingEnd {
@@ -57,7 +86,6 @@ fn missing_end_ascii() {
             end: "$EndNodes".into()
         }
     );
-    assert_eq!(e.location, Location::Line(line_no(&t, "$Elements")));
 }
 
 #[test]
@@ -65,75 +93,37 @@ fn missing_end_binary() {
     let mut b = bytes("slab_q4_v41_bin.msh");
     let at = find(&b, b"$EndElements");
     b[at + 11] = b'X';
-    let e = err_bytes(&b);
+    let e = byte_err(&b, at);
     assert!(
         matches!(&e.kind, K::MissingEnd { end, .. } if end == "$EndElements"),
         "{e}"
     );
-    assert_eq!(e.location, Location::Byte(at));
 }
 
 #[test]
 fn skipped_section_without_end() {
     let t = text(Q4_22) + "$Comments\nno end\n";
-    let e = err(&t);
+    let e = err_at_line(&t, "$Comments");
     assert!(
         matches!(&e.kind, K::MissingEnd { section, .. } if section == "$Comments"),
         "{e}"
     );
-    assert_eq!(e.location, Location::Line(line_no(&t, "$Comments")));
 }
 
 // ---- wrong counts ----
 
 #[test]
-fn wrong_count_ascii_too_many_declared() {
-    let t = replace_line(&text(Q4_22), "15", "16");
-    let e = err(&t);
-    assert_eq!(
-        e.kind,
-        K::WrongCount {
-            section: "$Nodes",
-            what: "nodes",
-            expected: 16
-        }
-    );
-    assert_eq!(e.location, Location::Line(line_no(&t, "$EndNodes")));
-}
-
-#[test]
-fn wrong_count_ascii_too_few_declared() {
-    let t = replace_line(&text(Q4_22), "15", "14");
-    let e = err(&t);
-    assert_eq!(
-        e.kind,
-        K::WrongCount {
-            section: "$Nodes",
-            what: "nodes",
-            expected: 14
-        }
-    );
-    assert_eq!(
-        e.location,
-        Location::Line(line_no(&t, "15 5.999999999998746 0.6874999999984586 0"))
-    );
-}
-
-#[test]
-fn wrong_count_v41_block_sum() {
-    // $Elements declares 20 of the 21 elements: the last block (8 quads)
-    // takes the sum past the header.
-    let t = replace_line(&text(Q4_41), "6 21 1 21", "6 20 1 21");
-    let e = err(&t);
-    assert_eq!(
-        e.kind,
-        K::WrongCount {
-            section: "$Elements",
-            what: "elements",
-            expected: 20
-        }
-    );
-    assert_eq!(e.location, Location::Line(line_no(&t, "2 1 3 8")));
+fn wrong_counts_ascii() {
+    // Too many nodes declared: reported where the nodes end; too few: at
+    // the first node past the count; $Elements declaring 20 of the 21
+    // elements: at the last block (8 quads), which takes the sum past it.
+    let past = "15 5.999999999998746 0.6874999999984586 0";
+    let e = line_err(Q4_22, "15", "16", Some("$EndNodes"));
+    assert_eq!(e.kind, wrong_count("$Nodes", "nodes", 16));
+    let e = line_err(Q4_22, "15", "14", Some(past));
+    assert_eq!(e.kind, wrong_count("$Nodes", "nodes", 14));
+    let e = line_err(Q4_41, "6 21 1 21", "6 20 1 21", Some("2 1 3 8"));
+    assert_eq!(e.kind, wrong_count("$Elements", "elements", 20));
 }
 
 #[test]
@@ -141,16 +131,8 @@ fn wrong_count_binary() {
     let mut b = bytes("slab_q4_v22_bin.msh");
     let at = find(&b, b"$Elements\n21\n") + 10;
     b[at + 1] = b'2'; // 21 -> 22
-    let e = err_bytes(&b);
-    assert_eq!(
-        e.kind,
-        K::WrongCount {
-            section: "$Elements",
-            what: "elements",
-            expected: 22
-        }
-    );
-    assert_eq!(e.location, Location::Byte(find(&b, b"\n$EndElements")));
+    let e = byte_err(&b, find(&b, b"\n$EndElements"));
+    assert_eq!(e.kind, wrong_count("$Elements", "elements", 22));
 }
 
 #[test]
@@ -161,23 +143,13 @@ fn huge_counts_are_errors_not_allocations() {
     let mut huge = b[..at].to_vec();
     huge.extend_from_slice(b"1000000000000000000");
     huge.extend_from_slice(&b[at + 2..]);
-    let e = err_bytes(&huge);
+    let e = byte_err(&huge, at + 20);
     assert!(matches!(e.kind, K::Truncated { .. }), "{e}");
-    assert_eq!(e.location, Location::Byte(at + 20));
     // And in a 4.1 ASCII header: the blocks hold 15, not 10^18.
-    let t = replace_line(&text(Q4_41), "9 15 1 15", "9 1000000000000000000 1 15");
-    let e = err(&t);
+    let e = line_err(Q4_41, "9 15 1 15", "9 1000000000000000000 1 15", None);
     assert_eq!(
         e.kind,
-        K::WrongCount {
-            section: "$Nodes",
-            what: "nodes",
-            expected: 1_000_000_000_000_000_000
-        }
-    );
-    assert_eq!(
-        e.location,
-        Location::Line(line_no(&t, "9 1000000000000000000 1 15"))
+        wrong_count("$Nodes", "nodes", 1_000_000_000_000_000_000)
     );
 }
 
@@ -185,20 +157,16 @@ fn huge_counts_are_errors_not_allocations() {
 
 #[test]
 fn non_numeric_ascii() {
-    let t = replace_line(&text(Q4_22), "5 1.999999999995288 0 0", "5 1.99x 0 0");
-    let e = err(&t);
-    assert!(
-        matches!(&e.kind, K::NotANumber { found, .. } if found == "1.99x"),
-        "{e}"
-    );
-    assert_eq!(e.location, Location::Line(line_no(&t, "5 1.99x 0 0")));
-    let t = replace_line(&text(Q4_41), "14 1 5 13 12", "14 1 5 six 12");
-    let e = err(&t);
-    assert!(
-        matches!(&e.kind, K::NotANumber { found, .. } if found == "six"),
-        "{e}"
-    );
-    assert_eq!(e.location, Location::Line(line_no(&t, "14 1 5 six 12")));
+    for (fixture, line, by, found) in [
+        (Q4_22, "5 1.999999999995288 0 0", "5 1.99x 0 0", "1.99x"),
+        (Q4_41, "14 1 5 13 12", "14 1 5 six 12", "six"),
+    ] {
+        let e = line_err(fixture, line, by, None);
+        assert!(
+            matches!(&e.kind, K::NotANumber { found: f, .. } if f == found),
+            "{e}"
+        );
+    }
 }
 
 #[test]
@@ -207,21 +175,30 @@ fn non_numeric_binary() {
     let data = find(&b, b"$Nodes\n15\n") + 10;
     let x = data + 28 * 2 + 4; // x of the third node
     b[x..x + 8].copy_from_slice(&f64::NAN.to_le_bytes());
-    let e = err_bytes(&b);
+    let e = byte_err(&b, x);
     assert!(matches!(e.kind, K::NotANumber { .. }), "{e}");
-    assert_eq!(e.location, Location::Byte(x));
 }
 
 // ---- element referencing a missing node ----
 
+/// The 2.2 binary fixture and its first quad4 element record.
+fn v22_bin_first_quad4() -> (Vec<u8>, Record) {
+    let b = bytes("slab_q4_v22_bin.msh");
+    let r = *v22_bin_elements(&b)
+        .iter()
+        .find(|r| r.type_id == 3)
+        .unwrap();
+    (b, r)
+}
+
 #[test]
 fn missing_node_ascii() {
-    let t = replace_line(
-        &text(Q4_22),
+    let e = line_err(
+        Q4_22,
         "14 3 2 10 1 1 5 13 12",
         "14 3 2 10 1 1 5 13 99",
+        None,
     );
-    let e = err(&t);
     assert_eq!(
         e.kind,
         K::MissingNode {
@@ -229,34 +206,23 @@ fn missing_node_ascii() {
             node: 99
         }
     );
-    assert_eq!(
-        e.location,
-        Location::Line(line_no(&t, "14 3 2 10 1 1 5 13 99"))
-    );
 }
 
 #[test]
 fn missing_node_binary() {
-    let mut b = bytes("slab_q4_v22_bin.msh");
-    let r = *v22_bin_elements(&b)
-        .iter()
-        .find(|r| r.type_id == 3)
-        .unwrap();
+    let (mut b, r) = v22_bin_first_quad4();
     let last = r.offset + 4 * (1 + r.ntags + 3);
     b[last..last + 4].copy_from_slice(&999i32.to_le_bytes());
-    let e = err_bytes(&b);
+    let e = byte_err(&b, r.offset);
     assert!(matches!(e.kind, K::MissingNode { node: 999, .. }), "{e}");
-    assert_eq!(e.location, Location::Byte(r.offset));
 }
 
 // ---- unknown physical group (4.1: an entity $Entities does not list) ----
 
 #[test]
 fn unknown_entity_ascii() {
-    let t = replace_line(&text(Q4_41), "2 1 3 8", "2 7 3 8");
-    let e = err(&t);
+    let e = line_err(Q4_41, "2 1 3 8", "2 7 3 8", None);
     assert_eq!(e.kind, K::UnknownEntity { dim: 2, tag: 7 });
-    assert_eq!(e.location, Location::Line(line_no(&t, "2 7 3 8")));
 }
 
 fn block_header(dim: i32, tag: i32, ty: i32, n: u64) -> Vec<u8> {
@@ -274,17 +240,15 @@ fn unknown_entity_binary() {
     let mut b = bytes("slab_q4_v41_bin.msh");
     let at = find(&b, &block_header(2, 1, 3, 8));
     b[at + 4] = 7;
-    let e = err_bytes(&b);
+    let e = byte_err(&b, at);
     assert_eq!(e.kind, K::UnknownEntity { dim: 2, tag: 7 });
-    assert_eq!(e.location, Location::Byte(at));
 }
 
 // ---- unsupported element type ----
 
 #[test]
 fn unsupported_element_ascii() {
-    let t = replace_line(&text(Q4_41), "2 1 3 8", "2 1 5 8");
-    let e = err(&t);
+    let e = line_err(Q4_41, "2 1 3 8", "2 1 5 8", None);
     // Element 14 is the first of that block in the fixture.
     assert_eq!(
         e.kind,
@@ -294,18 +258,13 @@ fn unsupported_element_ascii() {
             name: "hex8"
         }
     );
-    assert_eq!(e.location, Location::Line(line_no(&t, "2 1 5 8")));
 }
 
 #[test]
 fn unsupported_element_binary() {
-    let mut b = bytes("slab_q4_v22_bin.msh");
-    let r = *v22_bin_elements(&b)
-        .iter()
-        .find(|r| r.type_id == 3)
-        .unwrap();
+    let (mut b, r) = v22_bin_first_quad4();
     b[r.header..r.header + 4].copy_from_slice(&4i32.to_le_bytes());
-    let e = err_bytes(&b);
+    let e = byte_err(&b, r.header);
     assert!(
         matches!(
             e.kind,
@@ -317,24 +276,19 @@ fn unsupported_element_binary() {
         ),
         "{e}"
     );
-    assert_eq!(e.location, Location::Byte(r.header));
 }
 
 #[test]
 fn mixed_quad4_quad9_refused() {
-    let t = replace_line(
-        &text(Q4_22),
+    let e = line_err(
+        Q4_22,
         "15 3 2 10 1 12 13 11 4",
         "15 10 2 10 1 12 13 11 4 5 6 7 8 9",
+        None,
     );
-    let e = err(&t);
     assert!(
         matches!(&e.kind, K::NotQuads { found } if found.contains("quad4 and quad9")),
         "{e}"
-    );
-    assert_eq!(
-        e.location,
-        Location::Line(line_no(&t, "15 10 2 10 1 12 13 11 4 5 6 7 8 9"))
     );
 }
 
@@ -343,9 +297,9 @@ fn mixed_quad4_quad9_refused() {
 #[test]
 fn unsupported_version() {
     for v in ["3", "4.0", "2.1"] {
-        let e = err(&replace_line(&text(Q4_22), "2.2 0 8", &format!("{v} 0 8")));
+        // Located at line 2, the version's.
+        let e = line_err(Q4_22, "2.2 0 8", &format!("{v} 0 8"), None);
         assert_eq!(e.kind, K::UnsupportedVersion { version: v.into() });
-        assert_eq!(e.location, Location::Line(2));
     }
 }
 
@@ -355,9 +309,7 @@ fn big_endian_binary() {
     let at = find(&b, b"4.1 1 8\n") + 8;
     assert_eq!(&b[at..at + 4], &[1, 0, 0, 0]);
     b[at..at + 4].copy_from_slice(&[0, 0, 0, 1]);
-    let e = err_bytes(&b);
-    assert_eq!(e.kind, K::BigEndian);
-    assert_eq!(e.location, Location::Byte(at));
+    assert_eq!(byte_err(&b, at).kind, K::BigEndian);
 }
 
 #[test]
@@ -365,9 +317,8 @@ fn unsupported_data_size() {
     let mut b = bytes("slab_q4_v41_bin.msh");
     let at = find(&b, b"4.1 1 8\n");
     b[at + 6] = b'4';
-    let e = err_bytes(&b);
+    let e = byte_err(&b, at + 4);
     assert_eq!(e.kind, K::UnsupportedDataSize { size: 4 });
-    assert_eq!(e.location, Location::Byte(at + 4));
 }
 
 // ---- checks: degenerate cells, boundary elements off the cells ----
@@ -376,18 +327,15 @@ fn unsupported_data_size() {
 fn degenerate_cells() {
     // A repeated corner (zero-length side) and a bow-tie (crossed sides).
     for bad in ["16 3 2 10 1 5 6 6 13", "16 3 2 10 1 5 14 6 13"] {
-        let t = replace_line(&text(Q4_22), "16 3 2 10 1 5 6 14 13", bad);
-        let e = err(&t);
+        let e = line_err(Q4_22, "16 3 2 10 1 5 6 14 13", bad, None);
         assert_eq!(e.kind, K::DegenerateCell { element: 16 }, "{bad}");
-        assert_eq!(e.location, Location::Line(line_no(&t, bad)));
     }
 }
 
 #[test]
 fn boundary_element_not_on_a_cell_edge() {
     // 5-14 is a diagonal of cell 16 (5 6 14 13), not a side.
-    let t = replace_line(&text(Q4_22), "3 1 2 1 1 5 6", "3 1 2 1 1 5 14");
-    let e = err(&t);
+    let e = line_err(Q4_22, "3 1 2 1 1 5 6", "3 1 2 1 1 5 14", None);
     assert_eq!(
         e.kind,
         K::EdgeNotOnCell {
@@ -395,13 +343,11 @@ fn boundary_element_not_on_a_cell_edge() {
             group: "contact".into()
         }
     );
-    assert_eq!(e.location, Location::Line(line_no(&t, "3 1 2 1 1 5 14")));
 }
 
 #[test]
 fn line_order_mismatch() {
-    let t = replace_line(&text(Q4_22), "3 1 2 1 1 5 6", "3 8 2 1 1 5 6 1");
-    let e = err(&t);
+    let e = line_err(Q4_22, "3 1 2 1 1 5 6", "3 8 2 1 1 5 6 1", None);
     assert_eq!(
         e.kind,
         K::OrderMismatch {
@@ -410,7 +356,6 @@ fn line_order_mismatch() {
             cells: "quad4"
         }
     );
-    assert_eq!(e.location, Location::Line(line_no(&t, "3 8 2 1 1 5 6 1")));
 }
 
 #[test]
@@ -471,18 +416,14 @@ fn a_plane_at_constant_z_reads() {
 
 #[test]
 fn not_planar() {
-    let t = replace_line(
-        &text(Q4_22),
+    // Located at the node's line, where the fix is.
+    let e = line_err(
+        Q4_22,
         "9 6.000000000002768 1.375000000000173 0",
         "9 6.000000000002768 1.375000000000173 0.5",
+        None,
     );
-    let e = err(&t);
     assert!(matches!(e.kind, K::NotPlanar { node: 9, z, .. } if z == 0.5));
-    // The node's line, where the fix is.
-    assert_eq!(
-        e.location,
-        Location::Line(line_no(&t, "9 6.000000000002768 1.375000000000173 0.5"))
-    );
     // Rounding-level z (1e-14 of an 8-long mesh) is accepted.
     let t = replace_line(
         &text(Q4_22),
@@ -529,9 +470,8 @@ fn duplicate_node_tag_22_ascii_and_binary() {
     let data = find(&b, b"$Nodes\n15\n") + 10;
     let third: [u8; 4] = b[data + 28 * 2..data + 28 * 2 + 4].try_into().unwrap();
     b[data + 28 * 7..data + 28 * 7 + 4].copy_from_slice(&third);
-    let e = err_bytes(&b);
+    let e = byte_err(&b, data + 28 * 7);
     assert!(matches!(e.kind, K::DuplicateNode { .. }), "{e}");
-    assert_eq!(e.location, Location::Byte(data + 28 * 7));
     // MSH 4.1 binary: the second block's tag (after the 32-byte header, a
     // 20-byte block header, a tag and 24 bytes of coordinates, and the next
     // block header) takes the first one's.
@@ -540,14 +480,13 @@ fn duplicate_node_tag_22_ascii_and_binary() {
     let second = first + 8 + 24 + 20;
     let tag: [u8; 8] = b[first..first + 8].try_into().unwrap();
     b[second..second + 8].copy_from_slice(&tag);
-    let e = err_bytes(&b);
+    let e = byte_err(&b, second);
     assert_eq!(
         e.kind,
         K::DuplicateNode {
             tag: u64::from_le_bytes(tag)
         }
     );
-    assert_eq!(e.location, Location::Byte(second));
 }
 
 // ---- file structure ----
@@ -570,12 +509,11 @@ fn sections_out_of_order_or_missing() {
     let t = text(Q4_22);
     let (n0, n1) = (t.find("$Nodes").unwrap(), t.find("$Elements").unwrap());
     let swapped = format!("{}{}{}", &t[..n0], &t[n1..], &t[n0..n1]);
-    let e = err(&swapped);
+    let e = err_at_line(&swapped, "$Elements");
     assert!(
         matches!(&e.kind, K::SectionOrder { found, .. } if found == "$Elements"),
         "{e}"
     );
-    assert_eq!(e.location, Location::Line(line_no(&swapped, "$Elements")));
     let e = err(&t[..n1]);
     assert_eq!(
         e.kind,
@@ -618,16 +556,21 @@ fn file_errors_name_the_file_and_line() {
 
 // ---- ASCII records are whole lines ----
 
-/// The error and line of `t`, which must be a [`K::FieldCount`] with `found`
-/// numbers on the line equal to `line`.
-fn short_or_long(t: &str, line: &str, found: usize) -> String {
-    let e = err(t);
+/// The message of `e`, which must be a [`K::FieldCount`] with `found`
+/// numbers on the line.
+fn short_or_long(e: MeshError, found: usize) -> String {
     assert!(
         matches!(&e.kind, K::FieldCount { found: f, .. } if *f == found),
         "{e}"
     );
-    assert_eq!(e.location, Location::Line(line_no(t, line)), "{e}");
     e.to_string()
+}
+
+/// The error of `fixture` with its line `line` cut after its last blank:
+/// one number short, reported at the cut line.
+fn cut_last_number(fixture: &str, line: &str) -> MeshError {
+    let cut = line.trim_end().rsplit_once(' ').unwrap().0;
+    line_err(fixture, line.trim_end(), cut, None)
 }
 
 /// One number too few or too many on an element line is reported there,
@@ -636,45 +579,34 @@ fn short_or_long(t: &str, line: &str, found: usize) -> String {
 #[test]
 fn element_line_with_a_number_missing_or_extra() {
     // MSH 4.1: a quad4 line is its tag and 4 node tags.
-    let t = replace_line(&text(Q4_41), "14 1 5 13 12", "14 1 5 13");
-    let msg = short_or_long(&t, "14 1 5 13", 4);
+    let msg = short_or_long(line_err(Q4_41, "14 1 5 13 12", "14 1 5 13", None), 4);
     assert!(
         msg.contains("a quad4 element needs 5 numbers (its tag and 4 node tags), this line has 4")
             && msg.contains("re-export the mesh from Gmsh"),
         "{msg}"
     );
-    let t = replace_line(&text(Q4_41), "14 1 5 13 12", "14 1 5 13 12 7");
-    short_or_long(&t, "14 1 5 13 12 7", 6);
+    short_or_long(line_err(Q4_41, "14 1 5 13 12", "14 1 5 13 12 7", None), 6);
     // The last element before $EndElements.
     let t = text(Q4_41);
     let last = t.lines().nth(line_no(&t, "$EndElements") - 2).unwrap();
-    let cut = last.trim_end().rsplit_once(' ').unwrap().0;
-    let t = replace_line(&t, last.trim_end(), cut);
-    short_or_long(&t, cut, 4);
+    short_or_long(cut_last_number(Q4_41, last), 4);
     // MSH 2.2: number, type, number of tags, the tags, the node tags.
-    let t = replace_line(&text(Q4_22), "14 3 2 10 1 1 5 13 12", "14 3 2 10 1 1 5 13");
-    let msg = short_or_long(&t, "14 3 2 10 1 1 5 13", 8);
+    let q4 = "14 3 2 10 1 1 5 13 12";
+    let msg = short_or_long(line_err(Q4_22, q4, "14 3 2 10 1 1 5 13", None), 8);
     assert!(
         msg.contains("a quad4 element with 2 tags needs 9 numbers"),
         "{msg}"
     );
-    let t = replace_line(
-        &text(Q4_22),
-        "14 3 2 10 1 1 5 13 12",
-        "14 3 2 10 1 1 5 13 12 9",
-    );
-    short_or_long(&t, "14 3 2 10 1 1 5 13 12 9", 10);
-    let t = replace_line(&text(Q4_22), "14 3 2 10 1 1 5 13 12", "14 3");
-    short_or_long(&t, "14 3", 2);
+    short_or_long(line_err(Q4_22, q4, "14 3 2 10 1 1 5 13 12 9", None), 10);
+    short_or_long(line_err(Q4_22, q4, "14 3", None), 2);
     // quad9 (the review's q2short.msh): a node tag missing.
-    let t = text("slab_q9_v22_ascii.msh");
+    let q9 = "slab_q9_v22_ascii.msh";
+    let t = text(q9);
     let line = t
         .lines()
         .find(|l| l.split(' ').nth(1) == Some("10") && l.split_whitespace().count() == 14)
         .unwrap();
-    let cut = line.trim_end().rsplit_once(' ').unwrap().0;
-    let t = replace_line(&t, line.trim_end(), cut);
-    let msg = short_or_long(&t, cut, 13);
+    let msg = short_or_long(cut_last_number(q9, line), 13);
     assert!(
         msg.contains("a quad9 element with 2 tags needs 14 numbers"),
         "{msg}"
@@ -685,35 +617,23 @@ fn element_line_with_a_number_missing_or_extra() {
 #[test]
 fn node_and_header_lines_with_a_number_missing_or_extra() {
     // MSH 2.2: tag x y z.
-    let t = replace_line(
-        &text(Q4_22),
-        "5 1.999999999995288 0 0",
-        "5 1.999999999995288 0",
-    );
-    short_or_long(&t, "5 1.999999999995288 0", 3);
-    let t = replace_line(
-        &text(Q4_22),
-        "5 1.999999999995288 0 0",
-        "5 1.999999999995288 0 0 0",
-    );
-    short_or_long(&t, "5 1.999999999995288 0 0 0", 5);
+    let node = "5 1.999999999995288 0 0";
+    short_or_long(line_err(Q4_22, node, "5 1.999999999995288 0", None), 3);
+    short_or_long(line_err(Q4_22, node, "5 1.999999999995288 0 0 0", None), 5);
     // MSH 4.1: the tags one a line, then x y z one node a line.
-    let t = replace_line(&text(Q4_41), "1.999999999995288 0 0", "1.999999999995288 0");
-    short_or_long(&t, "1.999999999995288 0", 2);
+    let xyz = "1.999999999995288 0 0";
+    short_or_long(line_err(Q4_41, xyz, "1.999999999995288 0", None), 2);
     let t = text(Q4_41).replacen("\n5\n6\n7\n", "\n5 6\n6\n7\n", 1);
-    short_or_long(&t, "5 6", 2);
+    short_or_long(err_at_line(&t, "5 6"), 2);
     // An entity line (curve 1: bounding box, 1 physical tag, 2 points).
     let t = text(Q4_41);
     let line = t.lines().find(|l| l.starts_with("1 0 0 0 8 0 0 ")).unwrap();
     let long = format!("{} 5", line.trim_end());
-    let t = replace_line(&t, line.trim_end(), &long);
-    let msg = short_or_long(&t, &long, 13);
+    let msg = short_or_long(line_err(Q4_41, line.trim_end(), &long, None), 13);
     assert!(msg.contains("a curve entity needs"), "{msg}");
     // A block header and a section header.
-    let t = replace_line(&text(Q4_41), "0 1 15 1", "0 1 15");
-    short_or_long(&t, "0 1 15", 3);
-    let t = replace_line(&text(Q4_41), "6 21 1 21", "6 21 1 21 0");
-    short_or_long(&t, "6 21 1 21 0", 5);
+    short_or_long(line_err(Q4_41, "0 1 15 1", "0 1 15", None), 3);
+    short_or_long(line_err(Q4_41, "6 21 1 21", "6 21 1 21 0", None), 5);
 }
 
 /// ASCII files with CR LF line ends (written on Windows) are legitimate:
@@ -770,17 +690,15 @@ fn binary_with_crlf_line_ends() {
             }
             crlf.push(c);
         }
-        let e = err_bytes(&crlf);
+        let e = byte_err(&crlf, find(&crlf, b" 8\r\n") + 2);
         assert_eq!(e.kind, K::TextModeTransfer, "{name}: {e}");
-        assert_eq!(e.location, Location::Byte(find(&crlf, b" 8\r\n") + 2));
         assert!(e.to_string().contains("binary mode"), "{e}");
         // Only the byte-order integer shifted by a CR.
         let mut b = b.clone();
         let at = find(&b, b" 8\n") + 3;
         b.insert(at, b'\r');
-        let e = err_bytes(&b);
+        let e = byte_err(&b, at);
         assert_eq!(e.kind, K::TextModeTransfer, "{name}: {e}");
-        assert_eq!(e.location, Location::Byte(at));
     }
 }
 
