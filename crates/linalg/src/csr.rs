@@ -53,7 +53,7 @@ impl crate::simd::Kernel for Rows<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn run(self) {
+    fn run<S: crate::simd::Simd>(self, _simd: S) {
         for (k, yi) in self.y.iter_mut().enumerate() {
             *yi = row(self.a, self.c * CHUNK + k, self.x);
         }

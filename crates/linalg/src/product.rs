@@ -48,9 +48,15 @@ impl Product {
     /// covering chunk `c` (of [`crate::chunks::CHUNK`] rows), in order
     /// (call inside a [`crate::simd::Kernel`]).
     #[inline(always)]
-    pub fn batches(&self, c: usize, x: &[f64], to: &mut impl Batches) {
+    pub fn batches<S: crate::simd::Simd>(
+        &self,
+        simd: S,
+        c: usize,
+        x: &[f64],
+        to: &mut impl Batches,
+    ) {
         match self {
-            Product::Stencils(s) => s.batches(c, x, to),
+            Product::Stencils(s) => s.batches(simd, c, x, to),
             Product::Csr(k) => {
                 let end = ((c + 1) * CHUNK).min(k.nrows());
                 let mut buf = [0.0; BATCH];
@@ -72,6 +78,19 @@ impl Product {
         match self {
             Product::Stencils(s) => s.row(i, x),
             Product::Csr(k) => csr::row(k, i, x),
+        }
+    }
+
+    /// (K x)_i for each i of `rows` into `out`, with the bits the batches
+    /// give them.
+    pub fn rows(&self, rows: &[usize], x: &[f64], out: &mut [f64]) {
+        match self {
+            Product::Stencils(s) => s.rows(rows, x, out),
+            Product::Csr(k) => {
+                for (o, &i) in out.iter_mut().zip(rows) {
+                    *o = csr::row(k, i, x);
+                }
+            }
         }
     }
 

@@ -11,6 +11,12 @@
 //! the few types' blocks from cache. A product is then bound by the vectors,
 //! not by the matrix.
 //!
+//! Where the CPU's vectors hold w ≥ 4 doubles, w/2 consecutive node pairs
+//! (a *unit*, typed by its groups' types) are summed as one vector of w
+//! rows ([`Units`]): per block of the unit's types (the union of their
+//! offsets) a product with the diagonal terms and two with the other
+//! column's, each from a plain load of x shifted by one, so no shuffles.
+//!
 //! Each row is summed in its type's block order whatever batch or thread
 //! computes it: the same bits on any number of threads. Not the bits of the
 //! assembled K's product: within [`TOLERANCE`] · max |K_ij| · Σ_j |x_j| of
@@ -58,7 +64,29 @@ pub struct Stencils {
     values: Vec<[f64; 4]>,
     /// Groups of chunk c: chunk_groups[c]..chunk_groups[c + 1].
     chunk_groups: Vec<u32>,
+    /// The units for this CPU's vectors, if they are wide enough.
+    units: Option<Units>,
 }
+
+/// Units of w/2 alike-typed consecutive node pairs, summed w rows a vector.
+#[derive(Clone, Debug)]
+struct Units {
+    /// Doubles per vector (and rows per unit).
+    width: usize,
+    /// Unit of the w/2 groups from group g, or [`NO_UNIT`].
+    of_group: Vec<u32>,
+    /// Blocks of unit u: blocks[u]..blocks[u + 1].
+    blocks: Vec<u32>,
+    /// Each unit block's column offset from each row's own column.
+    offsets: Vec<i32>,
+    /// Per unit block, two vectors of w lanes: the diagonal terms (on x
+    /// at the offset) and the other column's (on x with its pairs of lanes
+    /// swapped); zero where a lane's group has no such block.
+    lanes: Vec<f64>,
+}
+
+/// No unit starts at this group.
+const NO_UNIT: u32 = u32::MAX;
 
 impl Stencils {
     /// The stencil types of a square CSR matrix with sorted columns at
@@ -133,14 +161,93 @@ impl Stencils {
         }
         let chunk_groups = chunk_groups(&group_rows, n);
         types.shrink_to_fit();
-        Some(Stencils {
+        let mut k = Stencils {
             group_rows,
             types,
             type_blocks,
             offsets,
             values,
             chunk_groups,
-        })
+            units: None,
+        };
+        let width = crate::simd::lanes();
+        if width >= 4 && width.is_multiple_of(2) {
+            k.units = Some(k.units(width));
+        }
+        Some(k)
+    }
+
+    /// The units of `width` rows: one from every group that starts w/2
+    /// consecutive node pairs whose every load stays inside x.
+    fn units(&self, width: usize) -> Units {
+        let (n, h) = (self.n(), width / 2);
+        let groups = self.types.len();
+        let mut index: HashMap<&[u32], u32> = HashMap::new();
+        let mut u = Units {
+            width,
+            of_group: vec![NO_UNIT; groups],
+            blocks: vec![0],
+            offsets: Vec::new(),
+            lanes: Vec::new(),
+        };
+        for g in 0..groups.saturating_sub(h - 1) {
+            let r = self.group_rows[g] as usize;
+            if !(1..=h).all(|q| self.group_rows[g + q] as usize == r + 2 * q) {
+                continue;
+            }
+            let key = &self.types[g..g + h];
+            let id = match index.get(key) {
+                Some(&id) => id,
+                None => {
+                    let id = u.blocks.len() as u32 - 1;
+                    self.add_unit(key, &mut u);
+                    index.insert(key, id);
+                    id
+                }
+            };
+            let b = u.blocks[id as usize] as usize..u.blocks[id as usize + 1] as usize;
+            let lo = u.offsets[b.clone()].iter().min().map_or(0, |&o| o as isize);
+            let hi = u.offsets[b].iter().max().map_or(0, |&o| o as isize);
+            if r as isize + lo >= 0 && r as isize + hi + width as isize <= n as isize {
+                u.of_group[g] = id;
+            }
+        }
+        u
+    }
+
+    /// Appends the unit of consecutive groups of types `key` to `u`: the
+    /// union of their block offsets, ascending (each type's own order), and
+    /// per offset the lanes of [`Units::lanes`].
+    fn add_unit(&self, key: &[u32], u: &mut Units) {
+        let w = u.width;
+        let mut offsets: Vec<i32> = key
+            .iter()
+            .flat_map(|&t| self.offsets[self.blocks(t)].iter().copied())
+            .collect();
+        offsets.sort_unstable();
+        offsets.dedup();
+        for &o in &offsets {
+            let mut lanes = vec![0.0; 2 * w];
+            for (q, &t) in key.iter().enumerate() {
+                let b = self.blocks(t);
+                if let Some(k) = self.offsets[b.clone()].iter().position(|&p| p == o) {
+                    let v = self.values[b.start + k];
+                    // Rows 2q (first) and 2q + 1 (second) of the unit.
+                    lanes[2 * q] = v[0];
+                    lanes[2 * q + 1] = v[3];
+                    lanes[w + 2 * q] = v[2];
+                    lanes[w + 2 * q + 1] = v[1];
+                }
+            }
+            u.offsets.push(o);
+            u.lanes.extend(lanes);
+        }
+        u.blocks.push(u.offsets.len() as u32);
+    }
+
+    /// Blocks of type t.
+    fn blocks(&self, t: u32) -> std::ops::Range<usize> {
+        self.type_blocks[t as usize] as usize..self.type_blocks[t as usize + 1] as usize
     }
 
     /// Rows.
@@ -168,10 +275,11 @@ impl Stencils {
     /// block's values are loaded once for all. Each row is summed in two
     /// partial sums, its own column's terms (the block's first column for
     /// a group's first row, the second for its second) and the other
-    /// column's, added at the end: the same terms in the same order
-    /// whatever Q, so the same bits, and 4Q independent chains of
-    /// additions. Four consecutive groups read one contiguous run of x
-    /// per block, which the compiler keeps in vector registers.
+    /// column's, added at the end, each term fused into its sum (one
+    /// rounding, as the units' vectors add them): the same terms in the
+    /// same order whatever Q, so the same bits, and 4Q independent chains.
+    /// Four consecutive groups read one contiguous run of x per block,
+    /// which the compiler keeps in vector registers.
     #[inline(always)]
     fn lockstep<const Q: usize>(&self, t: u32, rows: [usize; Q], x: &[f64]) -> [[f64; 2]; Q] {
         let b = self.type_blocks[t as usize] as usize..self.type_blocks[t as usize + 1] as usize;
@@ -180,10 +288,10 @@ impl Stencils {
             for q in 0..Q {
                 let c = (rows[q] as isize + o as isize) as usize;
                 let xs = &x[c..c + 2];
-                own[q][0] += v[0] * xs[0];
-                own[q][1] += v[3] * xs[1];
-                other[q][0] += v[2] * xs[1];
-                other[q][1] += v[1] * xs[0];
+                own[q][0] = v[0].mul_add(xs[0], own[q][0]);
+                own[q][1] = v[3].mul_add(xs[1], own[q][1]);
+                other[q][0] = v[2].mul_add(xs[1], other[q][0]);
+                other[q][1] = v[1].mul_add(xs[0], other[q][1]);
             }
         }
         std::array::from_fn(|q| [own[q][0] + other[q][0], own[q][1] + other[q][1]])
@@ -194,12 +302,31 @@ impl Stencils {
     /// Q1 node row), or two pairs of alike pairs alternating (a Q2 node
     /// row, corner and mid-side nodes in turn), else a group at a time.
     #[inline(always)]
-    fn groups_into(&self, g0: usize, g1: usize, x: &[f64], out: &mut [f64]) {
+    fn groups_into<S: crate::simd::Simd>(
+        &self,
+        simd: S,
+        g0: usize,
+        g1: usize,
+        x: &[f64],
+        out: &mut [f64],
+    ) {
         let base = self.group_rows[g0] as usize;
         let rows = |g: usize| self.group_rows[g] as usize;
+        let units = self.units.as_ref().filter(|u| u.width == S::F64_LANES);
         let mut g = g0;
         while g < g1 {
             let r = rows(g);
+            if let Some(u) = units {
+                let (w, h) = (u.width, u.width / 2);
+                let id = if g + h <= g1 { u.of_group[g] } else { NO_UNIT };
+                if id != NO_UNIT {
+                    let o = r - base;
+                    let sums = unit_sums(simd, u, id, r, x);
+                    crate::simd::store::<S>(&mut out[o..o + w], sums);
+                    g += h;
+                    continue;
+                }
+            }
             let pairs = g + 4 <= g1 && (1..=4).all(|q| rows(g + q) == r + 2 * q);
             let t = &self.types;
             if pairs && t[g] == t[g + 1] && t[g] == t[g + 2] && t[g] == t[g + 3] {
@@ -247,7 +374,13 @@ impl Stencils {
     /// covering chunk `c`, in order (call inside a
     /// [`crate::simd::Kernel`]).
     #[inline(always)]
-    pub fn batches(&self, c: usize, x: &[f64], to: &mut impl Batches) {
+    pub fn batches<S: crate::simd::Simd>(
+        &self,
+        simd: S,
+        c: usize,
+        x: &[f64],
+        to: &mut impl Batches,
+    ) {
         let (g0, g1) = (
             self.chunk_groups[c] as usize,
             self.chunk_groups[c + 1] as usize,
@@ -258,7 +391,7 @@ impl Stencils {
             let gb = (g + BATCH / 2).min(g1);
             let (ra, rb) = (self.group_rows[g] as usize, self.group_rows[gb] as usize);
             let out = &mut buf[..rb - ra];
-            self.groups_into(g, gb, x, out);
+            self.groups_into(simd, g, gb, x, out);
             to.batch(ra, out);
             g = gb;
         }
@@ -266,8 +399,41 @@ impl Stencils {
 
     /// (K x)_i, with the bits the batches give it.
     pub fn row(&self, i: usize, x: &[f64]) -> f64 {
-        let g = self.group_rows.partition_point(|&r| r as usize <= i) - 1;
-        self.group_sums(g, x)[i - self.group_rows[g] as usize]
+        let mut out = [0.0];
+        self.rows(&[i], x, &mut out);
+        out[0]
+    }
+
+    /// (K x)_i for each i of `rows` into `out`, with the bits the batches
+    /// give them; a node's two rows from one sum of its group.
+    pub fn rows(&self, rows: &[usize], x: &[f64], out: &mut [f64]) {
+        // Dispatched, so that the fused terms are the CPU's instruction.
+        struct Rows<'a>(&'a Stencils, &'a [usize], &'a [f64], &'a mut [f64]);
+        impl Kernel for Rows<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<S: crate::simd::Simd>(self, _simd: S) {
+                let Rows(k, rows, x, out) = self;
+                let mut last: Option<(usize, [f64; 2])> = None;
+                for (o, &i) in out.iter_mut().zip(rows) {
+                    let g = match last {
+                        Some((g, _))
+                            if k.group_rows[g] as usize <= i
+                                && i < k.group_rows[g + 1] as usize =>
+                        {
+                            g
+                        }
+                        _ => {
+                            let g = k.group_rows.partition_point(|&r| r as usize <= i) - 1;
+                            last = Some((g, k.group_sums(g, x)));
+                            g
+                        }
+                    };
+                    *o = last.expect("set above").1[i - k.group_rows[g] as usize];
+                }
+            }
+        }
+        crate::simd::vectorized(Rows(self, rows, x, out));
     }
 }
 
@@ -283,10 +449,32 @@ impl Kernel for Groups<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn run(self) {
+    fn run<S: crate::simd::Simd>(self, simd: S) {
         self.k
-            .groups_into(self.g.start, self.g.end, self.x, self.out);
+            .groups_into(simd, self.g.start, self.g.end, self.x, self.out);
     }
+}
+
+/// The sums of the w rows of unit `id` from row r: per row its own
+/// column's terms and the other column's in two fused sums, in the unit's
+/// block order, added at the end, as [`Stencils::lockstep`] sums them (a
+/// lane's zero terms add ±0 to a sum that started at +0, which changes no
+/// bit). The other column's x is the own column's with each pair of lanes
+/// swapped.
+#[inline(always)]
+fn unit_sums<S: crate::simd::Simd>(simd: S, u: &Units, id: u32, r: usize, x: &[f64]) -> S::f64s {
+    let w = S::F64_LANES;
+    let b = u.blocks[id as usize] as usize..u.blocks[id as usize + 1] as usize;
+    let load = crate::simd::load::<S>;
+    let (mut own, mut other) = (simd.splat_f64s(0.0), simd.splat_f64s(0.0));
+    let lanes = u.lanes[2 * w * b.start..2 * w * b.end].chunks_exact(2 * w);
+    for (&o, l) in u.offsets[b].iter().zip(lanes) {
+        let c = (r as isize + o as isize) as usize;
+        let xc = load(&x[c..c + w]);
+        own = simd.mul_add_f64s(load(&l[..w]), xc, own);
+        other = simd.mul_add_f64s(load(&l[w..]), crate::simd::swap_pairs(simd, xc), other);
+    }
+    simd.add_f64s(own, other)
 }
 
 /// Groups K's rows by node: two consecutive rows with the same columns (a

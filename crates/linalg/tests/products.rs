@@ -160,7 +160,8 @@ fn product_within_the_tolerance_of_the_assembled_one() {
     }
 }
 
-/// Batches, single rows, one thread and two: the same bits.
+/// Batches (here by the scalar path), single rows, one thread and two (by
+/// the CPU's vectors): the same bits.
 #[test]
 fn rows_have_the_same_bits_every_way() {
     let a = grid(200, 60, 1e-13, true);
@@ -178,7 +179,7 @@ fn rows_have_the_same_bits_every_way() {
     let (one, two) = (on(1), on(2));
     let mut batched = vec![f64::NAN; n];
     for c in 0..chunks(n) {
-        s.batches(c, &x, &mut |r0: usize, ku: &[f64]| {
+        s.batches(pulp::Scalar::new(), c, &x, &mut |r0: usize, ku: &[f64]| {
             batched[r0..r0 + ku.len()].copy_from_slice(ku)
         });
     }
@@ -194,4 +195,40 @@ fn rows_have_the_same_bits_every_way() {
 #[test]
 fn declines_what_has_no_structure() {
     assert!(Stencils::new(&grid(100, 20, 1e-6, false)).is_none());
+}
+
+/// On the structured Q1 and Q2 slabs (Q2's corner and mid-side node rows
+/// alternate stencils), the product by the CPU's vectors (units of node
+/// pairs where it has AVX or AVX-512) has the bits of the scalar path, on
+/// every row, chunk seams and boundary rows included.
+#[test]
+fn vectors_have_the_scalar_bits_on_the_slabs() {
+    use stickslip_testkit::{structured_slab, Slab};
+    use stickslip_time::History;
+    for (nx, ny, q2) in [(128, 32, false), (64, 16, true), (96, 24, true)] {
+        let slab = Slab::paper(structured_slab(nx, ny, q2), 1e-4, History::Step, true).unwrap();
+        let k = &slab.model.stiffness;
+        let s = Stencils::new(k).expect("a structured slab has stencil types");
+        let n = k.nrows();
+        let x = spread(n);
+        let mut vectors = vec![0.0; n];
+        s.spmv(&x, &mut vectors);
+        let mut scalar = vec![f64::NAN; n];
+        for c in 0..chunks(n) {
+            s.batches(pulp::Scalar::new(), c, &x, &mut |r0: usize, ku: &[f64]| {
+                scalar[r0..r0 + ku.len()].copy_from_slice(ku)
+            });
+        }
+        let all: Vec<usize> = (0..n).collect();
+        let mut rows = vec![0.0; n];
+        s.rows(&all, &x, &mut rows);
+        for i in 0..n {
+            assert_eq!(
+                vectors[i].to_bits(),
+                scalar[i].to_bits(),
+                "q2 {q2}, row {i}"
+            );
+            assert_eq!(vectors[i].to_bits(), rows[i].to_bits(), "q2 {q2}, row {i}");
+        }
+    }
 }

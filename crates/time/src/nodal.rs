@@ -27,9 +27,7 @@ impl NodalFriction {
     /// batches give them: `b`'s k-th call in [`NodalClosedForm::velocities`]
     /// is for `self.products()[k]`. [`NodalFriction::prepare`] first.
     pub(crate) fn form_products(&mut self, k: &Product, x: &[f64]) {
-        for (o, &i) in self.ku.iter_mut().zip(self.closed_form.dofs()) {
-            *o = k.row(i, x);
-        }
+        k.rows(self.closed_form.dofs(), x, &mut self.ku);
     }
 
     /// What [`NodalFriction::form_products`] formed.

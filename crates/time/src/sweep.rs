@@ -11,8 +11,9 @@
 //! `stickslip_linalg::chunks`: the same bits on any number of threads.
 
 use stickslip_linalg::chunks::{each_chunk, each_chunk_pair, CHUNK};
-use stickslip_linalg::simd::{vectorized, Batches, Kernel};
+use stickslip_linalg::simd::{load, store, vectorized, Batches, Kernel, Simd};
 use stickslip_linalg::Product;
+use stickslip_linalg::BATCH;
 
 /// The loads on the rows where the constant load or any load vector is
 /// nonzero (bit for bit: a −0 counts): tractions act on a boundary, so a
@@ -136,39 +137,20 @@ pub(crate) struct Sums {
     pub finite: bool,
 }
 
-/// A sum over rows in four lanes, row i in lane i mod 4, added
-/// (l0 + l1) + (l2 + l3) at the end: four chains of additions instead of
-/// one, in an order fixed by the rows whatever batch or thread adds them.
-#[derive(Clone, Copy, Default)]
-struct Lanes([f64; 4]);
+/// Rows per block of the sweep's sums: row i adds to lane i mod 8, and
+/// the lanes are added in a fixed tree at the end, so the sums have the
+/// same bits whatever the CPU's vector width, batch or thread.
+const LANES: usize = 8;
+
+/// A sum over rows in [`LANES`] lanes.
+#[derive(Clone, Copy)]
+struct Lanes([f64; LANES]);
 
 impl Lanes {
-    /// Adds term(a[k], b[k]) for rows i0 + k.
-    #[inline(always)]
-    fn add_pairs(&mut self, i0: usize, a: &[f64], b: &[f64], term: impl Fn(f64, f64) -> f64) {
-        let n = a.len().min(b.len());
-        let (a, b) = (&a[..n], &b[..n]);
-        let mut lanes = self.0;
-        let head = ((4 - i0 % 4) % 4).min(n);
-        for k in 0..head {
-            lanes[(i0 + k) % 4] += term(a[k], b[k]);
-        }
-        let (mut a4, mut b4) = (a[head..].chunks_exact(4), b[head..].chunks_exact(4));
-        for (x, y) in (&mut a4).zip(&mut b4) {
-            for l in 0..4 {
-                lanes[l] += term(x[l], y[l]);
-            }
-        }
-        // Past the whole quads row i0 + k sits in lane k.
-        for (l, (x, y)) in a4.remainder().iter().zip(b4.remainder()).enumerate() {
-            lanes[l] += term(*x, *y);
-        }
-        self.0 = lanes;
-    }
-
     #[inline(always)]
     fn total(self) -> f64 {
-        (self.0[0] + self.0[1]) + (self.0[2] + self.0[3])
+        let l = self.0;
+        ((l[0] + l[1]) + (l[2] + l[3])) + ((l[4] + l[5]) + (l[6] + l[7]))
     }
 }
 
@@ -200,9 +182,6 @@ pub(crate) fn sweep(
                 start,
                 vn,
                 an,
-                strain: Lanes::default(),
-                kinetic: Lanes::default(),
-                finite: true,
             },
         });
     });
@@ -225,18 +204,23 @@ impl Kernel for Chunk<'_, '_> {
     type Output = [f64; 3];
 
     #[inline(always)]
-    fn run(mut self) -> [f64; 3] {
-        self.k.batches(self.c, self.x, &mut self.rows);
-        let r = self.rows;
-        [
-            r.kinetic.total(),
-            if r.finite { 0.0 } else { 1.0 },
-            r.strain.total(),
-        ]
+    fn run<S: Simd>(self, simd: S) -> [f64; 3] {
+        let mut rows = Aligned {
+            simd,
+            rows: self.rows,
+            pending: [0.0; BATCH + LANES],
+            held: 0,
+            strain: [simd.splat_f64s(0.0); LANES],
+            kinetic: [simd.splat_f64s(0.0); LANES],
+            finite: simd.splat_f64s(0.0),
+        };
+        self.k.batches(simd, self.c, self.x, &mut rows);
+        rows.finish()
     }
 }
 
-/// The per-row work of a chunk of the sweep and its running sums.
+/// The per-row work of a chunk of the sweep: its rows, and where its
+/// sums go.
 struct ChunkRows<'a, 'b> {
     s: &'a StepData<'a>,
     friction: &'a [(usize, f64)],
@@ -245,37 +229,151 @@ struct ChunkRows<'a, 'b> {
     start: usize,
     vn: &'b mut [f64],
     an: &'b mut [f64],
-    strain: Lanes,
-    kinetic: Lanes,
-    finite: bool,
 }
 
-impl Batches for ChunkRows<'_, '_> {
+/// [`ChunkRows`] fed in blocks of [`LANES`] rows aligned to the chunk's
+/// start (a multiple of [`LANES`]): K r_K of the rows of an unfinished
+/// block is held until the next batch completes it. The sums' lanes sit in
+/// `LANES / W` vectors of W doubles.
+struct Aligned<'a, 'b, S: Simd> {
+    simd: S,
+    rows: ChunkRows<'a, 'b>,
+    /// K r_K from row `start + done` on, `held` of it.
+    pending: [f64; BATCH + LANES],
+    held: usize,
+    strain: [S::f64s; LANES],
+    kinetic: [S::f64s; LANES],
+    /// Σ 0·r_K + 0·ṙ_K: ±0 while every entry is finite, else NaN.
+    finite: S::f64s,
+}
+
+impl<S: Simd> Aligned<'_, '_, S> {
+    /// Rows `r0..r0 + ku.len()` (a whole number of vectors of W rows, from
+    /// a multiple of [`LANES`]): ṙ_K, r̈_K and the sums.
+    #[inline(always)]
+    fn rows(&mut self, r0: usize, ku: &[f64]) {
+        let (simd, w) = (self.simd, S::F64_LANES);
+        let rows = &mut self.rows;
+        let s = rows.s;
+        let n = ku.len();
+        let range = r0..r0 + n;
+        let local = r0 - rows.start..r0 - rows.start + n;
+        let (ld, m, rn) = (
+            &s.load_new[range.clone()],
+            &s.mass[range.clone()],
+            &s.r_new[range.clone()],
+        );
+        let (v, a) = (&s.v[range.clone()], &s.a[range.clone()]);
+        let (vn, an) = (&mut rows.vn[local.clone()], &mut rows.an[local]);
+        let splat = |x: f64| simd.splat_f64s(x);
+        let (cv, ca, scale, ratio) = (splat(s.cv), splat(s.ca), splat(s.scale), splat(s.ratio));
+        for j in (0..n).step_by(w) {
+            let at = j..j + w;
+            let (mj, vj, aj) = (
+                load::<S>(&m[at.clone()]),
+                load::<S>(&v[at.clone()]),
+                load::<S>(&a[at.clone()]),
+            );
+            // R̂_K as StepData::rhs forms it, then ṙ_K = R̂_K/(m·scale).
+            let rhs = simd.add_f64s(
+                simd.sub_f64s(load::<S>(&ld[at.clone()]), load::<S>(&ku[at.clone()])),
+                simd.mul_f64s(
+                    mj,
+                    simd.add_f64s(simd.mul_f64s(cv, vj), simd.mul_f64s(ca, aj)),
+                ),
+            );
+            store::<S>(&mut vn[at], simd.div_f64s(rhs, simd.mul_f64s(mj, scale)));
+        }
+        while rows.next < rows.friction.len() && rows.friction[rows.next].0 < range.end {
+            let (i, vi) = rows.friction[rows.next];
+            vn[i - r0] = vi;
+            rows.next += 1;
+        }
+        let zero = splat(0.0);
+        for j in (0..n).step_by(w) {
+            let at = j..j + w;
+            let (vj, aj) = (load::<S>(&v[at.clone()]), load::<S>(&a[at.clone()]));
+            let (vnj, rnj) = (load::<S>(&vn[at.clone()]), load::<S>(&rn[at.clone()]));
+            let anj = simd.sub_f64s(
+                simd.mul_f64s(simd.sub_f64s(vnj, vj), scale),
+                simd.mul_f64s(ratio, aj),
+            );
+            store::<S>(&mut an[at.clone()], anj);
+            self.finite = simd.add_f64s(
+                self.finite,
+                simd.add_f64s(simd.mul_f64s(rnj, zero), simd.mul_f64s(vnj, zero)),
+            );
+            let lane = (j % LANES) / w;
+            self.strain[lane] = simd.add_f64s(
+                self.strain[lane],
+                simd.mul_f64s(rnj, load::<S>(&ku[at.clone()])),
+            );
+            let mv = simd.mul_f64s(load::<S>(&m[at]), vnj);
+            self.kinetic[lane] = simd.add_f64s(self.kinetic[lane], simd.mul_f64s(mv, vnj));
+        }
+    }
+
+    /// The chunk's sums once every batch came: the held rows (fewer than
+    /// a block, at the chunk's end) one row a time in their lanes, then
+    /// [kinetic, not finite, strain].
+    #[inline(always)]
+    fn finish(mut self) -> [f64; 3] {
+        let w = S::F64_LANES;
+        let lanes = |v: &[S::f64s; LANES]| -> Lanes {
+            let mut l = [0.0; LANES];
+            for (k, v) in v.iter().take(LANES / w).enumerate() {
+                store::<S>(&mut l[k * w..(k + 1) * w], *v);
+            }
+            Lanes(l)
+        };
+        let (mut strain, mut kinetic) = (lanes(&self.strain), lanes(&self.kinetic));
+        let mut finite = self.simd.reduce_sum_f64s(self.finite) == 0.0;
+        let held = self.held;
+        if held > 0 {
+            let rows = &mut self.rows;
+            let s = rows.s;
+            let r0 = rows.start + rows.vn.len() - held;
+            for k in 0..held {
+                let (i, j) = (r0 + k, rows.vn.len() - held + k);
+                let ku = self.pending[k];
+                let mut vi = s.rhs(i, ku) / (s.mass[i] * s.scale);
+                if rows.next < rows.friction.len() && rows.friction[rows.next].0 == i {
+                    vi = rows.friction[rows.next].1;
+                    rows.next += 1;
+                }
+                rows.vn[j] = vi;
+                rows.an[j] = (vi - s.v[i]) * s.scale - s.ratio * s.a[i];
+                finite &= s.r_new[i].is_finite() && vi.is_finite();
+                strain.0[k] += s.r_new[i] * ku;
+                kinetic.0[k] += s.mass[i] * vi * vi;
+            }
+        }
+        [
+            kinetic.total(),
+            if finite { 0.0 } else { 1.0 },
+            strain.total(),
+        ]
+    }
+}
+
+impl<S: Simd> Batches for Aligned<'_, '_, S> {
     #[inline(always)]
     fn batch(&mut self, r0: usize, ku: &[f64]) {
-        let s = self.s;
-        let n = ku.len();
-        let rows = r0..r0 + n;
-        let (m, rn) = (&s.mass[rows.clone()], &s.r_new[rows.clone()]);
-        let (v, a) = (&s.v[rows.clone()], &s.a[rows.clone()]);
-        let vn = &mut self.vn[r0 - self.start..r0 - self.start + n];
-        let an = &mut self.an[r0 - self.start..r0 - self.start + n];
-        for j in 0..n {
-            vn[j] = s.rhs(r0 + j, ku[j]) / (m[j] * s.scale);
+        let first = r0 - self.held;
+        debug_assert_eq!((first - self.rows.start) % LANES, 0);
+        let total = self.held + ku.len();
+        let blocks = total / LANES * LANES;
+        if self.held == 0 {
+            // Aligned already: no copy.
+            self.rows(first, &ku[..blocks]);
+            let rest = &ku[blocks..];
+            self.pending[..rest.len()].copy_from_slice(rest);
+        } else {
+            self.pending[self.held..total].copy_from_slice(ku);
+            let pending = self.pending;
+            self.rows(first, &pending[..blocks]);
+            self.pending.copy_within(blocks..total, 0);
         }
-        while self.next < self.friction.len() && self.friction[self.next].0 < rows.end {
-            let (i, vi) = self.friction[self.next];
-            vn[i - r0] = vi;
-            self.next += 1;
-        }
-        let mut finite = self.finite;
-        for j in 0..n {
-            an[j] = (vn[j] - v[j]) * s.scale - s.ratio * a[j];
-            // `&`, not `&&`: no branch, so the loop stays vectorized.
-            finite &= rn[j].is_finite() & vn[j].is_finite();
-        }
-        self.finite = finite;
-        self.strain.add_pairs(r0, rn, ku, |r, u| r * u);
-        self.kinetic.add_pairs(r0, m, vn, |m, v| m * v * v);
+        self.held = total - blocks;
     }
 }
