@@ -83,34 +83,51 @@ pub fn each_chunk_summed<const S: usize>(
     add_in_order(partials)
 }
 
-/// Runs `body(c, y chunk, z chunk, sums)` over the same chunks of two
-/// vectors, each chunk with its own `S` partial sums, and returns them
-/// added in chunk order.
-pub fn each_chunk_pair<const S: usize>(
-    y: &mut [f64],
-    z: &mut [f64],
+/// Runs `body(c, chunks, sums)` over the same chunks of V vectors of one
+/// length, each chunk with its own `S` partial sums, and returns them
+/// added in chunk order. Allocates nothing: the chunks are split off by
+/// halves (on the pool, by `rayon::join`).
+pub fn each_chunk_of<const V: usize, const S: usize>(
+    vectors: [&mut [f64]; V],
     partials: &mut [[f64; S]],
-    body: impl Fn(usize, &mut [f64], &mut [f64], &mut [f64; S]) + Sync,
+    body: impl Fn(usize, [&mut [f64]; V], &mut [f64; S]) + Sync,
 ) -> [f64; S] {
-    let n = y.len();
+    let n = vectors.first().map_or(0, |v| v.len());
+    debug_assert!(vectors.iter().all(|v| v.len() == n));
     let partials = &mut partials[..chunks(n)];
-    if parallel(n) {
-        y.par_chunks_mut(CHUNK)
-            .zip(z.par_chunks_mut(CHUNK))
-            .zip(partials.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, ((y, z), p))| body(c, y, z, p));
-    } else {
-        for (c, ((y, z), p)) in y
-            .chunks_mut(CHUNK)
-            .zip(z.chunks_mut(CHUNK))
-            .zip(partials.iter_mut())
-            .enumerate()
-        {
-            body(c, y, z, p);
-        }
-    }
+    halves(0, vectors, partials, parallel(n), &body);
     add_in_order(partials)
+}
+
+/// [`each_chunk_of`] on chunks c0.. of `vectors`, one per entry of
+/// `partials`.
+fn halves<const V: usize, const S: usize>(
+    c0: usize,
+    vectors: [&mut [f64]; V],
+    partials: &mut [[f64; S]],
+    pool: bool,
+    body: &(impl Fn(usize, [&mut [f64]; V], &mut [f64; S]) + Sync),
+) {
+    if let [p] = partials {
+        return body(c0, vectors, p);
+    }
+    let mid = partials.len() / 2;
+    let mut pairs = vectors.map(|v| {
+        let (a, b) = v.split_at_mut((mid * CHUNK).min(v.len()));
+        (Some(a), Some(b))
+    });
+    let left = std::array::from_fn(|i| pairs[i].0.take().expect("split above"));
+    let right = std::array::from_fn(|i| pairs[i].1.take().expect("split above"));
+    let (pl, pr) = partials.split_at_mut(mid);
+    if pool {
+        rayon::join(
+            || halves(c0, left, pl, pool, body),
+            || halves(c0 + mid, right, pr, pool, body),
+        );
+    } else {
+        halves(c0, left, pl, pool, body);
+        halves(c0 + mid, right, pr, pool, body);
+    }
 }
 
 /// The chunks' partial sums added in chunk order.

@@ -15,23 +15,43 @@ pub enum Product {
     /// Stencil types ([`Stencils`]): within 1e-10 · max |K_ij| · Σ|x_j| of
     /// the assembled product, not its bits.
     Stencils(Stencils),
+    /// Every node row its own stencil ([`Stencils::node_blocks`]): 2×2 blocks
+    /// with 32-bit offsets, summed as the types are.
+    Blocks(Stencils),
     /// The assembled matrix.
     Csr(CsrMatrix<f64>),
 }
 
 impl Product {
-    /// The fastest form `k` allows (stencil types, else the CSR itself).
+    /// The fastest form `k` allows: stencil types, else node blocks, else
+    /// the CSR itself.
     pub fn new(k: CsrMatrix<f64>) -> Product {
-        match Stencils::new(&k) {
+        Product::with_types(Stencils::new(&k), k)
+    }
+
+    /// As [`Product::new`], with `k`'s stencil types formed already.
+    pub fn with_types(types: Option<Stencils>, k: CsrMatrix<f64>) -> Product {
+        match types {
             Some(s) => Product::Stencils(s),
-            None => Product::Csr(k),
+            None => match Stencils::node_blocks(&k) {
+                Some(b) => Product::Blocks(b),
+                None => Product::Csr(k),
+            },
+        }
+    }
+
+    /// The stencil types, if the product is by them.
+    pub fn types(&self) -> Option<&Stencils> {
+        match self {
+            Product::Stencils(s) => Some(s),
+            _ => None,
         }
     }
 
     /// Rows.
     pub fn n(&self) -> usize {
         match self {
-            Product::Stencils(s) => s.n(),
+            Product::Stencils(s) | Product::Blocks(s) => s.n(),
             Product::Csr(k) => k.nrows(),
         }
     }
@@ -39,7 +59,7 @@ impl Product {
     /// y = K x.
     pub fn spmv(&self, x: &[f64], y: &mut [f64]) {
         match self {
-            Product::Stencils(s) => s.spmv(x, y),
+            Product::Stencils(s) | Product::Blocks(s) => s.spmv(x, y),
             Product::Csr(k) => csr::spmv(k, x, y),
         }
     }
@@ -56,7 +76,7 @@ impl Product {
         to: &mut impl Batches,
     ) {
         match self {
-            Product::Stencils(s) => s.batches(simd, c, x, to),
+            Product::Stencils(s) | Product::Blocks(s) => s.batches(simd, c, x, to),
             Product::Csr(k) => {
                 let end = ((c + 1) * CHUNK).min(k.nrows());
                 let mut buf = [0.0; BATCH];
@@ -76,7 +96,7 @@ impl Product {
     /// (K x)_i, with the bits the batches give it.
     pub fn row(&self, i: usize, x: &[f64]) -> f64 {
         match self {
-            Product::Stencils(s) => s.row(i, x),
+            Product::Stencils(s) | Product::Blocks(s) => s.row(i, x),
             Product::Csr(k) => csr::row(k, i, x),
         }
     }
@@ -85,7 +105,7 @@ impl Product {
     /// give them.
     pub fn rows(&self, rows: &[usize], x: &[f64], out: &mut [f64]) {
         match self {
-            Product::Stencils(s) => s.rows(rows, x, out),
+            Product::Stencils(s) | Product::Blocks(s) => s.rows(rows, x, out),
             Product::Csr(k) => {
                 for (o, &i) in out.iter_mut().zip(rows) {
                     *o = csr::row(k, i, x);
@@ -97,15 +117,17 @@ impl Product {
     /// Bytes one product streams from the operator's data.
     pub fn bytes(&self) -> usize {
         match self {
-            Product::Stencils(s) => s.bytes(),
+            Product::Stencils(s) | Product::Blocks(s) => s.bytes(),
             Product::Csr(k) => 16 * k.nnz() + 8 * (k.nrows() + 1),
         }
     }
 
-    /// "stencil types" or "assembled CSR", for messages and the results.
+    /// "stencil types", "node blocks" or "assembled CSR", for messages and
+    /// the results.
     pub fn name(&self) -> &'static str {
         match self {
             Product::Stencils(_) => "stencil types",
+            Product::Blocks(_) => "node blocks",
             Product::Csr(_) => "assembled CSR",
         }
     }

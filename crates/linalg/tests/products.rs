@@ -232,3 +232,36 @@ fn vectors_have_the_scalar_bits_on_the_slabs() {
         }
     }
 }
+
+/// Where types do not pay, node blocks (every node row its own stencil)
+/// give the assembled product to rounding, with the same bits by rows, by
+/// the scalar batches and by the CPU's vectors.
+#[test]
+fn node_blocks_are_the_assembled_product() {
+    let a = grid(100, 20, 1e-6, false);
+    let b = Stencils::node_blocks(&a).expect("square");
+    let n = a.nrows();
+    let x = spread(n);
+    let want = plain_spmv(&a, &x);
+    let mut y = vec![0.0; n];
+    b.spmv(&x, &mut y);
+    let mut scalar = vec![f64::NAN; n];
+    for c in 0..chunks(n) {
+        b.batches(pulp::Scalar::new(), c, &x, &mut |r0: usize, ku: &[f64]| {
+            scalar[r0..r0 + ku.len()].copy_from_slice(ku)
+        });
+    }
+    for (i, r) in a.row_iter().enumerate() {
+        // Sums of the same products in another order: a few roundings of
+        // the terms' magnitude.
+        let scale: f64 = r
+            .col_indices()
+            .iter()
+            .zip(r.values())
+            .map(|(&j, v)| (v * x[j]).abs())
+            .sum();
+        assert!((y[i] - want[i]).abs() <= 1e-14 * scale, "row {i}");
+        assert_eq!(y[i].to_bits(), scalar[i].to_bits(), "row {i}");
+        assert_eq!(y[i].to_bits(), b.row(i, &x).to_bits(), "row {i}");
+    }
+}

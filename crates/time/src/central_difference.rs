@@ -14,7 +14,7 @@ use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError};
 use crate::stability::critical_step_with;
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
-use crate::sweep::{predict, sweep, Partials, SparseLoads, StepData, Sums};
+use crate::sweep::{loads_at, predict, sweep, Partials, SparseLoads, StepData, Sums};
 
 /// γ of central difference.
 const GAMMA: f64 = 0.5;
@@ -41,6 +41,11 @@ pub(crate) struct CentralDifference {
     b: Vec<f64>,
     diagonal: Vec<f64>,
     iter_scratch: Vec<SlipState>,
+    /// The predictor the sweep wrote for the step after it.
+    r_next: Vec<f64>,
+    /// (steps, Δt bits) of the state `r_next` went into `r_new` for: the
+    /// next step, if of that Δt, skips [`predict`].
+    predicted: Option<(u64, u64)>,
 }
 
 /// Builds the stepper and the initial state. The critical step is
@@ -85,10 +90,7 @@ pub(crate) fn start(
         loads,
         settings,
     )?;
-    let product = match types {
-        Some(s) => Product::Stencils(s),
-        None => Product::Csr(k),
-    };
+    let product = Product::with_types(types, k);
     let n = mass.len();
     let vectors: Vec<&[f64]> = loads.loads.iter().map(|l| &l.vector[..]).collect();
     let (mut friction, mut friction_slots) = (Vec::new(), Vec::new());
@@ -121,6 +123,8 @@ pub(crate) fn start(
         diagonal: if iterated { vec![0.0; n] } else { Vec::new() },
         iter_scratch: vec![SlipState::Stuck; n_c],
         mass,
+        r_next: vec![0.0; n],
+        predicted: None,
     };
     Ok((Box::new(stepper), state))
 }
@@ -188,21 +192,23 @@ impl CentralDifference {
         Ok(report.iterations)
     }
 
-    /// The step's velocities, accelerations and sums from the predictor
-    /// in `state.r_new` (the outputs apart from `state`, which is read).
+    /// The step's velocities, accelerations, sums and the next step's
+    /// predictor from the predictor in `state.r_new` (the outputs apart
+    /// from `state`, which is read).
     fn velocities(
         &mut self,
         run: &Run,
         state: &State,
-        scale: f64,
+        dt: f64,
         at: (u64, f64),
-        outputs: (&mut [f64], &mut [f64], &mut [SlipState]),
+        outputs: Outputs,
     ) -> Result<(Sums, usize), TimeError> {
-        // The mass is read by the step's data while the friction's parts
-        // are written: moved out for the step.
+        // The mass and the load rows are read by the step's data while the
+        // friction's parts are written: moved out for the step.
         let mass = std::mem::take(&mut self.mass);
-        let result = self.velocities_with(run, state, &mass, scale, at, outputs);
-        self.mass = mass;
+        let loads = std::mem::take(&mut self.sparse_loads);
+        let result = self.velocities_with(run, state, (&mass, loads.rows()), dt, at, outputs);
+        (self.mass, self.sparse_loads) = (mass, loads);
         result
     }
 
@@ -210,13 +216,15 @@ impl CentralDifference {
         &mut self,
         run: &Run,
         state: &State,
-        mass: &[f64],
-        scale: f64,
+        (mass, load_rows): (&[f64], &[usize]),
+        dt: f64,
         at: (u64, f64),
-        (v_new, a_new, classes_new): (&mut [f64], &mut [f64], &mut [SlipState]),
+        (v_new, a_new, r_next, classes_new): Outputs,
     ) -> Result<(Sums, usize), TimeError> {
+        let scale = 1.0 / (GAMMA * dt);
         let data = StepData {
             load_new: &state.load_new,
+            load_rows,
             mass,
             r_new: &state.r_new,
             v: &state.v,
@@ -225,6 +233,7 @@ impl CentralDifference {
             ca: 1.0 / GAMMA - 1.0,
             scale,
             ratio: (1.0 - GAMMA) / GAMMA,
+            next: [dt, 0.5 * dt * dt],
         };
         let mut iterations = 1;
         if let Some(contact) = &run.contact {
@@ -240,13 +249,20 @@ impl CentralDifference {
             &self.product,
             &data,
             &self.friction,
-            v_new,
-            a_new,
+            [v_new, a_new, r_next],
             &mut self.partials,
         );
         Ok((sums, iterations))
     }
 }
+
+/// ṙ_K, r̈_K, the next predictor and the classes a step writes.
+type Outputs<'a> = (
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [f64],
+    &'a mut [SlipState],
+);
 
 impl Stepper for CentralDifference {
     fn step(&mut self, run: &Run, state: &mut State) -> Result<StepInfo, TimeError> {
@@ -259,28 +275,36 @@ impl Stepper for CentralDifference {
         if self.thetas.iter().any(|t| !t.is_finite()) {
             return Err(self.non_finite(step, t_new));
         }
-        // β = 0: r_K = r + Δt ṙ + ½Δt² r̈ is final (no corrector).
-        let (work, load_dot) = predict(
+        // β = 0: r_K = r + Δt ṙ + ½Δt² r̈ is final (no corrector); the
+        // last sweep wrote it if this step's Δt is the last one's.
+        if self.predicted != Some((state.steps, dt.to_bits())) {
+            predict(
+                [&state.r, &state.v, &state.a],
+                [dt, 0.5 * dt * dt],
+                &mut state.r_new,
+            );
+        }
+        self.predicted = None;
+        let (work, load_dot) = loads_at(
             &self.sparse_loads,
             &self.thetas,
-            [&state.r, &state.v, &state.a],
-            [dt, 0.5 * dt * dt],
+            [&state.r, &state.r_new],
             &state.load,
             &mut state.load_new,
-            &mut state.r_new,
         );
-        let scale = 1.0 / (GAMMA * dt);
         let mut v_new = std::mem::take(&mut state.v_new);
         let mut a_new = std::mem::take(&mut state.a_new);
+        let mut r_next = std::mem::take(&mut self.r_next);
         let mut classes_new = std::mem::take(&mut state.classes_new);
         let result = self.velocities(
             run,
             state,
-            scale,
+            dt,
             (step, t_new),
-            (&mut v_new, &mut a_new, &mut classes_new),
+            (&mut v_new, &mut a_new, &mut r_next, &mut classes_new),
         );
         (state.v_new, state.a_new, state.classes_new) = (v_new, a_new, classes_new);
+        self.r_next = r_next;
         let (sums, iterations) = result?;
         if !sums.finite {
             return Err(self.non_finite(step, t_new));
@@ -299,6 +323,9 @@ impl Stepper for CentralDifference {
             (0.0, 0)
         };
         state.commit(dt, t_new, iterations);
+        // r_new now holds r_{K−1}, free: the next predictor goes there.
+        std::mem::swap(&mut state.r_new, &mut self.r_next);
+        self.predicted = Some((state.steps, dt.to_bits()));
         let energies = StepEnergies {
             kinetic: sums.kinetic,
             strain: sums.strain,
@@ -328,7 +355,7 @@ impl Stepper for CentralDifference {
     fn stencil_types(&self) -> Option<usize> {
         match &self.product {
             Product::Stencils(s) => Some(s.types()),
-            Product::Csr(_) => None,
+            Product::Blocks(_) | Product::Csr(_) => None,
         }
     }
 
@@ -336,11 +363,11 @@ impl Stepper for CentralDifference {
         self.product.bytes()
     }
 
-    /// K, and 11 vector streams: the predictor reads r, ṙ, r̈ and writes
-    /// r_K; the sweep reads r_K, m, ṙ, r̈, R_K and writes ṙ_K, r̈_K; and the
-    /// loads at their rows.
+    /// K, and 7 vector streams: the sweep reads r_K, m, ṙ, r̈ and writes
+    /// ṙ_K, r̈_K and the next predictor (a step of the last one's Δt skips
+    /// the predictor's pass); and the loads at their rows.
     fn bytes_per_step(&self) -> usize {
-        self.product.bytes() + 8 * 11 * self.mass.len() + self.sparse_loads.bytes()
+        self.product.bytes() + 8 * 7 * self.mass.len() + self.sparse_loads.bytes()
     }
 }
 

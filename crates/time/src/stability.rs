@@ -3,7 +3,7 @@
 
 use nalgebra_sparse::CsrMatrix;
 
-use stickslip_linalg::chunks::{each_chunk_pair, each_chunk_summed, partials, CHUNK};
+use stickslip_linalg::chunks::{each_chunk_of, each_chunk_summed, partials, CHUNK};
 use stickslip_linalg::csr::{dot, spmv};
 
 /// Largest eigenvalue of M⁻¹K for a diagonal (lumped) mass, by Lanczos on
@@ -82,7 +82,7 @@ pub fn largest_eigenvalue_with(
         // q_prev ← q, q ← w/β, x ← M^{-1/2} q.
         std::mem::swap(&mut q_prev, &mut q);
         let (w, s) = (&y, &scale);
-        each_chunk_pair(&mut q, &mut x, &mut partials, |c, q, x, _| {
+        each_chunk_of([&mut q, &mut x], &mut partials, |c, [q, x], _| {
             let r = c * CHUNK..c * CHUNK + q.len();
             let (w, s) = (&w[r.clone()], &s[r]);
             for i in 0..q.len() {

@@ -1,25 +1,28 @@
 //! The explicit step's passes over the free-DOF vectors (METHOD.md §4 with
 //! β = 0 and the lumped mass).
 //!
-//! An explicit step is bound by memory traffic, so it makes two sweeps: the
-//! predictor r_K = r + Δt ṙ + ½Δt² r̈ ([`predict`], with R_K formed only on
-//! the rows where a load is nonzero, [`SparseLoads`]); then, once r_K
-//! exists everywhere, one sweep ([`sweep`]) that forms K r_K by batches
-//! that stay in L1, R̂_K, ṙ_K = R̂_K/(m·scale) (or, at the contact DOFs,
-//! the velocity the nodal friction gave, formed before the sweep), r̈_K and
-//! the strain and kinetic sums. All passes run in the fixed chunks of
-//! `stickslip_linalg::chunks`: the same bits on any number of threads.
+//! An explicit step is bound by memory traffic, so it makes one sweep over
+//! the vectors ([`sweep`]): once the predictor r_K = r + Δt ṙ + ½Δt² r̈
+//! exists everywhere, it forms K r_K by batches that stay in L1, R̂_K,
+//! ṙ_K = R̂_K/(m·scale) (or, at the contact DOFs, the velocity the nodal
+//! friction gave, formed before the sweep), r̈_K, the strain and kinetic
+//! sums, and the next step's predictor r_K + Δt ṙ_K + ½Δt² r̈_K with
+//! [`predict`]'s operations: a next step of the same Δt skips that pass
+//! and only forms R_K on the rows where a load is nonzero ([`loads_at`],
+//! [`SparseLoads`]); the sweep reads R_K on those rows only. Streams per
+//! step: the sweep reads r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K, r_{K+1}. All
+//! passes run in the fixed chunks of `stickslip_linalg::chunks`: the same
+//! bits on any number of threads.
 
-use stickslip_linalg::chunks::{each_chunk, each_chunk_pair, CHUNK};
+use stickslip_linalg::chunks::{each_chunk, each_chunk_of, CHUNK};
 use stickslip_linalg::simd::{load, store, vectorized, Batches, Kernel, Simd};
 use stickslip_linalg::Product;
-use stickslip_linalg::BATCH;
 
 /// The loads on the rows where the constant load or any load vector is
 /// nonzero (bit for bit: a −0 counts): tractions act on a boundary, so a
 /// few rows. Elsewhere R_K = +0 + Σ θ_l·(+0) = +0 exactly for finite θ_l,
 /// and those rows of R_K are never written.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub(crate) struct SparseLoads {
     /// Rows, ascending.
     rows: Vec<usize>,
@@ -46,6 +49,11 @@ impl SparseLoads {
         }
     }
 
+    /// The rows, ascending.
+    pub fn rows(&self) -> &[usize] {
+        &self.rows
+    }
+
     /// Bytes a step moves for them: the row indices and the loads read,
     /// R_K written, R_{K−1}, r and r_K read at those rows.
     pub fn bytes(&self) -> usize {
@@ -56,24 +64,8 @@ impl SparseLoads {
 /// Per-chunk sums of the sweep: [kinetic, not finite, strain].
 pub(crate) type Partials = Vec<[f64; 3]>;
 
-/// The predictor r_K = r + c1 ṙ + c2 r̈ into `r_new` (every row), and
-/// R_K = constant + Σ θ_l load_l into `load_new` at the loads' rows only
-/// (its other rows hold +0), with the work Σ ½(R_K + R_{K−1})(r_K −
-/// r_{K−1}) and r_K·R_K over those rows: a row off the loads would add
-/// ½(+0)(r_K − r) = ±0, and a sum that starts at +0 is never −0, so
-/// leaving those rows out changes no bit. Every θ_l must be finite.
-/// Returns (work, r_K·R_K).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn predict(
-    sparse: &SparseLoads,
-    thetas: &[f64],
-    [r, v, a]: [&[f64]; 3],
-    [c1, c2]: [f64; 2],
-    load: &[f64],
-    load_new: &mut [f64],
-    r_new: &mut [f64],
-) -> (f64, f64) {
-    debug_assert!(thetas.iter().all(|t| t.is_finite()));
+/// The predictor r_K = r + c1 ṙ + c2 r̈ into `r_new` (every row).
+pub(crate) fn predict([r, v, a]: [&[f64]; 3], [c1, c2]: [f64; 2], r_new: &mut [f64]) {
     each_chunk(r_new, |c, rn| {
         let range = c * CHUNK..c * CHUNK + rn.len();
         let (r, v, a) = (&r[range.clone()], &v[range.clone()], &a[range]);
@@ -81,6 +73,22 @@ pub(crate) fn predict(
             rn[i] = r[i] + c1 * v[i] + c2 * a[i];
         }
     });
+}
+
+/// R_K = constant + Σ θ_l load_l into `load_new` at the loads' rows only
+/// (its other rows hold +0), with the work Σ ½(R_K + R_{K−1})(r_K −
+/// r_{K−1}) and r_K·R_K over those rows: a row off the loads would add
+/// ½(+0)(r_K − r) = ±0, and a sum that starts at +0 is never −0, so
+/// leaving those rows out changes no bit. Every θ_l must be finite.
+/// Returns (work, r_K·R_K).
+pub(crate) fn loads_at(
+    sparse: &SparseLoads,
+    thetas: &[f64],
+    [r, r_new]: [&[f64]; 2],
+    load: &[f64],
+    load_new: &mut [f64],
+) -> (f64, f64) {
+    debug_assert!(thetas.iter().all(|t| t.is_finite()));
     let (mut work, mut dot) = (0.0, 0.0);
     for (k, &i) in sparse.rows.iter().enumerate() {
         let mut l = sparse.constant[k];
@@ -100,6 +108,8 @@ pub(crate) fn predict(
 pub(crate) struct StepData<'a> {
     /// R_K (+0 off the load rows).
     pub load_new: &'a [f64],
+    /// The rows where R_K may be other than +0, ascending.
+    pub load_rows: &'a [usize],
     /// Lumped mass.
     pub mass: &'a [f64],
     /// r_K (the predictor, final for β = 0).
@@ -116,6 +126,8 @@ pub(crate) struct StepData<'a> {
     pub scale: f64,
     /// (1−γ)/γ.
     pub ratio: f64,
+    /// The predictor's coefficients for the next step: Δt and ½Δt².
+    pub next: [f64; 2],
 }
 
 impl StepData<'_> {
@@ -156,7 +168,9 @@ impl Lanes {
 
 /// The sweep: per row, K r_K, R̂_K, ṙ_K = R̂_K/(m·scale) — or, at the
 /// contact DOFs, the velocity the nodal friction gave (`friction`, (DOF,
-/// ṙ_K) sorted by DOF) — then r̈_K into `a_new` and the sums. K r_K comes
+/// ṙ_K) sorted by DOF) — then r̈_K into `a_new`, the next predictor into
+/// `r_next` and the sums. R̂_K is formed with R_K = +0 (the same bits as
+/// from the +0 stored there) and again at the load rows. K r_K comes
 /// in batches that stay in L1 ([`Product::batches`]), and each batch's
 /// rows go in loops over the batch: no dependence between rows, so their
 /// divisions overlap. Each chunk is a dispatched kernel
@@ -165,11 +179,11 @@ pub(crate) fn sweep(
     k: &Product,
     s: &StepData,
     friction: &[(usize, f64)],
-    v_new: &mut [f64],
-    a_new: &mut [f64],
+    [v_new, a_new, r_next]: [&mut [f64]; 3],
     partials: &mut Partials,
 ) -> Sums {
-    let [kinetic, not_finite, strain] = each_chunk_pair(v_new, a_new, partials, |c, vn, an, p| {
+    let outputs = [v_new, a_new, r_next];
+    let [kinetic, not_finite, strain] = each_chunk_of(outputs, partials, |c, [vn, an, rx], p| {
         let start = c * CHUNK;
         *p = vectorized(Chunk {
             k,
@@ -179,9 +193,11 @@ pub(crate) fn sweep(
                 s,
                 friction,
                 next: friction.partition_point(|f| f.0 < start),
+                next_load: s.load_rows.partition_point(|&i| i < start),
                 start,
                 vn,
                 an,
+                rx,
             },
         });
     });
@@ -208,7 +224,7 @@ impl Kernel for Chunk<'_, '_> {
         let mut rows = Aligned {
             simd,
             rows: self.rows,
-            pending: [0.0; BATCH + LANES],
+            pending: [0.0; LANES],
             held: 0,
             strain: [simd.splat_f64s(0.0); LANES],
             kinetic: [simd.splat_f64s(0.0); LANES],
@@ -226,9 +242,13 @@ struct ChunkRows<'a, 'b> {
     friction: &'a [(usize, f64)],
     /// The next entry of `friction` at or after the rows to come.
     next: usize,
+    /// The next load row at or after the rows to come.
+    next_load: usize,
     start: usize,
     vn: &'b mut [f64],
     an: &'b mut [f64],
+    /// The next step's predictor.
+    rx: &'b mut [f64],
 }
 
 /// [`ChunkRows`] fed in blocks of [`LANES`] rows aligned to the chunk's
@@ -238,8 +258,8 @@ struct ChunkRows<'a, 'b> {
 struct Aligned<'a, 'b, S: Simd> {
     simd: S,
     rows: ChunkRows<'a, 'b>,
-    /// K r_K from row `start + done` on, `held` of it.
-    pending: [f64; BATCH + LANES],
+    /// K r_K of the first `held` rows of an unfinished block.
+    pending: [f64; LANES],
     held: usize,
     strain: [S::f64s; LANES],
     kinetic: [S::f64s; LANES],
@@ -258,15 +278,17 @@ impl<S: Simd> Aligned<'_, '_, S> {
         let n = ku.len();
         let range = r0..r0 + n;
         let local = r0 - rows.start..r0 - rows.start + n;
-        let (ld, m, rn) = (
-            &s.load_new[range.clone()],
-            &s.mass[range.clone()],
-            &s.r_new[range.clone()],
-        );
+        let (m, rn) = (&s.mass[range.clone()], &s.r_new[range.clone()]);
         let (v, a) = (&s.v[range.clone()], &s.a[range.clone()]);
-        let (vn, an) = (&mut rows.vn[local.clone()], &mut rows.an[local]);
+        let (vn, an, rx) = (
+            &mut rows.vn[local.clone()],
+            &mut rows.an[local.clone()],
+            &mut rows.rx[local],
+        );
         let splat = |x: f64| simd.splat_f64s(x);
         let (cv, ca, scale, ratio) = (splat(s.cv), splat(s.ca), splat(s.scale), splat(s.ratio));
+        let (c1, c2) = (splat(s.next[0]), splat(s.next[1]));
+        let zero = splat(0.0);
         for j in (0..n).step_by(w) {
             let at = j..j + w;
             let (mj, vj, aj) = (
@@ -274,9 +296,10 @@ impl<S: Simd> Aligned<'_, '_, S> {
                 load::<S>(&v[at.clone()]),
                 load::<S>(&a[at.clone()]),
             );
-            // R̂_K as StepData::rhs forms it, then ṙ_K = R̂_K/(m·scale).
+            // R̂_K as StepData::rhs forms it from R_K = +0, then ṙ_K =
+            // R̂_K/(m·scale).
             let rhs = simd.add_f64s(
-                simd.sub_f64s(load::<S>(&ld[at.clone()]), load::<S>(&ku[at.clone()])),
+                simd.sub_f64s(zero, load::<S>(&ku[at.clone()])),
                 simd.mul_f64s(
                     mj,
                     simd.add_f64s(simd.mul_f64s(cv, vj), simd.mul_f64s(ca, aj)),
@@ -284,33 +307,45 @@ impl<S: Simd> Aligned<'_, '_, S> {
             );
             store::<S>(&mut vn[at], simd.div_f64s(rhs, simd.mul_f64s(mj, scale)));
         }
+        while rows.next_load < s.load_rows.len() && s.load_rows[rows.next_load] < range.end {
+            let i = s.load_rows[rows.next_load];
+            vn[i - r0] = s.rhs(i, ku[i - r0]) / (m[i - r0] * s.scale);
+            rows.next_load += 1;
+        }
         while rows.next < rows.friction.len() && rows.friction[rows.next].0 < range.end {
             let (i, vi) = rows.friction[rows.next];
             vn[i - r0] = vi;
             rows.next += 1;
         }
-        let zero = splat(0.0);
-        for j in (0..n).step_by(w) {
-            let at = j..j + w;
-            let (vj, aj) = (load::<S>(&v[at.clone()]), load::<S>(&a[at.clone()]));
-            let (vnj, rnj) = (load::<S>(&vn[at.clone()]), load::<S>(&rn[at.clone()]));
-            let anj = simd.sub_f64s(
-                simd.mul_f64s(simd.sub_f64s(vnj, vj), scale),
-                simd.mul_f64s(ratio, aj),
-            );
-            store::<S>(&mut an[at.clone()], anj);
-            self.finite = simd.add_f64s(
-                self.finite,
-                simd.add_f64s(simd.mul_f64s(rnj, zero), simd.mul_f64s(vnj, zero)),
-            );
-            let lane = (j % LANES) / w;
-            self.strain[lane] = simd.add_f64s(
-                self.strain[lane],
-                simd.mul_f64s(rnj, load::<S>(&ku[at.clone()])),
-            );
-            let mv = simd.mul_f64s(load::<S>(&m[at]), vnj);
-            self.kinetic[lane] = simd.add_f64s(self.kinetic[lane], simd.mul_f64s(mv, vnj));
+        // Local sums (registers), each block's vectors k in lanes k·w...
+        let (mut strain, mut kinetic, mut finite) = (self.strain, self.kinetic, self.finite);
+        for block in (0..n).step_by(LANES) {
+            for k in 0..LANES / w {
+                let at = block + k * w..block + (k + 1) * w;
+                let (vj, aj) = (load::<S>(&v[at.clone()]), load::<S>(&a[at.clone()]));
+                let (vnj, rnj) = (load::<S>(&vn[at.clone()]), load::<S>(&rn[at.clone()]));
+                let anj = simd.sub_f64s(
+                    simd.mul_f64s(simd.sub_f64s(vnj, vj), scale),
+                    simd.mul_f64s(ratio, aj),
+                );
+                store::<S>(&mut an[at.clone()], anj);
+                // predict's r + c1 ṙ + c2 r̈, for r_K, ṙ_K, r̈_K.
+                let next = simd.add_f64s(
+                    simd.add_f64s(rnj, simd.mul_f64s(c1, vnj)),
+                    simd.mul_f64s(c2, anj),
+                );
+                store::<S>(&mut rx[at.clone()], next);
+                finite = simd.add_f64s(
+                    finite,
+                    simd.add_f64s(simd.mul_f64s(rnj, zero), simd.mul_f64s(vnj, zero)),
+                );
+                strain[k] =
+                    simd.add_f64s(strain[k], simd.mul_f64s(rnj, load::<S>(&ku[at.clone()])));
+                let mv = simd.mul_f64s(load::<S>(&m[at]), vnj);
+                kinetic[k] = simd.add_f64s(kinetic[k], simd.mul_f64s(mv, vnj));
+            }
         }
+        (self.strain, self.kinetic, self.finite) = (strain, kinetic, finite);
     }
 
     /// The chunk's sums once every batch came: the held rows (fewer than
@@ -341,8 +376,10 @@ impl<S: Simd> Aligned<'_, '_, S> {
                     vi = rows.friction[rows.next].1;
                     rows.next += 1;
                 }
+                let ai = (vi - s.v[i]) * s.scale - s.ratio * s.a[i];
                 rows.vn[j] = vi;
-                rows.an[j] = (vi - s.v[i]) * s.scale - s.ratio * s.a[i];
+                rows.an[j] = ai;
+                rows.rx[j] = s.r_new[i] + s.next[0] * vi + s.next[1] * ai;
                 finite &= s.r_new[i].is_finite() && vi.is_finite();
                 strain.0[k] += s.r_new[i] * ku;
                 kinetic.0[k] += s.mass[i] * vi * vi;
@@ -359,21 +396,25 @@ impl<S: Simd> Aligned<'_, '_, S> {
 impl<S: Simd> Batches for Aligned<'_, '_, S> {
     #[inline(always)]
     fn batch(&mut self, r0: usize, ku: &[f64]) {
-        let first = r0 - self.held;
-        debug_assert_eq!((first - self.rows.start) % LANES, 0);
-        let total = self.held + ku.len();
-        let blocks = total / LANES * LANES;
-        if self.held == 0 {
-            // Aligned already: no copy.
-            self.rows(first, &ku[..blocks]);
-            let rest = &ku[blocks..];
-            self.pending[..rest.len()].copy_from_slice(rest);
-        } else {
-            self.pending[self.held..total].copy_from_slice(ku);
-            let pending = self.pending;
-            self.rows(first, &pending[..blocks]);
-            self.pending.copy_within(blocks..total, 0);
+        let (mut r, mut ku) = (r0, ku);
+        if self.held > 0 {
+            // Complete the held block from this batch's first rows.
+            let take = (LANES - self.held).min(ku.len());
+            self.pending[self.held..self.held + take].copy_from_slice(&ku[..take]);
+            self.held += take;
+            (r, ku) = (r + take, &ku[take..]);
+            if self.held < LANES {
+                return;
+            }
+            let block: [f64; LANES] = std::array::from_fn(|k| self.pending[k]);
+            self.rows(r - LANES, &block);
+            self.held = 0;
         }
-        self.held = total - blocks;
+        debug_assert_eq!((r - self.rows.start) % LANES, 0);
+        let blocks = ku.len() / LANES * LANES;
+        self.rows(r, &ku[..blocks]);
+        let rest = &ku[blocks..];
+        self.pending[..rest.len()].copy_from_slice(rest);
+        self.held = rest.len();
     }
 }
