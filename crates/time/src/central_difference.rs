@@ -336,6 +336,10 @@ impl Stepper for CentralDifference {
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))
     }
 
+    fn state_replaced(&mut self) {
+        self.predicted = None;
+    }
+
     fn dt_crit(&self) -> Option<f64> {
         Some(self.dt_crit)
     }

@@ -111,6 +111,7 @@ impl Integrator {
     /// not finite.
     pub fn restore(&mut self, c: &Checkpoint) -> Result<(), TimeError> {
         self.state.restore(c, self.run.settings.dt)?;
+        self.stepper.state_replaced();
         self.stepper.set_factorizations(c.factorizations);
         self.run.loads.at(self.state.t, &mut self.state.load);
         Ok(())

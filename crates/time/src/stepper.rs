@@ -58,6 +58,10 @@ pub(crate) trait Stepper: Send {
     /// Continues the count of factorizations from a checkpoint's.
     fn set_factorizations(&mut self, _count: u64) {}
 
+    /// The state was replaced (a checkpoint restored): forget what the
+    /// stepper formed ahead from the old one.
+    fn state_replaced(&mut self) {}
+
     /// Values stored per factor of the step's operator.
     fn factor_len(&self) -> usize {
         0
