@@ -97,14 +97,36 @@ fn is_number(v: &Value) -> bool {
 /// 1e-300: "use time.dt < 0").
 const MODERATE: std::ops::RangeInclusive<f64> = 1e-100..=1e100;
 
-/// A finite number of `v` outside [`MODERATE`] (and not 0).
-fn extreme(v: &Value) -> Option<f64> {
+/// A number of `v` that breaks the promise of docs/case-file.md: not
+/// finite, or neither 0 nor of a magnitude in [`MODERATE`].
+fn immoderate(v: &Value) -> Option<f64> {
     let x = match v {
         Value::Integer(i) => *i.value() as f64,
         Value::Float(f) => *f.value(),
         _ => return None,
     };
-    (x.is_finite() && x != 0.0 && !MODERATE.contains(&x.abs())).then_some(x)
+    (x != 0.0 && !(x.is_finite() && MODERATE.contains(&x.abs()))).then_some(x)
+}
+
+/// Every number inside `item`, at any depth (a history's table or
+/// frequency).
+fn nested_numbers<'a>(item: &'a Item, out: &mut Vec<&'a Value>) {
+    fn in_value<'a>(v: &'a Value, out: &mut Vec<&'a Value>) {
+        match v {
+            Value::Array(a) => a.iter().for_each(|v| in_value(v, out)),
+            Value::InlineTable(t) => t.iter().for_each(|(_, v)| in_value(v, out)),
+            _ => out.push(v),
+        }
+    }
+    match item {
+        Item::Value(v) => in_value(v, out),
+        Item::Table(t) => t.iter().for_each(|(_, i)| nested_numbers(i, out)),
+        Item::ArrayOfTables(a) => a
+            .iter()
+            .flat_map(|t| t.iter())
+            .for_each(|(_, i)| nested_numbers(i, out)),
+        Item::None => {}
+    }
 }
 
 /// Checks every key of `table` (at `path`) against `schema`: calls `report`
@@ -148,19 +170,42 @@ pub(crate) fn check_table(
         };
         let name = dotted(path);
         let span = item.span().or_else(|| key_span.clone());
-        let numbers: Vec<&Value> = match (kind, item) {
-            (Kind::Num, Item::Value(v)) => vec![v],
-            (Kind::Vec2, Item::Value(Value::Array(a))) => a.iter().collect(),
-            _ => Vec::new(),
-        };
-        if let Some(x) = numbers.into_iter().find_map(extreme) {
-            report(
-                span.clone(),
-                format!(
-                    "{name} = {x:e} is beyond what the computation can carry (magnitudes from \
-                     1e-100 to 1e100, or 0); choose units that keep the case's values moderate"
-                ),
-            );
+        // The promise of docs/case-file.md on every number, in one place:
+        // the value checks after serde need not repeat it key by key.
+        let mut numbers: Vec<&Value> = Vec::new();
+        match (kind, item) {
+            (Kind::Num, Item::Value(v)) => numbers.push(v),
+            (Kind::Vec2, Item::Value(Value::Array(a))) => numbers.extend(a.iter()),
+            (Kind::Any, _) => nested_numbers(item, &mut numbers),
+            _ => {}
+        }
+        if let Some(x) = numbers.into_iter().find_map(immoderate) {
+            let is = if matches!(kind, Kind::Any) {
+                format!("{name} holds {x:e}, which")
+            } else {
+                format!("{name} = {x:e}")
+            };
+            if x.is_finite() {
+                report(
+                    span.clone(),
+                    format!(
+                        "{is} is beyond what the computation can carry (magnitudes from \
+                         1e-100 to 1e100, or 0); choose units that keep the case's values moderate"
+                    ),
+                );
+            } else {
+                report(
+                    span.clone(),
+                    format!(
+                        "{is} is not a finite number; give a number (0, or of magnitude \
+                         1e-100 to 1e100)"
+                    ),
+                );
+                // As for a wrong type: the value checks would only repeat it.
+                typed.push((path.clone(), placeholder(kind), span.clone()));
+                path.pop();
+                continue;
+            }
         }
         let mut wrong = |want: &str, hint: &str| {
             report(

@@ -222,7 +222,8 @@ const MAX_STEPS: f64 = 1e12;
 /// Checks every value of the case serde read, collecting every problem,
 /// and completes it: paths resolved against the case file's directory,
 /// `output.file` defaulted, where each key is. `spans`: each value's
-/// place in the text serde read, by dotted key.
+/// place in the text serde read, by dotted key. Every number is finite
+/// and moderate here already (`keys::check_table` refused the others).
 fn complete(
     mut case: Case,
     path: &Path,
@@ -303,20 +304,6 @@ fn complete(
                 i, d.group
             ),
         );
-        let finite = d.ux.is_none_or(f64::is_finite) && d.uy.is_none_or(f64::is_finite);
-        check(
-            finite,
-            &group,
-            format!(
-                "dirichlet.{i} (group {:?}): {}: give finite numbers",
-                d.group,
-                [("ux", d.ux), ("uy", d.uy)]
-                    .iter()
-                    .filter_map(|(k, v)| v.map(|v| format!("{k} = {v}")))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        );
     }
 
     // A component of a group prescribed twice: even with equal values it is
@@ -357,39 +344,15 @@ fn complete(
                 if t.t.is_some() { "both" } else { "neither" }
             ),
         );
-        let finite = t.t.is_none_or(|v| v.iter().all(|x| x.is_finite()))
-            && t.pressure.is_none_or(f64::is_finite);
-        check(
-            finite,
-            &group,
-            format!("{what}: t and pressure must be finite numbers"),
-        );
         let history = format!("traction.{i}.history");
-        match &t.history {
-            History::Sin { omega } => check(
-                omega.is_finite(),
+        if let History::Table(p) = &t.history {
+            let increasing = p.windows(2).all(|w| w[1][0] > w[0][0]);
+            check(
+                !p.is_empty() && increasing,
                 &history,
-                format!("{what}: history sin omega = {omega} must be a finite number"),
-            ),
-            History::Table(p) => {
-                let increasing = p.windows(2).all(|w| w[1][0] > w[0][0]);
-                let finite = p.iter().flatten().all(|x| x.is_finite());
-                check(
-                    !p.is_empty() && increasing && finite,
-                    &history,
-                    format!("{what}: history table needs at least one [t, f] pair, finite values and strictly increasing times; e.g. {{ table = [[0.0, 0.0], [0.1, 1.0]] }}"),
-                );
-            }
-            History::Constant | History::Step => {}
+                format!("{what}: history table needs at least one [t, f] pair and strictly increasing times; e.g. {{ table = [[0.0, 0.0], [0.1, 1.0]] }}"),
+            );
         }
-    }
-
-    if let Some(b) = &case.body_force {
-        check(
-            b.iter().all(|x| x.is_finite()),
-            "body_force",
-            "body_force must be finite numbers".into(),
-        );
     }
 
     // [contact]

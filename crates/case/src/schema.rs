@@ -1,9 +1,9 @@
 //! The case schema (DESIGN.md "Case file"), declared once: the types serde
 //! fills are the types the rest of the code reads, and the key list that
 //! the key-by-key check walks ([`Section::KEYS`]) is generated from the
-//! same declarations by [`section!`], each key's [`Kind`] taken from its
-//! field's Rust type ([`Schema`]). docs/case-file.md is tested against
-//! [`key_paths`].
+//! same declarations by `section!` (below), each key's [`Kind`] taken
+//! from its field's Rust type ([`Schema`]). docs/case-file.md is tested
+//! against [`key_paths`].
 //!
 //! Values read as written (relative paths, defaults) are completed by
 //! loading (`load.rs`): paths resolved against the case file's directory,

@@ -14,6 +14,12 @@
 //! Exit codes (used by `main.rs`): 0 success; 2 bad input (case, mesh,
 //! arguments: a `stickslip_case::InputError`); 1 a run that failed after it
 //! started; 130 interrupted.
+//!
+//! Its system calls (signals, the results file's lock, free disk space)
+//! are in [`sys`], the one module allowed `unsafe`.
+
+// Deny, not forbid: `sys` allows it for itself.
+#![deny(unsafe_code)]
 
 /// `eprintln!` that does not panic when stderr is closed: a run's
 /// messages must not end it (`stickslip run ... 2>&1 | head` closes the
@@ -42,6 +48,7 @@ pub mod results_file;
 pub mod run;
 mod start;
 pub mod stress_cmd;
+pub mod sys;
 pub mod views;
 pub mod views_cmd;
 pub mod xdmf;

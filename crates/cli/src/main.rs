@@ -9,6 +9,9 @@
 //! every step written); 130 interrupted by SIGINT, SIGTERM or SIGHUP (the file is
 //! valid and holds a checkpoint to `--restart` from).
 
+// The system calls are in the library's `sys` module.
+#![forbid(unsafe_code)]
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -168,19 +171,6 @@ fn report(msg: &str) {
     }
 }
 
-/// Writing to a closed pipe ends the process quietly, as other Unix
-/// tools do (`stickslip probe ... | head` panicked on the broken pipe,
-/// exit 101). Not for `run`, which must write its results whatever
-/// becomes of its stderr: it writes its messages without panicking.
-#[allow(unsafe_code)]
-fn default_sigpipe() {
-    // SAFETY: restores the default action of one signal before any thread
-    // starts; no handler of ours is involved.
-    unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
-    }
-}
-
 /// Exit code for an error from a run or a check: 2 for bad input, else 1.
 fn fail(e: &anyhow::Error) -> ExitCode {
     if let Some(input) = e.downcast_ref::<InputError>() {
@@ -195,7 +185,12 @@ fn fail(e: &anyhow::Error) -> ExitCode {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     if !matches!(cli.command, Command::Run { .. }) {
-        default_sigpipe();
+        // Writing to a closed pipe ends the process quietly, as other Unix
+        // tools do (`stickslip probe ... | head` panicked on the broken
+        // pipe, exit 101). Not for `run`, which must write its results
+        // whatever becomes of its stderr: it writes its messages without
+        // panicking.
+        stickslip::sys::default_sigpipe();
     }
     match cli.command {
         Command::Run {

@@ -7,6 +7,8 @@ use std::path::Path;
 
 use stickslip_case::InputError;
 
+use crate::sys::{lock_held, ofd_lock};
+
 /// Refuses an output path `run` must not write (exit code 2), before
 /// anything is read: an existing OUT.h5, OUT.xdmf, OUT.contact.xdmf or
 /// OUT.views.h5 without `force`, an
@@ -140,7 +142,7 @@ pub fn in_use(path: &Path) -> bool {
         .read(true)
         .write(true)
         .open(path)
-        .is_ok_and(|f| ofd_lock(&f, false).is_err_and(|e| held(&e)));
+        .is_ok_and(|f| ofd_lock(&f, false).is_err_and(|e| lock_held(&e)));
     flocked || locked || being_written(path)
 }
 
@@ -148,12 +150,7 @@ pub fn in_use(path: &Path) -> bool {
 /// locking: a read lock of ours, released when `f` closes, conflicts with
 /// the run's write lock (and needs only read access to the file).
 pub fn being_written(path: &Path) -> bool {
-    std::fs::File::open(path).is_ok_and(|f| ofd_lock(&f, true).is_err_and(|e| held(&e)))
-}
-
-/// Whether a lock failed because another process holds one.
-fn held(e: &std::io::Error) -> bool {
-    e.kind() == std::io::ErrorKind::WouldBlock || e.raw_os_error() == Some(libc::EACCES)
+    std::fs::File::open(path).is_ok_and(|f| ofd_lock(&f, true).is_err_and(|e| lock_held(&e)))
 }
 
 /// A run's lock on its results file, held while it writes: an open file
@@ -205,7 +202,7 @@ impl RunLock {
         let f = std::fs::File::open(path)
             .map_err(|e| InputError(format!("cannot open {}: {e}", path.display())))?;
         match ofd_lock(&f, true) {
-            Err(e) if held(&e) => Err(busy(path)),
+            Err(e) if lock_held(&e) => Err(busy(path)),
             _ => Ok(RunLock { _file: f }),
         }
     }
@@ -213,7 +210,7 @@ impl RunLock {
     /// Takes the lock on `f`, the file `path` names.
     fn on(f: std::fs::File, path: &Path) -> Result<RunLock, InputError> {
         match ofd_lock(&f, false) {
-            Err(e) if held(&e) => Err(busy(path)),
+            Err(e) if lock_held(&e) => Err(busy(path)),
             // A file system without such locks (ENOLCK, EINVAL on some
             // network mounts): the run goes on unprotected, as HDF5's own
             // locking would let it.
@@ -281,24 +278,6 @@ fn busy(path: &Path) -> InputError {
          wait for it or close it, or write elsewhere with -o",
         path.display()
     ))
-}
-
-/// An F_OFD_SETLK lock on the whole of `f`: shared (`read`) or exclusive.
-#[allow(unsafe_code)]
-fn ofd_lock(f: &std::fs::File, read: bool) -> std::io::Result<()> {
-    use std::os::fd::AsRawFd;
-    // SAFETY: flock is plain data, and all zeros a valid value: the whole
-    // file from offset 0, and l_pid 0 as OFD locks require.
-    let mut fl: libc::flock = unsafe { std::mem::zeroed() };
-    fl.l_type = (if read { libc::F_RDLCK } else { libc::F_WRLCK }) as libc::c_short;
-    fl.l_whence = libc::SEEK_SET as libc::c_short;
-    // SAFETY: a valid descriptor and a pointer to a live flock.
-    let r = unsafe { libc::fcntl(f.as_raw_fd(), libc::F_OFD_SETLK, &fl) };
-    if r == -1 {
-        Err(std::io::Error::last_os_error())
-    } else {
-        Ok(())
-    }
 }
 
 /// Claims `out` for a new run: removes an old results file and its XDMF
@@ -373,18 +352,10 @@ pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
 
 /// Bytes free to an unprivileged writer on the file system of `path`'s
 /// directory, where it can be asked.
-#[allow(unsafe_code)]
 pub fn free_bytes(path: &Path) -> Option<u64> {
-    use std::os::unix::ffi::OsStrExt;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
-    // SAFETY: statvfs is plain data, all zeros a valid value; the call
-    // gets a NUL-terminated path and a pointer to a live statvfs.
-    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
-    let r = unsafe { libc::statvfs(c.as_ptr(), &mut st) };
-    #[allow(clippy::useless_conversion)] // u64 here; other platforms differ
-    (r == 0).then(|| u64::from(st.f_bavail).saturating_mul(u64::from(st.f_frsize)))
+    crate::sys::free_bytes_at(dir)
 }

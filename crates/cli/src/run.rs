@@ -508,21 +508,10 @@ impl StopFlags {
 /// exit 130 at once (the file keeps every flushed step). signal-hook's
 /// conditional shutdown exited without a word, which left the user
 /// guessing what was kept.
-#[allow(unsafe_code)]
 fn second_signal_exits(sig: i32, any: Arc<AtomicBool>) -> std::io::Result<()> {
     const MSG: &[u8] = b"\nstopped at once by a second signal: the results file keeps every step \
 up to its last flush (complete = false); continue it with --restart\n";
-    // SAFETY: the action only loads an atomic and calls write(2) and
-    // _exit(2), which are async-signal-safe.
-    unsafe {
-        signal_hook::low_level::register(sig, move || {
-            if any.load(Ordering::SeqCst) {
-                libc::write(2, MSG.as_ptr().cast(), MSG.len());
-                libc::_exit(130);
-            }
-        })?;
-    }
-    Ok(())
+    crate::sys::exit_on_signal_if(sig, any, MSG, 130)
 }
 
 /// How `stickslip run` behaves.

@@ -1535,6 +1535,67 @@ fn extreme_values_and_odd_files_are_refused_by_name() {
     );
 }
 
+/// docs/case-file.md promises every number of a case finite and, unless
+/// 0, of magnitude 1e-100 to 1e100: for every key, a history's numbers
+/// included (`output.flush_seconds = inf`, a sin history's omega = 1e200
+/// and a table's time 1e-200 were accepted; beta = gamma = inf was called
+/// unstable), each value one problem, named by key and line.
+#[test]
+fn every_number_is_finite_and_moderate_or_refused() {
+    let dir = scratch("every-number");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let infinite = "is not a finite number";
+    let huge = "beyond what the computation can carry";
+    for (set, words) in [
+        (
+            "output.flush_seconds=inf",
+            ["output.flush_seconds = inf", infinite],
+        ),
+        (
+            "output.flush_seconds=nan",
+            ["output.flush_seconds = NaN", infinite],
+        ),
+        (
+            "output.flush_seconds=1e200",
+            ["output.flush_seconds = 1e200", huge],
+        ),
+        ("material.E=-inf", ["material.E = -inf", infinite]),
+        ("dirichlet.0.uy=nan", ["dirichlet.0.uy = NaN", infinite]),
+        (
+            "traction.0.history={ sin = { omega = 1e200 } }",
+            ["traction.0.history holds 1e200", huge],
+        ),
+        (
+            "traction.0.history={ sin = { omega = inf } }",
+            ["traction.0.history holds inf", infinite],
+        ),
+        (
+            "traction.0.history={ table = [[0, 0], [1e-200, 1]] }",
+            ["traction.0.history holds 1e-200", huge],
+        ),
+    ] {
+        let e = refused(&case, &[set], &words);
+        assert_eq!(e.lines().count(), 1, "{set}: {e}");
+    }
+    // In the file, each on its line.
+    let (newmark, text) = slab_case(&dir, "newmark", |t| {
+        t.replace(
+            "scheme = \"central_difference\"",
+            "scheme = \"newmark\"\nbeta = inf\ngamma = inf",
+        )
+    });
+    let e = refused(&newmark, &[], &[]);
+    for key in ["beta", "gamma"] {
+        let l = line_of(&text, &format!("{key} = inf"));
+        assert!(
+            e.lines().any(|m| m.contains(&format!("newmark.toml:{l}:"))
+                && m.contains(&format!("time.{key} = inf {infinite}"))),
+            "time.{key} at line {l}:\n{e}"
+        );
+    }
+    assert_eq!(e.lines().count(), 2, "{e}");
+}
+
 /// A value of the wrong type is one problem: the placeholder that keeps
 /// the other checks going was reported too when the value came from --set
 /// ("material.nu = 1 must lie in (-1, 0.5)", "placeholder does not exist").

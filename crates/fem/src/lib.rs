@@ -1,7 +1,7 @@
 //! Q1/Q2 plane elasticity on a [`stickslip_mesh::Mesh`]: the matrices and
 //! vectors of METHOD.md §3 and the constraint bookkeeping.
 //!
-//! This crate owns the reference elements ([`reference`], shape functions
+//! This crate owns the reference elements ([`mod@reference`], shape functions
 //! into caller buffers), Gauss rules ([`quadrature`]), the isoparametric map
 //! ([`geometry`]), the material ([`Material`]), element operators
 //! ([`element`]: stiffness, consistent and HRZ-lumped mass, body force), the

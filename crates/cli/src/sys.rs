@@ -1,0 +1,90 @@
+//! The command's system calls, behind safe functions: the one place in the
+//! crate allowed `unsafe` (the crate root denies it). Signals for `run`
+//! and the other commands, the results file's lock, and the free space on
+//! a disk; what each is for is said where it is called.
+#![allow(unsafe_code)]
+
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// Restores the default action of SIGPIPE (end the process), which the
+/// Rust runtime sets to ignore. Call it before any thread starts.
+pub fn default_sigpipe() {
+    // SAFETY: sets the action of one signal to the default; no handler of
+    // ours is involved, and no other thread is changing signal actions.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+/// Adds an action on `sig` (beside any others registered with
+/// signal-hook): when it arrives while `armed` is set, writes `msg` to
+/// stderr and ends the process at once with exit code `code` (no
+/// unwinding, no destructors, no buffers flushed).
+///
+/// # Errors
+/// The action cannot be installed.
+pub(crate) fn exit_on_signal_if(
+    sig: i32,
+    armed: Arc<AtomicBool>,
+    msg: &'static [u8],
+    code: i32,
+) -> std::io::Result<()> {
+    // SAFETY: the action only loads an atomic and calls write(2) and
+    // _exit(2), which are async-signal-safe; it allocates nothing and
+    // takes no lock.
+    unsafe {
+        signal_hook::low_level::register(sig, move || {
+            if armed.load(Ordering::SeqCst) {
+                libc::write(2, msg.as_ptr().cast(), msg.len());
+                libc::_exit(code);
+            }
+        })?;
+    }
+    Ok(())
+}
+
+/// Takes an open file description lock (F_OFD_SETLK, not waiting) on the
+/// whole of `f`: shared if `read`, else exclusive. It lasts until every
+/// descriptor of this open file is closed.
+///
+/// # Errors
+/// The OS error: another process holds a conflicting lock ([`lock_held`]),
+/// or the file system has no such locks.
+pub(crate) fn ofd_lock(f: &std::fs::File, read: bool) -> std::io::Result<()> {
+    use std::os::fd::AsRawFd;
+    // SAFETY: flock is plain data, and all zeros a valid value: the whole
+    // file from offset 0, and l_pid 0 as OFD locks require.
+    let mut fl: libc::flock = unsafe { std::mem::zeroed() };
+    fl.l_type = (if read { libc::F_RDLCK } else { libc::F_WRLCK }) as libc::c_short;
+    fl.l_whence = libc::SEEK_SET as libc::c_short;
+    // SAFETY: a valid descriptor (borrowed from a live File) and a pointer
+    // to a live flock, which fcntl only reads.
+    let r = unsafe { libc::fcntl(f.as_raw_fd(), libc::F_OFD_SETLK, &fl) };
+    if r == -1 {
+        Err(std::io::Error::last_os_error())
+    } else {
+        Ok(())
+    }
+}
+
+/// Whether [`ofd_lock`] failed because another process holds a
+/// conflicting lock (fcntl(2) gives EAGAIN or EACCES for it).
+pub(crate) fn lock_held(e: &std::io::Error) -> bool {
+    e.kind() == std::io::ErrorKind::WouldBlock || e.raw_os_error() == Some(libc::EACCES)
+}
+
+/// Bytes free to an unprivileged writer on the file system holding `dir`
+/// (statvfs(3)), or None where it cannot be asked.
+pub(crate) fn free_bytes_at(dir: &Path) -> Option<u64> {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+    // SAFETY: statvfs is plain data, all zeros a valid value.
+    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
+    // SAFETY: a NUL-terminated path and a pointer to a live statvfs, which
+    // the call fills.
+    let r = unsafe { libc::statvfs(c.as_ptr(), &mut st) };
+    #[allow(clippy::useless_conversion)] // u64 here; other platforms differ
+    (r == 0).then(|| u64::from(st.f_bavail).saturating_mul(u64::from(st.f_frsize)))
+}
