@@ -4,7 +4,7 @@
 //! one row per output step in every time-dependent dataset (unlimited first
 //! dimension, chunked along time; shuffle + deflate when `compression` is
 //! 1-9, none by default). Rows are kept in memory up to the end of a chunk
-//! along time and written as one block per dataset ([`Pending`]), and
+//! along time and written as one block per dataset (`Pending`), and
 //! always before a flush. It is flushed every
 //! [`ResultsWriter::flush_every_steps`] appends or
 //! [`ResultsWriter::flush_every_secs`] seconds (or when the run says so,
@@ -1099,8 +1099,8 @@ impl ResultsWriter {
         Ok(())
     }
 
-    /// Appends one output step to every dataset (written with its block:
-    /// [`Pending`]).
+    /// Appends one output step to every dataset (kept in memory and written
+    /// with its chunk's block, or before the next flush).
     ///
     /// # Errors
     /// HDF5 errors, or slices whose lengths do not match the header.

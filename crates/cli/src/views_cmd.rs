@@ -3,8 +3,8 @@
 //! (Γ_C as line cells) and `OUT.views.h5` (what they point to,
 //! [`crate::views`]), for the records the file holds, of a finished run or
 //! of one interrupted or failed midway. With `OUT.stress.h5` beside it
-//! (`stickslip stress`, which calls [`write`] itself) `OUT.xdmf` lists the
-//! stresses too.
+//! (`stickslip stress`, which calls [`write()`] itself) `OUT.xdmf` lists
+//! the stresses too.
 //!
 //! The run writes none of these: their cost grows with the records, and a
 //! run of many cheap records paid several times its own time for them
@@ -29,7 +29,7 @@ use crate::xdmf::XdmfInfo;
 /// `OUT.views.h5` (3,048 together).
 const BYTES_PER_RECORD: usize = 5600;
 
-/// What [`write`] wrote.
+/// What [`write()`] wrote.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Written {
     /// Records listed.
@@ -43,7 +43,7 @@ pub struct Written {
 }
 
 /// `stickslip views OUT.h5`: checks that `path` is a results file no run
-/// is writing, then [`write`]s the viewers' files beside it.
+/// is writing, then writes the viewers' files beside it ([`write()`]).
 ///
 /// # Errors
 /// An [`InputError`] for a file that is missing, being written, or not a

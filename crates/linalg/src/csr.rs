@@ -27,7 +27,8 @@ pub(crate) fn row_dot(vals: &[f64], cols: &[usize], x: &[f64]) -> f64 {
     s
 }
 
-/// Row i of A times x, by [`row_dot`].
+/// Row i of A times x, in `row_dot`'s four interleaved partial sums: the
+/// same bits as row i of [`spmv`].
 #[inline(always)]
 pub fn row(a: &CsrMatrix<f64>, i: usize, x: &[f64]) -> f64 {
     let (p, q) = (a.row_offsets()[i], a.row_offsets()[i + 1]);

@@ -396,7 +396,7 @@ impl Supernodal {
     ///
     /// Column j needs A⁻¹Pᵀe_j only at the reach's DOFs, and its right-hand
     /// side lives there: a forward and a back solve restricted to the
-    /// reach. [`GROUP`] columns go through each supernode together (its
+    /// reach. `GROUP` columns go through each supernode together (its
     /// values are read once per group and the inner loops run over the
     /// group), groups in parallel; a column's arithmetic is the same on any
     /// thread.
@@ -535,7 +535,7 @@ impl Supernodal {
         self.xp = xp;
     }
 
-    /// The permutation: x_perm[i] = x[fwd[i]].
+    /// The permutation: `x_perm[i] = x[fwd[i]]`.
     pub fn forward_permutation(&self) -> &[u32] {
         &self.fwd
     }

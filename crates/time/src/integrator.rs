@@ -34,8 +34,8 @@ impl Integrator {
     /// r₀ the frictionless static equilibrium under the loads present at
     /// t = 0⁻, ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀.
     ///
-    /// A scheme is a [`Stepper`] made by its module's `start`; this match
-    /// is the one place that names them.
+    /// A scheme is a `Stepper` (the crate's internal trait) made by its
+    /// module's `start`; this match is the one place that names them.
     ///
     /// # Errors
     /// Settings out of range, Δt above the explicit critical step (unless

@@ -62,9 +62,9 @@ pub struct Checkpoint {
     pub initial_mechanical: f64,
     /// Remark 4.3 step-reduction counter.
     pub reduced_remaining: u64,
-    /// The clock ([`Clock`]): t₀, Δt and steps of the current run of
-    /// equal steps (`None` in files written before it: the continued run
-    /// then starts a new run of steps at `t`).
+    /// The drift-free clock (t = t₀ + k Δt): t₀, Δt and steps k of the
+    /// current run of equal steps (`None` in files written before it: the
+    /// continued run then starts a new run of steps at `t`).
     pub clock: Option<(f64, f64, u64)>,
     /// Stick/slip iterations so far.
     pub total_iterations: u64,

@@ -31,8 +31,8 @@ fn relative_to(path: &Path, base: &Path) -> PathBuf {
 
 /// The case text with the chosen configuration, for `--write OUT.toml`:
 /// the case as written (comments and layout kept, by toml_edit) with
-/// mesh.file, [time] and contact.eps changed; paths are rewritten relative
-/// to OUT's directory when it is not the case's.
+/// `mesh.file`, `[time]` and `contact.eps` changed; paths are rewritten
+/// relative to OUT's directory when it is not the case's.
 ///
 /// # Errors
 /// The case text does not parse (it did when it was loaded).
