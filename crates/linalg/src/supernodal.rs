@@ -894,9 +894,22 @@ fn permute_out(fwd: &[u32], xp: &[f64], x: &mut [f64]) {
 
 /// A supernode's forward step: the k × k triangle solved on its columns
 /// `xs`, then tmp = L_bot xs (m rows; one contiguous axpy per column). The
-/// block is column-major (k + m) × k.
-#[inline]
+/// block is column-major (k + m) × k. Dispatched (`crate::simd`): the
+/// loops vectorize as wide as the CPU allows, with the same operations.
 fn block_forward(block: &[f64], xs: &mut [f64], tmp: &mut [f64]) {
+    struct Forward<'a>(&'a [f64], &'a mut [f64], &'a mut [f64]);
+    impl crate::simd::Kernel for Forward<'_> {
+        type Output = ();
+        #[inline(always)]
+        fn run<S: crate::simd::Simd>(self, _simd: S) {
+            block_forward_body(self.0, self.1, self.2)
+        }
+    }
+    crate::simd::vectorized(Forward(block, xs, tmp))
+}
+
+#[inline(always)]
+fn block_forward_body(block: &[f64], xs: &mut [f64], tmp: &mut [f64]) {
     let k = xs.len();
     let ld = k + tmp.len();
     for j in 0..k {
@@ -920,9 +933,22 @@ fn block_forward(block: &[f64], xs: &mut [f64], tmp: &mut [f64]) {
 }
 
 /// A supernode's back step: xs −= L_botᵀ tmp (tmp = the pattern rows of
-/// x), then the k × k transposed triangle.
-#[inline]
+/// x), then the k × k transposed triangle. Dispatched as
+/// [`block_forward`].
 fn block_backward(block: &[f64], xs: &mut [f64], tmp: &[f64]) {
+    struct Backward<'a>(&'a [f64], &'a mut [f64], &'a [f64]);
+    impl crate::simd::Kernel for Backward<'_> {
+        type Output = ();
+        #[inline(always)]
+        fn run<S: crate::simd::Simd>(self, _simd: S) {
+            block_backward_body(self.0, self.1, self.2)
+        }
+    }
+    crate::simd::vectorized(Backward(block, xs, tmp))
+}
+
+#[inline(always)]
+fn block_backward_body(block: &[f64], xs: &mut [f64], tmp: &[f64]) {
     let k = xs.len();
     let ld = k + tmp.len();
     if !tmp.is_empty() {
@@ -939,7 +965,7 @@ fn block_backward(block: &[f64], xs: &mut [f64], tmp: &[f64]) {
 
 /// Σ aᵢbᵢ with four independent partial sums (the adder's latency, not
 /// memory, would bind a single chain).
-#[inline]
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let mut acc = [0.0; 4];
     let (a4, ar) = a.split_at(a.len() - a.len() % 4);
