@@ -40,14 +40,6 @@ impl Product {
         }
     }
 
-    /// The stencil types, if the product is by them.
-    pub fn types(&self) -> Option<&Stencils> {
-        match self {
-            Product::Stencils(s) => Some(s),
-            _ => None,
-        }
-    }
-
     /// Rows.
     pub fn n(&self) -> usize {
         match self {

@@ -3,9 +3,10 @@
 //! AVX2 with FMA on x86-64, else the baseline) and run as the CPU allows.
 //! Kernels are plain loops, or pulp's safe vector operations on the token
 //! they are handed; every function they call is `#[inline(always)]` so that
-//! it is compiled inside the dispatched one. Products and sums stay separate
-//! IEEE operations (Rust never contracts them into a fused multiply-add, and
-//! the kernels call no `mul_add`), so the same bits on every CPU.
+//! it is compiled inside the dispatched one. Rust never contracts a product
+//! and a sum into a fused multiply-add: a kernel fuses only where it asks
+//! to (`mul_add`), and then on every path, the scalar one included, so the
+//! same bits on every CPU.
 
 pub use pulp::Simd;
 

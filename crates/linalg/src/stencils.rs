@@ -14,8 +14,8 @@
 //! Where the CPU's vectors hold w ≥ 4 doubles, w/2 consecutive node pairs
 //! (a *unit*, typed by its groups' types) are summed as one vector of w
 //! rows ([`Units`]): per block of the unit's types (the union of their
-//! offsets) a product with the diagonal terms and two with the other
-//! column's, each from a plain load of x shifted by one, so no shuffles.
+//! offsets) one load of x, a fused multiply-add with the diagonal terms,
+//! and one with the other column's on x with each pair of lanes swapped.
 //!
 //! Each row is summed in its type's block order whatever batch or thread
 //! computes it: the same bits on any number of threads. Not the bits of the
@@ -102,24 +102,25 @@ impl Stencils {
         // The types may hold at most 1/8 of the stored blocks: then they
         // and the 8 bytes per group are at most about a quarter of the
         // blocks' stream.
-        Stencils::build(a, tol, Some((a.nnz() / 32).max(64)))
+        Stencils::build(a, Some(tol), Some((a.nnz() / 32).max(64)))
     }
 
     /// Every node row its own type: K as 2×2 blocks with 32-bit column
     /// offsets, 36 bytes a block against the CSR's 64 (unstructured
     /// meshes), summed as the types are.
     pub fn node_blocks(a: &CsrMatrix<f64>) -> Option<Stencils> {
-        Stencils::build(a, -1.0, None)
+        Stencils::build(a, None, None)
     }
 
-    /// The types at tolerance `tol` (below 0: no two groups merged), or
+    /// The types at tolerance `tol` (`None`: no two groups merged), or
     /// `None` where they would hold more blocks than `limit`.
-    fn build(a: &CsrMatrix<f64>, tol: f64, limit: Option<usize>) -> Option<Stencils> {
+    fn build(a: &CsrMatrix<f64>, tol: Option<f64>, limit: Option<usize>) -> Option<Stencils> {
         let n = a.nrows();
         if n < 2 || a.ncols() != n || n >= i32::MAX as usize {
             return None;
         }
-        let merge = tol >= 0.0;
+        let merge = tol.is_some();
+        let tol = tol.unwrap_or(0.0);
         let limit = limit.unwrap_or(usize::MAX);
         let max = a.values().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let tol = tol * max;
