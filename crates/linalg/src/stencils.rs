@@ -343,9 +343,24 @@ impl Stencils {
                 let id = if g + h <= g1 { u.of_group[g] } else { NO_UNIT };
                 if id != NO_UNIT {
                     let o = r - base;
-                    let sums = unit_sums(simd, u, id, r, x);
-                    crate::simd::store::<S>(&mut out[o..o + w], sums);
-                    g += h;
+                    // Alike units in a row share each block's loads and
+                    // give the sums independent chains.
+                    let alike = |q: usize| g + (q + 1) * h <= g1 && u.of_group[g + q * h] == id;
+                    let q = if (1..4).all(alike) {
+                        let sums = unit_sums(simd, u, id, [r, r + w, r + 2 * w, r + 3 * w], x);
+                        store_units::<S, _>(&mut out[o..o + 4 * w], sums);
+                        4
+                    } else if alike(1) {
+                        store_units::<S, _>(
+                            &mut out[o..o + 2 * w],
+                            unit_sums(simd, u, id, [r, r + w], x),
+                        );
+                        2
+                    } else {
+                        store_units::<S, _>(&mut out[o..o + w], unit_sums(simd, u, id, [r], x));
+                        1
+                    };
+                    g += q * h;
                     continue;
                 }
             }
@@ -427,31 +442,49 @@ impl Stencils {
     }
 
     /// (K x)_i for each i of `rows` into `out`, with the bits the batches
-    /// give them; a node's two rows from one sum of its group.
+    /// give them. Rows of consecutive groups (a contact face along a node
+    /// row of the grid) are summed as a batch is, in units where the
+    /// CPU's vectors allow, up to [`BATCH`] rows at a time.
     pub fn rows(&self, rows: &[usize], x: &[f64], out: &mut [f64]) {
         // Dispatched, so that the fused terms are the CPU's instruction.
         struct Rows<'a>(&'a Stencils, &'a [usize], &'a [f64], &'a mut [f64]);
         impl Kernel for Rows<'_> {
             type Output = ();
             #[inline(always)]
-            fn run<S: crate::simd::Simd>(self, _simd: S) {
+            fn run<S: crate::simd::Simd>(self, simd: S) {
                 let Rows(k, rows, x, out) = self;
-                let mut last: Option<(usize, [f64; 2])> = None;
-                for (o, &i) in out.iter_mut().zip(rows) {
-                    let g = match last {
-                        Some((g, _))
-                            if k.group_rows[g] as usize <= i
-                                && i < k.group_rows[g + 1] as usize =>
+                let starts = &k.group_rows;
+                let group_of = |i: usize| starts.partition_point(|&r| r as usize <= i) - 1;
+                let mut buf = [0.0; BATCH];
+                let mut j = 0;
+                while j < rows.len() {
+                    // The run of groups g0..g1 from row j's group on that
+                    // holds rows j..e, each in its predecessor's group or the
+                    // next, within BATCH rows.
+                    let g0 = group_of(rows[j]);
+                    let base = starts[g0] as usize;
+                    let (mut g1, mut e) = (g0 + 1, j + 1);
+                    while e < rows.len() {
+                        let i = rows[e];
+                        if i >= base && i < starts[g1] as usize {
+                            e += 1;
+                        } else if g1 < starts.len() - 1
+                            && i >= starts[g1] as usize
+                            && i < starts[g1 + 1] as usize
+                            && starts[g1 + 1] as usize - base <= BATCH
                         {
-                            g
+                            g1 += 1;
+                            e += 1;
+                        } else {
+                            break;
                         }
-                        _ => {
-                            let g = k.group_rows.partition_point(|&r| r as usize <= i) - 1;
-                            last = Some((g, k.group_sums(g, x)));
-                            g
-                        }
-                    };
-                    *o = last.expect("set above").1[i - k.group_rows[g] as usize];
+                    }
+                    let len = starts[g1] as usize - base;
+                    k.groups_into(simd, g0, g1, x, &mut buf[..len]);
+                    for (o, &i) in out[j..e].iter_mut().zip(&rows[j..e]) {
+                        *o = buf[i - base];
+                    }
+                    j = e;
                 }
             }
         }
@@ -477,26 +510,44 @@ impl Kernel for Groups<'_> {
     }
 }
 
-/// The sums of the w rows of unit `id` from row r: per row its own
+/// Stores consecutive units' sums into `out` (w doubles each), in order.
+#[inline(always)]
+fn store_units<S: crate::simd::Simd, const Q: usize>(out: &mut [f64], sums: [S::f64s; Q]) {
+    for (o, s) in out.chunks_exact_mut(S::F64_LANES).zip(sums) {
+        crate::simd::store::<S>(o, s);
+    }
+}
+
+/// The sums of the w rows of unit `id` from each row of `rows`, in
+/// lockstep (each block's lanes loaded once for all): per row its own
 /// column's terms and the other column's in two fused sums, in the unit's
 /// block order, added at the end, as [`Stencils::lockstep`] sums them (a
 /// lane's zero terms add ±0 to a sum that started at +0, which changes no
-/// bit). The other column's x is the own column's with each pair of lanes
-/// swapped.
+/// bit), so the same bits whatever Q. The other column's x is the own
+/// column's with each pair of lanes swapped.
 #[inline(always)]
-fn unit_sums<S: crate::simd::Simd>(simd: S, u: &Units, id: u32, r: usize, x: &[f64]) -> S::f64s {
+fn unit_sums<S: crate::simd::Simd, const Q: usize>(
+    simd: S,
+    u: &Units,
+    id: u32,
+    rows: [usize; Q],
+    x: &[f64],
+) -> [S::f64s; Q] {
     let w = S::F64_LANES;
     let b = u.blocks[id as usize] as usize..u.blocks[id as usize + 1] as usize;
     let load = crate::simd::load::<S>;
-    let (mut own, mut other) = (simd.splat_f64s(0.0), simd.splat_f64s(0.0));
+    let (mut own, mut other) = ([simd.splat_f64s(0.0); Q], [simd.splat_f64s(0.0); Q]);
     let lanes = u.lanes[2 * w * b.start..2 * w * b.end].chunks_exact(2 * w);
     for (&o, l) in u.offsets[b].iter().zip(lanes) {
-        let c = (r as isize + o as isize) as usize;
-        let xc = load(&x[c..c + w]);
-        own = simd.mul_add_f64s(load(&l[..w]), xc, own);
-        other = simd.mul_add_f64s(load(&l[w..]), crate::simd::swap_pairs(simd, xc), other);
+        let (diagonal, across) = (load(&l[..w]), load(&l[w..]));
+        for q in 0..Q {
+            let c = (rows[q] as isize + o as isize) as usize;
+            let xc = load(&x[c..c + w]);
+            own[q] = simd.mul_add_f64s(diagonal, xc, own[q]);
+            other[q] = simd.mul_add_f64s(across, crate::simd::swap_pairs(simd, xc), other[q]);
+        }
     }
-    simd.add_f64s(own, other)
+    std::array::from_fn(|q| simd.add_f64s(own[q], other[q]))
 }
 
 /// Groups K's rows by node: two consecutive rows with the same columns (a

@@ -230,6 +230,19 @@ fn vectors_have_the_scalar_bits_on_the_slabs() {
             );
             assert_eq!(vectors[i].to_bits(), rows[i].to_bits(), "q2 {q2}, row {i}");
         }
+        // Rows picked as a contact face's are (a node's x rows, runs of
+        // consecutive groups, in both directions, duplicates allowed).
+        for picked in [
+            (0..n).step_by(2).collect::<Vec<usize>>(),
+            (0..n).rev().step_by(3).collect(),
+            vec![5, 5, 6, 0, n - 1, 7, 8, 9, 200, 3],
+        ] {
+            let mut out = vec![f64::NAN; picked.len()];
+            s.rows(&picked, &x, &mut out);
+            for (&i, o) in picked.iter().zip(&out) {
+                assert_eq!(vectors[i].to_bits(), o.to_bits(), "q2 {q2}, picked row {i}");
+            }
+        }
     }
 }
 
