@@ -289,61 +289,64 @@ impl<S: Simd> Aligned<'_, '_, S> {
         let (cv, ca, scale, ratio) = (splat(s.cv), splat(s.ca), splat(s.scale), splat(s.ratio));
         let (c1, c2) = (splat(s.next[0]), splat(s.next[1]));
         let zero = splat(0.0);
+        // One pass over the rows, w at a time: their ṙ_K, the load and
+        // friction rows among them put in, then r̈_K, the predictor and the
+        // sums (each block's vectors k in lanes k·w...), the operands
+        // loaded once.
+        let (mut strain, mut kinetic, mut finite) = (self.strain, self.kinetic, self.finite);
         for j in (0..n).step_by(w) {
-            let at = j..j + w;
+            let (at, k) = (j..j + w, j % LANES / w);
             let (mj, vj, aj) = (
                 load::<S>(&m[at.clone()]),
                 load::<S>(&v[at.clone()]),
                 load::<S>(&a[at.clone()]),
             );
+            let (kj, rnj) = (load::<S>(&ku[at.clone()]), load::<S>(&rn[at.clone()]));
             // R̂_K as StepData::rhs forms it from R_K = +0, then ṙ_K =
             // R̂_K/(m·scale).
             let rhs = simd.add_f64s(
-                simd.sub_f64s(zero, load::<S>(&ku[at.clone()])),
+                simd.sub_f64s(zero, kj),
                 simd.mul_f64s(
                     mj,
                     simd.add_f64s(simd.mul_f64s(cv, vj), simd.mul_f64s(ca, aj)),
                 ),
             );
-            store::<S>(&mut vn[at], simd.div_f64s(rhs, simd.mul_f64s(mj, scale)));
-        }
-        while rows.next_load < s.load_rows.len() && s.load_rows[rows.next_load] < range.end {
-            let i = s.load_rows[rows.next_load];
-            vn[i - r0] = s.rhs(i, ku[i - r0]) / (m[i - r0] * s.scale);
-            rows.next_load += 1;
-        }
-        while rows.next < rows.friction.len() && rows.friction[rows.next].0 < range.end {
-            let (i, vi) = rows.friction[rows.next];
-            vn[i - r0] = vi;
-            rows.next += 1;
-        }
-        // Local sums (registers), each block's vectors k in lanes k·w...
-        let (mut strain, mut kinetic, mut finite) = (self.strain, self.kinetic, self.finite);
-        for block in (0..n).step_by(LANES) {
-            for k in 0..LANES / w {
-                let at = block + k * w..block + (k + 1) * w;
-                let (vj, aj) = (load::<S>(&v[at.clone()]), load::<S>(&a[at.clone()]));
-                let (vnj, rnj) = (load::<S>(&vn[at.clone()]), load::<S>(&rn[at.clone()]));
-                let anj = simd.sub_f64s(
-                    simd.mul_f64s(simd.sub_f64s(vnj, vj), scale),
-                    simd.mul_f64s(ratio, aj),
-                );
-                store::<S>(&mut an[at.clone()], anj);
-                // predict's r + c1 ṙ + c2 r̈, for r_K, ṙ_K, r̈_K.
-                let next = simd.add_f64s(
-                    simd.add_f64s(rnj, simd.mul_f64s(c1, vnj)),
-                    simd.mul_f64s(c2, anj),
-                );
-                store::<S>(&mut rx[at.clone()], next);
-                finite = simd.add_f64s(
-                    finite,
-                    simd.add_f64s(simd.mul_f64s(rnj, zero), simd.mul_f64s(vnj, zero)),
-                );
-                strain[k] =
-                    simd.add_f64s(strain[k], simd.mul_f64s(rnj, load::<S>(&ku[at.clone()])));
-                let mv = simd.mul_f64s(load::<S>(&m[at]), vnj);
-                kinetic[k] = simd.add_f64s(kinetic[k], simd.mul_f64s(mv, vnj));
+            let mut vnj = simd.div_f64s(rhs, simd.mul_f64s(mj, scale));
+            store::<S>(&mut vn[at.clone()], vnj);
+            let end = range.start + j + w;
+            let loads = rows.next_load < s.load_rows.len() && s.load_rows[rows.next_load] < end;
+            let nodal = rows.next < rows.friction.len() && rows.friction[rows.next].0 < end;
+            if loads || nodal {
+                while rows.next_load < s.load_rows.len() && s.load_rows[rows.next_load] < end {
+                    let i = s.load_rows[rows.next_load];
+                    vn[i - r0] = s.rhs(i, ku[i - r0]) / (m[i - r0] * s.scale);
+                    rows.next_load += 1;
+                }
+                while rows.next < rows.friction.len() && rows.friction[rows.next].0 < end {
+                    let (i, vi) = rows.friction[rows.next];
+                    vn[i - r0] = vi;
+                    rows.next += 1;
+                }
+                vnj = load::<S>(&vn[at.clone()]);
             }
+            let anj = simd.sub_f64s(
+                simd.mul_f64s(simd.sub_f64s(vnj, vj), scale),
+                simd.mul_f64s(ratio, aj),
+            );
+            store::<S>(&mut an[at.clone()], anj);
+            // predict's r + c1 ṙ + c2 r̈, for r_K, ṙ_K, r̈_K.
+            let next = simd.add_f64s(
+                simd.add_f64s(rnj, simd.mul_f64s(c1, vnj)),
+                simd.mul_f64s(c2, anj),
+            );
+            store::<S>(&mut rx[at], next);
+            finite = simd.add_f64s(
+                finite,
+                simd.add_f64s(simd.mul_f64s(rnj, zero), simd.mul_f64s(vnj, zero)),
+            );
+            strain[k] = simd.add_f64s(strain[k], simd.mul_f64s(rnj, kj));
+            let mv = simd.mul_f64s(mj, vnj);
+            kinetic[k] = simd.add_f64s(kinetic[k], simd.mul_f64s(mv, vnj));
         }
         (self.strain, self.kinetic, self.finite) = (strain, kinetic, finite);
     }
