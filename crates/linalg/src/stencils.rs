@@ -47,7 +47,7 @@ const COARSE: f64 = (1u64 << 24) as f64;
 
 /// Rows per batch of [`Stencils::batches`]: small enough to stay in L1
 /// between the product and the caller's per-row work.
-pub const BATCH: usize = 64;
+pub const BATCH: usize = 256;
 
 /// K by stencil types (module documentation).
 #[derive(Clone, Debug)]
