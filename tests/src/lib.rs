@@ -9,6 +9,8 @@
 //!   paper's slab on a committed mesh;
 //! * [`wave`] and [`sdof`]: the two dynamic problems with a closed form,
 //!   the 1-D wave (d'Alembert) and the single-DOF friction oscillator;
+//! * [`strip`]: a thin strip on a rough base pulled at one end, the
+//!   shear-lag problem of quasi-static friction and its 1-D closed form;
 //! * [`manufactured`]: the static manufactured solution of the fem
 //!   convergence test and verify's rates suite;
 //! * [`reference`](mod@reference): the plain sparse product and runs on
@@ -27,6 +29,7 @@ pub mod paths;
 pub mod reference;
 pub mod scene;
 pub mod sdof;
+pub mod strip;
 pub mod wave;
 
 pub use grid::{add_point_group, map_nodes, rectangle, slab, structured_slab};

@@ -9,9 +9,13 @@ use plotters::prelude::*;
 
 use crate::plotting::{axes, register_font, AxesStyle, COLORS};
 use crate::scene::Trace;
-use crate::{run_cases, Run};
+use crate::{run_cases, PaperCase, Run};
 
-/// One curve: legend label, points, colour index.
+/// The colour index of a curve drawn thick and black, apart from the
+/// palette: a reference the others are compared with.
+const REFERENCE: usize = usize::MAX;
+
+/// One curve: legend label, points, colour index (or [`REFERENCE`]).
 #[derive(Debug)]
 struct Series {
     label: String,
@@ -84,16 +88,20 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure) -> Resul
         )
         .map_err(err)?;
         for s in &p.series {
-            let color = COLORS[s.color % COLORS.len()];
+            let (color, width) = if s.color == REFERENCE {
+                (BLACK, 3)
+            } else {
+                (COLORS[s.color % COLORS.len()], 2)
+            };
             chart
                 .draw_series(LineSeries::new(
                     s.points.iter().copied(),
-                    color.stroke_width(2),
+                    color.stroke_width(width),
                 ))
                 .map_err(err)?
                 .label(s.label.as_str())
                 .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(2))
+                    PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(width))
                 });
         }
         chart
@@ -181,7 +189,34 @@ fn energy(t: &Trace, f: fn(&stickslip_time::Energy) -> f64) -> Vec<f64> {
     t.energy.iter().map(f).collect()
 }
 
-fn figures(runs: &[Run]) -> Result<Vec<Figure>, String> {
+/// The static curve of Fig. 5: σ_T along Γ_C at the end of the
+/// quasi-static run (the full load).
+fn static_distribution(t: &Trace, label: &str, color: usize) -> Series {
+    let last = t.sigma_all.last().cloned().unwrap_or_default();
+    let mut points: Vec<(f64, f64)> = t.contact_x.iter().copied().zip(last).collect();
+    points.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Series {
+        label: label.to_string(),
+        points,
+        color,
+    }
+}
+
+/// Reads and runs the static case of Fig. 5 (`STATIC_CASE`).
+fn static_run(root: &Path) -> Result<Trace, String> {
+    let case = PaperCase::read(&root.join(STATIC_CASE))?;
+    let trace = crate::scene::run(&case.scene()?);
+    match trace.error {
+        Some(e) => Err(format!("{STATIC_CASE}: {e}")),
+        None => Ok(trace),
+    }
+}
+
+/// The paper's Fig. 5 static analysis: the slab under t_x = 300 (twice the
+/// dynamic runs' end load), by quasi-static increments.
+pub const STATIC_CASE: &str = "cases/quasi-static/slab-static-tx300.toml";
+
+fn figures(runs: &[Run], static_trace: &Trace) -> Result<Vec<Figure>, String> {
     let eps_cases = [
         ("cd-step-eps1", "ε = 1"),
         ("cd-step-eps1e-2", "ε = 1e-2"),
@@ -244,11 +279,18 @@ fn figures(runs: &[Run]) -> Result<Vec<Figure>, String> {
     // Friction-stress distribution along Γ_C at several times.
     let t = trace(runs, "cd-step-eps1e-4")?;
     let times = [0.005, 0.02, 0.05, 0.1, 0.2, 0.5];
+    let mut curves = distribution(t, &times);
+    // Fig. 5 also plots the static analysis under t_x = 300.
+    curves.push(static_distribution(
+        static_trace,
+        "static, |t_x| = 300 (quasi-static, ε = 1e-4)",
+        REFERENCE,
+    ));
     let mut p1 = panel(
-        "Friction stress along Γ_C, central difference, ε = 1e-4, θ = H(t)",
+        "Friction stress along Γ_C, central difference, ε = 1e-4, θ = H(t), and static (cf. Fig. 5)",
         "σ_T",
         Some((-20.0, 100.0)),
-        distribution(t, &times),
+        curves,
     );
     p1.x_label = "x along Γ_C".into();
     p1.legend = SeriesLabelPosition::UpperLeft;
@@ -423,8 +465,9 @@ pub fn draw_all(root: &Path, out: &Path) -> Result<Vec<PathBuf>, String> {
     register_font()?;
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let runs = run_cases(root, None, &[])?;
+    let static_trace = static_run(root)?;
     let mut written = Vec::new();
-    for fig in figures(&runs)? {
+    for fig in figures(&runs, &static_trace)? {
         let height = 360 * fig.panels.len() as u32 + 40;
         let png = out.join(format!("{}.png", fig.stem));
         draw(

@@ -61,6 +61,7 @@ impl Fault {
                     }
                 }
                 Scheme::Newmark { .. } => scene.settings.mass = Some(MassKind::Lumped),
+                Scheme::QuasiStatic => {}
             },
         }
     }
@@ -169,7 +170,7 @@ pub fn run(scene: &Scene) -> Trace {
             return trace;
         }
     };
-    trace.mass = Some(integ.mass_kind());
+    trace.mass = integ.mass_kind();
     let mut sigma = vec![0.0; contact.len()];
     let mut slip = vec![0.0; contact.len()];
     let mut record = |i: &Integrator, dt: f64, trace: &mut Trace| {

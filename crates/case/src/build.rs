@@ -148,6 +148,7 @@ pub fn settings(case: &Case) -> Settings {
             beta: case.time.beta,
             gamma: case.time.gamma,
         },
+        Scheme::QuasiStatic => TimeScheme::QuasiStatic,
     };
     Settings {
         scheme,
@@ -336,8 +337,15 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
         // supports alone must hold the body (DofMap checks each connected part).
         let free = m.dofs.free_rigid_motions();
         if !free.is_empty() {
+            // Quasi-static increments factorize Δt K as well: friction
+            // does not stand in for a support there either.
+            let increments = if case.time.scheme == Scheme::QuasiStatic {
+                " and for the quasi-static increments (friction does not hold a body without supports)"
+            } else {
+                ""
+            };
             problems.push(format!(
-                "{dirichlet_at}the supports leave a rigid-body motion free for the initial static solve: {}; \
+                "{dirichlet_at}the supports leave a rigid-body motion free for the initial static solve{increments}: {}; \
                  add [[dirichlet]] conditions that prevent it (e.g. uy = 0 on a bottom or top group and ux = 0 on an end)",
                 free.join(", ")
             ));

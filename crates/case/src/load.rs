@@ -417,8 +417,8 @@ fn complete(
             format!("newmark with beta = {beta}, gamma = {gamma} is not unconditionally stable (needs 2*beta >= gamma >= 0.5); use e.g. beta = 0.25, gamma = 0.5 (trapezoidal) or beta = 0.3025, gamma = 0.6 (damped)"),
         );
     }
-    if tm.scheme == Scheme::CentralDifference {
-        // Newmark's parameters on an explicit run would be ignored
+    if tm.scheme != Scheme::Newmark {
+        // Newmark's parameters on another scheme would be ignored
         // silently: say so (a Newmark case switched by --set keeps them).
         for key in ["beta", "gamma"] {
             let dotted = format!("time.{key}");
@@ -427,8 +427,9 @@ fn complete(
                     false,
                     &dotted,
                     format!(
-                        "time.{key} is a Newmark parameter; scheme = \"central_difference\" has none: \
-                         remove it, or use scheme = \"newmark\""
+                        "time.{key} is a Newmark parameter; scheme = \"{}\" has none: \
+                         remove it, or use scheme = \"newmark\"",
+                        tm.scheme.name()
                     ),
                 );
             }
@@ -439,6 +440,13 @@ fn complete(
             m == MassKind::Lumped,
             "time.mass",
             "central_difference needs mass = \"lumped\" (with a consistent mass it is no longer explicit); remove the key or use scheme = \"newmark\"".into(),
+        );
+    }
+    if let (Scheme::QuasiStatic, Some(_)) = (tm.scheme, tm.mass) {
+        check(
+            false,
+            "time.mass",
+            "quasi_static increments have no inertia, so no mass: remove time.mass".into(),
         );
     }
     if let Some(r) = &tm.stick_reduction {

@@ -355,10 +355,23 @@ pub enum Scheme {
     CentralDifference,
     /// Implicit Newmark (β, γ).
     Newmark,
+    /// Load increments without inertia, friction on the increments' rate.
+    QuasiStatic,
 }
 
 impl Schema for Scheme {
     const KIND: Kind = Kind::Variant("central_difference");
+}
+
+impl Scheme {
+    /// The value `time.scheme` takes for it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Scheme::CentralDifference => "central_difference",
+            Scheme::Newmark => "newmark",
+            Scheme::QuasiStatic => "quasi_static",
+        }
+    }
 }
 
 /// Mass matrix kind.
@@ -397,7 +410,7 @@ fn default_gamma() -> f64 {
 section! {
     /// `[time]`.
     pub struct TimeSection {
-        /// Central difference or Newmark.
+        /// Central difference, Newmark, or quasi-static increments.
         "scheme" scheme: Scheme,
         /// Newmark β (default 0.25; refused for central difference).
         #[serde(default = "default_beta")]

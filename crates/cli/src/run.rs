@@ -86,7 +86,7 @@ fn setup_note(scene: &Scene, started: Instant) {
         (Scheme::CentralDifference, false) => format!(
             "the initial state (a static solve by sparse Cholesky, ordered by {order}, when loads act before t = 0) and the step's operators"
         ),
-        (Scheme::Newmark { .. }, _) => format!(
+        (Scheme::Newmark { .. } | Scheme::QuasiStatic, _) => format!(
             "the factor of the step's operator (sparse Cholesky, ordered by {order}) and the initial state"
         ),
     };
@@ -136,10 +136,15 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     }
     // The explicit integrator computed it already (by its own K·x);
     // Newmark's did not.
+    // Quasi-static increments have no inertia: no critical step, no
+    // vibration to resolve.
+    let quasi_static = case.time.scheme == case::Scheme::QuasiStatic;
     let crit = i.dt_crit().unwrap_or_else(|| {
         stickslip_time::stability::critical_step(&p.model.stiffness, &p.model.lumped_mass)
     });
-    println!("dt_crit     {crit:.6e} (central difference, lumped mass: 2/omega_max)");
+    if !quasi_static {
+        println!("dt_crit     {crit:.6e} (central difference, lumped mass: 2/omega_max)");
+    }
     // As the integrator counts: a last step within 1e-6 Δt of t_end is
     // not a step of its own.
     let steps = (case.time.t_end / case.time.dt - 1e-6).ceil().max(1.0);
@@ -167,6 +172,13 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
             p.model.stiffness.nnz(),
             i.stiffness_product()
         );
+    } else if quasi_static {
+        let n_c = i.contact().map_or(0, |c| c.len());
+        println!(
+            "solver      quasi-static increments (no inertia): sparse Cholesky (faer, {}) of dt·K, analysed once, factorized once per distinct dt; friction on the {n_c} contact unknowns by the Schur complement; nnz(K) = {}",
+            p.model.fill_order.name(),
+            p.model.stiffness.nnz(),
+        );
     } else {
         let n_c = i.contact().map_or(0, |c| c.len());
         println!(
@@ -180,7 +192,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         "steps       about {steps} to t_end = {} with dt = {:e}",
         case.time.t_end, case.time.dt
     );
-    if !i.is_explicit() {
+    if !i.is_explicit() && !quasi_static {
         // Stability is no guide for an implicit step: say what it resolves.
         println!(
             "accuracy    Newmark is stable at any dt, but follows a vibration only when its period spans \

@@ -94,6 +94,46 @@ fn every_paper_case_runs_and_writes_the_documented_layout() {
     }
 }
 
+const STATIC_CHECK: &str = r#"
+import sys, h5py, numpy as np
+f = h5py.File(sys.argv[1], "r")
+assert f.attrs["complete"] == True, "complete"
+t, u, v, a = f["time"][:], f["displacement"][:], f["velocity"][:], f["acceleration"][:]
+assert abs(t[-1] - 1.0) < 1e-12 and len(t) == 21, t
+# No inertia: r̈ = 0 and nothing kinetic; ṙ is the last increment over Δt.
+assert np.all(a == 0.0)
+assert np.all(f["energy/kinetic"][:] == 0.0)
+inc = (u[-1] - u[-2]) / (t[-1] - t[-2])
+assert np.max(np.abs(v[-1] - inc)) <= 1e-9 * np.max(np.abs(inc)), "velocity = increment / dt"
+strain = f["energy/strain"][:]
+assert np.max(np.abs(f["energy/balance"][:])) <= 1e-12 * np.max(strain) * len(t)
+assert f["energy/dissipated"][-1] > 0.0
+# |σ_T| ≤ g = 90, and the corner at the loaded end, (8, 0), slips under
+# the compressive load: σ_T = +g there.
+s = f["contact/friction_stress"][-1]
+assert np.max(np.abs(s)) <= 90.0 * (1 + 1e-12), s
+x = f["mesh/nodes"][:][f["contact/nodes"][:]]
+corner = np.argmin(np.hypot(x[:, 0] - 8.0, x[:, 1]))
+assert abs(s[corner] - 90.0) <= 1e-9 * 90.0, s[corner]
+print("ok")
+"#;
+
+#[test]
+fn the_static_case_runs_without_inertia_and_closes_its_ledger() {
+    let dir = scratch("static");
+    let case = root().join("cases/quasi-static/slab-static-tx300.toml");
+    let out = dir.join("static.h5");
+    let run = run(&case, &out, &["--force", "--quiet"]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    if let Some(stdout) = python_h5py(STATIC_CHECK, &[out.to_str().unwrap()]) {
+        assert!(stdout.contains("ok"), "{stdout}");
+    }
+}
+
 /// Writes a variant of the paper's first case with `edit` applied to its text.
 fn variant(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
     let base =

@@ -289,6 +289,41 @@ fn supports_that_leave_a_rigid_motion_free_are_refused() {
 }
 
 #[test]
+fn quasi_static_with_a_motion_only_friction_would_hold_is_refused() {
+    // The slab pressed on its rough base without the left end's ux = 0:
+    // friction (g = 90 over Γ_C) would hold it in x, but quasi-static
+    // increments factorize Δt K, so the supports must hold every motion;
+    // refused before any work, the motion named, at the [[dirichlet]].
+    let dir = scratch("rigid-qs");
+    let (case, text) = slab_case(&dir, "rigid", |t| {
+        t.replace(
+            "[[dirichlet]]        # the left end is held in x\ngroup = \"left\"\nux = 0.0\n",
+            "",
+        )
+        .replace(
+            "scheme = \"central_difference\"",
+            "scheme = \"quasi_static\"",
+        )
+    });
+    assert!(
+        text.contains("quasi_static"),
+        "the template's scheme changed"
+    );
+    let e = refused(
+        &case,
+        &[],
+        &[
+            "rigid-body motion free",
+            "quasi-static increments",
+            "translation in x",
+        ],
+    );
+    // At the first [[dirichlet]]'s group.
+    let line = line_of(&text, "[[dirichlet]]") + 1;
+    assert!(e.contains(&format!("rigid.toml:{line}:")), "{e}");
+}
+
+#[test]
 fn a_missing_mesh_file_is_refused() {
     let dir = scratch("nomesh");
     let (case, text) = slab_case(&dir, "nomesh", |t| {

@@ -348,8 +348,8 @@ impl Stepper for CentralDifference {
         true
     }
 
-    fn mass_kind(&self) -> MassKind {
-        MassKind::Lumped
+    fn mass_kind(&self) -> Option<MassKind> {
+        Some(MassKind::Lumped)
     }
 
     fn stiffness_product(&self) -> &'static str {

@@ -18,6 +18,8 @@ pub(crate) enum Mass<'a> {
     Lumped(&'a [f64]),
     /// The consistent mass.
     Consistent(&'a CsrMatrix<f64>),
+    /// No mass (quasi-static increments): r̈₀ = 0, nothing kinetic.
+    Massless,
 }
 
 impl Mass<'_> {
@@ -26,6 +28,7 @@ impl Mass<'_> {
         match self {
             Mass::Lumped(m) => x.iter().zip(*m).map(|(v, m)| m * v * v).sum(),
             Mass::Consistent(m) => quadratic_form(m, x, partials),
+            Mass::Massless => 0.0,
         }
     }
 }
@@ -79,6 +82,7 @@ pub(crate) fn initial_state(
             state.a.copy_from_slice(&rhs);
             solver.solve_in_place(&mut state.a);
         }
+        Mass::Massless => {}
     }
     if let Some(c) = contact {
         c.classify(&state.v, &mut state.classes);

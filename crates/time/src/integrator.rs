@@ -8,7 +8,7 @@ use crate::dynamics::{Dynamics, Load, Loads};
 use crate::settings::{ImplicitSolver, MassKind, Scheme, Settings, TimeError};
 use crate::state::{Checkpoint, Energy, State, StepInfo};
 use crate::stepper::{Run, Stepper};
-use crate::{central_difference, newmark};
+use crate::{central_difference, newmark, quasi_static};
 
 /// Integrates from the initial state to `t_end`, one step per call.
 pub struct Integrator {
@@ -66,6 +66,9 @@ impl Integrator {
                 &loads,
                 &settings,
             )?,
+            Scheme::QuasiStatic => {
+                quasi_static::start(dynamics, contact.as_ref(), &loads, &settings)?
+            }
         };
         Ok(Integrator {
             run: Run {
@@ -218,8 +221,8 @@ impl Integrator {
     pub fn is_explicit(&self) -> bool {
         self.stepper.is_explicit()
     }
-    /// The mass the scheme uses.
-    pub fn mass_kind(&self) -> MassKind {
+    /// The mass the scheme uses; `None` for quasi-static increments.
+    pub fn mass_kind(&self) -> Option<MassKind> {
         self.stepper.mass_kind()
     }
     /// Friction stress σ_T = −g φ_ε(v_T) at each contact node.

@@ -6,7 +6,8 @@
 //! its nodal friction solved in closed form (`central_difference.rs`), and
 //! Newmark (β, γ) written with the velocity as the unknown (`newmark/`),
 //! its friction by the Schur complement on the contact DOFs or, as the
-//! reference, by refactorizing A₀ + C per stuck set. Also the consistent
+//! reference, by refactorizing A₀ + C per stuck set; and quasi-static load
+//! increments (`quasi_static.rs`), the same solve without mass. Also the consistent
 //! initial state (Remark 4.1, `initial.rs`), the step reduction after
 //! sticking (Remark 4.3), the critical step of the explicit scheme
 //! (`stability.rs`) and the energy ledger. It works on free-DOF vectors
@@ -27,6 +28,7 @@ mod initial;
 mod integrator;
 mod newmark;
 mod nodal;
+mod quasi_static;
 mod settings;
 pub mod stability;
 mod state;

@@ -17,14 +17,18 @@ pub enum Scheme {
         /// γ.
         gamma: f64,
     },
+    /// Load increments without inertia (`quasi_static.rs`): each step the
+    /// static problem with friction on the increment's rate.
+    QuasiStatic,
 }
 
 impl Scheme {
-    /// (β, γ).
+    /// (β, γ); NaN for quasi-static increments, which have none.
     pub fn parameters(self) -> (f64, f64) {
         match self {
             Scheme::CentralDifference => (0.0, 0.5),
             Scheme::Newmark { beta, gamma } => (beta, gamma),
+            Scheme::QuasiStatic => (f64::NAN, f64::NAN),
         }
     }
 }
@@ -124,7 +128,8 @@ impl Settings {
     }
 
     /// Checks the settings for a model of `n` free DOFs and returns the
-    /// mass the scheme uses.
+    /// mass the scheme uses (quasi-static increments use none; the value
+    /// is then unused).
     ///
     /// # Errors
     /// [`TimeError::Settings`] naming the setting and what to do.
@@ -178,6 +183,12 @@ impl Settings {
                 }
                 Ok(m.unwrap_or(MassKind::Consistent))
             }
+            (Scheme::QuasiStatic, None) => Ok(MassKind::Consistent),
+            (Scheme::QuasiStatic, Some(_)) => bad(
+                "time.mass with time.scheme = \"quasi_static\": quasi-static increments have no inertia; \
+                 remove time.mass"
+                    .into(),
+            ),
         }
     }
 }

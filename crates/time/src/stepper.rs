@@ -39,8 +39,8 @@ pub(crate) trait Stepper: Send {
     /// True when a step solves no linear system.
     fn is_explicit(&self) -> bool;
 
-    /// The mass the scheme uses.
-    fn mass_kind(&self) -> MassKind;
+    /// The mass the scheme uses (`None`: no inertia).
+    fn mass_kind(&self) -> Option<MassKind>;
 
     /// How a step forms its products with K (for messages and results).
     fn stiffness_product(&self) -> &'static str;

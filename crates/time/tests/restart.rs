@@ -47,7 +47,7 @@ fn assert_same_state(a: &Integrator, b: &Integrator, what: &str) {
 
 #[test]
 fn restored_runs_are_bit_identical_to_uninterrupted_ones() {
-    for scheme in [Scheme::CentralDifference, NEWMARK] {
+    for scheme in [Scheme::CentralDifference, NEWMARK, Scheme::QuasiStatic] {
         let s = paper_slab("slab-q2-8x2.msh", 1e-4, History::Step);
         let mut whole = s.integrator(settings(scheme, 0.5)).unwrap();
         finish(&mut whole);

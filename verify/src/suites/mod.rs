@@ -4,3 +4,4 @@ pub mod analytic;
 pub mod paper;
 pub mod rates;
 pub mod reference;
+pub mod strip;

@@ -115,6 +115,14 @@ fn check(o: &Options) -> anyhow::Result<()> {
 /// Input problems as [`InputError`]; pilot runs that fail; an unwritable output.
 pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
     check(o)?;
+    if case.time.scheme == stickslip_case::Scheme::QuasiStatic {
+        return Err(input(format!(
+            "{}time.scheme = \"quasi_static\": advise picks among the dynamic schemes (central \
+             difference, Newmark), Δt and ε by pilot runs; a quasi-static case has no such choice. \
+             Advise the dynamic case instead (e.g. --set time.scheme=\"central_difference\")",
+            case.at("time.scheme")
+        )));
+    }
     let json = o.json;
     let mut log = |l: &str| {
         if !json {

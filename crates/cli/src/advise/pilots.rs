@@ -116,6 +116,7 @@ pub fn run_traced(case: &Case, q: Quantity, at: Option<[f64; 2]>) -> anyhow::Res
             match case.time.scheme {
                 CaseScheme::CentralDifference => "central difference".to_string(),
                 CaseScheme::Newmark => format!("newmark {}/{}", case.time.beta, case.time.gamma),
+                CaseScheme::QuasiStatic => "quasi-static".to_string(),
             },
             case.time.dt,
         )

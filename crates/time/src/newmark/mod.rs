@@ -3,15 +3,17 @@
 //! stick/slip iteration of §5 on the friction. Two ways to solve a step:
 //! the Schur complement on the contact DOFs with A₀ factorized once per Δt
 //! (`schur.rs`, the default), or A₀ + C refactorized per stuck set
-//! (`direct.rs`, the reference).
+//! (`direct.rs`, the reference). [`ImplicitFriction`] is that solve of a
+//! step's velocity with its friction, which the quasi-static increments
+//! share (`quasi_static.rs`: the same system with M = 0).
 
 mod direct;
 mod schur;
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{iterate, stick_events, ContactSurface, SlipState};
-use stickslip_linalg::chunks;
 use stickslip_linalg::csr::{load_minus_k_plus_m, same_pattern, two_forms};
+use stickslip_linalg::{chunks, FillOrder};
 
 use crate::dynamics::{Dynamics, Loads};
 use crate::initial::{initial_state, Mass};
@@ -28,6 +30,16 @@ enum Solver {
     Direct(DirectOperator),
 }
 
+/// The velocity of an implicit step with its friction: for R̂ = b, the
+/// stick/slip iteration of §5 on (c_K K + c_M M + C) ṙ = b − F by the
+/// run's solver.
+pub(crate) struct ImplicitFriction {
+    solver: Solver,
+    /// The Schur path's nodal tangential velocities.
+    nodal_velocity: Vec<f64>,
+    iter_scratch: Vec<SlipState>,
+}
+
 /// The Newmark stepper.
 pub(crate) struct Newmark {
     beta: f64,
@@ -36,14 +48,11 @@ pub(crate) struct Newmark {
     k: CsrMatrix<f64>,
     /// The scheme's mass on K's pattern (the lumped one on the diagonal).
     m: CsrMatrix<f64>,
-    solver: Solver,
-    /// The Schur path's nodal tangential velocities.
-    nodal_velocity: Vec<f64>,
+    friction: ImplicitFriction,
     /// R̂_K, and M's vector of it.
     b: Vec<f64>,
     tmp: Vec<f64>,
     partials: Vec<[f64; 2]>,
-    iter_scratch: Vec<SlipState>,
 }
 
 /// Builds the stepper and the initial state.
@@ -81,55 +90,75 @@ pub(crate) fn start(
         }
     };
     assert!(same_pattern(&k, &m), "K and M share one pattern (fem)");
-    let use_paths = match settings.implicit_solver {
-        ImplicitSolver::SchurPaths => Some(true),
-        ImplicitSolver::SchurReach => Some(false),
-        _ => None,
-    };
-    let solver = match settings.implicit_solver {
-        ImplicitSolver::Schur | ImplicitSolver::SchurPaths | ImplicitSolver::SchurReach => {
-            Solver::Schur(
-                SchurOperator::new(&k, &fill_order, contact, use_paths)
-                    .map_err(TimeError::Static)?,
-            )
-        }
-        ImplicitSolver::Direct => Solver::Direct(
-            DirectOperator::new(&k, &fill_order, contact).map_err(TimeError::Static)?,
-        ),
-    };
+    let friction = ImplicitFriction::new(&k, &fill_order, contact, settings)?;
     let mass = match mass_kind {
         MassKind::Consistent => Mass::Consistent(&m),
         MassKind::Lumped => Mass::Lumped(&lumped_mass),
     };
     let state = initial_state(&k, mass, &fill_order, contact, loads, settings)?;
-    let n_c = contact.map_or(0, |c| c.len());
     let stepper = Newmark {
         beta,
         gamma,
         mass_kind,
         k,
         m,
-        solver,
-        nodal_velocity: vec![0.0; n_c],
+        friction,
         b: vec![0.0; n],
         tmp: vec![0.0; n],
         partials: chunks::partials(n),
-        iter_scratch: vec![SlipState::Stuck; n_c],
     };
     Ok((Box::new(stepper), state))
 }
 
-impl Newmark {
-    /// ṙ_K into `v_new` for R̂_K in `b`: the iteration of §5 with the
-    /// step's solver. Returns the linear solves made.
-    fn velocity(
+impl ImplicitFriction {
+    /// The settings' solver for K's pattern (which M shares), analysed
+    /// once for the run.
+    ///
+    /// # Errors
+    /// [`TimeError::Static`] when the analysis fails.
+    pub(crate) fn new(
+        k: &CsrMatrix<f64>,
+        fill_order: &FillOrder,
+        contact: Option<&ContactSurface>,
+        settings: &Settings,
+    ) -> Result<ImplicitFriction, TimeError> {
+        let use_paths = match settings.implicit_solver {
+            ImplicitSolver::SchurPaths => Some(true),
+            ImplicitSolver::SchurReach => Some(false),
+            _ => None,
+        };
+        let solver = match settings.implicit_solver {
+            ImplicitSolver::Schur | ImplicitSolver::SchurPaths | ImplicitSolver::SchurReach => {
+                Solver::Schur(
+                    SchurOperator::new(k, fill_order, contact, use_paths)
+                        .map_err(TimeError::Static)?,
+                )
+            }
+            ImplicitSolver::Direct => Solver::Direct(
+                DirectOperator::new(k, fill_order, contact).map_err(TimeError::Static)?,
+            ),
+        };
+        let n_c = contact.map_or(0, |c| c.len());
+        Ok(ImplicitFriction {
+            solver,
+            nodal_velocity: vec![0.0; n_c],
+            iter_scratch: vec![SlipState::Stuck; n_c],
+        })
+    }
+
+    /// ṙ into `v_new` for the right-hand side `b` and the operator
+    /// c_K K + c_M M (+ C): the iteration of §5 with the step's solver,
+    /// the operator's factor formed once per Δt. Returns the linear solves
+    /// made.
+    pub(crate) fn velocity(
         &mut self,
         run: &Run,
-        dt: f64,
+        (dt, c_k, k): (f64, f64, &CsrMatrix<f64>),
+        (c_m, m): (f64, &CsrMatrix<f64>),
+        b: &[f64],
         (classes_new, v_new): (&mut [SlipState], &mut [f64]),
         (step, t): (u64, f64),
     ) -> Result<usize, TimeError> {
-        let (c_k, c_m) = (self.beta / self.gamma * dt, 1.0 / (self.gamma * dt));
         let options = run.settings.iteration;
         let failed = |f| {
             TimeError::from_iteration(f, (step, t, options.remark_4_2), |source| {
@@ -138,13 +167,13 @@ impl Newmark {
         };
         match &mut self.solver {
             Solver::Schur(op) => {
-                op.set_dt(dt, c_k, &self.k, c_m, &self.m)
+                op.set_dt(dt, c_k, k, c_m, m)
                     .map_err(|source| TimeError::Solve { step, t, source })?;
                 if run.contact.is_none() {
-                    op.solve_plain(&self.b, v_new);
+                    op.solve_plain(b, v_new);
                     return Ok(1);
                 }
-                op.begin(&self.b);
+                op.begin(b);
                 let reduced = op
                     .reduced
                     .take()
@@ -163,16 +192,13 @@ impl Newmark {
                 Ok(report.iterations)
             }
             Solver::Direct(op) => {
-                op.set_dt(dt, c_k, &self.k, c_m, &self.m);
+                op.set_dt(dt, c_k, k, c_m, m);
                 let Some(contact) = &run.contact else {
-                    op.solve_plain(&self.b, v_new)
+                    op.solve_plain(b, v_new)
                         .map_err(|source| TimeError::Solve { step, t, source })?;
                     return Ok(1);
                 };
-                let mut system = ImplicitStep {
-                    operator: op,
-                    b: &self.b,
-                };
+                let mut system = ImplicitStep { operator: op, b };
                 let report = iterate(
                     contact,
                     &mut system,
@@ -184,6 +210,39 @@ impl Newmark {
                 .map_err(failed)?;
                 Ok(report.iterations)
             }
+        }
+    }
+
+    /// Numeric factorizations so far.
+    pub(crate) fn factorizations(&self) -> u64 {
+        match &self.solver {
+            Solver::Schur(op) => op.factorizations,
+            Solver::Direct(op) => op.factorizations,
+        }
+    }
+
+    /// Continues the count of factorizations from a checkpoint's.
+    pub(crate) fn set_factorizations(&mut self, count: u64) {
+        match &mut self.solver {
+            Solver::Schur(op) => op.factorizations = count,
+            Solver::Direct(op) => op.factorizations = count,
+        }
+    }
+
+    /// Values stored per factor of A₀ (Schur path; 0 otherwise).
+    pub(crate) fn factor_len(&self) -> usize {
+        match &self.solver {
+            Solver::Schur(op) => op.factor_len(),
+            Solver::Direct(_) => 0,
+        }
+    }
+
+    /// (values of W the step uses, values of the factor on the contact
+    /// DOFs' paths to the root).
+    pub(crate) fn paths_len(&self) -> (usize, usize) {
+        match &self.solver {
+            Solver::Schur(op) => op.paths_len(),
+            Solver::Direct(_) => (0, 0),
         }
     }
 }
@@ -221,7 +280,15 @@ impl Stepper for Newmark {
         );
         state.classes_new.copy_from_slice(&state.classes);
         let mut v_new = std::mem::take(&mut state.v_new);
-        let result = self.velocity(run, dt, (&mut state.classes_new, &mut v_new), (step, t_new));
+        let (c_k, c_m) = (beta / gamma * dt, 1.0 / (gamma * dt));
+        let result = self.friction.velocity(
+            run,
+            (dt, c_k, &self.k),
+            (c_m, &self.m),
+            &self.b,
+            (&mut state.classes_new, &mut v_new),
+            (step, t_new),
+        );
         state.v_new = v_new;
         let iterations = result?;
 
@@ -272,8 +339,8 @@ impl Stepper for Newmark {
         false
     }
 
-    fn mass_kind(&self) -> MassKind {
-        self.mass_kind
+    fn mass_kind(&self) -> Option<MassKind> {
+        Some(self.mass_kind)
     }
 
     fn stiffness_product(&self) -> &'static str {
@@ -281,38 +348,26 @@ impl Stepper for Newmark {
     }
 
     fn factorizations(&self) -> u64 {
-        match &self.solver {
-            Solver::Schur(op) => op.factorizations,
-            Solver::Direct(op) => op.factorizations,
-        }
+        self.friction.factorizations()
     }
 
     fn set_factorizations(&mut self, count: u64) {
-        match &mut self.solver {
-            Solver::Schur(op) => op.factorizations = count,
-            Solver::Direct(op) => op.factorizations = count,
-        }
+        self.friction.set_factorizations(count);
     }
 
     fn factor_len(&self) -> usize {
-        match &self.solver {
-            Solver::Schur(op) => op.factor_len(),
-            Solver::Direct(_) => 0,
-        }
+        self.friction.factor_len()
     }
 
     fn paths_len(&self) -> (usize, usize) {
-        match &self.solver {
-            Solver::Schur(op) => op.paths_len(),
-            Solver::Direct(_) => (0, 0),
-        }
+        self.friction.paths_len()
     }
 }
 
 /// Friction dissipation of the step and the number of nodes that went
 /// from slip to stick, from the new velocity; fills `forces_new`
 /// (`ContactSurface::step_dissipation`).
-fn friction_ledger(c: &ContactSurface, state: &mut State, dt: f64) -> (f64, usize) {
+pub(crate) fn friction_ledger(c: &ContactSurface, state: &mut State, dt: f64) -> (f64, usize) {
     let dissipated = c.step_dissipation(
         &state.v_new,
         &state.v,

@@ -1,0 +1,179 @@
+//! Quasi-static load increments with regularized friction: no inertia,
+//! each increment over [t_{K−1}, t_K] the static problem
+//!
+//!   K r_K + J((r_K − r_{K−1})/Δt) = R(t_K)
+//!
+//! (the paper's law on the increment's rate, as Campos, Oden and Kikuchi's
+//! static analysis the paper's Fig. 5 compares with). With ṙ_K = (r_K −
+//! r_{K−1})/Δt it is Newmark's velocity equation with M = 0 and β/γ = 1:
+//! (Δt K + C) ṙ_K = R(t_K) − K r_{K−1} − F, solved by the same
+//! [`ImplicitFriction`] (the iteration of §5 with Remark 4.2, the Schur
+//! complement on the contact DOFs with Δt K factorized once per distinct
+//! Δt). ε keeps its unit of a velocity: a stuck node creeps at most ε per
+//! unit of time, so the time scale of the loading matters as in dynamics.
+//!
+//! The energy ledger (METHOD.md §6) with nothing kinetic: the trapezoid
+//! rule for the loads' work, ½(R_K + R_{K−1})·Δr, and for friction's,
+//! ½(J_K + J_{K−1})·Δr, so that ½r_KᵀKr_K − ½r_{K−1}ᵀKr_{K−1} = ½(r_K +
+//! r_{K−1})ᵀK Δr closes the balance to round-off whenever the previous
+//! increment was in equilibrium; hence R_0 is the load of the initial
+//! static state (R(0⁻), Remark 4.1), and a load switched on at t = 0 enters
+//! with the first increment.
+
+use nalgebra_sparse::CsrMatrix;
+use stickslip_contact::{stick_events, ContactSurface};
+use stickslip_linalg::chunks;
+use stickslip_linalg::csr::{dot, quadratic_form, spmv};
+
+use crate::dynamics::{Dynamics, Loads};
+use crate::initial::{initial_state, Mass};
+use crate::newmark::ImplicitFriction;
+use crate::settings::{MassKind, Settings, TimeError};
+use crate::state::{State, StepEnergies, StepInfo};
+use crate::stepper::{Run, Stepper};
+
+/// The quasi-static stepper.
+pub(crate) struct QuasiStatic {
+    k: CsrMatrix<f64>,
+    friction: ImplicitFriction,
+    /// R(t_K) − K r_{K−1}.
+    b: Vec<f64>,
+    partials: Vec<[f64; 2]>,
+}
+
+/// Builds the stepper and the initial state: r₀ the frictionless static
+/// state under R(0⁻) (Remark 4.1), ṙ₀ = r̈₀ = 0.
+///
+/// # Errors
+/// A singular K (a rigid-body motion the supports leave free).
+pub(crate) fn start(
+    dynamics: Dynamics,
+    contact: Option<&ContactSurface>,
+    loads: &Loads,
+    settings: &Settings,
+) -> Result<(Box<dyn Stepper>, State), TimeError> {
+    let Dynamics {
+        stiffness: k,
+        fill_order,
+        ..
+    } = dynamics;
+    let n = k.nrows();
+    let friction = ImplicitFriction::new(&k, &fill_order, contact, settings)?;
+    let mut state = initial_state(&k, Mass::Massless, &fill_order, contact, loads, settings)?;
+    if !settings.restoring {
+        // The previous increment's load is the one r₀ equilibrates.
+        state.load = loads.before_start();
+        state.energy.total = state.energy.strain - dot(&state.r, &state.load);
+    }
+    let stepper = QuasiStatic {
+        k,
+        friction,
+        b: vec![0.0; n],
+        partials: chunks::partials(n),
+    };
+    Ok((Box::new(stepper), state))
+}
+
+impl Stepper for QuasiStatic {
+    fn step(&mut self, run: &Run, state: &mut State) -> Result<StepInfo, TimeError> {
+        let settings = &run.settings;
+        let (dt, t_new) = state.next_step(settings);
+        let step = state.steps + 1;
+        run.loads.at(t_new, &mut state.load_new);
+        spmv(&self.k, &state.r, &mut self.b);
+        for (b, l) in self.b.iter_mut().zip(&state.load_new) {
+            *b = l - *b;
+        }
+        state.classes_new.copy_from_slice(&state.classes);
+        let mut v_new = std::mem::take(&mut state.v_new);
+        // The operator Δt K + 0·K: Newmark's with β/γ = 1 and no mass.
+        let result = self.friction.velocity(
+            run,
+            (dt, dt, &self.k),
+            (0.0, &self.k),
+            &self.b,
+            (&mut state.classes_new, &mut v_new),
+            (step, t_new),
+        );
+        state.v_new = v_new;
+        let iterations = result?;
+
+        let mut finite = true;
+        for (((r_new, r), v_new), a_new) in state
+            .r_new
+            .iter_mut()
+            .zip(&state.r)
+            .zip(&state.v_new)
+            .zip(state.a_new.iter_mut())
+        {
+            *r_new = r + dt * v_new;
+            finite &= r_new.is_finite() & v_new.is_finite();
+            *a_new = 0.0;
+        }
+        if !finite {
+            return Err(TimeError::NonFinite {
+                step,
+                t: t_new,
+                hint: String::new(),
+            });
+        }
+        let (mut work, mut load_dot) = (0.0, 0.0);
+        for k in 0..state.r.len() {
+            work += 0.5 * (state.load_new[k] + state.load[k]) * (state.r_new[k] - state.r[k]);
+            load_dot += state.r_new[k] * state.load_new[k];
+        }
+        // Friction's work over the increment Δr = Δt ṙ_K: the ledger's
+        // ½Δt(v + v_new) with both velocities the increment's rate.
+        let (dissipated, stick_events) = match &run.contact {
+            Some(c) => {
+                let d = c.step_dissipation(
+                    &state.v_new,
+                    &state.v_new,
+                    dt,
+                    &state.forces,
+                    &mut state.forces_new,
+                );
+                (d, stick_events(&state.classes, &state.classes_new))
+            }
+            None => (0.0, 0),
+        };
+        state.commit(dt, t_new, iterations);
+        let strain = 0.5 * quadratic_form(&self.k, &state.r, &mut self.partials);
+        let energies = StepEnergies {
+            kinetic: 0.0,
+            strain,
+            work,
+            dissipated,
+            load_dot,
+        };
+        Ok(state.close_step(energies, settings, dt, iterations, stick_events))
+    }
+
+    fn is_explicit(&self) -> bool {
+        false
+    }
+
+    fn mass_kind(&self) -> Option<MassKind> {
+        None
+    }
+
+    fn stiffness_product(&self) -> &'static str {
+        "assembled CSR"
+    }
+
+    fn factorizations(&self) -> u64 {
+        self.friction.factorizations()
+    }
+
+    fn set_factorizations(&mut self, count: u64) {
+        self.friction.set_factorizations(count);
+    }
+
+    fn factor_len(&self) -> usize {
+        self.friction.factor_len()
+    }
+
+    fn paths_len(&self) -> (usize, usize) {
+        self.friction.paths_len()
+    }
+}
