@@ -136,7 +136,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         ),
         None => println!("contact     none (no friction code runs)"),
     }
-    if let Some(why) = friction_off(case, i) {
+    if let Some(why) = friction_off(case, i).filter(|_| i.contact().is_some()) {
         println!("friction    off: {why}; the steps run no friction code");
     }
     // The explicit integrator computed it already (by its own K·x);
@@ -740,7 +740,7 @@ struct Ending {
     failure: Option<String>,
     /// The signal that stopped it, if one did.
     interrupted: Option<&'static str>,
-    /// The state before the last step (and the rows then): that step is
+    /// The state before the last step (and the rows and frames then): that step is
     /// shortened to land on t_end, so a restart with a later t_end must
     /// redo it at full length to match a run that never stopped.
     before_last: Option<(stickslip_time::Checkpoint, (usize, usize))>,
