@@ -423,7 +423,7 @@ section! {
 /// Frames of the full fields over [0, t_end] when the case names neither
 /// `output.frames`, `output.interval` nor `output.every`: enough for a
 /// film or a probe, and a file whose fields do not grow with the steps
-/// (a 1M-DOF run of 1,000 steps wrote 24 GB at every step).
+/// (docs/results.md, "What is written, and why").
 pub const DEFAULT_FRAMES: usize = 200;
 
 fn default_flush_every() -> usize {
