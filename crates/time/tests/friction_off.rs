@@ -101,3 +101,25 @@ fn a_surface_with_friction_counts_a_pass_a_step() {
         assert_eq!(i.friction_passes(), 20, "{scheme:?}");
     }
 }
+
+#[test]
+fn a_checkpoint_with_classes_restores_on_a_surface_without_friction() {
+    // A version that ran friction code on a μ = 0 surface stored its
+    // classes and (zero) forces; the run without friction continues from
+    // it as from its own checkpoint.
+    let settings = Settings::new(Scheme::CentralDifference, 1e-3, 0.02);
+    let s = slab(PRESSURE, Some(0.0));
+    let mut a = s.integrator(settings.clone()).unwrap();
+    let n_c = a.contact().unwrap().len();
+    for _ in 0..10 {
+        a.step().unwrap();
+    }
+    let mut old = a.checkpoint();
+    assert!(old.classes.is_empty() && old.forces.is_empty());
+    old.classes = vec![1; n_c];
+    old.forces = vec![0.0; n_c];
+    let mut b = s.integrator(settings).unwrap();
+    b.restore(&old).unwrap();
+    let b = same_bits("restored", b, a);
+    assert_eq!(b.friction_passes(), 0);
+}
