@@ -51,8 +51,10 @@ def main():
     # 3. Read.
     import numpy as np
 
-    nodes, t, u, contact, s, sigma, v_t, state = common.read(
-        h5, "mesh/nodes", "time", "displacement", "contact/nodes", "contact/s",
+    # The histories (time, contact/*) are at every step; the fields
+    # (displacement) at frames, whose times are frames/time.
+    nodes, t, u, tf, contact, s, sigma, v_t, state = common.read(
+        h5, "mesh/nodes", "time", "displacement", "frames/time", "contact/nodes", "contact/s",
         "contact/friction_stress", "contact/slip_velocity", "contact/state",
     )
     ux = u[:, :, 0]
@@ -62,7 +64,7 @@ def main():
     ratio = np.abs(sigma).max() / g
     dissipation = (sigma * v_t).max()  # <= 0 at every node and step
     slipping = (state != 0).mean(axis=1)
-    print(f"nodes {len(nodes)}, base nodes with friction {len(contact)}, output steps {len(t)}")
+    print(f"nodes {len(nodes)}, base nodes with friction {len(contact)}, output steps {len(t)}, frames {len(tf)}")
     print(f"final u_x of the pushed corner (0, 0): {ux[-1, corner]:.6f}")
     print(f"max |sigma_T| / g: {ratio:.6f}")
     print(f"max sigma_T * v_T: {dissipation:.3e}")
@@ -71,7 +73,7 @@ def main():
     # 4. Plot.
     plt = common.pyplot()
     fig, (a, b) = plt.subplots(2, 1, figsize=(6.5, 6))
-    a.plot(t, ux[:, corner])
+    a.plot(tf, ux[:, corner])
     a.set_xlabel("t")
     a.set_ylabel("u_x at the pushed corner (0, 0)")
     a.set_title("A block pushed towards a wall along a rough base")

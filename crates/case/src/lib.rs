@@ -35,6 +35,7 @@ pub use load::{load, load_str, parse_str};
 pub use method::{Method, PAPER_REDUCTION};
 pub use restart::restart_changes;
 pub use schema::{
-    Case, ContactSection, DirichletSection, History, Hypothesis, MassKind, MaterialSection,
+    Case, ContactSection, DirichletSection, Fields, History, Hypothesis, MassKind, MaterialSection,
     MeshSection, OutputSection, Scheme, StickReduction, TimeSection, TractionSection,
+    DEFAULT_FRAMES,
 };

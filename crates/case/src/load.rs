@@ -468,10 +468,41 @@ fn complete(
     // [output]
     let o = &case.output;
     check(
-        o.every > 0,
+        o.every != Some(0),
         "output.every",
-        "output.every must be >= 1 (1 writes every step)".into(),
+        "output.every must be >= 1 (1 writes the fields at every step)".into(),
     );
+    check(
+        o.frames != Some(0),
+        "output.frames",
+        "output.frames must be >= 1 (frames of the fields over [0, t_end]; default 200)".into(),
+    );
+    if let Some(dt) = o.interval {
+        check(
+            dt > 0.0,
+            "output.interval",
+            format!("output.interval = {dt} must be > 0 (the simulated time between frames)"),
+        );
+    }
+    // One rule for when the fields are written: a second one is refused
+    // where it stands, rather than one of them silently ignored.
+    let given: Vec<&str> = ["frames", "interval", "every"]
+        .into_iter()
+        .filter(|k| spans.contains_key(&format!("output.{k}")))
+        .collect();
+    if let [first, rest @ ..] = &given[..] {
+        for other in rest {
+            check(
+                false,
+                &format!("output.{other}"),
+                format!(
+                    "output.{other} and output.{first} both say when the fields are written; \
+                     keep one of them (frames: N over [0, t_end], interval: simulated time \
+                     between frames, every: N steps)"
+                ),
+            );
+        }
+    }
     check(
         o.flush_every > 0,
         "output.flush_every",
@@ -660,7 +691,12 @@ t_end = 0.5
             dir.join("case.h5"),
             "default output is <case stem>.h5 beside the case"
         );
-        assert_eq!(c.output.every, 1);
+        assert_eq!(c.output.every, None);
+        assert_eq!(
+            c.output.fields(),
+            crate::schema::Fields::Frames(crate::schema::DEFAULT_FRAMES),
+            "the fields at frames by default"
+        );
         assert_eq!(c.source, GOOD);
     }
 
@@ -754,6 +790,50 @@ t_end = 0.5
     }
 
     #[test]
+    fn one_rule_for_the_frames() {
+        for (keys, fields) in [
+            ("frames = 7\n", crate::schema::Fields::Frames(7)),
+            ("interval = 0.25\n", crate::schema::Fields::Interval(0.25)),
+            ("every = 3\n", crate::schema::Fields::Every(3)),
+        ] {
+            let c = load_text("frames", &format!("{GOOD}[output]\n{keys}"), &[]).unwrap();
+            assert_eq!(c.output.fields(), fields, "{keys}");
+        }
+        // Two rules: the second is refused at its line, the first named.
+        let text = format!("{GOOD}[output]\nframes = 7\nevery = 3\ninterval = 0.0\n");
+        let e = load_text("two", &text, &[]).unwrap_err().0;
+        for (needle, what) in [
+            ("every = 3", "output.every and output.frames both say"),
+            (
+                "interval = 0.0",
+                "output.interval and output.frames both say",
+            ),
+            ("interval = 0.0", "output.interval = 0 must be > 0"),
+        ] {
+            let l = line_of(&text, needle);
+            assert!(
+                e.lines()
+                    .any(|m| m.contains(&format!("case.toml:{l}:")) && m.contains(what)),
+                "no '{what}' at line {l} in:\n{e}"
+            );
+        }
+        // A --set of another rule than the file's replaces it.
+        let c = load_text(
+            "set",
+            &format!("{GOOD}[output]\nevery = 1\n"),
+            &["output.frames=10"],
+        )
+        .unwrap();
+        assert_eq!(c.output.fields(), crate::schema::Fields::Frames(10));
+        assert_eq!(c.output.every, None);
+        assert!(!c.source.contains("every"), "{}", c.source);
+        let e = load_text("zero", &format!("{GOOD}[output]\nframes = 0\n"), &[])
+            .unwrap_err()
+            .0;
+        assert!(e.contains("output.frames must be >= 1"), "{e}");
+    }
+
+    #[test]
     fn newmark_stability_condition() {
         // 2β ≥ γ ≥ ½ (textbook unconditional stability): (0.3025, 0.6) passes,
         // (0.25, 0.4) and (0.2, 0.5) fail.
@@ -820,7 +900,7 @@ t_end = 0.5
         assert_eq!(c.time.scheme, Scheme::Newmark);
         assert!(!c.contact.as_ref().unwrap().remark_4_2);
         assert_eq!(c.dirichlet[0].uy, Some(0.5));
-        assert_eq!(c.output.every, 10);
+        assert_eq!(c.output.fields(), crate::schema::Fields::Every(10));
         // The source is the case as run, and still carries the user's comment.
         let again = load_str(&c.path, &c.source, &[]).unwrap();
         assert_eq!(again.time, c.time);

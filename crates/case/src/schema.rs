@@ -433,9 +433,11 @@ section! {
     }
 }
 
-fn default_every() -> usize {
-    1
-}
+/// Frames of the full fields over [0, t_end] when the case names neither
+/// `output.frames`, `output.interval` nor `output.every`: enough for a
+/// film or a probe, and a file whose fields do not grow with the steps
+/// (docs/results.md, "What is written, and why").
+pub const DEFAULT_FRAMES: usize = 200;
 
 fn default_flush_every() -> usize {
     100
@@ -452,9 +454,14 @@ section! {
         /// (default `<case stem>.h5` next to the case file).
         #[serde(default)]
         "file" file: PathBuf,
-        /// Write every `every`-th step (default 1).
-        #[serde(default = "default_every")]
-        "every" every: usize,
+        /// Full fields (u, v, a) at `frames` frames over [0, t_end]: the
+        /// first steps at or after k·t_end/frames (default
+        /// [`DEFAULT_FRAMES`] when neither `interval` nor `every` is given).
+        "frames" frames: Option<usize>,
+        /// ... or at the first steps at or after k·interval.
+        "interval" interval: Option<f64>,
+        /// ... or at every `every`-th step.
+        "every" every: Option<usize>,
         /// Flush the file (and rewrite the checkpoint) at least every this
         /// many steps (default 100).
         #[serde(default = "default_flush_every")]
@@ -473,7 +480,9 @@ impl Default for OutputSection {
     fn default() -> Self {
         OutputSection {
             file: PathBuf::new(),
-            every: default_every(),
+            frames: None,
+            interval: None,
+            every: None,
             flush_every: default_flush_every(),
             flush_seconds: default_flush_seconds(),
             compression: None,
@@ -481,7 +490,29 @@ impl Default for OutputSection {
     }
 }
 
+/// When a run writes the full fields (u, v, a): `output.frames`,
+/// `output.interval` or `output.every`, at most one of them given (loading
+/// refuses more), the initial state and the last step always.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Fields {
+    /// At the first steps at or after k·t_end/N, k = 1..N.
+    Frames(usize),
+    /// At the first steps at or after k·Δt_out.
+    Interval(f64),
+    /// At every N-th step.
+    Every(usize),
+}
+
 impl OutputSection {
+    /// When the full fields are written.
+    pub fn fields(&self) -> Fields {
+        match (self.every, self.interval, self.frames) {
+            (Some(n), _, _) => Fields::Every(n.max(1)),
+            (None, Some(dt), _) => Fields::Interval(dt),
+            (None, None, n) => Fields::Frames(n.unwrap_or(DEFAULT_FRAMES).max(1)),
+        }
+    }
+
     /// The deflate level asked for, if any (validated to 0..=9 when the
     /// case was loaded).
     pub fn deflate_level(&self) -> Option<u8> {

@@ -21,8 +21,23 @@ pub(crate) fn apply_set(doc: &mut toml_edit::DocumentMut, set: &str) -> Result<(
     let val = val.trim();
     let mut value: Value = val.parse().unwrap_or_else(|_| Value::from(val));
     value.decor_mut().clear();
-    set_in(doc.as_table_mut(), &segs, value, key)
+    set_in(doc.as_table_mut(), &segs, value, key)?;
+    // One rule says when the fields are written, and a file may give only
+    // one (loading refuses two): the one set on the command line replaces
+    // the file's, so that `--set output.frames=50` runs a case that says
+    // `every = 1`.
+    if let ["output", rule @ ("frames" | "interval" | "every")] = segs[..] {
+        if let Some(output) = doc.get_mut("output").and_then(Item::as_table_like_mut) {
+            for other in FIELD_RULES.iter().filter(|&&r| r != rule) {
+                output.remove(other);
+            }
+        }
+    }
+    Ok(())
 }
+
+/// The `[output]` keys that say when the fields are written.
+const FIELD_RULES: [&str; 3] = ["frames", "interval", "every"];
 
 fn set_in(t: &mut dyn TableLike, segs: &[&str], mut value: Value, key: &str) -> Result<(), String> {
     let (k, rest) = segs.split_first().expect("non-empty path");

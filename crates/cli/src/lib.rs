@@ -41,12 +41,14 @@ macro_rules! say_out {
 }
 
 pub mod advise;
+pub mod frames;
 pub mod mesh_cmd;
 pub mod output;
 pub mod probe;
 pub mod results_file;
 pub mod run;
 mod start;
+mod stored;
 pub mod stress_cmd;
 pub mod sys;
 pub mod views;

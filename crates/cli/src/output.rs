@@ -1,9 +1,12 @@
 //! The HDF5 results writer (DESIGN.md "Results").
 //!
 //! The file is created with the mesh and the contact surface, then grows by
-//! one row per output step in every time-dependent dataset (unlimited first
-//! dimension, chunked along time; shuffle + deflate when `compression` is
-//! 1-9, none by default). Rows are kept in memory up to the end of a chunk
+//! one row per step in every history (`/time`, `/energy/*`, `/solver/*`,
+//! `/contact/*`) and by one row per frame (a step whose record carries the
+//! fields, [`crate::frames`]) in the fields (`/displacement`, `/velocity`,
+//! `/acceleration`) and `/frames/{time,row}`: unlimited first dimension,
+//! chunked along time; shuffle + deflate when `compression` is 1-9, none
+//! by default. Rows are kept in memory up to the end of a chunk
 //! along time and written as one block per dataset (`Pending`), and
 //! always before a flush. It is flushed every
 //! [`ResultsWriter::flush_every_steps`] appends or
@@ -29,7 +32,9 @@ use anyhow::{bail, ensure, Context, Result};
 use hdf5::types::VarLenUnicode;
 use hdf5::{Dataset, File, Group, H5Type};
 use ndarray::{s, Array1, Array2, ArrayView1, ArrayView2};
-use stickslip_time::{Checkpoint, Energy};
+use stickslip_time::Checkpoint;
+
+pub use crate::stored::{read_checkpoint, stored_mesh_change, Stored};
 
 /// What the file holds before the first step.
 #[derive(Clone, Copy, Debug)]
@@ -49,7 +54,8 @@ pub struct Header<'a> {
 }
 
 /// One output step. Vectors are full, `2 * n_nodes` long, interleaved
-/// (x, y) per node; contact arrays are `n_c` long (empty without contact).
+/// (x, y) per node, or all three empty for a step that is no frame (its
+/// histories only); contact arrays are `n_c` long (empty without contact).
 #[derive(Clone, Copy, Debug)]
 pub struct Record<'a> {
     /// Time.
@@ -95,6 +101,9 @@ pub struct Summary {
     pub factorizations: u64,
     /// Critical time step of the explicit scheme, if estimated.
     pub dt_crit: Option<f64>,
+    /// Why friction did no work, if it did none (`/solver` attribute
+    /// `friction`: "off: ..."; "on" otherwise).
+    pub friction_off: Option<String>,
     /// Why the run stopped early, if it did (root attribute `failure`).
     pub failure: Option<String>,
     /// How the steps formed their products with K
@@ -106,13 +115,16 @@ pub struct Summary {
     pub fill_order: Option<String>,
 }
 
-/// Growing datasets, one row per output step.
+/// Growing datasets: the histories one row per step, the fields and
+/// `/frames` one per frame.
 #[derive(Debug)]
 struct Series {
     time: Dataset,
     displacement: Dataset,
     velocity: Dataset,
     acceleration: Dataset,
+    frame_time: Dataset,
+    frame_row: Dataset,
     contact: Option<ContactSeries>,
     energy: [Dataset; 6],
     dt: Dataset,
@@ -120,9 +132,10 @@ struct Series {
 }
 
 impl Series {
-    /// Every growing dataset resized to `rows` rows (of `n` nodes and `n_c`
-    /// contact nodes); all are tried, the first error returned.
-    fn resize(&self, rows: usize, n: usize, n_c: usize) -> Result<()> {
+    /// Every history resized to `rows` rows and every field to `frames`
+    /// (of `n` nodes and `n_c` contact nodes); all are tried, the first
+    /// error returned.
+    fn resize(&self, (rows, frames): (usize, usize), n: usize, n_c: usize) -> Result<()> {
         let mut results = Vec::new();
         for d in [&self.time, &self.dt, &self.iterations]
             .into_iter()
@@ -130,8 +143,11 @@ impl Series {
         {
             results.push(d.resize(rows));
         }
+        for d in [&self.frame_time, &self.frame_row] {
+            results.push(d.resize(frames));
+        }
         for d in [&self.displacement, &self.velocity, &self.acceleration] {
-            results.push(d.resize((rows, n, 2)));
+            results.push(d.resize((frames, n, 2)));
         }
         if let Some(c) = &self.contact {
             for d in [&c.friction_stress, &c.slip_velocity, &c.state] {
@@ -164,6 +180,10 @@ struct ContactSeries {
 struct Pending {
     /// One entry a row: its length is the number of rows.
     time: Vec<f64>,
+    /// One entry a frame: its time and its row (counted from the file's
+    /// first).
+    frame_time: Vec<f64>,
+    frame_row: Vec<u64>,
     displacement: Vec<f64>,
     velocity: Vec<f64>,
     acceleration: Vec<f64>,
@@ -180,8 +200,17 @@ impl Pending {
         self.time.len()
     }
 
-    fn push(&mut self, rec: &Record) {
+    fn frames(&self) -> usize {
+        self.frame_time.len()
+    }
+
+    /// Appends `rec` as the file's row `row`.
+    fn push(&mut self, rec: &Record, row: usize) {
         self.time.push(rec.t);
+        if !rec.displacement.is_empty() {
+            self.frame_time.push(rec.t);
+            self.frame_row.push(row as u64);
+        }
         self.displacement.extend_from_slice(rec.displacement);
         self.velocity.extend_from_slice(rec.velocity);
         self.acceleration.extend_from_slice(rec.acceleration);
@@ -221,6 +250,8 @@ impl Pending {
         }
         self.state.clear();
         self.iterations.clear();
+        self.frame_time.clear();
+        self.frame_row.clear();
     }
 }
 
@@ -234,12 +265,15 @@ pub struct ResultsWriter {
     n_c: usize,
     /// Rows appended, written or still in `pending`.
     rows: usize,
-    /// Rows on disk at the last flush that succeeded.
-    flushed_rows: usize,
+    /// Frames (rows of the fields) appended.
+    frames: usize,
+    /// Rows and frames on disk at the last flush that succeeded.
+    flushed: (usize, usize),
     /// Appended rows not yet in the datasets.
     pending: Pending,
     /// Rows per chunk of the vector fields along time: `pending` is
-    /// written when the row count reaches a multiple of it.
+    /// written when the frame count reaches a multiple of it (or holds
+    /// [`HISTORY_BLOCK`] rows).
     block_rows: usize,
     since_flush: usize,
     last_flush: Instant,
@@ -259,6 +293,9 @@ pub struct CheckpointExtra {
     /// Output rows in the file that belong to the checkpointed state (rows
     /// written later are dropped on restart).
     pub rows: usize,
+    /// Frames (rows of the fields) that belong to it (files written before
+    /// the frames: `rows`).
+    pub frames: usize,
     /// Wall time spent so far (summed over restarts).
     pub wall_time_s: f64,
     /// Largest |energy balance| so far.
@@ -268,21 +305,6 @@ pub struct CheckpointExtra {
     /// 1 grid rows, 2 reverse Cuthill–McKee; files written before the
     /// node orders: 0).
     pub node_order: u8,
-}
-
-/// A results file's `/checkpoint` and what a restart needs besides.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Stored {
-    /// The integrator's state.
-    pub checkpoint: Checkpoint,
-    /// Rows, wall time, largest balance.
-    pub extra: CheckpointExtra,
-    /// The case TOML as run (root attribute `case`).
-    pub case_source: String,
-    /// Root attribute `complete`.
-    pub complete: bool,
-    /// `/time`, the first `extra.rows` entries.
-    pub times: Vec<f64>,
 }
 
 /// Node order written in `/mesh/cells` attribute `node_order`.
@@ -351,6 +373,10 @@ const ENERGY_NAMES: [&str; 6] = [
     "balance",
 ];
 
+/// Rows of the histories kept in memory at most before they are written
+/// (the chunk of the 1-D series), however rare the frames.
+const HISTORY_BLOCK: usize = SERIES_CHUNK;
+
 /// Rows per chunk along time so that a chunk stays within HDF5's default
 /// 1 MiB chunk cache (a partly written chunk then stays in memory instead of
 /// being re-read and re-compressed on every append).
@@ -367,15 +393,25 @@ fn filtered(b: hdf5::DatasetBuilderEmpty, level: u8) -> hdf5::DatasetBuilderEmpt
     }
 }
 
+/// Rows per chunk along time of the 1-D series (`/time`, `/energy/*`,
+/// `/solver/*`, `/frames/*`).
+pub const SERIES_CHUNK: usize = 1024;
+
 fn series_1d<T: H5Type>(g: &Group, name: &str, level: u8) -> Result<Dataset> {
     Ok(filtered(g.new_dataset::<T>(), level)
-        .chunk(1024)
+        .chunk(SERIES_CHUNK)
         .shape(0..)
         .create(name)?)
 }
 
+/// Rows per chunk along time of a contact series of `n` nodes and `size`
+/// bytes a value.
+pub fn contact_chunk_rows(n: usize, size: usize) -> usize {
+    chunk_rows(n * size).clamp(1, 64)
+}
+
 fn series_2d<T: H5Type>(g: &Group, name: &str, n: usize, level: u8) -> Result<Dataset> {
-    let rows = chunk_rows(n * std::mem::size_of::<T>()).clamp(1, 64);
+    let rows = contact_chunk_rows(n, std::mem::size_of::<T>());
     Ok(filtered(g.new_dataset::<T>(), level)
         .chunk((rows, n))
         .shape((0.., n))
@@ -426,16 +462,6 @@ fn put_vector<T: H5Type>(g: &Group, name: &str, v: &[T]) -> Result<()> {
     Ok(())
 }
 
-fn get_vector<T: H5Type>(g: &Group, name: &str) -> Result<Vec<T>> {
-    let ds = g
-        .dataset(name)
-        .with_context(|| format!("/checkpoint/{name} is missing"))?;
-    if ds.size() == 0 {
-        return Ok(Vec::new());
-    }
-    Ok(ds.read_raw::<T>()?)
-}
-
 /// Writes (or rewrites) a scalar attribute.
 fn put_scalar<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<()> {
     match loc.attr(name) {
@@ -445,7 +471,7 @@ fn put_scalar<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<(
     Ok(())
 }
 
-fn get_scalar<T: H5Type>(loc: &hdf5::Location, name: &str) -> Result<T> {
+pub(crate) fn get_scalar<T: H5Type>(loc: &hdf5::Location, name: &str) -> Result<T> {
     loc.attr(name)
         .with_context(|| format!("/checkpoint attribute {name} is missing"))?
         .read_scalar::<T>()
@@ -453,169 +479,10 @@ fn get_scalar<T: H5Type>(loc: &hdf5::Location, name: &str) -> Result<T> {
 }
 
 /// The two checkpoint slots.
-const SLOTS: [&str; 2] = ["a", "b"];
+pub(crate) const SLOTS: [&str; 2] = ["a", "b"];
 
 /// Order of `/checkpoint/energy`.
 const ENERGY_ORDER: &str = "kinetic, strain, external_work, dissipated, total, balance";
-
-/// Reads `/checkpoint`, the case and `complete` of a results file.
-///
-/// # Errors
-/// The file cannot be opened, was not written by `stickslip run`, or has no
-/// checkpoint (written before any flush, or by a version without restart).
-pub fn read_checkpoint(path: &Path) -> Result<Stored> {
-    let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
-    let program = text_attr(&file, "program").unwrap_or_default();
-    ensure!(
-        program == "stickslip",
-        "{} was not written by stickslip run (no program = \"stickslip\" attribute)",
-        path.display()
-    );
-    let case_source = text_attr(&file, "case").with_context(|| {
-        format!(
-            "{}: cannot read the case it stores; start a new run instead of restarting",
-            path.display()
-        )
-    })?;
-    let complete = file.attr("complete")?.read_scalar::<bool>()?;
-    if !file.link_exists("checkpoint") {
-        bail!(
-            "{} holds no checkpoint (the run stopped before its first flush); run the case again",
-            path.display()
-        );
-    }
-    let cg = file.group("checkpoint")?;
-    let slot: u8 = get_scalar(&cg, "slot")?;
-    let g = cg
-        .group(SLOTS[usize::from(slot).min(1)])
-        .context("/checkpoint: the current slot is missing")?;
-    let e: Vec<f64> = get_vector(&g, "energy")?;
-    ensure!(
-        e.len() == 6,
-        "/checkpoint/energy has {} values, expected 6",
-        e.len()
-    );
-    let checkpoint = Checkpoint {
-        t: get_scalar(&g, "t")?,
-        steps: get_scalar(&g, "steps")?,
-        displacement: get_vector(&g, "displacement")?,
-        velocity: get_vector(&g, "velocity")?,
-        acceleration: get_vector(&g, "acceleration")?,
-        classes: get_vector(&g, "classes")?,
-        forces: get_vector(&g, "forces")?,
-        energy: Energy {
-            kinetic: e[0],
-            strain: e[1],
-            external_work: e[2],
-            dissipated: e[3],
-            total: e[4],
-            balance: e[5],
-        },
-        initial_mechanical: get_scalar(&g, "initial_mechanical")?,
-        reduced_remaining: get_scalar(&g, "reduced_remaining")?,
-        // Absent in files written before the drift-free clock: the
-        // restart then starts a new run of steps at t.
-        clock: if g.attr("clock_t0").is_ok() {
-            Some((
-                get_scalar(&g, "clock_t0")?,
-                get_scalar(&g, "clock_dt")?,
-                get_scalar(&g, "clock_steps")?,
-            ))
-        } else {
-            None
-        },
-        total_iterations: get_scalar(&g, "total_iterations")?,
-        factorizations: get_scalar(&g, "factorizations")?,
-    };
-    let extra = CheckpointExtra {
-        rows: get_scalar::<u64>(&g, "rows")? as usize,
-        wall_time_s: get_scalar(&g, "wall_time_s")?,
-        max_balance: get_scalar(&g, "max_balance")?,
-        // Absent in files of versions before the node orders: the mesh's.
-        node_order: if g.attr("node_order").is_ok() {
-            get_scalar(&g, "node_order")?
-        } else {
-            0
-        },
-    };
-    let time = file.dataset("time")?;
-    let n = time.shape().first().copied().unwrap_or(0);
-    ensure!(
-        extra.rows <= n && extra.rows >= 1,
-        "/checkpoint says {} rows but /time has {n}: the file is damaged; run the case again",
-        extra.rows
-    );
-    let times = time.read_slice_1d::<f64, _>(s![..extra.rows])?.to_vec();
-    // A file whose /time was damaged (rows never written read as the fill
-    // value 0) would be continued with a wrong history.
-    let rising = times.windows(2).all(|w| w[0] < w[1]);
-    let last = times.last().copied().unwrap_or(0.0);
-    ensure!(
-        rising && last <= checkpoint.t,
-        "/time's first {} rows do not rise to the checkpoint's t = {} (they end at {last}): \
-         the file is damaged; run the case again",
-        extra.rows,
-        checkpoint.t
-    );
-    Ok(Stored {
-        checkpoint,
-        extra,
-        case_source,
-        complete,
-        times,
-    })
-}
-
-/// How the mesh stored in a results file differs from `mesh`, if it does
-/// (a restart must continue on the mesh the run started on: the case
-/// names the mesh file, and the file may have changed since).
-///
-/// # Errors
-/// The file's `/mesh` cannot be read.
-pub fn stored_mesh_change(path: &Path, mesh: &stickslip_mesh::Mesh) -> Result<Option<String>> {
-    let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
-    let g = file.group("mesh")?;
-    let kind = text_attr(&g, "kind")?;
-    if kind != mesh.kind.name() {
-        return Ok(Some(format!(
-            "the stored mesh's cells are {kind}, the mesh's now {}",
-            mesh.kind.name()
-        )));
-    }
-    let nodes = g.dataset("nodes")?;
-    let cells = g.dataset("cells")?;
-    let npc = mesh.kind.nodes_per_cell();
-    if nodes.shape() != [mesh.nodes.len(), 2] || cells.shape() != [mesh.n_cells(), npc] {
-        return Ok(Some(format!(
-            "the stored mesh has {} nodes and {} cells, the mesh now {} and {}",
-            nodes.shape().first().copied().unwrap_or(0),
-            cells.shape().first().copied().unwrap_or(0),
-            mesh.nodes.len(),
-            mesh.n_cells()
-        )));
-    }
-    let stored = nodes.read_2d::<f64>()?;
-    if let Some(i) = (0..mesh.nodes.len())
-        .find(|&i| (0..2).any(|k| stored[[i, k]].to_bits() != mesh.nodes[i][k].to_bits()))
-    {
-        return Ok(Some(format!(
-            "node {i} was at ({}, {}) and is now at ({}, {})",
-            stored[[i, 0]],
-            stored[[i, 1]],
-            mesh.nodes[i][0],
-            mesh.nodes[i][1]
-        )));
-    }
-    let stored = cells.read_2d::<i64>()?;
-    if let Some(c) = (0..mesh.n_cells())
-        .find(|&c| (0..npc).any(|k| stored[[c, k]] != mesh.cells[c * npc + k] as i64))
-    {
-        return Ok(Some(format!(
-            "cell {c} has other nodes than in the stored mesh"
-        )));
-    }
-    Ok(None)
-}
 
 fn index_array(v: impl ExactSizeIterator<Item = usize>) -> Array1<i64> {
     v.map(|i| i as i64).collect()
@@ -719,11 +586,20 @@ impl ResultsWriter {
         }
         let energy: [Dataset; 6] = energy.try_into().expect("six energy series");
         let solver = file.create_group("solver")?;
+        let frames = file.create_group("frames")?;
+        string_attr(
+            &frames,
+            "about",
+            "the rows of /displacement, /velocity and /acceleration: each one's time and its row of /time \
+             (and of the histories /energy/*, /solver/*, /contact/*, written at every step)",
+        )?;
         let series = Series {
             time: series_1d::<f64>(&file, "time", level)?,
             displacement: series_3d(&file, "displacement", n_nodes, level)?,
             velocity: series_3d(&file, "velocity", n_nodes, level)?,
             acceleration: series_3d(&file, "acceleration", n_nodes, level)?,
+            frame_time: series_1d::<f64>(&frames, "time", level)?,
+            frame_row: series_1d::<u64>(&frames, "row", level)?,
             contact,
             energy,
             dt: series_1d::<f64>(&solver, "dt", level)?,
@@ -737,7 +613,8 @@ impl ResultsWriter {
             n_nodes,
             n_c,
             rows: 0,
-            flushed_rows: 0,
+            frames: 0,
+            flushed: (0, 0),
             pending: Pending::default(),
             block_rows,
             since_flush: 0,
@@ -749,17 +626,19 @@ impl ResultsWriter {
     }
 
     /// Opens a results file written by [`ResultsWriter::create`] to append
-    /// to it after row `rows` (later rows, written after the checkpoint, are
-    /// dropped), marks it `complete = false` and removes a `failure`
-    /// attribute. `n_nodes` and `n_c` must match the file (the same mesh and
-    /// contact surface).
+    /// to it after row `rows` and frame `frames` (later rows, written after
+    /// the checkpoint, are dropped), marks it `complete = false` and
+    /// removes a `failure` attribute. `n_nodes` and `n_c` must match the
+    /// file (the same mesh and contact surface). A file written before the
+    /// frames (its fields at every row) gets its `/frames`: `/time` and the
+    /// rows in order.
     ///
     /// # Errors
     /// HDF5 errors (e.g. the file is open in another program), or a file
     /// whose layout does not match.
     pub fn open_append(
         path: &Path,
-        rows: usize,
+        (rows, frames): (usize, usize),
         n_nodes: usize,
         n_c: usize,
     ) -> Result<ResultsWriter> {
@@ -802,24 +681,45 @@ impl ResultsWriter {
         for name in ENERGY_NAMES {
             energy.push(ds(&format!("energy/{name}"))?);
         }
+        if !file.link_exists("frames") {
+            ensure!(
+                frames == rows,
+                "{}: the file has no /frames, so its fields are at every row, but its checkpoint \
+                 says {frames} frames of {rows} rows: the file is damaged; run the case again",
+                path.display()
+            );
+            // Two numbers a frame: unfiltered whatever the run's level.
+            let g = file.create_group("frames")?;
+            let t = series_1d::<f64>(&g, "time", 0)?;
+            let r = series_1d::<u64>(&g, "row", 0)?;
+            let times = ds("time")?.read_slice_1d::<f64, _>(s![..rows])?;
+            t.resize(rows)?;
+            t.write_slice(&times, s![..rows])?;
+            r.resize(rows)?;
+            r.write_slice(&(0..rows as u64).collect::<Array1<u64>>(), s![..rows])?;
+        }
         let series = Series {
             time: ds("time")?,
             displacement: ds("displacement")?,
             velocity: ds("velocity")?,
             acceleration: ds("acceleration")?,
+            frame_time: ds("frames/time")?,
+            frame_row: ds("frames/row")?,
             contact,
             energy: energy.try_into().expect("six energy series"),
             dt: ds("solver/dt")?,
             iterations: ds("solver/iterations")?,
         };
         let have = series.time.shape().first().copied().unwrap_or(0);
+        let have_frames = series.frame_time.shape().first().copied().unwrap_or(0);
         ensure!(
-            rows <= have,
-            "{}: cannot continue after row {rows}, the file has {have}",
+            rows <= have && frames <= have_frames && frames <= rows,
+            "{}: cannot continue after row {rows} and frame {frames}, the file has {have} rows \
+             and {have_frames} frames",
             path.display()
         );
         // Rows past the checkpoint (written before a crash) are recomputed.
-        series.resize(rows, n_nodes, n_c)?;
+        series.resize((rows, frames), n_nodes, n_c)?;
         file.attr("complete")?.write_scalar(&false)?;
         if file.attr("failure").is_ok() {
             file.delete_attr("failure")?;
@@ -832,7 +732,8 @@ impl ResultsWriter {
             n_nodes,
             n_c,
             rows,
-            flushed_rows: rows,
+            frames,
+            flushed: (rows, frames),
             pending: Pending::default(),
             block_rows,
             since_flush: 0,
@@ -846,6 +747,11 @@ impl ResultsWriter {
     /// Output rows written so far.
     pub fn rows(&self) -> usize {
         self.rows
+    }
+
+    /// Frames (rows of the fields) written so far.
+    pub fn frames(&self) -> usize {
+        self.frames
     }
 
     /// Rewrites the root attribute `case` (a restart stores the case it
@@ -908,17 +814,19 @@ impl ResultsWriter {
     pub fn room_needed(&self, n_free: usize) -> u64 {
         // The rows go to the datasets a chunk at a time (whole chunks are
         // allocated), so the next write may take a chunk of every series.
-        let record = (6 * self.n_nodes + 3 * self.n_c + 9) * 8;
+        let fields = self.block_rows * (6 * self.n_nodes + 2) * 8;
+        let histories = HISTORY_BLOCK * (3 * self.n_c + 9) * 8;
         let checkpoint = 5 * n_free * 8;
-        (2 * (self.block_rows * record + checkpoint) + (1 << 20)) as u64
+        (2 * (fields + histories + checkpoint) + (1 << 20)) as u64
     }
 
-    /// Whether the next [`ResultsWriter::append`] writes its chunk of rows
-    /// to the file (where [`ResultsWriter::room_needed`] should be checked,
-    /// besides before a flush: HDF5 writes chunks as they fill, not at the
-    /// flush).
-    pub fn append_writes(&self) -> bool {
-        (self.rows + 1).is_multiple_of(self.block_rows)
+    /// Whether the next [`ResultsWriter::append`], of a frame if `frame`,
+    /// writes its chunk of rows to the file (where
+    /// [`ResultsWriter::room_needed`] should be checked, besides before a
+    /// flush: HDF5 writes chunks as they fill, not at the flush).
+    pub fn append_writes(&self, frame: bool) -> bool {
+        (frame && (self.frames + 1).is_multiple_of(self.block_rows))
+            || self.pending.rows() + 1 >= HISTORY_BLOCK
     }
 
     /// Counts a step toward [`ResultsWriter::flush_due`] without writing a
@@ -947,12 +855,13 @@ impl ResultsWriter {
         let Err(e) = r else {
             return Ok(());
         };
-        let kept = self.flushed_rows;
+        let kept = self.flushed;
         // Best effort: the disk may still be full.
         let _ = self.series.resize(kept, self.n_nodes, self.n_c);
         let _ = self.file.flush();
         self.pending.clear();
-        self.rows = kept;
+        (self.rows, self.frames) = kept;
+        let kept = kept.0;
         Err(e.context(format!(
             "cannot write to the results file (is the disk full?); it keeps its first {kept} \
              records and the checkpoint of its last flush: make room and continue the run with \
@@ -1024,6 +933,7 @@ impl ResultsWriter {
         put_scalar(&g, "total_iterations", cp.total_iterations)?;
         put_scalar(&g, "factorizations", cp.factorizations)?;
         put_scalar(&g, "rows", extra.rows as u64)?;
+        put_scalar(&g, "frames", extra.frames as u64)?;
         put_scalar(&g, "wall_time_s", extra.wall_time_s)?;
         put_scalar(&g, "max_balance", extra.max_balance)?;
         put_scalar(&g, "node_order", extra.node_order)?;
@@ -1040,7 +950,7 @@ impl ResultsWriter {
     pub fn flush(&mut self) -> Result<()> {
         let r = self.write_pending().and_then(|()| Ok(self.file.flush()?));
         self.failed_write(r)?;
-        self.flushed_rows = self.rows;
+        self.flushed = (self.rows, self.frames);
         self.since_flush = 0;
         self.last_flush = Instant::now();
         Ok(())
@@ -1059,6 +969,8 @@ impl ResultsWriter {
         }
         let (n, n_c) = (self.n_nodes, self.n_c);
         let (k0, k1) = (self.rows - m, self.rows);
+        let mf = p.frames();
+        let (f0, f1) = (self.frames - mf, self.frames);
         let s = &self.series;
         for (ds, v) in [(&s.time, &p.time), (&s.dt, &p.dt)]
             .into_iter()
@@ -1070,16 +982,24 @@ impl ResultsWriter {
         s.iterations.resize(k1)?;
         s.iterations
             .write_slice(ArrayView1::from(&p.iterations[..]), s![k0..k1])?;
-        for (ds, v) in [
-            (&s.displacement, &p.displacement),
-            (&s.velocity, &p.velocity),
-            (&s.acceleration, &p.acceleration),
-        ] {
-            ds.resize((k1, n, 2))?;
-            ds.write_slice(
-                ndarray::ArrayView3::from_shape((m, n, 2), &v[..])?,
-                s![k0..k1, .., ..],
-            )?;
+        if mf > 0 {
+            s.frame_time.resize(f1)?;
+            s.frame_time
+                .write_slice(ArrayView1::from(&p.frame_time[..]), s![f0..f1])?;
+            s.frame_row.resize(f1)?;
+            s.frame_row
+                .write_slice(ArrayView1::from(&p.frame_row[..]), s![f0..f1])?;
+            for (ds, v) in [
+                (&s.displacement, &p.displacement),
+                (&s.velocity, &p.velocity),
+                (&s.acceleration, &p.acceleration),
+            ] {
+                ds.resize((f1, n, 2))?;
+                ds.write_slice(
+                    ndarray::ArrayView3::from_shape((mf, n, 2), &v[..])?,
+                    s![f0..f1, .., ..],
+                )?;
+            }
         }
         if let Some(c) = &s.contact {
             for (ds, v) in [
@@ -1099,21 +1019,24 @@ impl ResultsWriter {
         Ok(())
     }
 
-    /// Appends one output step to every dataset (kept in memory and written
-    /// with its chunk's block, or before the next flush).
+    /// Appends one output step to every history, and to the fields when
+    /// the record carries them (a frame); kept in memory and written with
+    /// its chunk's block, or before the next flush.
     ///
     /// # Errors
     /// HDF5 errors, or slices whose lengths do not match the header.
     pub fn append(&mut self, rec: &Record) -> Result<()> {
         let (n, n_c, k) = (self.n_nodes, self.n_c, self.rows);
+        let frame = !rec.displacement.is_empty();
         for (name, v) in [
             ("displacement", rec.displacement),
             ("velocity", rec.velocity),
             ("acceleration", rec.acceleration),
         ] {
             ensure!(
-                v.len() == 2 * n,
-                "record {k}: {name} has {} values, expected 2 * {n} nodes",
+                v.len() == if frame { 2 * n } else { 0 },
+                "record {k}: {name} has {} values, expected 2 * {n} nodes (or, with the others, \
+                 none for a step that is no frame)",
                 v.len()
             );
         }
@@ -1127,9 +1050,14 @@ impl ResultsWriter {
                 "record {k}: {name} has {len} values, expected {n_c} contact nodes"
             );
         }
-        self.pending.push(rec);
+        self.pending.push(rec, k);
         self.rows += 1;
-        if self.rows.is_multiple_of(self.block_rows) {
+        if frame {
+            self.frames += 1;
+        }
+        if (frame && self.frames.is_multiple_of(self.block_rows))
+            || self.pending.rows() >= HISTORY_BLOCK
+        {
             self.write_pending()?;
         }
         if self.auto_flush {
@@ -1153,6 +1081,14 @@ impl ResultsWriter {
         put_scalar(&solver, "wall_time_s", summary.wall_time_s)?;
         put_scalar(&solver, "steps", summary.steps)?;
         put_scalar(&solver, "factorizations", summary.factorizations)?;
+        if solver.attr("friction").is_ok() {
+            solver.delete_attr("friction")?;
+        }
+        let friction = summary
+            .friction_off
+            .as_ref()
+            .map_or("on".to_string(), |why| format!("off: {why}"));
+        string_attr(&solver, "friction", &friction)?;
         if let Some(d) = summary.dt_crit {
             put_scalar(&solver, "dt_crit", d)?;
         }
@@ -1307,6 +1243,7 @@ pub(crate) mod tests {
                     factorizations: 2,
                     dt_crit: Some(0.25),
                     failure: (!c).then(|| "iteration cap hit at step 3".to_string()),
+                    friction_off: None,
                     stiffness_product: "stencil types".into(),
                     fill_order: Some("nested dissection".into()),
                 },
@@ -1572,7 +1509,7 @@ pub(crate) mod tests {
                 .to_string()
         };
         let finish_again = |fill_order: Option<&str>| {
-            let w = ResultsWriter::open_append(&path, 3, 6, 3).unwrap();
+            let w = ResultsWriter::open_append(&path, (3, 3), 6, 3).unwrap();
             let summary = Summary {
                 steps: 40,
                 fill_order: fill_order.map(Into::into),
@@ -1668,6 +1605,108 @@ pub(crate) mod tests {
         }
         assert!(!f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
         drop(f);
+        std::fs::remove_file(&path).ok();
+    }
+
+    /// A record of the tiny mesh with contact at `t`: fields `[d, v, a]`,
+    /// friction stress `fs`, the rest 0.
+    fn record_of<'a>(t: f64, [d, v, a]: [&'a [f64]; 3], fs: &'a [f64]) -> Record<'a> {
+        Record {
+            t,
+            displacement: d,
+            velocity: v,
+            acceleration: a,
+            friction_stress: fs,
+            slip_velocity: &[0.0; 3],
+            state: &[0; 3],
+            kinetic: 0.0,
+            strain: 0.0,
+            external_work: 0.0,
+            dissipated: 0.0,
+            total: 0.0,
+            balance: 0.0,
+            dt: 0.1,
+            iterations: 1,
+        }
+    }
+
+    /// Appends rows `k0..k1` of the tiny mesh with contact, the fields of
+    /// row k being `u(k, ·)` on the rows where `frame(k)`.
+    fn append_rows(w: &mut ResultsWriter, rows: std::ops::Range<usize>, frame: fn(usize) -> bool) {
+        for k in rows {
+            let d: Vec<f64> = (0..12).map(|i| u(k, i)).collect();
+            let f: &[f64] = if frame(k) { &d } else { &[] };
+            let fs = [k as f64; 3];
+            w.append(&record_of(0.1 * k as f64, [f, f, f], &fs))
+                .unwrap();
+        }
+    }
+
+    /// The histories grow a row a record, the fields and `/frames` a row a
+    /// frame; `/frames/row` names each frame's row, and a restart after
+    /// row 7 (frame 3) keeps both in step. Expected values: the rows the
+    /// test wrote.
+    #[test]
+    fn frames_and_histories_grow_apart() {
+        let _guard = h5_lock();
+        let path = scratch("frames");
+        let mesh = tiny_mesh();
+        let every_third = |k: usize| k.is_multiple_of(3);
+        let mut w = ResultsWriter::create(&path, &test_header(&mesh, true)).unwrap();
+        append_rows(&mut w, 0..10, every_third);
+        assert_eq!((w.rows(), w.frames()), (10, 4));
+        w.finish(true, &Summary::default()).unwrap();
+        let check = |rows: usize, frame_rows: &[u64]| {
+            let f = File::open(&path).unwrap();
+            let t = f.dataset("time").unwrap().read_1d::<f64>().unwrap();
+            assert_eq!(t.len(), rows);
+            let fs = f
+                .dataset("contact/friction_stress")
+                .unwrap()
+                .read_2d::<f64>()
+                .unwrap();
+            assert_eq!(fs.nrows(), rows);
+            assert_eq!(fs[[rows - 1, 0]], (rows - 1) as f64);
+            let r = f.dataset("frames/row").unwrap().read_1d::<u64>().unwrap();
+            assert_eq!(r.to_vec(), frame_rows);
+            let ft = f.dataset("frames/time").unwrap().read_1d::<f64>().unwrap();
+            let want: Vec<f64> = frame_rows.iter().map(|&k| 0.1 * k as f64).collect();
+            assert_eq!(ft.to_vec(), want);
+            let d = f
+                .dataset("displacement")
+                .unwrap()
+                .read_dyn::<f64>()
+                .unwrap();
+            assert_eq!(d.shape(), [frame_rows.len(), 6, 2]);
+            for (j, &k) in frame_rows.iter().enumerate() {
+                assert_eq!(d[[j, 5, 1]], u(k as usize, 11), "frame {j}");
+            }
+        };
+        check(10, &[0, 3, 6, 9]);
+        // A restart from row 7, frame 3 (rows 7-9 and frame 9 dropped),
+        // its frames now on the even rows.
+        let mut w = ResultsWriter::open_append(&path, (7, 3), 6, 3).unwrap();
+        append_rows(&mut w, 7..12, |k| k.is_multiple_of(2));
+        w.finish(true, &Summary::default()).unwrap();
+        check(12, &[0, 3, 6, 8, 10]);
+        // A file of a version before the frames (its fields at every row)
+        // gets its /frames when continued.
+        let mut w = ResultsWriter::create(&path, &test_header(&mesh, true)).unwrap();
+        append_rows(&mut w, 0..4, |_| true);
+        w.finish(true, &Summary::default()).unwrap();
+        File::open_rw(&path).unwrap().unlink("frames").unwrap();
+        let mut w = ResultsWriter::open_append(&path, (4, 4), 6, 3).unwrap();
+        append_rows(&mut w, 4..6, |k| k == 5);
+        w.finish(true, &Summary::default()).unwrap();
+        check(6, &[0, 1, 2, 3, 5]);
+        // Fields of a frame are whole or absent.
+        let mut w = ResultsWriter::create(&path, &test_header(&mesh, true)).unwrap();
+        let d = [0.0; 12];
+        let e = w
+            .append(&record_of(0.0, [&d, &[], &d], &[0.0; 3]))
+            .unwrap_err();
+        assert!(e.to_string().contains("velocity has 0 values"), "{e}");
+        drop(w);
         std::fs::remove_file(&path).ok();
     }
 

@@ -11,6 +11,8 @@ use ndarray::s;
 
 use stickslip_case::InputError;
 
+use crate::frames::Frames;
+
 /// A field that can be probed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Field {
@@ -156,11 +158,11 @@ fn open_results(file: &Path) -> Result<File, InputError> {
     })
 }
 
-/// `/time`, checked against the records of `/displacement` before it is
-/// read: a damaged file may claim more rows than it holds, and reading
-/// them would allocate that much (a file that claimed 1e11 rows aborted
-/// probe on an 800 GB allocation). The two grow together; between two
-/// records one may be one row ahead.
+/// `/time` (a row a step, the histories'), checked against the rows of
+/// `/contact/friction_stress` (what it is read for) before it is read: a damaged file may claim more rows than
+/// it holds, and reading them would allocate that much (a file that
+/// claimed 1e11 rows aborted probe on an 800 GB allocation). The two grow
+/// together; between two records one may be one row ahead.
 pub(crate) fn read_time(f: &File, name: &str) -> Result<Vec<f64>, InputError> {
     let rows = |ds: &str| {
         f.dataset(ds)
@@ -171,11 +173,11 @@ pub(crate) fn read_time(f: &File, name: &str) -> Result<Vec<f64>, InputError> {
             ))
             })
     };
-    let (t_rows, u_rows) = (rows("time")?, rows("displacement")?);
-    if t_rows > u_rows + 1 {
+    let (t_rows, c_rows) = (rows("time")?, rows("contact/friction_stress")?);
+    if t_rows > c_rows + 1 {
         return Err(InputError(format!(
-            "{name}: /time has {t_rows} rows but /displacement {u_rows}: the file is damaged; \
-             run the case again"
+            "{name}: /time has {t_rows} rows but /contact/friction_stress {c_rows}: the file is \
+             damaged; run the case again"
         )));
     }
     f.dataset("time")
@@ -336,12 +338,13 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
     let node = (0..nodes.nrows())
         .min_by(|&a, &b| dist(a).total_cmp(&dist(b)))
         .expect("n > 0");
-    let t = read_time(&f, &name)?;
-
-    let values: Vec<f64> = match field.node_dataset() {
+    // The node fields are at the frames, the contact's at every step.
+    let frame_time = || Frames::read(&f, &name).map(|fr| fr.time);
+    let (t, values): (Vec<f64>, Vec<f64>) = match field.node_dataset() {
         None if field.stress().is_some() => {
             let (mesh, material) = stored_model(&f, &name)?;
-            stress_history(&f, &name, &mesh, &material, node, field)?
+            let values = stress_history(&f, &name, &mesh, &material, node, field)?;
+            (frame_time()?, values)
         }
         None => {
             let contact = f
@@ -368,22 +371,34 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
                 )));
             };
             let ds = format!("contact/{}", field.name());
-            f.dataset(&ds)
+            let t = read_time(&f, &name)?;
+            let values = f
+                .dataset(&ds)
                 .and_then(|d| d.read_slice_1d::<f64, _>(s![.., j]))
                 .map_err(|e| h5(&format!("cannot read /{ds}"), e))?
-                .to_vec()
+                .to_vec();
+            (t, values)
         }
-        Some((ds, comp)) => f
-            .dataset(ds)
-            .and_then(|d| d.read_slice_1d::<f64, _>(s![.., node, comp]))
-            .map_err(|e| h5(&format!("cannot read /{ds}"), e))?
-            .to_vec(),
+        Some((ds, comp)) => {
+            let t = frame_time()?;
+            let values = f
+                .dataset(ds)
+                .and_then(|d| d.read_slice_1d::<f64, _>(s![.., node, comp]))
+                .map_err(|e| h5(&format!("cannot read /{ds}"), e))?
+                .to_vec();
+            (t, values)
+        }
     };
     let complete = f
         .attr("complete")
         .and_then(|a| a.read_scalar::<bool>())
         .unwrap_or(false);
     let (mut t, mut values) = (t, values);
+    let what = if field.on_contact() {
+        "output steps"
+    } else {
+        "frames"
+    };
     if values.len() != t.len() {
         if complete {
             return Err(InputError(format!(
@@ -401,7 +416,7 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
         values.truncate(n);
     }
     let mut info = format!(
-        "node {node} at ({}, {}), distance {:.3e} from ({}, {}); {} output steps",
+        "node {node} at ({}, {}), distance {:.3e} from ({}, {}); {} {what}",
         nodes[[node, 0]],
         nodes[[node, 1]],
         dist(node),
@@ -455,7 +470,8 @@ pub struct AlongArgs {
     /// contact) at the times of --times, as CSV, instead of a history at --at.
     #[arg(long, value_name = "GROUP", conflicts_with = "at")]
     pub along: Option<String>,
-    /// With --along: comma-separated times; each uses the nearest output step.
+    /// With --along: comma-separated times; each uses the nearest frame (u, v, a and the
+    /// stresses) or output step (the contact fields).
     #[arg(
         long,
         value_name = "T1,T2,..",
@@ -754,7 +770,16 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
     }
     let slots = slot(&order);
 
-    let t_all = read_time(&f, &name)?;
+    // The node fields are at the frames (k: a frame, `row_of[k]` its row of
+    // /time), the contact's at every step.
+    let (t_all, row_of): (Vec<f64>, Vec<usize>) = if contact_field {
+        let t = read_time(&f, &name)?;
+        let rows = (0..t.len()).collect();
+        (t, rows)
+    } else {
+        let frames = Frames::read(&f, &name)?;
+        (frames.time, frames.row)
+    };
     if t_all.is_empty() {
         return Err(InputError(format!(
             "{name}: /time is empty: the run wrote no output step"
@@ -787,7 +812,8 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
             .expect("non-empty");
         let _ = write!(
             info,
-            "t = {ta}: record {k} at t = {} (nearest; off by {:.3e})",
+            "t = {ta}: record {} at t = {} (nearest; off by {:.3e})",
+            row_of[k],
             t_all[k],
             (t_all[k] - ta).abs()
         );
@@ -836,7 +862,7 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
                     .collect()
             }
         };
-        records.push(k);
+        records.push(row_of[k]);
         t_used.push(t_all[k]);
         values.push(row);
     }

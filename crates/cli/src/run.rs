@@ -3,7 +3,8 @@
 //!
 //! Everything that can be refused is refused before any time step (the
 //! model is built by `stickslip-case`), as an [`InputError`] (exit code
-//! 2). Once stepping starts, every completed output step is in the file; a
+//! 2). Once stepping starts, every completed step is in the file (its
+//! histories; the fields at frames, `frames.rs`); a
 //! failure marks the file `complete = false`, records the reason and
 //! returns [`Outcome::Failed`]. Where a run starts (a new file, or a
 //! restart's checkpoint) is `start.rs`.
@@ -20,6 +21,7 @@ use stickslip_fem::{DofMap, NodeOrder};
 use stickslip_mesh::Mesh;
 use stickslip_time::{ImplicitSolver, Integrator, Scheme};
 
+use crate::frames::Schedule;
 use crate::output::{self, CheckpointExtra, Record, ResultsWriter, Summary};
 use crate::start;
 
@@ -134,6 +136,9 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         ),
         None => println!("contact     none (no friction code runs)"),
     }
+    if let Some(why) = friction_off(case, i).filter(|_| i.contact().is_some()) {
+        println!("friction    off: {why}; the steps run no friction code");
+    }
     // The explicit integrator computed it already (by its own K·x);
     // Newmark's did not.
     // Quasi-static increments have no inertia: no critical step, no
@@ -154,7 +159,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         // K, the only one of the run; else r₀ = 0 and there is none.
         let preloaded = i.displacement().iter().any(|&x| x != 0.0);
         println!(
-            "solver      explicit: {}; friction solved node by node in closed form; K·x by {}",
+            "solver      explicit: {}; {}; K·x by {}",
             if preloaded {
                 format!(
                     "no linear system per step (the preloaded initial state by one sparse Cholesky (faer, {}) of K)",
@@ -162,6 +167,11 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
                 )
             } else {
                 "no linear system".to_string()
+            },
+            if i.friction() {
+                "friction solved node by node in closed form"
+            } else {
+                "no friction"
             },
             i.stiffness_product()
         );
@@ -180,9 +190,15 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
             p.model.stiffness.nnz(),
         );
     } else {
-        let n_c = i.contact().map_or(0, |c| c.len());
+        let friction = match i.contact().filter(|_| i.friction()) {
+            Some(c) => format!(
+                "friction on the {} contact unknowns by the Schur complement",
+                c.len()
+            ),
+            None => "no friction".to_string(),
+        };
         println!(
-            "solver      implicit Newmark: sparse Cholesky (faer, {}) of A₀, analysed once, factorized once per distinct dt; friction on the {n_c} contact unknowns by the Schur complement; nnz(K) = {}; K·x by {}",
+            "solver      implicit Newmark: sparse Cholesky (faer, {}) of A₀, analysed once, factorized once per distinct dt; {friction}; nnz(K) = {}; K·x by {}",
             p.model.fill_order.name(),
             p.model.stiffness.nnz(),
             i.stiffness_product()
@@ -201,18 +217,19 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
             std::f64::consts::PI * crit
         );
     }
-    let (records, bytes) =
-        output_size(case, p.mesh.nodes.len(), i.contact().map_or(0, |c| c.len()));
+    let size = output_size(case, p.mesh.nodes.len(), i.contact().map_or(0, |c| c.len()));
     println!(
-        "output      about {records} records (every {} steps) of {}, {}",
-        case.output.every,
+        "output      {}: about {} frames of u, v, a ({}) and {} rows of histories (time, energy, contact), {}",
         case.output.file.display(),
-        human_bytes(bytes)
+        size.frames,
+        Schedule::new(case.output.fields(), case.time.t_end).describe(),
+        size.rows,
+        human_bytes(size.bytes)
     );
     if let Some(free) = room_for(&case.output.file, true) {
-        if bytes > free as f64 {
+        if size.bytes > free as f64 {
             println!(
-                "warning     that is more than the {} free on its disk: `run` refuses it; write fewer records (output.every) or elsewhere (-o)",
+                "warning     that is more than the {} free on its disk: `run` refuses it; write fewer frames (output.frames, output.interval, output.every) or elsewhere (-o)",
                 human_bytes(free as f64)
             );
         }
@@ -248,19 +265,63 @@ fn disk_nearly_full(
     ))
 }
 
-/// Records and bytes a run of `case` writes from t = 0 (uncompressed): per
-/// record u, v, a at every node (6 doubles), the contact's stress and slip
-/// (2 doubles) and state (1 byte), about 12 scalars besides (time, the
-/// ledger, dt, iterations).
-fn output_size(case: &Case, nodes: usize, contact_nodes: usize) -> (f64, f64) {
+/// What a run of `case` writes from t = 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct OutputSize {
+    /// Frames of the fields, the initial state included.
+    pub(crate) frames: f64,
+    /// Rows of the histories: every step and the initial state.
+    pub(crate) rows: f64,
+    /// Bytes, uncompressed.
+    pub(crate) bytes: f64,
+}
+
+/// Frames, rows and bytes a run of `case` writes from t = 0
+/// (uncompressed), each series in whole chunks of rows: per frame u, v, a
+/// at every node (6 doubles) and its time and row; per row the contact's
+/// stress and slip (2 doubles) and state (1 byte), and 10 series besides
+/// (time, the ledger, dt, iterations: 68 bytes); the mesh, twice the
+/// checkpoint (its two slots: r, ṙ, r̈ at 2 values a node) and HDF5's own
+/// structures (about 64 kB) besides.
+pub(crate) fn output_size(case: &Case, nodes: usize, contact_nodes: usize) -> OutputSize {
     let steps = (case.time.t_end / case.time.dt - 1e-6).ceil().max(1.0);
-    let every = case.output.every.max(1) as f64;
-    let records = (steps / every).floor() + 1.0;
-    // The node vectors take whole chunks of rows.
-    let block = output::vector_chunk_rows(nodes) as f64;
-    let rows = (records / block).ceil() * block;
-    let bytes = rows * 48.0 * nodes as f64 + records * (17.0 * contact_nodes as f64 + 96.0);
-    (records, bytes)
+    let schedule = Schedule::new(case.output.fields(), case.time.t_end);
+    let frames = schedule.frames(steps, case.time.dt);
+    let rows = if schedule.histories_every_step() {
+        steps + 1.0
+    } else {
+        frames
+    };
+    let up = |n: f64, chunk: usize| (n / chunk as f64).ceil() * chunk as f64;
+    let (nodes_f, n_c) = (nodes as f64, contact_nodes as f64);
+    let contact = up(rows, output::contact_chunk_rows(contact_nodes, 8)) * 16.0 * n_c
+        + up(rows, output::contact_chunk_rows(contact_nodes, 1)) * n_c;
+    let bytes = up(frames, output::vector_chunk_rows(nodes)) * 48.0 * nodes_f
+        + up(frames, output::SERIES_CHUNK) * 16.0
+        + up(rows, output::SERIES_CHUNK) * 68.0
+        + contact
+        + 2.0 * 3.0 * 16.0 * nodes_f
+        + 16.0 * nodes_f
+        + 65536.0;
+    OutputSize {
+        frames,
+        rows,
+        bytes,
+    }
+}
+
+/// Why the steps of `case` run no friction code, if they run none: no
+/// contact surface, or one that carries no friction (μ = 0, no pressure).
+pub(crate) fn friction_off(case: &Case, i: &Integrator) -> Option<String> {
+    if i.friction() {
+        return None;
+    }
+    Some(match &case.contact {
+        None => "the case has no [contact]".to_string(),
+        Some(c) if c.mu == 0.0 => "contact.mu = 0".to_string(),
+        Some(c) if c.pressure == 0.0 => "contact.pressure = 0".to_string(),
+        Some(_) => "no node of the contact surface carries friction (w g = 0)".to_string(),
+    })
 }
 
 /// Bytes free for the results file `out`: its disk's free space, and with
@@ -426,27 +487,30 @@ impl FullState {
     }
 }
 
+/// The integrator's state as a record of the results file: its fields
+/// (expanded to every node) only if `frame`.
 pub(crate) fn record<'a>(
     i: &Integrator,
     dofs: &DofMap,
     s: &'a mut FullState,
-    dt: f64,
-    iterations: u32,
+    (dt, iterations): (f64, u32),
+    frame: bool,
 ) -> Record<'a> {
-    dofs.expand(i.displacement(), &mut s.u);
-    dofs.expand_homogeneous(i.velocity(), &mut s.v);
-    dofs.expand_homogeneous(i.acceleration(), &mut s.a);
+    if frame {
+        dofs.expand(i.displacement(), &mut s.u);
+        dofs.expand_homogeneous(i.velocity(), &mut s.v);
+        dofs.expand_homogeneous(i.acceleration(), &mut s.a);
+    }
     i.friction_stress(&mut s.stress);
     i.slip_velocity(&mut s.slip);
-    for (o, c) in s.state.iter_mut().zip(i.classes()) {
-        *o = c.code();
-    }
+    i.slip_states(&mut s.state);
     let e = i.energy();
+    let fields = |v: &'a [f64]| if frame { v } else { &[] };
     Record {
         t: i.time(),
-        displacement: &s.u,
-        velocity: &s.v,
-        acceleration: &s.a,
+        displacement: fields(&s.u),
+        velocity: fields(&s.v),
+        acceleration: fields(&s.a),
         friction_stress: &s.stress,
         slip_velocity: &s.slip,
         state: &s.state,
@@ -579,8 +643,9 @@ fn blow_up(i: &Integrator, initial: f64) -> Option<f64> {
     (mechanical > bound && mechanical > f64::MIN_POSITIVE).then_some(bound)
 }
 
-/// `stickslip run`: integrate to t_end writing every `output.every`-th
-/// step; flush and checkpoint every `output.flush_every` steps or
+/// `stickslip run`: integrate to t_end writing the histories at every
+/// step and the fields at frames (`output.frames`, `output.interval`,
+/// `output.every`); flush and checkpoint every `output.flush_every` steps or
 /// `output.flush_seconds` seconds; stop cleanly on SIGINT, SIGTERM or SIGHUP; with
 /// `options.restart`, continue the file `out` from its checkpoint.
 ///
@@ -612,13 +677,16 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     // off by orders of magnitude filled 14 GB in 75 s): refused before it
     // starts, where the run's own stop at a full disk would come late.
     if !options.restart {
-        let (records, bytes) = output_size(case, mesh.nodes.len(), n_c);
-        if let Some(free) = room_for(out, true).filter(|&f| bytes > f as f64) {
+        let size = output_size(case, mesh.nodes.len(), n_c);
+        if let Some(free) = room_for(out, true).filter(|&f| size.bytes > f as f64) {
             return Err(input(format!(
-                "{}: the run would write about {records} records ({}) to {}, whose disk has {} free; \
-                 write every Nth step (output.every), shorten time.t_end, or write elsewhere with -o",
+                "{}: the run would write about {} frames and {} rows ({}) to {}, whose disk has {} free; \
+                 write fewer frames (output.frames, output.interval, output.every), shorten time.t_end, \
+                 or write elsewhere with -o",
                 case.path.display(),
-                human_bytes(bytes),
+                size.frames,
+                size.rows,
+                human_bytes(size.bytes),
                 out.display(),
                 human_bytes(free as f64)
             )));
@@ -648,6 +716,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         integrator,
         writer: opened.writer,
         full,
+        schedule: Schedule::new(case.output.fields(), case.time.t_end),
         times: opened.times,
         max_balance: opened.max_balance,
         wall_before: opened.wall_before,
@@ -683,10 +752,10 @@ struct Ending {
     failure: Option<String>,
     /// The signal that stopped it, if one did.
     interrupted: Option<&'static str>,
-    /// The state before the last step (and the rows then): that step is
+    /// The state before the last step (and the rows and frames then): that step is
     /// shortened to land on t_end, so a restart with a later t_end must
     /// redo it at full length to match a run that never stopped.
-    before_last: Option<(stickslip_time::Checkpoint, usize)>,
+    before_last: Option<(stickslip_time::Checkpoint, (usize, usize))>,
 }
 
 /// What a run shows while it steps: a bar on a terminal, else (a log) a
@@ -773,6 +842,8 @@ struct Session<'a> {
     integrator: Integrator,
     writer: ResultsWriter,
     full: FullState,
+    /// Which steps write the fields.
+    schedule: Schedule,
     /// Times of the records written.
     times: Vec<f64>,
     max_balance: f64,
@@ -783,14 +854,18 @@ struct Session<'a> {
 
 impl Session<'_> {
     /// Writes `cp` (or the current state) as the file's checkpoint, with
-    /// `rows` records (or all so far).
+    /// `rows` records and `frames` frames (or all so far).
     fn checkpoint(
         &mut self,
-        at: Option<(stickslip_time::Checkpoint, usize)>,
+        at: Option<(stickslip_time::Checkpoint, (usize, usize))>,
     ) -> anyhow::Result<()> {
-        let (cp, rows) = at.unwrap_or_else(|| (self.integrator.checkpoint(), self.writer.rows()));
+        let (cp, (rows, frames)) = at.unwrap_or_else(|| {
+            let written = (self.writer.rows(), self.writer.frames());
+            (self.integrator.checkpoint(), written)
+        });
         let extra = CheckpointExtra {
             rows,
+            frames,
             wall_time_s: self.wall_before + self.started.elapsed().as_secs_f64(),
             max_balance: self.max_balance,
             node_order: self.dofs.node_order().code(),
@@ -798,15 +873,15 @@ impl Session<'_> {
         self.writer.write_checkpoint(&cp, &extra)
     }
 
-    /// Appends the current state as a record.
-    fn append(&mut self, dt: f64, iterations: u32) -> anyhow::Result<()> {
+    /// Appends the current state as a record, with the fields if `frame`.
+    fn append(&mut self, dt: f64, iterations: u32, frame: bool) -> anyhow::Result<()> {
         self.times.push(self.integrator.time());
         self.writer.append(&record(
             &self.integrator,
             self.dofs,
             &mut self.full,
-            dt,
-            iterations,
+            (dt, iterations),
+            frame,
         ))
     }
 
@@ -816,10 +891,10 @@ impl Session<'_> {
         disk_nearly_full(&self.writer, self.dofs, self.out, &self.integrator)
     }
 
-    /// Steps to t_end (or a failure, a signal), writing every
-    /// `output.every`-th step, flushing and checkpointing when due.
+    /// Steps to t_end (or a failure, a signal), writing every step's
+    /// histories and the frames' fields, flushing and checkpointing when
+    /// due.
     fn step_to_end(&mut self, progress: &mut Progress) -> anyhow::Result<Ending> {
-        let every = self.case.output.every.max(1) as u64;
         let mut ending = Ending {
             failure: None,
             interrupted: None,
@@ -828,7 +903,9 @@ impl Session<'_> {
         while !self.integrator.done() {
             let i = &self.integrator;
             let near_end = i.t_end() - i.time() <= self.case.time.dt * (1.0 + 1e-6);
-            let before = near_end.then(|| (i.checkpoint(), self.writer.rows()));
+            let before =
+                near_end.then(|| (i.checkpoint(), (self.writer.rows(), self.writer.frames())));
+            let t_prev = i.time();
             let info = match self.integrator.step() {
                 Ok(info) => info,
                 Err(e) => {
@@ -838,26 +915,30 @@ impl Session<'_> {
             };
             self.max_balance = self.max_balance.max(self.integrator.energy().balance.abs());
             self.writer.count_step();
-            let write = self.integrator.steps().is_multiple_of(every) || self.integrator.done();
-            if write {
-                // HDF5 writes a chunk of rows as it fills: the room for
-                // it is checked before, as before a flush.
-                if self.writer.append_writes() {
+            let i = &self.integrator;
+            // A blow-up's last state is written whole: it shows where.
+            let blown = i
+                .is_explicit()
+                .then(|| blow_up(i, self.initial_mechanical))
+                .flatten();
+            let frame = blown.is_some()
+                || self
+                    .schedule
+                    .is_frame(i.steps(), t_prev, i.time(), i.done());
+            if frame || self.schedule.histories_every_step() {
+                // HDF5 writes a chunk of rows as it fills: the room for it
+                // is checked before, as before a flush.
+                if self.writer.append_writes(frame) {
                     if let Some(e) = self.disk_nearly_full() {
                         ending.failure = Some(e);
                         break;
                     }
                 }
-                self.append(info.dt, info.iterations as u32)?;
+                self.append(info.dt, info.iterations as u32, frame)?;
             }
-            if self.integrator.is_explicit() {
-                if let Some(bound) = blow_up(&self.integrator, self.initial_mechanical) {
-                    if !write {
-                        self.append(info.dt, info.iterations as u32)?;
-                    }
-                    ending.failure = Some(blow_up_failure(&self.integrator, bound, self.case));
-                    break;
-                }
+            if let Some(bound) = blown {
+                ending.failure = Some(blow_up_failure(&self.integrator, bound, self.case));
+                break;
             }
             if self.integrator.done() {
                 ending.before_last = before;
@@ -910,11 +991,13 @@ impl Session<'_> {
             )),
             _ => None,
         };
+        let friction_off = friction_off(self.case, i);
         let summary = Summary {
             wall_time_s: self.wall_before + self.started.elapsed().as_secs_f64(),
             steps: i.steps(),
             factorizations: i.factorizations(),
             dt_crit: i.dt_crit(),
+            friction_off: friction_off.clone(),
             failure: reason.clone(),
             stiffness_product: i.stiffness_product().into(),
             fill_order: fill_order_attr(i.fill_order(), self.options.restart),
@@ -922,6 +1005,7 @@ impl Session<'_> {
         let steps_run = i.steps() - steps_before;
         let step_s = stepping.elapsed().as_secs_f64() / steps_run.max(1) as f64;
         let rows = self.writer.rows();
+        let frames = self.writer.frames();
         let warnings = self.writer.warnings();
         self.writer.finish(complete, &summary)?;
         let status = if complete {
@@ -934,8 +1018,12 @@ impl Session<'_> {
         let (case, out, i) = (self.case, self.out, &self.integrator);
         let e = i.energy();
         if !self.options.quiet {
+            let friction = match &friction_off {
+                Some(why) => format!("friction off ({why})"),
+                None => format!("{} stick/slip iterations", i.total_iterations()),
+            };
             say!(
-                "{} {} steps to t = {:.6} ({} stick/slip iterations, {} factorizations, K by {}) in {:.3} s (setup {setup_s:.3} s, {} a step with output)",
+                "{} {} steps to t = {:.6} ({friction}, {} factorizations, K by {}) in {:.3} s (setup {setup_s:.3} s, {} a step with output)",
                 match status {
                     "complete" => "done:",
                     "interrupted" => "interrupted:",
@@ -943,7 +1031,6 @@ impl Session<'_> {
                 },
                 i.steps(),
                 i.time(),
-                i.total_iterations(),
                 i.factorizations(),
                 summary.stiffness_product,
                 summary.wall_time_s,
@@ -962,7 +1049,10 @@ impl Session<'_> {
                 "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}); largest |balance| {:.3e}{damped}",
                 e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
             );
-            say!("results: {} ({rows} records)", out.display());
+            say!(
+                "results: {} ({rows} rows of histories; {frames} frames of u, v, a)",
+                out.display()
+            );
             say!(
                 "view: `{}`, then open {} in ParaView (meshio and PyVista read it too)",
                 view_command(out),
@@ -981,6 +1071,8 @@ impl Session<'_> {
                 "t": i.time(),
                 "t_end": i.t_end(),
                 "records": rows,
+                "frames": frames,
+                "friction": friction_off.as_ref().map_or("on".to_string(), |why| format!("off: {why}")),
                 "wall_time_s": summary.wall_time_s,
                 "setup_s": setup_s,
                 "step_s": step_s,

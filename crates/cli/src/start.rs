@@ -58,7 +58,8 @@ pub(crate) fn fresh(
         case.output.deflate_level().unwrap_or(output::DEFLATE_LEVEL),
     )
     .with_context(|| format!("cannot create the results file {}", out.display()))?;
-    writer.append(&record(integrator, dofs, full, 0.0, 0))?;
+    // The initial state is frame 0.
+    writer.append(&record(integrator, dofs, full, (0.0, 0), true))?;
     // Kept in the file and printed with --quiet too: quiet silences
     // progress, not what the user should know.
     let warnings = setup_warnings(mesh, &full.u, integrator);
@@ -157,15 +158,21 @@ pub(crate) fn resume(
         .restore(cp)
         .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
     let n_c = integrator.contact().map_or(0, |c| c.len());
-    let mut writer = ResultsWriter::open_append(out, stored.extra.rows, mesh.nodes.len(), n_c)?;
+    let mut writer = ResultsWriter::open_append(
+        out,
+        (stored.extra.rows, stored.extra.frames),
+        mesh.nodes.len(),
+        n_c,
+    )?;
     writer.set_case(&case.source)?;
     if !quiet {
         say!(
-            "restart: continuing {} from step {}, t = {} ({} records kept)",
+            "restart: continuing {} from step {}, t = {} ({} records and {} frames kept)",
             out.display(),
             cp.steps,
             cp.t,
-            stored.extra.rows
+            stored.extra.rows,
+            stored.extra.frames
         );
     }
     Ok(Opened {

@@ -7,8 +7,9 @@
 //! afterwards from `/displacement` and the material of the case the file
 //! stores, as `stickslip probe --field sxx` does at one node: at each node
 //! the average of its cells' σ = D ε there (`stickslip_fem::nodal_stresses`),
-//! into `OUT.stress.h5`: `/stress` [n_out, n_nodes, 3] (σ_xx, σ_yy, σ_xy)
-//! and `/von_mises` [n_out, n_nodes], with a view of each record's
+//! into `OUT.stress.h5`: `/stress` [n_frames, n_nodes, 3] (σ_xx, σ_yy,
+//! σ_xy) and `/von_mises` [n_frames, n_nodes] (a row per frame, as
+//! `/displacement`), with a view of each frame's
 //! σ_xx, σ_yy, σ_xy and von Mises under `/views`; and writes the viewers'
 //! files as `stickslip views` does, `OUT.xdmf` listing the stresses. The
 //! results file is only read: a full disk or a kill leaves it as it was
@@ -42,7 +43,8 @@ pub fn command(
     let (mesh, material) = crate::probe::stored_model(&f, &name)?;
     let n_nodes = mesh.nodes.len();
     let u = f.dataset("displacement")?;
-    let times = f.dataset("time")?.read_1d::<f64>()?.to_vec();
+    // A record here is a frame: the rows of /displacement.
+    let times = crate::frames::Frames::read(&f, &name)?.time;
     let rows = times.len().min(u.shape().first().copied().unwrap_or(0));
     let complete = f
         .attr("complete")
@@ -152,7 +154,7 @@ fn write_stresses(
             if c < 3 {
                 crate::views::column_view(&v, ".", "stress", (n_nodes, 3), k, c)?;
             } else {
-                crate::views::row_view::<f64>(&v, ".", "von_mises", n_nodes, k)?;
+                crate::views::row_view::<f64>(&v, ".", "von_mises", n_nodes, (k, k))?;
             }
         }
     }

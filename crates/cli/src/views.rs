@@ -99,12 +99,15 @@ pub struct Layout<'a> {
     pub contact: Option<&'a ContactLine>,
 }
 
-/// Makes `OUT.views.h5` hold the views of records `0..rows` of the results
-/// file `out`, adding those it lacks.
+/// Makes `OUT.views.h5` hold the views of the frames of the results file
+/// `out`, adding those it lacks: frame k's node vectors are row k of
+/// `/displacement` and the others, its contact fields row `rows[k]` of
+/// `/contact/*` (its row of `/time`; `rows` has one entry a frame).
 ///
 /// # Errors
 /// `out` without a UTF-8 file name, or HDF5 failing to write the file.
-pub fn update(out: &Path, layout: &Layout, rows: usize) -> anyhow::Result<()> {
+pub fn update(out: &Path, layout: &Layout, frame_rows: &[usize]) -> anyhow::Result<()> {
+    let rows = frame_rows.len();
     let source = file_name(out)?;
     let path = views_path(out);
     let n_c = layout.contact.map_or(0, |c| c.points.len());
@@ -125,10 +128,11 @@ pub fn update(out: &Path, layout: &Layout, rows: usize) -> anyhow::Result<()> {
                 let g = f.group(&format!("contact/{name}"))?;
                 let src = format!("contact/{name}");
                 for k in g.len() as usize..rows {
+                    let at = (k, frame_rows[k]);
                     if small {
-                        row_view::<i8>(&g, source, &src, n_c, k)?;
+                        row_view::<i8>(&g, source, &src, n_c, at)?;
                     } else {
-                        row_view::<f64>(&g, source, &src, n_c, k)?;
+                        row_view::<f64>(&g, source, &src, n_c, at)?;
                     }
                 }
             }
@@ -168,8 +172,9 @@ fn create(path: &Path, source: &str, layout: &Layout) -> anyhow::Result<File> {
     crate::output::string_attr(
         &f,
         "about",
-        "views (HDF5 virtual datasets) of one record each of the results file named by `source`, \
-         for OUT.xdmf and OUT.contact.xdmf; /NAME/K is row K of /NAME there, node vectors with z = 0",
+        "views (HDF5 virtual datasets) of one frame each of the results file named by `source`, \
+         for OUT.xdmf and OUT.contact.xdmf; /NAME/K is row K of /NAME there (frame K), node vectors with z = 0; \
+         /contact/NAME/K is row /frames/row[K] of /contact/NAME there (the histories' row of frame K)",
     )?;
     crate::output::string_attr(&f, "source", source)?;
     let n_c = layout.contact.map_or(0, |c| c.points.len());
@@ -217,18 +222,19 @@ fn vector_view(g: &hdf5::Group, source: &str, src: &str, n: usize, k: usize) -> 
     Ok(())
 }
 
-/// `g/k`: row k of the `[rows, n]` dataset `src` of `source`.
+/// `g/k`: row `r` of the `[rows, n]` dataset `src` of `source`, for
+/// `(k, r)`.
 pub(crate) fn row_view<T: hdf5::H5Type>(
     g: &hdf5::Group,
     source: &str,
     src: &str,
     n: usize,
-    k: usize,
+    (k, r): (usize, usize),
 ) -> hdf5::Result<()> {
-    let row = Selection::from(Hyperslab::from((k..k + 1, 0..n)));
+    let row = Selection::from(Hyperslab::from((r..r + 1, 0..n)));
     g.new_dataset::<T>()
         .shape(n)
-        .virtual_map(source, src, (rows_past(k), n), row, n, ..)
+        .virtual_map(source, src, (rows_past(r), n), row, n, ..)
         .create(k.to_string().as_str())?;
     Ok(())
 }

@@ -95,9 +95,11 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         }
     };
     let n_nodes = nodes.first().copied().unwrap_or(0);
-    let times = crate::probe::read_time(&f, &name)?;
-    // A run killed between writing /time and the vectors: list the
-    // records every dataset holds.
+    // A record here is a frame: the fields' rows and their contact rows.
+    let frames = crate::frames::Frames::read(&f, &name)?;
+    let times = frames.time;
+    // A run killed between writing /frames and the vectors: list the
+    // frames every dataset holds.
     let rows = times
         .len()
         .min(shape("displacement")?.first().copied().unwrap_or(0));
@@ -122,7 +124,7 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         n_nodes,
         contact: contact.as_ref(),
     };
-    crate::views::update(out, &layout, rows)?;
+    crate::views::update(out, &layout, &frames.row[..rows])?;
     let info = XdmfInfo {
         n_nodes,
         kind,

@@ -439,7 +439,12 @@ fn broken_promises(c: &Case) -> Vec<String> {
         c.time.dt > 0.0 && c.time.t_end > 0.0,
         "time.dt and time.t_end must be > 0",
     );
-    promise(c.output.every >= 1, "output.every must be >= 1");
+    promise(c.output.every != Some(0), "output.every must be >= 1");
+    promise(c.output.frames != Some(0), "output.frames must be >= 1");
+    promise(
+        c.output.interval.is_none_or(|dt| dt > 0.0),
+        "output.interval must be > 0",
+    );
     promise(
         c.output.compression.is_none_or(|l| l <= 9),
         "output.compression is 0 to 9",
@@ -672,7 +677,7 @@ fn the_checks_find_broken_promises() {
     let breaks: [fn(&mut Case); 6] = [
         |c| c.material.nu = 0.5,
         |c| c.material.e = 1e101,
-        |c| c.output.every = 0,
+        |c| c.output.every = Some(0),
         |c| {
             c.traction[0].history = History::Sin {
                 omega: f64::INFINITY,

@@ -660,6 +660,7 @@ fn assert_same_datasets(a: &Path, b: &Path) {
                         .map(|&x| x as u64)
                         .collect()
                 },
+                TypeDescriptor::Unsigned(IntSize::U8) => |d| d.read_raw::<u64>().unwrap(),
                 other => panic!("{name}: unexpected type {other:?}"),
             };
         let (va, vb) = if da.size() == 0 {
@@ -1372,25 +1373,36 @@ fn damaged_results_files_are_refused() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("not UTF-8"), "{}", stderr(&o));
 
-    let huge = dir.join("huge.h5");
-    std::fs::copy(&good, &huge).unwrap();
-    {
-        let f = hdf5::File::open_rw(&huge).unwrap();
-        f.unlink("time").unwrap();
-        f.new_dataset::<f64>()
+    // A copy of the good file whose dataset `name` claims 1e11 rows.
+    let claims_huge = |file: &str, name: &str| {
+        let path = dir.join(file);
+        std::fs::copy(&good, &path).unwrap();
+        let f = hdf5::File::open_rw(&path).unwrap();
+        f.unlink(name).unwrap();
+        let (group, leaf) = name.rsplit_once('/').unwrap_or((".", name));
+        f.group(group)
+            .unwrap()
+            .new_dataset::<f64>()
             .chunk(1024)
             .shape(100_000_000_000usize)
-            .create("time")
+            .create(leaf)
             .unwrap();
+        path
+    };
+    let huge = claims_huge("huge.h5", "time");
+    let huge_frames = claims_huge("huge-frames.h5", "frames/time");
+    // /time is what the contact's histories are read against, /frames/time
+    // what the fields are.
+    for (file, field) in [(&huge, "friction_stress"), (&huge_frames, "ux")] {
+        let probe = bin()
+            .arg("probe")
+            .arg(file)
+            .args(["--at", "8,0", "--field", field])
+            .output()
+            .unwrap();
+        assert_eq!(probe.status.code(), Some(2), "{}", stderr(&probe));
+        assert!(stderr(&probe).contains("damaged"), "{}", stderr(&probe));
     }
-    let probe = bin()
-        .arg("probe")
-        .arg(&huge)
-        .args(["--at", "8,0"])
-        .output()
-        .unwrap();
-    assert_eq!(probe.status.code(), Some(2), "{}", stderr(&probe));
-    assert!(stderr(&probe).contains("damaged"), "{}", stderr(&probe));
     let o = restart(&case, &huge, &["--set", "time.t_end=0.1"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("damaged"), "{}", stderr(&o));

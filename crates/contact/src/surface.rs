@@ -200,6 +200,13 @@ impl ContactSurface {
         self.nodes.is_empty()
     }
 
+    /// True when some node's friction can act: w_J g_J > 0. A surface
+    /// where μ = 0 or the pressure is 0 carries none (σ_T = −g φ_ε(v_T) is
+    /// 0 whatever v_T), and a run needs none of its friction code.
+    pub fn carries_friction(&self) -> bool {
+        self.nodes.iter().any(|n| n.force_scale() != 0.0)
+    }
+
     /// True when every tangent is along x or y, so the damping matrix C is
     /// diagonal (DESIGN.md: a straight axis-aligned contact line keeps C
     /// diagonal).

@@ -310,6 +310,7 @@ impl Stepper for CentralDifference {
             return Err(self.non_finite(step, t_new));
         }
         let (dissipated, stick_events) = if run.contact.is_some() {
+            state.friction_passes += 1;
             self.nodal.closed_form().ledger(
                 &state.v_new,
                 &state.v,

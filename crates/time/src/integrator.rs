@@ -13,6 +13,10 @@ use crate::{central_difference, newmark, quasi_static};
 /// Integrates from the initial state to `t_end`, one step per call.
 pub struct Integrator {
     run: Run,
+    /// The contact surface as the observers see it (slip velocities,
+    /// stresses): `run.contact` or, where it carries no friction, the
+    /// surface the scheme runs without.
+    surface: Option<ContactSurface>,
     state: State,
     stepper: Box<dyn Stepper>,
     fill_order: FillOrder,
@@ -47,8 +51,12 @@ impl Integrator {
         settings: Settings,
     ) -> Result<Integrator, TimeError> {
         let mass_kind = settings.check(dynamics.n())?;
-        // A scene without friction nodes runs no friction code.
-        let contact = contact.filter(|c| !c.is_empty());
+        // A scene without friction nodes runs no friction code; nor does
+        // one whose nodes carry none (μ = 0 or no pressure: w g = 0 at
+        // every node), which then steps as a scene without a contact
+        // surface, the surface kept for the observers.
+        let surface = contact.filter(|c| !c.is_empty());
+        let contact = surface.clone().filter(ContactSurface::carries_friction);
         let loads = Loads {
             constant: dynamics.constant_load.clone(),
             loads,
@@ -71,6 +79,7 @@ impl Integrator {
             }
         };
         Ok(Integrator {
+            surface,
             run: Run {
                 contact,
                 loads,
@@ -113,6 +122,21 @@ impl Integrator {
     /// or the contact surface, a class code is not −1, 0 or 1, or a value is
     /// not finite.
     pub fn restore(&mut self, c: &Checkpoint) -> Result<(), TimeError> {
+        // A run without friction on a surface keeps no classes or forces;
+        // a checkpoint of a version that ran friction code on it (all
+        // forces 0) has them.
+        let n_c = self.surface.as_ref().map_or(0, ContactSurface::len);
+        let without_friction;
+        let c = if self.run.contact.is_none() && n_c > 0 && c.classes.len() == n_c {
+            without_friction = Checkpoint {
+                classes: Vec::new(),
+                forces: Vec::new(),
+                ..c.clone()
+            };
+            &without_friction
+        } else {
+            c
+        };
         self.state.restore(c, self.run.settings.dt)?;
         self.stepper.state_replaced();
         self.stepper.set_factorizations(c.factorizations);
@@ -158,9 +182,38 @@ impl Integrator {
     pub fn classes(&self) -> &[SlipState] {
         &self.state.classes
     }
-    /// The contact surface, if the scene has friction.
+    /// The contact surface, if the scene has friction-carrying nodes
+    /// (whether their friction can act or not: [`Integrator::friction`]).
     pub fn contact(&self) -> Option<&ContactSurface> {
-        self.run.contact.as_ref()
+        self.surface.as_ref()
+    }
+    /// True when the steps run friction code: the scene has a contact
+    /// surface and w g > 0 at some node of it.
+    pub fn friction(&self) -> bool {
+        self.run.contact.is_some()
+    }
+    /// Steps of this integrator that ran friction code (none where
+    /// [`Integrator::friction`] is false).
+    pub fn friction_passes(&self) -> u64 {
+        self.state.friction_passes
+    }
+    /// Stick/slip state code of each contact node (0 stuck, ±1 slipping
+    /// along ±τ): the step's classes, or where friction is off the law's
+    /// class of the tangential velocity (no force acts either way).
+    pub fn slip_states(&self, out: &mut [i8]) {
+        match (&self.run.contact, &self.surface) {
+            (Some(_), _) => {
+                for (o, c) in out.iter_mut().zip(&self.state.classes) {
+                    *o = c.code();
+                }
+            }
+            (None, Some(c)) => {
+                for (o, n) in out.iter_mut().zip(&c.nodes) {
+                    *o = c.law.classify(n.tangential(&self.state.v)).code();
+                }
+            }
+            (None, None) => {}
+        }
     }
     /// The energy ledger now.
     pub fn energy(&self) -> Energy {
@@ -227,13 +280,13 @@ impl Integrator {
     }
     /// Friction stress σ_T = −g φ_ε(v_T) at each contact node.
     pub fn friction_stress(&self, out: &mut [f64]) {
-        if let Some(c) = &self.run.contact {
+        if let Some(c) = &self.surface {
             c.friction_stress(&self.state.v, out);
         }
     }
     /// Tangential (slip) velocity at each contact node.
     pub fn slip_velocity(&self, out: &mut [f64]) {
-        if let Some(c) = &self.run.contact {
+        if let Some(c) = &self.surface {
             for (o, n) in out.iter_mut().zip(&c.nodes) {
                 *o = n.tangential(&self.state.v);
             }

@@ -131,6 +131,10 @@ pub(crate) struct State {
     pub initial_mechanical: f64,
     pub reduced_remaining: usize,
     pub total_iterations: u64,
+    /// Steps of this process that ran friction code (the nodal closed
+    /// form or the stick/slip iteration); not checkpointed: it counts
+    /// work, not state.
+    pub friction_passes: u64,
     pub r_new: Vec<f64>,
     pub v_new: Vec<f64>,
     pub a_new: Vec<f64>,
@@ -170,6 +174,7 @@ impl State {
             initial_mechanical: 0.0,
             reduced_remaining: 0,
             total_iterations: 0,
+            friction_passes: 0,
             r_new: vec![0.0; n],
             v_new: vec![0.0; n],
             a_new: vec![0.0; n],

@@ -320,7 +320,10 @@ impl Stepper for Newmark {
             load_dot += state.r_new[k] * state.load_new[k];
         }
         let (dissipated, stick_events) = match &run.contact {
-            Some(c) => friction_ledger(c, state, dt),
+            Some(c) => {
+                state.friction_passes += 1;
+                friction_ledger(c, state, dt)
+            }
             None => (0.0, 0),
         };
         state.commit(dt, t_new, iterations);
