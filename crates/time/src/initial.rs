@@ -1,5 +1,6 @@
 //! The initial state of paper Remark 4.1 (METHOD.md §4): r₀ the
-//! frictionless static equilibrium under the loads present at t = 0⁻,
+//! frictionless static equilibrium under the loads present at t = 0⁻ (or
+//! r₀ = 0 for a start at rest, every load then acting from t = 0 on),
 //! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀, again without friction.
 
 use nalgebra_sparse::CsrMatrix;
@@ -8,7 +9,7 @@ use stickslip_linalg::csr::{dot, quadratic_form, spmv};
 use stickslip_linalg::{chunks, FillOrder, SparseCholesky};
 
 use crate::dynamics::Loads;
-use crate::settings::{Settings, TimeError};
+use crate::settings::{InitialState, Settings, TimeError};
 use crate::state::{Energy, State};
 
 /// The mass a scheme uses, as the initial state needs it.
@@ -31,8 +32,8 @@ impl Mass<'_> {
 }
 
 /// The state at t = 0 for a scheme with mass `mass`: Remark 4.1's r₀ (no
-/// factorization where nothing acts before t = 0, or where the state will
-/// come from a checkpoint: r₀ = 0 then), ṙ₀, r̈₀, R(0), the contact
+/// factorization where nothing acts before t = 0, where the run starts at
+/// rest, or where the state will come from a checkpoint: r₀ = 0 then), ṙ₀, r̈₀, R(0), the contact
 /// classes and forces at ṙ₀, and the energies.
 ///
 /// # Errors
@@ -49,7 +50,7 @@ pub(crate) fn initial_state(
     let n = k.nrows();
     let mut state = State::new(n, contact.map_or(0, |c| c.len()), settings.dt);
     let mut r = loads.before_start();
-    if settings.restoring {
+    if settings.restoring || settings.initial_state == InitialState::Rest {
         r.fill(0.0);
     } else if r.iter().any(|&x| x != 0.0) {
         let mut solver = SparseCholesky::analyze(k, fill_order).map_err(TimeError::Static)?;

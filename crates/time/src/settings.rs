@@ -64,6 +64,17 @@ pub enum ImplicitSolver {
     Direct,
 }
 
+/// Where a run starts (the case's `[initial] state`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum InitialState {
+    /// Remark 4.1: r₀ the frictionless static equilibrium under the loads
+    /// present at t = 0⁻.
+    #[default]
+    Static,
+    /// r₀ = 0: every load acts from t = 0 on, nothing before.
+    Rest,
+}
+
 /// Remark 4.3: after a step in which a node went from slip to stick, the
 /// next `steps` steps use `dt`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -96,6 +107,8 @@ pub struct Settings {
     pub explicit_friction: ExplicitFriction,
     /// How implicit steps solve.
     pub implicit_solver: ImplicitSolver,
+    /// r₀: Remark 4.1's static state (default) or rest.
+    pub initial_state: InitialState,
     /// ṙ₀ (default zero).
     pub initial_velocity: Option<Vec<f64>>,
     /// The state will come from a checkpoint ([`crate::Integrator::restore`]):
@@ -118,6 +131,7 @@ impl Settings {
             allow_unstable: false,
             explicit_friction: ExplicitFriction::ClosedForm,
             implicit_solver: ImplicitSolver::Schur,
+            initial_state: InitialState::Static,
             initial_velocity: None,
             restoring: false,
         }
