@@ -125,6 +125,8 @@ fn refused(case: &Case, e: TimeError) -> InputError {
     let key = match e {
         TimeError::Unstable { .. } => "time.dt",
         TimeError::Static(_) => "dirichlet.0.group",
+        TimeError::Unbalanced(_) if case.locations.contains_key("initial.state") => "initial.state",
+        TimeError::Unbalanced(_) => "dirichlet.0.group",
         _ => "time.scheme",
     };
     InputError(format!("{}[time]: {e}", case.at(key)))
@@ -349,14 +351,19 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
         _ => None,
     };
     if let Some(m) = &model {
-        // The initial static solve (Remark 4.1) is frictionless: the
-        // supports alone must hold the body (DofMap checks each connected part).
-        let free = m.dofs.free_rigid_motions();
-        if !free.is_empty() {
+        // A part's free rigid motions are the integrator's to handle (the
+        // static preload on their complement, or a start at rest); a node
+        // of no cell has no stiffness at all, and nothing can hold it.
+        let loose: Vec<&String> = m
+            .dofs
+            .free_rigid_motions()
+            .iter()
+            .filter(|l| l.contains("belongs to no cell"))
+            .collect();
+        if !loose.is_empty() {
             problems.push(format!(
-                "{dirichlet_at}the supports leave a rigid-body motion free for the initial static solve: {}; \
-                 add [[dirichlet]] conditions that prevent it (e.g. uy = 0 on a bottom or top group and ux = 0 on an end)",
-                free.join(", ")
+                "{dirichlet_at}{}; add [[dirichlet]] conditions that hold it, or remove it from the mesh",
+                loose.iter().map(|l| l.as_str()).collect::<Vec<_>>().join(", ")
             ));
         }
     }

@@ -267,25 +267,42 @@ fn a_contact_surface_held_in_its_tangent_is_refused() {
 }
 
 #[test]
-fn supports_that_leave_a_rigid_motion_free_are_refused() {
-    // Without the left end's ux = 0 nothing holds the slab in x (the
-    // initial static solve is frictionless, Remark 4.1).
+fn a_floating_part_under_unbalanced_preloads_is_refused() {
+    // Without the left end's ux = 0 nothing holds the slab in x. With the
+    // end load H(t) the loads before t = 0 (the contact pressure, reacted
+    // by the top's rollers) are in equilibrium and the case runs; with the
+    // end load "constant" they push the slab in x (net force −150 per unit
+    // height on the end of height 1) and the static preload does not exist.
     let dir = scratch("rigid");
-    let (case, _) = slab_case(&dir, "rigid", |t| {
+    let floating = |t: String| {
         t.replace(
             "[[dirichlet]]        # the left end is held in x\ngroup = \"left\"\nux = 0.0\n",
             "",
         )
+    };
+    let (case, _) = slab_case(&dir, "balanced", floating);
+    let o = run(&case, &dir.join("balanced.h5"), &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (case, text) = slab_case(&dir, "unbalanced", |t| {
+        floating(t).replace("history = \"step\"", "history = \"constant\"")
     });
     refused(
         &case,
         &[],
         &[
-            "rigid-body motion free",
-            "translation in x",
-            "[[dirichlet]]",
+            &format!("unbalanced.toml:{}:", line_of(&text, "group = \"support\"")),
+            "not in equilibrium",
+            "translation in x: net force F_x = -1.5",
+            "state = \"rest\"",
         ],
     );
+    // Started at rest, the same case needs no static state and runs.
+    let (case, _) = slab_case(&dir, "rest", |t| {
+        floating(t).replace("history = \"step\"", "history = \"constant\"")
+            + "\n[initial]\nstate = \"rest\"\n"
+    });
+    let o = run(&case, &dir.join("rest.h5"), &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 #[test]

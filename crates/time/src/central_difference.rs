@@ -66,6 +66,7 @@ pub(crate) fn start(
         lumped_mass: mass,
         fill_order,
         stencils,
+        rigid_modes,
         ..
     } = dynamics;
     let types = if stencils { Stencils::new(&k) } else { None };
@@ -85,6 +86,7 @@ pub(crate) fn start(
     let state = initial_state(
         &k,
         Mass::Lumped(&mass),
+        &rigid_modes,
         &fill_order,
         contact,
         loads,

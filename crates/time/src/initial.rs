@@ -5,6 +5,7 @@
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
+use stickslip_fem::RigidMode;
 use stickslip_linalg::csr::{dot, quadratic_form, spmv};
 use stickslip_linalg::{chunks, FillOrder, SparseCholesky};
 
@@ -22,6 +23,18 @@ pub(crate) enum Mass<'a> {
 }
 
 impl Mass<'_> {
+    /// M x into `out`.
+    pub fn apply(&self, x: &[f64], out: &mut [f64]) {
+        match self {
+            Mass::Lumped(m) => {
+                for ((o, x), m) in out.iter_mut().zip(x).zip(*m) {
+                    *o = m * x;
+                }
+            }
+            Mass::Consistent(m) => spmv(m, x, out),
+        }
+    }
+
     /// xᵀ M x.
     pub fn form(&self, x: &[f64], partials: &mut [[f64; 2]]) -> f64 {
         match self {
@@ -36,12 +49,17 @@ impl Mass<'_> {
 /// rest, or where the state will come from a checkpoint: r₀ = 0 then), ṙ₀, r̈₀, R(0), the contact
 /// classes and forces at ṙ₀, and the energies.
 ///
+/// Where the supports leave rigid motions free (`modes`), the static state
+/// is solved on their complement (`floating.rs`).
+///
 /// # Errors
-/// [`TimeError::Static`] when K (or a consistent M) is not positive
-/// definite: a rigid-body motion left free.
+/// [`TimeError::Unbalanced`] when the preload does work along a free rigid
+/// motion; [`TimeError::Static`] when K (or a consistent M) is otherwise
+/// not positive definite.
 pub(crate) fn initial_state(
     k: &CsrMatrix<f64>,
     mass: Mass,
+    modes: &[RigidMode],
     fill_order: &FillOrder,
     contact: Option<&ContactSurface>,
     loads: &Loads,
@@ -52,6 +70,8 @@ pub(crate) fn initial_state(
     let mut r = loads.before_start();
     if settings.restoring || settings.initial_state == InitialState::Rest {
         r.fill(0.0);
+    } else if !modes.is_empty() {
+        crate::floating::solve(k, mass, fill_order, modes, &mut r)?;
     } else if r.iter().any(|&x| x != 0.0) {
         let mut solver = SparseCholesky::analyze(k, fill_order).map_err(TimeError::Static)?;
         solver.factorize(k).map_err(TimeError::Static)?;

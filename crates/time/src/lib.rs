@@ -22,6 +22,7 @@
 
 mod central_difference;
 mod dynamics;
+mod floating;
 mod history;
 mod initial;
 mod integrator;

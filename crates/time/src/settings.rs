@@ -220,6 +220,17 @@ pub enum TimeError {
          add Dirichlet conditions that fix translation in x and y and rotation"
     )]
     Static(SolverError),
+    /// The loads present before t = 0 do work along a rigid motion the
+    /// supports leave free: the static preload has no solution.
+    #[error(
+        "the loads present before t = 0 (the \"constant\" histories, the contact pressure, the body \
+         force) are not in equilibrium along the rigid motions the supports leave free, so the \
+         initial static state (Remark 4.1) does not exist: {}; start at rest ([initial] state = \
+         \"rest\": every load acts from t = 0 on), or balance the loads (or hold the part with \
+         [[dirichlet]] conditions)",
+        unbalanced_list(.0)
+    )]
+    Unbalanced(Vec<(String, f64)>),
     /// A factorization failed during the run.
     #[error("step {step} (t = {t:.6e}): the linear solve failed: {source}")]
     Solve {
@@ -258,6 +269,24 @@ pub enum TimeError {
         /// Extra advice (the critical step of an explicit run).
         hint: String,
     },
+}
+
+/// "translation in x: net force F_x = …; rotation about (x, y): moment
+/// about (x, y) M = …": a unit translation's work is the net force along
+/// it, a unit rotation's the moment about its centre.
+fn unbalanced_list(motions: &[(String, f64)]) -> String {
+    motions
+        .iter()
+        .map(|(label, work)| {
+            if let Some(rest) = label.strip_prefix("translation in ") {
+                let axis = &rest[..1];
+                format!("{label}: net force F_{axis} = {work:.6e}")
+            } else {
+                format!("{label}: moment M = {work:.6e}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 impl TimeError {

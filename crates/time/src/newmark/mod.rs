@@ -63,6 +63,7 @@ pub(crate) fn start(
         consistent_mass,
         lumped_mass,
         fill_order,
+        rigid_modes,
         ..
     } = dynamics;
     let n = k.nrows();
@@ -101,7 +102,15 @@ pub(crate) fn start(
         MassKind::Consistent => Mass::Consistent(&m),
         MassKind::Lumped => Mass::Lumped(&lumped_mass),
     };
-    let state = initial_state(&k, mass, &fill_order, contact, loads, settings)?;
+    let state = initial_state(
+        &k,
+        mass,
+        &rigid_modes,
+        &fill_order,
+        contact,
+        loads,
+        settings,
+    )?;
     let n_c = contact.map_or(0, |c| c.len());
     let stepper = Newmark {
         beta,
