@@ -14,7 +14,7 @@ use stickslip_fem::{
 use stickslip_mesh::Mesh;
 use stickslip_time::{
     Dynamics, ExplicitFriction, History as TimeHistory, ImplicitSolver, InitialState as TimeStart,
-    Integrator, Load, MassKind as TimeMass, Scheme as TimeScheme, Settings,
+    Integrator, Load, MassKind as TimeMass, Rayleigh, Scheme as TimeScheme, Settings,
     StickReduction as TimeReduction, TimeError,
 };
 
@@ -124,6 +124,15 @@ impl Scene {
 fn refused(case: &Case, e: TimeError) -> InputError {
     let key = match e {
         TimeError::Unstable { .. } => "time.dt",
+        // Damping that made a stable Δt unstable is to blame, not Δt.
+        TimeError::UnstableDamped { dt, undamped, .. } if dt <= undamped => {
+            if case.locations.contains_key("material.damping.beta") {
+                "material.damping.beta"
+            } else {
+                "material.damping"
+            }
+        }
+        TimeError::UnstableDamped { .. } => "time.dt",
         TimeError::Static(_) => "dirichlet.0.group",
         TimeError::Unbalanced(_) if case.locations.contains_key("initial.state") => "initial.state",
         TimeError::Unbalanced(_) => "dirichlet.0.group",
@@ -178,6 +187,13 @@ pub fn settings(case: &Case) -> Settings {
         },
         // Needs the mesh: `assemble` fills it in.
         initial_velocity: None,
+        damping: case
+            .material
+            .damping
+            .map_or_else(Rayleigh::default, |d| Rayleigh {
+                alpha: d.alpha,
+                beta: d.beta,
+            }),
         implicit_solver: ImplicitSolver::Schur,
         restoring: false,
     }

@@ -293,6 +293,22 @@ fn complete(
         format!("material.nu = {nu} must lie in (-1, 0.5); 0.5 (incompressible) cannot be modelled with displacements only"),
     );
 
+    if let Some(d) = &m.damping {
+        for (key, value, what) in [
+            ("alpha", d.alpha, "mass-proportional, 1/time"),
+            ("beta", d.beta, "stiffness-proportional, time"),
+        ] {
+            check(
+                value >= 0.0 && value.is_finite(),
+                &format!("material.damping.{key}"),
+                format!(
+                    "material.damping.{key} = {value} must be a finite number >= 0 (Rayleigh damping \
+                     C = alpha M + beta K; {key} is {what}); use 0 for none"
+                ),
+            );
+        }
+    }
+
     // [[dirichlet]]
     for (i, d) in case.dirichlet.iter().enumerate() {
         let group = format!("dirichlet.{i}.group");
@@ -622,7 +638,8 @@ t_end = 0.5
                 e: 1000.0,
                 nu: 0.3,
                 rho: 1.0,
-                hypothesis: Hypothesis::PlaneStrain
+                hypothesis: Hypothesis::PlaneStrain,
+                damping: None,
             }
         );
         assert_eq!(c.dirichlet.len(), 2);

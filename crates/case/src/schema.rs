@@ -217,6 +217,21 @@ section! {
         /// Plane strain (default) or plane stress.
         #[serde(default)]
         "hypothesis" hypothesis: Hypothesis,
+        /// Rayleigh damping C = alpha M + beta K, if any.
+        "damping" damping: Option<Damping>,
+    }
+}
+
+section! {
+    /// `material.damping`: Rayleigh damping C = αM + βK.
+    #[derive(Copy)]
+    pub struct Damping {
+        /// α, mass-proportional (1/time; default 0).
+        #[serde(default)]
+        "alpha" alpha: f64,
+        /// β, stiffness-proportional (time; default 0).
+        #[serde(default)]
+        "beta" beta: f64,
     }
 }
 

@@ -74,9 +74,11 @@ pub struct Record<'a> {
     pub external_work: f64,
     /// Friction dissipation so far.
     pub dissipated: f64,
+    /// Rayleigh damping's dissipation so far (0 without damping).
+    pub damped: f64,
     /// kinetic + strain − rᵀR(t) (the paper's Fig. 9).
     pub total: f64,
-    /// kinetic + strain − initial − work + dissipated.
+    /// kinetic + strain − initial − work + dissipated + damped.
     pub balance: f64,
     /// The step that led here.
     pub dt: f64,
@@ -114,7 +116,7 @@ struct Series {
     velocity: Dataset,
     acceleration: Dataset,
     contact: Option<ContactSeries>,
-    energy: [Dataset; 6],
+    energy: [Dataset; 7],
     dt: Dataset,
     iterations: Dataset,
 }
@@ -170,7 +172,7 @@ struct Pending {
     friction_stress: Vec<f64>,
     slip_velocity: Vec<f64>,
     state: Vec<i8>,
-    energy: [Vec<f64>; 6],
+    energy: [Vec<f64>; 7],
     dt: Vec<f64>,
     iterations: Vec<u32>,
 }
@@ -195,6 +197,7 @@ impl Pending {
             rec.dissipated,
             rec.total,
             rec.balance,
+            rec.damped,
         ];
         for (series, v) in self.energy.iter_mut().zip(e) {
             series.push(v);
@@ -342,13 +345,14 @@ fn scalar_attr<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<
 pub const DEFLATE_LEVEL: u8 = 0;
 
 /// Names of the `/energy` series, in [`Record`] order.
-const ENERGY_NAMES: [&str; 6] = [
+const ENERGY_NAMES: [&str; 7] = [
     "kinetic",
     "strain",
     "external_work",
     "dissipated",
     "total",
     "balance",
+    "damped",
 ];
 
 /// Rows per chunk along time so that a chunk stays within HDF5's default
@@ -456,7 +460,7 @@ fn get_scalar<T: H5Type>(loc: &hdf5::Location, name: &str) -> Result<T> {
 const SLOTS: [&str; 2] = ["a", "b"];
 
 /// Order of `/checkpoint/energy`.
-const ENERGY_ORDER: &str = "kinetic, strain, external_work, dissipated, total, balance";
+const ENERGY_ORDER: &str = "kinetic, strain, external_work, dissipated, total, balance, damped";
 
 /// Reads `/checkpoint`, the case and `complete` of a results file.
 ///
@@ -490,9 +494,10 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         .group(SLOTS[usize::from(slot).min(1)])
         .context("/checkpoint: the current slot is missing")?;
     let e: Vec<f64> = get_vector(&g, "energy")?;
+    // Six in files written before damping (damped = 0 then).
     ensure!(
-        e.len() == 6,
-        "/checkpoint/energy has {} values, expected 6",
+        e.len() == 6 || e.len() == 7,
+        "/checkpoint/energy has {} values, expected 7",
         e.len()
     );
     let checkpoint = Checkpoint {
@@ -508,6 +513,7 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
             strain: e[1],
             external_work: e[2],
             dissipated: e[3],
+            damped: e.get(6).copied().unwrap_or(0.0),
             total: e[4],
             balance: e[5],
         },
@@ -717,7 +723,7 @@ impl ResultsWriter {
         for name in ENERGY_NAMES {
             energy.push(series_1d::<f64>(&e, name, level)?);
         }
-        let energy: [Dataset; 6] = energy.try_into().expect("six energy series");
+        let energy: [Dataset; 7] = energy.try_into().expect("seven energy series");
         let solver = file.create_group("solver")?;
         let series = Series {
             time: series_1d::<f64>(&file, "time", level)?,
@@ -800,7 +806,14 @@ impl ResultsWriter {
         );
         let mut energy = Vec::new();
         for name in ENERGY_NAMES {
-            energy.push(ds(&format!("energy/{name}"))?);
+            let at = format!("energy/{name}");
+            // Files written before damping have no /energy/damped: made
+            // here, the resize below gives its rows the fill value 0.
+            if name == "damped" && !file.link_exists(&at) {
+                energy.push(series_1d::<f64>(&file.group("energy")?, name, 0)?);
+                continue;
+            }
+            energy.push(ds(&at)?);
         }
         let series = Series {
             time: ds("time")?,
@@ -808,7 +821,7 @@ impl ResultsWriter {
             velocity: ds("velocity")?,
             acceleration: ds("acceleration")?,
             contact,
-            energy: energy.try_into().expect("six energy series"),
+            energy: energy.try_into().expect("seven energy series"),
             dt: ds("solver/dt")?,
             iterations: ds("solver/iterations")?,
         };
@@ -1006,6 +1019,7 @@ impl ResultsWriter {
                 e.dissipated,
                 e.total,
                 e.balance,
+                e.damped,
             ],
         )?;
         let energy = g.dataset("energy")?;
@@ -1291,6 +1305,7 @@ pub(crate) mod tests {
                 strain: 2.0 + k as f64,
                 external_work: 3.0 + k as f64,
                 dissipated: 4.0 + k as f64,
+                damped: 0.0,
                 total: 5.0 + k as f64,
                 balance: 6.0 + k as f64,
                 dt: 0.1,
@@ -1619,6 +1634,7 @@ pub(crate) mod tests {
                     strain: 0.0,
                     external_work: 0.0,
                     dissipated: 0.0,
+                    damped: 0.0,
                     total: 0.0,
                     balance: 0.0,
                     dt: 0.5,
@@ -1734,6 +1750,7 @@ pub(crate) mod tests {
             strain: 0.0,
             external_work: 0.0,
             dissipated: 0.0,
+            damped: 0.0,
             total: 0.0,
             balance: 0.0,
             dt: 0.0,
@@ -1782,6 +1799,7 @@ pub(crate) mod tests {
                 strain: 0.0,
                 external_work: 0.0,
                 dissipated: 0.0,
+                damped: 0.0,
                 total: 0.0,
                 balance: 0.0,
                 dt: 1.0,
@@ -1840,6 +1858,7 @@ pub(crate) mod tests {
                 strain: 0.0,
                 external_work: 0.0,
                 dissipated: 0.0,
+                damped: 0.0,
                 total: 0.0,
                 balance: 0.0,
                 dt: 1.0,

@@ -442,6 +442,7 @@ pub(crate) fn record<'a>(
         strain: e.strain,
         external_work: e.external_work,
         dissipated: e.dissipated,
+        damped: e.damped,
         total: e.total,
         balance: e.balance,
         dt,
@@ -946,8 +947,14 @@ impl Session<'_> {
             } else {
                 String::new()
             };
+            // Rayleigh damping's share, where the case has it.
+            let rayleigh = if case.material.damping.is_some() {
+                format!(", damped {:.6}", e.damped)
+            } else {
+                String::new()
+            };
             say!(
-                "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}); largest |balance| {:.3e}{damped}",
+                "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}{rayleigh}); largest |balance| {:.3e}{damped}",
                 e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
             );
             say!("results: {} ({rows} records)", out.display());
@@ -983,6 +990,7 @@ impl Session<'_> {
                     "strain": e.strain,
                     "external_work": e.external_work,
                     "dissipated": e.dissipated,
+                    "damped": e.damped,
                     "total": e.total,
                     "balance": e.balance,
                     "max_abs_balance": self.max_balance,

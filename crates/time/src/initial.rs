@@ -1,7 +1,8 @@
 //! The initial state of paper Remark 4.1 (METHOD.md §4): r₀ the
 //! frictionless static equilibrium under the loads present at t = 0⁻ (or
 //! r₀ = 0 for a start at rest, every load then acting from t = 0 on),
-//! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀, again without friction.
+//! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀ − C ṙ₀ (C the Rayleigh
+//! damping), again without friction.
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
@@ -88,6 +89,16 @@ pub(crate) fn initial_state(
     for (x, l) in rhs.iter_mut().zip(&state.load) {
         *x = l - *x;
     }
+    // With damping and an initial velocity, M r̈₀ = R(0) − K r₀ − C ṙ₀.
+    let damping = settings.damping;
+    if damping.is_on() && settings.initial_velocity.is_some() {
+        let (mut kv, mut mv) = (vec![0.0; n], vec![0.0; n]);
+        spmv(k, &state.v, &mut kv);
+        mass.apply(&state.v, &mut mv);
+        for ((x, kv), mv) in rhs.iter_mut().zip(&kv).zip(&mv) {
+            *x -= damping.alpha * mv + damping.beta * kv;
+        }
+    }
     match mass {
         Mass::Lumped(m) => {
             for ((a, x), m) in state.a.iter_mut().zip(&rhs).zip(m) {
@@ -114,6 +125,7 @@ pub(crate) fn initial_state(
         strain,
         external_work: 0.0,
         dissipated: 0.0,
+        damped: 0.0,
         total: kinetic + strain - dot(&state.r, &state.load),
         balance: 0.0,
     };

@@ -38,7 +38,7 @@ pub use dynamics::{Dynamics, Load};
 pub use history::History;
 pub use integrator::Integrator;
 pub use settings::{
-    ExplicitFriction, ImplicitSolver, InitialState, MassKind, Scheme, Settings, StickReduction,
-    TimeError,
+    ExplicitFriction, ImplicitSolver, InitialState, MassKind, Rayleigh, Scheme, Settings,
+    StickReduction, TimeError,
 };
 pub use state::{Checkpoint, Energy, StepInfo};

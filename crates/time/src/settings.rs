@@ -75,6 +75,22 @@ pub enum InitialState {
     Rest,
 }
 
+/// Rayleigh damping C = αM + βK (METHOD.md §8), M the scheme's mass.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Rayleigh {
+    /// α, the mass-proportional coefficient (1/time).
+    pub alpha: f64,
+    /// β, the stiffness-proportional coefficient (time).
+    pub beta: f64,
+}
+
+impl Rayleigh {
+    /// True when C ≠ 0.
+    pub fn is_on(&self) -> bool {
+        self.alpha != 0.0 || self.beta != 0.0
+    }
+}
+
 /// Remark 4.3: after a step in which a node went from slip to stick, the
 /// next `steps` steps use `dt`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -111,6 +127,8 @@ pub struct Settings {
     pub initial_state: InitialState,
     /// ṙ₀ (default zero).
     pub initial_velocity: Option<Vec<f64>>,
+    /// Rayleigh damping (default none).
+    pub damping: Rayleigh,
     /// The state will come from a checkpoint ([`crate::Integrator::restore`]):
     /// the initial static solve (Remark 4.1), whose factor of K would be
     /// most of a large restart's setup and peak memory, is skipped and r₀
@@ -133,6 +151,7 @@ impl Settings {
             implicit_solver: ImplicitSolver::Schur,
             initial_state: InitialState::Static,
             initial_velocity: None,
+            damping: Rayleigh::default(),
             restoring: false,
         }
     }
@@ -166,6 +185,13 @@ impl Settings {
         }
         if self.iteration.max_iterations == 0 {
             return bad("contact.max_iterations must be at least 1".into());
+        }
+        let Rayleigh { alpha, beta } = self.damping;
+        if !(alpha >= 0.0 && alpha.is_finite() && beta >= 0.0 && beta.is_finite()) {
+            return bad(format!(
+                "material.damping = {{ alpha = {alpha}, beta = {beta} }}: the Rayleigh coefficients \
+                 must be finite and >= 0 (C = alpha M + beta K; 0 for none)"
+            ));
         }
         if let Some(v0) = &self.initial_velocity {
             if v0.len() != n {
@@ -213,6 +239,32 @@ pub enum TimeError {
         dt: f64,
         /// The estimated critical step.
         dt_crit: f64,
+    },
+    /// Δt above the explicit scheme's critical step with stiffness-
+    /// proportional damping.
+    #[error(
+        "time.dt = {dt:e} is above the critical step of central difference with Rayleigh damping \
+         beta = {beta:e}: at ω_max = {omega:.6e} (the largest of M⁻¹K) the damping ratio is \
+         ξ = beta ω_max / 2 = {xi:.4e}, and Δt_crit = (2/ω_max)(√(1+ξ²) − ξ) = {dt_crit:.6e} \
+         (undamped {undamped:.6e}){no_step}: use time.dt < {dt_crit:.4e}, lower material.damping.beta, \
+         or use time.scheme = \"newmark\" (unconditionally stable with any damping)"
+    )]
+    UnstableDamped {
+        /// The step asked for.
+        dt: f64,
+        /// The critical step with damping.
+        dt_crit: f64,
+        /// The critical step without damping, 2/ω_max.
+        undamped: f64,
+        /// ω_max.
+        omega: f64,
+        /// β.
+        beta: f64,
+        /// ξ at ω_max.
+        xi: f64,
+        /// ", so small that central difference has no usable stable step"
+        /// where Δt_crit is not a positive normal number, else "".
+        no_step: &'static str,
     },
     /// The initial static solve failed (rigid-body motion left free).
     #[error(

@@ -138,7 +138,13 @@ impl Newmark {
         (classes_new, v_new): (&mut [SlipState], &mut [f64]),
         (step, t): (u64, f64),
     ) -> Result<usize, TimeError> {
-        let (c_k, c_m) = (self.beta / self.gamma * dt, 1.0 / (self.gamma * dt));
+        // Rayleigh damping C = αM + βK joins A₀ (METHOD.md §8); R̂_K is
+        // unchanged, as ṙ_K is the unknown.
+        let c = run.settings.damping;
+        let (mut c_k, mut c_m) = (self.beta / self.gamma * dt, 1.0 / (self.gamma * dt));
+        if c.is_on() {
+            (c_k, c_m) = (c_k + c.beta, c_m + c.alpha);
+        }
         let options = run.settings.iteration;
         let failed = |f| {
             TimeError::from_iteration(f, (step, t, options.remark_4_2), |source| {
@@ -194,6 +200,24 @@ impl Newmark {
                 Ok(report.iterations)
             }
         }
+    }
+}
+
+impl Newmark {
+    /// The damping's dissipation over the step, Δt ṙ̄ᵀCṙ̄ with ṙ̄ = ½(ṙ_K +
+    /// ṙ_{K−1}) (before the commit): ½(Cṙ_K + Cṙ_{K−1})·½Δt(ṙ_K + ṙ_{K−1}),
+    /// the friction's trapezoidal rule, exact for Newmark ¼, ½. 0 without
+    /// damping (no pass over the vectors).
+    fn damped(&mut self, settings: &Settings, state: &State, dt: f64) -> f64 {
+        let c = settings.damping;
+        if !c.is_on() {
+            return 0.0;
+        }
+        for ((t, v), vn) in self.tmp.iter_mut().zip(&state.v).zip(&state.v_new) {
+            *t = 0.5 * (v + vn);
+        }
+        let (vkv, vmv) = two_forms(&self.k, &self.tmp, &self.m, &self.tmp, &mut self.partials);
+        dt * (c.alpha * vmv + c.beta * vkv)
     }
 }
 
@@ -265,6 +289,7 @@ impl Stepper for Newmark {
             Some(c) => friction_ledger(c, state, dt),
             None => (0.0, 0),
         };
+        let damped = self.damped(settings, state, dt);
         state.commit(dt, t_new, iterations);
         let (rkr, vmv) = two_forms(&self.k, &state.r, &self.m, &state.v, &mut self.partials);
         let energies = StepEnergies {
@@ -272,6 +297,7 @@ impl Stepper for Newmark {
             strain: 0.5 * rkr,
             work,
             dissipated,
+            damped,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))
