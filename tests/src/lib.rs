@@ -9,6 +9,9 @@
 //!   paper's slab on a committed mesh;
 //! * [`wave`] and [`sdof`]: the two dynamic problems with a closed form,
 //!   the 1-D wave (d'Alembert) and the single-DOF friction oscillator;
+//! * [`block`] and [`damping`]: a block held only by friction (floating
+//!   in x, rollers on its top) and Rayleigh damping's runs, with their
+//!   closed forms;
 //! * [`manufactured`]: the static manufactured solution of the fem
 //!   convergence test and verify's rates suite;
 //! * [`reference`](mod@reference): the plain sparse product and runs on
@@ -21,6 +24,8 @@
 //! kit when the kit depends on that library (they would see two copies of
 //! its types): such tests live in the crate's `tests/` folder.
 
+pub mod block;
+pub mod damping;
 pub mod grid;
 pub mod manufactured;
 pub mod paths;
