@@ -120,25 +120,25 @@ impl Scene {
     }
 }
 
-/// The integrator's refusal, at the key it concerns.
+/// The integrator's refusal, at the key it concerns and under its table.
 fn refused(case: &Case, e: TimeError) -> InputError {
-    let key = match e {
-        TimeError::Unstable { .. } => "time.dt",
+    let at = |key: &'static str| case.locations.contains_key(key).then_some(key);
+    let (key, table) = match e {
+        TimeError::Unstable { .. } => ("time.dt", "[time]"),
         // Damping that made a stable Δt unstable is to blame, not Δt.
-        TimeError::UnstableDamped { dt, undamped, .. } if dt <= undamped => {
-            if case.locations.contains_key("material.damping.beta") {
-                "material.damping.beta"
-            } else {
-                "material.damping"
-            }
-        }
-        TimeError::UnstableDamped { .. } => "time.dt",
-        TimeError::Static(_) => "dirichlet.0.group",
-        TimeError::Unbalanced(_) if case.locations.contains_key("initial.state") => "initial.state",
-        TimeError::Unbalanced(_) => "dirichlet.0.group",
-        _ => "time.scheme",
+        TimeError::UnstableDamped { dt, undamped, .. } if dt <= undamped => (
+            at("material.damping.beta").unwrap_or("material.damping"),
+            "[material]",
+        ),
+        TimeError::UnstableDamped { .. } => ("time.dt", "[time]"),
+        TimeError::Static(_) => ("dirichlet.0.group", "[time]"),
+        TimeError::Unbalanced(_) => (
+            at("initial.state").unwrap_or("dirichlet.0.group"),
+            "[initial]",
+        ),
+        _ => ("time.scheme", "[time]"),
     };
-    InputError(format!("{}[time]: {e}", case.at(key)))
+    InputError(format!("{}{table}: {e}", case.at(key)))
 }
 
 /// The time crate's copy of a load history.
