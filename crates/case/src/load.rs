@@ -216,8 +216,8 @@ pub fn parse_str(text: &str) -> Result<Case, InputError> {
 }
 
 /// Most steps a case may ask for: 1e12 steps take days even on the paper's
-/// 85-node mesh.
-const MAX_STEPS: f64 = 1e12;
+/// 85-node mesh (the time crate's bound on a damped critical step too).
+const MAX_STEPS: f64 = stickslip_time::MAX_STABLE_STEPS;
 
 /// Checks every value of the case serde read, collecting every problem,
 /// and completes it: paths resolved against the case file's directory,

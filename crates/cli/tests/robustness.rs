@@ -333,6 +333,16 @@ fn bad_damping_and_initial_velocities_are_refused_at_their_lines() {
             "newmark",
         ],
     );
+    // β = 1e10: ξ ≈ 1.8e12 and Δt_crit ≈ 1.6e-15, 3e13 steps to t_end.
+    let (case, text) = slab_case(&dir, "no-step", with_damping("{ beta = 1e10 }"));
+    refused(
+        &case,
+        &[],
+        &[
+            &format!("no-step.toml:{}:", line_of(&text, "beta = 1e10")),
+            "no usable stable step",
+        ],
+    );
     let (case, text) = slab_case(&dir, "velocity-group", |t| {
         t + "\n[[initial.velocities]]\ngroup = \"nowhere\"\nvelocity = [1.0, 0.0]\n"
     });

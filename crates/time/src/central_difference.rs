@@ -10,7 +10,7 @@ use stickslip_linalg::{csr, Product, Stencils};
 use crate::dynamics::{Dynamics, Loads};
 use crate::initial::{initial_state, Mass};
 use crate::nodal::NodalFriction;
-use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError};
+use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError, MAX_STABLE_STEPS};
 use crate::stability::critical_step_with;
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
@@ -440,7 +440,8 @@ fn damped_critical_step(undamped: f64, settings: &Settings) -> Result<f64, TimeE
     let xi = 0.5 * beta * omega;
     // (√(1+ξ²) − ξ) = 1/(√(1+ξ²) + ξ), without the cancellation.
     let dt_crit = undamped / ((1.0 + xi * xi).sqrt() + xi);
-    let usable = dt_crit.is_normal();
+    let steps = settings.t_end / dt_crit;
+    let usable = dt_crit.is_normal() && steps <= MAX_STABLE_STEPS;
     if (settings.dt > dt_crit || !usable) && !settings.allow_unstable {
         return Err(TimeError::UnstableDamped {
             dt: settings.dt,
@@ -450,9 +451,12 @@ fn damped_critical_step(undamped: f64, settings: &Settings) -> Result<f64, TimeE
             beta,
             xi,
             no_step: if usable {
-                ""
+                String::new()
             } else {
-                ", so small that central difference has no usable stable step"
+                format!(
+                    ", so small that a stable run to t_end would take {steps:.1e} steps: central \
+                     difference has no usable stable step"
+                )
             },
         });
     }

@@ -39,6 +39,6 @@ pub use history::History;
 pub use integrator::Integrator;
 pub use settings::{
     ExplicitFriction, ImplicitSolver, InitialState, MassKind, Rayleigh, Scheme, Settings,
-    StickReduction, TimeError,
+    StickReduction, TimeError, MAX_STABLE_STEPS,
 };
 pub use state::{Checkpoint, Energy, StepInfo};

@@ -222,6 +222,11 @@ impl Settings {
     }
 }
 
+/// More steps than a run could ever take (the case's bound on t_end/Δt):
+/// a damped critical step that needs more to reach t_end leaves central
+/// difference no usable stable step.
+pub const MAX_STABLE_STEPS: f64 = 1e12;
+
 /// Why a run could not start or a step failed.
 #[derive(Debug, thiserror::Error)]
 pub enum TimeError {
@@ -262,9 +267,10 @@ pub enum TimeError {
         beta: f64,
         /// ξ at ω_max.
         xi: f64,
-        /// ", so small that central difference has no usable stable step"
-        /// where Δt_crit is not a positive normal number, else "".
-        no_step: &'static str,
+        /// Where Δt_crit is not a positive normal number or a stable run to
+        /// t_end would take more than [`MAX_STABLE_STEPS`] steps, what
+        /// says so ("so small that ..."), else "".
+        no_step: String,
     },
     /// The initial static solve failed (rigid-body motion left free).
     #[error(
