@@ -124,6 +124,20 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
             NodeOrder::Bandwidth => "by reverse Cuthill-McKee (a band around the diagonal)",
         }
     );
+    let free: Vec<&str> = p
+        .model
+        .dofs
+        .rigid_modes()
+        .iter()
+        .map(|m| m.label.as_str())
+        .collect();
+    if !free.is_empty() {
+        println!(
+            "floating    the supports leave free: {} (held there by friction alone; the static \
+             preload, if any, is solved without those motions)",
+            free.join(", ")
+        );
+    }
     match i.contact() {
         Some(c) => println!(
             "contact     {:?}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
@@ -139,7 +153,15 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     let crit = i.dt_crit().unwrap_or_else(|| {
         stickslip_time::stability::critical_step(&p.model.stiffness, &p.model.lumped_mass)
     });
-    println!("dt_crit     {crit:.6e} (central difference, lumped mass: 2/omega_max)");
+    let damped = case.material.damping.is_some_and(|d| d.beta > 0.0) && i.is_explicit();
+    println!(
+        "dt_crit     {crit:.6e} (central difference, lumped mass: {})",
+        if damped {
+            "(2/omega_max)(sqrt(1+xi^2) - xi), xi = beta omega_max/2"
+        } else {
+            "2/omega_max"
+        }
+    );
     // As the integrator counts: a last step within 1e-6 Δt of t_end is
     // not a step of its own.
     let steps = (case.time.t_end / case.time.dt - 1e-6).ceil().max(1.0);

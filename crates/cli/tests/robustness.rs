@@ -283,6 +283,14 @@ fn a_floating_part_under_unbalanced_preloads_is_refused() {
     let (case, _) = slab_case(&dir, "balanced", floating);
     let o = run(&case, &dir.join("balanced.h5"), &[]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // `check` says which motions are free.
+    let o = check(&case, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && out.contains("floating    the supports leave free: translation in x"),
+        "{out}{}",
+        stderr(&o)
+    );
     let (case, text) = slab_case(&dir, "unbalanced", |t| {
         floating(t).replace("history = \"step\"", "history = \"constant\"")
     });
