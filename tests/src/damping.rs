@@ -161,7 +161,7 @@ pub fn mode_decay(scheme: Scheme, xi: f64) -> Result<[f64; 3], SceneError> {
     Ok([rate, xi * omega, i.energy().balance.abs() / kinetic0])
 }
 
-/// Whether central difference on the cantilever with βK is stable at Δt
+/// Whether central difference on the cantilever with `damping` is stable at Δt
 /// for 3000 steps from a velocity with every mode in it: its kinetic +
 /// strain energy never exceeds ten times the initial (damping only lowers
 /// it while stable; above the threshold the top mode grows by a factor
@@ -169,14 +169,9 @@ pub fn mode_decay(scheme: Scheme, xi: f64) -> Result<[f64; 3], SceneError> {
 ///
 /// # Errors
 /// The integrator's, other than the state leaving the floating-point range.
-pub fn stable(beta: f64, dt: f64) -> Result<bool, SceneError> {
+pub fn stable(damping: Rayleigh, dt: f64) -> Result<bool, SceneError> {
     let s = cantilever();
-    let mut set = settings(
-        Scheme::CentralDifference,
-        dt,
-        dt * 3000.5,
-        Rayleigh { alpha: 0.0, beta },
-    );
+    let mut set = settings(Scheme::CentralDifference, dt, dt * 3000.5, damping);
     set.allow_unstable = true;
     set.initial_velocity = Some(
         (0..s.n_free())
@@ -203,28 +198,24 @@ pub fn stable(beta: f64, dt: f64) -> Result<bool, SceneError> {
 
 /// Central difference's damped stability threshold on the cantilever,
 /// bisected to a relative width of 1e-3 between half and twice the
-/// prediction: (threshold, prediction the integrator reports).
+/// prediction: (threshold, prediction the integrator reports; NaN
+/// threshold when those do not bracket it).
 ///
 /// # Errors
-/// The integrator's, or a bracket that does not bracket.
-pub fn damped_threshold(beta: f64) -> Result<(f64, f64), SceneError> {
+/// The integrator's.
+pub fn damped_threshold(damping: Rayleigh) -> Result<(f64, f64), SceneError> {
     let s = cantilever();
     let predicted = s
-        .integrator(settings(
-            Scheme::CentralDifference,
-            1e-6,
-            1e-3,
-            Rayleigh { alpha: 0.0, beta },
-        ))?
+        .integrator(settings(Scheme::CentralDifference, 1e-6, 1e-3, damping))?
         .dt_crit()
         .unwrap_or(f64::NAN);
     let (mut lo, mut hi) = (0.5 * predicted, 2.0 * predicted);
-    if !stable(beta, lo)? || stable(beta, hi)? {
+    if !stable(damping, lo)? || stable(damping, hi)? {
         return Ok((f64::NAN, predicted));
     }
     while hi - lo > 1e-3 * lo {
         let mid = 0.5 * (lo + hi);
-        if stable(beta, mid)? {
+        if stable(damping, mid)? {
             lo = mid;
         } else {
             hi = mid;
