@@ -21,9 +21,9 @@ How
 ---
 1. Mesh block.geo with the gmsh Python module (16 x 8 quad4 cells). The
    physical groups name what the case file refers to: base, wall, push.
-2. Run case.toml (central difference; a rigid body motion left free would
-   make the initial static solve singular, hence the wall: stickslip refuses
-   such a case and says so).
+2. Run case.toml (central difference; the wall holds the right face, so
+   the block is pushed against it; without it the block would be held in x
+   by friction alone, as in example 4).
 3. Read block.h5 with h5py, and plot u_x of the pushed face's bottom corner
    and sigma_T / g along the base at a few times into OUT/block.png.
 

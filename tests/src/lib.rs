@@ -11,6 +11,9 @@
 //!   the 1-D wave (d'Alembert) and the single-DOF friction oscillator;
 //! * [`strip`]: a thin strip on a rough base pulled at one end, the
 //!   shear-lag problem of quasi-static friction and its 1-D closed form;
+//! * [`block`] and [`damping`]: a block held only by friction (floating
+//!   in x, rollers on its top) and Rayleigh damping's runs, with their
+//!   closed forms;
 //! * [`manufactured`]: the static manufactured solution of the fem
 //!   convergence test and verify's rates suite;
 //! * [`reference`](mod@reference): the plain sparse product and runs on
@@ -23,6 +26,8 @@
 //! kit when the kit depends on that library (they would see two copies of
 //! its types): such tests live in the crate's `tests/` folder.
 
+pub mod block;
+pub mod damping;
 pub mod grid;
 pub mod manufactured;
 pub mod paths;

@@ -59,6 +59,7 @@ pub fn integrator(
         constant_load: vec![0.0],
         stencils: true,
         fill_order: Default::default(),
+        rigid_modes: Vec::new(),
     };
     let node = ContactNode {
         node: 0,

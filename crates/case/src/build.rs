@@ -13,13 +13,13 @@ use stickslip_fem::{
 };
 use stickslip_mesh::Mesh;
 use stickslip_time::{
-    Dynamics, ExplicitFriction, History as TimeHistory, ImplicitSolver, Integrator, Load,
-    MassKind as TimeMass, Scheme as TimeScheme, Settings, StickReduction as TimeReduction,
-    TimeError,
+    Dynamics, ExplicitFriction, History as TimeHistory, ImplicitSolver, InitialState as TimeStart,
+    Integrator, Load, MassKind as TimeMass, Rayleigh, Scheme as TimeScheme, Settings,
+    StickReduction as TimeReduction, TimeError,
 };
 
 use crate::error::{listed, InputError};
-use crate::schema::{Case, History, Hypothesis, MassKind, Scheme};
+use crate::schema::{Case, History, Hypothesis, InitialState, MassKind, Scheme};
 
 /// A case assembled: everything the integrator is built from, each part
 /// open to change before it is (`verify` injects its faults here).
@@ -120,14 +120,25 @@ impl Scene {
     }
 }
 
-/// The integrator's refusal, at the key it concerns.
+/// The integrator's refusal, at the key it concerns and under its table.
 fn refused(case: &Case, e: TimeError) -> InputError {
-    let key = match e {
-        TimeError::Unstable { .. } => "time.dt",
-        TimeError::Static(_) => "dirichlet.0.group",
-        _ => "time.scheme",
+    let at = |key: &'static str| case.locations.contains_key(key).then_some(key);
+    let (key, table) = match e {
+        TimeError::Unstable { .. } => ("time.dt", "[time]"),
+        // Damping that made a stable Δt unstable is to blame, not Δt.
+        TimeError::UnstableDamped { dt, undamped, .. } if dt <= undamped => (
+            at("material.damping.beta").unwrap_or("material.damping"),
+            "[material]",
+        ),
+        TimeError::UnstableDamped { .. } => ("time.dt", "[time]"),
+        TimeError::Static(_) => ("dirichlet.0.group", "[time]"),
+        TimeError::Unbalanced(_) => (
+            at("initial.state").unwrap_or("dirichlet.0.group"),
+            "[initial]",
+        ),
+        _ => ("time.scheme", "[time]"),
     };
-    InputError(format!("{}[time]: {e}", case.at(key)))
+    InputError(format!("{}{table}: {e}", case.at(key)))
 }
 
 /// The time crate's copy of a load history.
@@ -171,7 +182,19 @@ pub fn settings(case: &Case) -> Settings {
             }),
         allow_unstable: case.time.allow_unstable,
         explicit_friction: ExplicitFriction::ClosedForm,
+        initial_state: match case.initial.state {
+            InitialState::Static => TimeStart::Static,
+            InitialState::Rest => TimeStart::Rest,
+        },
+        // Needs the mesh: `assemble` fills it in.
         initial_velocity: None,
+        damping: case
+            .material
+            .damping
+            .map_or_else(Rayleigh::default, |d| Rayleigh {
+                alpha: d.alpha,
+                beta: d.beta,
+            }),
         implicit_solver: ImplicitSolver::Schur,
         restoring: false,
     }
@@ -293,6 +316,18 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
         );
     }
 
+    for (i, v) in case.initial.velocities.iter().enumerate() {
+        groups_ok &= check_group(
+            &mesh,
+            case,
+            &format!("initial.velocities.{i}.group"),
+            &v.group,
+            None,
+            "an initial velocity",
+            &mut problems,
+        );
+    }
+
     let hypothesis = match case.material.hypothesis {
         Hypothesis::PlaneStrain => FemHypothesis::PlaneStrain,
         Hypothesis::PlaneStress => FemHypothesis::PlaneStress,
@@ -333,21 +368,28 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
         _ => None,
     };
     if let Some(m) = &model {
-        // The initial static solve (Remark 4.1) is frictionless: the
-        // supports alone must hold the body (DofMap checks each connected part).
+        // A part's free rigid motions are the integrator's to handle (the
+        // static preload on their complement, or a start at rest); a node
+        // of no cell has no stiffness at all, and nothing can hold it.
+        // Quasi-static increments factorize Δt K, and friction does not
+        // stand in for a support there.
         let free = m.dofs.free_rigid_motions();
-        if !free.is_empty() {
-            // Quasi-static increments factorize Δt K as well: friction
-            // does not stand in for a support there either.
-            let increments = if case.time.scheme == Scheme::QuasiStatic {
-                " and for the quasi-static increments (friction does not hold a body without supports)"
-            } else {
-                ""
-            };
+        let quasi_static = case.time.scheme == Scheme::QuasiStatic;
+        let refused: Vec<&String> = free
+            .iter()
+            .filter(|l| quasi_static || l.contains("belongs to no cell"))
+            .collect();
+        if quasi_static && !refused.is_empty() {
             problems.push(format!(
-                "{dirichlet_at}the supports leave a rigid-body motion free for the initial static solve{increments}: {}; \
+                "{dirichlet_at}the supports leave a rigid-body motion free for the initial static solve \
+                 and for the quasi-static increments (friction does not hold a body without supports): {}; \
                  add [[dirichlet]] conditions that prevent it (e.g. uy = 0 on a bottom or top group and ux = 0 on an end)",
-                free.join(", ")
+                refused.iter().map(|l| l.as_str()).collect::<Vec<_>>().join(", ")
+            ));
+        } else if !refused.is_empty() {
+            problems.push(format!(
+                "{dirichlet_at}{}; add [[dirichlet]] conditions that hold it, or remove it from the mesh",
+                refused.iter().map(|l| l.as_str()).collect::<Vec<_>>().join(", ")
             ));
         }
     }
@@ -429,11 +471,160 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
     if !problems.is_empty() {
         return Err(InputError(listed(problems)));
     }
+    let mut settings = settings(case);
+    settings.initial_velocity = initial_velocity(case, &mesh, &model.dofs);
     Ok(Scene {
         mesh,
         model,
         contact,
         loads,
-        settings: settings(case),
+        settings,
     })
+}
+
+/// ṙ₀ on the free DOFs from `[initial]`: `velocity` at every node, then
+/// each `[[initial.velocities]]` entry on its group's nodes, in case order
+/// (the groups are checked against the mesh already). `None` when the case
+/// gives no velocity, so that a run without one stays as it was.
+fn initial_velocity(case: &Case, mesh: &Mesh, dofs: &DofMap) -> Option<Vec<f64>> {
+    let initial = &case.initial;
+    if initial.velocity.is_none() && initial.velocities.is_empty() {
+        return None;
+    }
+    let mut full = vec![0.0; 2 * mesh.nodes.len()];
+    if let Some(v) = initial.velocity {
+        for node in full.chunks_exact_mut(2) {
+            node.copy_from_slice(&v);
+        }
+    }
+    for entry in &initial.velocities {
+        if let Ok(group) = mesh.group(&entry.group) {
+            for &node in &group.nodes {
+                full[2 * node..2 * node + 2].copy_from_slice(&entry.velocity);
+            }
+        }
+    }
+    let mut free = vec![0.0; dofs.n_free()];
+    dofs.restrict(&full, &mut free);
+    Some(free)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The paper's slab on the committed Q2 8×2 mesh with `extra` TOML
+    /// appended, loaded from a scratch directory.
+    fn slab_case(name: &str, extra: &str) -> Case {
+        slab_case_text(name, extra).0
+    }
+
+    /// 1-based line of the first line of `text` holding `needle`.
+    fn line_of(text: &str, needle: &str) -> usize {
+        text.lines()
+            .position(|l| l.contains(needle))
+            .expect("needle")
+            + 1
+    }
+
+    /// [`slab_case`] and its text.
+    fn slab_case_text(name: &str, extra: &str) -> (Case, String) {
+        let mesh = stickslip_testkit::meshes_dir().join("slab-q2-8x2.msh");
+        let text = format!(
+            r#"[mesh]
+file = "{}"
+[material]
+E = 1000
+nu = 0.3
+rho = 1.0
+[[dirichlet]]
+group = "support"
+uy = 0.0
+[[dirichlet]]
+group = "left"
+ux = 0.0
+[contact]
+group = "contact"
+pressure = 300.0
+mu = 0.3
+eps = 1e-4
+[time]
+scheme = "central_difference"
+dt = 1e-3
+t_end = 0.5
+{extra}"#,
+            mesh.display().to_string().replace('\\', "/")
+        );
+        let path = stickslip_testkit::scratch(&format!("build-{name}")).join("case.toml");
+        std::fs::write(&path, &text).unwrap();
+        (crate::load(&path, &[]).unwrap(), text)
+    }
+
+    /// `velocity` sets every node, a group's entry its own nodes; held
+    /// DOFs have none (the left end's u_x, the top's u_y).
+    #[test]
+    fn initial_velocities_go_to_their_nodes() {
+        let case = slab_case(
+            "velocities",
+            "[initial]\nstate = \"rest\"\nvelocity = [0.5, 0.25]\n\
+             [[initial.velocities]]\ngroup = \"contact\"\nvelocity = [1.0, -2.0]\n",
+        );
+        let scene = assemble(&case).unwrap();
+        assert_eq!(scene.settings.initial_state, TimeStart::Rest);
+        let v = scene.settings.initial_velocity.as_ref().unwrap();
+        let contact = scene.mesh.group("contact").unwrap().nodes.clone();
+        let dofs = &scene.model.dofs;
+        let mut seen = [false; 2];
+        for node in 0..scene.mesh.nodes.len() {
+            let on_contact = contact.binary_search(&node).is_ok();
+            let want = if on_contact { [1.0, -2.0] } else { [0.5, 0.25] };
+            for c in 0..2 {
+                if let Some(i) = dofs.free(node, c) {
+                    assert_eq!(v[i], want[c], "node {node} component {c}");
+                    seen[usize::from(on_contact)] = true;
+                }
+            }
+        }
+        assert_eq!(seen, [true, true]);
+    }
+
+    /// Without an `[initial]` velocity the settings carry none (the run's
+    /// bits are those of a case without the section).
+    #[test]
+    fn no_initial_section_no_velocity() {
+        let scene = assemble(&slab_case("none", "")).unwrap();
+        assert_eq!(scene.settings.initial_state, TimeStart::Static);
+        assert!(scene.settings.initial_velocity.is_none());
+    }
+
+    /// An unknown group and a velocity of the wrong length are refused at
+    /// their lines.
+    #[test]
+    fn bad_initial_velocities_name_their_lines() {
+        let (case, text) = slab_case_text(
+            "unknown-group",
+            "[[initial.velocities]]\ngroup = \"nowhere\"\nvelocity = [1.0, 0.0]\n",
+        );
+        let e = assemble(&case).unwrap_err().0;
+        let at = format!("case.toml:{}:", line_of(&text, "\"nowhere\""));
+        assert!(
+            e.contains(&at) && e.contains("no physical group \"nowhere\""),
+            "{e}"
+        );
+        let mesh = stickslip_testkit::meshes_dir().join("slab-q2-8x2.msh");
+        let path = stickslip_testkit::scratch("build-length").join("case.toml");
+        let text = format!(
+            "[mesh]\nfile = \"{}\"\n[material]\nE = 1000\nnu = 0.3\nrho = 1.0\n\
+             [time]\nscheme = \"central_difference\"\ndt = 1e-3\nt_end = 0.5\n\
+             [initial]\nvelocity = [1.0, 0.0, 2.0]\n",
+            mesh.display().to_string().replace('\\', "/")
+        );
+        std::fs::write(&path, &text).unwrap();
+        let e = crate::load(&path, &[]).unwrap_err().0;
+        let at = format!("case.toml:{}:", line_of(&text, "[1.0, 0.0, 2.0]"));
+        assert!(
+            e.contains(&at) && e.contains("a vector of two numbers"),
+            "{e}"
+        );
+    }
 }

@@ -216,8 +216,8 @@ pub fn parse_str(text: &str) -> Result<Case, InputError> {
 }
 
 /// Most steps a case may ask for: 1e12 steps take days even on the paper's
-/// 85-node mesh.
-const MAX_STEPS: f64 = 1e12;
+/// 85-node mesh (the time crate's bound on a damped critical step too).
+const MAX_STEPS: f64 = stickslip_time::MAX_STABLE_STEPS;
 
 /// Checks every value of the case serde read, collecting every problem,
 /// and completes it: paths resolved against the case file's directory,
@@ -292,6 +292,22 @@ fn complete(
         "material.nu",
         format!("material.nu = {nu} must lie in (-1, 0.5); 0.5 (incompressible) cannot be modelled with displacements only"),
     );
+
+    if let Some(d) = &m.damping {
+        for (key, value, what) in [
+            ("alpha", d.alpha, "mass-proportional, 1/time"),
+            ("beta", d.beta, "stiffness-proportional, time"),
+        ] {
+            check(
+                value >= 0.0 && value.is_finite(),
+                &format!("material.damping.{key}"),
+                format!(
+                    "material.damping.{key} = {value} must be a finite number >= 0 (Rayleigh damping \
+                     C = alpha M + beta K; {key} is {what}); use 0 for none"
+                ),
+            );
+        }
+    }
 
     // [[dirichlet]]
     for (i, d) in case.dirichlet.iter().enumerate() {
@@ -661,7 +677,8 @@ t_end = 0.5
                 e: 1000.0,
                 nu: 0.3,
                 rho: 1.0,
-                hypothesis: Hypothesis::PlaneStrain
+                hypothesis: Hypothesis::PlaneStrain,
+                damping: None,
             }
         );
         assert_eq!(c.dirichlet.len(), 2);

@@ -141,6 +141,9 @@ section! {
         "body_force" body_force: Option<[f64; 2]>,
         /// The frictional contact surface, if any.
         "contact" contact: Option<ContactSection>,
+        /// The state at t = 0.
+        #[serde(default)]
+        "initial" initial: InitialSection,
         /// Time integration.
         "time" time: TimeSection,
         /// Results file.
@@ -214,6 +217,21 @@ section! {
         /// Plane strain (default) or plane stress.
         #[serde(default)]
         "hypothesis" hypothesis: Hypothesis,
+        /// Rayleigh damping C = alpha M + beta K, if any.
+        "damping" damping: Option<Damping>,
+    }
+}
+
+section! {
+    /// `material.damping`: Rayleigh damping C = αM + βK.
+    #[derive(Copy)]
+    pub struct Damping {
+        /// α, mass-proportional (1/time; default 0).
+        #[serde(default)]
+        "alpha" alpha: f64,
+        /// β, stiffness-proportional (time; default 0).
+        #[serde(default)]
+        "beta" beta: f64,
     }
 }
 
@@ -344,6 +362,49 @@ section! {
         /// Iteration cap per step (default 100).
         #[serde(default = "default_max_iterations")]
         "max_iterations" max_iterations: usize,
+    }
+}
+
+/// Where a run starts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InitialState {
+    /// Remark 4.1: the frictionless static equilibrium under the loads
+    /// present before t = 0.
+    #[default]
+    Static,
+    /// Undeformed (u = 0): every load acts from t = 0 on.
+    Rest,
+}
+
+impl Schema for InitialState {
+    const KIND: Kind = Kind::Variant("static");
+}
+
+section! {
+    /// One `[[initial.velocities]]` table: the initial velocity of a group's
+    /// nodes.
+    pub struct GroupVelocity {
+        /// Physical group name (any dimension).
+        "group" group: String,
+        /// (v_x, v_y) of every node of the group.
+        "velocity" velocity: [f64; 2],
+    }
+}
+
+section! {
+    /// `[initial]`: the state at t = 0.
+    #[derive(Default)]
+    pub struct InitialSection {
+        /// Static preload (default) or rest.
+        #[serde(default)]
+        "state" state: InitialState,
+        /// A uniform initial velocity of every node (default zero).
+        "velocity" velocity: Option<[f64; 2]>,
+        /// Initial velocities per group, in place of `velocity` on the
+        /// group's nodes (a later entry wins where groups share nodes).
+        #[serde(default)]
+        "velocities" velocities: Vec<GroupVelocity>,
     }
 }
 

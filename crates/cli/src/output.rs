@@ -80,9 +80,11 @@ pub struct Record<'a> {
     pub external_work: f64,
     /// Friction dissipation so far.
     pub dissipated: f64,
+    /// Rayleigh damping's dissipation so far (0 without damping).
+    pub damped: f64,
     /// kinetic + strain − rᵀR(t) (the paper's Fig. 9).
     pub total: f64,
-    /// kinetic + strain − initial − work + dissipated.
+    /// kinetic + strain − initial − work + dissipated + damped.
     pub balance: f64,
     /// The step that led here.
     pub dt: f64,
@@ -126,7 +128,7 @@ struct Series {
     frame_time: Dataset,
     frame_row: Dataset,
     contact: Option<ContactSeries>,
-    energy: [Dataset; 6],
+    energy: [Dataset; 7],
     dt: Dataset,
     iterations: Dataset,
 }
@@ -190,7 +192,7 @@ struct Pending {
     friction_stress: Vec<f64>,
     slip_velocity: Vec<f64>,
     state: Vec<i8>,
-    energy: [Vec<f64>; 6],
+    energy: [Vec<f64>; 7],
     dt: Vec<f64>,
     iterations: Vec<u32>,
 }
@@ -224,6 +226,7 @@ impl Pending {
             rec.dissipated,
             rec.total,
             rec.balance,
+            rec.damped,
         ];
         for (series, v) in self.energy.iter_mut().zip(e) {
             series.push(v);
@@ -364,13 +367,14 @@ fn scalar_attr<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<
 pub const DEFLATE_LEVEL: u8 = 0;
 
 /// Names of the `/energy` series, in [`Record`] order.
-const ENERGY_NAMES: [&str; 6] = [
+const ENERGY_NAMES: [&str; 7] = [
     "kinetic",
     "strain",
     "external_work",
     "dissipated",
     "total",
     "balance",
+    "damped",
 ];
 
 /// Rows of the histories kept in memory at most before they are written
@@ -482,7 +486,7 @@ pub(crate) fn get_scalar<T: H5Type>(loc: &hdf5::Location, name: &str) -> Result<
 pub(crate) const SLOTS: [&str; 2] = ["a", "b"];
 
 /// Order of `/checkpoint/energy`.
-const ENERGY_ORDER: &str = "kinetic, strain, external_work, dissipated, total, balance";
+const ENERGY_ORDER: &str = "kinetic, strain, external_work, dissipated, total, balance, damped";
 
 fn index_array(v: impl ExactSizeIterator<Item = usize>) -> Array1<i64> {
     v.map(|i| i as i64).collect()
@@ -584,7 +588,7 @@ impl ResultsWriter {
         for name in ENERGY_NAMES {
             energy.push(series_1d::<f64>(&e, name, level)?);
         }
-        let energy: [Dataset; 6] = energy.try_into().expect("six energy series");
+        let energy: [Dataset; 7] = energy.try_into().expect("seven energy series");
         let solver = file.create_group("solver")?;
         let frames = file.create_group("frames")?;
         string_attr(
@@ -679,7 +683,14 @@ impl ResultsWriter {
         );
         let mut energy = Vec::new();
         for name in ENERGY_NAMES {
-            energy.push(ds(&format!("energy/{name}"))?);
+            let at = format!("energy/{name}");
+            // Files written before damping have no /energy/damped: made
+            // here, the resize below gives its rows the fill value 0.
+            if name == "damped" && !file.link_exists(&at) {
+                energy.push(series_1d::<f64>(&file.group("energy")?, name, 0)?);
+                continue;
+            }
+            energy.push(ds(&at)?);
         }
         if !file.link_exists("frames") {
             ensure!(
@@ -706,7 +717,7 @@ impl ResultsWriter {
             frame_time: ds("frames/time")?,
             frame_row: ds("frames/row")?,
             contact,
-            energy: energy.try_into().expect("six energy series"),
+            energy: energy.try_into().expect("seven energy series"),
             dt: ds("solver/dt")?,
             iterations: ds("solver/iterations")?,
         };
@@ -915,6 +926,7 @@ impl ResultsWriter {
                 e.dissipated,
                 e.total,
                 e.balance,
+                e.damped,
             ],
         )?;
         let energy = g.dataset("energy")?;
@@ -1227,6 +1239,7 @@ pub(crate) mod tests {
                 strain: 2.0 + k as f64,
                 external_work: 3.0 + k as f64,
                 dissipated: 4.0 + k as f64,
+                damped: 0.0,
                 total: 5.0 + k as f64,
                 balance: 6.0 + k as f64,
                 dt: 0.1,
@@ -1556,6 +1569,7 @@ pub(crate) mod tests {
                     strain: 0.0,
                     external_work: 0.0,
                     dissipated: 0.0,
+                    damped: 0.0,
                     total: 0.0,
                     balance: 0.0,
                     dt: 0.5,
@@ -1623,6 +1637,7 @@ pub(crate) mod tests {
             strain: 0.0,
             external_work: 0.0,
             dissipated: 0.0,
+            damped: 0.0,
             total: 0.0,
             balance: 0.0,
             dt: 0.1,
@@ -1773,6 +1788,7 @@ pub(crate) mod tests {
             strain: 0.0,
             external_work: 0.0,
             dissipated: 0.0,
+            damped: 0.0,
             total: 0.0,
             balance: 0.0,
             dt: 0.0,
@@ -1821,6 +1837,7 @@ pub(crate) mod tests {
                 strain: 0.0,
                 external_work: 0.0,
                 dissipated: 0.0,
+                damped: 0.0,
                 total: 0.0,
                 balance: 0.0,
                 dt: 1.0,
@@ -1879,6 +1896,7 @@ pub(crate) mod tests {
                 strain: 0.0,
                 external_work: 0.0,
                 dissipated: 0.0,
+                damped: 0.0,
                 total: 0.0,
                 balance: 0.0,
                 dt: 1.0,

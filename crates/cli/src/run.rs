@@ -126,6 +126,20 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
             NodeOrder::Bandwidth => "by reverse Cuthill-McKee (a band around the diagonal)",
         }
     );
+    let free: Vec<&str> = p
+        .model
+        .dofs
+        .rigid_modes()
+        .iter()
+        .map(|m| m.label.as_str())
+        .collect();
+    if !free.is_empty() {
+        println!(
+            "floating    the supports leave free: {} (held there by friction alone; the static \
+             preload, if any, is solved without those motions)",
+            free.join(", ")
+        );
+    }
     match i.contact() {
         Some(c) => println!(
             "contact     {:?}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
@@ -147,8 +161,16 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     let crit = i.dt_crit().unwrap_or_else(|| {
         stickslip_time::stability::critical_step(&p.model.stiffness, &p.model.lumped_mass)
     });
+    let damped = case.material.damping.is_some_and(|d| d.beta > 0.0) && i.is_explicit();
     if !quasi_static {
-        println!("dt_crit     {crit:.6e} (central difference, lumped mass: 2/omega_max)");
+        println!(
+            "dt_crit     {crit:.6e} (central difference, lumped mass: {})",
+            if damped {
+                "(2/omega_max)(sqrt(1+xi^2) - xi), xi = beta omega_max/2"
+            } else {
+                "2/omega_max"
+            }
+        );
     }
     // As the integrator counts: a last step within 1e-6 Δt of t_end is
     // not a step of its own.
@@ -518,6 +540,7 @@ pub(crate) fn record<'a>(
         strain: e.strain,
         external_work: e.external_work,
         dissipated: e.dissipated,
+        damped: e.damped,
         total: e.total,
         balance: e.balance,
         dt,
@@ -1045,8 +1068,14 @@ impl Session<'_> {
             } else {
                 String::new()
             };
+            // Rayleigh damping's share, where the case has it.
+            let rayleigh = if case.material.damping.is_some() {
+                format!(", damped {:.6}", e.damped)
+            } else {
+                String::new()
+            };
             say!(
-                "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}); largest |balance| {:.3e}{damped}",
+                "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}{rayleigh}); largest |balance| {:.3e}{damped}",
                 e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
             );
             say!(
@@ -1087,6 +1116,7 @@ impl Session<'_> {
                     "strain": e.strain,
                     "external_work": e.external_work,
                     "dissipated": e.dissipated,
+                    "damped": e.damped,
                     "total": e.total,
                     "balance": e.balance,
                     "max_abs_balance": self.max_balance,

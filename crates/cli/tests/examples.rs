@@ -152,6 +152,22 @@ fn example_03_inclined_contact() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+#[test]
+fn example_04_block_slides_to_rest() {
+    let Some((out, dir)) = run_example("04-block-slides-to-rest", "block.png") else {
+        return;
+    };
+    // Rigid closed form (examples/04's docstring): a = mu p / (rho H) =
+    // 0.5 * 10 / 1 = 5 from v0 = 1: it stops after v0/a = 0.2 having slid
+    // v0^2/(2a) = 0.1. Within 1% for this stiff block (the stop is read at
+    // the output's every 10 steps of 1e-4, 0.5% of it).
+    let stop = number(&out, "stop time:");
+    assert!((stop / 0.2 - 1.0).abs() < 0.01, "{out}");
+    let distance = number(&out, "distance slid:");
+    assert!((distance / 0.1 - 1.0).abs() < 0.01, "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// examples/warp_pyvista.py: PyVista reads a run's XDMF, warps the mesh
 /// by the displacement and writes a PNG without a display. Expected
 /// values from the hdf5 crate's reading of the .h5: the last record's

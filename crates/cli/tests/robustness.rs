@@ -267,25 +267,139 @@ fn a_contact_surface_held_in_its_tangent_is_refused() {
 }
 
 #[test]
-fn supports_that_leave_a_rigid_motion_free_are_refused() {
-    // Without the left end's ux = 0 nothing holds the slab in x (the
-    // initial static solve is frictionless, Remark 4.1).
+fn a_floating_part_under_unbalanced_preloads_is_refused() {
+    // Without the left end's ux = 0 nothing holds the slab in x. With the
+    // end load H(t) the loads before t = 0 (the contact pressure, reacted
+    // by the top's rollers) are in equilibrium and the case runs; with the
+    // end load "constant" they push the slab in x (net force −150 per unit
+    // height on the end of height 1) and the static preload does not exist.
     let dir = scratch("rigid");
-    let (case, _) = slab_case(&dir, "rigid", |t| {
+    let floating = |t: String| {
         t.replace(
             "[[dirichlet]]        # the left end is held in x\ngroup = \"left\"\nux = 0.0\n",
             "",
         )
+    };
+    let (case, _) = slab_case(&dir, "balanced", floating);
+    let o = run(&case, &dir.join("balanced.h5"), &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // `check` says which motions are free.
+    let o = check(&case, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && out.contains("floating    the supports leave free: translation in x"),
+        "{out}{}",
+        stderr(&o)
+    );
+    let (case, text) = slab_case(&dir, "unbalanced", |t| {
+        floating(t).replace("history = \"step\"", "history = \"constant\"")
     });
     refused(
         &case,
         &[],
         &[
-            "rigid-body motion free",
-            "translation in x",
-            "[[dirichlet]]",
+            &format!("unbalanced.toml:{}:", line_of(&text, "group = \"support\"")),
+            "not in equilibrium",
+            "translation in x: net force F_x = -1.5",
+            "state = \"rest\"",
         ],
     );
+    // Started at rest, the same case needs no static state and runs.
+    let (case, _) = slab_case(&dir, "rest", |t| {
+        floating(t).replace("history = \"step\"", "history = \"constant\"")
+            + "\n[initial]\nstate = \"rest\"\n"
+    });
+    let o = run(&case, &dir.join("rest.h5"), &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn bad_damping_and_initial_velocities_are_refused_at_their_lines() {
+    let dir = scratch("damping-input");
+    let with_damping = |d: &'static str| {
+        move |t: String| t.replace("rho = 1.0", &format!("rho = 1.0\ndamping = {d}"))
+    };
+    let (case, text) = slab_case(&dir, "negative", with_damping("{ alpha = -1.0 }"));
+    refused(
+        &case,
+        &[],
+        &[
+            &format!("negative.toml:{}:", line_of(&text, "alpha = -1.0")),
+            "material.damping.alpha = -1 must be a finite number >= 0",
+        ],
+    );
+    // β = 1: at the slab's ω_max (about 1.1e3, Δt_crit = 5.6e-3 undamped)
+    // ξ ≈ 560 and Δt_crit ≈ 1.6e-6, far below time.dt = 1e-3.
+    let (case, text) = slab_case(&dir, "too-damped", with_damping("{ beta = 1.0 }"));
+    refused(
+        &case,
+        &[],
+        &[
+            &format!("too-damped.toml:{}:", line_of(&text, "beta = 1.0")),
+            "Rayleigh damping beta = 1e0",
+            "lower material.damping.beta",
+            "newmark",
+        ],
+    );
+    // β = 1e10: ξ ≈ 1.8e12 and Δt_crit ≈ 1.6e-15, 3e13 steps to t_end.
+    let (case, text) = slab_case(&dir, "no-step", with_damping("{ beta = 1e10 }"));
+    refused(
+        &case,
+        &[],
+        &[
+            &format!("no-step.toml:{}:", line_of(&text, "beta = 1e10")),
+            "no usable stable step",
+        ],
+    );
+    let (case, text) = slab_case(&dir, "velocity-group", |t| {
+        t + "\n[[initial.velocities]]\ngroup = \"nowhere\"\nvelocity = [1.0, 0.0]\n"
+    });
+    refused(
+        &case,
+        &[],
+        &[
+            &format!("velocity-group.toml:{}:", line_of(&text, "\"nowhere\"")),
+            "no physical group \"nowhere\"",
+        ],
+    );
+    let (case, text) = slab_case(&dir, "velocity-length", |t| {
+        t + "\n[initial]\nvelocity = [1.0]\n"
+    });
+    refused(
+        &case,
+        &[],
+        &[
+            &format!(
+                "velocity-length.toml:{}:",
+                line_of(&text, "velocity = [1.0]")
+            ),
+            "a vector of two numbers",
+        ],
+    );
+}
+
+/// A damped run books the damping's dissipation in /energy/damped: 0 at
+/// the start, never decreasing, positive at the end; an undamped run's
+/// series is all zeros.
+#[test]
+fn a_damped_run_writes_its_damped_energy() {
+    let dir = scratch("damped-energy");
+    for (name, damping, positive) in [
+        ("damped", "\ndamping = { alpha = 5.0, beta = 1e-4 }", true),
+        ("undamped", "", false),
+    ] {
+        let (case, _) = slab_case(&dir, name, |t| {
+            t.replace("rho = 1.0", &format!("rho = 1.0{damping}"))
+        });
+        let out = dir.join(format!("{name}.h5"));
+        let o = run(&case, &out, &[]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let f = hdf5::File::open(&out).unwrap();
+        let d: Vec<f64> = f.dataset("energy/damped").unwrap().read_raw().unwrap();
+        assert_eq!(d[0], 0.0);
+        assert!(d.windows(2).all(|w| w[1] >= w[0]), "{name}: {d:?}");
+        assert_eq!(*d.last().unwrap() > 0.0, positive, "{name}: {d:?}");
+    }
 }
 
 #[test]

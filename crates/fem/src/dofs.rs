@@ -112,7 +112,22 @@ pub struct DofMap {
     free_to_full: Vec<usize>,
     any_nonzero_prescribed: bool,
     free_rigid_motions: Vec<String>,
+    rigid_modes: Vec<RigidMode>,
     order: NodeOrder,
+}
+
+/// A rigid motion the supports leave free, as a vector on the free DOFs: a
+/// unit translation, or a unit rotation (one radian, small) about a point,
+/// over the nodes of one connected part. K annihilates it; the work of a
+/// load along it is the load's net force in that direction, or its moment
+/// about that point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigidMode {
+    /// "translation in x", "rotation about (x, y)", ... as
+    /// [`DofMap::free_rigid_motions`] names it.
+    pub label: String,
+    /// The motion on the free DOFs (zero off its part).
+    pub vector: Vec<f64>,
 }
 
 impl DofMap {
@@ -168,7 +183,7 @@ impl DofMap {
         };
         let (free_index, free_to_full) = number(&fixed, &nodes);
         let any_nonzero_prescribed = prescribed.iter().any(|&v| v != 0.0);
-        let free_rigid_motions = rigid_motions_left_free(mesh, &free_index);
+        let (free_rigid_motions, rigid_modes) = rigid_motions_left_free(mesh, &free_index);
         Ok(DofMap {
             n_nodes,
             free_index,
@@ -176,6 +191,7 @@ impl DofMap {
             free_to_full,
             any_nonzero_prescribed,
             free_rigid_motions,
+            rigid_modes,
             order,
         })
     }
@@ -274,6 +290,12 @@ impl DofMap {
     /// to the free DOFs can be positive definite.
     pub fn free_rigid_motions(&self) -> &[String] {
         &self.free_rigid_motions
+    }
+    /// The free rigid motions of the parts as vectors (nodes of no cell,
+    /// which [`DofMap::free_rigid_motions`] also names, have none): the
+    /// null space of K on the free DOFs.
+    pub fn rigid_modes(&self) -> &[RigidMode] {
+        &self.rigid_modes
     }
 
     /// Gathers the free entries of a full vector.
@@ -453,7 +475,7 @@ fn bandwidth_order(mesh: &Mesh) -> Vec<usize> {
     order
 }
 
-fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> Vec<String> {
+fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> (Vec<String>, Vec<RigidMode>) {
     let n_nodes = mesh.nodes.len();
     let part = connected_parts(mesh);
     let n_parts = part
@@ -462,6 +484,8 @@ fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> Vec<String> {
         .max()
         .map_or(0, |&p| p + 1);
     let mut motions = Vec::new();
+    let mut modes = Vec::new();
+    let n_free = free_index.iter().filter(|&&f| f != FIXED).count();
     // Nodes in no cell have no stiffness at all.
     for v in 0..n_nodes {
         if part[v] == usize::MAX && (free_index[2 * v] != FIXED || free_index[2 * v + 1] != FIXED) {
@@ -529,22 +553,62 @@ fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> Vec<String> {
             .filter(|&i| largest == 0.0 || values[i] <= 1e-12 * largest)
             .collect();
         let mut free = Vec::new();
+        // Each free motion as (ux, uy) of a node at (x, y).
+        let mut shapes: Vec<[f64; 3]> = Vec::new();
         if !any[k][0] {
             free.push("translation in x".to_string());
+            shapes.push([1.0, 0.0, f64::NAN]);
         }
         if !any[k][1] {
             free.push("translation in y".to_string());
+            shapes.push([0.0, 1.0, f64::NAN]);
         }
         if null.len() > free.len() {
+            // The null vector (a, b, c) with the largest c is a rotation
+            // about (−b/c, a/c) in the centred, scaled coordinates; where a
+            // translation is free too the centre's coordinate across it is
+            // as good as any (the difference is that translation).
+            let i = null
+                .iter()
+                .copied()
+                .max_by(|&p, &q| vectors[2][p].abs().total_cmp(&vectors[2][q].abs()))
+                .expect("a null vector");
+            let (a, bb, c) = (vectors[0][i], vectors[1][i], vectors[2][i]);
+            let (mut px, mut py) = (cx - bb / c * scale, cy + a / c * scale);
+            if !any[k][0] {
+                py = cy;
+            }
+            if !any[k][1] {
+                px = cx;
+            }
             if free.is_empty() {
-                // The null vector (a, b, c) is a rotation about (−b/c, a/c).
-                let i = null[0];
-                let (a, bb, c) = (vectors[0][i], vectors[1][i], vectors[2][i]);
-                let (px, py) = (cx - bb / c * scale, cy + a / c * scale);
                 free.push(format!("rotation about ({px:.6}, {py:.6})"));
             } else {
                 free.push("rotation".to_string());
             }
+            shapes.push([px, py, 1.0]);
+        }
+        for (label, shape) in free.iter().zip(&shapes) {
+            let mut vector = vec![0.0; n_free];
+            for v in (0..n_nodes).filter(|&v| part[v] == k) {
+                let [x, y] = mesh.nodes[v];
+                let u = if shape[2] == 1.0 {
+                    [-(y - shape[1]), x - shape[0]]
+                } else {
+                    [shape[0], shape[1]]
+                };
+                for c in 0..2 {
+                    if free_index[2 * v + c] != FIXED {
+                        vector[free_index[2 * v + c]] = u[c];
+                    }
+                }
+            }
+            let label = if label == "rotation" {
+                format!("rotation about ({:.6}, {:.6})", shape[0], shape[1])
+            } else {
+                label.clone()
+            };
+            modes.push((k, label, vector));
         }
         if n_parts > 1 {
             let v = first_node[k];
@@ -559,7 +623,23 @@ fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> Vec<String> {
         }
         motions.extend(free);
     }
-    motions
+    let modes = modes
+        .into_iter()
+        .map(|(k, label, vector)| RigidMode {
+            label: if n_parts > 1 {
+                let v = first_node[k];
+                let p = mesh.nodes[v];
+                format!(
+                    "{label} of the separate part of the mesh containing node {v} at ({}, {})",
+                    p[0], p[1]
+                )
+            } else {
+                label
+            },
+            vector,
+        })
+        .collect();
+    (motions, modes)
 }
 
 /// Connected component of each node in the graph where the nodes of a cell

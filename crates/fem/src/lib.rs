@@ -33,7 +33,7 @@ pub mod statics;
 
 pub use assembly::{free_dof_pattern, node_adjacency};
 pub use boundary::{boundary_quadrature, BoundaryNode};
-pub use dofs::{Dirichlet, DofMap, NodeOrder};
+pub use dofs::{Dirichlet, DofMap, NodeOrder, RigidMode};
 pub use error::FemError;
 pub use loads::{
     body_force_load, body_force_load_with, traction_load, traction_load_with, Traction,

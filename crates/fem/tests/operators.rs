@@ -1,9 +1,9 @@
 //! Assembled operators: rigid-body modes, mass totals, HRZ ratios, shared
 //! pattern, `combine`, and thread-count independence.
 
-use stickslip_fem::{Hypothesis, Material, Model};
+use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
 use stickslip_mesh::{CellKind, Mesh};
-use stickslip_testkit::{map_nodes, on_threads, plain_spmv, rectangle};
+use stickslip_testkit::{add_point_group, map_nodes, on_threads, plain_spmv, rectangle};
 
 fn material() -> Material {
     Material::new(1000.0, 0.3, 2.5, Hypothesis::PlaneStrain).unwrap()
@@ -26,6 +26,46 @@ fn distorted(kind: CellKind, nx: usize, ny: usize) -> Mesh {
 
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// The rigid modes the DofMap reports are the motions the supports leave
+/// free: K annihilates each (theory, as above), each vanishes where a DOF
+/// is held (it is a vector on the free DOFs only), and they are, per
+/// support: none held (3: x, y, rotation), rollers u_y = 0 on the top (1:
+/// x), u_y = 0 at one point (2: x, and rotation about that point).
+#[test]
+fn the_rigid_modes_are_the_free_motions() {
+    let mut mesh = distorted(CellKind::Quad9, 3, 2);
+    add_point_group(&mut mesh, "corner", &[0]);
+    // (A rotation with x free is about any point of the held node's
+    // vertical: the one at the centre's height, y = 1, is reported.)
+    let cases: [(Vec<Dirichlet>, &[&str]); 3] = [
+        (
+            vec![],
+            &[
+                "translation in x",
+                "translation in y",
+                "rotation about (1.500000, 1.000000)",
+            ],
+        ),
+        (vec![Dirichlet::new("top", 1, 0.0)], &["translation in x"]),
+        (
+            vec![Dirichlet::new("corner", 1, 0.0)],
+            &["translation in x", "rotation about (0.000000, 1.000000)"],
+        ),
+    ];
+    for (k, (conditions, labels)) in cases.iter().enumerate() {
+        let model = Model::new(&mesh, &material(), conditions).unwrap();
+        let modes = model.dofs.rigid_modes();
+        let got: Vec<&str> = modes.iter().map(|m| m.label.as_str()).collect();
+        assert_eq!(&got[..], *labels, "case {k}");
+        let k_norm = norm(model.stiffness.values());
+        for m in modes {
+            let kr = plain_spmv(&model.stiffness, &m.vector);
+            let rel = norm(&kr) / (k_norm * norm(&m.vector));
+            assert!(rel < 1e-10, "case {k} {}: {rel:e}", m.label);
+        }
+    }
 }
 
 /// Expected (theory): a rigid motion has zero strain, so K r = 0. With no

@@ -10,11 +10,11 @@ use stickslip_linalg::{csr, Product, Stencils};
 use crate::dynamics::{Dynamics, Loads};
 use crate::initial::{initial_state, Mass};
 use crate::nodal::NodalFriction;
-use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError};
+use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError, MAX_STABLE_STEPS};
 use crate::stability::critical_step_with;
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
-use crate::sweep::{loads_at, predict, sweep, Partials, SparseLoads, StepData, Sums};
+use crate::sweep::{loads_at, predict, sweep, Damped, Partials, SparseLoads, StepData, Sums};
 
 /// γ of central difference.
 const GAMMA: f64 = 0.5;
@@ -46,6 +46,14 @@ pub(crate) struct CentralDifference {
     /// (steps, Δt bits) of the state `r_next` went into `r_new` for: the
     /// next step, if of that Δt, skips [`predict`].
     predicted: Option<(u64, u64)>,
+    /// With Rayleigh damping: K r at the current state (for the stiffness
+    /// part's half-step velocity) and K r_K the sweep writes; empty
+    /// without damping.
+    ku: Vec<f64>,
+    ku_new: Vec<f64>,
+    /// `ku` is not K r of the current state (before the first step, after
+    /// a restore): the next step forms it first.
+    ku_stale: bool,
 }
 
 /// Builds the stepper and the initial state. The critical step is
@@ -66,6 +74,7 @@ pub(crate) fn start(
         lumped_mass: mass,
         fill_order,
         stencils,
+        rigid_modes,
         ..
     } = dynamics;
     let types = if stencils { Stencils::new(&k) } else { None };
@@ -76,15 +85,11 @@ pub(crate) fn start(
         },
         &mass,
     );
-    if settings.dt > dt_crit && !settings.allow_unstable {
-        return Err(TimeError::Unstable {
-            dt: settings.dt,
-            dt_crit,
-        });
-    }
+    let dt_crit = damped_critical_step(dt_crit, settings)?;
     let state = initial_state(
         &k,
         Mass::Lumped(&mass),
+        &rigid_modes,
         &fill_order,
         contact,
         loads,
@@ -109,6 +114,7 @@ pub(crate) fn start(
         friction = dofs.into_iter().map(|i| (i, 0.0)).collect();
     }
     let iterated = settings.explicit_friction == ExplicitFriction::Iterate;
+    let damped = settings.damping.is_on();
     let n_c = contact.map_or(0, |c| c.len());
     let stepper = CentralDifference {
         product,
@@ -125,6 +131,9 @@ pub(crate) fn start(
         mass,
         r_next: vec![0.0; n],
         predicted: None,
+        ku: if damped { vec![0.0; n] } else { Vec::new() },
+        ku_new: if damped { vec![0.0; n] } else { Vec::new() },
+        ku_stale: true,
     };
     Ok((Box::new(stepper), state))
 }
@@ -143,7 +152,7 @@ impl CentralDifference {
         (classes, classes_new, v_new): (&[SlipState], &mut [SlipState], &mut [f64]),
         (step, t): (u64, f64),
     ) -> Result<usize, TimeError> {
-        self.nodal.prepare(contact, data.mass, data.scale);
+        self.nodal.prepare(contact, data.mass, data.dscale);
         if settings.explicit_friction == ExplicitFriction::ClosedForm {
             self.nodal.form_products(&self.product, data.r_new);
             let (ku, friction, slots) = (
@@ -166,7 +175,7 @@ impl CentralDifference {
             *b = data.rhs(i, *b);
         }
         for (d, m) in self.diagonal.iter_mut().zip(data.mass) {
-            *d = m * data.scale;
+            *d = m * data.dscale;
         }
         let mut system = DiagonalStep {
             diagonal: &self.diagonal,
@@ -207,8 +216,9 @@ impl CentralDifference {
         // friction's parts are written: moved out for the step.
         let mass = std::mem::take(&mut self.mass);
         let loads = std::mem::take(&mut self.sparse_loads);
-        let result = self.velocities_with(run, state, (&mass, loads.rows()), dt, at, outputs);
-        (self.mass, self.sparse_loads) = (mass, loads);
+        let ku = std::mem::take(&mut self.ku);
+        let result = self.velocities_with(run, state, (&mass, loads.rows(), &ku), dt, at, outputs);
+        (self.mass, self.sparse_loads, self.ku) = (mass, loads, ku);
         result
     }
 
@@ -216,12 +226,27 @@ impl CentralDifference {
         &mut self,
         run: &Run,
         state: &State,
-        (mass, load_rows): (&[f64], &[usize]),
+        (mass, load_rows, ku): (&[f64], &[usize], &[f64]),
         dt: f64,
         at: (u64, f64),
         (v_new, a_new, r_next, classes_new): Outputs,
     ) -> Result<(Sums, usize), TimeError> {
         let scale = 1.0 / (GAMMA * dt);
+        // Rayleigh damping (METHOD.md §8): αM centred, exact with the
+        // lumped mass (M/(γΔt) + αM is diagonal); βK on the half-step
+        // velocity (r_K − r_{K−1})/Δt, explicit.
+        let c = run.settings.damping;
+        let (dscale, damped) = if c.is_on() {
+            (
+                scale + c.alpha,
+                Some(Damped {
+                    ku_prev: ku,
+                    bs: c.beta / dt,
+                }),
+            )
+        } else {
+            (scale, None)
+        };
         let data = StepData {
             load_new: &state.load_new,
             load_rows,
@@ -232,6 +257,8 @@ impl CentralDifference {
             cv: scale,
             ca: 1.0 / GAMMA - 1.0,
             scale,
+            dscale,
+            damped,
             ratio: (1.0 - GAMMA) / GAMMA,
             next: [dt, 0.5 * dt * dt],
         };
@@ -245,11 +272,13 @@ impl CentralDifference {
                 at,
             )?;
         }
+        let ku_new = (!self.ku_new.is_empty()).then_some(&mut self.ku_new[..]);
         let sums = sweep(
             &self.product,
             &data,
             &self.friction,
             [v_new, a_new, r_next],
+            ku_new,
             &mut self.partials,
         );
         Ok((sums, iterations))
@@ -285,6 +314,10 @@ impl Stepper for CentralDifference {
             );
         }
         self.predicted = None;
+        if self.ku_stale && !self.ku.is_empty() {
+            self.product.spmv(&state.r, &mut self.ku);
+        }
+        self.ku_stale = false;
         let (work, load_dot) = loads_at(
             &self.sparse_loads,
             &self.thetas,
@@ -326,12 +359,16 @@ impl Stepper for CentralDifference {
         state.commit(dt, t_new, iterations);
         // r_new now holds r_{K−1}, free: the next predictor goes there.
         std::mem::swap(&mut state.r_new, &mut self.r_next);
+        std::mem::swap(&mut self.ku, &mut self.ku_new);
+        let c = settings.damping;
+        let damped = c.alpha * dt * sums.damped[0] + c.beta * sums.damped[1];
         self.predicted = Some((state.steps, dt.to_bits()));
         let energies = StepEnergies {
             kinetic: sums.kinetic,
             strain: sums.strain,
             work,
             dissipated,
+            damped,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))
@@ -339,6 +376,7 @@ impl Stepper for CentralDifference {
 
     fn state_replaced(&mut self) {
         self.predicted = None;
+        self.ku_stale = true;
     }
 
     fn dt_crit(&self) -> Option<f64> {
@@ -372,8 +410,58 @@ impl Stepper for CentralDifference {
     /// ṙ_K, r̈_K and the next predictor (a step of the last one's Δt skips
     /// the predictor's pass); and the loads at their rows.
     fn bytes_per_step(&self) -> usize {
-        self.product.bytes() + 8 * 7 * self.mass.len() + self.sparse_loads.bytes()
+        // A damped sweep also reads K r_{K−1} and R_K and writes K r_K.
+        let streams = if self.ku.is_empty() { 7 } else { 10 };
+        self.product.bytes() + 8 * streams * self.mass.len() + self.sparse_loads.bytes()
     }
+}
+
+/// The critical step with Rayleigh damping from the undamped one,
+/// 2/ω_max: Δt_crit = (2/ω_max)(√(1+ξ²) − ξ), ξ = βω_max/2 (METHOD.md §8).
+/// The mass part, centred, does not lower it: for a mode ω the step's
+/// characteristic polynomial (1 + αΔt/2)z² − (2 − Ω² − 2ξΩ)z + 1 − αΔt/2
+/// − 2ξΩ, Ω = ωΔt, has its root at z = −1 where Ω² + 4ξΩ = 4, whatever
+/// α; the bound falls with ω, so ω_max sets it. Zero modes (a floating
+/// part) bound nothing.
+///
+/// # Errors
+/// Δt above it (unless allowed), or no usable stable step at all.
+fn damped_critical_step(undamped: f64, settings: &Settings) -> Result<f64, TimeError> {
+    let beta = settings.damping.beta;
+    if beta == 0.0 {
+        if settings.dt > undamped && !settings.allow_unstable {
+            return Err(TimeError::Unstable {
+                dt: settings.dt,
+                dt_crit: undamped,
+            });
+        }
+        return Ok(undamped);
+    }
+    let omega = 2.0 / undamped;
+    let xi = 0.5 * beta * omega;
+    // (√(1+ξ²) − ξ) = 1/(√(1+ξ²) + ξ), without the cancellation.
+    let dt_crit = undamped / ((1.0 + xi * xi).sqrt() + xi);
+    let steps = settings.t_end / dt_crit;
+    let usable = dt_crit.is_normal() && steps <= MAX_STABLE_STEPS;
+    if (settings.dt > dt_crit || !usable) && !settings.allow_unstable {
+        return Err(TimeError::UnstableDamped {
+            dt: settings.dt,
+            dt_crit,
+            undamped,
+            omega,
+            beta,
+            xi,
+            no_step: if usable {
+                String::new()
+            } else {
+                format!(
+                    ", so small that a stable run to t_end would take {steps:.1e} steps: central \
+                     difference has no usable stable step"
+                )
+            },
+        });
+    }
+    Ok(dt_crit)
 }
 
 impl CentralDifference {

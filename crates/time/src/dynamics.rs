@@ -2,7 +2,7 @@
 //! (METHOD.md §3), as the schemes receive it.
 
 use nalgebra_sparse::CsrMatrix;
-use stickslip_fem::Model;
+use stickslip_fem::{Model, RigidMode};
 use stickslip_linalg::FillOrder;
 
 use crate::history::History;
@@ -27,6 +27,9 @@ pub struct Dynamics {
     pub stencils: bool,
     /// The ordering of the factors of K, A₀ and M ([`Model::fill_order`]).
     pub fill_order: FillOrder,
+    /// The rigid motions the supports leave free (K's null space; empty
+    /// for a held body): the static preload is solved on their complement.
+    pub rigid_modes: Vec<RigidMode>,
 }
 
 impl Dynamics {
@@ -39,6 +42,7 @@ impl Dynamics {
             constant_load: model.dirichlet_load.clone(),
             stencils: true,
             fill_order: model.fill_order.clone(),
+            rigid_modes: model.dofs.rigid_modes().to_vec(),
         }
     }
 
@@ -51,6 +55,7 @@ impl Dynamics {
             lumped_mass: model.lumped_mass,
             constant_load: model.dirichlet_load,
             stencils: true,
+            rigid_modes: model.dofs.rigid_modes().to_vec(),
             fill_order: model.fill_order,
         }
     }

@@ -1,14 +1,17 @@
 //! The initial state of paper Remark 4.1 (METHOD.md §4): r₀ the
-//! frictionless static equilibrium under the loads present at t = 0⁻,
-//! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀, again without friction.
+//! frictionless static equilibrium under the loads present at t = 0⁻ (or
+//! r₀ = 0 for a start at rest, every load then acting from t = 0 on),
+//! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀ − C ṙ₀ (C the Rayleigh
+//! damping), again without friction.
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
+use stickslip_fem::RigidMode;
 use stickslip_linalg::csr::{dot, quadratic_form, spmv};
 use stickslip_linalg::{chunks, FillOrder, SparseCholesky};
 
 use crate::dynamics::Loads;
-use crate::settings::{Settings, TimeError};
+use crate::settings::{InitialState, Settings, TimeError};
 use crate::state::{Energy, State};
 
 /// The mass a scheme uses, as the initial state needs it.
@@ -23,6 +26,19 @@ pub(crate) enum Mass<'a> {
 }
 
 impl Mass<'_> {
+    /// M x into `out`.
+    pub fn apply(&self, x: &[f64], out: &mut [f64]) {
+        match self {
+            Mass::Lumped(m) => {
+                for ((o, x), m) in out.iter_mut().zip(x).zip(*m) {
+                    *o = m * x;
+                }
+            }
+            Mass::Consistent(m) => spmv(m, x, out),
+            Mass::Massless => out.fill(0.0),
+        }
+    }
+
     /// xᵀ M x.
     pub fn form(&self, x: &[f64], partials: &mut [[f64; 2]]) -> f64 {
         match self {
@@ -34,16 +50,21 @@ impl Mass<'_> {
 }
 
 /// The state at t = 0 for a scheme with mass `mass`: Remark 4.1's r₀ (no
-/// factorization where nothing acts before t = 0, or where the state will
-/// come from a checkpoint: r₀ = 0 then), ṙ₀, r̈₀, R(0), the contact
+/// factorization where nothing acts before t = 0, where the run starts at
+/// rest, or where the state will come from a checkpoint: r₀ = 0 then), ṙ₀, r̈₀, R(0), the contact
 /// classes and forces at ṙ₀, and the energies.
 ///
+/// Where the supports leave rigid motions free (`modes`), the static state
+/// is solved on their complement (`floating.rs`).
+///
 /// # Errors
-/// [`TimeError::Static`] when K (or a consistent M) is not positive
-/// definite: a rigid-body motion left free.
+/// [`TimeError::Unbalanced`] when the preload does work along a free rigid
+/// motion; [`TimeError::Static`] when K (or a consistent M) is otherwise
+/// not positive definite.
 pub(crate) fn initial_state(
     k: &CsrMatrix<f64>,
     mass: Mass,
+    modes: &[RigidMode],
     fill_order: &FillOrder,
     contact: Option<&ContactSurface>,
     loads: &Loads,
@@ -52,8 +73,10 @@ pub(crate) fn initial_state(
     let n = k.nrows();
     let mut state = State::new(n, contact.map_or(0, |c| c.len()), settings.dt);
     let mut r = loads.before_start();
-    if settings.restoring {
+    if settings.restoring || settings.initial_state == InitialState::Rest {
         r.fill(0.0);
+    } else if !modes.is_empty() {
+        crate::floating::solve(k, mass, fill_order, modes, &mut r)?;
     } else if r.iter().any(|&x| x != 0.0) {
         let mut solver = SparseCholesky::analyze(k, fill_order).map_err(TimeError::Static)?;
         solver.factorize(k).map_err(TimeError::Static)?;
@@ -69,6 +92,16 @@ pub(crate) fn initial_state(
     spmv(k, &state.r, &mut rhs);
     for (x, l) in rhs.iter_mut().zip(&state.load) {
         *x = l - *x;
+    }
+    // With damping and an initial velocity, M r̈₀ = R(0) − K r₀ − C ṙ₀.
+    let damping = settings.damping;
+    if damping.is_on() && settings.initial_velocity.is_some() {
+        let (mut kv, mut mv) = (vec![0.0; n], vec![0.0; n]);
+        spmv(k, &state.v, &mut kv);
+        mass.apply(&state.v, &mut mv);
+        for ((x, kv), mv) in rhs.iter_mut().zip(&kv).zip(&mv) {
+            *x -= damping.alpha * mv + damping.beta * kv;
+        }
     }
     match mass {
         Mass::Lumped(m) => {
@@ -97,6 +130,7 @@ pub(crate) fn initial_state(
         strain,
         external_work: 0.0,
         dissipated: 0.0,
+        damped: 0.0,
         total: kinetic + strain - dot(&state.r, &state.load),
         balance: 0.0,
     };

@@ -23,6 +23,7 @@
 
 mod central_difference;
 mod dynamics;
+mod floating;
 mod history;
 mod initial;
 mod integrator;
@@ -39,6 +40,7 @@ pub use dynamics::{Dynamics, Load};
 pub use history::History;
 pub use integrator::Integrator;
 pub use settings::{
-    ExplicitFriction, ImplicitSolver, MassKind, Scheme, Settings, StickReduction, TimeError,
+    ExplicitFriction, ImplicitSolver, InitialState, MassKind, Rayleigh, Scheme, Settings,
+    StickReduction, TimeError, MAX_STABLE_STEPS,
 };
 pub use state::{Checkpoint, Energy, StepInfo};

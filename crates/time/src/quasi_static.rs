@@ -55,11 +55,20 @@ pub(crate) fn start(
     let Dynamics {
         stiffness: k,
         fill_order,
+        rigid_modes,
         ..
     } = dynamics;
     let n = k.nrows();
     let friction = ImplicitFriction::new(&k, &fill_order, contact, settings)?;
-    let mut state = initial_state(&k, Mass::Massless, &fill_order, contact, loads, settings)?;
+    let mut state = initial_state(
+        &k,
+        Mass::Massless,
+        &rigid_modes,
+        &fill_order,
+        contact,
+        loads,
+        settings,
+    )?;
     if !settings.restoring {
         // The previous increment's load is the one r₀ equilibrates.
         state.load = loads.before_start();
@@ -144,6 +153,7 @@ impl Stepper for QuasiStatic {
             strain,
             work,
             dissipated,
+            damped: 0.0,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))

@@ -68,6 +68,33 @@ pub enum ImplicitSolver {
     Direct,
 }
 
+/// Where a run starts (the case's `[initial] state`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum InitialState {
+    /// Remark 4.1: r₀ the frictionless static equilibrium under the loads
+    /// present at t = 0⁻.
+    #[default]
+    Static,
+    /// r₀ = 0: every load acts from t = 0 on, nothing before.
+    Rest,
+}
+
+/// Rayleigh damping C = αM + βK (METHOD.md §8), M the scheme's mass.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Rayleigh {
+    /// α, the mass-proportional coefficient (1/time).
+    pub alpha: f64,
+    /// β, the stiffness-proportional coefficient (time).
+    pub beta: f64,
+}
+
+impl Rayleigh {
+    /// True when C ≠ 0.
+    pub fn is_on(&self) -> bool {
+        self.alpha != 0.0 || self.beta != 0.0
+    }
+}
+
 /// Remark 4.3: after a step in which a node went from slip to stick, the
 /// next `steps` steps use `dt`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -100,8 +127,12 @@ pub struct Settings {
     pub explicit_friction: ExplicitFriction,
     /// How implicit steps solve.
     pub implicit_solver: ImplicitSolver,
+    /// r₀: Remark 4.1's static state (default) or rest.
+    pub initial_state: InitialState,
     /// ṙ₀ (default zero).
     pub initial_velocity: Option<Vec<f64>>,
+    /// Rayleigh damping (default none).
+    pub damping: Rayleigh,
     /// The state will come from a checkpoint ([`crate::Integrator::restore`]):
     /// the initial static solve (Remark 4.1), whose factor of K would be
     /// most of a large restart's setup and peak memory, is skipped and r₀
@@ -122,7 +153,9 @@ impl Settings {
             allow_unstable: false,
             explicit_friction: ExplicitFriction::ClosedForm,
             implicit_solver: ImplicitSolver::Schur,
+            initial_state: InitialState::Static,
             initial_velocity: None,
+            damping: Rayleigh::default(),
             restoring: false,
         }
     }
@@ -157,6 +190,13 @@ impl Settings {
         }
         if self.iteration.max_iterations == 0 {
             return bad("contact.max_iterations must be at least 1".into());
+        }
+        let Rayleigh { alpha, beta } = self.damping;
+        if !(alpha >= 0.0 && alpha.is_finite() && beta >= 0.0 && beta.is_finite()) {
+            return bad(format!(
+                "material.damping = {{ alpha = {alpha}, beta = {beta} }}: the Rayleigh coefficients \
+                 must be finite and >= 0 (C = alpha M + beta K; 0 for none)"
+            ));
         }
         if let Some(v0) = &self.initial_velocity {
             if v0.len() != n {
@@ -193,6 +233,11 @@ impl Settings {
     }
 }
 
+/// More steps than a run could ever take (the case's bound on t_end/Δt):
+/// a damped critical step that needs more to reach t_end leaves central
+/// difference no usable stable step.
+pub const MAX_STABLE_STEPS: f64 = 1e12;
+
 /// Why a run could not start or a step failed.
 #[derive(Debug, thiserror::Error)]
 pub enum TimeError {
@@ -211,12 +256,50 @@ pub enum TimeError {
         /// The estimated critical step.
         dt_crit: f64,
     },
+    /// Δt above the explicit scheme's critical step with stiffness-
+    /// proportional damping.
+    #[error(
+        "time.dt = {dt:e} is above the critical step of central difference with Rayleigh damping \
+         beta = {beta:e}: at ω_max = {omega:.6e} (the largest of M⁻¹K) the damping ratio is \
+         ξ = beta ω_max / 2 = {xi:.4e}, and Δt_crit = (2/ω_max)(√(1+ξ²) − ξ) = {dt_crit:.6e} \
+         (undamped {undamped:.6e}){no_step}: use time.dt < {dt_crit:.4e}, lower material.damping.beta, \
+         or use time.scheme = \"newmark\" (unconditionally stable with any damping)"
+    )]
+    UnstableDamped {
+        /// The step asked for.
+        dt: f64,
+        /// The critical step with damping.
+        dt_crit: f64,
+        /// The critical step without damping, 2/ω_max.
+        undamped: f64,
+        /// ω_max.
+        omega: f64,
+        /// β.
+        beta: f64,
+        /// ξ at ω_max.
+        xi: f64,
+        /// Where Δt_crit is not a positive normal number or a stable run to
+        /// t_end would take more than [`MAX_STABLE_STEPS`] steps, what
+        /// says so ("so small that ..."), else "".
+        no_step: String,
+    },
     /// The initial static solve failed (rigid-body motion left free).
     #[error(
         "the initial static solve failed: {0}; the supports leave a rigid-body motion free: \
          add Dirichlet conditions that fix translation in x and y and rotation"
     )]
     Static(SolverError),
+    /// The loads present before t = 0 do work along a rigid motion the
+    /// supports leave free: the static preload has no solution.
+    #[error(
+        "the loads present before t = 0 (the \"constant\" histories, the contact pressure, the body \
+         force) are not in equilibrium along the rigid motions the supports leave free, so the \
+         initial static state (Remark 4.1) does not exist: {}; start at rest ([initial] state = \
+         \"rest\": every load acts from t = 0 on), or balance the loads (or hold the part with \
+         [[dirichlet]] conditions)",
+        unbalanced_list(.0)
+    )]
+    Unbalanced(Vec<(String, f64)>),
     /// A factorization failed during the run.
     #[error("step {step} (t = {t:.6e}): the linear solve failed: {source}")]
     Solve {
@@ -255,6 +338,24 @@ pub enum TimeError {
         /// Extra advice (the critical step of an explicit run).
         hint: String,
     },
+}
+
+/// "translation in x: net force F_x = …; rotation about (x, y): moment
+/// about (x, y) M = …": a unit translation's work is the net force along
+/// it, a unit rotation's the moment about its centre.
+fn unbalanced_list(motions: &[(String, f64)]) -> String {
+    motions
+        .iter()
+        .map(|(label, work)| {
+            if let Some(rest) = label.strip_prefix("translation in ") {
+                let axis = &rest[..1];
+                format!("{label}: net force F_{axis} = {work:.6e}")
+            } else {
+                format!("{label}: moment M = {work:.6e}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 impl TimeError {

@@ -156,20 +156,31 @@ mod tests {
     use super::*;
     use nalgebra_sparse::CooMatrix;
 
-    #[test]
-    fn spring_chain_eigenvalue_matches_closed_form() {
-        // Fixed-fixed chain of n unit masses and unit springs: eigenvalues
-        // 4 sin²(kπ/(2(n+1))), k = 1..n; the largest has k = n.
-        let n = 400;
+    /// K of a chain of n unit springs between n nodes, its ends held by a
+    /// spring each (`fixed`) or free.
+    fn chain(n: usize, fixed: bool) -> CsrMatrix<f64> {
         let mut coo = CooMatrix::new(n, n);
         for i in 0..n {
-            coo.push(i, i, 2.0);
+            let ends = if fixed {
+                2
+            } else {
+                usize::from(i > 0) + usize::from(i + 1 < n)
+            };
+            coo.push(i, i, ends as f64);
             if i > 0 {
                 coo.push(i, i - 1, -1.0);
                 coo.push(i - 1, i, -1.0);
             }
         }
-        let k = CsrMatrix::from(&coo);
+        CsrMatrix::from(&coo)
+    }
+
+    #[test]
+    fn spring_chain_eigenvalue_matches_closed_form() {
+        // Fixed-fixed chain of n unit masses and unit springs: eigenvalues
+        // 4 sin²(kπ/(2(n+1))), k = 1..n; the largest has k = n.
+        let n = 400;
+        let k = chain(n, true);
         let m = vec![1.0; n];
         let exact = 4.0
             * (n as f64 * std::f64::consts::PI / (2.0 * (n as f64 + 1.0)))
@@ -189,5 +200,26 @@ mod tests {
         let m4 = vec![4.0; n];
         let ratio = critical_step(&k, &m4) / critical_step(&k, &m);
         assert!((ratio - 2.0).abs() < 1e-6, "ratio {ratio}");
+    }
+
+    #[test]
+    fn a_free_chain_has_zero_modes_and_the_same_top() {
+        // Free-free chain of n unit masses and unit springs (a floating
+        // part: K has the rigid translation in its null space):
+        // eigenvalues 4 sin²(kπ/(2n)), k = 0..n−1; the zero mode is in the
+        // start vector and must not disturb the top one (k = n − 1).
+        let n = 400;
+        let k = chain(n, false);
+        let m = vec![1.0; n];
+        let exact = 4.0
+            * ((n as f64 - 1.0) * std::f64::consts::PI / (2.0 * n as f64))
+                .sin()
+                .powi(2);
+        let lambda = largest_eigenvalue(&k, &m, 300);
+        assert!(lambda <= exact * (1.0 + 1e-12), "Ritz value above λ_max");
+        assert!(
+            (lambda - exact).abs() < 1e-5 * exact,
+            "λ = {lambda}, closed form {exact}"
+        );
     }
 }

@@ -18,10 +18,15 @@ pub struct Energy {
     /// ∫ J·ṙ dt, trapezoidal rule: Σ ½(J_K + J_{K−1})·½Δt(ṙ_K + ṙ_{K−1}),
     /// ≥ 0 step by step since φ_ε is odd and increasing.
     pub dissipated: f64,
+    /// ∫ ṙᵀCṙ dt of Rayleigh damping (METHOD.md §8), ≥ 0 step by step:
+    /// Newmark Σ Δt ṙ̄ᵀCṙ̄ with ṙ̄ = ½(ṙ_K + ṙ_{K−1}); central difference
+    /// its mass part so, its stiffness part as the force it applies,
+    /// (β/Δt)K(r_K − r_{K−1}), times r_K − r_{K−1}. 0 without damping.
+    pub damped: f64,
     /// kinetic + strain − rᵀR(t): the paper's total energy (Fig. 9).
     pub total: f64,
-    /// kinetic + strain − initial − work + dissipated; zero up to round-off
-    /// for the trapezoidal rule (Newmark ¼, ½).
+    /// kinetic + strain − initial − work + dissipated + damped; zero up to
+    /// round-off for the trapezoidal rule (Newmark ¼, ½).
     pub balance: f64,
 }
 
@@ -153,6 +158,8 @@ pub(crate) struct StepEnergies {
     pub work: f64,
     /// The friction's dissipation over the step.
     pub dissipated: f64,
+    /// The damping's dissipation over the step.
+    pub damped: f64,
     /// r_K · R_K.
     pub load_dot: f64,
 }
@@ -233,8 +240,12 @@ impl State {
         l.strain = e.strain;
         l.external_work += e.work;
         l.dissipated += e.dissipated;
+        l.damped += e.damped;
         l.total = e.kinetic + e.strain - e.load_dot;
-        l.balance = e.kinetic + e.strain - self.initial_mechanical - l.external_work + l.dissipated;
+        // Without damping `+ l.damped` adds +0: the same bits as before.
+        l.balance = e.kinetic + e.strain - self.initial_mechanical - l.external_work
+            + l.dissipated
+            + l.damped;
         if let Some(r) = settings.stick_reduction {
             if stick_events > 0 {
                 self.reduced_remaining = r.steps;

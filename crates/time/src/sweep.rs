@@ -13,6 +13,13 @@
 //! step: the sweep reads r_K, m, ṙ, r̈ and writes ṙ_K, r̈_K, r_{K+1}. All
 //! passes run in the fixed chunks of `stickslip_linalg::chunks`: the same
 //! bits on any number of threads.
+//!
+//! With Rayleigh damping (METHOD.md §8) the sweep takes another path, row
+//! by row, only then: the mass part divides by m·(1/(γΔt) + α) (centred,
+//! exact), the stiffness part is the force (β/Δt)(K r_K − K r_{K−1}) of the
+//! half-step velocity, K r_{K−1} kept from the last sweep (which writes
+//! K r_K for the next), and the damping's dissipation is summed alongside.
+//! The undamped path is untouched: no extra stream, no extra sum.
 
 use stickslip_linalg::chunks::{each_chunk, each_chunk_of, CHUNK};
 use stickslip_linalg::simd::{load, store, vectorized, Batches, Kernel, Simd};
@@ -61,8 +68,10 @@ impl SparseLoads {
     }
 }
 
-/// Per-chunk sums of the sweep: [kinetic, not finite, strain].
-pub(crate) type Partials = Vec<[f64; 3]>;
+/// Per-chunk sums of the sweep: [kinetic, not finite, strain, the
+/// damping's mass part Σ m ṙ̄², its stiffness part Σ (K r_K − K r_{K−1})
+/// (ṙ + ½Δt r̈)].
+pub(crate) type Partials = Vec<[f64; 5]>;
 
 /// The predictor r_K = r + c1 ṙ + c2 r̈ into `r_new` (every row).
 pub(crate) fn predict([r, v, a]: [&[f64]; 3], [c1, c2]: [f64; 2], r_new: &mut [f64]) {
@@ -122,20 +131,39 @@ pub(crate) struct StepData<'a> {
     pub cv: f64,
     /// See `cv`.
     pub ca: f64,
-    /// 1/(γΔt): ṙ_K = b/(m·scale), r̈_K = (ṙ_K − ṙ)·scale − ratio·r̈.
+    /// 1/(γΔt): r̈_K = (ṙ_K − ṙ)·scale − ratio·r̈.
     pub scale: f64,
+    /// ṙ_K = R̂_K/(m·dscale): `scale`, plus α with mass-proportional
+    /// damping.
+    pub dscale: f64,
+    /// The stiffness-proportional damping's data, with damping on.
+    pub damped: Option<Damped<'a>>,
     /// (1−γ)/γ.
     pub ratio: f64,
     /// The predictor's coefficients for the next step: Δt and ½Δt².
     pub next: [f64; 2],
 }
 
+/// What a damped sweep reads besides the undamped one's.
+pub(crate) struct Damped<'a> {
+    /// K r_{K−1}.
+    pub ku_prev: &'a [f64],
+    /// β/Δt: the stiffness part's force is bs·(K r_K − K r_{K−1}).
+    pub bs: f64,
+}
+
 impl StepData<'_> {
     /// R̂_K at row i from its K r_K: R_K − K r_K + m(cv ṙ + ca r̈)
-    /// (METHOD.md §4 with the lumped mass).
+    /// (METHOD.md §4 with the lumped mass), less the stiffness-proportional
+    /// damping force with damping on.
     #[inline(always)]
     pub fn rhs(&self, i: usize, ku: f64) -> f64 {
-        self.load_new[i] - ku + self.mass[i] * (self.cv * self.v[i] + self.ca * self.a[i])
+        let rhs =
+            self.load_new[i] - ku + self.mass[i] * (self.cv * self.v[i] + self.ca * self.a[i]);
+        match &self.damped {
+            None => rhs,
+            Some(d) => rhs - d.bs * (ku - d.ku_prev[i]),
+        }
     }
 }
 
@@ -145,6 +173,9 @@ pub(crate) struct Sums {
     pub strain: f64,
     /// ½ ṙ_Kᵀ M_L ṙ_K.
     pub kinetic: f64,
+    /// With damping: (Σ m ṙ̄², Σ (K r_K − K r_{K−1})(ṙ + ½Δt r̈)), ṙ̄ =
+    /// ½(ṙ_K + ṙ); zeros without.
+    pub damped: [f64; 2],
     /// Every entry of r_K and ṙ_K is finite.
     pub finite: bool,
 }
@@ -180,32 +211,55 @@ pub(crate) fn sweep(
     s: &StepData,
     friction: &[(usize, f64)],
     [v_new, a_new, r_next]: [&mut [f64]; 3],
+    ku_new: Option<&mut [f64]>,
     partials: &mut Partials,
 ) -> Sums {
-    let outputs = [v_new, a_new, r_next];
-    let [kinetic, not_finite, strain] = each_chunk_of(outputs, partials, |c, [vn, an, rx], p| {
-        let start = c * CHUNK;
-        *p = vectorized(Chunk {
-            k,
-            c,
-            x: s.r_new,
-            rows: ChunkRows {
-                s,
-                friction,
-                next: friction.partition_point(|f| f.0 < start),
-                next_load: s.load_rows.partition_point(|&i| i < start),
-                start,
-                vn,
-                an,
-                rx,
+    let [kinetic, not_finite, strain, mass_part, stiffness_part] = match ku_new {
+        None => each_chunk_of([v_new, a_new, r_next], partials, |c, [vn, an, rx], p| {
+            *p = chunk(k, s, friction, c, [vn, an, rx], None);
+        }),
+        Some(ku) => each_chunk_of(
+            [v_new, a_new, r_next, ku],
+            partials,
+            |c, [vn, an, rx, ku], p| {
+                *p = chunk(k, s, friction, c, [vn, an, rx], Some(ku));
             },
-        });
-    });
+        ),
+    };
     Sums {
         strain: 0.5 * strain,
         kinetic: 0.5 * kinetic,
+        damped: [mass_part, stiffness_part],
         finite: not_finite == 0.0,
     }
+}
+
+/// Chunk `c` of [`sweep`] (its outputs' rows, and K r_K's where kept).
+fn chunk(
+    k: &Product,
+    s: &StepData,
+    friction: &[(usize, f64)],
+    c: usize,
+    [vn, an, rx]: [&mut [f64]; 3],
+    ku: Option<&mut [f64]>,
+) -> [f64; 5] {
+    let start = c * CHUNK;
+    vectorized(Chunk {
+        k,
+        c,
+        x: s.r_new,
+        rows: ChunkRows {
+            s,
+            friction,
+            next: friction.partition_point(|f| f.0 < start),
+            next_load: s.load_rows.partition_point(|&i| i < start),
+            start,
+            vn,
+            an,
+            rx,
+            ku,
+        },
+    })
 }
 
 /// One chunk of the sweep, as a dispatched kernel.
@@ -217,10 +271,10 @@ struct Chunk<'a, 'b> {
 }
 
 impl Kernel for Chunk<'_, '_> {
-    type Output = [f64; 3];
+    type Output = [f64; 5];
 
     #[inline(always)]
-    fn run<S: Simd>(self, simd: S) -> [f64; 3] {
+    fn run<S: Simd>(self, simd: S) -> [f64; 5] {
         let mut rows = Aligned {
             simd,
             rows: self.rows,
@@ -229,6 +283,7 @@ impl Kernel for Chunk<'_, '_> {
             strain: [simd.splat_f64s(0.0); LANES],
             kinetic: [simd.splat_f64s(0.0); LANES],
             finite: simd.splat_f64s(0.0),
+            damped_sums: [0.0; 5],
         };
         self.k.batches(simd, self.c, self.x, &mut rows);
         rows.finish()
@@ -249,6 +304,28 @@ struct ChunkRows<'a, 'b> {
     an: &'b mut [f64],
     /// The next step's predictor.
     rx: &'b mut [f64],
+    /// K r_K, kept for the next step's damping (damped sweeps only).
+    ku: Option<&'b mut [f64]>,
+}
+
+impl ChunkRows<'_, '_> {
+    /// Row i alone from its K r_K: ṙ_K (or the friction's, at a contact
+    /// DOF), r̈_K and the next predictor written; returns ṙ_K.
+    #[inline(always)]
+    fn row(&mut self, i: usize, ku: f64) -> f64 {
+        let s = self.s;
+        let l = i - self.start;
+        let mut vi = s.rhs(i, ku) / (s.mass[i] * s.dscale);
+        if self.next < self.friction.len() && self.friction[self.next].0 == i {
+            vi = self.friction[self.next].1;
+            self.next += 1;
+        }
+        let ai = (vi - s.v[i]) * s.scale - s.ratio * s.a[i];
+        self.vn[l] = vi;
+        self.an[l] = ai;
+        self.rx[l] = s.r_new[i] + s.next[0] * vi + s.next[1] * ai;
+        vi
+    }
 }
 
 /// [`ChunkRows`] fed in blocks of [`LANES`] rows aligned to the chunk's
@@ -265,6 +342,8 @@ struct Aligned<'a, 'b, S: Simd> {
     kinetic: [S::f64s; LANES],
     /// Σ 0·r_K + 0·ṙ_K: ±0 while every entry is finite, else NaN.
     finite: S::f64s,
+    /// A damped sweep's sums, row by row ([`Partials`]' order).
+    damped_sums: [f64; 5],
 }
 
 impl<S: Simd> Aligned<'_, '_, S> {
@@ -287,6 +366,7 @@ impl<S: Simd> Aligned<'_, '_, S> {
         );
         let splat = |x: f64| simd.splat_f64s(x);
         let (cv, ca, scale, ratio) = (splat(s.cv), splat(s.ca), splat(s.scale), splat(s.ratio));
+        let dscale = splat(s.dscale);
         let (c1, c2) = (splat(s.next[0]), splat(s.next[1]));
         let zero = splat(0.0);
         // One pass over the rows, w at a time: their ṙ_K, the load and
@@ -303,7 +383,7 @@ impl<S: Simd> Aligned<'_, '_, S> {
             );
             let (kj, rnj) = (load::<S>(&ku[at.clone()]), load::<S>(&rn[at.clone()]));
             // R̂_K as StepData::rhs forms it from R_K = +0, then ṙ_K =
-            // R̂_K/(m·scale).
+            // R̂_K/(m·dscale).
             let rhs = simd.add_f64s(
                 simd.sub_f64s(zero, kj),
                 simd.mul_f64s(
@@ -311,7 +391,7 @@ impl<S: Simd> Aligned<'_, '_, S> {
                     simd.add_f64s(simd.mul_f64s(cv, vj), simd.mul_f64s(ca, aj)),
                 ),
             );
-            let mut vnj = simd.div_f64s(rhs, simd.mul_f64s(mj, scale));
+            let mut vnj = simd.div_f64s(rhs, simd.mul_f64s(mj, dscale));
             store::<S>(&mut vn[at.clone()], vnj);
             let end = range.start + j + w;
             let loads = rows.next_load < s.load_rows.len() && s.load_rows[rows.next_load] < end;
@@ -319,7 +399,7 @@ impl<S: Simd> Aligned<'_, '_, S> {
             if loads || nodal {
                 while rows.next_load < s.load_rows.len() && s.load_rows[rows.next_load] < end {
                     let i = s.load_rows[rows.next_load];
-                    vn[i - r0] = s.rhs(i, ku[i - r0]) / (m[i - r0] * s.scale);
+                    vn[i - r0] = s.rhs(i, ku[i - r0]) / (m[i - r0] * s.dscale);
                     rows.next_load += 1;
                 }
                 while rows.next < rows.friction.len() && rows.friction[rows.next].0 < end {
@@ -355,7 +435,10 @@ impl<S: Simd> Aligned<'_, '_, S> {
     /// a block, at the chunk's end) one row a time in their lanes, then
     /// [kinetic, not finite, strain].
     #[inline(always)]
-    fn finish(mut self) -> [f64; 3] {
+    fn finish(mut self) -> [f64; 5] {
+        if self.rows.s.damped.is_some() {
+            return self.damped_sums;
+        }
         let w = S::F64_LANES;
         let lanes = |v: &[S::f64s; LANES]| -> Lanes {
             let mut l = [0.0; LANES];
@@ -372,17 +455,9 @@ impl<S: Simd> Aligned<'_, '_, S> {
             let s = rows.s;
             let r0 = rows.start + rows.vn.len() - held;
             for k in 0..held {
-                let (i, j) = (r0 + k, rows.vn.len() - held + k);
+                let i = r0 + k;
                 let ku = self.pending[k];
-                let mut vi = s.rhs(i, ku) / (s.mass[i] * s.scale);
-                if rows.next < rows.friction.len() && rows.friction[rows.next].0 == i {
-                    vi = rows.friction[rows.next].1;
-                    rows.next += 1;
-                }
-                let ai = (vi - s.v[i]) * s.scale - s.ratio * s.a[i];
-                rows.vn[j] = vi;
-                rows.an[j] = ai;
-                rows.rx[j] = s.r_new[i] + s.next[0] * vi + s.next[1] * ai;
+                let vi = rows.row(i, ku);
                 finite &= s.r_new[i].is_finite() && vi.is_finite();
                 strain.0[k] += s.r_new[i] * ku;
                 kinetic.0[k] += s.mass[i] * vi * vi;
@@ -392,13 +467,45 @@ impl<S: Simd> Aligned<'_, '_, S> {
             kinetic.total(),
             if finite { 0.0 } else { 1.0 },
             strain.total(),
+            0.0,
+            0.0,
         ]
+    }
+
+    /// A damped sweep's rows `r0..r0 + ku.len()`, one at a time (any
+    /// range): what [`Aligned::rows`] and [`Aligned::finish`] do, with
+    /// [`StepData::rhs`]'s damping force and m·dscale, K r_K kept, and the
+    /// damping's sums.
+    fn damped_rows(&mut self, r0: usize, ku: &[f64]) {
+        let rows = &mut self.rows;
+        let s = rows.s;
+        let d = s.damped.as_ref().expect("a damped sweep");
+        let sums = &mut self.damped_sums;
+        let half_dt = 0.5 * s.next[0];
+        for (j, &kui) in ku.iter().enumerate() {
+            let i = r0 + j;
+            let vi = rows.row(i, kui);
+            if let Some(out) = rows.ku.as_deref_mut() {
+                out[i - rows.start] = kui;
+            }
+            if !(s.r_new[i].is_finite() && vi.is_finite()) {
+                sums[1] = 1.0;
+            }
+            sums[0] += s.mass[i] * vi * vi;
+            sums[2] += s.r_new[i] * kui;
+            let mean = 0.5 * (vi + s.v[i]);
+            sums[3] += s.mass[i] * mean * mean;
+            sums[4] += (kui - d.ku_prev[i]) * (s.v[i] + half_dt * s.a[i]);
+        }
     }
 }
 
 impl<S: Simd> Batches for Aligned<'_, '_, S> {
     #[inline(always)]
     fn batch(&mut self, r0: usize, ku: &[f64]) {
+        if self.rows.s.damped.is_some() {
+            return self.damped_rows(r0, ku);
+        }
         let (mut r, mut ku) = (r0, ku);
         if self.held > 0 {
             // Complete the held block from this batch's first rows.

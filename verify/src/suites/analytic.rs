@@ -1,6 +1,7 @@
 //! Closed-form problems: the Coulomb oscillator, d'Alembert's wave, the
-//! static slab, the patch test, and quasi-static friction on a strip
-//! (`strip.rs`).
+//! static slab, the patch test, quasi-static friction on a strip
+//! (`strip.rs`), and the bodies held only by friction with Rayleigh
+//! damping (`friction_held.rs`).
 
 use std::path::Path;
 
@@ -24,6 +25,7 @@ pub fn run(root: &Path, opts: &Options, r: &mut Report) {
     static_slab(root, r);
     patch(r);
     super::strip::run_all(opts, r);
+    super::friction_held::run(opts, r);
 }
 
 fn coulomb_oscillator(opts: &Options, r: &mut Report) {

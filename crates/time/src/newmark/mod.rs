@@ -72,6 +72,7 @@ pub(crate) fn start(
         consistent_mass,
         lumped_mass,
         fill_order,
+        rigid_modes,
         ..
     } = dynamics;
     let n = k.nrows();
@@ -95,7 +96,15 @@ pub(crate) fn start(
         MassKind::Consistent => Mass::Consistent(&m),
         MassKind::Lumped => Mass::Lumped(&lumped_mass),
     };
-    let state = initial_state(&k, mass, &fill_order, contact, loads, settings)?;
+    let state = initial_state(
+        &k,
+        mass,
+        &rigid_modes,
+        &fill_order,
+        contact,
+        loads,
+        settings,
+    )?;
     let stepper = Newmark {
         beta,
         gamma,
@@ -247,6 +256,24 @@ impl ImplicitFriction {
     }
 }
 
+impl Newmark {
+    /// The damping's dissipation over the step, Δt ṙ̄ᵀCṙ̄ with ṙ̄ = ½(ṙ_K +
+    /// ṙ_{K−1}) (before the commit): ½(Cṙ_K + Cṙ_{K−1})·½Δt(ṙ_K + ṙ_{K−1}),
+    /// the friction's trapezoidal rule, exact for Newmark ¼, ½. 0 without
+    /// damping (no pass over the vectors).
+    fn damped(&mut self, settings: &Settings, state: &State, dt: f64) -> f64 {
+        let c = settings.damping;
+        if !c.is_on() {
+            return 0.0;
+        }
+        for ((t, v), vn) in self.tmp.iter_mut().zip(&state.v).zip(&state.v_new) {
+            *t = 0.5 * (v + vn);
+        }
+        let (vkv, vmv) = two_forms(&self.k, &self.tmp, &self.m, &self.tmp, &mut self.partials);
+        dt * (c.alpha * vmv + c.beta * vkv)
+    }
+}
+
 impl Stepper for Newmark {
     fn step(&mut self, run: &Run, state: &mut State) -> Result<StepInfo, TimeError> {
         let settings = &run.settings;
@@ -280,7 +307,13 @@ impl Stepper for Newmark {
         );
         state.classes_new.copy_from_slice(&state.classes);
         let mut v_new = std::mem::take(&mut state.v_new);
-        let (c_k, c_m) = (beta / gamma * dt, 1.0 / (gamma * dt));
+        // Rayleigh damping C = αM + βK joins A₀ (METHOD.md §8); R̂_K is
+        // unchanged, as ṙ_K is the unknown.
+        let c = run.settings.damping;
+        let (mut c_k, mut c_m) = (beta / gamma * dt, 1.0 / (gamma * dt));
+        if c.is_on() {
+            (c_k, c_m) = (c_k + c.beta, c_m + c.alpha);
+        }
         let result = self.friction.velocity(
             run,
             (dt, c_k, &self.k),
@@ -326,6 +359,7 @@ impl Stepper for Newmark {
             }
             None => (0.0, 0),
         };
+        let damped = self.damped(settings, state, dt);
         state.commit(dt, t_new, iterations);
         let (rkr, vmv) = two_forms(&self.k, &state.r, &self.m, &state.v, &mut self.partials);
         let energies = StepEnergies {
@@ -333,6 +367,7 @@ impl Stepper for Newmark {
             strain: 0.5 * rkr,
             work,
             dissipated,
+            damped,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))
