@@ -916,6 +916,8 @@ mod tests {
             contact_nodes: &[0, 1, 2],
             contact_s: &[0.0, 1.0, 2.0],
             contact_lines: &[[0, 1], [1, 2]],
+            contact_surface: &[],
+            contact_groups: &[],
         };
         let mut w = ResultsWriter::create(path, &header).unwrap();
         for k in 0..4 {

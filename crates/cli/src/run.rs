@@ -126,8 +126,12 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     );
     match i.contact() {
         Some(c) => println!(
-            "contact     {:?}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
-            c.group,
+            "contact     {}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
+            c.parts
+                .iter()
+                .map(|p| format!("{:?}", p.group))
+                .collect::<Vec<_>>()
+                .join(" + "),
             c.len(),
             c.excluded.len(),
             c.law.eps

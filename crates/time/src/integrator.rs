@@ -5,6 +5,8 @@ use stickslip_contact::{ContactSurface, SlipState};
 use stickslip_linalg::FillOrder;
 
 use crate::dynamics::{Dynamics, Load, Loads};
+use crate::history::History;
+use crate::pressure::BoundHistories;
 use crate::settings::{ImplicitSolver, MassKind, Scheme, Settings, TimeError};
 use crate::state::{Checkpoint, Energy, State, StepInfo};
 use crate::stepper::{Run, Stepper};
@@ -16,6 +18,8 @@ pub struct Integrator {
     state: State,
     stepper: Box<dyn Stepper>,
     fill_order: FillOrder,
+    /// The friction bounds' histories, where a surface's pressure changes.
+    bounds: Option<BoundHistories>,
 }
 
 impl std::fmt::Debug for Integrator {
@@ -76,7 +80,33 @@ impl Integrator {
             state,
             stepper,
             fill_order,
+            bounds: None,
         })
+    }
+
+    /// Makes each contact surface's pressure change in time: the bounds of
+    /// surface k (`ContactSurface::parts[k]`) are their built values times
+    /// `histories[k]`(t), set before each step for the time it ends at
+    /// (the friction of a step acts at its end, METHOD.md §4). Constant
+    /// and step histories change nothing after t = 0 and cost nothing.
+    /// Call it on a fresh integrator, before [`Integrator::restore`].
+    pub fn set_pressure_histories(&mut self, histories: &[History]) {
+        let Some(contact) = self.run.contact.as_mut() else {
+            return;
+        };
+        self.bounds = BoundHistories::new(contact, histories);
+        if let Some(b) = &mut self.bounds {
+            b.apply(self.state.t, contact);
+            // The initial forces are w g φ_ε(ṙ₀) with g at t = 0.
+            contact.nodal_forces(&self.state.v, &mut self.state.forces);
+        }
+    }
+
+    /// Sets the bounds for time `t`, where they change in time.
+    fn bounds_at(&mut self, t: f64) {
+        if let (Some(b), Some(c)) = (&mut self.bounds, &mut self.run.contact) {
+            b.apply(t, c);
+        }
     }
 
     /// True once t_end is reached.
@@ -90,7 +120,16 @@ impl Integrator {
     /// A failed linear solve, a stick/slip iteration that hits its cap, or a
     /// non-finite state. The state is left at the last completed step.
     pub fn step(&mut self) -> Result<StepInfo, TimeError> {
-        self.stepper.step(&self.run, &mut self.state)
+        if self.bounds.is_none() {
+            return self.stepper.step(&self.run, &mut self.state);
+        }
+        let t_new = self.state.next_step(&self.run.settings).1;
+        self.bounds_at(t_new);
+        let result = self.stepper.step(&self.run, &mut self.state);
+        if result.is_err() {
+            self.bounds_at(self.state.t);
+        }
+        result
     }
 
     /// Everything needed to continue this run bit-identically
@@ -114,6 +153,7 @@ impl Integrator {
         self.stepper.state_replaced();
         self.stepper.set_factorizations(c.factorizations);
         self.run.loads.at(self.state.t, &mut self.state.load);
+        self.bounds_at(self.state.t);
         Ok(())
     }
 

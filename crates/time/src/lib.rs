@@ -27,6 +27,7 @@ mod initial;
 mod integrator;
 mod newmark;
 mod nodal;
+mod pressure;
 mod settings;
 pub mod stability;
 mod state;

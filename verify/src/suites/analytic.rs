@@ -1,5 +1,6 @@
 //! Closed-form problems: the Coulomb oscillator, d'Alembert's wave, the
-//! static slab, and the patch test.
+//! static slab, and the patch test; and the checks of several surfaces and
+//! a pressure that changes (`surfaces.rs`).
 
 use std::path::Path;
 
@@ -22,6 +23,7 @@ pub fn run(root: &Path, opts: &Options, r: &mut Report) {
     wave(root, opts, r);
     static_slab(root, r);
     patch(r);
+    super::surfaces::run(root, opts, r);
 }
 
 fn coulomb_oscillator(opts: &Options, r: &mut Report) {

@@ -1,6 +1,7 @@
-//! The four suites of `verify`.
+//! The four suites of `verify` (`surfaces` runs within `analytic`).
 
 pub mod analytic;
 pub mod paper;
 pub mod rates;
 pub mod reference;
+pub mod surfaces;
