@@ -593,7 +593,9 @@ pub fn sections() -> Vec<(String, &'static [(&'static str, Kind)])> {
     let mut out = Vec::new();
     walk(ROOT, "", &mut |name, kind| match kind {
         Kind::Table(sub) => out.push((name.to_string(), *sub)),
-        Kind::Tables(sub) | Kind::OneOrTables(sub) => out.push((format!("[{name}]"), *sub)),
+        Kind::Tables(sub) => out.push((format!("[{name}]"), *sub)),
+        // Named as its single table, `[contact]`, which stays valid.
+        Kind::OneOrTables(sub) => out.push((name.to_string(), *sub)),
         _ => {}
     });
     out

@@ -127,11 +127,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     match i.contact() {
         Some(c) => println!(
             "contact     {}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
-            c.parts
-                .iter()
-                .map(|p| format!("{:?}", p.group))
-                .collect::<Vec<_>>()
-                .join(" + "),
+            c.names(),
             c.len(),
             c.excluded.len(),
             c.law.eps
@@ -344,12 +340,12 @@ fn oblique_supports(mesh: &Mesh, c: &ContactSurface) -> Option<String> {
     };
     let count = count[0] + count[1];
     Some(format!(
-        "{count} of the {} friction nodes of \"{}\" have {fixed} fixed by a [[dirichlet]] condition although the face is not normal \
+        "{count} of the {} friction nodes of {} have {fixed} fixed by a [[dirichlet]] condition although the face is not normal \
          to that axis there (up to {:.1}° off, at ({x}, {y})): friction acts along the face's tangent, but these nodes can move only along {free}, \
          so the support takes part of the friction force and the slip is the tangent's share of their motion; \
          support the contact face only where it is straight along x or y, or leave it free and let the [contact] pressure carry the normal load",
         c.len(),
-        c.group,
+        c.names(),
         off.asin().to_degrees()
     ))
 }

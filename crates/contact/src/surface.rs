@@ -390,6 +390,17 @@ impl ContactSurface {
         Ok(joined)
     }
 
+    /// The surfaces' groups for a message: `"contact"`, or `"contact" +
+    /// "support"` for several.
+    pub fn names(&self) -> String {
+        let names: Vec<String> = self
+            .parts
+            .iter()
+            .map(|p| format!("{:?}", p.group))
+            .collect();
+        names.join(" + ")
+    }
+
     /// The surface (index into [`ContactSurface::parts`]) of each node.
     pub fn part_of_nodes(&self) -> Vec<usize> {
         let mut out = vec![0; self.nodes.len()];
