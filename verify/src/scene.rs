@@ -113,7 +113,7 @@ impl PaperCase {
 
     /// The friction law's ε.
     pub fn eps(&self) -> f64 {
-        self.case.contact.as_ref().map_or(f64::NAN, |c| c.eps)
+        self.case.contact.first().map_or(f64::NAN, |c| c.eps)
     }
 
     /// True for a Heaviside end load (the H(t) runs), false for sin.

@@ -29,10 +29,13 @@ pub struct Scene {
     pub mesh: Mesh,
     /// K, M, lumped M, DOF map.
     pub model: Model,
-    /// The friction surface, if the case has one.
+    /// The friction nodes of the case's surfaces, if it has any.
     pub contact: Option<ContactSurface>,
-    /// The tractions in case order, then the body force, then the contact
-    /// pressure, each restricted to the free DOFs.
+    /// Each contact surface's pressure history, in case order
+    /// ([`Integrator::set_pressure_histories`]).
+    pub pressure_histories: Vec<TimeHistory>,
+    /// The tractions in case order, then the body force, then each contact
+    /// surface's pressure, each restricted to the free DOFs.
     pub loads: Vec<Load>,
     /// Scheme, Δt, mass, iteration, step reduction.
     pub settings: Settings,
@@ -80,12 +83,14 @@ impl Scene {
     /// cannot take), or the initial static solve failed.
     pub fn integrator(&self) -> Result<Integrator, TimeError> {
         let dynamics = Dynamics::from_model(&self.model);
-        Integrator::new(
+        let mut i = Integrator::new(
             dynamics,
             self.contact.clone(),
             self.loads.clone(),
             self.settings.clone(),
-        )
+        )?;
+        i.set_pressure_histories(&self.pressure_histories);
+        Ok(i)
     }
 
     /// The integrator, the model kept.
@@ -94,8 +99,9 @@ impl Scene {
     /// As [`Scene::integrator`], located in `case`.
     pub fn prepared(self, case: &Case) -> Result<Prepared, InputError> {
         let dynamics = Dynamics::from_model(&self.model);
-        let integrator = Integrator::new(dynamics, self.contact, self.loads, self.settings)
+        let mut integrator = Integrator::new(dynamics, self.contact, self.loads, self.settings)
             .map_err(|e| refused(case, e))?;
+        integrator.set_pressure_histories(&self.pressure_histories);
         Ok(Prepared {
             mesh: self.mesh,
             model: self.model,
@@ -110,8 +116,9 @@ impl Scene {
     pub fn running(self, case: &Case) -> Result<Running, InputError> {
         let dofs = self.model.dofs.clone();
         let dynamics = Dynamics::from_model_owned(self.model);
-        let integrator = Integrator::new(dynamics, self.contact, self.loads, self.settings)
+        let mut integrator = Integrator::new(dynamics, self.contact, self.loads, self.settings)
             .map_err(|e| refused(case, e))?;
+        integrator.set_pressure_histories(&self.pressure_histories);
         Ok(Running {
             mesh: self.mesh,
             dofs,
@@ -175,7 +182,7 @@ pub fn settings(case: &Case) -> Settings {
         }),
         iteration: case
             .contact
-            .as_ref()
+            .first()
             .map_or_else(IterationOptions::default, |c| IterationOptions {
                 remark_4_2: c.remark_4_2,
                 max_iterations: c.max_iterations,
@@ -304,11 +311,11 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
             &mut problems,
         );
     }
-    if let Some(c) = &case.contact {
+    for (i, c) in case.contact.iter().enumerate() {
         groups_ok &= check_group(
             &mesh,
             case,
-            "contact.group",
+            &case.contact_key(i, "group"),
             &c.group,
             Some(1),
             "the contact surface",
@@ -440,34 +447,9 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
             history: TimeHistory::Constant,
         });
     }
-    let mut contact = None;
-    if let Some(c) = &case.contact {
-        // The prescribed normal traction on Γ_C is a load like any other,
-        // present before t = 0 (it makes the initial static state, METHOD.md §3).
-        full.iter_mut().for_each(|x| *x = 0.0);
-        match traction_load(&mesh, &c.group, Traction::Pressure(c.pressure), &mut full) {
-            Ok(()) => loads.push(Load {
-                vector: restrict(&full),
-                history: TimeHistory::Constant,
-            }),
-            Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
-        }
-        match ContactSurface::from_group(&mesh, &model.dofs, &c.group, c.pressure, c.mu, c.eps) {
-            // Every node's tangential DOF held: the friction the case asks
-            // for could act nowhere, and a run without it is not the run
-            // the case describes.
-            Ok(s) if s.is_empty() => problems.push(format!(
-                "{}[contact]: no node of group \"{}\" can slide: [[dirichlet]] conditions hold the tangential \
-                 motion of all its {} nodes, so friction would act nowhere; remove the [[dirichlet]] on the \
-                 contact surface's tangential direction, or remove [contact] for a run without friction",
-                case.at("contact.group"),
-                c.group,
-                s.excluded.len()
-            )),
-            Ok(s) => contact = Some(s),
-            Err(e) => problems.push(format!("{}[contact]: {e}", case.at("contact.group"))),
-        }
-    }
+    let surfaces =
+        crate::surfaces::surfaces(case, &mesh, &model.dofs, &restrict, history, &mut problems);
+    loads.extend(surfaces.loads);
     if !problems.is_empty() {
         return Err(InputError(listed(problems)));
     }
@@ -476,7 +458,8 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
     Ok(Scene {
         mesh,
         model,
-        contact,
+        contact: surfaces.contact,
+        pressure_histories: surfaces.histories,
         loads,
         settings,
     })

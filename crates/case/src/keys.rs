@@ -248,14 +248,20 @@ pub(crate) fn check_table(
                 "a table",
                 &format!("write it as [{name}] followed by its keys, or {{ key = value }}"),
             ),
-            (Kind::Tables(sub), Item::ArrayOfTables(a)) => {
+            (Kind::OneOrTables(sub), Item::Table(t)) => {
+                check_table(t, path, sub, report, removals, typed)
+            }
+            (Kind::OneOrTables(sub), Item::Value(Value::InlineTable(t))) => {
+                check_table(t, path, sub, report, removals, typed)
+            }
+            (Kind::Tables(sub) | Kind::OneOrTables(sub), Item::ArrayOfTables(a)) => {
                 for (i, t) in a.iter().enumerate() {
                     path.push(Seg::Index(i));
                     check_table(t, path, sub, report, removals, typed);
                     path.pop();
                 }
             }
-            (Kind::Tables(sub), Item::Value(Value::Array(a)))
+            (Kind::Tables(sub) | Kind::OneOrTables(sub), Item::Value(Value::Array(a)))
                 if a.iter().all(|v| matches!(v, Value::InlineTable(_))) =>
             {
                 for (i, v) in a.iter().enumerate() {
@@ -266,6 +272,10 @@ pub(crate) fn check_table(
                     }
                 }
             }
+            (Kind::OneOrTables(_), _) => wrong(
+                "a table or a list of tables",
+                &format!("write it as [{name}] followed by its keys, or one [[{name}]] section per entry"),
+            ),
             (Kind::Tables(_), _) => wrong(
                 "a list of tables",
                 &format!("write one [[{name}]] section per entry"),
@@ -286,7 +296,7 @@ fn placeholder(kind: &Kind) -> Option<Value> {
         Kind::Bool => Value::from(false),
         Kind::Vec2 => Value::Array(toml_edit::Array::from_iter([0.0, 0.0])),
         Kind::StrList => Value::Array(toml_edit::Array::new()),
-        Kind::Table(_) | Kind::Tables(_) | Kind::Any => return None,
+        Kind::Table(_) | Kind::Tables(_) | Kind::OneOrTables(_) | Kind::Any => return None,
     })
 }
 

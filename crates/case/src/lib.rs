@@ -28,6 +28,7 @@ pub mod pilot;
 mod restart;
 pub mod schema;
 mod set;
+mod surfaces;
 
 pub use build::{assemble, prepare, settings, Prepared, Running, Scene};
 pub use error::{listed, InputError, SHOWN};
@@ -36,6 +37,6 @@ pub use method::{Method, PAPER_REDUCTION};
 pub use restart::restart_changes;
 pub use schema::{
     Case, ContactSection, DirichletSection, Fields, History, Hypothesis, MassKind, MaterialSection,
-    MeshSection, OutputSection, Scheme, StickReduction, TimeSection, TractionSection,
-    DEFAULT_FRAMES,
+    MeshSection, OutputSection, Profile, Scheme, StickReduction, Surfaces, TimeSection,
+    TractionSection, DEFAULT_FRAMES,
 };

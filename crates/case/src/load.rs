@@ -372,20 +372,65 @@ fn complete(
     }
 
     // [contact]
-    if let Some(c) = &case.contact {
+    for (i, c) in case.contact.iter().enumerate() {
+        let key = |k: &str| crate::schema::contact_key_in(spans.keys(), i, k);
         let (p, mu, eps) = (c.pressure, c.mu, c.eps);
-        check(p >= 0.0 && p.is_finite(), "contact.pressure", format!("contact.pressure = {p} must be >= 0 and finite (it presses the body onto the surface; g = mu * pressure)"));
+        check(p >= 0.0 && p.is_finite(), &key("pressure"), format!("contact.pressure = {p} must be >= 0 and finite (it presses the body onto the surface; g = mu * pressure)"));
         check(
             mu >= 0.0 && mu.is_finite(),
-            "contact.mu",
+            &key("mu"),
             format!("contact.mu = {mu} must be >= 0 and finite; use 0 for frictionless contact"),
         );
-        check(eps > 0.0 && eps.is_finite(), "contact.eps", format!("contact.eps = {eps} must be > 0 and finite (the friction law's regularization; the paper uses 1e-4 to 1)"));
+        check(eps > 0.0 && eps.is_finite(), &key("eps"), format!("contact.eps = {eps} must be > 0 and finite (the friction law's regularization; the paper uses 1e-4 to 1)"));
         check(
             c.max_iterations > 0,
-            "contact.max_iterations",
+            &key("max_iterations"),
             "contact.max_iterations must be >= 1 (default 100)".into(),
         );
+        if let History::Table(p) = &c.pressure_history {
+            let increasing = p.windows(2).all(|w| w[1][0] > w[0][0]);
+            check(
+                !p.is_empty() && increasing,
+                &key("pressure_history"),
+                "contact.pressure_history: the table needs at least one [t, f] pair and strictly increasing times; e.g. { table = [[0.0, 1.0], [0.5, 0.2]] }".into(),
+            );
+        }
+        if let Some(profile) = &c.pressure_profile {
+            let rows = &profile.table;
+            let increasing = rows.windows(2).all(|w| w[1][0] > w[0][0]);
+            check(
+                !rows.is_empty() && increasing && rows[0][0] >= 0.0,
+                &key("pressure_profile"),
+                "contact.pressure_profile: the table needs at least one [s, factor] row, s >= 0 and strictly increasing along the surface (s as in /contact/s); e.g. { table = [[0.0, 1.0], [2.0, 0.5]] }".into(),
+            );
+            if let Some(r) = rows.iter().find(|r| !(r[1] >= 0.0 && r[1].is_finite())) {
+                check(
+                    false,
+                    &key("pressure_profile"),
+                    format!("contact.pressure_profile: factor {} at s = {} must be >= 0 and finite (a negative factor would pull the surface off; write 0 where it carries no pressure)", r[1], r[0]),
+                );
+            }
+        }
+        if i > 0 {
+            let first = &case.contact[0];
+            check(
+                eps.to_bits() == first.eps.to_bits(),
+                &key("eps"),
+                format!("contact.eps = {eps} differs from the first surface's {}: all [[contact]] surfaces share one regularization ε; give them the same eps", first.eps),
+            );
+            check(
+                c.remark_4_2 == first.remark_4_2 && c.max_iterations == first.max_iterations,
+                &key("group"),
+                "contact: remark_4_2 and max_iterations set the run's one stick/slip iteration; give them the same values on every [[contact]] (or on none)".into(),
+            );
+            if let Some(j) = case.contact[..i].iter().position(|o| o.group == c.group) {
+                check(
+                    false,
+                    &key("group"),
+                    format!("contact: group {:?} is already contact surface {} ; a node carries the friction of one surface only; give each [[contact]] its own group", c.group, j + 1),
+                );
+            }
+        }
     }
 
     // [time]
@@ -696,7 +741,7 @@ t_end = 0.5
             History::Step,
             "DESIGN.md: history defaults to step"
         );
-        let k = c.contact.unwrap();
+        let k = &c.contact[0];
         assert!(k.remark_4_2);
         assert_eq!(k.max_iterations, 100);
         assert_eq!(c.time.scheme, Scheme::CentralDifference);
@@ -915,7 +960,7 @@ t_end = 0.5
         .unwrap();
         assert_eq!(c.time.dt, 5e-4);
         assert_eq!(c.time.scheme, Scheme::Newmark);
-        assert!(!c.contact.as_ref().unwrap().remark_4_2);
+        assert!(!c.contact[0].remark_4_2);
         assert_eq!(c.dirichlet[0].uy, Some(0.5));
         assert_eq!(c.output.fields(), crate::schema::Fields::Every(10));
         // The source is the case as run, and still carries the user's comment.

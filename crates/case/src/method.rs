@@ -101,7 +101,7 @@ impl Method {
         }
         c.time.stick_reduction = (self == Method::TrapezoidalReduced)
             .then(|| case.time.stick_reduction.unwrap_or(PAPER_REDUCTION));
-        if let Some(contact) = &mut c.contact {
+        for contact in c.contact.iter_mut() {
             contact.eps = eps;
         }
         c

@@ -37,6 +37,8 @@ pub enum Kind {
     Table(&'static [(&'static str, Kind)]),
     /// A list of tables with these keys (`[[name]]`).
     Tables(&'static [(&'static str, Kind)]),
+    /// One table (`[name]`) or a list of them (`[[name]]`) with these keys.
+    OneOrTables(&'static [(&'static str, Kind)]),
     /// Anything (checked by serde: `history`).
     Any,
 }
@@ -139,8 +141,10 @@ section! {
         "traction" traction: Vec<TractionSection>,
         /// Constant body force per unit volume (bx, by), if any.
         "body_force" body_force: Option<[f64; 2]>,
-        /// The frictional contact surface, if any.
-        "contact" contact: Option<ContactSection>,
+        /// The frictional contact surfaces: `[contact]` (one) or
+        /// `[[contact]]` (several); empty without friction.
+        #[serde(default)]
+        "contact" contact: Surfaces,
         /// The state at t = 0.
         #[serde(default)]
         "initial" initial: InitialSection,
@@ -170,6 +174,71 @@ impl Case {
             Some(l) => format!("{l}: "),
             None => format!("{}: ", self.path.display()),
         }
+    }
+
+    /// The dotted key of contact surface `i`'s `key`: `contact.KEY` for a
+    /// single `[contact]` table, `contact.I.KEY` in a list of `[[contact]]`.
+    pub fn contact_key(&self, i: usize, key: &str) -> String {
+        contact_key_in(self.locations.keys(), i, key)
+    }
+}
+
+/// [`Case::contact_key`] among the dotted keys `keys` of a case's text.
+pub(crate) fn contact_key_in<'a>(
+    mut keys: impl Iterator<Item = &'a String>,
+    i: usize,
+    key: &str,
+) -> String {
+    let listed = format!("contact.{i}.");
+    if keys.any(|k| k.starts_with(&listed)) {
+        format!("{listed}{key}")
+    } else {
+        format!("contact.{key}")
+    }
+}
+
+/// The contact surfaces of a case, in the order given: `[contact]` is
+/// one, `[[contact]]` several, none without friction.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Surfaces(pub Vec<ContactSection>);
+
+impl std::ops::Deref for Surfaces {
+    type Target = Vec<ContactSection>;
+    fn deref(&self) -> &Vec<ContactSection> {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for Surfaces {
+    fn deref_mut(&mut self) -> &mut Vec<ContactSection> {
+        &mut self.0
+    }
+}
+
+impl Schema for Surfaces {
+    const KIND: Kind = Kind::OneOrTables(ContactSection::KEYS);
+}
+
+/// `[contact]` as one surface, `[[contact]]` as a list (serde's own errors
+/// kept: a history or a key is reported as for any table).
+impl<'de> Deserialize<'de> for Surfaces {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Surfaces, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = Surfaces;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a [contact] table or [[contact]] tables")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Surfaces, A::Error> {
+                let one =
+                    ContactSection::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(Surfaces(vec![one]))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Surfaces, A::Error> {
+                Vec::deserialize(serde::de::value::SeqAccessDeserializer::new(seq)).map(Surfaces)
+            }
+        }
+        d.deserialize_any(Visitor)
     }
 }
 
@@ -345,6 +414,22 @@ fn default_max_iterations() -> usize {
     100
 }
 
+fn constant_history() -> History {
+    History::Constant
+}
+
+section! {
+    /// `pressure_profile = { table = [[s, factor], ..] }`: the pressure's
+    /// factor along the surface, linear between rows.
+    pub struct Profile {
+        /// Rows [s, factor], s increasing from the surface's start.
+        #[serde(deserialize_with = "table_points")]
+        "table" table: Vec<[f64; 2]>,
+    }
+}
+
+kind!(Kind::Any => Vec<[f64; 2]>);
+
 section! {
     /// `[contact]`: the regularized Coulomb friction surface (METHOD.md).
     pub struct ContactSection {
@@ -354,8 +439,14 @@ section! {
         "pressure" pressure: f64,
         /// Coulomb coefficient μ.
         "mu" mu: f64,
-        /// Regularization ε of the friction law.
+        /// Regularization ε of the friction law (one for all surfaces).
         "eps" eps: f64,
+        /// Time factor of the pressure (the normal load and g = μ p);
+        /// default `"constant"`, today's pressure present before t = 0.
+        #[serde(default = "constant_history")]
+        "pressure_history" pressure_history: History,
+        /// Factor of the pressure along the surface's arc length s.
+        "pressure_profile" pressure_profile: Option<Profile>,
         /// The paper's Remark 4.2 rule in the iteration (default true).
         #[serde(default = "default_remark_4_2")]
         "remark_4_2" remark_4_2: bool,
@@ -594,7 +685,7 @@ fn walk(keys: &'static [(&'static str, Kind)], prefix: &str, visit: &mut dyn FnM
             format!("{prefix}.{key}")
         };
         visit(&name, kind);
-        if let Kind::Table(sub) | Kind::Tables(sub) = kind {
+        if let Kind::Table(sub) | Kind::Tables(sub) | Kind::OneOrTables(sub) = kind {
             walk(sub, &name, visit);
         }
     }
@@ -608,6 +699,8 @@ pub fn sections() -> Vec<(String, &'static [(&'static str, Kind)])> {
     walk(ROOT, "", &mut |name, kind| match kind {
         Kind::Table(sub) => out.push((name.to_string(), *sub)),
         Kind::Tables(sub) => out.push((format!("[{name}]"), *sub)),
+        // Named as its single table, `[contact]`, which stays valid.
+        Kind::OneOrTables(sub) => out.push((name.to_string(), *sub)),
         _ => {}
     });
     out
@@ -619,7 +712,10 @@ pub fn sections() -> Vec<(String, &'static [(&'static str, Kind)])> {
 pub fn key_paths() -> Vec<String> {
     let mut out = Vec::new();
     walk(ROOT, "", &mut |name, kind| {
-        if !matches!(kind, Kind::Table(_) | Kind::Tables(_)) {
+        if !matches!(
+            kind,
+            Kind::Table(_) | Kind::Tables(_) | Kind::OneOrTables(_)
+        ) {
             out.push(name.to_string());
         }
     });

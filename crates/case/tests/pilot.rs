@@ -62,7 +62,7 @@ fn a_method_configures_the_case() {
         (c.time.dt, c.time.mass, c.time.stick_reduction),
         (2e-3, None, None)
     );
-    assert_eq!(c.contact.as_ref().unwrap().eps, 1e-2);
+    assert_eq!(c.contact[0].eps, 1e-2);
     assert_eq!(c.mesh.file, mesh);
     let r = Method::TrapezoidalReduced.configure(&case, &mesh, 5e-3, 1e-4);
     assert_eq!((r.time.beta, r.time.gamma), (0.25, 0.5));

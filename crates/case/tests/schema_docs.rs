@@ -57,7 +57,8 @@ fn keys_of(table: &toml::Table, schema: &[(&str, Kind)], prefix: &str, out: &mut
         let kind = schema.iter().find(|(k, _)| k == key).map(|(_, kind)| kind);
         match (kind, value) {
             (Some(Kind::Table(sub)), toml::Value::Table(t)) => keys_of(t, sub, &name, out),
-            (Some(Kind::Tables(sub)), toml::Value::Array(a)) => {
+            (Some(Kind::OneOrTables(sub)), toml::Value::Table(t)) => keys_of(t, sub, &name, out),
+            (Some(Kind::Tables(sub) | Kind::OneOrTables(sub)), toml::Value::Array(a)) => {
                 for t in a.iter().filter_map(toml::Value::as_table) {
                     keys_of(t, sub, &name, out);
                 }

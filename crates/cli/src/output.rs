@@ -51,6 +51,12 @@ pub struct Header<'a> {
     /// nodes (indices into `contact_nodes`, the body on the left), for
     /// the viewers' line cells (`/contact/lines`).
     pub contact_lines: &'a [[usize; 2]],
+    /// The surface of each contact node, an index into `contact_groups`
+    /// (`/contact/surface`; empty: not written).
+    pub contact_surface: &'a [usize],
+    /// The contact surfaces' groups in case order (`/contact` attribute
+    /// `groups`).
+    pub contact_groups: &'a [String],
 }
 
 /// One output step. Vectors are full, `2 * n_nodes` long, interleaved
@@ -488,6 +494,39 @@ pub(crate) const SLOTS: [&str; 2] = ["a", "b"];
 /// Order of `/checkpoint/energy`.
 const ENERGY_ORDER: &str = "kinetic, strain, external_work, dissipated, total, balance, damped";
 
+/// `/contact/surface` and the attribute `groups`: which surface of the
+/// case each contact node is on.
+fn write_surfaces(c: &Group, header: &Header) -> Result<()> {
+    if header.contact_surface.is_empty() {
+        return Ok(());
+    }
+    ensure!(
+        header.contact_surface.len() == header.contact_nodes.len()
+            && header
+                .contact_surface
+                .iter()
+                .all(|&k| k < header.contact_groups.len()),
+        "contact_surface has {} entries for {} contact nodes and {} surfaces",
+        header.contact_surface.len(),
+        header.contact_nodes.len(),
+        header.contact_groups.len()
+    );
+    c.new_dataset_builder()
+        .with_data(&index_array(header.contact_surface.iter().copied()))
+        .create("surface")?;
+    let groups: Vec<VarLenUnicode> = header
+        .contact_groups
+        .iter()
+        .map(|g| g.parse::<VarLenUnicode>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| anyhow::anyhow!("a contact group name: {e}"))?;
+    c.new_attr::<VarLenUnicode>()
+        .shape(groups.len())
+        .create("groups")?
+        .write(&groups)?;
+    Ok(())
+}
+
 fn index_array(v: impl ExactSizeIterator<Item = usize>) -> Array1<i64> {
     v.map(|i| i as i64).collect()
 }
@@ -575,6 +614,7 @@ impl ResultsWriter {
                 header.contact_lines[i][k] as i64
             });
             c.new_dataset_builder().with_data(&lines).create("lines")?;
+            write_surfaces(&c, header)?;
             Some(ContactSeries {
                 friction_stress: series_2d::<f64>(&c, "friction_stress", n_c, level)?,
                 slip_velocity: series_2d::<f64>(&c, "slip_velocity", n_c, level)?,
@@ -1211,6 +1251,8 @@ pub(crate) mod tests {
             contact_nodes: &[0, 1, 2],
             contact_s: &[0.0, 1.0, 2.0],
             contact_lines: &[[0, 1], [1, 2]],
+            contact_surface: &[0, 0, 1],
+            contact_groups: &["bottom".to_string(), "top".to_string()],
         };
         // Compressed, so that the filters' path is the one read back (the
         // default is none: `default_output_is_unfiltered`).
@@ -1279,6 +1321,8 @@ pub(crate) mod tests {
             contact_nodes: nodes,
             contact_s: s,
             contact_lines: lines,
+            contact_surface: &[],
+            contact_groups: &[],
         }
     }
 
@@ -1302,6 +1346,21 @@ pub(crate) mod tests {
         };
         assert_eq!(attr_s("program"), "stickslip");
         assert_eq!(attr_s("case"), "title = \"tiny\"\n");
+        // Each contact node's surface, and the surfaces' groups, as given.
+        let surface = f
+            .dataset("contact/surface")
+            .unwrap()
+            .read_raw::<i64>()
+            .unwrap();
+        assert_eq!(surface, [0, 0, 1]);
+        let groups = f.group("contact").unwrap().attr("groups").unwrap();
+        let groups: Vec<String> = groups
+            .read_raw::<VarLenUnicode>()
+            .unwrap()
+            .iter()
+            .map(|g| g.as_str().to_string())
+            .collect();
+        assert_eq!(groups, ["bottom", "top"]);
         assert!(f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
         assert!(
             f.attr("failure").is_err(),

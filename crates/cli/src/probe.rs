@@ -656,13 +656,28 @@ fn order_along(
 }
 
 /// The contact group of the case stored in the file, if any.
-fn contact_group(f: &File) -> Option<String> {
-    let case = crate::output::text_attr(f, "case").ok()?;
-    let doc: toml::Table = case.parse().ok()?;
-    doc.get("contact")?
-        .get("group")?
-        .as_str()
-        .map(str::to_string)
+/// The groups of the file's contact surfaces: `/contact`'s attribute
+/// `groups`, or in a file written before it the case's `[contact]` group.
+fn contact_groups(f: &File) -> Vec<String> {
+    if let Ok(groups) = f
+        .group("contact")
+        .and_then(|c| c.attr("groups"))
+        .and_then(|a| a.read_raw::<hdf5::types::VarLenUnicode>())
+    {
+        return groups.iter().map(|g| g.as_str().to_string()).collect();
+    }
+    let Some(doc) = crate::output::text_attr(f, "case")
+        .ok()
+        .and_then(|c| c.parse::<toml::Table>().ok())
+    else {
+        return Vec::new();
+    };
+    let group = |t: &toml::Value| t.get("group")?.as_str().map(str::to_string);
+    match doc.get("contact") {
+        Some(toml::Value::Array(a)) => a.iter().filter_map(group).collect(),
+        Some(t) => group(t).into_iter().collect(),
+        None => Vec::new(),
+    }
 }
 
 /// `--along GROUP --times T1,..`: `field` at the nodes of `group`, in order
@@ -715,7 +730,7 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
     let (mut order, mut s) = order_along(&name, group, &nodes, &cells, &members)?;
 
     let contact_field = field.on_contact();
-    let is_contact_group = contact_group(&f).as_deref() == Some(group);
+    let is_contact_group = contact_groups(&f).iter().any(|g| g == group);
     let contact: Option<(Vec<i64>, Vec<f64>)> = if contact_field || is_contact_group {
         let c = f
             .dataset("contact/nodes")
@@ -942,6 +957,8 @@ mod tests {
             contact_nodes: &[0, 1, 2],
             contact_s: &[0.0, 1.0, 2.0],
             contact_lines: &[[0, 1], [1, 2]],
+            contact_surface: &[],
+            contact_groups: &[],
         };
         let mut w = ResultsWriter::create(path, &header).unwrap();
         for k in 0..4 {

@@ -142,8 +142,8 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     }
     match i.contact() {
         Some(c) => println!(
-            "contact     {:?}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
-            c.group,
+            "contact     {}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
+            c.names(),
             c.len(),
             c.excluded.len(),
             c.law.eps
@@ -338,11 +338,15 @@ pub(crate) fn friction_off(case: &Case, i: &Integrator) -> Option<String> {
     if i.friction() {
         return None;
     }
-    Some(match &case.contact {
-        None => "the case has no [contact]".to_string(),
-        Some(c) if c.mu == 0.0 => "contact.mu = 0".to_string(),
-        Some(c) if c.pressure == 0.0 => "contact.pressure = 0".to_string(),
-        Some(_) => "no node of the contact surface carries friction (w g = 0)".to_string(),
+    let surfaces = &case.contact;
+    Some(if surfaces.is_empty() {
+        "the case has no [contact]".to_string()
+    } else if surfaces.iter().all(|c| c.mu == 0.0) {
+        "contact.mu = 0".to_string()
+    } else if surfaces.iter().all(|c| c.pressure == 0.0) {
+        "contact.pressure = 0".to_string()
+    } else {
+        "no node of the contact surfaces carries friction (w g = 0)".to_string()
     })
 }
 
@@ -435,12 +439,12 @@ fn oblique_supports(mesh: &Mesh, c: &ContactSurface) -> Option<String> {
     };
     let count = count[0] + count[1];
     Some(format!(
-        "{count} of the {} friction nodes of \"{}\" have {fixed} fixed by a [[dirichlet]] condition although the face is not normal \
+        "{count} of the {} friction nodes of {} have {fixed} fixed by a [[dirichlet]] condition although the face is not normal \
          to that axis there (up to {:.1}° off, at ({x}, {y})): friction acts along the face's tangent, but these nodes can move only along {free}, \
          so the support takes part of the friction force and the slip is the tangent's share of their motion; \
          support the contact face only where it is straight along x or y, or leave it free and let the [contact] pressure carry the normal load",
         c.len(),
-        c.group,
+        c.names(),
         off.asin().to_degrees()
     ))
 }

@@ -41,9 +41,20 @@ pub(crate) fn fresh(
         .contact()
         .map(|c| c.nodes.iter().map(|n| (n.node, n.s)).unzip())
         .unwrap_or_default();
-    let contact_lines = integrator
+    let contact_lines: Vec<[usize; 2]> = integrator
         .contact()
-        .map(|c| crate::views::contact_lines(mesh, &c.group, &contact_nodes))
+        .into_iter()
+        .flat_map(|c| &c.parts)
+        .flat_map(|p| crate::views::contact_lines(mesh, &p.group, &contact_nodes))
+        .collect();
+    let (contact_surface, contact_groups): (Vec<usize>, Vec<String>) = integrator
+        .contact()
+        .map(|c| {
+            (
+                c.part_of_nodes(),
+                c.parts.iter().map(|p| p.group.clone()).collect(),
+            )
+        })
         .unwrap_or_default();
     let header = Header {
         case_source: &case.source,
@@ -51,6 +62,8 @@ pub(crate) fn fresh(
         contact_nodes: &contact_nodes,
         contact_s: &contact_s,
         contact_lines: &contact_lines,
+        contact_surface: &contact_surface,
+        contact_groups: &contact_groups,
     };
     let mut writer = ResultsWriter::create_with(
         out,

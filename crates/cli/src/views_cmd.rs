@@ -104,6 +104,8 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         .len()
         .min(shape("displacement")?.first().copied().unwrap_or(0));
     let (contact, note) = contact_line(&f, out)?;
+    // Files written before it have no /contact/surface: one surface.
+    let surface = f.link_exists("contact/surface");
     let stress = stress_name(out, rows);
     drop(f);
 
@@ -139,10 +141,13 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
     let line = contact.filter(|c| !c.lines.is_empty());
     let contact_path = crate::xdmf::contact_xdmf_path(out);
     match &line {
-        Some(c) => {
-            crate::xdmf::write_contact_xdmf(out, &times[..rows], c.points.len(), c.lines.len())
-                .with_context(|| format!("cannot write {}", contact_path.display()))?
-        }
+        Some(c) => crate::xdmf::write_contact_xdmf(
+            out,
+            &times[..rows],
+            c.points.len(),
+            (c.lines.len(), surface),
+        )
+        .with_context(|| format!("cannot write {}", contact_path.display()))?,
         // One of an earlier results file would list other records.
         None => {
             let _ = std::fs::remove_file(&contact_path);

@@ -80,10 +80,17 @@ pub fn xdmf_text(h5_name: &str, info: &XdmfInfo) -> String {
 }
 
 /// The XML of `OUT.contact.xdmf` for the results file named `h5_name`,
-/// whose contact line has `n_c` nodes and `n_lines` segments.
-pub fn contact_text(h5_name: &str, times: &[f64], n_c: usize, n_lines: usize) -> String {
+/// whose contact line has `n_c` nodes and `n_lines` segments, and each
+/// node's surface where the file has `/contact/surface` (`surface`).
+pub fn contact_text(
+    h5_name: &str,
+    times: &[f64],
+    n_c: usize,
+    n_lines: usize,
+    surface: bool,
+) -> String {
     let mut x = Vec::with_capacity(1024 + times.len() * 1400);
-    write_contact(&mut x, h5_name, times, (n_c, n_lines)).expect("writing to memory");
+    write_contact(&mut x, h5_name, times, (n_c, n_lines, surface)).expect("writing to memory");
     String::from_utf8(x).expect("the XML is UTF-8")
 }
 
@@ -190,7 +197,7 @@ fn write_contact(
     x: &mut impl Write,
     h5_name: &str,
     times: &[f64],
-    (n_c, n_lines): (usize, usize),
+    (n_c, n_lines, surface): (usize, usize, bool),
 ) -> std::io::Result<()> {
     let h5 = xml_escape(h5_name);
     let views = xml_escape(&views_name(h5_name));
@@ -205,6 +212,10 @@ fn write_contact(
         mesh(x, ("Polyline", n_lines, 2), &lines, n_c, &points)?;
         let s = format!("{h5}:/contact/s");
         attribute(x, "s", "Scalar", &dims, ("Float", 8), &s)?;
+        if surface {
+            let path = format!("{h5}:/contact/surface");
+            attribute(x, "surface", "Scalar", &dims, ("Int", 8), &path)?;
+        }
         for (name, small) in CONTACT_FIELDS {
             let number = if small { ("Int", 1) } else { ("Float", 8) };
             let path = format!("{views}:/contact/{name}/{k}");
@@ -245,12 +256,12 @@ pub fn write_contact_xdmf(
     out: &Path,
     times: &[f64],
     n_c: usize,
-    n_lines: usize,
+    (n_lines, surface): (usize, bool),
 ) -> std::io::Result<()> {
     let name = crate::views::file_name(out)
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.to_string()))?;
     replace(&contact_xdmf_path(out), |w| {
-        write_contact(w, name, times, (n_c, n_lines))
+        write_contact(w, name, times, (n_c, n_lines, surface))
     })
 }
 
@@ -325,7 +336,7 @@ mod tests {
 
     #[test]
     fn the_contact_file_has_lines_and_the_friction_fields() {
-        let x = contact_text("slab.h5", &[0.0, 0.25], 16, 15);
+        let x = contact_text("slab.h5", &[0.0, 0.25], 16, 15, false);
         assert_eq!(count(&x, "GridType=\"Uniform\""), 2);
         assert_eq!(
             count(
@@ -341,6 +352,17 @@ mod tests {
             "NumberType=\"Int\" Precision=\"1\" Format=\"HDF\">slab.views.h5:/contact/state/0<"
         ));
         assert_eq!(count(&x, "<DataItem"), count(&x, "</DataItem>"));
+        assert_eq!(count(&x, "/contact/surface<"), 0);
+        // With /contact/surface, each record names it once, as 64-bit ints.
+        let x = contact_text("slab.h5", &[0.0, 0.25], 16, 15, true);
+        assert_eq!(
+            count(
+                &x,
+                "NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">slab.h5:/contact/surface<"
+            ),
+            2
+        );
+        assert_eq!(count(&x, "<DataItem"), count(&x, "</DataItem>"));
     }
 
     #[test]
@@ -350,14 +372,14 @@ mod tests {
         let times = [0.0, 0.25, 0.5];
         let out = dir.join("slab.h5");
         write_xdmf(&out, &info(&times)).unwrap();
-        write_contact_xdmf(&out, &times, 16, 15).unwrap();
+        write_contact_xdmf(&out, &times, 16, (15, false)).unwrap();
         assert_eq!(
             std::fs::read_to_string(dir.join("slab.xdmf")).unwrap(),
             xdmf_text("slab.h5", &info(&times))
         );
         assert_eq!(
             std::fs::read_to_string(dir.join("slab.contact.xdmf")).unwrap(),
-            contact_text("slab.h5", &times, 16, 15)
+            contact_text("slab.h5", &times, 16, 15, false)
         );
         assert!(!dir.join("slab.xdmf.part").exists());
         assert!(!dir.join("slab.contact.xdmf.part").exists());

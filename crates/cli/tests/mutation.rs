@@ -398,7 +398,7 @@ fn broken_promises(c: &Case) -> Vec<String> {
         }
     }
     numbers.extend(c.body_force.iter().flatten().map(|&x| ("body_force", x)));
-    if let Some(ct) = &c.contact {
+    for ct in c.contact.iter() {
         numbers.extend([
             ("contact.pressure", ct.pressure),
             ("contact.mu", ct.mu),
@@ -425,7 +425,7 @@ fn broken_promises(c: &Case) -> Vec<String> {
     let m = &c.material;
     promise(m.e > 0.0 && m.rho > 0.0, "E and rho must be > 0");
     promise(m.nu > -1.0 && m.nu < 0.5, "nu must lie in (-1, 0.5)");
-    if let Some(ct) = &c.contact {
+    for ct in c.contact.iter() {
         promise(ct.pressure >= 0.0, "contact.pressure must be >= 0");
         promise(ct.eps > 0.0, "contact.eps must be > 0");
     }
@@ -683,7 +683,7 @@ fn the_checks_find_broken_promises() {
                 omega: f64::INFINITY,
             }
         },
-        |c| c.contact.as_mut().unwrap().eps = 0.0,
+        |c| c.contact[0].eps = 0.0,
         |c| {
             c.mesh.file.set_extension("absent");
         },

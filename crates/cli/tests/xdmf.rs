@@ -101,6 +101,9 @@ def expected(h5, part):
         n_c = len(contact)
         arrays = {v: f["contact/" + v][:][rows] for v in ["friction_stress", "slip_velocity", "state"]}
         arrays["s"] = np.broadcast_to(f["contact/s"][:], (len(time), n_c))
+        if "contact/surface" in f:
+            # Each node's surface, as s: one array shown at every record.
+            arrays["surface"] = np.broadcast_to(f["contact/surface"][:], (len(time), n_c))
         # /contact/nodes follows the straight contact face node by node, and
         # only its end node is held: each segment joins two neighbours.
         lines = np.array([[i, i + 1] for i in range(n_c - 1)])
@@ -173,7 +176,8 @@ fn python(script: &str, args: &[&Path]) -> String {
 fn oks(tag: &str, records: usize) -> [String; 2] {
     [
         format!("ok {tag} body: {records} records, 7 arrays, 85 points"),
-        format!("ok {tag} contact: {records} records, 4 arrays, 16 points"),
+        // s, surface and the three friction fields.
+        format!("ok {tag} contact: {records} records, 5 arrays, 16 points"),
     ]
 }
 

@@ -30,4 +30,4 @@ pub use iteration::{iterate, IterationFailure, IterationOptions, IterationReport
 pub use law::{FrictionLaw, SlipState};
 pub use ledger::stick_events;
 pub use nodal::{DiagonalStep, NodalClosedForm};
-pub use surface::{ContactError, ContactNode, ContactSurface};
+pub use surface::{ContactError, ContactNode, ContactSurface, SurfacePart};

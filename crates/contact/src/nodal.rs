@@ -37,8 +37,9 @@ struct Node {
 /// for the last D.
 #[derive(Clone, Debug, Default)]
 pub struct NodalClosedForm {
-    /// The bits of the scale the constants are for (None: not formed).
-    scale: Option<u64>,
+    /// The bits of the scale and the surface's bounds revision the
+    /// constants are for (None: not formed).
+    scale: Option<(u64, u64)>,
     eps: f64,
     inv_eps: f64,
     nodes: Vec<Node>,
@@ -49,9 +50,11 @@ pub struct NodalClosedForm {
 
 impl NodalClosedForm {
     /// Forms the constants for D = `mass`·`scale` (`mass` per free DOF)
-    /// unless they are formed for this scale already.
+    /// unless they are formed for this scale and these bounds already (a
+    /// bound that changes in time forms them again at each change only).
     pub fn prepare(&mut self, surface: &ContactSurface, mass: &[f64], scale: f64) {
-        if self.scale == Some(scale.to_bits()) && self.nodes.len() == surface.nodes.len() {
+        let key = (scale.to_bits(), surface.revision);
+        if self.scale == Some(key) && self.nodes.len() == surface.nodes.len() {
             return;
         }
         let law = surface.law;
@@ -81,7 +84,7 @@ impl NodalClosedForm {
                 stuck: law.stuck_factor(c),
             });
         }
-        self.scale = Some(scale.to_bits());
+        self.scale = Some(key);
     }
 
     /// The contact nodes' free DOFs, node by node: the k-th is the one

@@ -20,6 +20,20 @@ pub enum ContactError {
     /// A parameter out of range.
     #[error("contact: {0}")]
     Parameter(String),
+    /// A node on two surfaces.
+    #[error(
+        "node {node} is on contact surfaces {first:?} and {second:?}: a node carries the friction \
+         of one surface only; make the groups disjoint (end one line a node short, or merge them \
+         into one group with one pressure and μ)"
+    )]
+    Overlap {
+        /// Mesh node index (0-based).
+        node: usize,
+        /// The first surface's group.
+        first: String,
+        /// The second surface's group.
+        second: String,
+    },
 }
 
 /// One node of Γ_C that carries friction.
@@ -105,14 +119,34 @@ impl ContactNode {
     }
 }
 
-/// The friction surface: the nodes of one named line group that carry
-/// friction, ordered along the line, and the regularized law.
-#[derive(Clone, Debug)]
-pub struct ContactSurface {
+/// One surface of a case's friction nodes: its group and where its nodes
+/// are in [`ContactSurface::nodes`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfacePart {
     /// Name of the physical group.
     pub group: String,
-    /// Friction-carrying nodes in order along the surface.
+    /// Its nodes' indices in [`ContactSurface::nodes`].
+    pub nodes: std::ops::Range<usize>,
+}
+
+/// The friction surface: the nodes of one or several named line groups
+/// that carry friction, each group's ordered along its line, and the
+/// regularized law. Friction couples no two nodes, so several surfaces
+/// are one set of nodes, each with its own bound.
+#[derive(Clone, Debug)]
+pub struct ContactSurface {
+    /// Name of the (first) physical group.
+    pub group: String,
+    /// Friction-carrying nodes in order along the surface, surface by
+    /// surface.
     pub nodes: Vec<ContactNode>,
+    /// The surfaces the nodes belong to, in order; their ranges tile
+    /// `nodes`.
+    pub parts: Vec<SurfacePart>,
+    /// Counts changes of the bounds after the surface was built
+    /// ([`ContactSurface::set_bounds`]): whatever was formed from the
+    /// bounds is formed again when it moves.
+    pub revision: u64,
     /// Mesh nodes of the group left out because a Dirichlet condition fixes
     /// their tangential motion (e.g. the slab's corner (0, 0)).
     pub excluded: Vec<usize>,
@@ -166,8 +200,13 @@ impl ContactSurface {
         }
         Ok(ContactSurface {
             group: group.to_string(),
+            parts: vec![SurfacePart {
+                group: group.to_string(),
+                nodes: 0..nodes.len(),
+            }],
             nodes,
             excluded,
+            revision: 0,
             law: FrictionLaw { eps },
         })
     }
@@ -184,8 +223,13 @@ impl ContactSurface {
         check_parameters(0.0, 0.0, eps)?;
         Ok(ContactSurface {
             group: group.to_string(),
+            parts: vec![SurfacePart {
+                group: group.to_string(),
+                nodes: 0..nodes.len(),
+            }],
             nodes,
             excluded: Vec::new(),
+            revision: 0,
             law: FrictionLaw { eps },
         })
     }
@@ -302,8 +346,88 @@ impl ContactSurface {
         ContactSurface {
             group: self.group.clone(),
             nodes,
+            parts: self.parts.clone(),
             excluded: Vec::new(),
+            revision: self.revision,
             law: self.law,
+        }
+    }
+
+    /// Joins surfaces built apart into one set of friction nodes, surface
+    /// after surface, each node keeping its own bound.
+    ///
+    /// # Errors
+    /// No surface, surfaces with different ε (the law is one), or a node
+    /// that carries friction on two surfaces (counted twice, and with two
+    /// tangents).
+    pub fn join(surfaces: Vec<ContactSurface>) -> Result<ContactSurface, ContactError> {
+        let mut iter = surfaces.into_iter();
+        let Some(mut joined) = iter.next() else {
+            return Err(ContactError::Parameter("no contact surface to join".into()));
+        };
+        for s in iter {
+            if s.law.eps.to_bits() != joined.law.eps.to_bits() {
+                return Err(ContactError::Parameter(format!(
+                    "surface {:?} has eps = {} but surface {:?} has eps = {}: the surfaces share one \
+                     regularization ε; give every [[contact]] the same eps",
+                    s.group, s.law.eps, joined.group, joined.law.eps
+                )));
+            }
+            // Only nodes that carry friction count: a node a support holds
+            // still on both surfaces carries none on either.
+            let mine: std::collections::HashSet<usize> = s.nodes.iter().map(|n| n.node).collect();
+            for part in &joined.parts {
+                let theirs = &joined.nodes[part.nodes.clone()];
+                if let Some(n) = theirs.iter().find(|n| mine.contains(&n.node)) {
+                    return Err(ContactError::Overlap {
+                        node: n.node,
+                        first: part.group.clone(),
+                        second: s.group.clone(),
+                    });
+                }
+            }
+            let start = joined.nodes.len();
+            joined.parts.push(SurfacePart {
+                group: s.group,
+                nodes: start..start + s.nodes.len(),
+            });
+            joined.nodes.extend(s.nodes);
+            joined.excluded.extend(s.excluded);
+        }
+        Ok(joined)
+    }
+
+    /// The surfaces' groups for a message: `"contact"`, or `"contact" +
+    /// "support"` for several.
+    pub fn names(&self) -> String {
+        let names: Vec<String> = self
+            .parts
+            .iter()
+            .map(|p| format!("{:?}", p.group))
+            .collect();
+        names.join(" + ")
+    }
+
+    /// The surface (index into [`ContactSurface::parts`]) of each node.
+    pub fn part_of_nodes(&self) -> Vec<usize> {
+        let mut out = vec![0; self.nodes.len()];
+        for (k, p) in self.parts.iter().enumerate() {
+            out[p.nodes.clone()].iter_mut().for_each(|o| *o = k);
+        }
+        out
+    }
+
+    /// Sets node j's bound g_J to `bound(j)` for every node, and counts a
+    /// revision when any changed.
+    pub fn set_bounds(&mut self, mut bound: impl FnMut(usize) -> f64) {
+        let mut changed = false;
+        for (j, n) in self.nodes.iter_mut().enumerate() {
+            let g = bound(j);
+            changed |= g.to_bits() != n.bound.to_bits();
+            n.bound = g;
+        }
+        if changed {
+            self.revision += 1;
         }
     }
 }

@@ -5,6 +5,8 @@ use stickslip_contact::{ContactSurface, SlipState};
 use stickslip_linalg::FillOrder;
 
 use crate::dynamics::{Dynamics, Load, Loads};
+use crate::history::History;
+use crate::pressure::BoundHistories;
 use crate::settings::{ImplicitSolver, MassKind, Scheme, Settings, TimeError};
 use crate::state::{Checkpoint, Energy, State, StepInfo};
 use crate::stepper::{Run, Stepper};
@@ -13,13 +15,15 @@ use crate::{central_difference, newmark, quasi_static};
 /// Integrates from the initial state to `t_end`, one step per call.
 pub struct Integrator {
     run: Run,
-    /// The contact surface as the observers see it (slip velocities,
-    /// stresses): `run.contact` or, where it carries no friction, the
-    /// surface the scheme runs without.
+    /// The contact surface the scheme runs without, where it carries no
+    /// friction (kept for the observers: slip velocities, stresses);
+    /// otherwise the surface is `run.contact`, whose bounds the steps set.
     surface: Option<ContactSurface>,
     state: State,
     stepper: Box<dyn Stepper>,
     fill_order: FillOrder,
+    /// The friction bounds' histories, where a surface's pressure changes.
+    bounds: Option<BoundHistories>,
 }
 
 impl std::fmt::Debug for Integrator {
@@ -55,8 +59,10 @@ impl Integrator {
         // one whose nodes carry none (μ = 0 or no pressure: w g = 0 at
         // every node), which then steps as a scene without a contact
         // surface, the surface kept for the observers.
-        let surface = contact.filter(|c| !c.is_empty());
-        let contact = surface.clone().filter(ContactSurface::carries_friction);
+        let (contact, surface) = match contact.filter(|c| !c.is_empty()) {
+            Some(c) if c.carries_friction() => (Some(c), None),
+            other => (None, other),
+        };
         let loads = Loads {
             constant: dynamics.constant_load.clone(),
             loads,
@@ -88,7 +94,33 @@ impl Integrator {
             state,
             stepper,
             fill_order,
+            bounds: None,
         })
+    }
+
+    /// Makes each contact surface's pressure change in time: the bounds of
+    /// surface k (`ContactSurface::parts[k]`) are their built values times
+    /// `histories[k]`(t), set before each step for the time it ends at
+    /// (the friction of a step acts at its end, METHOD.md §4). Constant
+    /// and step histories change nothing after t = 0 and cost nothing.
+    /// Call it on a fresh integrator, before [`Integrator::restore`].
+    pub fn set_pressure_histories(&mut self, histories: &[History]) {
+        let Some(contact) = self.run.contact.as_mut() else {
+            return;
+        };
+        self.bounds = BoundHistories::new(contact, histories);
+        if let Some(b) = &mut self.bounds {
+            b.apply(self.state.t, contact);
+            // The initial forces are w g φ_ε(ṙ₀) with g at t = 0.
+            contact.nodal_forces(&self.state.v, &mut self.state.forces);
+        }
+    }
+
+    /// Sets the bounds for time `t`, where they change in time.
+    fn bounds_at(&mut self, t: f64) {
+        if let (Some(b), Some(c)) = (&mut self.bounds, &mut self.run.contact) {
+            b.apply(t, c);
+        }
     }
 
     /// True once t_end is reached.
@@ -102,7 +134,16 @@ impl Integrator {
     /// A failed linear solve, a stick/slip iteration that hits its cap, or a
     /// non-finite state. The state is left at the last completed step.
     pub fn step(&mut self) -> Result<StepInfo, TimeError> {
-        self.stepper.step(&self.run, &mut self.state)
+        if self.bounds.is_none() {
+            return self.stepper.step(&self.run, &mut self.state);
+        }
+        let t_new = self.state.next_step(&self.run.settings).1;
+        self.bounds_at(t_new);
+        let result = self.stepper.step(&self.run, &mut self.state);
+        if result.is_err() {
+            self.bounds_at(self.state.t);
+        }
+        result
     }
 
     /// Everything needed to continue this run bit-identically
@@ -125,7 +166,7 @@ impl Integrator {
         // A run without friction on a surface keeps no classes or forces;
         // a checkpoint of a version that ran friction code on it (all
         // forces 0) has them.
-        let n_c = self.surface.as_ref().map_or(0, ContactSurface::len);
+        let n_c = self.contact().map_or(0, ContactSurface::len);
         let without_friction;
         let c = if self.run.contact.is_none() && n_c > 0 && c.classes.len() == n_c {
             without_friction = Checkpoint {
@@ -141,6 +182,7 @@ impl Integrator {
         self.stepper.state_replaced();
         self.stepper.set_factorizations(c.factorizations);
         self.run.loads.at(self.state.t, &mut self.state.load);
+        self.bounds_at(self.state.t);
         Ok(())
     }
 
@@ -185,7 +227,7 @@ impl Integrator {
     /// The contact surface, if the scene has friction-carrying nodes
     /// (whether their friction can act or not: [`Integrator::friction`]).
     pub fn contact(&self) -> Option<&ContactSurface> {
-        self.surface.as_ref()
+        self.run.contact.as_ref().or(self.surface.as_ref())
     }
     /// True when the steps run friction code: the scene has a contact
     /// surface and w g > 0 at some node of it.
@@ -280,13 +322,13 @@ impl Integrator {
     }
     /// Friction stress σ_T = −g φ_ε(v_T) at each contact node.
     pub fn friction_stress(&self, out: &mut [f64]) {
-        if let Some(c) = &self.surface {
+        if let Some(c) = self.contact() {
             c.friction_stress(&self.state.v, out);
         }
     }
     /// Tangential (slip) velocity at each contact node.
     pub fn slip_velocity(&self, out: &mut [f64]) {
-        if let Some(c) = &self.surface {
+        if let Some(c) = self.contact() {
             for (o, n) in out.iter_mut().zip(&c.nodes) {
                 *o = n.tangential(&self.state.v);
             }

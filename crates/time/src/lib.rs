@@ -29,6 +29,7 @@ mod initial;
 mod integrator;
 mod newmark;
 mod nodal;
+mod pressure;
 mod quasi_static;
 mod settings;
 pub mod stability;

@@ -1,7 +1,8 @@
 //! Closed-form problems: the Coulomb oscillator, d'Alembert's wave, the
 //! static slab, the patch test, quasi-static friction on a strip
-//! (`strip.rs`), and the bodies held only by friction with Rayleigh
-//! damping (`friction_held.rs`).
+//! (`strip.rs`), the bodies held only by friction with Rayleigh damping
+//! (`friction_held.rs`), and the checks of several surfaces and a
+//! pressure that changes (`surfaces.rs`).
 
 use std::path::Path;
 
@@ -26,6 +27,7 @@ pub fn run(root: &Path, opts: &Options, r: &mut Report) {
     patch(r);
     super::strip::run_all(opts, r);
     super::friction_held::run(opts, r);
+    super::surfaces::run(root, opts, r);
 }
 
 fn coulomb_oscillator(opts: &Options, r: &mut Report) {

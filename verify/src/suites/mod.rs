@@ -1,4 +1,4 @@
-//! The four suites of `verify`.
+//! The four suites of `verify` (`surfaces` runs within `analytic`).
 
 pub mod analytic;
 pub mod friction_held;
@@ -6,3 +6,4 @@ pub mod paper;
 pub mod rates;
 pub mod reference;
 pub mod strip;
+pub mod surfaces;

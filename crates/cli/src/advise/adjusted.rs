@@ -130,10 +130,18 @@ pub fn adjusted_case(
     } else {
         time.remove("stick_reduction");
     }
-    if case.contact.is_some() {
-        let contact = doc["contact"]
+    // Every surface shares the one ε: [contact] or each [[contact]].
+    let mut tables: Vec<&mut dyn toml_edit::TableLike> = match &mut doc["contact"] {
+        Item::ArrayOfTables(a) => a
+            .iter_mut()
+            .map(|t| t as &mut dyn toml_edit::TableLike)
+            .collect(),
+        Item::None => Vec::new(),
+        other => vec![other
             .as_table_like_mut()
-            .context("[contact] is not a table")?;
+            .context("[contact] is not a table")?],
+    };
+    for contact in tables.iter_mut() {
         match contact.get_mut("eps") {
             Some(Item::Value(old)) => {
                 let decor = old.decor().clone();

@@ -303,7 +303,7 @@ pub fn estimate(
         e_nm_all.push(en);
     }
     let mut d_eps = vec![0.0];
-    let eps_list: Vec<f64> = if case.contact.is_some() {
+    let eps_list: Vec<f64> = if !case.contact.is_empty() {
         let base = cd_runs[0];
         for f in &EPS_FACTORS[1..] {
             let k = pilots.run(

@@ -133,5 +133,5 @@ pub fn read_ladder(
 
 /// The case's ε (NaN without a [contact] section).
 pub(super) fn eps_of(case: &Case) -> f64 {
-    case.contact.as_ref().map_or(f64::NAN, |c| c.eps)
+    case.contact.first().map_or(f64::NAN, |c| c.eps)
 }

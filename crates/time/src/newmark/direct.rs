@@ -21,6 +21,9 @@ pub(crate) struct DirectOperator {
     entries: Vec<[Option<usize>; 4]>,
     key_dt: f64,
     key_stuck: Vec<bool>,
+    /// The bounds' revision C was formed with (a bound that changes in
+    /// time changes C).
+    key_revision: u64,
     valid: bool,
     pub factorizations: u64,
 }
@@ -58,6 +61,7 @@ impl DirectOperator {
             entries,
             key_dt: f64::NAN,
             key_stuck: contact.map(|s| vec![false; s.len()]).unwrap_or_default(),
+            key_revision: 0,
             valid: false,
             factorizations: 0,
         })
@@ -95,7 +99,9 @@ impl DirectOperator {
         surface: Option<&ContactSurface>,
         classes: &[SlipState],
     ) -> Result<(), SolverError> {
+        let revision = surface.map_or(0, |s| s.revision);
         let same = self.valid
+            && self.key_revision == revision
             && self
                 .key_stuck
                 .iter()
@@ -116,6 +122,7 @@ impl DirectOperator {
                 *k = c.is_stuck();
             }
         }
+        self.key_revision = revision;
         self.valid = false;
         self.cholesky.factorize(&self.work)?;
         self.factorizations += 1;

@@ -183,10 +183,18 @@ impl ImplicitFriction {
                     return Ok(1);
                 }
                 op.begin(b);
-                let reduced = op
+                let mut reduced = op
                     .reduced
                     .take()
                     .expect("a contact surface has its nodal surface");
+                if let Some(c) = run
+                    .contact
+                    .as_ref()
+                    .filter(|c| c.revision != reduced.revision)
+                {
+                    reduced.set_bounds(|j| c.nodes[j].bound);
+                    reduced.revision = c.revision;
+                }
                 let result = iterate(
                     &reduced,
                     &mut op.nodal_system(),

@@ -70,6 +70,8 @@ struct Entry {
 struct DenseFactor {
     entry_id: u64,
     stuck: Vec<bool>,
+    /// The bounds' revision W was formed with.
+    revision: u64,
     valid: bool,
     /// Stuck node indices.
     index: Vec<usize>,
@@ -150,6 +152,7 @@ impl SchurOperator {
         let dense = DenseFactor {
             entry_id: u64::MAX,
             stuck: vec![false; n_c],
+            revision: 0,
             valid: false,
             index: Vec::with_capacity(n_c),
             w: Vec::with_capacity(n_c),
@@ -402,6 +405,7 @@ impl SchurOperator {
         let d = &mut self.dense;
         let same = d.valid
             && d.entry_id == entry.id
+            && d.revision == reduced.revision
             && d.stuck.iter().zip(classes).all(|(&k, c)| k == c.is_stuck());
         if !same {
             d.valid = false;
@@ -442,6 +446,7 @@ impl SchurOperator {
                 }
             }
             d.entry_id = entry.id;
+            d.revision = reduced.revision;
             d.valid = true;
         }
         let m = d.index.len();
