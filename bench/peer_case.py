@@ -212,14 +212,17 @@ class Scene:
 class Results:
     """The peer's results file, written record by record (module doc)."""
 
-    def __init__(self, path, scene, nodes=None):
+    def __init__(self, path, scene, nodes=None, contact=None):
+        """`nodes`, `contact`: the peer's own nodes (coordinates) and
+        friction nodes (indices into them) where they are not the mesh's."""
         self.file = h5py.File(path, "w")
         self.file.attrs["program"] = os.path.basename(sys.argv[0])
         self.n_out = len(scene.record_steps())
         nodes = scene.nodes if nodes is None else nodes
+        contact = scene.contact if contact is None else contact
         self.file["mesh/nodes"] = nodes
-        self.file["contact/nodes"] = scene.contact
-        f, n, c = self.file, len(nodes), len(scene.contact)
+        self.file["contact/nodes"] = contact
+        f, n, c = self.file, len(nodes), len(contact)
         self.time = f.create_dataset("time", (self.n_out,), dtype="f8")
         self.fields = [f.create_dataset(k, (self.n_out, n, 2), dtype="f8") for k in ("displacement", "velocity", "acceleration")]
         self.stress = f.create_dataset("contact/friction_stress", (self.n_out, c), dtype="f8")
