@@ -95,7 +95,12 @@ class Scene:
         flip = area < 0
         turned = [0, 3, 2, 1] + ([7, 6, 5, 4, 8] if self.order == 2 else [])
         cells[flip] = cells[flip][:, turned]
-        self.cells = cells
+        # Nodes of no cell (Gmsh's Mesh.SaveAll) are dropped, as stickslip does.
+        used, cells = np.unique(cells, return_inverse=True)
+        renumber = np.full(len(self.nodes), -1)
+        renumber[used] = np.arange(len(used))
+        self.nodes = self.nodes[used]
+        self.cells = cells.reshape(-1, 9 if self.order == 2 else 4)
         # Line groups by name: their edges, nodes (end, end[, mid]).
         self.lines = {}
         for name, blocks in m.cell_sets.items():
@@ -104,7 +109,7 @@ class Scene:
             edges = [m.cells[i].data[sel] for i, sel in enumerate(blocks)
                      if sel is not None and len(sel) and m.cells[i].type.startswith("line")]
             if edges:
-                self.lines[name] = np.concatenate(edges)
+                self.lines[name] = renumber[np.concatenate(edges)]
         n = len(self.nodes)
         self.fixed = np.zeros((n, 2), dtype=bool)
         for d in case.get("dirichlet", []):
