@@ -232,3 +232,15 @@ pub(crate) fn check(root: &Path, ours: &Path, theirs: &Path) -> Result<f64, Stri
         )),
     }
 }
+
+/// A peer as the bench would find it installed, for tests of which runs it
+/// makes (`fenicsx`: structured meshes only).
+#[cfg(test)]
+pub(crate) fn installed(name: &'static str) -> Peer {
+    Peer {
+        name,
+        python: PathBuf::from("python3"),
+        script: "",
+        structured_only: name == "fenicsx",
+    }
+}

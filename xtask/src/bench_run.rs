@@ -56,6 +56,14 @@ struct Rung {
     paper: bool,
 }
 
+impl Rung {
+    /// Whether every cell is a rectangle (the committed slabs and Gmsh's
+    /// structured ones).
+    fn structured(&self) -> bool {
+        self.gmsh.is_none_or(|g| g.3)
+    }
+}
+
 const RUNGS: [Rung; 8] = [
     Rung {
         name: "paper q2-8x2",
@@ -188,10 +196,9 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         let dt_crit = dt_crit(&exe, root, &mesh)?;
         let cd_dt = 0.9 * dt_crit;
         let mesh_set = format!("mesh.file={}", mesh.display());
-        let structured = rung.gmsh.is_none_or(|g| g.3);
         let fits: Vec<bool> = peers
             .iter()
-            .map(|p| p.fits(rung.dofs, structured))
+            .map(|p| p.fits(rung.dofs, rung.structured()))
             .collect();
         if only.as_deref() != Some("newmark") {
             let steps = 1000.0;
@@ -465,4 +472,32 @@ fn dt_crit(exe: &Path, root: &Path, mesh: &Path) -> Result<f64, String> {
                 String::from_utf8_lossy(&o.stderr)
             )
         })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rungs each peer runs, as the module doc lists them.
+    #[test]
+    fn the_peers_run_the_rungs_the_doc_names() {
+        let runs = |name| -> Vec<&str> {
+            let peer = crate::bench_peers::installed(name);
+            RUNGS
+                .iter()
+                .filter(|r| peer.fits(r.dofs, r.structured()))
+                .map(|r| r.name)
+                .collect()
+        };
+        let structured = [
+            "paper q2-8x2",
+            "q2-64x16",
+            "q1-128x32",
+            "q1-352x88",
+            "q2-352x88",
+            "q1-708x177",
+        ];
+        assert_eq!(runs("scipy"), structured);
+        assert_eq!(runs("fenicsx"), structured);
+    }
 }
