@@ -69,10 +69,24 @@ def load_case(path, sets):
         for k in path_:
             table = table.setdefault(k, {})
         table[last] = value
-    known = {"title", "mesh", "material", "dirichlet", "traction", "contact", "time", "output"}
-    for k in case:
+    known = {
+        "mesh": {"file", "ladder"},
+        "material": {"E", "nu", "rho", "hypothesis"},
+        "dirichlet": {"group", "ux", "uy"},
+        "traction": {"group", "t", "history"},
+        "contact": {"group", "pressure", "mu", "eps"},
+        "time": {"scheme", "dt", "t_end", "beta", "gamma", "allow_unstable"},
+        "output": {"file", "every"},
+    }
+    for k, v in case.items():
+        if k == "title":
+            continue
         if k not in known:
             refuse(f"the peer does not know [{k}]")
+        for table in v if isinstance(v, list) else [v]:
+            for key in table:
+                if key not in known[k]:
+                    refuse(f"the peer does not know {k}.{key}")
     if case["material"].get("hypothesis", "plane_strain") != "plane_strain":
         refuse("the peer knows plane strain only")
     return case
