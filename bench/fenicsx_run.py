@@ -5,7 +5,7 @@ whole process is timed as stickslip's is.
     python bench/fenicsx_run.py CASE.toml -o OUT.h5 [--set KEY=VALUE]...
 
 It needs DOLFINx with real PETSc (the `dolfinx-solver-real` wheel, Python
-≥ 3.12), meshio, h5py and scipy; `cargo xtask bench run` installs them into
+≥ 3.12), meshio and h5py; `cargo xtask bench run` installs them into
 a venv (target/bench/fenicsx) when they are missing. `import dolfinx_solver`
 must come before `import dolfinx` (it loads the wheel's PETSc).
 
@@ -44,7 +44,6 @@ from dolfinx import fem
 from dolfinx.io import gmsh as gmshio
 from dolfinx.mesh import CellType, meshtags_from_entities
 from mpi4py import MPI
-from petsc4py import PETSc
 
 import peer_case
 

@@ -23,7 +23,7 @@ use std::process::{Command, Stdio};
 const PEER_MAX_DOFS: u64 = 260_000;
 
 /// The pip packages of the FEniCSx venv.
-const FENICSX_PACKAGES: [&str; 4] = ["dolfinx-solver-real", "meshio", "h5py", "scipy"];
+const FENICSX_PACKAGES: [&str; 3] = ["dolfinx-solver-real", "meshio", "h5py"];
 
 /// One peer: its name in the table and the CSV, the interpreter and the
 /// script that make a run.
@@ -66,6 +66,14 @@ impl Peer {
 /// # Errors
 /// An unknown name, or the only peer asked for cannot be installed.
 pub(crate) fn peers(root: &Path, names: &[String]) -> Result<Vec<Peer>, String> {
+    if !names.is_empty() {
+        // bench/peer_check.py, on this machine's Python.
+        crate::python::ensure_python_modules(&[
+            ("numpy", "numpy"),
+            ("scipy", "scipy"),
+            ("h5py", "h5py"),
+        ])?;
+    }
     let mut peers = Vec::new();
     for name in names {
         let peer = match name.as_str() {
@@ -105,7 +113,7 @@ fn fenicsx(root: &Path) -> Result<Peer, String> {
     let python = venv.join("bin/python");
     let imports = |py: &Path| {
         Command::new(py)
-            .args(["-c", "import dolfinx_solver, dolfinx, meshio, h5py, scipy"])
+            .args(["-c", "import dolfinx_solver, dolfinx, meshio, h5py"])
             .stdin(Stdio::null())
             .output()
             .is_ok_and(|o| o.status.success())
@@ -126,7 +134,7 @@ fn fenicsx(root: &Path) -> Result<Peer, String> {
             Command::new(&python)
                 .args(["-m", "pip", "install", "--disable-pip-version-check", "-q"])
                 .args(FENICSX_PACKAGES),
-            "pip install dolfinx-solver-real meshio h5py scipy",
+            "pip install dolfinx-solver-real meshio h5py",
         )?;
         if !imports(&python) {
             return Err(format!(
