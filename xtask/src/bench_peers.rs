@@ -121,7 +121,7 @@ fn fenicsx(root: &Path) -> Result<Peer, String> {
     if !imports(&python) {
         let base = python_312()?;
         eprintln!(
-            "bench run: installing DOLFINx 0.11 for the FEniCSx peer into {} ({}; about 500 MB)",
+            "bench run: installing DOLFINx 0.11 for the FEniCSx peer into {} ({}; about 400 MB)",
             venv.display(),
             base.display()
         );
