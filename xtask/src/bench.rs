@@ -80,6 +80,12 @@ pub(crate) fn timed_run<S: AsRef<OsStr>>(
     for kv in sets {
         cmd.arg("--set").arg(kv);
     }
+    timed(cmd)
+}
+
+/// `cmd` run to its end, timed: its output and wall seconds; an error only
+/// when it does not start.
+pub(crate) fn timed(mut cmd: Command) -> Result<(Output, f64), String> {
     let t = Instant::now();
     let o = cmd.output().map_err(|e| {
         format!(

@@ -11,6 +11,24 @@
 //! written at 11 records of the run (output.every), as a user of a long run
 //! sets it. Each results file is removed after its run.
 //!
+//! The peers (`bench_peers.rs`, bench/README.md): each run is also made,
+//! interleaved with ours, by a numpy/scipy process (bench/scipy_run.py:
+//! scikit-fem's K and M, the same scheme in numpy) and a FEniCSx one
+//! (bench/fenicsx_run.py: DOLFINx 0.11, Newton by PETSc SNES for Newmark),
+//! each reading the case file and the mesh and writing its results file.
+//! The FEniCSx peer is installed into a venv (target/bench/fenicsx) when
+//! it is missing, saying so. Before anything is timed, one run of each
+//! peer on each of its runs is compared with one of ours
+//! (bench/peer_check.py: displacements at every common record, to 1e-8 of
+//! the largest); a peer that differs stops the bench with an error. Both
+//! run the rungs up to 260k DOFs, the FEniCSx one the structured ones only
+//! (its row-sum lumped mass is HRZ's on rectangular cells only): the paper
+//! mesh, q2-64x16, q1-128x32, q1-352x88, q2-352x88 and q1-708x177; the
+//! 500k and 1M rungs are ours alone. The table and the CSV give each
+//! peer's median, its ratio to ours (peer / ours) and its agreement.
+//! `--peers scipy,fenicsx` or `none` chooses them; by default both, and
+//! none when `--against` compares another binary.
+//!
 //! With `--against EXE`, every run is also made with that binary (for
 //! instance a build of an earlier commit), interleaved round by round, and
 //! the table gives the ratio of the medians: a change measured run against
@@ -22,6 +40,7 @@
 //!
 //!     cargo xtask bench run [--rounds N] [--max-dofs N] [--rungs NAME,...]
 //!         [--against EXE] [--against-env K=V]... [--only cd|newmark]
+//!         [--peers scipy,fenicsx|none]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -35,6 +54,14 @@ struct Rung {
     dofs: u64,
     /// The paper's cases as they are shipped (their Δt, t_end and output).
     paper: bool,
+}
+
+impl Rung {
+    /// Whether every cell is a rectangle (the committed slabs and Gmsh's
+    /// structured ones).
+    fn structured(&self) -> bool {
+        self.gmsh.is_none_or(|g| g.3)
+    }
 }
 
 const RUNGS: [Rung; 8] = [
@@ -107,7 +134,8 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     let mut only: Option<String> = None;
     let mut rungs: Option<Vec<String>> = None;
     let mut against_env: Vec<(String, String)> = Vec::new();
-    let usage = "[--rounds N] [--max-dofs N] [--rungs NAME,...] [--against EXE] [--against-env K=V]... [--only cd|newmark]";
+    let mut peer_names: Option<Vec<String>> = None;
+    let usage = "[--rounds N] [--max-dofs N] [--rungs NAME,...] [--against EXE] [--against-env K=V]... [--only cd|newmark] [--peers scipy,fenicsx|none]";
     crate::bench::args("bench run", usage, args, |a, it| {
         match a {
             "--rounds" => rounds = crate::bench::integer_arg::<usize>(a, "a number", it)?.max(1),
@@ -128,6 +156,14 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                 rungs = Some(list.split(',').map(str::to_string).collect());
             }
             "--only" => only = Some(it.next().ok_or("--only needs cd or newmark")?.clone()),
+            "--peers" => {
+                let list = it.next().ok_or("--peers needs scipy,fenicsx or none")?;
+                peer_names = Some(if list == "none" {
+                    Vec::new()
+                } else {
+                    list.split(',').map(str::to_string).collect()
+                });
+            }
             _ => return Ok(false),
         }
         Ok(true)
@@ -138,10 +174,19 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         exes.push(against.clone().unwrap_or_else(|| exe.clone()));
     }
     let compared = exes.len() == 2;
+    // The peers by default when no other binary is compared.
+    let peer_names = peer_names.unwrap_or_else(|| {
+        if compared {
+            Vec::new()
+        } else {
+            vec!["scipy".into(), "fenicsx".into()]
+        }
+    });
+    let peers = crate::bench_peers::peers(root, &peer_names)?;
 
     let full = rungs.is_none() && only.is_none() && max_dofs == u64::MAX;
-    // The runs: (label, case, sets).
-    let mut runs: Vec<(String, &'static str, Vec<String>)> = Vec::new();
+    // The runs: (label, case, sets, which peers run it).
+    let mut runs: Vec<(String, &'static str, Vec<String>, Vec<bool>)> = Vec::new();
     let chosen = |r: &Rung| rungs.as_ref().is_none_or(|n| n.iter().any(|n| n == r.name));
     for rung in RUNGS.iter().filter(|r| r.dofs <= max_dofs && chosen(r)) {
         let mesh = match rung.gmsh {
@@ -151,6 +196,10 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         let dt_crit = dt_crit(&exe, root, &mesh)?;
         let cd_dt = 0.9 * dt_crit;
         let mesh_set = format!("mesh.file={}", mesh.display());
+        let fits: Vec<bool> = peers
+            .iter()
+            .map(|p| p.fits(rung.dofs, rung.structured()))
+            .collect();
         if only.as_deref() != Some("newmark") {
             let steps = 1000.0;
             runs.push((
@@ -166,6 +215,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                         "output.every=100".into(),
                     ]
                 },
+                fits.clone(),
             ));
         }
         let nm_steps = match rung.dofs {
@@ -188,14 +238,16 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                         format!("output.every={}", (nm_steps as u64 / 10).max(1)),
                     ]
                 },
+                fits,
             ));
         }
     }
-    // times[run][exe]
-    let mut times = vec![vec![Vec::new(); exes.len()]; runs.len()];
+    let checks = check_peers(root, &exe, &dir, &peers, &runs)?;
+    // times[run][exe, then peer]
+    let mut times = vec![vec![Vec::new(); exes.len() + peers.len()]; runs.len()];
     for round in 0..rounds {
         eprintln!("bench run: round {} of {rounds}", round + 1);
-        for (r, (label, case, sets)) in runs.iter().enumerate() {
+        for (r, (label, case, sets, fits)) in runs.iter().enumerate() {
             for (e, exe) in exes.iter().enumerate() {
                 let out = dir.join(format!("r{r}-e{e}.h5"));
                 let mut cmd = Command::new(exe);
@@ -219,6 +271,20 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                 }
                 times[r][e].push(secs);
             }
+            for (p, peer) in peers.iter().enumerate().filter(|(p, _)| fits[*p]) {
+                let out = dir.join(format!("r{r}-{}.h5", peer.name));
+                let (o, secs) = crate::bench::timed(peer.command(root, &out, case, sets))?;
+                let _ = std::fs::remove_file(&out);
+                if o.status.success() {
+                    times[r][exes.len() + p].push(secs);
+                } else {
+                    eprintln!(
+                        "bench run: {label} ({} peer) failed, left out of its median: {}",
+                        peer.name,
+                        String::from_utf8_lossy(&o.stderr).trim()
+                    );
+                }
+            }
         }
     }
     let median = |t: &mut Vec<f64>| {
@@ -229,9 +295,16 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     if compared {
         csv.push_str(",against_median_s,ratio");
     }
+    for peer in &peers {
+        let p = peer.name;
+        csv.push_str(&format!(",{p}_median_s,{p}_ratio,{p}_check"));
+    }
     csv.push('\n');
     println!("\nwall time of whole `stickslip run` processes (release), medians of {rounds} interleaved rounds:\n");
     print!("{:<32} {:>10} {:>10}", "run", "median s", "fastest");
+    for peer in &peers {
+        print!(" {:>12} {:>8}", format!("{} s", peer.name), "/ ours");
+    }
     if compared {
         print!(" {:>12} {:>8}", "against s", "ratio");
         println!(
@@ -246,16 +319,28 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     } else {
         println!();
     }
-    for (r, (label, _, _)) in runs.iter().enumerate() {
+    for (r, (label, _, _, fits)) in runs.iter().enumerate() {
         let m = median(&mut times[r][0]);
         let fastest = times[r][0].first().copied().unwrap_or(f64::NAN);
         print!("{label:<32} {m:>10.4} {fastest:>10.4}");
         csv.push_str(&format!("{label},{m:.5},{fastest:.5},{rounds}"));
+        let mut peer_csv = String::new();
+        for p in 0..peers.len() {
+            if fits[p] {
+                let mp = median(&mut times[r][exes.len() + p]);
+                print!(" {mp:>12.4} {:>8.1}", mp / m);
+                peer_csv.push_str(&format!(",{mp:.5},{:.2},{:.1e}", mp / m, checks[r][p]));
+            } else {
+                print!(" {:>12} {:>8}", "-", "-");
+                peer_csv.push_str(",,,");
+            }
+        }
         if compared {
             let ma = median(&mut times[r][1]);
             print!(" {ma:>12.4} {:>8.3}", m / ma);
             csv.push_str(&format!(",{ma:.5},{:.4}", m / ma));
         }
+        csv.push_str(&peer_csv);
         println!();
         csv.push('\n');
     }
@@ -269,6 +354,64 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         println!("and {}", docs.display());
     }
     Ok(())
+}
+
+/// Each peer's agreement with stickslip on each run it makes
+/// (`checks[run][peer]`, NaN where it does not run it), before anything is
+/// timed: one run of each, their results files compared.
+///
+/// # Errors
+/// A run that fails, or a peer that differs by more than 1e-8: the bench
+/// stops there and says which.
+fn check_peers(
+    root: &Path,
+    exe: &Path,
+    dir: &Path,
+    peers: &[crate::bench_peers::Peer],
+    runs: &[(String, &'static str, Vec<String>, Vec<bool>)],
+) -> Result<Vec<Vec<f64>>, String> {
+    let mut checks = vec![vec![f64::NAN; peers.len()]; runs.len()];
+    for (r, (label, case, sets, fits)) in runs.iter().enumerate() {
+        if !fits.contains(&true) {
+            continue;
+        }
+        let ours = dir.join(format!("check-r{r}.h5"));
+        let flags = ["--quiet", "--force"];
+        let (o, _) = crate::bench::timed_run(Command::new(exe), root, &flags, &ours, case, sets)?;
+        if !o.status.success() {
+            return Err(format!(
+                "{label}: stickslip failed: {}",
+                String::from_utf8_lossy(&o.stderr).trim()
+            ));
+        }
+        for (p, peer) in peers.iter().enumerate().filter(|(p, _)| fits[*p]) {
+            let theirs = dir.join(format!("check-r{r}-{}.h5", peer.name));
+            let (o, _) = crate::bench::timed(peer.command(root, &theirs, case, sets))?;
+            if !o.status.success() {
+                return Err(format!(
+                    "{label}: the {} peer failed: {}",
+                    peer.name,
+                    String::from_utf8_lossy(&o.stderr).trim()
+                ));
+            }
+            let rel = crate::bench_peers::check(root, &ours, &theirs).map_err(|e| {
+                format!(
+                    "{label}: the {} peer disagrees with stickslip, so it is not timed: {e}",
+                    peer.name
+                )
+            })?;
+            eprintln!(
+                "bench run: {label}: the {} peer agrees to {rel:.1e}",
+                peer.name
+            );
+            checks[r][p] = rel;
+            let _ = std::fs::remove_file(&theirs);
+        }
+        for ext in ["h5", "xdmf"] {
+            let _ = std::fs::remove_file(ours.with_extension(ext));
+        }
+    }
+    Ok(checks)
 }
 
 /// The rung's mesh, written by Gmsh from cases/slab.geo unless it is there.
@@ -329,4 +472,32 @@ fn dt_crit(exe: &Path, root: &Path, mesh: &Path) -> Result<f64, String> {
                 String::from_utf8_lossy(&o.stderr)
             )
         })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rungs each peer runs, as the module doc lists them.
+    #[test]
+    fn the_peers_run_the_rungs_the_doc_names() {
+        let runs = |name| -> Vec<&str> {
+            let peer = crate::bench_peers::installed(name);
+            RUNGS
+                .iter()
+                .filter(|r| peer.fits(r.dofs, r.structured()))
+                .map(|r| r.name)
+                .collect()
+        };
+        let structured = [
+            "paper q2-8x2",
+            "q2-64x16",
+            "q1-128x32",
+            "q1-352x88",
+            "q2-352x88",
+            "q1-708x177",
+        ];
+        assert_eq!(runs("scipy"), structured);
+        assert_eq!(runs("fenicsx"), structured);
+    }
 }

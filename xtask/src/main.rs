@@ -13,6 +13,7 @@ mod bench_advise;
 mod bench_fem;
 mod bench_mesh;
 mod bench_output;
+mod bench_peers;
 mod bench_run;
 mod bench_step;
 mod meshes;
@@ -48,7 +49,8 @@ usage: cargo xtask <command> [args]
   bench fem         assembly and Cholesky on the Q2 slab ladder against
                     scikit-fem and scipy's splu (--refine 8,16,32,64 --no-peer)
   bench run         whole `stickslip run` processes on the slab ladder, both
-                    schemes [--rounds N] [--max-dofs N] [--against EXE]
+                    schemes, against a numpy/scipy and a FEniCSx peer
+                    [--rounds N] [--max-dofs N] [--against EXE] [--peers LIST]
   bench output      wall time of whole runs (paper slab, a 4k-node slab) with
                     their results written uncompressed, deflated, or not at all
   bench advise      wall time of advise's pick against the cheapest configuration of
