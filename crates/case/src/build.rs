@@ -139,10 +139,10 @@ fn refused(case: &Case, e: TimeError) -> InputError {
         ),
         TimeError::UnstableDamped { .. } => ("time.dt", "[time]"),
         TimeError::Static(_) => ("dirichlet.0.group", "[time]"),
-        TimeError::Unbalanced(_) => (
-            at("initial.state").unwrap_or("dirichlet.0.group"),
-            "[initial]",
-        ),
+        TimeError::Unbalanced(_) => match at("initial.state") {
+            Some(key) => (key, "[initial]"),
+            None => ("dirichlet.0.group", "[[dirichlet]]"),
+        },
         _ => ("time.scheme", "[time]"),
     };
     InputError(format!("{}{table}: {e}", case.at(key)))

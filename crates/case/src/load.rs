@@ -427,7 +427,7 @@ fn complete(
                 check(
                     false,
                     &key("group"),
-                    format!("contact: group {:?} is already contact surface {} ; a node carries the friction of one surface only; give each [[contact]] its own group", c.group, j + 1),
+                    format!("contact: group {:?} is already contact surface {}; a node carries the friction of one surface only; give each [[contact]] its own group", c.group, j + 1),
                 );
             }
         }
@@ -503,12 +503,35 @@ fn complete(
             "central_difference needs mass = \"lumped\" (with a consistent mass it is no longer explicit); remove the key or use scheme = \"newmark\"".into(),
         );
     }
-    if let (Scheme::QuasiStatic, Some(_)) = (tm.scheme, tm.mass) {
-        check(
-            false,
-            "time.mass",
-            "quasi_static increments have no inertia, so no mass: remove time.mass".into(),
-        );
+    if tm.scheme == Scheme::QuasiStatic {
+        // Keys of inertia would be ignored silently by increments without
+        // it: refuse each at its line.
+        let init = &case.initial;
+        let inertia = [
+            (tm.mass.is_some(), "time.mass", "no mass: remove time.mass"),
+            (
+                case.material.damping.is_some(),
+                "material.damping",
+                "no damping: remove material.damping",
+            ),
+            (
+                init.velocity.is_some(),
+                "initial.velocity",
+                "no initial velocity: remove initial.velocity",
+            ),
+            (
+                !init.velocities.is_empty(),
+                "initial.velocities.0.group",
+                "no initial velocity: remove [[initial.velocities]]",
+            ),
+        ];
+        for (given, key, what) in inertia {
+            check(
+                !given,
+                key,
+                format!("quasi_static increments have no inertia, so {what}"),
+            );
+        }
     }
     if let Some(r) = &tm.stick_reduction {
         check(
@@ -910,6 +933,36 @@ t_end = 0.5
                 e.contains(&format!("case.toml:{}:", line_of(&text, "gamma ="))),
                 "{e}"
             );
+        }
+    }
+
+    #[test]
+    fn quasi_static_refuses_the_keys_of_inertia_at_their_lines() {
+        // Damping and initial velocities mean nothing without inertia;
+        // quasi-static increments would ignore them silently.
+        let text = GOOD
+            .replace("\"central_difference\"", "\"quasi_static\"")
+            .replace("rho = 1.0", "rho = 1.0\ndamping = { alpha = 1.0, beta = 0.0 }")
+            + "[initial]\nvelocity = [1.0, 0.0]\n[[initial.velocities]]\ngroup = \"load\"\nvelocity = [0.0, 1.0]\n";
+        let e = load_text("qs-inertia", &text, &[]).unwrap_err().0;
+        for (needle, what) in [
+            ("damping =", "no damping"),
+            ("velocity = [1.0", "no initial velocity"),
+            ("group = \"load\"\nvelocity", "no initial velocity"),
+        ] {
+            let line = match needle.split_once('\n') {
+                // The entry's group line, which follows the table header.
+                Some((first, _)) => text
+                    .lines()
+                    .enumerate()
+                    .filter(|(_, l)| l.contains(first))
+                    .map(|(i, _)| i + 1)
+                    .last()
+                    .expect("the entry's group"),
+                None => line_of(&text, needle),
+            };
+            assert!(e.contains(&format!("case.toml:{line}:")), "{needle}: {e}");
+            assert!(e.contains(what), "{what}: {e}");
         }
     }
 

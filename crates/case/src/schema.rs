@@ -355,8 +355,8 @@ impl Schema for History {
     const KIND: Kind = Kind::Any;
 }
 
-/// A table's rows, each exactly [t, f] (serde's [f64; 2] takes [t, f, x]
-/// and drops x).
+/// A table's rows, each exactly two numbers (serde's [f64; 2] takes [t, f,
+/// x] and drops x).
 fn table_points<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
     let rows = Vec::<Vec<f64>>::deserialize(d)?;
     rows.iter()
@@ -364,7 +364,7 @@ fn table_points<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>,
         .map(|(i, r)| match r[..] {
             [t, f] => Ok([t, f]),
             _ => Err(serde::de::Error::custom(format!(
-                "table row {} has {} numbers; each row is [t, f]",
+                "table row {} has {} numbers; each row is two: [t, f] in a history, [s, factor] in a profile",
                 i + 1,
                 r.len()
             ))),

@@ -75,9 +75,11 @@ pub(crate) fn initial_state(
     let mut r = loads.before_start();
     if settings.restoring || settings.initial_state == InitialState::Rest {
         r.fill(0.0);
+    } else if r.iter().all(|&x| x == 0.0) {
+        // Nothing acts before t = 0: r₀ = 0, no factorization.
     } else if !modes.is_empty() {
         crate::floating::solve(k, mass, fill_order, modes, &mut r)?;
-    } else if r.iter().any(|&x| x != 0.0) {
+    } else {
         let mut solver = SparseCholesky::analyze(k, fill_order).map_err(TimeError::Static)?;
         solver.factorize(k).map_err(TimeError::Static)?;
         solver.solve_in_place(&mut r);

@@ -28,7 +28,7 @@ use stickslip_linalg::csr::{dot, quadratic_form, spmv};
 use crate::dynamics::{Dynamics, Loads};
 use crate::initial::{initial_state, Mass};
 use crate::newmark::ImplicitFriction;
-use crate::settings::{MassKind, Settings, TimeError};
+use crate::settings::{InitialState, MassKind, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
 
@@ -58,6 +58,13 @@ pub(crate) fn start(
         rigid_modes,
         ..
     } = dynamics;
+    if !rigid_modes.is_empty() {
+        // Each increment factorizes Δt K, and nothing holds a free motion
+        // without inertia (the case file refuses such a part earlier).
+        return Err(TimeError::Settings(
+            "quasi-static increments need supports that hold every rigid-body motion".into(),
+        ));
+    }
     let n = k.nrows();
     let friction = ImplicitFriction::new(&k, &fill_order, contact, settings)?;
     let mut state = initial_state(
@@ -70,8 +77,12 @@ pub(crate) fn start(
         settings,
     )?;
     if !settings.restoring {
-        // The previous increment's load is the one r₀ equilibrates.
-        state.load = loads.before_start();
+        // The previous increment's load is the one r₀ equilibrates: the
+        // loads before t = 0, or none for a start at rest (r₀ = 0).
+        state.load = match settings.initial_state {
+            InitialState::Static => loads.before_start(),
+            InitialState::Rest => vec![0.0; n],
+        };
         state.energy.total = state.energy.strain - dot(&state.r, &state.load);
     }
     let stepper = QuasiStatic {
@@ -126,15 +137,12 @@ impl Stepper for QuasiStatic {
                 hint: String::new(),
             });
         }
-        let (mut work, mut load_dot) = (0.0, 0.0);
-        for k in 0..state.r.len() {
-            work += 0.5 * (state.load_new[k] + state.load[k]) * (state.r_new[k] - state.r[k]);
-            load_dot += state.r_new[k] * state.load_new[k];
-        }
+        let (work, load_dot) = state.load_work();
         // Friction's work over the increment Δr = Δt ṙ_K: the ledger's
         // ½Δt(v + v_new) with both velocities the increment's rate.
         let (dissipated, stick_events) = match &run.contact {
             Some(c) => {
+                state.friction_passes += 1;
                 let d = c.step_dissipation(
                     &state.v_new,
                     &state.v_new,

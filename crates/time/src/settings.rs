@@ -223,6 +223,16 @@ impl Settings {
                 }
                 Ok(m.unwrap_or(MassKind::Consistent))
             }
+            (Scheme::QuasiStatic, _) if self.damping.is_on() => bad(
+                "material.damping with time.scheme = \"quasi_static\": quasi-static increments have no \
+                 inertia and no damping; remove material.damping"
+                    .into(),
+            ),
+            (Scheme::QuasiStatic, _) if self.initial_velocity.is_some() => bad(
+                "[initial] velocity with time.scheme = \"quasi_static\": quasi-static increments have no \
+                 inertia, so no initial velocity; remove it"
+                    .into(),
+            ),
             (Scheme::QuasiStatic, None) => Ok(MassKind::Consistent),
             (Scheme::QuasiStatic, Some(_)) => bad(
                 "time.mass with time.scheme = \"quasi_static\": quasi-static increments have no inertia; \

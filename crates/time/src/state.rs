@@ -211,6 +211,18 @@ impl State {
         }
     }
 
+    /// The loads' work over the step by the trapezoid rule, Σ ½(R_K +
+    /// R_{K−1})(r_K − r_{K−1}), and r_K·R_K (METHOD.md §6), before
+    /// [`State::commit`].
+    pub fn load_work(&self) -> (f64, f64) {
+        let (mut work, mut load_dot) = (0.0, 0.0);
+        for k in 0..self.r.len() {
+            work += 0.5 * (self.load_new[k] + self.load[k]) * (self.r_new[k] - self.r[k]);
+            load_dot += self.r_new[k] * self.load_new[k];
+        }
+        (work, load_dot)
+    }
+
     /// Makes the new state current at t_new, a step of `dt` on: r, ṙ, r̈,
     /// R, the classes and forces.
     pub fn commit(&mut self, dt: f64, t_new: f64, iterations: usize) {

@@ -1,18 +1,19 @@
 //! Nothing for what a scene lacks: a contact surface whose friction
 //! cannot act (μ = 0, or no normal pressure: w g = 0 at every node) costs
-//! no stick/slip iteration and no friction pass in either scheme, and its
+//! no stick/slip iteration and no friction pass in any scheme, and its
 //! run is the run without a contact surface, bit for bit.
 
 use stickslip_testkit::read_mesh;
 use stickslip_testkit::scene::{Slab, END_LOAD, MU, NU, PRESSURE};
 use stickslip_time::{History, Integrator, Scheme, Settings};
 
-const SCHEMES: [Scheme; 2] = [
+const SCHEMES: [Scheme; 3] = [
     Scheme::CentralDifference,
     Scheme::Newmark {
         beta: 0.25,
         gamma: 0.5,
     },
+    Scheme::QuasiStatic,
 ];
 
 /// The paper's slab on its Q2 8×2 mesh with `pressure` on the bottom and

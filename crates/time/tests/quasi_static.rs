@@ -3,8 +3,10 @@
 //! for the whole run.
 
 use stickslip_mesh::CellKind;
+use stickslip_testkit::read_mesh;
+use stickslip_testkit::scene::{Slab, END_LOAD, MU, NU, PRESSURE};
 use stickslip_testkit::strip::Strip;
-use stickslip_time::{History, Integrator, Scheme, Settings};
+use stickslip_time::{History, InitialState, Integrator, Scheme, Settings};
 
 /// The pull ramped from 0 at t = 0 to P at t = 1.
 fn ramp() -> History {
@@ -71,4 +73,29 @@ fn ledger_closes_and_the_factor_is_reused() {
     assert!(integrator.acceleration().iter().all(|&a| a == 0.0));
     assert_eq!(integrator.steps(), 20);
     assert_eq!(integrator.factorizations(), 1);
+}
+
+/// A start at rest (r₀ = 0, every load from t = 0 on, the contact
+/// pressure included, which the static start applies before t = 0): the
+/// first increment's work is done from R = 0, and the ledger still closes.
+#[test]
+fn a_start_at_rest_closes_the_ledger() {
+    let mesh = read_mesh("slab-q2-8x2.msh").expect("committed mesh reads");
+    let slab = Slab::new(mesh, NU, PRESSURE, Some(MU), 1e-4, END_LOAD, History::Step)
+        .expect("scene builds");
+    let mut settings = Settings::new(Scheme::QuasiStatic, 0.05, 1.0);
+    settings.initial_state = InitialState::Rest;
+    let mut integrator = slab.integrator(settings).expect("the run starts");
+    assert!(integrator.displacement().iter().all(|&x| x == 0.0));
+    while !integrator.done() {
+        integrator.step().expect("an increment converges");
+        let e = integrator.energy();
+        assert!(
+            e.balance.abs() <= 1e-10 * e.external_work.abs(),
+            "t = {}: balance {} of work {}",
+            integrator.time(),
+            e.balance,
+            e.external_work
+        );
+    }
 }

@@ -355,11 +355,7 @@ impl Stepper for Newmark {
                 hint: String::new(),
             });
         }
-        let (mut work, mut load_dot) = (0.0, 0.0);
-        for k in 0..state.r.len() {
-            work += 0.5 * (state.load_new[k] + state.load[k]) * (state.r_new[k] - state.r[k]);
-            load_dot += state.r_new[k] * state.load_new[k];
-        }
+        let (work, load_dot) = state.load_work();
         let (dissipated, stick_events) = match &run.contact {
             Some(c) => {
                 state.friction_passes += 1;
