@@ -46,9 +46,16 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         .map(|m| m.label.as_str())
         .collect();
     if !free.is_empty() {
+        // Friction is all that can hold them; with none acting the run
+        // warns (`setup_warnings`, below).
+        let held = if i.friction() {
+            "held there by friction alone"
+        } else {
+            "nothing holds them: no friction acts"
+        };
         println!(
-            "floating    the supports leave free: {} (held there by friction alone; the static \
-             preload, if any, is solved without those motions)",
+            "floating    the supports leave free: {} ({held}; the static preload, if any, is \
+             solved without those motions)",
             free.join(", ")
         );
     }
@@ -172,7 +179,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     // Remark 4.1 ran in its setup): the run's warning, before the run.
     let mut u = vec![0.0; 2 * p.mesh.nodes.len()];
     p.model.dofs.expand(i.displacement(), &mut u);
-    for w in setup_warnings(&p.mesh, &u, i) {
+    for w in setup_warnings(&p.mesh, &p.model.dofs, &u, i) {
         println!("warning     {w}");
     }
     Ok(())

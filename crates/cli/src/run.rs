@@ -226,13 +226,39 @@ fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
 /// What runs but is likely not meant, in the words `check` prints and a
 /// fresh run says before its first step (one list, so the two cannot
 /// drift apart): `u` is the initial displacement at every node.
-pub(crate) fn setup_warnings(mesh: &Mesh, u: &[f64], integrator: &Integrator) -> Vec<String> {
+pub(crate) fn setup_warnings(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    u: &[f64],
+    integrator: &Integrator,
+) -> Vec<String> {
     stickslip_mesh::degenerate_cells(mesh, stickslip_mesh::DEGENERATE_RATIO)
         .map(|d| d.to_string())
         .into_iter()
         .chain(large_static_displacement(mesh, u))
         .chain(integrator.contact().and_then(|c| oblique_supports(mesh, c)))
+        .chain(unheld_motions(dofs, integrator))
         .collect()
+}
+
+/// The rigid-body motions the supports leave free where no friction acts
+/// (μ = 0, no pressure, no `[contact]`), or `None`: friction is all that
+/// holds a floating part, so with none a net load along such a motion
+/// moves the part as a rigid body without bound.
+fn unheld_motions(dofs: &DofMap, integrator: &Integrator) -> Option<String> {
+    let free: Vec<&str> = dofs
+        .rigid_modes()
+        .iter()
+        .map(|m| m.label.as_str())
+        .collect();
+    (!free.is_empty() && !integrator.friction()).then(|| {
+        format!(
+            "the supports leave free {} and no friction acts: nothing holds the part there, and any \
+             net load along those motions moves it as a rigid body; hold them by a [[dirichlet]] \
+             condition, or give the [contact] a friction coefficient mu > 0",
+            free.join(", ")
+        )
+    })
 }
 
 /// Degrees by which a fixed direction may leave a contact face's normal
