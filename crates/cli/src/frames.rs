@@ -112,33 +112,52 @@ pub struct Frames {
     pub row: Vec<usize>,
 }
 
+/// Rows of the dataset `ds` of `f` (named `name` in messages) as its
+/// shape says, nothing read.
+fn rows(f: &File, name: &str, ds: &str) -> Result<usize, InputError> {
+    f.dataset(ds)
+        .map(|d| d.shape().first().copied().unwrap_or(0))
+        .map_err(|e| {
+            InputError(format!(
+                "{name}: cannot read /{ds}: {e}; give a results file written by `stickslip run`"
+            ))
+        })
+}
+
+/// Rows of the dataset `ds` of `f`, checked against those of `against`
+/// before `ds` is read: a damaged file may claim more rows than it holds,
+/// and reading them would allocate that much. The two grow together;
+/// between two records `ds` may be one row ahead.
+pub(crate) fn checked_rows(
+    f: &File,
+    name: &str,
+    ds: &str,
+    against: &str,
+) -> Result<usize, InputError> {
+    let (n, limit) = (rows(f, name, ds)?, rows(f, name, against)?);
+    if n > limit + 1 {
+        return Err(InputError(format!(
+            "{name}: /{ds} has {n} rows but /{against} {limit}: the file is damaged; \
+             run the case again"
+        )));
+    }
+    Ok(n)
+}
+
 impl Frames {
-    /// The frames of `f` (named `name` in messages), checked against the
-    /// rows of `/displacement` before they are read: a damaged file may
-    /// claim more rows than it holds, and reading them would allocate that
-    /// much (a file that claimed 1e11 rows aborted probe on an 800 GB
-    /// allocation). The two grow together; between two frames one may be
-    /// a row ahead. A frame whose row is past `/time` is dropped.
+    /// The frames of `f` (named `name` in messages), their times checked
+    /// against the rows of `/displacement` ([`checked_rows`]). A frame
+    /// whose row is past `/time` is dropped.
     pub fn read(f: &File, name: &str) -> Result<Frames, InputError> {
         let bad = |ds: &str, e: hdf5::Error| {
             InputError(format!(
                 "{name}: cannot read /{ds}: {e}; give a results file written by `stickslip run`"
             ))
         };
-        let rows = |ds: &str| {
-            f.dataset(ds)
-                .map(|d| d.shape().first().copied().unwrap_or(0))
-                .map_err(|e| bad(ds, e))
-        };
         let by_frames = f.link_exists("frames");
         let time_ds = if by_frames { "frames/time" } else { "time" };
-        let (t_rows, u_rows, h_rows) = (rows(time_ds)?, rows("displacement")?, rows("time")?);
-        if t_rows > u_rows + 1 {
-            return Err(InputError(format!(
-                "{name}: /{time_ds} has {t_rows} rows but /displacement {u_rows}: the file is damaged; \
-                 run the case again"
-            )));
-        }
+        checked_rows(f, name, time_ds, "displacement")?;
+        let h_rows = rows(f, name, "time")?;
         let time = f
             .dataset(time_ds)
             .and_then(|d| d.read_1d::<f64>())

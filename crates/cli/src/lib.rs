@@ -1,5 +1,6 @@
 //! The `stickslip` command's library: the HDF5 results and checkpoints
-//! ([`output`]), runs and checks ([`run`]), the `mesh` report
+//! ([`output`]), runs ([`run`]) and checks
+//! ([`check_cmd`]), the `mesh` report
 //! ([`mesh_cmd`]), the `probe` reader ([`probe`]), the results file's
 //! protection ([`results_file`]), the `advise` command ([`advise`]: the
 //! cheapest configuration for a tolerance) and the viewers' files
@@ -41,6 +42,7 @@ macro_rules! say_out {
 }
 
 pub mod advise;
+pub mod check_cmd;
 pub mod frames;
 pub mod mesh_cmd;
 pub mod output;

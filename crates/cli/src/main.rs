@@ -17,7 +17,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use stickslip::{advise, mesh_cmd, probe, run, views_cmd};
+use stickslip::{advise, check_cmd, mesh_cmd, probe, run, views_cmd};
 use stickslip_case as case;
 use stickslip_case::InputError;
 
@@ -262,7 +262,7 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            match run::check(&case) {
+            match check_cmd::check(&case) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&e),
             }

@@ -11,7 +11,7 @@ use ndarray::s;
 
 use stickslip_case::InputError;
 
-use crate::frames::Frames;
+use crate::frames::{checked_rows, Frames};
 
 /// A field that can be probed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -158,28 +158,11 @@ fn open_results(file: &Path) -> Result<File, InputError> {
     })
 }
 
-/// `/time` (a row a step, the histories'), checked against the rows of
-/// `/contact/friction_stress` (what it is read for) before it is read: a damaged file may claim more rows than
-/// it holds, and reading them would allocate that much (a file that
-/// claimed 1e11 rows aborted probe on an 800 GB allocation). The two grow
-/// together; between two records one may be one row ahead.
+/// `/time` (a row a step, the histories'), its rows checked against
+/// those of `/contact/friction_stress`, what it is read for
+/// ([`checked_rows`]).
 pub(crate) fn read_time(f: &File, name: &str) -> Result<Vec<f64>, InputError> {
-    let rows = |ds: &str| {
-        f.dataset(ds)
-            .map(|d| d.shape().first().copied().unwrap_or(0))
-            .map_err(|e| {
-                InputError(format!(
-                "{name}: cannot read /{ds}: {e}; give a results file written by `stickslip run`"
-            ))
-            })
-    };
-    let (t_rows, c_rows) = (rows("time")?, rows("contact/friction_stress")?);
-    if t_rows > c_rows + 1 {
-        return Err(InputError(format!(
-            "{name}: /time has {t_rows} rows but /contact/friction_stress {c_rows}: the file is \
-             damaged; run the case again"
-        )));
-    }
+    checked_rows(f, name, "time", "contact/friction_stress")?;
     f.dataset("time")
         .and_then(|d| d.read_1d::<f64>())
         .map(|t| t.to_vec())

@@ -1,5 +1,6 @@
-//! `stickslip run` and `stickslip check`: from a validated case to a model,
-//! an integrator and the HDF5 results, step by step.
+//! `stickslip run`: from a validated case to a model, an integrator and
+//! the HDF5 results, step by step; the model and the setup warnings it
+//! shares with `stickslip check` (`check_cmd.rs`).
 //!
 //! Everything that can be refused is refused before any time step (the
 //! model is built by `stickslip-case`), as an [`InputError`] (exit code
@@ -17,9 +18,9 @@ use std::time::Instant;
 
 use stickslip_case::{self as case, Case, InputError, Prepared, Running, Scene};
 use stickslip_contact::ContactSurface;
-use stickslip_fem::{DofMap, NodeOrder};
+use stickslip_fem::DofMap;
 use stickslip_mesh::Mesh;
-use stickslip_time::{ImplicitSolver, Integrator, Scheme};
+use stickslip_time::{Integrator, Scheme};
 
 use crate::frames::Schedule;
 use crate::output::{self, CheckpointExtra, Record, ResultsWriter, Summary};
@@ -52,7 +53,7 @@ pub(crate) fn input(msg: impl Into<String>) -> anyhow::Error {
 
 /// A case's model and integrator ([`stickslip_case::assemble`]), the
 /// model kept (`check`); with `progress`, [`setup_note`].
-fn prepare(case: &Case, progress: bool) -> Result<Prepared, InputError> {
+pub(crate) fn prepare(case: &Case, progress: bool) -> Result<Prepared, InputError> {
     let started = Instant::now();
     let scene = stickslip_case::assemble(case)?;
     if progress {
@@ -96,174 +97,6 @@ fn setup_note(scene: &Scene, started: Instant) {
         "model: {n_free} free DOFs, assembled in {:.1} s; now {work}",
         started.elapsed().as_secs_f64(),
     );
-}
-
-/// `stickslip check`: validate, print the model size, Δt_crit and solver.
-///
-/// # Errors
-/// Input problems as [`InputError`].
-pub fn check(case: &Case) -> anyhow::Result<()> {
-    let p = prepare(case, true)?;
-    let i = &p.integrator;
-    println!("case        {}", case.path.display());
-    if let Some(t) = &case.title {
-        println!("title       {t}");
-    }
-    println!(
-        "mesh        {} nodes, {} {} cells ({})",
-        p.mesh.nodes.len(),
-        p.mesh.n_cells(),
-        p.mesh.kind.name(),
-        case.mesh.file.display()
-    );
-    println!(
-        "DOFs        {} free of {}, numbered {}",
-        p.model.dofs.n_free(),
-        2 * p.mesh.nodes.len(),
-        match p.model.dofs.node_order() {
-            NodeOrder::Mesh => "node by node in the mesh file's order",
-            NodeOrder::Grid => "row by row of the structured grid the nodes form",
-            NodeOrder::Bandwidth => "by reverse Cuthill-McKee (a band around the diagonal)",
-        }
-    );
-    let free: Vec<&str> = p
-        .model
-        .dofs
-        .rigid_modes()
-        .iter()
-        .map(|m| m.label.as_str())
-        .collect();
-    if !free.is_empty() {
-        println!(
-            "floating    the supports leave free: {} (held there by friction alone; the static \
-             preload, if any, is solved without those motions)",
-            free.join(", ")
-        );
-    }
-    match i.contact() {
-        Some(c) => println!(
-            "contact     {}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
-            c.names(),
-            c.len(),
-            c.excluded.len(),
-            c.law.eps
-        ),
-        None => println!("contact     none (no friction code runs)"),
-    }
-    if let Some(why) = friction_off(case, i).filter(|_| i.contact().is_some()) {
-        println!("friction    off: {why}; the steps run no friction code");
-    }
-    // The explicit integrator computed it already (by its own K·x);
-    // Newmark's did not.
-    // Quasi-static increments have no inertia: no critical step, no
-    // vibration to resolve.
-    let quasi_static = case.time.scheme == case::Scheme::QuasiStatic;
-    let crit = i.dt_crit().unwrap_or_else(|| {
-        stickslip_time::stability::critical_step(&p.model.stiffness, &p.model.lumped_mass)
-    });
-    let damped = case.material.damping.is_some_and(|d| d.beta > 0.0) && i.is_explicit();
-    if !quasi_static {
-        println!(
-            "dt_crit     {crit:.6e} (central difference, lumped mass: {})",
-            if damped {
-                "(2/omega_max)(sqrt(1+xi^2) - xi), xi = beta omega_max/2"
-            } else {
-                "2/omega_max"
-            }
-        );
-    }
-    // As the integrator counts: a last step within 1e-6 Δt of t_end is
-    // not a step of its own.
-    let steps = (case.time.t_end / case.time.dt - 1e-6).ceil().max(1.0);
-    if i.is_explicit() {
-        // A preload (a constant load, nonzero prescribed displacements)
-        // puts the initial state at r₀ = K⁻¹ R(0⁻): one factorization of
-        // K, the only one of the run; else r₀ = 0 and there is none.
-        let preloaded = i.displacement().iter().any(|&x| x != 0.0);
-        println!(
-            "solver      explicit: {}; {}; K·x by {}",
-            if preloaded {
-                format!(
-                    "no linear system per step (the preloaded initial state by one sparse Cholesky (faer, {}) of K)",
-                    p.model.fill_order.name()
-                )
-            } else {
-                "no linear system".to_string()
-            },
-            if i.friction() {
-                "friction solved node by node in closed form"
-            } else {
-                "no friction"
-            },
-            i.stiffness_product()
-        );
-    } else if i.implicit_solver() == ImplicitSolver::Direct {
-        println!(
-            "solver      implicit Newmark: sparse Cholesky (faer, {}) of A₀ + C, analysed once, refactorized when dt or the stuck set changes; nnz(K) = {}; K·x by {}",
-            p.model.fill_order.name(),
-            p.model.stiffness.nnz(),
-            i.stiffness_product()
-        );
-    } else if quasi_static {
-        let n_c = i.contact().map_or(0, |c| c.len());
-        println!(
-            "solver      quasi-static increments (no inertia): sparse Cholesky (faer, {}) of dt·K, analysed once, factorized once per distinct dt; friction on the {n_c} contact unknowns by the Schur complement; nnz(K) = {}",
-            p.model.fill_order.name(),
-            p.model.stiffness.nnz(),
-        );
-    } else {
-        let friction = match i.contact().filter(|_| i.friction()) {
-            Some(c) => format!(
-                "friction on the {} contact unknowns by the Schur complement",
-                c.len()
-            ),
-            None => "no friction".to_string(),
-        };
-        println!(
-            "solver      implicit Newmark: sparse Cholesky (faer, {}) of A₀, analysed once, factorized once per distinct dt; {friction}; nnz(K) = {}; K·x by {}",
-            p.model.fill_order.name(),
-            p.model.stiffness.nnz(),
-            i.stiffness_product()
-        );
-    }
-    println!(
-        "steps       about {steps} to t_end = {} with dt = {:e}",
-        case.time.t_end, case.time.dt
-    );
-    if !i.is_explicit() && !quasi_static {
-        // Stability is no guide for an implicit step: say what it resolves.
-        println!(
-            "accuracy    Newmark is stable at any dt, but follows a vibration only when its period spans \
-             about 10 steps or more: here periods above {:.3e}; the mesh's shortest is {:.3e} (pi dt_crit)",
-            10.0 * case.time.dt,
-            std::f64::consts::PI * crit
-        );
-    }
-    let size = output_size(case, p.mesh.nodes.len(), i.contact().map_or(0, |c| c.len()));
-    println!(
-        "output      {}: about {} frames of u, v, a ({}) and {} rows of histories (time, energy, contact), {}",
-        case.output.file.display(),
-        size.frames,
-        Schedule::new(case.output.fields(), case.time.t_end).describe(),
-        size.rows,
-        human_bytes(size.bytes)
-    );
-    if let Some(free) = room_for(&case.output.file, true) {
-        if size.bytes > free as f64 {
-            println!(
-                "warning     that is more than the {} free on its disk: `run` refuses it; write fewer frames (output.frames, output.interval, output.every) or elsewhere (-o)",
-                human_bytes(free as f64)
-            );
-        }
-    }
-    // The integrator holds the initial state already (the static solve of
-    // Remark 4.1 ran in its setup): the run's warning, before the run.
-    let mut u = vec![0.0; 2 * p.mesh.nodes.len()];
-    p.model.dofs.expand(i.displacement(), &mut u);
-    for w in setup_warnings(&p.mesh, &u, i) {
-        println!("warning     {w}");
-    }
-    Ok(())
 }
 
 /// The failure of a run whose disk has less room than its next write
@@ -352,7 +185,7 @@ pub(crate) fn friction_off(case: &Case, i: &Integrator) -> Option<String> {
 
 /// Bytes free for the results file `out`: its disk's free space, and with
 /// `force` the old OUT.h5 and OUT.xdmf, which the run removes first.
-fn room_for(out: &Path, force: bool) -> Option<u64> {
+pub(crate) fn room_for(out: &Path, force: bool) -> Option<u64> {
     let free = crate::results_file::free_bytes(out)?;
     let old: u64 = if force {
         [out.to_path_buf(), out.with_extension("xdmf")]
@@ -393,13 +226,39 @@ fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
 /// What runs but is likely not meant, in the words `check` prints and a
 /// fresh run says before its first step (one list, so the two cannot
 /// drift apart): `u` is the initial displacement at every node.
-pub(crate) fn setup_warnings(mesh: &Mesh, u: &[f64], integrator: &Integrator) -> Vec<String> {
+pub(crate) fn setup_warnings(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    u: &[f64],
+    integrator: &Integrator,
+) -> Vec<String> {
     stickslip_mesh::degenerate_cells(mesh, stickslip_mesh::DEGENERATE_RATIO)
         .map(|d| d.to_string())
         .into_iter()
         .chain(large_static_displacement(mesh, u))
         .chain(integrator.contact().and_then(|c| oblique_supports(mesh, c)))
+        .chain(unheld_motions(dofs, integrator))
         .collect()
+}
+
+/// The rigid-body motions the supports leave free where no friction acts
+/// (μ = 0, no pressure, no `[contact]`), or `None`: friction is all that
+/// holds a floating part, so with none a net load along such a motion
+/// moves the part as a rigid body without bound.
+fn unheld_motions(dofs: &DofMap, integrator: &Integrator) -> Option<String> {
+    let free: Vec<&str> = dofs
+        .rigid_modes()
+        .iter()
+        .map(|m| m.label.as_str())
+        .collect();
+    (!free.is_empty() && !integrator.friction()).then(|| {
+        format!(
+            "the supports leave free {} and no friction acts: nothing holds the part there, and any \
+             net load along those motions moves it as a rigid body; hold them by a [[dirichlet]] \
+             condition, or give the [contact] a friction coefficient mu > 0",
+            free.join(", ")
+        )
+    })
 }
 
 /// Degrees by which a fixed direction may leave a contact face's normal
@@ -474,7 +333,7 @@ fn human_seconds(s: f64) -> String {
 }
 
 /// "1.2 GB"-style size (decimal units).
-fn human_bytes(b: f64) -> String {
+pub(crate) fn human_bytes(b: f64) -> String {
     let units = ["bytes", "kB", "MB", "GB", "TB", "PB"];
     let mut u = 0;
     let mut v = b;

@@ -282,14 +282,57 @@ fn a_floating_part_under_unbalanced_preloads_is_refused() {
     };
     let (case, _) = slab_case(&dir, "balanced", floating);
     let o = run(&case, &dir.join("balanced.h5"), &[]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    // `check` says which motions are free.
+    assert!(
+        o.status.success() && !stderr(&o).contains("no friction acts"),
+        "{}",
+        stderr(&o)
+    );
+    // `check` says which motions are free, and that friction holds them
+    // (the slab's contact has mu = 0.3).
     let o = check(&case, &[]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(
-        o.status.success() && out.contains("floating    the supports leave free: translation in x"),
+        o.status.success()
+            && out.contains(
+                "floating    the supports leave free: translation in x (held there by friction alone;"
+            )
+            && !out.contains("nothing holds"),
         "{out}{}",
         stderr(&o)
+    );
+    // With mu = 0 no friction acts: nothing holds the part in x, which
+    // `check` says and warns of, and a run warns of before its first step.
+    let o = check(&case, &["contact.mu=0.0"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    let warning = "the supports leave free translation in x and no friction acts: nothing holds the part there";
+    assert!(
+        o.status.success()
+            && out.contains(
+                "floating    the supports leave free: translation in x (nothing holds them: no friction acts;"
+            )
+            && !out.contains("held there by friction")
+            && out.contains(&format!("warning     {warning}")),
+        "{out}{}",
+        stderr(&o)
+    );
+    let mut c = bin();
+    c.arg("run")
+        .arg(&case)
+        .arg("-o")
+        .arg(dir.join("frictionless.h5"))
+        .args([
+            "--quiet",
+            "--force",
+            "--set",
+            "contact.mu=0.0",
+            "--set",
+            "time.t_end=2e-3",
+        ]);
+    let o = c.output().unwrap();
+    let e = stderr(&o);
+    assert!(
+        e.contains(&format!("balanced.toml: warning: {warning}")),
+        "{e}"
     );
     let (case, text) = slab_case(&dir, "unbalanced", |t| {
         floating(t).replace("history = \"step\"", "history = \"constant\"")

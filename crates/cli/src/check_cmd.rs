@@ -1,0 +1,186 @@
+//! `stickslip check`: a case validated and its model built as a run
+//! would build it, then what the run would be (model size, contact,
+//! Δt_crit, solver, steps, output) and the warnings a run prints before
+//! its first step, without stepping.
+
+use stickslip_case::{self as case, Case};
+use stickslip_fem::NodeOrder;
+use stickslip_time::ImplicitSolver;
+
+use crate::frames::Schedule;
+use crate::run::{friction_off, human_bytes, output_size, prepare, room_for, setup_warnings};
+
+/// `stickslip check`: validate, print the model size, Δt_crit and solver.
+///
+/// # Errors
+/// Input problems as [`InputError`].
+pub fn check(case: &Case) -> anyhow::Result<()> {
+    let p = prepare(case, true)?;
+    let i = &p.integrator;
+    println!("case        {}", case.path.display());
+    if let Some(t) = &case.title {
+        println!("title       {t}");
+    }
+    println!(
+        "mesh        {} nodes, {} {} cells ({})",
+        p.mesh.nodes.len(),
+        p.mesh.n_cells(),
+        p.mesh.kind.name(),
+        case.mesh.file.display()
+    );
+    println!(
+        "DOFs        {} free of {}, numbered {}",
+        p.model.dofs.n_free(),
+        2 * p.mesh.nodes.len(),
+        match p.model.dofs.node_order() {
+            NodeOrder::Mesh => "node by node in the mesh file's order",
+            NodeOrder::Grid => "row by row of the structured grid the nodes form",
+            NodeOrder::Bandwidth => "by reverse Cuthill-McKee (a band around the diagonal)",
+        }
+    );
+    let free: Vec<&str> = p
+        .model
+        .dofs
+        .rigid_modes()
+        .iter()
+        .map(|m| m.label.as_str())
+        .collect();
+    if !free.is_empty() {
+        // Friction is all that can hold them; with none acting the run
+        // warns (`setup_warnings`, below).
+        let held = if i.friction() {
+            "held there by friction alone"
+        } else {
+            "nothing holds them: no friction acts"
+        };
+        println!(
+            "floating    the supports leave free: {} ({held}; the static preload, if any, is \
+             solved without those motions)",
+            free.join(", ")
+        );
+    }
+    match i.contact() {
+        Some(c) => println!(
+            "contact     {}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
+            c.names(),
+            c.len(),
+            c.excluded.len(),
+            c.law.eps
+        ),
+        None => println!("contact     none (no friction code runs)"),
+    }
+    if let Some(why) = friction_off(case, i).filter(|_| i.contact().is_some()) {
+        println!("friction    off: {why}; the steps run no friction code");
+    }
+    // The explicit integrator computed it already (by its own K·x);
+    // Newmark's did not.
+    // Quasi-static increments have no inertia: no critical step, no
+    // vibration to resolve.
+    let quasi_static = case.time.scheme == case::Scheme::QuasiStatic;
+    let crit = i.dt_crit().unwrap_or_else(|| {
+        stickslip_time::stability::critical_step(&p.model.stiffness, &p.model.lumped_mass)
+    });
+    let damped = case.material.damping.is_some_and(|d| d.beta > 0.0) && i.is_explicit();
+    if !quasi_static {
+        println!(
+            "dt_crit     {crit:.6e} (central difference, lumped mass: {})",
+            if damped {
+                "(2/omega_max)(sqrt(1+xi^2) - xi), xi = beta omega_max/2"
+            } else {
+                "2/omega_max"
+            }
+        );
+    }
+    // As the integrator counts: a last step within 1e-6 Δt of t_end is
+    // not a step of its own.
+    let steps = (case.time.t_end / case.time.dt - 1e-6).ceil().max(1.0);
+    if i.is_explicit() {
+        // A preload (a constant load, nonzero prescribed displacements)
+        // puts the initial state at r₀ = K⁻¹ R(0⁻): one factorization of
+        // K, the only one of the run; else r₀ = 0 and there is none.
+        let preloaded = i.displacement().iter().any(|&x| x != 0.0);
+        println!(
+            "solver      explicit: {}; {}; K·x by {}",
+            if preloaded {
+                format!(
+                    "no linear system per step (the preloaded initial state by one sparse Cholesky (faer, {}) of K)",
+                    p.model.fill_order.name()
+                )
+            } else {
+                "no linear system".to_string()
+            },
+            if i.friction() {
+                "friction solved node by node in closed form"
+            } else {
+                "no friction"
+            },
+            i.stiffness_product()
+        );
+    } else if i.implicit_solver() == ImplicitSolver::Direct {
+        println!(
+            "solver      implicit Newmark: sparse Cholesky (faer, {}) of A₀ + C, analysed once, refactorized when dt or the stuck set changes; nnz(K) = {}; K·x by {}",
+            p.model.fill_order.name(),
+            p.model.stiffness.nnz(),
+            i.stiffness_product()
+        );
+    } else if quasi_static {
+        let n_c = i.contact().map_or(0, |c| c.len());
+        println!(
+            "solver      quasi-static increments (no inertia): sparse Cholesky (faer, {}) of dt·K, analysed once, factorized once per distinct dt; friction on the {n_c} contact unknowns by the Schur complement; nnz(K) = {}",
+            p.model.fill_order.name(),
+            p.model.stiffness.nnz(),
+        );
+    } else {
+        let friction = match i.contact().filter(|_| i.friction()) {
+            Some(c) => format!(
+                "friction on the {} contact unknowns by the Schur complement",
+                c.len()
+            ),
+            None => "no friction".to_string(),
+        };
+        println!(
+            "solver      implicit Newmark: sparse Cholesky (faer, {}) of A₀, analysed once, factorized once per distinct dt; {friction}; nnz(K) = {}; K·x by {}",
+            p.model.fill_order.name(),
+            p.model.stiffness.nnz(),
+            i.stiffness_product()
+        );
+    }
+    println!(
+        "steps       about {steps} to t_end = {} with dt = {:e}",
+        case.time.t_end, case.time.dt
+    );
+    if !i.is_explicit() && !quasi_static {
+        // Stability is no guide for an implicit step: say what it resolves.
+        println!(
+            "accuracy    Newmark is stable at any dt, but follows a vibration only when its period spans \
+             about 10 steps or more: here periods above {:.3e}; the mesh's shortest is {:.3e} (pi dt_crit)",
+            10.0 * case.time.dt,
+            std::f64::consts::PI * crit
+        );
+    }
+    let size = output_size(case, p.mesh.nodes.len(), i.contact().map_or(0, |c| c.len()));
+    println!(
+        "output      {}: about {} frames of u, v, a ({}) and {} rows of histories (time, energy, contact), {}",
+        case.output.file.display(),
+        size.frames,
+        Schedule::new(case.output.fields(), case.time.t_end).describe(),
+        size.rows,
+        human_bytes(size.bytes)
+    );
+    if let Some(free) = room_for(&case.output.file, true) {
+        if size.bytes > free as f64 {
+            println!(
+                "warning     that is more than the {} free on its disk: `run` refuses it; write fewer frames (output.frames, output.interval, output.every) or elsewhere (-o)",
+                human_bytes(free as f64)
+            );
+        }
+    }
+    // The integrator holds the initial state already (the static solve of
+    // Remark 4.1 ran in its setup): the run's warning, before the run.
+    let mut u = vec![0.0; 2 * p.mesh.nodes.len()];
+    p.model.dofs.expand(i.displacement(), &mut u);
+    for w in setup_warnings(&p.mesh, &p.model.dofs, &u, i) {
+        println!("warning     {w}");
+    }
+    Ok(())
+}
