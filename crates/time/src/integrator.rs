@@ -6,6 +6,7 @@ use stickslip_linalg::FillOrder;
 
 use crate::dynamics::{Dynamics, Load, Loads};
 use crate::history::History;
+use crate::newmark::ImplicitFriction;
 use crate::pressure::BoundHistories;
 use crate::settings::{ImplicitSolver, MassKind, Scheme, Settings, TimeError};
 use crate::state::{Checkpoint, Energy, State, StepInfo};
@@ -149,7 +150,7 @@ impl Integrator {
     /// Everything needed to continue this run bit-identically
     /// ([`Integrator::restore`] on a fresh integrator of the same case).
     pub fn checkpoint(&self) -> Checkpoint {
-        self.state.checkpoint(self.stepper.factorizations())
+        self.state.checkpoint(self.factorizations())
     }
 
     /// Replaces the state of a freshly built integrator (same case) by the
@@ -180,7 +181,9 @@ impl Integrator {
         };
         self.state.restore(c, self.run.settings.dt)?;
         self.stepper.state_replaced();
-        self.stepper.set_factorizations(c.factorizations);
+        if let Some(f) = self.stepper.implicit_mut() {
+            f.set_factorizations(c.factorizations);
+        }
         self.run.loads.at(self.state.t, &mut self.state.load);
         self.bounds_at(self.state.t);
         Ok(())
@@ -267,18 +270,24 @@ impl Integrator {
     }
     /// Numeric factorizations of the implicit operator so far.
     pub fn factorizations(&self) -> u64 {
-        self.stepper.factorizations()
+        self.stepper
+            .implicit()
+            .map_or(0, ImplicitFriction::factorizations)
     }
     /// Values stored per factor of A₀ (Schur path; 0 otherwise): with 8
     /// bytes each, the memory of one Δt's factor.
     pub fn factor_len(&self) -> usize {
-        self.stepper.factor_len()
+        self.stepper
+            .implicit()
+            .map_or(0, ImplicitFriction::factor_len)
     }
     /// Implicit runs with friction: (values of W = L⁻¹Pᵀ the step uses, 0
     /// when it solves on the reach instead; values of the factor on the
     /// contact DOFs' paths to the root). For the cost figures.
     pub fn paths_len(&self) -> (usize, usize) {
-        self.stepper.paths_len()
+        self.stepper
+            .implicit()
+            .map_or((0, 0), ImplicitFriction::paths_len)
     }
     /// Bytes of K one explicit step streams; 0 for implicit runs.
     pub fn explicit_matrix_bytes(&self) -> usize {

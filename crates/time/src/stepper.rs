@@ -6,6 +6,7 @@
 use stickslip_contact::ContactSurface;
 
 use crate::dynamics::Loads;
+use crate::newmark::ImplicitFriction;
 use crate::settings::{MassKind, Settings, TimeError};
 use crate::state::{State, StepInfo};
 
@@ -50,28 +51,20 @@ pub(crate) trait Stepper: Send {
         None
     }
 
-    /// Numeric factorizations so far.
-    fn factorizations(&self) -> u64 {
-        0
+    /// The step's implicit solve with friction, where it has one (its
+    /// factorizations and the sizes of its factor).
+    fn implicit(&self) -> Option<&ImplicitFriction> {
+        None
     }
 
-    /// Continues the count of factorizations from a checkpoint's.
-    fn set_factorizations(&mut self, _count: u64) {}
+    /// [`Stepper::implicit`], to continue its count from a checkpoint's.
+    fn implicit_mut(&mut self) -> Option<&mut ImplicitFriction> {
+        None
+    }
 
     /// The state was replaced (a checkpoint restored): forget what the
     /// stepper formed ahead from the old one.
     fn state_replaced(&mut self) {}
-
-    /// Values stored per factor of the step's operator.
-    fn factor_len(&self) -> usize {
-        0
-    }
-
-    /// (values of W = L⁻¹Pᵀ the step uses, values of the factor on the
-    /// contact DOFs' paths to the root).
-    fn paths_len(&self) -> (usize, usize) {
-        (0, 0)
-    }
 
     /// Bytes of K one step streams.
     fn matrix_bytes(&self) -> usize {

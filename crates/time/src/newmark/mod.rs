@@ -389,20 +389,12 @@ impl Stepper for Newmark {
         "assembled CSR"
     }
 
-    fn factorizations(&self) -> u64 {
-        self.friction.factorizations()
+    fn implicit(&self) -> Option<&ImplicitFriction> {
+        Some(&self.friction)
     }
 
-    fn set_factorizations(&mut self, count: u64) {
-        self.friction.set_factorizations(count);
-    }
-
-    fn factor_len(&self) -> usize {
-        self.friction.factor_len()
-    }
-
-    fn paths_len(&self) -> (usize, usize) {
-        self.friction.paths_len()
+    fn implicit_mut(&mut self) -> Option<&mut ImplicitFriction> {
+        Some(&mut self.friction)
     }
 }
 
