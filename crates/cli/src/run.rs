@@ -404,6 +404,7 @@ pub(crate) fn record<'a>(
         external_work: e.external_work,
         dissipated: e.dissipated,
         damped: e.damped,
+        foundation: e.foundation,
         total: e.total,
         balance: e.balance,
         dt,

@@ -2,6 +2,7 @@
 //! forces at the new velocity, the work they dissipate over the step, and
 //! the slip → stick events that Remark 4.3's step reduction follows.
 
+use crate::foundation::split_work;
 use crate::law::SlipState;
 use crate::surface::ContactSurface;
 
@@ -13,7 +14,10 @@ impl ContactSurface {
     /// ([`ContactNode::motion`](crate::ContactNode::motion)). Δs_J is
     /// (r_K − r_{K−1})·τ_J for Newmark ¼, ½, so the energy balance closes
     /// to round-off there; with φ_ε odd and increasing the sum is never
-    /// negative for any scheme.
+    /// negative for any scheme. On a moving foundation the force is
+    /// w_J g_J φ_ε(w) on the slip w = v_T − V and the work splits into the
+    /// dissipated part, on the slip increment, and the foundation's
+    /// (METHOD.md §9), the second of the pair returned (0 at rest).
     pub fn step_dissipation(
         &self,
         v_new: &[f64],
@@ -21,19 +25,29 @@ impl ContactSurface {
         dt: f64,
         forces_old: &[f64],
         forces: &mut [f64],
-    ) -> f64 {
-        let mut dissipated = 0.0;
-        for ((n, f), f_old) in self.nodes.iter().zip(forces.iter_mut()).zip(forces_old) {
+    ) -> (f64, f64) {
+        let (mut dissipated, mut foundation) = (0.0, 0.0);
+        for (j, ((n, f), f_old)) in self
+            .nodes
+            .iter()
+            .zip(forces.iter_mut())
+            .zip(forces_old)
+            .enumerate()
+        {
             let (v_t, increment) = n.motion(v_new, v, dt);
-            *f = n.force(&self.law, v_t);
-            dissipated += work(*f, *f_old, increment);
+            *f = n.force(&self.law, self.slip(j, v_t));
+            let (d, w) = split_work(*f, *f_old, increment, self.foundation_speed(j), dt);
+            dissipated += d;
+            foundation += w;
         }
-        dissipated
+        (dissipated, foundation)
     }
 
     /// [`ContactSurface::step_dissipation`] with the nodes' tangential
     /// velocities given (`u_new`, `u`: one per node), as a step that solves
-    /// for them forms them (the modal step).
+    /// for them forms them (the modal step); on a moving foundation its sum
+    /// is the friction's net work on the body, dissipated less the
+    /// foundation's.
     pub fn step_dissipation_tangential(
         &self,
         u_new: &[f64],
@@ -43,14 +57,15 @@ impl ContactSurface {
         forces: &mut [f64],
     ) -> f64 {
         let mut dissipated = 0.0;
-        for (((n, f), f_old), (u_new, u)) in self
+        for (j, (((n, f), f_old), (u_new, u))) in self
             .nodes
             .iter()
             .zip(forces.iter_mut())
             .zip(forces_old)
             .zip(u_new.iter().zip(u))
+            .enumerate()
         {
-            *f = n.force(&self.law, *u_new);
+            *f = n.force(&self.law, self.slip(j, *u_new));
             dissipated += work(*f, *f_old, 0.5 * dt * (u_new + u));
         }
         dissipated

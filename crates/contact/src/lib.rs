@@ -20,6 +20,7 @@
 
 #![forbid(unsafe_code)]
 
+mod foundation;
 mod iteration;
 mod law;
 mod ledger;

@@ -11,9 +11,9 @@
 //! Products by these reciprocals round differently from the quotients, to
 //! within rounding.
 
+use crate::foundation::split_work;
 use crate::iteration::StepSystem;
 use crate::law::{FrictionLaw, SlipState};
-use crate::ledger::work;
 use crate::surface::{ContactNode, ContactSurface};
 
 /// The constants of one contact node for one D.
@@ -31,6 +31,8 @@ struct Node {
     c: f64,
     /// 1/(1 + c/ε): the stuck root is p times this.
     stuck: f64,
+    /// The foundation's speed V (METHOD.md §9), 0 at rest.
+    foundation: f64,
 }
 
 /// The closed-form nodal friction of a diagonal step, its constants formed
@@ -55,6 +57,12 @@ impl NodalClosedForm {
     pub fn prepare(&mut self, surface: &ContactSurface, mass: &[f64], scale: f64) {
         let key = (scale.to_bits(), surface.revision);
         if self.scale == Some(key) && self.nodes.len() == surface.nodes.len() {
+            // A foundation's speed may change every step; it forms nothing.
+            if !surface.foundation.is_empty() {
+                for (j, node) in self.nodes.iter_mut().enumerate() {
+                    node.foundation = surface.foundation_speed(j);
+                }
+            }
             return;
         }
         let law = surface.law;
@@ -62,7 +70,7 @@ impl NodalClosedForm {
         self.inv_eps = 1.0 / law.eps;
         self.nodes.clear();
         self.dofs.clear();
-        for node in &surface.nodes {
+        for (j, node) in surface.nodes.iter().enumerate() {
             self.dofs.extend(node.dofs.iter().flatten());
             let wg = node.force_scale();
             let (mut a, mut inv_d, mut w, mut q) = ([0.0; 2], [0.0; 2], [0.0; 2], 0.0);
@@ -82,6 +90,7 @@ impl NodalClosedForm {
                 w,
                 c,
                 stuck: law.stuck_factor(c),
+                foundation: surface.foundation_speed(j),
             });
         }
         self.scale = Some(key);
@@ -119,8 +128,10 @@ impl NodalClosedForm {
                     p += node.a[c] * bj[c];
                 }
             }
-            let t = law.solve_nodal_by(p, node.c, node.stuck);
-            let phi = law.class_and_phi_by_reciprocal(t, self.inv_eps).1;
+            // The slip w = t − V solves w + c φ_ε(w) = p − V (METHOD.md §9);
+            // p − 0 is p, so a foundation at rest moves no bit.
+            let w = law.solve_nodal_by(p - node.foundation, node.c, node.stuck);
+            let phi = law.class_and_phi_by_reciprocal(w, self.inv_eps).1;
             for c in 0..2 {
                 if let Some(i) = dofs[c] {
                     out(j, c, i, bj[c] * node.inv_d[c] - phi * node.w[c]);
@@ -133,8 +144,8 @@ impl NodalClosedForm {
     /// of [`ContactSurface::classify`], [`ContactSurface::step_dissipation`]
     /// and [`stick_events`](crate::stick_events): the classes of `v_new`
     /// into `classes`, the forces f_J into `forces`, and (the work
-    /// dissipated from `v` to `v_new` over `dt`, the slip → stick events
-    /// against `old`).
+    /// dissipated from `v` to `v_new` over `dt`, the foundation's work over
+    /// it, the slip → stick events against `old`).
     #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn ledger(
@@ -146,9 +157,9 @@ impl NodalClosedForm {
         classes: &mut [SlipState],
         forces_old: &[f64],
         forces: &mut [f64],
-    ) -> (f64, usize) {
+    ) -> (f64, f64, usize) {
         let law = self.law();
-        let (mut dissipated, mut events) = (0.0, 0);
+        let (mut dissipated, mut foundation, mut events) = (0.0, 0.0, 0);
         for ((((node, class), f), f_old), was) in self
             .nodes
             .iter()
@@ -158,11 +169,13 @@ impl NodalClosedForm {
             .zip(old)
         {
             let (vt, increment) = node.node.motion(v_new, v, dt);
-            (*class, *f) = node.node.class_and_force(&law, vt);
-            dissipated += work(*f, *f_old, increment);
+            (*class, *f) = node.node.class_and_force(&law, vt - node.foundation);
+            let (d, w) = split_work(*f, *f_old, increment, node.foundation, dt);
+            dissipated += d;
+            foundation += w;
             events += usize::from(class.sticks_after(*was));
         }
-        (dissipated, events)
+        (dissipated, foundation, events)
     }
 }
 
@@ -307,7 +320,7 @@ mod tests {
                     dissipated += 0.5 * (f + f_old) * increment;
                 }
                 let mut surface_forces = vec![0.0; 5];
-                let surface_dissipated =
+                let (surface_dissipated, _) =
                     contact.step_dissipation(&v_new, &v, dt, &forces_old, &mut surface_forces);
                 assert_eq!(surface_dissipated.to_bits(), dissipated.to_bits());
                 assert_eq!(surface_forces, forces);
@@ -334,7 +347,8 @@ mod tests {
                     "amp {amp}"
                 );
                 assert_eq!(got.0.to_bits(), dissipated.to_bits(), "amp {amp}");
-                assert_eq!(got.1, events, "amp {amp}");
+                assert_eq!(got.1.to_bits(), 0f64.to_bits(), "amp {amp}");
+                assert_eq!(got.2, events, "amp {amp}");
                 for c in &classes {
                     seen[match c {
                         SlipState::Stuck => 0,

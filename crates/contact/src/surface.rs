@@ -152,6 +152,9 @@ pub struct ContactSurface {
     pub excluded: Vec<usize>,
     /// The regularized law with its ε.
     pub law: FrictionLaw,
+    /// Each node's foundation speed V_J along τ_J (METHOD.md §9); empty
+    /// while the foundation is at rest (`foundation.rs`).
+    pub foundation: Vec<f64>,
 }
 
 impl ContactSurface {
@@ -208,6 +211,7 @@ impl ContactSurface {
             excluded,
             revision: 0,
             law: FrictionLaw { eps },
+            foundation: Vec::new(),
         })
     }
 
@@ -231,6 +235,7 @@ impl ContactSurface {
             excluded: Vec::new(),
             revision: 0,
             law: FrictionLaw { eps },
+            foundation: Vec::new(),
         })
     }
 
@@ -262,29 +267,29 @@ impl ContactSurface {
 
     /// Classifies every node from a free-DOF velocity vector.
     pub fn classify(&self, velocity: &[f64], classes: &mut [SlipState]) {
-        for (n, c) in self.nodes.iter().zip(classes.iter_mut()) {
-            *c = self.law.classify(n.tangential(velocity));
+        for (j, (n, c)) in self.nodes.iter().zip(classes.iter_mut()).enumerate() {
+            *c = self.law.classify(self.slip(j, n.tangential(velocity)));
         }
     }
 
     /// Nodal friction force magnitudes f_J = w_J g_J φ_ε(v_TJ) along τ_J
     /// (the friction force vector is J = Σ f_J τ_J, paper eq. (4.5)).
     pub fn nodal_forces(&self, velocity: &[f64], out: &mut [f64]) {
-        for (n, f) in self.nodes.iter().zip(out.iter_mut()) {
-            *f = n.force(&self.law, n.tangential(velocity));
+        for (j, (n, f)) in self.nodes.iter().zip(out.iter_mut()).enumerate() {
+            *f = n.force(&self.law, self.slip(j, n.tangential(velocity)));
         }
     }
 
     /// Friction stress σ_T = −g φ_ε(v_T) at each node (paper eq. (4.10)),
     /// by [`ContactSurface::stress`].
     pub fn friction_stress(&self, velocity: &[f64], out: &mut [f64]) {
-        for (n, s) in self.nodes.iter().zip(out.iter_mut()) {
-            *s = self.stress(n, n.tangential(velocity));
+        for (j, (n, s)) in self.nodes.iter().zip(out.iter_mut()).enumerate() {
+            *s = self.stress(n, self.slip(j, n.tangential(velocity)));
         }
     }
 
-    /// σ_T = −g φ_ε(v_T) of `node` at tangential velocity `v_t`, +0 where
-    /// v_T = 0 (−g · 0 is −0, which printed as "-0.000").
+    /// σ_T = −g φ_ε(w) of `node` at slip `w` (v_T where the foundation is
+    /// at rest), +0 where w = 0 (−g · 0 is −0, which printed as "-0.000").
     pub fn stress(&self, node: &ContactNode, v_t: f64) -> f64 {
         -node.bound * self.law.phi(v_t) + 0.0
     }
@@ -312,14 +317,21 @@ impl ContactSurface {
         }
     }
 
-    /// Subtracts the slip forces F = Σ w g sign(v) τ of slipping nodes from a
-    /// right-hand side on free DOFs (F moves to the right as −F).
+    /// Subtracts the slip forces F = Σ w g sign(w) τ of slipping nodes from a
+    /// right-hand side on free DOFs (F moves to the right as −F). A stuck
+    /// node on a moving foundation has the force (w g/ε)(v_T − V) τ, whose
+    /// part −(w g/ε) V τ is constant: it moves to the right as +(w g/ε) V τ.
     pub fn subtract_slip_forces(&self, classes: &[SlipState], rhs: &mut [f64]) {
-        for (n, c) in self.nodes.iter().zip(classes) {
-            if c.is_stuck() {
-                continue;
-            }
-            let f = n.slip_force(*c);
+        for (j, (n, c)) in self.nodes.iter().zip(classes).enumerate() {
+            let f = if c.is_stuck() {
+                let v = self.foundation_speed(j);
+                if v == 0.0 {
+                    continue;
+                }
+                -n.stuck_damping(&self.law) * v
+            } else {
+                n.slip_force(*c)
+            };
             for a in 0..2 {
                 if let Some(i) = n.dofs[a] {
                     rhs[i] -= f * n.tangent[a];
@@ -350,6 +362,7 @@ impl ContactSurface {
             excluded: Vec::new(),
             revision: self.revision,
             law: self.law,
+            foundation: self.foundation.clone(),
         }
     }
 

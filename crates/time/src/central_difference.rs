@@ -342,7 +342,7 @@ impl Stepper for CentralDifference {
         if !sums.finite {
             return Err(self.non_finite(step, t_new));
         }
-        let (dissipated, stick_events) = if run.contact.is_some() {
+        let (dissipated, foundation, stick_events) = if run.contact.is_some() {
             state.friction_passes += 1;
             self.nodal.closed_form().ledger(
                 &state.v_new,
@@ -354,7 +354,7 @@ impl Stepper for CentralDifference {
                 &mut state.forces_new,
             )
         } else {
-            (0.0, 0)
+            (0.0, 0.0, 0)
         };
         state.commit(dt, t_new, iterations);
         // r_new now holds r_{K−1}, free: the next predictor goes there.
@@ -369,6 +369,7 @@ impl Stepper for CentralDifference {
             work,
             dissipated,
             damped,
+            foundation,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))

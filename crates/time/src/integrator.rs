@@ -5,6 +5,7 @@ use stickslip_contact::{ContactSurface, SlipState};
 use stickslip_linalg::FillOrder;
 
 use crate::dynamics::{Dynamics, Load, Loads};
+use crate::foundation::FoundationHistories;
 use crate::history::History;
 use crate::newmark::ImplicitFriction;
 use crate::pressure::BoundHistories;
@@ -25,6 +26,8 @@ pub struct Integrator {
     fill_order: FillOrder,
     /// The friction bounds' histories, where a surface's pressure changes.
     bounds: Option<BoundHistories>,
+    /// The foundations' speeds that change in time.
+    foundations: Option<FoundationHistories>,
 }
 
 impl std::fmt::Debug for Integrator {
@@ -96,6 +99,7 @@ impl Integrator {
             stepper,
             fill_order,
             bounds: None,
+            foundations: None,
         })
     }
 
@@ -118,9 +122,32 @@ impl Integrator {
     }
 
     /// Sets the bounds for time `t`, where they change in time.
+    /// Makes each contact surface's foundation speed (built into the
+    /// surface, [`ContactSurface::set_foundation`]) change in time: V_J of
+    /// surface k times `histories[k]`(t), set before each step for the time
+    /// it ends at, as [`Integrator::set_pressure_histories`] sets the
+    /// bounds. Nothing is kept where no foundation moves or every history
+    /// is constant. Call it on a fresh integrator, before
+    /// [`Integrator::restore`].
+    pub fn set_foundation_histories(&mut self, histories: &[History]) {
+        let Some(contact) = self.run.contact.as_mut() else {
+            return;
+        };
+        self.foundations = FoundationHistories::new(contact, histories);
+        if let Some(f) = &mut self.foundations {
+            f.apply(self.state.t, contact);
+            // The initial classes and forces act on the slip at t = 0.
+            contact.classify(&self.state.v, &mut self.state.classes);
+            contact.nodal_forces(&self.state.v, &mut self.state.forces);
+        }
+    }
+
     fn bounds_at(&mut self, t: f64) {
         if let (Some(b), Some(c)) = (&mut self.bounds, &mut self.run.contact) {
             b.apply(t, c);
+        }
+        if let (Some(f), Some(c)) = (&mut self.foundations, &mut self.run.contact) {
+            f.apply(t, c);
         }
     }
 
@@ -135,7 +162,7 @@ impl Integrator {
     /// A failed linear solve, a stick/slip iteration that hits its cap, or a
     /// non-finite state. The state is left at the last completed step.
     pub fn step(&mut self) -> Result<StepInfo, TimeError> {
-        if self.bounds.is_none() {
+        if self.bounds.is_none() && self.foundations.is_none() {
             return self.stepper.step(&self.run, &mut self.state);
         }
         let t_new = self.state.next_step(&self.run.settings).1;
@@ -253,8 +280,11 @@ impl Integrator {
                 }
             }
             (None, Some(c)) => {
-                for (o, n) in out.iter_mut().zip(&c.nodes) {
-                    *o = c.law.classify(n.tangential(&self.state.v)).code();
+                for (j, (o, n)) in out.iter_mut().zip(&c.nodes).enumerate() {
+                    *o = c
+                        .law
+                        .classify(c.slip(j, n.tangential(&self.state.v)))
+                        .code();
                 }
             }
             (None, None) => {}
@@ -335,11 +365,12 @@ impl Integrator {
             c.friction_stress(&self.state.v, out);
         }
     }
-    /// Tangential (slip) velocity at each contact node.
+    /// The slip w = v_T − V at each contact node (v_T on a foundation at
+    /// rest).
     pub fn slip_velocity(&self, out: &mut [f64]) {
         if let Some(c) = self.contact() {
-            for (o, n) in out.iter_mut().zip(&c.nodes) {
-                *o = n.tangential(&self.state.v);
+            for (j, (o, n)) in out.iter_mut().zip(&c.nodes).enumerate() {
+                *o = c.slip(j, n.tangential(&self.state.v));
             }
         }
     }

@@ -24,6 +24,7 @@
 mod central_difference;
 mod dynamics;
 mod floating;
+mod foundation;
 mod history;
 mod initial;
 mod integrator;

@@ -140,7 +140,7 @@ impl Stepper for QuasiStatic {
         let (work, load_dot) = state.load_work();
         // Friction's work over the increment Δr = Δt ṙ_K: the ledger's
         // ½Δt(v + v_new) with both velocities the increment's rate.
-        let (dissipated, stick_events) = match &run.contact {
+        let ((dissipated, foundation), stick_events) = match &run.contact {
             Some(c) => {
                 state.friction_passes += 1;
                 let d = c.step_dissipation(
@@ -152,7 +152,7 @@ impl Stepper for QuasiStatic {
                 );
                 (d, stick_events(&state.classes, &state.classes_new))
             }
-            None => (0.0, 0),
+            None => ((0.0, 0.0), 0),
         };
         state.commit(dt, t_new, iterations);
         let strain = 0.5 * quadratic_form(&self.k, &state.r, &mut self.partials);
@@ -162,6 +162,7 @@ impl Stepper for QuasiStatic {
             work,
             dissipated,
             damped: 0.0,
+            foundation,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))

@@ -25,9 +25,13 @@ pub struct Energy {
     pub damped: f64,
     /// kinetic + strain − rᵀR(t): the paper's total energy (Fig. 9).
     pub total: f64,
-    /// kinetic + strain − initial − work + dissipated + damped; zero up to
-    /// round-off for the trapezoidal rule (Newmark ¼, ½).
+    /// kinetic + strain − initial − work + dissipated + damped − foundation;
+    /// zero up to round-off for the trapezoidal rule (Newmark ¼, ½).
     pub balance: f64,
+    /// W_f, the work a moving foundation did on the body through friction
+    /// (METHOD.md §9): Σ −½(f_K + f_{K−1}) V Δt per node, `dissipated`
+    /// then counting the work on the slip only. 0 on a foundation at rest.
+    pub foundation: f64,
 }
 
 /// What one step did.
@@ -160,6 +164,8 @@ pub(crate) struct StepEnergies {
     pub dissipated: f64,
     /// The damping's dissipation over the step.
     pub damped: f64,
+    /// The foundation's work over the step.
+    pub foundation: f64,
     /// r_K · R_K.
     pub load_dot: f64,
 }
@@ -253,11 +259,15 @@ impl State {
         l.external_work += e.work;
         l.dissipated += e.dissipated;
         l.damped += e.damped;
+        l.foundation += e.foundation;
         l.total = e.kinetic + e.strain - e.load_dot;
-        // Without damping `+ l.damped` adds +0: the same bits as before.
+        // Without damping `+ l.damped` adds +0, and on a foundation at rest
+        // `- l.foundation` subtracts +0 (+0 plus ±0 is +0): the same bits
+        // as before.
         l.balance = e.kinetic + e.strain - self.initial_mechanical - l.external_work
             + l.dissipated
-            + l.damped;
+            + l.damped
+            - l.foundation;
         if let Some(r) = settings.stick_reduction {
             if stick_events > 0 {
                 self.reduced_remaining = r.steps;

@@ -25,6 +25,8 @@ use direct::{DirectOperator, ImplicitStep};
 use schur::SchurOperator;
 
 /// How a step solves.
+// One per run, so the variants' sizes cost nothing worth a box.
+#[allow(clippy::large_enum_variant)]
 enum Solver {
     Schur(SchurOperator),
     Direct(DirectOperator),
@@ -195,6 +197,9 @@ impl ImplicitFriction {
                     reduced.set_bounds(|j| c.nodes[j].bound);
                     reduced.revision = c.revision;
                 }
+                if let Some(c) = run.contact.as_ref().filter(|c| !c.foundation.is_empty()) {
+                    reduced.foundation.clone_from(&c.foundation);
+                }
                 let result = iterate(
                     &reduced,
                     &mut op.nodal_system(),
@@ -356,12 +361,12 @@ impl Stepper for Newmark {
             });
         }
         let (work, load_dot) = state.load_work();
-        let (dissipated, stick_events) = match &run.contact {
+        let ((dissipated, foundation), stick_events) = match &run.contact {
             Some(c) => {
                 state.friction_passes += 1;
                 friction_ledger(c, state, dt)
             }
-            None => (0.0, 0),
+            None => ((0.0, 0.0), 0),
         };
         let damped = self.damped(settings, state, dt);
         state.commit(dt, t_new, iterations);
@@ -372,6 +377,7 @@ impl Stepper for Newmark {
             work,
             dissipated,
             damped,
+            foundation,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))
@@ -401,13 +407,17 @@ impl Stepper for Newmark {
 /// Friction dissipation of the step and the number of nodes that went
 /// from slip to stick, from the new velocity; fills `forces_new`
 /// (`ContactSurface::step_dissipation`).
-pub(crate) fn friction_ledger(c: &ContactSurface, state: &mut State, dt: f64) -> (f64, usize) {
-    let dissipated = c.step_dissipation(
+pub(crate) fn friction_ledger(
+    c: &ContactSurface,
+    state: &mut State,
+    dt: f64,
+) -> ((f64, f64), usize) {
+    let work = c.step_dissipation(
         &state.v_new,
         &state.v,
         dt,
         &state.forces,
         &mut state.forces_new,
     );
-    (dissipated, stick_events(&state.classes, &state.classes_new))
+    (work, stick_events(&state.classes, &state.classes_new))
 }

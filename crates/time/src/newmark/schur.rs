@@ -456,7 +456,9 @@ impl SchurOperator {
             d.slip.clear();
             d.slip.extend((0..n_c).filter(|&j| self.f[j] != 0.0));
             for (a, &ja) in d.index.iter().enumerate() {
-                let mut r = self.p[ja];
+                // A stuck node's force D(u − V): the slip p − V on the
+                // right (METHOD.md §9), p itself at rest.
+                let mut r = reduced.slip(ja, self.p[ja]);
                 for &j in &d.slip {
                     r -= s[j * n_c + ja] * self.f[j];
                 }

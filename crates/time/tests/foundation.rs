@@ -1,0 +1,172 @@
+//! A moving foundation (METHOD.md §9: the law acts on the slip v_T − V) on
+//! the single mass of tests/sdof.rs (m = 1, k = 100, ω = 10, friction
+//! force g = 1), no load, at rest at 0, on a belt at speed V:
+//!
+//! * V = 5, far above the mass's speed: it slips backward against the belt
+//!   the whole run, the belt dragging it by +g, so ẍ + ω²x = g and
+//!   x(t) = (g/k)(1 − cos ωt) (its speed peaks at g/(kω)·ω² /ω = 0.1 < V);
+//! * V = 1e-4 below ε = 1e-2: the viscous branch, force −(g/ε)(ẋ − V),
+//!   at rest at last where k x = (g/ε)V, x = gV/(εk) = 1e-4;
+//!
+//! by every way of solving a step, with the ledger closed by the
+//! foundation's work; and a foundation at V = 0 moves no bit.
+
+use nalgebra_sparse::{CooMatrix, CsrMatrix};
+use stickslip_contact::{ContactNode, ContactSurface};
+use stickslip_testkit::sdof::{G, K, OMEGA};
+use stickslip_time::{
+    Dynamics, ExplicitFriction, History, ImplicitSolver, Integrator, Scheme, Settings,
+};
+
+const NEWMARK: Scheme = Scheme::Newmark {
+    beta: 0.25,
+    gamma: 0.5,
+};
+
+fn belt(speed: Option<f64>, eps: f64, settings: Settings) -> Integrator {
+    let scalar = |v: f64| {
+        let mut coo = CooMatrix::new(1, 1);
+        coo.push(0, 0, v);
+        CsrMatrix::from(&coo)
+    };
+    let dynamics = Dynamics {
+        stiffness: scalar(K),
+        consistent_mass: scalar(1.0),
+        lumped_mass: vec![1.0],
+        constant_load: vec![0.0],
+        stencils: true,
+        fill_order: Default::default(),
+        rigid_modes: Vec::new(),
+    };
+    let node = ContactNode {
+        node: 0,
+        dofs: [Some(0), None],
+        weight: 1.0,
+        tangent: [1.0, 0.0],
+        s: 0.0,
+        bound: G,
+    };
+    let mut surface = ContactSurface::from_nodes("mass", vec![node], eps).unwrap();
+    if let Some(v) = speed {
+        surface.set_foundation(|_| v);
+    }
+    let mut i = Integrator::new(dynamics, Some(surface), Vec::new(), settings).unwrap();
+    i.set_foundation_histories(&[History::Constant]);
+    i
+}
+
+/// The ways of solving a step, at Δt = 1e-3 to `t_end`.
+fn solvers(t_end: f64) -> Vec<(&'static str, Settings)> {
+    let cd = Settings::new(Scheme::CentralDifference, 1e-3, t_end);
+    let mut iterated = cd.clone();
+    iterated.explicit_friction = ExplicitFriction::Iterate;
+    let nm = Settings::new(NEWMARK, 1e-3, t_end);
+    let mut direct = nm.clone();
+    direct.implicit_solver = ImplicitSolver::Direct;
+    vec![
+        ("closed form", cd),
+        ("explicit iteration", iterated),
+        ("Schur", nm),
+        ("direct", direct),
+    ]
+}
+
+#[test]
+fn a_fast_belt_drags_the_mass_by_g() {
+    let amplitude = G / K;
+    for (name, settings) in solvers(1.0) {
+        let newmark = !matches!(settings.scheme, Scheme::CentralDifference);
+        let mut i = belt(Some(5.0), 1e-2, settings);
+        let mut worst: f64 = 0.0;
+        i.step().unwrap();
+        let (first, x1) = (i.energy().balance, i.displacement()[0]);
+        while !i.done() {
+            i.step().unwrap();
+            let exact = amplitude * (1.0 - (OMEGA * i.time()).cos());
+            worst = worst.max((i.displacement()[0] - exact).abs());
+            assert!(!i.classes()[0].is_stuck(), "{name}: t = {}", i.time());
+        }
+        // The start is frictionless (Remark 4.1: r̈₀ = 0, not g), which
+        // leaves the velocity gΔt/2 short after the first step and an
+        // oscillation of amplitude gΔt/(2ω) = 5e-5; beside it both schemes
+        // are second order, (ωΔt)² = 1e-4 of the amplitude per radian over
+        // ten radians, 1e-3 of it.
+        let dt = 1e-3;
+        let bound = G * dt / (2.0 * OMEGA) + 1e-3 * amplitude;
+        assert!(worst < bound, "{name}: {worst:e} > {bound:e}");
+        let e = i.energy();
+        // The belt did work on the mass: W_f = ∫ g V dt = 5 over the run,
+        // nearly all of it dissipated on the slip.
+        assert!(
+            (e.foundation - G * 5.0).abs() < 1e-2,
+            "{name}: {}",
+            e.foundation
+        );
+        assert!(e.dissipated > 0.0);
+        if newmark {
+            // The trapezoidal rule closes the ledger to round-off after the
+            // first step, which books ½(f₁ + f₀)Δr with f₀ = −g, where the
+            // frictionless start (Remark 4.1) had none: at most g x₁.
+            assert!(first.abs() <= G * x1, "{name}: first step {first:e}");
+            let drift = e.balance - first;
+            assert!(drift.abs() < 1e-12, "{name}: balance moved {drift:e}");
+        } else {
+            // Central difference's ledger is O(Δt²) of the energies.
+            assert!(
+                e.balance.abs() < 1e-3 * e.foundation,
+                "{name}: {:e}",
+                e.balance
+            );
+        }
+    }
+}
+
+#[test]
+fn a_slow_belt_holds_the_mass_on_the_viscous_branch() {
+    let (eps, speed) = (1e-2, 1e-4);
+    let rest = G * speed / (eps * K);
+    let mut settings = solvers(20.0);
+    settings.push((
+        "quasi-static",
+        Settings::new(Scheme::QuasiStatic, 1e-3, 20.0),
+    ));
+    for (name, settings) in settings {
+        let mut i = belt(Some(speed), eps, settings);
+        while !i.done() {
+            i.step().unwrap();
+        }
+        assert!(i.classes()[0].is_stuck(), "{name}");
+        // The slow root of s² + (g/ε)s + k = 0 is ≈ −1.01: after 20 time
+        // units e⁻²⁰ ≈ 2e-9 of the approach is left.
+        let x = i.displacement()[0];
+        assert!((x - rest).abs() < 1e-6 * rest, "{name}: {x:e} vs {rest:e}");
+    }
+}
+
+#[test]
+fn a_foundation_at_rest_moves_no_bit() {
+    for (name, settings) in solvers(0.5) {
+        let mut a = belt(None, 1e-2, settings.clone());
+        let mut b = belt(Some(0.0), 1e-2, settings);
+        // A step force P = 2.5 makes the mass slip and stick (tests/sdof.rs).
+        let mut c = a.checkpoint();
+        c.velocity[0] = 1.0;
+        a.restore(&c).unwrap();
+        b.restore(&c).unwrap();
+        while !a.done() {
+            a.step().unwrap();
+            b.step().unwrap();
+            assert_eq!(
+                a.displacement()[0].to_bits(),
+                b.displacement()[0].to_bits(),
+                "{name}"
+            );
+            assert_eq!(
+                a.velocity()[0].to_bits(),
+                b.velocity()[0].to_bits(),
+                "{name}"
+            );
+            assert_eq!(a.energy(), b.energy(), "{name}");
+        }
+    }
+}
