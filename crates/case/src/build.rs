@@ -34,6 +34,9 @@ pub struct Scene {
     /// Each contact surface's pressure history, in case order
     /// ([`Integrator::set_pressure_histories`]).
     pub pressure_histories: Vec<TimeHistory>,
+    /// Each contact surface's foundation history, in case order
+    /// ([`Integrator::set_foundation_histories`]).
+    pub foundation_histories: Vec<TimeHistory>,
     /// The tractions in case order, then the body force, then each contact
     /// surface's pressure, each restricted to the free DOFs.
     pub loads: Vec<Load>,
@@ -90,6 +93,7 @@ impl Scene {
             self.settings.clone(),
         )?;
         i.set_pressure_histories(&self.pressure_histories);
+        i.set_foundation_histories(&self.foundation_histories);
         Ok(i)
     }
 
@@ -102,6 +106,7 @@ impl Scene {
         let mut integrator = Integrator::new(dynamics, self.contact, self.loads, self.settings)
             .map_err(|e| refused(case, e))?;
         integrator.set_pressure_histories(&self.pressure_histories);
+        integrator.set_foundation_histories(&self.foundation_histories);
         Ok(Prepared {
             mesh: self.mesh,
             model: self.model,
@@ -119,6 +124,7 @@ impl Scene {
         let mut integrator = Integrator::new(dynamics, self.contact, self.loads, self.settings)
             .map_err(|e| refused(case, e))?;
         integrator.set_pressure_histories(&self.pressure_histories);
+        integrator.set_foundation_histories(&self.foundation_histories);
         Ok(Running {
             mesh: self.mesh,
             dofs,
@@ -460,6 +466,7 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
         model,
         contact: surfaces.contact,
         pressure_histories: surfaces.histories,
+        foundation_histories: surfaces.foundation_histories,
         loads,
         settings,
     })

@@ -395,6 +395,14 @@ fn complete(
                 "contact.pressure_history: the table needs at least one [t, f] pair and strictly increasing times; e.g. { table = [[0.0, 1.0], [0.5, 0.2]] }".into(),
             );
         }
+        if let History::Table(p) = &c.foundation_history {
+            let increasing = p.windows(2).all(|w| w[1][0] > w[0][0]);
+            check(
+                !p.is_empty() && increasing,
+                &key("foundation_history"),
+                "contact.foundation_history: the table needs at least one [t, f] pair and strictly increasing times; e.g. { table = [[0.0, 0.0], [0.5, 1.0]] }".into(),
+            );
+        }
         if let Some(profile) = &c.pressure_profile {
             let rows = &profile.table;
             let increasing = rows.windows(2).all(|w| w[1][0] > w[0][0]);

@@ -447,6 +447,15 @@ section! {
         "pressure_history" pressure_history: History,
         /// Factor of the pressure along the surface's arc length s.
         "pressure_profile" pressure_profile: Option<Profile>,
+        /// Speed V of the foundation along the surface's tangent τ (a
+        /// conveyor belt): the law acts on the slip v_T − V (METHOD.md §9);
+        /// default 0, a foundation at rest.
+        #[serde(default)]
+        "foundation_velocity" foundation_velocity: f64,
+        /// Time factor of V, the forms of a traction's `history`; default
+        /// `"constant"`.
+        #[serde(default = "constant_history")]
+        "foundation_history" foundation_history: History,
         /// The paper's Remark 4.2 rule in the iteration (default true).
         #[serde(default = "default_remark_4_2")]
         "remark_4_2" remark_4_2: bool,

@@ -20,6 +20,8 @@ pub(crate) struct Surfaces {
     pub loads: Vec<Load>,
     /// Each surface's pressure history, in case order.
     pub histories: Vec<TimeHistory>,
+    /// Each surface's foundation history, in case order.
+    pub foundation_histories: Vec<TimeHistory>,
 }
 
 /// Builds the surfaces of `case`, pushing every problem to `problems`.
@@ -113,13 +115,26 @@ pub(crate) fn surfaces(
             Err(e) => problems.push(format!("{}[contact]: {e}", at("group"))),
         }
         out.histories.push(history(&c.pressure_history));
+        out.foundation_histories
+            .push(history(&c.foundation_history));
     }
     if !problems.is_empty() || built.is_empty() {
         return out;
     }
     let last = built.last().map_or(0, |b| b.0);
+    // Each built surface's foundation speed, kept only where one moves.
+    let speeds: Vec<f64> = built
+        .iter()
+        .map(|(i, _)| case.contact[*i].foundation_velocity)
+        .collect();
     match ContactSurface::join(built.into_iter().map(|(_, s)| s).collect()) {
-        Ok(s) => out.contact = Some(s),
+        Ok(mut s) => {
+            if speeds.iter().any(|&v| v != 0.0) {
+                let part = s.part_of_nodes();
+                s.set_foundation(|j| speeds[part[j]]);
+            }
+            out.contact = Some(s);
+        }
         Err(ContactError::Overlap {
             node,
             first,

@@ -192,3 +192,62 @@ eps = 1e-2
         "runs past the end of surface \"contact\", which is 8 long",
     );
 }
+
+/// `foundation_velocity` reaches each surface's nodes: V on the bottom's,
+/// 0 on the top's; a case without it keeps no speeds at all.
+#[test]
+fn each_surface_keeps_its_own_foundation_speed() {
+    let belt = "foundation_velocity = 2.5\nfoundation_history = { sin = { omega = 3.0 } }\n";
+    let case = load(&slab(&format!("{BOTTOM}{belt}{TOP}"))).unwrap();
+    let scene = assemble(&case).unwrap();
+    let c = scene.contact.as_ref().unwrap();
+    for j in c.parts[0].nodes.clone() {
+        assert_eq!(c.foundation_speed(j), 2.5);
+    }
+    for j in c.parts[1].nodes.clone() {
+        assert_eq!(c.foundation_speed(j), 0.0);
+    }
+    assert_eq!(scene.foundation_histories.len(), 2);
+    let plain = assemble(&load(&slab(BOTTOM)).unwrap()).unwrap();
+    assert!(plain.contact.unwrap().foundation.is_empty());
+}
+
+#[test]
+fn bad_foundations_are_named_at_their_line() {
+    // A speed of the wrong type, a history of the wrong form (both found
+    // before the values are read), then a table unsorted in time.
+    let text = slab(&format!(
+        "{BOTTOM}foundation_velocity = \"fast\"\nfoundation_history = \"ramp\"\n"
+    ));
+    let e = load(&text).unwrap_err();
+    assert_at(
+        &e,
+        &text,
+        "foundation_velocity = \"fast\"",
+        "expected a number",
+    );
+    assert_at(
+        &e,
+        &text,
+        "foundation_history = \"ramp\"",
+        "unknown variant `ramp`",
+    );
+    let text = slab(&format!(
+        "{BOTTOM}{TOP}foundation_velocity = 1.0\nfoundation_history = {{ table = [[0.5, 1.0], [0.1, 0.0]] }}\n"
+    ));
+    let e = load(&text).unwrap_err();
+    assert_at(
+        &e,
+        &text,
+        "[[0.5, 1.0], [0.1, 0.0]]",
+        "strictly increasing times",
+    );
+    let text = slab(&format!("{BOTTOM}foundation_velocity = inf\n"));
+    let e = load(&text).unwrap_err();
+    assert_at(
+        &e,
+        &text,
+        "foundation_velocity = inf",
+        "is not a finite number",
+    );
+}

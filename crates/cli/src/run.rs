@@ -933,11 +933,15 @@ impl Session<'_> {
                 String::new()
             };
             // Rayleigh damping's share, where the case has it.
-            let rayleigh = if case.material.damping.is_some() {
+            let mut rayleigh = if case.material.damping.is_some() {
                 format!(", damped {:.6}", e.damped)
             } else {
                 String::new()
             };
+            // A moving foundation's work, where a surface has one.
+            if case.contact.iter().any(|c| c.foundation_velocity != 0.0) {
+                rayleigh.push_str(&format!(", foundation {:.6}", e.foundation));
+            }
             say!(
                 "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}{rayleigh}); largest |balance| {:.3e}{damped}",
                 e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
