@@ -1,6 +1,8 @@
-//! The four suites of `verify` (`surfaces` runs within `analytic`).
+//! The four suites of `verify` (`surfaces` and `belt` run within
+//! `analytic`).
 
 pub mod analytic;
+pub mod belt;
 pub mod friction_held;
 pub mod paper;
 pub mod rates;

@@ -190,6 +190,10 @@ fn plain_pressure(root: &Path, opts: &Options, r: &mut Report) {
             "pressure 600, profile ½",
             "pressure_profile = { table = [[0.0, 0.5]] }\npressure = 600.0",
         ),
+        (
+            "foundation at rest",
+            "foundation_velocity = 0.0\nfoundation_history = { sin = { omega = 3.0 } }",
+        ),
     ];
     for file in ["cd-step-eps1e-2.toml", "newmark-step.toml"] {
         for (what, extra) in variants {
