@@ -47,6 +47,35 @@ pub fn integrator(
     dt: f64,
     t_end: f64,
 ) -> Result<Integrator, SceneError> {
+    with_surface(p, surface(eps)?, Settings::new(scheme, dt, t_end))
+}
+
+/// The oscillator's one friction node (weight 1, bound g, tangent x) as a
+/// surface of its own, for a test to give a foundation or a μ(w).
+///
+/// # Errors
+/// ε ≤ 0.
+pub fn surface(eps: f64) -> Result<ContactSurface, SceneError> {
+    let node = ContactNode {
+        node: 0,
+        dofs: [Some(0), None],
+        weight: 1.0,
+        tangent: [1.0, 0.0],
+        s: 0.0,
+        bound: G,
+    };
+    Ok(ContactSurface::from_nodes("mass", vec![node], eps)?)
+}
+
+/// The oscillator with friction on `surface` and the step force P.
+///
+/// # Errors
+/// Settings the integrator refuses.
+pub fn with_surface(
+    p: f64,
+    surface: ContactSurface,
+    settings: Settings,
+) -> Result<Integrator, SceneError> {
     let scalar = |v: f64| {
         let mut coo = CooMatrix::new(1, 1);
         coo.push(0, 0, v);
@@ -61,25 +90,11 @@ pub fn integrator(
         fill_order: Default::default(),
         rigid_modes: Vec::new(),
     };
-    let node = ContactNode {
-        node: 0,
-        dofs: [Some(0), None],
-        weight: 1.0,
-        tangent: [1.0, 0.0],
-        s: 0.0,
-        bound: G,
-    };
-    let surface = ContactSurface::from_nodes("mass", vec![node], eps)?;
     let loads = vec![Load {
         vector: vec![p],
         history: History::Step,
     }];
-    Ok(Integrator::new(
-        dynamics,
-        Some(surface),
-        loads,
-        Settings::new(scheme, dt, t_end),
-    )?)
+    Ok(Integrator::new(dynamics, Some(surface), loads, settings)?)
 }
 
 /// (largest |x − x_exact| over [0, 1], x(1)).

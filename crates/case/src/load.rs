@@ -23,7 +23,7 @@ use std::path::Path;
 use crate::error::{listed, InputError};
 use crate::keys::{check_table, dotted, remove_path, seg_name, value_spans};
 use crate::locate::{line_col, Locator};
-use crate::schema::{Case, History, MassKind, Scheme, ROOT};
+use crate::schema::{Case, History, MassKind, Mu, Scheme, ROOT};
 use crate::set::apply_set;
 
 /// Reads, overrides (`--set KEY=VALUE`, VALUE parsed as TOML, else taken as a
@@ -374,13 +374,35 @@ fn complete(
     // [contact]
     for (i, c) in case.contact.iter().enumerate() {
         let key = |k: &str| crate::schema::contact_key_in(spans.keys(), i, k);
-        let (p, mu, eps) = (c.pressure, c.mu, c.eps);
+        let (p, mu, eps) = (c.pressure, c.mu.at_rest(), c.eps);
         check(p >= 0.0 && p.is_finite(), &key("pressure"), format!("contact.pressure = {p} must be >= 0 and finite (it presses the body onto the surface; g = mu * pressure)"));
         check(
             mu >= 0.0 && mu.is_finite(),
             &key("mu"),
             format!("contact.mu = {mu} must be >= 0 and finite; use 0 for frictionless contact"),
         );
+        if let Mu::Speed {
+            stat,
+            kinetic,
+            speed,
+        } = c.mu
+        {
+            check(
+                (0.0..=stat).contains(&kinetic),
+                &key("mu"),
+                format!("contact.mu: kinetic = {kinetic} must be >= 0 and at most static = {stat} (friction falls from static to kinetic as the surface slips); give kinetic <= static, or mu = {stat} for one coefficient"),
+            );
+            check(
+                speed > 0.0 && speed.is_finite(),
+                &key("mu"),
+                format!("contact.mu: speed = {speed} must be > 0 and finite (the slip speed over which mu falls from static towards kinetic, in the model's units)"),
+            );
+            check(
+                case.time.scheme == crate::schema::Scheme::CentralDifference,
+                &key("mu"),
+                "contact.mu = { static, kinetic, speed } runs with the explicit scheme only (its nodal closed form; the implicit stick/slip iteration takes a constant mu): set [time] scheme = \"central_difference\", or give a constant mu".into(),
+            );
+        }
         check(eps > 0.0 && eps.is_finite(), &key("eps"), format!("contact.eps = {eps} must be > 0 and finite (the friction law's regularization; the paper uses 1e-4 to 1)"));
         check(
             c.max_iterations > 0,

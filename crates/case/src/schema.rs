@@ -418,6 +418,100 @@ fn constant_history() -> History {
     History::Constant
 }
 
+/// The friction coefficient: `mu = 0.3`, the paper's constant law, or
+/// `mu = { static = μs, kinetic = μk, speed = vs }`, μ(w) = μk + (μs − μk)
+/// e^{−|w|/vs} on the slip speed (METHOD.md §9).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Mu {
+    /// μ for every slip speed.
+    Constant(f64),
+    /// μ falling from μs at rest to μk.
+    Speed {
+        /// μs.
+        stat: f64,
+        /// μk.
+        kinetic: f64,
+        /// vs.
+        speed: f64,
+    },
+}
+
+impl Mu {
+    /// μ at rest: the constant μ, or μs (the friction bound's g = μ p).
+    pub fn at_rest(&self) -> f64 {
+        match *self {
+            Mu::Constant(mu) | Mu::Speed { stat: mu, .. } => mu,
+        }
+    }
+}
+
+impl Schema for Mu {
+    const KIND: Kind = Kind::Any;
+}
+
+const MU_FORMS: &str =
+    "write mu = 0.3, or mu = { static = 0.5, kinetic = 0.3, speed = 1e-2 } for a coefficient that falls from static to kinetic with the slip speed";
+
+impl<'de> Deserialize<'de> for Mu {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Mu, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = Mu;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(
+                    f,
+                    "a number or a table {{ static, kinetic, speed }}; {MU_FORMS}"
+                )
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Mu, E> {
+                Ok(Mu::Constant(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Mu, E> {
+                Ok(Mu::Constant(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Mu, E> {
+                Ok(Mu::Constant(v as f64))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Mu, A::Error> {
+                use serde::de::Error;
+                let mut got: [Option<f64>; 3] = [None; 3];
+                let names = ["static", "kinetic", "speed"];
+                while let Some(key) = map.next_key::<String>()? {
+                    let Some(k) = names.iter().position(|n| *n == key) else {
+                        return Err(A::Error::custom(format!(
+                            "mu has no key `{key}`: its keys are static, kinetic and speed; {MU_FORMS}"
+                        )));
+                    };
+                    got[k] = Some(
+                        map.next_value::<f64>()
+                            .map_err(|e| A::Error::custom(format!("mu.{key}: {e}; {MU_FORMS}")))?,
+                    );
+                }
+                match got {
+                    [Some(stat), Some(kinetic), Some(speed)] => Ok(Mu::Speed {
+                        stat,
+                        kinetic,
+                        speed,
+                    }),
+                    _ => {
+                        let missing: Vec<&str> = names
+                            .iter()
+                            .zip(got)
+                            .filter(|(_, v)| v.is_none())
+                            .map(|(n, _)| *n)
+                            .collect();
+                        Err(A::Error::custom(format!(
+                            "mu lacks {}; {MU_FORMS}",
+                            missing.join(" and ")
+                        )))
+                    }
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
 section! {
     /// `pressure_profile = { table = [[s, factor], ..] }`: the pressure's
     /// factor along the surface, linear between rows.
@@ -437,8 +531,8 @@ section! {
         "group" group: String,
         /// Prescribed normal pressure F_n (friction bound g = μ F_n).
         "pressure" pressure: f64,
-        /// Coulomb coefficient μ.
-        "mu" mu: f64,
+        /// Coulomb coefficient μ, or μ falling with the slip speed.
+        "mu" mu: Mu,
         /// Regularization ε of the friction law (one for all surfaces).
         "eps" eps: f64,
         /// Time factor of the pressure (the normal load and g = μ p);

@@ -4,12 +4,12 @@
 //! joined into the one set of friction nodes the integrator takes
 //! (friction couples no two nodes, METHOD.md §3).
 
-use stickslip_contact::{ContactError, ContactSurface};
+use stickslip_contact::{ContactError, ContactSurface, Weakening};
 use stickslip_fem::{boundary_quadrature, traction_load, traction_load_with, DofMap, Traction};
 use stickslip_mesh::Mesh;
 use stickslip_time::{History as TimeHistory, Load};
 
-use crate::schema::{Case, ContactSection, History};
+use crate::schema::{Case, ContactSection, History, Mu};
 
 /// What the contact surfaces add to a scene.
 #[derive(Debug, Default)]
@@ -122,17 +122,34 @@ pub(crate) fn surfaces(
         return out;
     }
     let last = built.last().map_or(0, |b| b.0);
-    // Each built surface's foundation speed, kept only where one moves.
+    // Each built surface's foundation speed, kept only where one moves,
+    // and its fall of μ with the slip speed (g = μs p times μ(|w|)/μs =
+    // r + (1 − r) e^{−|w|/vs}).
     let speeds: Vec<f64> = built
         .iter()
         .map(|(i, _)| case.contact[*i].foundation_velocity)
         .collect();
+    let weakening: Vec<Option<Weakening>> = built
+        .iter()
+        .map(|(i, _)| match case.contact[*i].mu {
+            Mu::Constant(_) => None,
+            Mu::Speed {
+                stat,
+                kinetic,
+                speed,
+            } => Some(Weakening {
+                ratio: if stat > 0.0 { kinetic / stat } else { 1.0 },
+                speed,
+            }),
+        })
+        .collect();
     match ContactSurface::join(built.into_iter().map(|(_, s)| s).collect()) {
         Ok(mut s) => {
+            let part = s.part_of_nodes();
             if speeds.iter().any(|&v| v != 0.0) {
-                let part = s.part_of_nodes();
                 s.set_foundation(|j| speeds[part[j]]);
             }
+            s.set_weakening(|j| weakening[part[j]]);
             out.contact = Some(s);
         }
         Err(ContactError::Overlap {
@@ -163,7 +180,8 @@ fn surface(
     c: &ContactSection,
     profile: Option<&History>,
 ) -> Result<ContactSurface, ContactError> {
-    let mut s = ContactSurface::from_group(mesh, dofs, &c.group, c.pressure, c.mu, c.eps)?;
+    let mut s =
+        ContactSurface::from_group(mesh, dofs, &c.group, c.pressure, c.mu.at_rest(), c.eps)?;
     if let Some(f) = profile {
         let built: Vec<(f64, f64)> = s.nodes.iter().map(|n| (n.bound, n.s)).collect();
         s.set_bounds(|j| built[j].0 * f.value(built[j].1));

@@ -81,7 +81,7 @@ fn one_table_and_a_list_are_both_surfaces() {
     let two = load(&slab(&format!("{BOTTOM}{TOP}"))).unwrap();
     assert_eq!(two.contact.len(), 2);
     assert_eq!(
-        (two.contact[1].group.as_str(), two.contact[1].mu),
+        (two.contact[1].group.as_str(), two.contact[1].mu.at_rest()),
         ("support", 0.2)
     );
     let none = load(&slab("")).unwrap();
@@ -250,4 +250,55 @@ fn bad_foundations_are_named_at_their_line() {
         "foundation_velocity = inf",
         "is not a finite number",
     );
+}
+
+/// `mu = { static, kinetic, speed }`: g = μs·p on the nodes, the fall
+/// r = μk/μs and vs on each; `mu = 0.3` keeps none.
+#[test]
+fn a_speed_dependent_mu_reaches_the_nodes() {
+    let bottom = BOTTOM.replace(
+        "mu = 0.3",
+        "mu = { static = 0.5, kinetic = 0.25, speed = 1e-2 }",
+    );
+    let scene = assemble(&load(&slab(&bottom)).unwrap()).unwrap();
+    let c = scene.contact.unwrap();
+    for (j, n) in c.nodes.iter().enumerate() {
+        assert_eq!(n.bound, 0.5 * 300.0);
+        let k = c.weakening_of(j).unwrap();
+        assert_eq!((k.ratio, k.speed), (0.5, 1e-2));
+    }
+    let plain = assemble(&load(&slab(BOTTOM)).unwrap()).unwrap();
+    assert!(!plain.contact.unwrap().weakens());
+}
+
+#[test]
+fn bad_speed_dependent_mus_are_named_at_their_line() {
+    let with = |mu: &str| slab(&BOTTOM.replace("mu = 0.3", mu));
+    for (mu, what) in [
+        (
+            "mu = { static = 0.3, kinetic = 0.5, speed = 1e-2 }",
+            "at most static = 0.3",
+        ),
+        (
+            "mu = { static = 0.3, kinetic = 0.2, speed = 0.0 }",
+            "speed = 0 must be > 0",
+        ),
+        (
+            "mu = { static = 0.3, kinetic = 0.2, sped = 1e-2 }",
+            "mu has no key `sped`",
+        ),
+        ("mu = { static = 0.3, kinetic = 0.2 }", "mu lacks speed"),
+        (
+            "mu = \"high\"",
+            "a number or a table { static, kinetic, speed }",
+        ),
+    ] {
+        let text = with(mu);
+        let e = load(&text).unwrap_err();
+        assert_at(&e, &text, mu, what);
+    }
+    let text = with("mu = { static = 0.3, kinetic = 0.2, speed = 1e-2 }")
+        .replace("scheme = \"central_difference\"", "scheme = \"newmark\"");
+    let e = load(&text).unwrap_err();
+    assert_at(&e, &text, "mu = {", "runs with the explicit scheme only");
 }

@@ -174,7 +174,7 @@ pub(crate) fn friction_off(case: &Case, i: &Integrator) -> Option<String> {
     let surfaces = &case.contact;
     Some(if surfaces.is_empty() {
         "the case has no [contact]".to_string()
-    } else if surfaces.iter().all(|c| c.mu == 0.0) {
+    } else if surfaces.iter().all(|c| c.mu.at_rest() == 0.0) {
         "contact.mu = 0".to_string()
     } else if surfaces.iter().all(|c| c.pressure == 0.0) {
         "contact.pressure = 0".to_string()

@@ -35,7 +35,8 @@ impl ContactSurface {
             .enumerate()
         {
             let (v_t, increment) = n.motion(v_new, v, dt);
-            *f = n.force(&self.law, self.slip(j, v_t));
+            let w = self.slip(j, v_t);
+            *f = n.force(&self.law, w) * self.factor(j, w);
             let (d, w) = split_work(*f, *f_old, increment, self.foundation_speed(j), dt);
             dissipated += d;
             foundation += w;

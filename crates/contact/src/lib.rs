@@ -24,11 +24,13 @@ mod foundation;
 mod iteration;
 mod law;
 mod ledger;
+mod mu_speed;
 mod nodal;
 mod surface;
 
 pub use iteration::{iterate, IterationFailure, IterationOptions, IterationReport, StepSystem};
 pub use law::{FrictionLaw, SlipState};
 pub use ledger::stick_events;
+pub use mu_speed::Weakening;
 pub use nodal::{DiagonalStep, NodalClosedForm};
 pub use surface::{ContactError, ContactNode, ContactSurface, SurfacePart};

@@ -33,6 +33,8 @@ struct Node {
     stuck: f64,
     /// The foundation's speed V (METHOD.md §9), 0 at rest.
     foundation: f64,
+    /// The fall of μ with the slip speed, `None` for the constant law.
+    weakening: Option<crate::Weakening>,
 }
 
 /// The closed-form nodal friction of a diagonal step, its constants formed
@@ -91,6 +93,7 @@ impl NodalClosedForm {
                 c,
                 stuck: law.stuck_factor(c),
                 foundation: surface.foundation_speed(j),
+                weakening: surface.weakening_of(j),
             });
         }
         self.scale = Some(key);
@@ -130,8 +133,17 @@ impl NodalClosedForm {
             }
             // The slip w = t − V solves w + c φ_ε(w) = p − V (METHOD.md §9);
             // p − 0 is p, so a foundation at rest moves no bit.
-            let w = law.solve_nodal_by(p - node.foundation, node.c, node.stuck);
-            let phi = law.class_and_phi_by_reciprocal(w, self.inv_eps).1;
+            let phi = match node.weakening {
+                None => {
+                    let w = law.solve_nodal_by(p - node.foundation, node.c, node.stuck);
+                    law.class_and_phi_by_reciprocal(w, self.inv_eps).1
+                }
+                // μ(|w|)/μs times φ_ε(w), on the root mu_speed.rs chooses.
+                Some(k) => {
+                    let w = k.solve_nodal(&law, p - node.foundation, node.c);
+                    law.phi(w) * k.factor(w.abs())
+                }
+            };
             for c in 0..2 {
                 if let Some(i) = dofs[c] {
                     out(j, c, i, bj[c] * node.inv_d[c] - phi * node.w[c]);
@@ -169,7 +181,11 @@ impl NodalClosedForm {
             .zip(old)
         {
             let (vt, increment) = node.node.motion(v_new, v, dt);
-            (*class, *f) = node.node.class_and_force(&law, vt - node.foundation);
+            let w = vt - node.foundation;
+            (*class, *f) = node.node.class_and_force(&law, w);
+            if let Some(k) = node.weakening {
+                *f *= k.factor(w.abs());
+            }
             let (d, w) = split_work(*f, *f_old, increment, node.foundation, dt);
             dissipated += d;
             foundation += w;

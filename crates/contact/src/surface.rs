@@ -155,6 +155,10 @@ pub struct ContactSurface {
     /// Each node's foundation speed V_J along τ_J (METHOD.md §9); empty
     /// while the foundation is at rest (`foundation.rs`).
     pub foundation: Vec<f64>,
+    /// Each node's fall of μ with the slip speed (METHOD.md §9), `None`
+    /// for the constant law; empty where every node's μ is constant
+    /// (`mu_speed.rs`).
+    pub weakening: Vec<Option<crate::Weakening>>,
 }
 
 impl ContactSurface {
@@ -212,6 +216,7 @@ impl ContactSurface {
             revision: 0,
             law: FrictionLaw { eps },
             foundation: Vec::new(),
+            weakening: Vec::new(),
         })
     }
 
@@ -236,6 +241,7 @@ impl ContactSurface {
             revision: 0,
             law: FrictionLaw { eps },
             foundation: Vec::new(),
+            weakening: Vec::new(),
         })
     }
 
@@ -276,7 +282,8 @@ impl ContactSurface {
     /// (the friction force vector is J = Σ f_J τ_J, paper eq. (4.5)).
     pub fn nodal_forces(&self, velocity: &[f64], out: &mut [f64]) {
         for (j, (n, f)) in self.nodes.iter().zip(out.iter_mut()).enumerate() {
-            *f = n.force(&self.law, self.slip(j, n.tangential(velocity)));
+            let w = self.slip(j, n.tangential(velocity));
+            *f = n.force(&self.law, w) * self.factor(j, w);
         }
     }
 
@@ -284,7 +291,8 @@ impl ContactSurface {
     /// by [`ContactSurface::stress`].
     pub fn friction_stress(&self, velocity: &[f64], out: &mut [f64]) {
         for (j, (n, s)) in self.nodes.iter().zip(out.iter_mut()).enumerate() {
-            *s = self.stress(n, self.slip(j, n.tangential(velocity)));
+            let w = self.slip(j, n.tangential(velocity));
+            *s = self.stress(n, w) * self.factor(j, w);
         }
     }
 
@@ -363,6 +371,7 @@ impl ContactSurface {
             revision: self.revision,
             law: self.law,
             foundation: self.foundation.clone(),
+            weakening: self.weakening.clone(),
         }
     }
 

@@ -59,6 +59,19 @@ impl Integrator {
         settings: Settings,
     ) -> Result<Integrator, TimeError> {
         let mass_kind = settings.check(dynamics.n())?;
+        // μ falling with the slip speed is solved node by node in the
+        // explicit closed form only: the stick/slip iteration's slip
+        // forces are constant per class, which μ(w) is not.
+        let explicit = settings.scheme == Scheme::CentralDifference
+            && settings.explicit_friction == crate::settings::ExplicitFriction::ClosedForm;
+        if contact.as_ref().is_some_and(ContactSurface::weakens) && !explicit {
+            return Err(TimeError::Settings(
+                "a friction coefficient that falls with the slip speed (mu = { static, kinetic, speed }) \
+                 runs with the explicit scheme's nodal closed form only: use time.scheme = \
+                 \"central_difference\", or a constant mu"
+                    .into(),
+            ));
+        }
         // A scene without friction nodes runs no friction code; nor does
         // one whose nodes carry none (μ = 0 or no pressure: w g = 0 at
         // every node), which then steps as a scene without a contact

@@ -11,12 +11,8 @@
 //! by every way of solving a step, with the ledger closed by the
 //! foundation's work; and a foundation at V = 0 moves no bit.
 
-use nalgebra_sparse::{CooMatrix, CsrMatrix};
-use stickslip_contact::{ContactNode, ContactSurface};
-use stickslip_testkit::sdof::{G, K, OMEGA};
-use stickslip_time::{
-    Dynamics, ExplicitFriction, History, ImplicitSolver, Integrator, Scheme, Settings,
-};
+use stickslip_testkit::sdof::{self, G, K, OMEGA};
+use stickslip_time::{ExplicitFriction, History, ImplicitSolver, Integrator, Scheme, Settings};
 
 const NEWMARK: Scheme = Scheme::Newmark {
     beta: 0.25,
@@ -24,33 +20,11 @@ const NEWMARK: Scheme = Scheme::Newmark {
 };
 
 fn belt(speed: Option<f64>, eps: f64, settings: Settings) -> Integrator {
-    let scalar = |v: f64| {
-        let mut coo = CooMatrix::new(1, 1);
-        coo.push(0, 0, v);
-        CsrMatrix::from(&coo)
-    };
-    let dynamics = Dynamics {
-        stiffness: scalar(K),
-        consistent_mass: scalar(1.0),
-        lumped_mass: vec![1.0],
-        constant_load: vec![0.0],
-        stencils: true,
-        fill_order: Default::default(),
-        rigid_modes: Vec::new(),
-    };
-    let node = ContactNode {
-        node: 0,
-        dofs: [Some(0), None],
-        weight: 1.0,
-        tangent: [1.0, 0.0],
-        s: 0.0,
-        bound: G,
-    };
-    let mut surface = ContactSurface::from_nodes("mass", vec![node], eps).unwrap();
+    let mut surface = sdof::surface(eps).unwrap();
     if let Some(v) = speed {
         surface.set_foundation(|_| v);
     }
-    let mut i = Integrator::new(dynamics, Some(surface), Vec::new(), settings).unwrap();
+    let mut i = sdof::with_surface(0.0, surface, settings).unwrap();
     i.set_foundation_histories(&[History::Constant]);
     i
 }
@@ -167,6 +141,28 @@ fn a_foundation_at_rest_moves_no_bit() {
                 "{name}"
             );
             assert_eq!(a.energy(), b.energy(), "{name}");
+        }
+    }
+}
+
+/// μ falling with the slip speed is solved by the explicit closed form
+/// only; every iterating solver refuses it rather than run a law whose
+/// slip forces it would take as constant.
+#[test]
+fn a_speed_dependent_mu_runs_in_the_closed_form_only() {
+    for (name, settings) in solvers(0.01) {
+        let closed = name == "closed form";
+        let mut surface = sdof::surface(1e-3).unwrap();
+        surface.set_weakening(|_| {
+            Some(stickslip_contact::Weakening {
+                ratio: 0.5,
+                speed: 1e-2,
+            })
+        });
+        let result = sdof::with_surface(2.5, surface, settings);
+        assert_eq!(result.is_ok(), closed, "{name}");
+        if let Err(e) = result {
+            assert!(e.to_string().contains("central_difference"), "{name}: {e}");
         }
     }
 }

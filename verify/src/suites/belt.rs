@@ -12,7 +12,9 @@
 
 use std::path::Path;
 
-use stickslip_time::Integrator;
+use stickslip_contact::Weakening;
+use stickslip_testkit::sdof;
+use stickslip_time::{Integrator, Rayleigh, Scheme, Settings};
 
 use crate::report::Report;
 
@@ -22,9 +24,16 @@ const MU: f64 = 0.3;
 const V: f64 = 1.0;
 
 /// Runs the check on both schemes.
-/// e^{−αt/2} = e^{−10} of the start's motion is left at t = 10 with α = 2,
-/// in quick mode as in full (a 148-DOF slab: a fraction of a second).
+/// Runs the checks: the held slab on both schemes, stick-slip on the
+/// oscillator. e^{−αt/2} = e^{−10} of the slab's start is left at t = 10
+/// with α = 2, in quick mode as in full (a 148-DOF slab: a fraction of a
+/// second); the oscillator is one DOF.
 pub fn run(root: &Path, r: &mut Report) {
+    held_slab(root, r);
+    stick_slip(r);
+}
+
+fn held_slab(root: &Path, r: &mut Report) {
     for (name, scheme, dt) in [
         ("central difference", "central_difference", 4e-3),
         ("Newmark", "newmark", 1e-2),
@@ -115,4 +124,119 @@ fn late_against_static(root: &Path, scheme: &str, dt: f64, t_end: f64) -> Result
         .map(|(u, e)| (u - e).abs())
         .fold(0.0, f64::max);
     Ok(error / moved)
+}
+
+/// The oscillator's belt speed, μk/μs, vs, its mass-proportional damping
+/// (ξ = α/(2ω) = 0.025 on ω = 10: the start's motion dies out, a cycle the
+/// belt feeds does not), the run's length and the cycles measured at its
+/// end.
+const BELT: f64 = 0.05;
+const RATIO: f64 = 0.6;
+const VS: f64 = 1e-3;
+const ALPHA: f64 = 0.5;
+const T_END: f64 = 12.0;
+const CYCLES: usize = 6;
+
+/// The mass on a spring (m = 1, k = 100, g = μs·p = 1) on a belt at 0.05,
+/// with μ(w)/μs = r + (1 − r) e^{−|w|/vs}: (period, peak-to-peak amplitude
+/// of x) over the last cycles, a cycle from one slip → stick event to the
+/// next; `None` when it no longer sticks once the start's motion has died
+/// out (after t = 6: e^{−αt/2} = 0.22 of it is left, below the cycles'
+/// amplitude).
+fn cycles(ratio: f64, dt: f64, eps: f64) -> Result<Option<(f64, f64)>, String> {
+    let mut surface = sdof::surface(eps).map_err(|e| e.to_string())?;
+    surface.set_foundation(|_| BELT);
+    surface.set_weakening(|_| Some(Weakening { ratio, speed: VS }));
+    let mut settings = Settings::new(Scheme::CentralDifference, dt, T_END);
+    settings.damping = Rayleigh {
+        alpha: ALPHA,
+        beta: 0.0,
+    };
+    let mut i = sdof::with_surface(0.0, surface, settings).map_err(|e| e.to_string())?;
+    let (mut sticks, mut xs) = (Vec::new(), Vec::new());
+    let mut stuck = i.classes()[0].is_stuck();
+    while !i.done() {
+        i.step().map_err(|e| e.to_string())?;
+        let now = i.classes()[0].is_stuck();
+        if now && !stuck && i.time() > 0.5 * T_END {
+            sticks.push(i.time());
+        }
+        stuck = now;
+        xs.push((i.time(), i.displacement()[0]));
+    }
+    if sticks.len() < CYCLES + 1 {
+        return Ok(None);
+    }
+    let last = &sticks[sticks.len() - CYCLES - 1..];
+    let period = (last[CYCLES] - last[0]) / CYCLES as f64;
+    let span = xs.iter().filter(|(t, _)| *t >= last[0]).map(|&(_, x)| x);
+    let (lo, hi) = span.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    });
+    Ok(Some((period, hi - lo)))
+}
+
+/// μs > μk: stick-slip cycles, their period and amplitude at four levels
+/// of (Δt, ε) halved together. Converged when each change from a level to
+/// the next is at most the one before it and the last is below 1% of the
+/// finest value. μs = μk: no stick after the start.
+fn stick_slip(r: &mut Report) {
+    let levels = [(4e-4, 1e-4), (2e-4, 5e-5), (1e-4, 2.5e-5), (5e-5, 1.25e-5)];
+    let mut found = Vec::new();
+    for (dt, eps) in levels {
+        let case = format!("stick-slip on a belt, Δt = {dt:e}, ε = {eps:e}");
+        match cycles(RATIO, dt, eps) {
+            Ok(Some((period, amplitude))) => {
+                r.holds(
+                    &case,
+                    "period, peak-to-peak x",
+                    format!(
+                        "{}, {}",
+                        crate::report::num(period),
+                        crate::report::num(amplitude)
+                    ),
+                    "cycles of stick and slip",
+                    true,
+                );
+                found.push((period, amplitude));
+            }
+            Ok(None) => r.holds(&case, "cycles", "steady sliding".into(), "cycles", false),
+            Err(e) => r.holds(&case, "runs", e, "runs", false),
+        }
+    }
+    if found.len() == levels.len() {
+        let periods: Vec<f64> = found.iter().map(|f| f.0).collect();
+        let amplitudes: Vec<f64> = found.iter().map(|f| f.1).collect();
+        for (what, x) in [("period", periods), ("amplitude", amplitudes)] {
+            let changes: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
+            let (last, finest) = (changes[changes.len() - 1], x[x.len() - 1]);
+            r.at_most(
+                "stick-slip on a belt, convergence",
+                &format!("{what}: last change / finest"),
+                last / finest,
+                0.01,
+                "converged to 1%",
+            );
+            let listed: Vec<String> = changes.iter().map(|c| crate::report::num(*c)).collect();
+            r.holds(
+                "stick-slip on a belt, convergence",
+                &format!("{what}: changes as Δt, ε halve"),
+                listed.join(", "),
+                "each ≤ the one before",
+                changes.windows(2).all(|w| w[1] <= w[0]),
+            );
+        }
+    }
+    let case = "μs = μk on a belt";
+    match cycles(1.0, levels[0].0, levels[0].1) {
+        Ok(None) => r.holds(case, "sticks after t = 6", "never".into(), "never", true),
+        Ok(Some((period, _))) => r.holds(
+            case,
+            "sticks after t = 6",
+            format!("every {}", crate::report::num(period)),
+            "never",
+            false,
+        ),
+        Err(e) => r.holds(case, "runs", e, "runs", false),
+    }
 }

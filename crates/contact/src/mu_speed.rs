@@ -1,0 +1,175 @@
+//! Static against kinetic friction (METHOD.md §9): μ(w) = μk + (μs − μk)
+//! e^{−|w|/vs} on the slip speed, written as the static bound g = μs·p
+//! times the factor m(|w|) = r + (1 − r) e^{−|w|/vs}, r = μk/μs, so that
+//! σ_T = −g m(|w|) φ_ε(w).
+//!
+//! The nodal scalar equation of a diagonal step, w + c m(|w|) φ_ε(w) = q
+//! (c = w_J g τᵀD⁻¹τ, q the step's slip without friction), is no longer
+//! monotone: on the slip branch h(w) = w + c m(w) is convex and falls
+//! near ε where c (1 − r)/vs > 1, so up to three roots exist. The choice
+//! ([`Weakening::solve_nodal`]) is the stuck root when there is one, else
+//! the slip root, which is then unique and has q's sign: h is odd, and on
+//! the slip branch convex from below q at ε to +∞, so it crosses q once.
+
+use crate::law::FrictionLaw;
+use crate::surface::ContactSurface;
+
+/// The fall of the friction coefficient with the slip speed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weakening {
+    /// r = μk/μs in [0, 1].
+    pub ratio: f64,
+    /// vs > 0, the slip speed over which μ falls by 1/e of μs − μk.
+    pub speed: f64,
+}
+
+impl Weakening {
+    /// m(s) = r + (1 − r) e^{−s/vs}: μ(s)/μs, 1 at s = 0, r as s → ∞.
+    #[inline]
+    pub fn factor(&self, s: f64) -> f64 {
+        self.ratio + (1.0 - self.ratio) * (-s / self.speed).exp()
+    }
+
+    /// The root of w + c m(|w|) φ_ε(w) = q (c ≥ 0): the stuck one, in
+    /// [−ε, ε], where |q| ≤ ε + c m(ε), else the slip one (module doc).
+    pub fn solve_nodal(&self, law: &FrictionLaw, q: f64, c: f64) -> f64 {
+        let (a, eps) = (q.abs(), law.eps);
+        let w = if a <= eps + c * self.factor(eps) {
+            // h(w) = w (1 + c m(w)/ε) on [0, ε]: 0 at 0, at least a at
+            // min(a, ε) (h(w) ≥ w for w ≥ 0).
+            bisect(|w| w + c * self.factor(w) * w / eps - a, 0.0, a.min(eps))
+        } else {
+            // w + c m(w) − a: ≤ 0 at max(ε, a − c) (m ≤ 1, and h(ε) < a),
+            // ≥ 0 at a − c r (m ≥ r).
+            bisect(
+                |w| w + c * self.factor(w) - a,
+                eps.max(a - c),
+                (a - c * self.ratio).max(eps),
+            )
+        };
+        w.copysign(q)
+    }
+}
+
+/// A root of `f` in [lo, hi] with f(lo) ≤ 0 ≤ f(hi), by bisection to the
+/// last bit: the interval halves until its ends are adjacent doubles.
+fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
+    for _ in 0..2100 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        let v = f(mid);
+        if v == 0.0 {
+            return mid;
+        }
+        if v < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    if f(hi).abs() < f(lo).abs() {
+        hi
+    } else {
+        lo
+    }
+}
+
+impl ContactSurface {
+    /// Sets node j's fall of μ with the slip speed (`None`: the constant
+    /// law). A surface of constant μ everywhere keeps none.
+    pub fn set_weakening(&mut self, mut law: impl FnMut(usize) -> Option<Weakening>) {
+        self.weakening = (0..self.nodes.len()).map(&mut law).collect();
+        if self.weakening.iter().all(Option::is_none) {
+            self.weakening.clear();
+        }
+    }
+
+    /// Node j's fall of μ, `None` for the constant law.
+    #[inline]
+    pub fn weakening_of(&self, j: usize) -> Option<Weakening> {
+        self.weakening.get(j).copied().flatten()
+    }
+
+    /// True when some node's μ falls with the slip speed.
+    pub fn weakens(&self) -> bool {
+        !self.weakening.is_empty()
+    }
+
+    /// μ(|w|)/μs at node j and slip `w`: 1, exactly, for the constant law.
+    #[inline]
+    pub(crate) fn factor(&self, j: usize, w: f64) -> f64 {
+        self.weakening_of(j).map_or(1.0, |k| k.factor(w.abs()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The chosen root satisfies its equation, is stuck whenever a stuck
+    /// root exists (|q| ≤ ε + c m(ε)), and slips with q's sign otherwise;
+    /// where c (1 − r)/vs > 1 the equation has three roots for some q
+    /// (stuck and two slip ones), counted here by sign changes of the
+    /// residual on a fine grid, and the stuck one is taken.
+    #[test]
+    fn the_root_is_stuck_when_it_can_be() {
+        let law = FrictionLaw { eps: 1e-4 };
+        let k = Weakening {
+            ratio: 0.5,
+            speed: 1e-3,
+        };
+        let mut three = 0;
+        for &c in &[1e-4, 1e-3, 5e-3, 2e-2] {
+            let h = |w: f64| w + c * k.factor(w.abs()) * law.phi(w);
+            for i in -400..=400 {
+                let q = f64::from(i) * 5e-5;
+                let w = k.solve_nodal(&law, q, c);
+                let scale = q.abs() + c;
+                assert!(
+                    (h(w) - q).abs() <= 1e-12 * scale,
+                    "c = {c}, q = {q}: residual {}",
+                    h(w) - q
+                );
+                let stuck_exists = q.abs() <= law.eps + c * k.factor(law.eps);
+                assert_eq!(
+                    w.abs() <= law.eps,
+                    stuck_exists,
+                    "c = {c}, q = {q}: w = {w}"
+                );
+                if !stuck_exists {
+                    assert_eq!(w.signum(), q.signum());
+                }
+                // Roots on w > 0: sign changes of h − q on a grid to 10q.
+                let roots = (0..20_000)
+                    .map(|n| f64::from(n) * 1e-6)
+                    .map(|w| h(w) - q)
+                    .collect::<Vec<_>>()
+                    .windows(2)
+                    .filter(|p| p[0] == 0.0 || p[0].signum() != p[1].signum())
+                    .count();
+                if q > 0.0 && roots >= 3 {
+                    three += 1;
+                    assert!(
+                        w.abs() <= law.eps,
+                        "c = {c}, q = {q}: three roots, took {w}"
+                    );
+                }
+            }
+        }
+        assert!(three > 0, "some q with three roots");
+    }
+
+    #[test]
+    fn the_factor_falls_from_one_to_r() {
+        let k = Weakening {
+            ratio: 0.6,
+            speed: 0.01,
+        };
+        assert_eq!(k.factor(0.0), 1.0);
+        // e^{−1} of the fall at s = vs: 0.6 + 0.4/e.
+        assert!((k.factor(0.01) - (0.6 + 0.4 * (-1f64).exp())).abs() < 1e-15);
+        assert!((k.factor(1.0) - 0.6).abs() < 1e-15);
+    }
+}
