@@ -444,11 +444,6 @@ fn complete(
         if i > 0 {
             let first = &case.contact[0];
             check(
-                eps.to_bits() == first.eps.to_bits(),
-                &key("eps"),
-                format!("contact.eps = {eps} differs from the first surface's {}: all [[contact]] surfaces share one regularization ε; give them the same eps", first.eps),
-            );
-            check(
                 c.remark_4_2 == first.remark_4_2 && c.max_iterations == first.max_iterations,
                 &key("group"),
                 "contact: remark_4_2 and max_iterations set the run's one stick/slip iteration; give them the same values on every [[contact]] (or on none)".into(),

@@ -533,7 +533,7 @@ section! {
         "pressure" pressure: f64,
         /// Coulomb coefficient μ, or μ falling with the slip speed.
         "mu" mu: Mu,
-        /// Regularization ε of the friction law (one for all surfaces).
+        /// Regularization ε of the friction law (each surface its own).
         "eps" eps: f64,
         /// Time factor of the pressure (the normal load and g = μ p);
         /// default `"constant"`, today's pressure present before t = 0.

@@ -130,8 +130,8 @@ fn each_surface_keeps_its_own_bounds() {
 
 #[test]
 fn bad_surfaces_are_named_at_their_line() {
-    // Unsorted profile, a negative factor, a different eps, the same
-    // group twice, an unsorted pressure history.
+    // Unsorted profile, a negative factor, the same group twice, an
+    // unsorted pressure history (a different eps is the top's own).
     let text = slab(&format!(
         "{BOTTOM}pressure_profile = {{ table = [[2.0, 1.0], [1.0, 1.0]] }}\n\
          {}pressure_profile = {{ table = [[0.0, -0.5]] }}\n\
@@ -142,7 +142,7 @@ fn bad_surfaces_are_named_at_their_line() {
     let e = load(&text).unwrap_err();
     assert_at(&e, &text, "[[2.0, 1.0], [1.0, 1.0]]", "strictly increasing");
     assert_at(&e, &text, "[[0.0, -0.5]]", "must be >= 0");
-    assert_at(&e, &text, "eps = 1e-3", "share one regularization");
+    assert!(!e.contains("eps"), "{e}");
     let second_bottom = text.match_indices("group = \"contact\"").nth(1).unwrap().0;
     let line = text[..second_bottom].lines().count() + 1;
     assert!(
@@ -191,6 +191,21 @@ eps = 1e-2
         "[9.0, 1.0]",
         "runs past the end of surface \"contact\", which is 8 long",
     );
+}
+
+/// Each surface keeps its own eps: the bottom's nodes 1e-2, the top's 1e-3.
+#[test]
+fn each_surface_keeps_its_own_eps() {
+    let top = TOP.replace("eps = 1e-2", "eps = 1e-3");
+    let scene = assemble(&load(&slab(&format!("{BOTTOM}{top}"))).unwrap()).unwrap();
+    let c = scene.contact.unwrap();
+    for (k, eps) in [(0, 1e-2), (1, 1e-3)] {
+        for j in c.parts[k].nodes.clone() {
+            assert_eq!(c.law_of(j).eps, eps);
+        }
+    }
+    let same = assemble(&load(&slab(&format!("{BOTTOM}{TOP}"))).unwrap()).unwrap();
+    assert!(same.contact.unwrap().node_eps.is_empty());
 }
 
 /// `foundation_velocity` reaches each surface's nodes: V on the bottom's,

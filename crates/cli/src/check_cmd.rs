@@ -61,11 +61,21 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     }
     match i.contact() {
         Some(c) => println!(
-            "contact     {}: {} friction nodes ({} left out: tangential motion fixed), eps = {:e}",
+            "contact     {}: {} friction nodes ({} left out: tangential motion fixed), eps = {}",
             c.names(),
             c.len(),
             c.excluded.len(),
-            c.law.eps
+            // One ε, or each surface's where they differ.
+            if case.contact.iter().all(|s| s.eps == c.law.eps) {
+                format!("{:e}", c.law.eps)
+            } else {
+                let each: Vec<String> = case
+                    .contact
+                    .iter()
+                    .map(|s| format!("{:e}", s.eps))
+                    .collect();
+                each.join(" / ")
+            }
         ),
         None => println!("contact     none (no friction code runs)"),
     }

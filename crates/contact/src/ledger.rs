@@ -36,7 +36,7 @@ impl ContactSurface {
         {
             let (v_t, increment) = n.motion(v_new, v, dt);
             let w = self.slip(j, v_t);
-            *f = n.force(&self.law, w) * self.factor(j, w);
+            *f = n.force(&self.law_of(j), w) * self.factor(j, w);
             let (d, w) = split_work(*f, *f_old, increment, self.foundation_speed(j), dt);
             dissipated += d;
             foundation += w;
@@ -66,7 +66,7 @@ impl ContactSurface {
             .zip(u_new.iter().zip(u))
             .enumerate()
         {
-            *f = n.force(&self.law, self.slip(j, *u_new));
+            *f = n.force(&self.law_of(j), self.slip(j, *u_new));
             dissipated += work(*f, *f_old, 0.5 * dt * (u_new + u));
         }
         dissipated

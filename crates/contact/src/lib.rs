@@ -26,6 +26,7 @@ mod law;
 mod ledger;
 mod mu_speed;
 mod nodal;
+mod regularization;
 mod surface;
 
 pub use iteration::{iterate, IterationFailure, IterationOptions, IterationReport, StepSystem};

@@ -35,6 +35,9 @@ struct Node {
     foundation: f64,
     /// The fall of μ with the slip speed, `None` for the constant law.
     weakening: Option<crate::Weakening>,
+    /// The law with the node's ε, and 1/ε.
+    law: FrictionLaw,
+    inv_eps: f64,
 }
 
 /// The closed-form nodal friction of a diagonal step, its constants formed
@@ -44,8 +47,6 @@ pub struct NodalClosedForm {
     /// The bits of the scale and the surface's bounds revision the
     /// constants are for (None: not formed).
     scale: Option<(u64, u64)>,
-    eps: f64,
-    inv_eps: f64,
     nodes: Vec<Node>,
     /// The nodes' free DOFs in the order [`NodalClosedForm::velocities`]
     /// asks for b there.
@@ -67,12 +68,10 @@ impl NodalClosedForm {
             }
             return;
         }
-        let law = surface.law;
-        self.eps = law.eps;
-        self.inv_eps = 1.0 / law.eps;
         self.nodes.clear();
         self.dofs.clear();
         for (j, node) in surface.nodes.iter().enumerate() {
+            let law = surface.law_of(j);
             self.dofs.extend(node.dofs.iter().flatten());
             let wg = node.force_scale();
             let (mut a, mut inv_d, mut w, mut q) = ([0.0; 2], [0.0; 2], [0.0; 2], 0.0);
@@ -94,6 +93,8 @@ impl NodalClosedForm {
                 stuck: law.stuck_factor(c),
                 foundation: surface.foundation_speed(j),
                 weakening: surface.weakening_of(j),
+                law,
+                inv_eps: 1.0 / law.eps,
             });
         }
         self.scale = Some(key);
@@ -105,10 +106,6 @@ impl NodalClosedForm {
         &self.dofs
     }
 
-    fn law(&self) -> FrictionLaw {
-        FrictionLaw { eps: self.eps }
-    }
-
     /// Calls `out(node, component, dof, ṙ)` for every free DOF of every
     /// contact node, given `b(dof, k)` = b there, the k-th contact DOF in
     /// node order. [`NodalClosedForm::prepare`] first.
@@ -118,9 +115,9 @@ impl NodalClosedForm {
         mut b: impl FnMut(usize, usize) -> f64,
         mut out: impl FnMut(usize, usize, usize, f64),
     ) {
-        let law = self.law();
         let mut k = 0;
         for (j, node) in self.nodes.iter().enumerate() {
+            let law = node.law;
             let dofs = &node.node.dofs;
             let mut bj = [0.0; 2];
             let mut p = 0.0;
@@ -136,7 +133,7 @@ impl NodalClosedForm {
             let phi = match node.weakening {
                 None => {
                     let w = law.solve_nodal_by(p - node.foundation, node.c, node.stuck);
-                    law.class_and_phi_by_reciprocal(w, self.inv_eps).1
+                    law.class_and_phi_by_reciprocal(w, node.inv_eps).1
                 }
                 // μ(|w|)/μs times φ_ε(w), on the root mu_speed.rs chooses.
                 Some(k) => {
@@ -170,7 +167,6 @@ impl NodalClosedForm {
         forces_old: &[f64],
         forces: &mut [f64],
     ) -> (f64, f64, usize) {
-        let law = self.law();
         let (mut dissipated, mut foundation, mut events) = (0.0, 0.0, 0);
         for ((((node, class), f), f_old), was) in self
             .nodes
@@ -182,7 +178,7 @@ impl NodalClosedForm {
         {
             let (vt, increment) = node.node.motion(v_new, v, dt);
             let w = vt - node.foundation;
-            (*class, *f) = node.node.class_and_force(&law, w);
+            (*class, *f) = node.node.class_and_force(&node.law, w);
             if let Some(k) = node.weakening {
                 *f *= k.factor(w.abs());
             }
@@ -221,11 +217,11 @@ impl StepSystem for DiagonalStep<'_> {
         for (v, d) in velocity.iter_mut().zip(self.diagonal) {
             *v /= d;
         }
-        for (n, c) in surface.nodes.iter().zip(classes) {
+        for (j, (n, c)) in surface.nodes.iter().zip(classes).enumerate() {
             if !c.is_stuck() {
                 continue;
             }
-            let k = n.stuck_damping(&surface.law);
+            let k = n.stuck_damping(&surface.law_of(j));
             // (D + k ττᵀ)⁻¹ r = D⁻¹r − D⁻¹τ k (τᵀD⁻¹r) / (1 + k τᵀD⁻¹τ).
             let mut t_dinv_r = 0.0;
             let mut t_dinv_t = 0.0;

@@ -159,6 +159,9 @@ pub struct ContactSurface {
     /// for the constant law; empty where every node's μ is constant
     /// (`mu_speed.rs`).
     pub weakening: Vec<Option<crate::Weakening>>,
+    /// Each node's ε where joined surfaces have different ones, empty
+    /// where all share `law.eps` (`regularization.rs`).
+    pub node_eps: Vec<f64>,
 }
 
 impl ContactSurface {
@@ -217,6 +220,7 @@ impl ContactSurface {
             law: FrictionLaw { eps },
             foundation: Vec::new(),
             weakening: Vec::new(),
+            node_eps: Vec::new(),
         })
     }
 
@@ -242,6 +246,7 @@ impl ContactSurface {
             law: FrictionLaw { eps },
             foundation: Vec::new(),
             weakening: Vec::new(),
+            node_eps: Vec::new(),
         })
     }
 
@@ -274,7 +279,9 @@ impl ContactSurface {
     /// Classifies every node from a free-DOF velocity vector.
     pub fn classify(&self, velocity: &[f64], classes: &mut [SlipState]) {
         for (j, (n, c)) in self.nodes.iter().zip(classes.iter_mut()).enumerate() {
-            *c = self.law.classify(self.slip(j, n.tangential(velocity)));
+            *c = self
+                .law_of(j)
+                .classify(self.slip(j, n.tangential(velocity)));
         }
     }
 
@@ -283,7 +290,7 @@ impl ContactSurface {
     pub fn nodal_forces(&self, velocity: &[f64], out: &mut [f64]) {
         for (j, (n, f)) in self.nodes.iter().zip(out.iter_mut()).enumerate() {
             let w = self.slip(j, n.tangential(velocity));
-            *f = n.force(&self.law, w) * self.factor(j, w);
+            *f = n.force(&self.law_of(j), w) * self.factor(j, w);
         }
     }
 
@@ -292,14 +299,14 @@ impl ContactSurface {
     pub fn friction_stress(&self, velocity: &[f64], out: &mut [f64]) {
         for (j, (n, s)) in self.nodes.iter().zip(out.iter_mut()).enumerate() {
             let w = self.slip(j, n.tangential(velocity));
-            *s = self.stress(n, w) * self.factor(j, w);
+            *s = self.stress(j, w) * self.factor(j, w);
         }
     }
 
     /// σ_T = −g φ_ε(w) of `node` at slip `w` (v_T where the foundation is
     /// at rest), +0 where w = 0 (−g · 0 is −0, which printed as "-0.000").
-    pub fn stress(&self, node: &ContactNode, v_t: f64) -> f64 {
-        -node.bound * self.law.phi(v_t) + 0.0
+    pub fn stress(&self, j: usize, v_t: f64) -> f64 {
+        -self.nodes[j].bound * self.law_of(j).phi(v_t) + 0.0
     }
 
     /// Adds the damping of stuck nodes, w g/ε ττᵀ (METHOD.md §3, C of
@@ -314,7 +321,7 @@ impl ContactSurface {
             if !c.is_stuck() {
                 continue;
             }
-            let k = n.stuck_damping(&self.law);
+            let k = n.stuck_damping(&self.law_of(j));
             for a in 0..2 {
                 for b in 0..2 {
                     if n.dofs[a].is_some() && n.dofs[b].is_some() {
@@ -336,7 +343,7 @@ impl ContactSurface {
                 if v == 0.0 {
                     continue;
                 }
-                -n.stuck_damping(&self.law) * v
+                -n.stuck_damping(&self.law_of(j)) * v
             } else {
                 n.slip_force(*c)
             };
@@ -372,6 +379,7 @@ impl ContactSurface {
             law: self.law,
             foundation: self.foundation.clone(),
             weakening: self.weakening.clone(),
+            node_eps: self.node_eps.clone(),
         }
     }
 
@@ -379,22 +387,15 @@ impl ContactSurface {
     /// after surface, each node keeping its own bound.
     ///
     /// # Errors
-    /// No surface, surfaces with different ε (the law is one), or a node
-    /// that carries friction on two surfaces (counted twice, and with two
-    /// tangents).
+    /// No surface, or a node that carries friction on two surfaces
+    /// (counted twice, and with two tangents). Surfaces of different ε
+    /// keep each its own per node (`regularization.rs`).
     pub fn join(surfaces: Vec<ContactSurface>) -> Result<ContactSurface, ContactError> {
         let mut iter = surfaces.into_iter();
         let Some(mut joined) = iter.next() else {
             return Err(ContactError::Parameter("no contact surface to join".into()));
         };
         for s in iter {
-            if s.law.eps.to_bits() != joined.law.eps.to_bits() {
-                return Err(ContactError::Parameter(format!(
-                    "surface {:?} has eps = {} but surface {:?} has eps = {}: the surfaces share one \
-                     regularization ε; give every [[contact]] the same eps",
-                    s.group, s.law.eps, joined.group, joined.law.eps
-                )));
-            }
             // Only nodes that carry friction count: a node a support holds
             // still on both surfaces carries none on either.
             let mine: std::collections::HashSet<usize> = s.nodes.iter().map(|n| n.node).collect();
@@ -408,6 +409,7 @@ impl ContactSurface {
                     });
                 }
             }
+            joined.join_eps(&s);
             let start = joined.nodes.len();
             joined.parts.push(SurfacePart {
                 group: s.group,

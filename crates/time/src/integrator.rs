@@ -295,7 +295,7 @@ impl Integrator {
             (None, Some(c)) => {
                 for (j, (o, n)) in out.iter_mut().zip(&c.nodes).enumerate() {
                     *o = c
-                        .law
+                        .law_of(j)
                         .classify(c.slip(j, n.tangential(&self.state.v)))
                         .code();
                 }

@@ -415,7 +415,7 @@ impl SchurOperator {
                 d.stuck[j] = c.is_stuck();
                 if c.is_stuck() {
                     d.index.push(j);
-                    d.w.push(node.stuck_damping(&reduced.law).sqrt());
+                    d.w.push(node.stuck_damping(&reduced.law_of(j)).sqrt());
                 }
             }
             let m = d.index.len();
