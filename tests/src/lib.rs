@@ -34,6 +34,7 @@ pub mod paths;
 pub mod reference;
 pub mod scene;
 pub mod sdof;
+pub mod solvers;
 pub mod strip;
 pub mod wave;
 

@@ -7,9 +7,8 @@
 use nalgebra_sparse::{CooMatrix, CsrMatrix};
 use stickslip_contact::{ContactNode, ContactSurface};
 use stickslip_testkit::sdof::{self, G, K};
-use stickslip_time::{
-    Dynamics, ExplicitFriction, History, ImplicitSolver, Integrator, Load, Scheme, Settings,
-};
+use stickslip_testkit::solvers::every_solver;
+use stickslip_time::{Dynamics, History, Integrator, Load, Settings};
 
 const P: [f64; 2] = [2.5, 5.0];
 const EPS: [f64; 2] = [1e-2, 1e-4];
@@ -53,25 +52,7 @@ fn pair(settings: Settings) -> Integrator {
 
 #[test]
 fn each_surface_keeps_its_own_eps() {
-    let cd = Settings::new(Scheme::CentralDifference, 1e-4, 0.8);
-    let mut iterated = cd.clone();
-    iterated.explicit_friction = ExplicitFriction::Iterate;
-    let nm = Settings::new(
-        Scheme::Newmark {
-            beta: 0.25,
-            gamma: 0.5,
-        },
-        1e-4,
-        0.8,
-    );
-    let mut direct = nm.clone();
-    direct.implicit_solver = ImplicitSolver::Direct;
-    for (name, settings) in [
-        ("closed form", cd),
-        ("explicit iteration", iterated),
-        ("Schur", nm),
-        ("direct", direct),
-    ] {
+    for (name, settings) in every_solver(1e-4, 0.8) {
         let mut both = pair(settings.clone());
         let mut alone: Vec<Integrator> = (0..2)
             .map(|j| {

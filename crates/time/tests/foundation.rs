@@ -12,12 +12,8 @@
 //! foundation's work; and a foundation at V = 0 moves no bit.
 
 use stickslip_testkit::sdof::{self, G, K, OMEGA};
-use stickslip_time::{ExplicitFriction, History, ImplicitSolver, Integrator, Scheme, Settings};
-
-const NEWMARK: Scheme = Scheme::Newmark {
-    beta: 0.25,
-    gamma: 0.5,
-};
+use stickslip_testkit::solvers::every_solver;
+use stickslip_time::{History, Integrator, Scheme, Settings};
 
 fn belt(speed: Option<f64>, eps: f64, settings: Settings) -> Integrator {
     let mut surface = sdof::surface(eps).unwrap();
@@ -31,18 +27,7 @@ fn belt(speed: Option<f64>, eps: f64, settings: Settings) -> Integrator {
 
 /// The ways of solving a step, at Δt = 1e-3 to `t_end`.
 fn solvers(t_end: f64) -> Vec<(&'static str, Settings)> {
-    let cd = Settings::new(Scheme::CentralDifference, 1e-3, t_end);
-    let mut iterated = cd.clone();
-    iterated.explicit_friction = ExplicitFriction::Iterate;
-    let nm = Settings::new(NEWMARK, 1e-3, t_end);
-    let mut direct = nm.clone();
-    direct.implicit_solver = ImplicitSolver::Direct;
-    vec![
-        ("closed form", cd),
-        ("explicit iteration", iterated),
-        ("Schur", nm),
-        ("direct", direct),
-    ]
+    every_solver(1e-3, t_end)
 }
 
 #[test]
