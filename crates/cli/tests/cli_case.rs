@@ -54,7 +54,7 @@ fn case_errors_exit_2_with_file_and_line() {
         &'static str,
         &'static str,
     );
-    let cases: [BadCase; 7] = [
+    let cases: [BadCase; 10] = [
         (
             "unknown-key",
             |t| t.replace("eps = 1e-4", "eps = 1e-4\nepsilon = 1"),
@@ -101,6 +101,34 @@ fn case_errors_exit_2_with_file_and_line() {
             |t| t.replace("\"central_difference\"", "\"leapfrog\""),
             "leapfrog",
             "unknown variant `leapfrog`",
+        ),
+        (
+            "mu-speed-zero",
+            |t| {
+                t.replace(
+                    "\nmu = 0.3",
+                    "\nmu = { static = 0.3, kinetic = 0.2, speed = 0 }",
+                )
+            },
+            "speed = 0 }",
+            "speed = 0 must be > 0",
+        ),
+        (
+            "mu-kinetic-above",
+            |t| {
+                t.replace(
+                    "\nmu = 0.3",
+                    "\nmu = { static = 0.3, kinetic = 0.4, speed = 1e-2 }",
+                )
+            },
+            "kinetic = 0.4",
+            "must be >= 0 and at most static = 0.3",
+        ),
+        (
+            "foundation-string",
+            |t| t.replace("eps = 1e-4", "eps = 1e-4\nfoundation_velocity = \"fast\""),
+            "foundation_velocity",
+            "expected a number",
         ),
     ];
     for (name, edit, needle, what) in cases {
