@@ -972,16 +972,16 @@ impl ResultsWriter {
             e.damped,
             e.foundation,
         ];
-        // A slot written before moving foundations holds seven values; it
-        // keeps them while the foundation has done no work.
+        // A slot written before damping holds six values, before moving
+        // foundations seven; it keeps them while the values it has no room
+        // for are 0.
         let held = g
             .dataset("energy")
             .ok()
             .map_or(values.len(), |d| d.shape().iter().product());
-        let kept = if held == 7 && e.foundation == 0.0 {
-            7
-        } else {
-            8
+        let kept = match held {
+            6 | 7 if values[held..].iter().all(|&v| v == 0.0) => held,
+            _ => values.len(),
         };
         put_vector(&g, "energy", &values[..kept])?;
         let energy = g.dataset("energy")?;
