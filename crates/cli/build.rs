@@ -2,8 +2,8 @@
 //!
 //! hdf5-metno-sys asks the linker for `-lhdf5` and finds the shared
 //! library, which Debian builds with its S3 driver: loading it loads
-//! libcurl, OpenSSL, GnuTLS, Kerberos and LDAP, 38 shared libraries whose
-//! relocations are most of a small run's start-up. The static archive
+//! libcurl, OpenSSL, GnuTLS, Kerberos and LDAP, whose relocations are
+//! most of a small run's start-up (docs/performance.md). The static archive
 //! (Debian's libhdf5-dev ships it) brings only the objects we call, and
 //! those need no network library; only its compression filters need zlib
 //! and szip (libaec), linked statically too.

@@ -30,9 +30,8 @@
 //! none when `--against` compares another binary.
 //!
 //! Small runs are repeated: a run of ours of a few milliseconds is at the
-//! mercy of the scheduler and of caches a shared host keeps evicting (the
-//! paper's run read 44 ms as the median of 3 rounds, 12 ms as that of 15
-//! runs in a row). Each run is made once untimed before the rounds (files
+//! mercy of the scheduler and of caches a shared host keeps evicting
+//! (docs/performance.md, "Start-up and small runs"). Each run is made once untimed before the rounds (files
 //! and the binary in the page cache), which also says how long it takes;
 //! each round then makes it as many times as fill [`ROUND_SECONDS`] (at
 //! most [`MAX_REPEATS`], at least once), ours and `--against`'s
@@ -55,9 +54,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// Seconds of runs a round makes of each run, at least: a paper-mesh run
-/// of about 12 ms is made 25 times a round, the Q2 64×16 slab's (about
-/// 0.1 s) 5 times, anything of 0.5 s or more once.
+/// Seconds of runs a round makes of each run, at least: a run of 20 ms is
+/// made 25 times a round, one of 0.1 s 5 times, anything of 0.5 s or
+/// more once.
 const ROUND_SECONDS: f64 = 0.5;
 
 /// The most times a round makes one run.

@@ -402,8 +402,8 @@ const HISTORY_BLOCK: usize = SERIES_CHUNK;
 
 /// Bytes of rows kept in memory before they are written (a frame larger
 /// than this is written as it comes). Each block costs about 15 HDF5
-/// writes: on a small mesh whose every step is a frame, writing a block
-/// per chunk of rows (16 frames) was a quarter of the run.
+/// writes, which on a small mesh whose every step is a frame cost more
+/// than the steps when made at every chunk's end (docs/performance.md).
 const PENDING_BYTES: usize = 1 << 20;
 
 /// Rows per chunk along time so that a chunk stays within HDF5's default
@@ -450,8 +450,7 @@ fn series_2d<T: H5Type>(g: &Group, name: &str, n: usize, level: u8) -> Result<Da
 /// Rows per chunk along time of the node vectors (`/displacement` and the
 /// others) of a mesh of `n` nodes: a run's file grows by whole chunks of
 /// them. At most 64 KiB a chunk (where a row is smaller), as every flush
-/// writes the chunk it ends in whole: a chunk of 1 MiB made each flush of
-/// the Q2 64×16 slab's run (a frame every 100 steps) write 3 MB.
+/// writes the chunk it ends in whole, however few of its rows are new.
 pub fn vector_chunk_rows(n: usize) -> usize {
     ((64 << 10) / (n * 16).max(1)).clamp(1, 16)
 }
