@@ -26,15 +26,23 @@ fn main() {
     println!("cargo::rerun-if-changed=build.rs");
     println!("cargo::rerun-if-env-changed=STICKSLIP_HDF5_LINK");
     println!("cargo::rerun-if-env-changed=HDF5_DIR");
+    // For the test that checks what the binary loads.
+    let how = if link_static() { "static" } else { "dynamic" };
+    println!("cargo::rustc-env=STICKSLIP_HDF5_LINKED={how}");
+}
+
+/// Puts the linker script in place, if the archives are there and no one
+/// asked for the shared library; whether it did.
+fn link_static() -> bool {
     if env::var("STICKSLIP_HDF5_LINK").is_ok_and(|v| v == "dynamic") {
-        return;
+        return false;
     }
     if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("linux") {
-        return;
+        return false;
     }
     let Some(hdf5) = hdf5_archive() else {
         println!("cargo::warning=no static libhdf5.a found: HDF5 is linked as a shared library (slower start-up)");
-        return;
+        return false;
     };
     let mut archives = vec![hdf5];
     for name in ["libsz.a", "libaec.a", "libz.a"] {
@@ -42,7 +50,7 @@ fn main() {
             Some(p) => archives.push(p),
             None => {
                 println!("cargo::warning=no {name} found: HDF5 is linked as a shared library (slower start-up)");
-                return;
+                return false;
             }
         }
     }
@@ -59,6 +67,7 @@ fn main() {
         println!("cargo::rerun-if-changed={}", p.display());
     }
     println!("cargo::rustc-link-search=native={}", dir.display());
+    true
 }
 
 /// The static HDF5 beside the shared one the build finds: `HDF5_DIR/lib`,
