@@ -29,6 +29,15 @@
 //! `--peers scipy,fenicsx` or `none` chooses them; by default both, and
 //! none when `--against` compares another binary.
 //!
+//! Small runs are repeated: a run of ours of a few milliseconds is at the
+//! mercy of the scheduler and of caches a shared host keeps evicting
+//! (docs/performance.md, "Start-up and small runs"). Each run is made once untimed before the rounds (files
+//! and the binary in the page cache), which also says how long it takes;
+//! each round then makes it as many times as fill [`ROUND_SECONDS`] (at
+//! most [`MAX_REPEATS`], at least once), ours and `--against`'s
+//! alternately, each peer likewise by its checked run's time. The medians
+//! are over every timed run; the CSV's `samples` column counts ours.
+//!
 //! With `--against EXE`, every run is also made with that binary (for
 //! instance a build of an earlier commit), interleaved round by round, and
 //! the table gives the ratio of the medians: a change measured run against
@@ -44,6 +53,23 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// Seconds of runs a round makes of each run, at least: a run of 20 ms is
+/// made 25 times a round, one of 0.1 s 5 times, anything of 0.5 s or
+/// more once.
+const ROUND_SECONDS: f64 = 0.5;
+
+/// The most times a round makes one run.
+const MAX_REPEATS: usize = 25;
+
+/// How many times a round makes a run that takes `secs`.
+fn repeats(secs: f64) -> usize {
+    if secs.is_finite() && secs > 0.0 {
+        ((ROUND_SECONDS / secs).ceil() as usize).clamp(1, MAX_REPEATS)
+    } else {
+        1
+    }
+}
 
 /// (name, mesh file relative to the root or a Gmsh rung, DOFs roughly).
 struct Rung {
@@ -242,47 +268,70 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
             ));
         }
     }
-    let checks = check_peers(root, &exe, &dir, &peers, &runs)?;
+    let (checks, peer_secs) = check_peers(root, &exe, &dir, &peers, &runs)?;
+    // Ours (and --against's) once each, untimed: warm caches, and the
+    // time that sets the repeats.
+    let run_exe = |r: usize, e: usize, case: &str, sets: &[String]| {
+        let out = dir.join(format!("r{r}-e{e}.h5"));
+        let mut cmd = Command::new(&exes[e]);
+        if e == 1 {
+            cmd.envs(against_env.iter().map(|(k, v)| (k, v)));
+        }
+        let flags = ["--quiet", "--force"];
+        let result = crate::bench::timed_run(cmd, root, &flags, &out, case, sets);
+        for ext in ["h5", "xdmf"] {
+            let _ = std::fs::remove_file(out.with_extension(ext));
+        }
+        result
+    };
+    let mut repeats_of = Vec::with_capacity(runs.len());
+    for (r, (_, case, sets, _)) in runs.iter().enumerate() {
+        let mut ours = f64::NAN;
+        for e in 0..exes.len() {
+            let (o, secs) = run_exe(r, e, case, sets)?;
+            if e == 0 && o.status.success() {
+                ours = secs;
+            }
+        }
+        let mut n = vec![repeats(ours); exes.len()];
+        n.extend(peer_secs[r].iter().map(|&s| repeats(s)));
+        repeats_of.push(n);
+    }
     // times[run][exe, then peer]
     let mut times = vec![vec![Vec::new(); exes.len() + peers.len()]; runs.len()];
     for round in 0..rounds {
         eprintln!("bench run: round {} of {rounds}", round + 1);
         for (r, (label, case, sets, fits)) in runs.iter().enumerate() {
-            for (e, exe) in exes.iter().enumerate() {
-                let out = dir.join(format!("r{r}-e{e}.h5"));
-                let mut cmd = Command::new(exe);
-                if e == 1 {
-                    cmd.envs(against_env.iter().map(|(k, v)| (k, v)));
+            for _ in 0..repeats_of[r][0] {
+                for e in 0..exes.len() {
+                    let (o, secs) = run_exe(r, e, case, sets)?;
+                    if !o.status.success() {
+                        // One failed run (a full disk, a shared host's hiccup)
+                        // leaves the others' figures standing.
+                        eprintln!(
+                            "bench run: {label} ({}) failed, left out of its median: {}",
+                            exes[e].display(),
+                            String::from_utf8_lossy(&o.stderr).trim()
+                        );
+                        continue;
+                    }
+                    times[r][e].push(secs);
                 }
-                let flags = ["--quiet", "--force"];
-                let (o, secs) = crate::bench::timed_run(cmd, root, &flags, &out, case, sets)?;
-                for ext in ["h5", "xdmf"] {
-                    let _ = std::fs::remove_file(out.with_extension(ext));
-                }
-                if !o.status.success() {
-                    // One failed run (a full disk, a shared host's hiccup)
-                    // leaves the others' figures standing.
-                    eprintln!(
-                        "bench run: {label} ({}) failed, left out of its median: {}",
-                        exe.display(),
-                        String::from_utf8_lossy(&o.stderr).trim()
-                    );
-                    continue;
-                }
-                times[r][e].push(secs);
             }
             for (p, peer) in peers.iter().enumerate().filter(|(p, _)| fits[*p]) {
-                let out = dir.join(format!("r{r}-{}.h5", peer.name));
-                let (o, secs) = crate::bench::timed(peer.command(root, &out, case, sets))?;
-                let _ = std::fs::remove_file(&out);
-                if o.status.success() {
-                    times[r][exes.len() + p].push(secs);
-                } else {
-                    eprintln!(
-                        "bench run: {label} ({} peer) failed, left out of its median: {}",
-                        peer.name,
-                        String::from_utf8_lossy(&o.stderr).trim()
-                    );
+                for _ in 0..repeats_of[r][exes.len() + p] {
+                    let out = dir.join(format!("r{r}-{}.h5", peer.name));
+                    let (o, secs) = crate::bench::timed(peer.command(root, &out, case, sets))?;
+                    let _ = std::fs::remove_file(&out);
+                    if o.status.success() {
+                        times[r][exes.len() + p].push(secs);
+                    } else {
+                        eprintln!(
+                            "bench run: {label} ({} peer) failed, left out of its median: {}",
+                            peer.name,
+                            String::from_utf8_lossy(&o.stderr).trim()
+                        );
+                    }
                 }
             }
         }
@@ -291,7 +340,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         t.sort_by(f64::total_cmp);
         t.get(t.len() / 2).copied().unwrap_or(f64::NAN)
     };
-    let mut csv = String::from("run,median_s,fastest_s,rounds");
+    let mut csv = String::from("run,median_s,fastest_s,rounds,samples");
     if compared {
         csv.push_str(",against_median_s,ratio");
     }
@@ -300,8 +349,14 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         csv.push_str(&format!(",{p}_median_s,{p}_ratio,{p}_check"));
     }
     csv.push('\n');
-    println!("\nwall time of whole `stickslip run` processes (release), medians of {rounds} interleaved rounds:\n");
-    print!("{:<32} {:>10} {:>10}", "run", "median s", "fastest");
+    println!(
+        "\nwall time of whole `stickslip run` processes (release), medians over {rounds} interleaved rounds \
+         (short runs repeated within a round, `samples`):\n"
+    );
+    print!(
+        "{:<32} {:>10} {:>10} {:>7}",
+        "run", "median s", "fastest", "samples"
+    );
     for peer in &peers {
         print!(" {:>12} {:>8}", format!("{} s", peer.name), "/ ours");
     }
@@ -322,8 +377,9 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     for (r, (label, _, _, fits)) in runs.iter().enumerate() {
         let m = median(&mut times[r][0]);
         let fastest = times[r][0].first().copied().unwrap_or(f64::NAN);
-        print!("{label:<32} {m:>10.4} {fastest:>10.4}");
-        csv.push_str(&format!("{label},{m:.5},{fastest:.5},{rounds}"));
+        let samples = times[r][0].len();
+        print!("{label:<32} {m:>10.4} {fastest:>10.4} {samples:>7}");
+        csv.push_str(&format!("{label},{m:.5},{fastest:.5},{rounds},{samples}"));
         let mut peer_csv = String::new();
         for p in 0..peers.len() {
             if fits[p] {
@@ -356,9 +412,13 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     Ok(())
 }
 
+/// A figure per run and peer: `[run][peer]`.
+type PerPeer = Vec<Vec<f64>>;
+
 /// Each peer's agreement with stickslip on each run it makes
 /// (`checks[run][peer]`, NaN where it does not run it), before anything is
-/// timed: one run of each, their results files compared.
+/// timed: one run of each, their results files compared; and how long
+/// that run of each peer took (NaN where none was made).
 ///
 /// # Errors
 /// A run that fails, or a peer that differs by more than 1e-8: the bench
@@ -369,8 +429,9 @@ fn check_peers(
     dir: &Path,
     peers: &[crate::bench_peers::Peer],
     runs: &[(String, &'static str, Vec<String>, Vec<bool>)],
-) -> Result<Vec<Vec<f64>>, String> {
+) -> Result<(PerPeer, PerPeer), String> {
     let mut checks = vec![vec![f64::NAN; peers.len()]; runs.len()];
+    let mut secs = checks.clone();
     for (r, (label, case, sets, fits)) in runs.iter().enumerate() {
         if !fits.contains(&true) {
             continue;
@@ -386,7 +447,8 @@ fn check_peers(
         }
         for (p, peer) in peers.iter().enumerate().filter(|(p, _)| fits[*p]) {
             let theirs = dir.join(format!("check-r{r}-{}.h5", peer.name));
-            let (o, _) = crate::bench::timed(peer.command(root, &theirs, case, sets))?;
+            let (o, took) = crate::bench::timed(peer.command(root, &theirs, case, sets))?;
+            secs[r][p] = took;
             if !o.status.success() {
                 return Err(format!(
                     "{label}: the {} peer failed: {}",
@@ -411,7 +473,7 @@ fn check_peers(
             let _ = std::fs::remove_file(ours.with_extension(ext));
         }
     }
-    Ok(checks)
+    Ok((checks, secs))
 }
 
 /// The rung's mesh, written by Gmsh from cases/slab.geo unless it is there.
@@ -477,6 +539,20 @@ fn dt_crit(exe: &Path, root: &Path, mesh: &Path) -> Result<f64, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The repeats a round makes: ⌈0.5 s / t⌉ between 1 and 25, so that a
+    /// round spends at least half a second on a run where it can.
+    #[test]
+    fn short_runs_are_repeated_to_fill_half_a_second() {
+        assert_eq!(repeats(0.012), 25); // ⌈41.7⌉, capped
+        assert_eq!(repeats(0.021), 24); // ⌈23.8⌉
+        assert_eq!(repeats(0.1), 5);
+        assert_eq!(repeats(0.3), 2); // ⌈1.67⌉
+        assert_eq!(repeats(0.5), 1);
+        assert_eq!(repeats(8.0), 1);
+        // No timed run (it failed, or no peer made one): once.
+        assert_eq!(repeats(f64::NAN), 1);
+    }
 
     /// The rungs each peer runs, as the module doc lists them.
     #[test]

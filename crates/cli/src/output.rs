@@ -181,11 +181,11 @@ struct ContactSeries {
 /// and a hyperslab write per dataset), which on small meshes is most of a
 /// run: the paper's slab, 501 rows, 0.12-0.13 s a run of which the steps
 /// are about 1 ms (2026-11-24). Rows are kept here and written one block
-/// per dataset when the row count reaches the end of a chunk along time
-/// (so a chunk is compressed once, whole), and before every flush,
-/// checkpoint and the end of the run, so a flushed file holds every row
-/// appended before the flush. At most one chunk of rows per dataset
-/// (≤ 1 MiB each, [`chunk_rows`]).
+/// per dataset when they reach [`PENDING_BYTES`] (or [`HISTORY_BLOCK`]
+/// rows), and before every flush, checkpoint and the end of the run, so a
+/// flushed file holds every row appended before the flush. A block need
+/// not end at a chunk's end: HDF5 keeps the partly written chunk in its
+/// cache (1 MiB a dataset, more than a chunk) until the next block fills it.
 #[derive(Debug, Default)]
 struct Pending {
     /// One entry a row: its length is the number of rows.
@@ -212,6 +212,20 @@ impl Pending {
 
     fn frames(&self) -> usize {
         self.frame_time.len()
+    }
+
+    /// Bytes held.
+    fn bytes(&self) -> usize {
+        let f64s = self.time.len()
+            + self.frame_time.len()
+            + self.displacement.len()
+            + self.velocity.len()
+            + self.acceleration.len()
+            + self.friction_stress.len()
+            + self.slip_velocity.len()
+            + self.dt.len()
+            + self.energy.iter().map(Vec::len).sum::<usize>();
+        8 * (f64s + self.frame_row.len()) + self.state.len() + 4 * self.iterations.len()
     }
 
     /// Appends `rec` as the file's row `row`.
@@ -283,9 +297,8 @@ pub struct ResultsWriter {
     flushed: (usize, usize),
     /// Appended rows not yet in the datasets.
     pending: Pending,
-    /// Rows per chunk of the vector fields along time: `pending` is
-    /// written when the frame count reaches a multiple of it (or holds
-    /// [`HISTORY_BLOCK`] rows).
+    /// Rows per chunk of the vector fields along time (whole chunks are
+    /// allocated in the file).
     block_rows: usize,
     since_flush: usize,
     last_flush: Instant,
@@ -391,6 +404,12 @@ const ENERGY_NAMES: [&str; 8] = [
 /// (the chunk of the 1-D series), however rare the frames.
 const HISTORY_BLOCK: usize = SERIES_CHUNK;
 
+/// Bytes of rows kept in memory before they are written (a frame larger
+/// than this is written as it comes). Each block costs about 15 HDF5
+/// writes, which on a small mesh whose every step is a frame cost more
+/// than the steps when made at every chunk's end (docs/performance.md).
+const PENDING_BYTES: usize = 1 << 20;
+
 /// Rows per chunk along time so that a chunk stays within HDF5's default
 /// 1 MiB chunk cache (a partly written chunk then stays in memory instead of
 /// being re-read and re-compressed on every append).
@@ -434,9 +453,10 @@ fn series_2d<T: H5Type>(g: &Group, name: &str, n: usize, level: u8) -> Result<Da
 
 /// Rows per chunk along time of the node vectors (`/displacement` and the
 /// others) of a mesh of `n` nodes: a run's file grows by whole chunks of
-/// them.
+/// them. At most 64 KiB a chunk (where a row is smaller), as every flush
+/// writes the chunk it ends in whole, however few of its rows are new.
 pub fn vector_chunk_rows(n: usize) -> usize {
-    chunk_rows(n * 16).clamp(1, 16)
+    ((64 << 10) / (n * 16).max(1)).clamp(1, 16)
 }
 
 fn series_3d(g: &Group, name: &str, n: usize, level: u8) -> Result<Dataset> {
@@ -871,7 +891,8 @@ impl ResultsWriter {
     pub fn room_needed(&self, n_free: usize) -> u64 {
         // The rows go to the datasets a chunk at a time (whole chunks are
         // allocated), so the next write may take a chunk of every series.
-        let fields = self.block_rows * (6 * self.n_nodes + 2) * 8;
+        let frame_bytes = (6 * self.n_nodes + 2) * 8;
+        let fields = self.block_rows.max(PENDING_BYTES / frame_bytes + 1) * frame_bytes;
         let histories = HISTORY_BLOCK * (3 * self.n_c + 9) * 8;
         let checkpoint = 5 * n_free * 8;
         (2 * (fields + histories + checkpoint) + (1 << 20)) as u64
@@ -882,8 +903,15 @@ impl ResultsWriter {
     /// [`ResultsWriter::room_needed`] should be checked, besides before a
     /// flush: HDF5 writes chunks as they fill, not at the flush).
     pub fn append_writes(&self, frame: bool) -> bool {
-        (frame && (self.frames + 1).is_multiple_of(self.block_rows))
+        self.pending.bytes() + self.row_bytes(frame) >= PENDING_BYTES
             || self.pending.rows() + 1 >= HISTORY_BLOCK
+    }
+
+    /// Bytes a record adds to [`Pending`], a frame's if `frame`.
+    fn row_bytes(&self, frame: bool) -> usize {
+        let histories = 8 * (9 + 2 * self.n_c) + self.n_c + 4;
+        let fields = if frame { 8 * (6 * self.n_nodes + 2) } else { 0 };
+        histories + fields
     }
 
     /// Counts a step toward [`ResultsWriter::flush_due`] without writing a
@@ -1122,9 +1150,7 @@ impl ResultsWriter {
         if frame {
             self.frames += 1;
         }
-        if (frame && self.frames.is_multiple_of(self.block_rows))
-            || self.pending.rows() >= HISTORY_BLOCK
-        {
+        if self.pending.bytes() >= PENDING_BYTES || self.pending.rows() >= HISTORY_BLOCK {
             self.write_pending()?;
         }
         if self.auto_flush {
@@ -1738,6 +1764,42 @@ pub(crate) mod tests {
     /// frame; `/frames/row` names each frame's row, and a restart after
     /// row 7 (frame 3) keeps both in step. Expected values: the rows the
     /// test wrote.
+    /// `append_writes` (which the run's check of free disk space relies
+    /// on) is true exactly before the appends that write their block.
+    /// Expected: a 20 × 20 node grid's frame is 8 (6·400 + 2) = 19,216
+    /// bytes and the histories of 3 contact nodes 8 (9 + 6) + 3 + 4 = 127
+    /// bytes a row, so 55 frame rows reach PENDING_BYTES
+    /// (⌈1,048,576 / 19,343⌉): rows 54, 109, 164; the 35 frames left and
+    /// rows without fields then reach HISTORY_BLOCK (1,024 rows) at row
+    /// 164 + 1,024 = 1,188 before 1 MiB.
+    #[test]
+    fn append_writes_says_which_appends_write() {
+        let _guard = h5_lock();
+        let path = scratch("append-writes");
+        let mesh = stickslip_testkit::grid::rectangle(CellKind::Quad4, 19, 19, [0.0; 2], [1.0; 2]);
+        let header = test_header(&mesh, true);
+        let mut w = ResultsWriter::create(&path, &header).unwrap();
+        w.auto_flush = false;
+        let n = 2 * mesh.nodes.len();
+        let mut writes = Vec::new();
+        for k in 0..1500 {
+            let frame = k < 200;
+            let predicted = w.append_writes(frame);
+            let d: Vec<f64> = (0..n).map(|i| u(k, i)).collect();
+            let f: &[f64] = if frame { &d } else { &[] };
+            w.append(&record_of(0.1 * k as f64, [f, f, f], &[k as f64; 3]))
+                .unwrap();
+            let wrote = w.pending.rows() == 0;
+            assert_eq!(predicted, wrote, "row {k}");
+            if wrote {
+                writes.push(k);
+            }
+        }
+        assert_eq!(writes, [54, 109, 164, 1188]);
+        drop(w);
+        std::fs::remove_file(&path).ok();
+    }
+
     #[test]
     fn frames_and_histories_grow_apart() {
         let _guard = h5_lock();
