@@ -82,7 +82,7 @@ fn one_table_and_a_list_are_both_surfaces() {
     assert_eq!(two.contact.len(), 2);
     assert_eq!(
         (two.contact[1].group.as_str(), two.contact[1].mu),
-        ("support", 0.2)
+        ("support", Some(0.2))
     );
     let none = load(&slab("")).unwrap();
     assert!(none.contact.is_empty());

@@ -88,6 +88,8 @@ pub struct Record<'a> {
     pub dissipated: f64,
     /// Rayleigh damping's dissipation so far (0 without damping).
     pub damped: f64,
+    /// The energy a compliant foundation stores (0 without one).
+    pub foundation: f64,
     /// kinetic + strain − rᵀR(t) (the paper's Fig. 9).
     pub total: f64,
     /// kinetic + strain − initial − work + dissipated + damped.
@@ -134,7 +136,7 @@ struct Series {
     frame_time: Dataset,
     frame_row: Dataset,
     contact: Option<ContactSeries>,
-    energy: [Dataset; 7],
+    energy: [Dataset; 8],
     dt: Dataset,
     iterations: Dataset,
 }
@@ -198,7 +200,7 @@ struct Pending {
     friction_stress: Vec<f64>,
     slip_velocity: Vec<f64>,
     state: Vec<i8>,
-    energy: [Vec<f64>; 7],
+    energy: [Vec<f64>; 8],
     dt: Vec<f64>,
     iterations: Vec<u32>,
 }
@@ -233,6 +235,7 @@ impl Pending {
             rec.total,
             rec.balance,
             rec.damped,
+            rec.foundation,
         ];
         for (series, v) in self.energy.iter_mut().zip(e) {
             series.push(v);
@@ -373,7 +376,7 @@ fn scalar_attr<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<
 pub const DEFLATE_LEVEL: u8 = 0;
 
 /// Names of the `/energy` series, in [`Record`] order.
-const ENERGY_NAMES: [&str; 7] = [
+const ENERGY_NAMES: [&str; 8] = [
     "kinetic",
     "strain",
     "external_work",
@@ -381,6 +384,7 @@ const ENERGY_NAMES: [&str; 7] = [
     "total",
     "balance",
     "damped",
+    "foundation_stored",
 ];
 
 /// Rows of the histories kept in memory at most before they are written
@@ -492,7 +496,8 @@ pub(crate) fn get_scalar<T: H5Type>(loc: &hdf5::Location, name: &str) -> Result<
 pub(crate) const SLOTS: [&str; 2] = ["a", "b"];
 
 /// Order of `/checkpoint/energy`.
-const ENERGY_ORDER: &str = "kinetic, strain, external_work, dissipated, total, balance, damped";
+const ENERGY_ORDER: &str =
+    "kinetic, strain, external_work, dissipated, total, balance, damped, foundation";
 
 /// `/contact/surface` and the attribute `groups`: which surface of the
 /// case each contact node is on.
@@ -628,7 +633,7 @@ impl ResultsWriter {
         for name in ENERGY_NAMES {
             energy.push(series_1d::<f64>(&e, name, level)?);
         }
-        let energy: [Dataset; 7] = energy.try_into().expect("seven energy series");
+        let energy: [Dataset; 8] = energy.try_into().expect("eight energy series");
         let solver = file.create_group("solver")?;
         let frames = file.create_group("frames")?;
         string_attr(
@@ -724,9 +729,10 @@ impl ResultsWriter {
         let mut energy = Vec::new();
         for name in ENERGY_NAMES {
             let at = format!("energy/{name}");
-            // Files written before damping have no /energy/damped: made
-            // here, the resize below gives its rows the fill value 0.
-            if name == "damped" && !file.link_exists(&at) {
+            // Files written before damping (or the compliant foundation)
+            // have no /energy/damped (foundation_stored): made here, the
+            // resize below gives its rows the fill value 0.
+            if matches!(name, "damped" | "foundation_stored") && !file.link_exists(&at) {
                 energy.push(series_1d::<f64>(&file.group("energy")?, name, 0)?);
                 continue;
             }
@@ -757,7 +763,7 @@ impl ResultsWriter {
             frame_time: ds("frames/time")?,
             frame_row: ds("frames/row")?,
             contact,
-            energy: energy.try_into().expect("seven energy series"),
+            energy: energy.try_into().expect("eight energy series"),
             dt: ds("solver/dt")?,
             iterations: ds("solver/iterations")?,
         };
@@ -967,6 +973,7 @@ impl ResultsWriter {
                 e.total,
                 e.balance,
                 e.damped,
+                e.foundation,
             ],
         )?;
         let energy = g.dataset("energy")?;
@@ -1282,6 +1289,7 @@ pub(crate) mod tests {
                 external_work: 3.0 + k as f64,
                 dissipated: 4.0 + k as f64,
                 damped: 0.0,
+                foundation: 0.0,
                 total: 5.0 + k as f64,
                 balance: 6.0 + k as f64,
                 dt: 0.1,
@@ -1629,6 +1637,7 @@ pub(crate) mod tests {
                     external_work: 0.0,
                     dissipated: 0.0,
                     damped: 0.0,
+                    foundation: 0.0,
                     total: 0.0,
                     balance: 0.0,
                     dt: 0.5,
@@ -1697,6 +1706,7 @@ pub(crate) mod tests {
             external_work: 0.0,
             dissipated: 0.0,
             damped: 0.0,
+            foundation: 0.0,
             total: 0.0,
             balance: 0.0,
             dt: 0.1,
@@ -1848,6 +1858,7 @@ pub(crate) mod tests {
             external_work: 0.0,
             dissipated: 0.0,
             damped: 0.0,
+            foundation: 0.0,
             total: 0.0,
             balance: 0.0,
             dt: 0.0,
@@ -1897,6 +1908,7 @@ pub(crate) mod tests {
                 external_work: 0.0,
                 dissipated: 0.0,
                 damped: 0.0,
+                foundation: 0.0,
                 total: 0.0,
                 balance: 0.0,
                 dt: 1.0,
@@ -1956,6 +1968,7 @@ pub(crate) mod tests {
                 external_work: 0.0,
                 dissipated: 0.0,
                 damped: 0.0,
+                foundation: 0.0,
                 total: 0.0,
                 balance: 0.0,
                 dt: 1.0,

@@ -971,6 +971,7 @@ mod tests {
                 external_work: 0.0,
                 dissipated: 0.0,
                 damped: 0.0,
+                foundation: 0.0,
                 total: 0.0,
                 balance: 0.0,
                 dt: 0.25,

@@ -174,9 +174,9 @@ pub(crate) fn friction_off(case: &Case, i: &Integrator) -> Option<String> {
     let surfaces = &case.contact;
     Some(if surfaces.is_empty() {
         "the case has no [contact]".to_string()
-    } else if surfaces.iter().all(|c| c.mu == 0.0) {
+    } else if surfaces.iter().all(|c| c.mu == Some(0.0)) {
         "contact.mu = 0".to_string()
-    } else if surfaces.iter().all(|c| c.pressure == 0.0) {
+    } else if surfaces.iter().all(|c| c.pressure == Some(0.0)) {
         "contact.pressure = 0".to_string()
     } else {
         "no node of the contact surfaces carries friction (w g = 0)".to_string()
@@ -404,6 +404,7 @@ pub(crate) fn record<'a>(
         external_work: e.external_work,
         dissipated: e.dissipated,
         damped: e.damped,
+        foundation: e.foundation,
         total: e.total,
         balance: e.balance,
         dt,

@@ -88,6 +88,7 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
             external_work: e[2],
             dissipated: e[3],
             damped: e.get(6).copied().unwrap_or(0.0),
+            foundation: e.get(7).copied().unwrap_or(0.0),
             total: e[4],
             balance: e[5],
         },

@@ -20,12 +20,14 @@
 
 #![forbid(unsafe_code)]
 
+mod compliance;
 mod iteration;
 mod law;
 mod ledger;
 mod nodal;
 mod surface;
 
+pub use compliance::{Compliance, CompliantNode, Foundation};
 pub use iteration::{iterate, IterationFailure, IterationOptions, IterationReport, StepSystem};
 pub use law::{FrictionLaw, SlipState};
 pub use ledger::stick_events;

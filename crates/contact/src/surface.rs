@@ -4,6 +4,7 @@
 use stickslip_fem::{boundary_quadrature, DofMap, FemError};
 use stickslip_mesh::Mesh;
 
+use crate::compliance::CompliantNode;
 use crate::law::{FrictionLaw, SlipState};
 
 /// Why a contact surface could not be built.
@@ -152,6 +153,10 @@ pub struct ContactSurface {
     pub excluded: Vec<usize>,
     /// The regularized law with its ε.
     pub law: FrictionLaw,
+    /// The nodes a compliant foundation holds (METHOD.md §10), in node
+    /// order; their bounds follow the approach. Empty where every surface
+    /// has a prescribed pressure.
+    pub compliance: Vec<CompliantNode>,
 }
 
 impl ContactSurface {
@@ -208,6 +213,7 @@ impl ContactSurface {
             excluded,
             revision: 0,
             law: FrictionLaw { eps },
+            compliance: Vec::new(),
         })
     }
 
@@ -231,6 +237,7 @@ impl ContactSurface {
             excluded: Vec::new(),
             revision: 0,
             law: FrictionLaw { eps },
+            compliance: Vec::new(),
         })
     }
 
@@ -350,6 +357,7 @@ impl ContactSurface {
             excluded: Vec::new(),
             revision: self.revision,
             law: self.law,
+            compliance: self.compliance.clone(),
         }
     }
 
@@ -387,6 +395,12 @@ impl ContactSurface {
                 }
             }
             let start = joined.nodes.len();
+            joined
+                .compliance
+                .extend(s.compliance.iter().map(|c| CompliantNode {
+                    index: c.index + start,
+                    ..*c
+                }));
             joined.parts.push(SurfacePart {
                 group: s.group,
                 nodes: start..start + s.nodes.len(),

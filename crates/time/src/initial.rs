@@ -133,6 +133,7 @@ pub(crate) fn initial_state(
         external_work: 0.0,
         dissipated: 0.0,
         damped: 0.0,
+        foundation: 0.0,
         total: kinetic + strain - dot(&state.r, &state.load),
         balance: 0.0,
     };

@@ -23,9 +23,13 @@ pub struct Energy {
     /// its mass part so, its stiffness part as the force it applies,
     /// (β/Δt)K(r_K − r_{K−1}), times r_K − r_{K−1}. 0 without damping.
     pub damped: f64,
-    /// kinetic + strain − rᵀR(t): the paper's total energy (Fig. 9).
+    /// Σ w_J c_n δ_J^{m_n+1}/(m_n+1): the energy a compliant foundation
+    /// stores (METHOD.md §10); 0 without one.
+    pub foundation: f64,
+    /// kinetic + strain + foundation − rᵀR(t): the paper's total energy (Fig. 9).
     pub total: f64,
-    /// kinetic + strain − initial − work + dissipated + damped; zero up to
+    /// kinetic + strain + foundation − initial − work + dissipated +
+    /// damped; zero up to
     /// round-off for the trapezoidal rule (Newmark ¼, ½).
     pub balance: f64,
 }
@@ -160,6 +164,8 @@ pub(crate) struct StepEnergies {
     pub dissipated: f64,
     /// The damping's dissipation over the step.
     pub damped: f64,
+    /// The foundation's stored energy at r_K.
+    pub foundation: f64,
     /// r_K · R_K.
     pub load_dot: f64,
 }
@@ -253,9 +259,12 @@ impl State {
         l.external_work += e.work;
         l.dissipated += e.dissipated;
         l.damped += e.damped;
-        l.total = e.kinetic + e.strain - e.load_dot;
+        l.foundation = e.foundation;
+        // kinetic + strain ≥ +0, so adding a foundation's +0 keeps its bits.
+        let mechanical = e.kinetic + e.strain + e.foundation;
+        l.total = mechanical - e.load_dot;
         // Without damping `+ l.damped` adds +0: the same bits as before.
-        l.balance = e.kinetic + e.strain - self.initial_mechanical - l.external_work
+        l.balance = mechanical - self.initial_mechanical - l.external_work
             + l.dissipated
             + l.damped;
         if let Some(r) = settings.stick_reduction {

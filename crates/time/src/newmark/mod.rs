@@ -283,7 +283,7 @@ impl Newmark {
 }
 
 impl Stepper for Newmark {
-    fn step(&mut self, run: &Run, state: &mut State) -> Result<StepInfo, TimeError> {
+    fn step(&mut self, run: &mut Run, state: &mut State) -> Result<StepInfo, TimeError> {
         let settings = &run.settings;
         let (dt, t_new) = state.next_step(settings);
         let step = state.steps + 1;
@@ -372,6 +372,7 @@ impl Stepper for Newmark {
             work,
             dissipated,
             damped,
+            foundation: 0.0,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))

@@ -1,0 +1,119 @@
+//! The bar-impact problem of Hughes et al. (1976) on a compliant wall
+//! (METHOD.md §10): a strip of length L (ν = 0, its transverse motion held,
+//! so a 1-D bar of wave speed c = √(E/ρ)) moving at v₀ touches a rigid wall
+//! at t = 0. With a rigid wall the contact lasts 2L/c at the stress ρcv₀
+//! and the bar leaves at −v₀; a wall of finite stiffness c_n approaches
+//! these as c_n grows.
+
+use stickslip_contact::{Compliance, ContactSurface};
+use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
+use stickslip_mesh::CellKind;
+use stickslip_time::{Dynamics, InitialState, Integrator, Scheme, Settings};
+
+use crate::grid::rectangle;
+use crate::scene::SceneError;
+
+/// The bar's length.
+pub const L: f64 = 1.0;
+/// Its height (one row of cells).
+pub const H: f64 = 0.05;
+/// The impact speed.
+pub const V0: f64 = 0.1;
+/// E = ρ = 1: c = 1, so the rigid wall's contact time is 2L and its
+/// stress ρcv₀ = v₀.
+pub const C: f64 = 1.0;
+
+/// What one run of the bar gave.
+#[derive(Clone, Copy, Debug)]
+pub struct Impact {
+    /// From t = 0 to the last step the wall pushed.
+    pub contact_time: f64,
+    /// The wall's mean stress over the middle half of the contact, [L/2c,
+    /// 3L/2c].
+    pub stress: f64,
+    /// The bar's mean velocity at the end (t = 3L/c).
+    pub exit_velocity: f64,
+    /// The ledger's largest |balance| over the initial kinetic energy.
+    pub balance: f64,
+    /// The explicit critical step the run had (with the wall's springs).
+    pub dt_crit: f64,
+}
+
+/// The bar of `nx` Q1 cells against a wall of stiffness `cn·E/h` (h =
+/// L/nx, so `cn` is the wall's stiffness relative to a cell's), by
+/// central difference at `courant` times its critical step, run to 3L/c.
+///
+/// # Errors
+/// The scene's or the integrator's.
+pub fn run(nx: usize, cn: f64, courant: f64) -> Result<Impact, SceneError> {
+    let mesh = rectangle(CellKind::Quad4, nx, 1, [0.0, 0.0], [L, H]);
+    let material = Material::new(1.0, 0.0, 1.0, Hypothesis::PlaneStrain)?;
+    let model = Model::new(&mesh, &material, &[Dirichlet::new("domain", 1, 0.0)])?;
+    let law = Compliance {
+        cn: cn * nx as f64 / L,
+        mn: 1.0,
+        ct: 0.0,
+        mt: 1.0,
+    };
+    let wall = ([L, 0.0], [-1.0, 0.0]);
+    let contact = ContactSurface::on_foundation(&mesh, &model.dofs, "right", wall, law, 1e-3)?;
+    let mut v0 = vec![0.0; model.dofs.n_free()];
+    for node in 0..mesh.nodes.len() {
+        if let Some(d) = model.dofs.free(node, 0) {
+            v0[d] = V0;
+        }
+    }
+    let t_end = 3.0 * L / C;
+    let settings = |dt: f64| {
+        let mut s = Settings::new(Scheme::CentralDifference, dt, t_end);
+        s.initial_state = InitialState::Rest;
+        s.initial_velocity = Some(v0.clone());
+        s
+    };
+    let build = |dt: f64| {
+        Integrator::new(
+            Dynamics::from_model(&model),
+            Some(contact.clone()),
+            Vec::new(),
+            settings(dt),
+        )
+    };
+    let dt_crit = build(1e-6)?.dt_crit().unwrap_or(f64::NAN);
+    let mut run = build(courant * dt_crit)?;
+    let e0 = run.energy().kinetic;
+    let n_c = contact.len();
+    let mut sigma = vec![0.0; n_c];
+    let (mut last, mut sum, mut count, mut balance) = (0.0_f64, 0.0, 0usize, 0.0_f64);
+    while !run.done() {
+        run.step()?;
+        let t = run.time();
+        run.normal_traction(&mut sigma);
+        let c = run.contact().expect("a contact surface");
+        let force: f64 = c.nodes.iter().zip(&sigma).map(|(n, s)| n.weight * s).sum();
+        if force > 0.0 {
+            last = t;
+        }
+        if (0.5 * L / C..=1.5 * L / C).contains(&t) {
+            sum += force / H;
+            count += 1;
+        }
+        balance = balance.max(run.energy().balance.abs() / e0);
+    }
+    // The mean velocity with the trapezoid weights of the uniform grid
+    // (the lumped mass of Q1 cells of one size).
+    let (mut mv, mut m) = (0.0, 0.0);
+    for (node, x) in mesh.nodes.iter().enumerate() {
+        if let Some(d) = model.dofs.free(node, 0) {
+            let w = if x[0] == 0.0 || x[0] == L { 0.5 } else { 1.0 };
+            mv += w * run.velocity()[d];
+            m += w;
+        }
+    }
+    Ok(Impact {
+        contact_time: last,
+        stress: sum / count.max(1) as f64,
+        exit_velocity: mv / m,
+        balance,
+        dt_crit,
+    })
+}
