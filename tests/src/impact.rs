@@ -39,22 +39,27 @@ pub struct Impact {
     pub dt_crit: f64,
 }
 
-/// The bar of `nx` Q1 cells against a wall of stiffness `cn·E/h` (h =
-/// L/nx, so `cn` is the wall's stiffness relative to a cell's), by
-/// central difference at `courant` times its critical step, run to 3L/c.
-///
-/// # Errors
-/// The scene's or the integrator's.
-pub fn run(nx: usize, cn: f64, courant: f64) -> Result<Impact, SceneError> {
-    let mesh = rectangle(CellKind::Quad4, nx, 1, [0.0, 0.0], [L, H]);
-    let material = Material::new(1.0, 0.0, 1.0, Hypothesis::PlaneStrain)?;
-    let model = Model::new(&mesh, &material, &[Dirichlet::new("domain", 1, 0.0)])?;
-    let law = Compliance {
+/// The frictionless linear wall (m_n = 1) of stiffness `cn·E/h` for the
+/// bar of `nx` cells (h = L/nx: `cn` is the wall's stiffness relative to
+/// a cell's).
+pub fn wall(nx: usize, cn: f64) -> Compliance {
+    Compliance {
         cn: cn * nx as f64 / L,
         mn: 1.0,
         ct: 0.0,
         mt: 1.0,
-    };
+    }
+}
+
+/// The bar of `nx` Q1 cells against a wall of law `law`, by central
+/// difference at `courant` times its critical step, run to 3L/c.
+///
+/// # Errors
+/// The scene's or the integrator's.
+pub fn run(nx: usize, law: Compliance, courant: f64) -> Result<Impact, SceneError> {
+    let mesh = rectangle(CellKind::Quad4, nx, 1, [0.0, 0.0], [L, H]);
+    let material = Material::new(1.0, 0.0, 1.0, Hypothesis::PlaneStrain)?;
+    let model = Model::new(&mesh, &material, &[Dirichlet::new("domain", 1, 0.0)])?;
     let wall = ([L, 0.0], [-1.0, 0.0]);
     let contact = ContactSurface::on_foundation(&mesh, &model.dofs, "right", wall, law, 1e-3)?;
     let mut v0 = vec![0.0; model.dofs.n_free()];

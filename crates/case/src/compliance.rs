@@ -72,10 +72,7 @@ fn check_compliance(
     for (k, given) in [
         ("pressure", c.pressure.is_some()),
         ("pressure_profile", c.pressure_profile.is_some()),
-        (
-            "pressure_history",
-            c.pressure_history != History::Constant,
-        ),
+        ("pressure_history", c.pressure_history != History::Constant),
     ] {
         check(
             !given,
@@ -195,7 +192,10 @@ pub(crate) fn compliant_surface(
     at: &dyn Fn(&str) -> String,
     problems: &mut Vec<String>,
 ) -> Result<ContactSurface, ContactError> {
-    let f = c.foundation.as_ref().expect("checked: law = \"compliance\" has a foundation");
+    let f = c
+        .foundation
+        .as_ref()
+        .expect("checked: law = \"compliance\" has a foundation");
     let length = f.normal[0].hypot(f.normal[1]);
     let normal = [f.normal[0] / length, f.normal[1] / length];
     let cn = c.cn.expect("checked: law = \"compliance\" has cn");

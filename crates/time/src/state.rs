@@ -264,9 +264,8 @@ impl State {
         let mechanical = e.kinetic + e.strain + e.foundation;
         l.total = mechanical - e.load_dot;
         // Without damping `+ l.damped` adds +0: the same bits as before.
-        l.balance = mechanical - self.initial_mechanical - l.external_work
-            + l.dissipated
-            + l.damped;
+        l.balance =
+            mechanical - self.initial_mechanical - l.external_work + l.dissipated + l.damped;
         if let Some(r) = settings.stick_reduction {
             if stick_events > 0 {
                 self.reduced_remaining = r.steps;

@@ -3,22 +3,77 @@
 //! closed form is a contact of 2L/c at the stress ρcv₀ = v₀, the bar
 //! leaving at −v₀.
 
-use stickslip_testkit::impact::{run, C, L, V0};
+use stickslip_contact::Compliance;
+use stickslip_testkit::impact::{run, wall, C, L, V0};
+use stickslip_testkit::scene::SceneError;
+use stickslip_time::TimeError;
 
+/// As the wall stiffens, the contact time approaches 2L/c: the error falls
+/// at each step of c_n (40 cells, Courant 0.5); at c_n = E/h the run is
+/// within the mesh's resolution of the rigid wall's closed form.
 #[test]
-fn print_table() {
-    for nx in [20, 40] {
-        for cn in [1.0, 10.0, 100.0] { for courant in [0.9, 0.5, 0.2] {
-            let r = run(nx, cn, courant).unwrap();
-            println!(
-                "nx {nx} cn {cn} courant {courant}: time {:.4} (2L/c {}), stress {:.5} ({V0}), exit {:.5}, balance {:.2e}, dt_crit {:.3e}",
-                r.contact_time,
-                2.0 * L / C,
-                r.stress,
-                r.exit_velocity,
-                r.balance,
-                r.dt_crit
-            );
-        } }
+fn bar_impact_approaches_the_rigid_wall() {
+    let rigid_time = 2.0 * L / C;
+    let mut last = f64::INFINITY;
+    for cn in [0.1, 0.3, 1.0, 3.0] {
+        let r = run(40, wall(40, cn), 0.5).unwrap();
+        let error = (r.contact_time - rigid_time).abs();
+        assert!(
+            error < last,
+            "c_n = {cn}: contact time {} (2L/c = {rigid_time}) not closer than at the softer wall ({last})",
+            r.contact_time
+        );
+        last = error;
     }
+    let r = run(40, wall(40, 1.0), 0.5).unwrap();
+    // Release is resolved to a few cells' crossing times, 4h/c = 0.1; the
+    // plateau stress ρcv₀ and the exit speed v₀ to 2% (the dispersion of
+    // the mesh and the step); the ledger to 1% of the kinetic energy.
+    assert!((r.contact_time - rigid_time).abs() < 0.1, "{r:?}");
+    assert!((r.stress - V0).abs() < 0.02 * V0, "{r:?}");
+    assert!((r.exit_velocity + V0).abs() < 0.02 * V0, "{r:?}");
+    assert!(r.balance < 1e-2, "{r:?}");
+}
+
+/// The critical step includes the wall's springs: a Δt just above the
+/// estimate with them is refused at the start.
+#[test]
+fn a_step_above_the_walls_critical_step_is_refused() {
+    let r = run(20, wall(20, 10.0), 1.0).unwrap();
+    match run(20, wall(20, 10.0), 1.02) {
+        Err(SceneError::Time(TimeError::Unstable { dt_crit, .. })) => {
+            assert_eq!(dt_crit.to_bits(), r.dt_crit.to_bits());
+        }
+        other => panic!("expected the refusal, got {other:?}"),
+    }
+    // Without the springs, 1-D Q1 with the lumped mass: Δt_crit = h/c =
+    // 0.05; the wall (ten times a cell's stiffness) lowers it.
+    let soft = run(20, wall(20, 1e-9), 0.5).unwrap();
+    assert!((soft.dt_crit - 0.05).abs() < 1e-3, "{soft:?}");
+    assert!(r.dt_crit < 0.6 * soft.dt_crit, "{r:?}");
+}
+
+/// m_n > 1: the stiffness grows with the approach, and a step whose Δt the
+/// deepening contact makes unstable stops with the reason.
+#[test]
+fn a_wall_stiffening_past_the_step_stops_the_run() {
+    let law = Compliance {
+        cn: 1e6,
+        mn: 2.0,
+        ct: 0.0,
+        mt: 2.0,
+    };
+    match run(20, law, 0.95) {
+        Err(SceneError::Time(TimeError::Settings(m))) => {
+            assert!(
+                m.contains("contact stiffness") && m.contains("reduce time.dt"),
+                "{m}"
+            );
+        }
+        other => panic!("expected the stop, got {other:?}"),
+    }
+    // A gentle wall of the same power runs through and lets the bar go.
+    let gentle = Compliance { cn: 100.0, ..law };
+    let r = run(20, gentle, 0.5).unwrap();
+    assert!((r.exit_velocity + V0).abs() < 0.05 * V0, "{r:?}");
 }
