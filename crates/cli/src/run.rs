@@ -933,11 +933,15 @@ impl Session<'_> {
                 String::new()
             };
             // Rayleigh damping's share, where the case has it.
-            let rayleigh = if case.material.damping.is_some() {
+            let mut rayleigh = if case.material.damping.is_some() {
                 format!(", damped {:.6}", e.damped)
             } else {
                 String::new()
             };
+            // A compliant foundation's stored energy, where the case has one.
+            if i.contact().is_some_and(|c| c.is_compliant()) {
+                rayleigh.push_str(&format!(", foundation {:.6}", e.foundation));
+            }
             say!(
                 "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}{rayleigh}); largest |balance| {:.3e}{damped}",
                 e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
@@ -981,6 +985,7 @@ impl Session<'_> {
                     "external_work": e.external_work,
                     "dissipated": e.dissipated,
                     "damped": e.damped,
+                    "foundation_stored": e.foundation,
                     "total": e.total,
                     "balance": e.balance,
                     "max_abs_balance": self.max_balance,
