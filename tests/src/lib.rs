@@ -12,7 +12,8 @@
 //! * [`strip`]: a thin strip on a rough base pulled at one end, the
 //!   shear-lag problem of quasi-static friction and its 1-D closed form;
 //! * [`impact`]: the bar-impact problem of Hughes et al. on a compliant
-//!   wall, with the rigid wall's closed form;
+//!   wall, with the rigid wall's closed form, and [`settle`]: a block
+//!   settling on a compliant floor under a pressure;
 //! * [`block`] and [`damping`]: a block held only by friction (floating
 //!   in x, rollers on its top) and Rayleigh damping's runs, with their
 //!   closed forms;
@@ -37,6 +38,7 @@ pub mod paths;
 pub mod reference;
 pub mod scene;
 pub mod sdof;
+pub mod settle;
 pub mod strip;
 pub mod wave;
 

@@ -77,3 +77,16 @@ fn a_wall_stiffening_past_the_step_stops_the_run() {
     let r = run(20, gentle, 0.5).unwrap();
     assert!((r.exit_velocity + V0).abs() < 0.05 * V0, "{r:?}");
 }
+
+/// A block pressed by p onto a compliant floor settles at the approach
+/// (p/c_n)^{1/m_n} = 0.01 (p = 10), linear and quadratic.
+#[test]
+fn a_pressed_block_settles_at_the_static_approach() {
+    for (cn, mn) in [(1e3, 1.0), (1e5, 2.0)] {
+        let (most, least) = stickslip_testkit::settle::settle(8, cn, mn).unwrap();
+        let expected = (stickslip_testkit::settle::P / cn).powf(1.0 / mn);
+        for d in [most, least] {
+            assert!((d - expected).abs() < 1e-9, "m_n = {mn}: {d} vs {expected}");
+        }
+    }
+}

@@ -28,6 +28,7 @@ pub fn run(root: &Path, opts: &Options, r: &mut Report) {
     super::strip::run_all(opts, r);
     super::friction_held::run(opts, r);
     super::surfaces::run(root, opts, r);
+    super::compliance::run(r);
 }
 
 fn coulomb_oscillator(opts: &Options, r: &mut Report) {

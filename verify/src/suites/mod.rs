@@ -1,6 +1,7 @@
-//! The four suites of `verify` (`surfaces` runs within `analytic`).
+//! The four suites of `verify` (`surfaces` and `compliance` run within `analytic`).
 
 pub mod analytic;
+pub mod compliance;
 pub mod friction_held;
 pub mod paper;
 pub mod rates;
