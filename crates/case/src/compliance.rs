@@ -11,6 +11,10 @@ use stickslip_mesh::Mesh;
 
 use crate::schema::{Case, ContactLaw, ContactSection, History, InitialState, Scheme};
 
+/// A key's dotted path on the surface, and whether a dotted key is in the
+/// case's text.
+type Keys<'a> = (&'a dyn Fn(&str) -> String, &'a dyn Fn(&str) -> bool);
+
 /// The compliance law's keys, refused on a prescribed-pressure surface.
 const COMPLIANCE_KEYS: [&str; 5] = ["foundation", "cn", "mn", "ct", "mt"];
 
@@ -20,7 +24,7 @@ const COMPLIANCE_KEYS: [&str; 5] = ["foundation", "cn", "mn", "ct", "mt"];
 pub(crate) fn check_law(
     case: &Case,
     c: &ContactSection,
-    (key, written): (&dyn Fn(&str) -> String, &dyn Fn(&str) -> bool),
+    (key, written): Keys,
     check: &mut dyn FnMut(bool, &str, String),
 ) {
     let given = |k: &str| match k {
@@ -65,7 +69,7 @@ pub(crate) fn check_law(
 fn check_compliance(
     case: &Case,
     c: &ContactSection,
-    (key, written): (&dyn Fn(&str) -> String, &dyn Fn(&str) -> bool),
+    (key, written): Keys,
     check: &mut dyn FnMut(bool, &str, String),
 ) {
     let law = key("law");

@@ -134,7 +134,7 @@ impl ContactSurface {
     ) -> Result<ContactSurface, ContactError> {
         let bad = |m: String| Err(ContactError::Parameter(m));
         let length = normal[0].hypot(normal[1]);
-        if !((length - 1.0).abs() < 1e-12) {
+        if (length - 1.0).abs() >= 1e-12 || length.is_nan() {
             return bad(format!("foundation normal {normal:?} is not a unit vector"));
         }
         let Compliance { cn, mn, ct, mt } = law;

@@ -24,10 +24,11 @@ use crate::stepper::{Run, Stepper};
 use direct::{DirectOperator, ImplicitStep};
 use schur::SchurOperator;
 
-/// How a step solves.
+/// How a step solves (each operator boxed: they are large and of unlike
+/// sizes, and one is made per run).
 enum Solver {
-    Schur(SchurOperator),
-    Direct(DirectOperator),
+    Schur(Box<SchurOperator>),
+    Direct(Box<DirectOperator>),
 }
 
 /// The velocity of an implicit step with its friction: for R̂ = b, the
@@ -138,14 +139,14 @@ impl ImplicitFriction {
         };
         let solver = match settings.implicit_solver {
             ImplicitSolver::Schur | ImplicitSolver::SchurPaths | ImplicitSolver::SchurReach => {
-                Solver::Schur(
+                Solver::Schur(Box::new(
                     SchurOperator::new(k, fill_order, contact, use_paths)
                         .map_err(TimeError::Static)?,
-                )
+                ))
             }
-            ImplicitSolver::Direct => Solver::Direct(
+            ImplicitSolver::Direct => Solver::Direct(Box::new(
                 DirectOperator::new(k, fill_order, contact).map_err(TimeError::Static)?,
-            ),
+            )),
         };
         let n_c = contact.map_or(0, |c| c.len());
         Ok(ImplicitFriction {
