@@ -8,7 +8,7 @@
 use stickslip_contact::{Compliance, ContactSurface};
 use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
 use stickslip_mesh::CellKind;
-use stickslip_time::{Dynamics, InitialState, Integrator, Scheme, Settings};
+use stickslip_time::{Dynamics, InitialState, Integrator, Scheme, Settings, TimeError};
 
 use crate::grid::rectangle;
 use crate::scene::SceneError;
@@ -37,6 +37,9 @@ pub struct Impact {
     pub balance: f64,
     /// The explicit critical step the run had (with the wall's springs).
     pub dt_crit: f64,
+    /// The largest mechanical energy (kinetic + strain + the wall's) over
+    /// the initial kinetic energy: 1 for an exact run.
+    pub growth: f64,
 }
 
 /// The frictionless linear wall (m_n = 1) of stiffness `cn·E/h` for the
@@ -57,6 +60,21 @@ pub fn wall(nx: usize, cn: f64) -> Compliance {
 /// # Errors
 /// The scene's or the integrator's.
 pub fn run(nx: usize, law: Compliance, courant: f64) -> Result<Impact, SceneError> {
+    run_with(nx, law, courant, false)
+}
+
+/// [`run`], above the critical step too where `allow_unstable` (the
+/// stability study's bisection); a run whose state leaves the floating-
+/// point range ends there with [`Impact::growth`] infinite.
+///
+/// # Errors
+/// The scene's or the integrator's, but for a non-finite state.
+pub fn run_with(
+    nx: usize,
+    law: Compliance,
+    courant: f64,
+    allow_unstable: bool,
+) -> Result<Impact, SceneError> {
     let mesh = rectangle(CellKind::Quad4, nx, 1, [0.0, 0.0], [L, H]);
     let material = Material::new(1.0, 0.0, 1.0, Hypothesis::PlaneStrain)?;
     let model = Model::new(&mesh, &material, &[Dirichlet::new("domain", 1, 0.0)])?;
@@ -73,6 +91,7 @@ pub fn run(nx: usize, law: Compliance, courant: f64) -> Result<Impact, SceneErro
         let mut s = Settings::new(Scheme::CentralDifference, dt, t_end);
         s.initial_state = InitialState::Rest;
         s.initial_velocity = Some(v0.clone());
+        s.allow_unstable = allow_unstable;
         s
     };
     let build = |dt: f64| {
@@ -85,13 +104,23 @@ pub fn run(nx: usize, law: Compliance, courant: f64) -> Result<Impact, SceneErro
     };
     let dt_crit = build(1e-6)?.dt_crit().unwrap_or(f64::NAN);
     let mut run = build(courant * dt_crit)?;
+    let mut growth: f64 = 1.0;
     let e0 = run.energy().kinetic;
     let n_c = contact.len();
     let mut sigma = vec![0.0; n_c];
     let (mut last, mut sum, mut count, mut balance) = (0.0_f64, 0.0, 0usize, 0.0_f64);
     while !run.done() {
-        run.step()?;
+        match run.step() {
+            Ok(_) => {}
+            Err(TimeError::NonFinite { .. }) if allow_unstable => {
+                growth = f64::INFINITY;
+                break;
+            }
+            Err(e) => return Err(e.into()),
+        }
         let t = run.time();
+        let e = run.energy();
+        growth = growth.max((e.kinetic + e.strain + e.foundation) / e0);
         run.normal_traction(&mut sigma);
         let c = run.contact().expect("a contact surface");
         let force: f64 = c.nodes.iter().zip(&sigma).map(|(n, s)| n.weight * s).sum();
@@ -120,5 +149,6 @@ pub fn run(nx: usize, law: Compliance, courant: f64) -> Result<Impact, SceneErro
         exit_velocity: mv / m,
         balance,
         dt_crit,
+        growth,
     })
 }
