@@ -68,10 +68,11 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         .group(SLOTS[usize::from(slot).min(1)])
         .context("/checkpoint: the current slot is missing")?;
     let e: Vec<f64> = get_vector(&g, "energy")?;
-    // Six in files written before damping (damped = 0 then).
+    // Six in files written before damping (damped = 0 then), seven before
+    // the compliant foundation (its stored energy 0 then).
     ensure!(
-        e.len() == 6 || e.len() == 7,
-        "/checkpoint/energy has {} values, expected 7",
+        (6..=8).contains(&e.len()),
+        "/checkpoint/energy has {} values, expected 8",
         e.len()
     );
     let checkpoint = Checkpoint {
