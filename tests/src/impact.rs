@@ -7,7 +7,7 @@
 
 use stickslip_contact::{Compliance, ContactSurface};
 use stickslip_fem::{Dirichlet, Hypothesis, Material, Model};
-use stickslip_mesh::CellKind;
+use stickslip_mesh::{CellKind, Mesh};
 use stickslip_time::{Dynamics, InitialState, Integrator, Scheme, Settings, TimeError};
 
 use crate::grid::rectangle;
@@ -54,6 +54,70 @@ pub fn wall(nx: usize, cn: f64) -> Compliance {
     }
 }
 
+/// The bar of `nx` Q1 cells, at v₀ and touching the wall x = L at t = 0,
+/// its integrators made on demand.
+#[derive(Debug)]
+pub struct Bar {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// The model (transverse motion held).
+    pub model: Model,
+    /// The wall's surface.
+    pub contact: ContactSurface,
+    v0: Vec<f64>,
+}
+
+impl Bar {
+    /// The bar of `nx` cells against a wall of law `law`.
+    ///
+    /// # Errors
+    /// The scene's.
+    pub fn new(nx: usize, law: Compliance) -> Result<Bar, SceneError> {
+        let mesh = rectangle(CellKind::Quad4, nx, 1, [0.0, 0.0], [L, H]);
+        let material = Material::new(1.0, 0.0, 1.0, Hypothesis::PlaneStrain)?;
+        let model = Model::new(&mesh, &material, &[Dirichlet::new("domain", 1, 0.0)])?;
+        let wall = ([L, 0.0], [-1.0, 0.0]);
+        let contact = ContactSurface::on_foundation(&mesh, &model.dofs, "right", wall, law, 1e-3)?;
+        let mut v0 = vec![0.0; model.dofs.n_free()];
+        for node in 0..mesh.nodes.len() {
+            if let Some(d) = model.dofs.free(node, 0) {
+                v0[d] = V0;
+            }
+        }
+        Ok(Bar {
+            mesh,
+            model,
+            contact,
+            v0,
+        })
+    }
+
+    /// A fresh integrator from rest at v₀ with step `dt` to 3L/c.
+    ///
+    /// # Errors
+    /// The integrator's.
+    pub fn integrator(&self, dt: f64, allow_unstable: bool) -> Result<Integrator, TimeError> {
+        let mut s = Settings::new(Scheme::CentralDifference, dt, 3.0 * L / C);
+        s.initial_state = InitialState::Rest;
+        s.initial_velocity = Some(self.v0.clone());
+        s.allow_unstable = allow_unstable;
+        Integrator::new(
+            Dynamics::from_model(&self.model),
+            Some(self.contact.clone()),
+            Vec::new(),
+            s,
+        )
+    }
+
+    /// The explicit critical step with the wall's springs.
+    ///
+    /// # Errors
+    /// The integrator's.
+    pub fn dt_crit(&self) -> Result<f64, TimeError> {
+        Ok(self.integrator(1e-6, false)?.dt_crit().unwrap_or(f64::NAN))
+    }
+}
+
 /// The bar of `nx` Q1 cells against a wall of law `law`, by central
 /// difference at `courant` times its critical step, run to 3L/c.
 ///
@@ -75,35 +139,10 @@ pub fn run_with(
     courant: f64,
     allow_unstable: bool,
 ) -> Result<Impact, SceneError> {
-    let mesh = rectangle(CellKind::Quad4, nx, 1, [0.0, 0.0], [L, H]);
-    let material = Material::new(1.0, 0.0, 1.0, Hypothesis::PlaneStrain)?;
-    let model = Model::new(&mesh, &material, &[Dirichlet::new("domain", 1, 0.0)])?;
-    let wall = ([L, 0.0], [-1.0, 0.0]);
-    let contact = ContactSurface::on_foundation(&mesh, &model.dofs, "right", wall, law, 1e-3)?;
-    let mut v0 = vec![0.0; model.dofs.n_free()];
-    for node in 0..mesh.nodes.len() {
-        if let Some(d) = model.dofs.free(node, 0) {
-            v0[d] = V0;
-        }
-    }
-    let t_end = 3.0 * L / C;
-    let settings = |dt: f64| {
-        let mut s = Settings::new(Scheme::CentralDifference, dt, t_end);
-        s.initial_state = InitialState::Rest;
-        s.initial_velocity = Some(v0.clone());
-        s.allow_unstable = allow_unstable;
-        s
-    };
-    let build = |dt: f64| {
-        Integrator::new(
-            Dynamics::from_model(&model),
-            Some(contact.clone()),
-            Vec::new(),
-            settings(dt),
-        )
-    };
-    let dt_crit = build(1e-6)?.dt_crit().unwrap_or(f64::NAN);
-    let mut run = build(courant * dt_crit)?;
+    let bar = Bar::new(nx, law)?;
+    let dt_crit = bar.dt_crit()?;
+    let mut run = bar.integrator(courant * dt_crit, allow_unstable)?;
+    let (mesh, model, contact) = (&bar.mesh, &bar.model, &bar.contact);
     let mut growth: f64 = 1.0;
     let e0 = run.energy().kinetic;
     let n_c = contact.len();
