@@ -622,6 +622,8 @@ pub fn main(out: &Path, quick: bool) -> Result<(), String> {
         1000,
         620,
     )?;
+    // 4. The critical step with a compliant wall.
+    crate::stability_compliance::main(out)?;
     eprintln!(
         "stability study done in {:.0} s; wrote {}/stability-*",
         start.elapsed().as_secs_f64(),

@@ -11,6 +11,9 @@
 //!   the 1-D wave (d'Alembert) and the single-DOF friction oscillator;
 //! * [`strip`]: a thin strip on a rough base pulled at one end, the
 //!   shear-lag problem of quasi-static friction and its 1-D closed form;
+//! * [`impact`]: the bar-impact problem of Hughes et al. on a compliant
+//!   wall, with the rigid wall's closed form, and [`settle`]: a block
+//!   settling on a compliant floor under a pressure;
 //! * [`block`] and [`damping`]: a block held only by friction (floating
 //!   in x, rollers on its top) and Rayleigh damping's runs, with their
 //!   closed forms;
@@ -29,11 +32,13 @@
 pub mod block;
 pub mod damping;
 pub mod grid;
+pub mod impact;
 pub mod manufactured;
 pub mod paths;
 pub mod reference;
 pub mod scene;
 pub mod sdof;
+pub mod settle;
 pub mod solvers;
 pub mod strip;
 pub mod wave;

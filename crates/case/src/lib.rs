@@ -19,6 +19,7 @@
 #![forbid(unsafe_code)]
 
 mod build;
+mod compliance;
 mod error;
 mod keys;
 mod load;

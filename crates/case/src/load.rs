@@ -374,18 +374,25 @@ fn complete(
     // [contact]
     for (i, c) in case.contact.iter().enumerate() {
         let key = |k: &str| crate::schema::contact_key_in(spans.keys(), i, k);
-        let (p, mu, eps) = (c.pressure, c.mu.at_rest(), c.eps);
+        crate::compliance::check_law(
+            &case,
+            c,
+            (&key, &|k: &str| spans.contains_key(k)),
+            &mut check,
+        );
+        // A key the law lacks is refused above; 0 checks nothing here.
+        let (p, mu, eps) = (c.pressure.unwrap_or(0.0), c.mu_at_rest(), c.eps);
         check(p >= 0.0 && p.is_finite(), &key("pressure"), format!("contact.pressure = {p} must be >= 0 and finite (it presses the body onto the surface; g = mu * pressure)"));
         check(
             mu >= 0.0 && mu.is_finite(),
             &key("mu"),
             format!("contact.mu = {mu} must be >= 0 and finite; use 0 for frictionless contact"),
         );
-        if let Mu::Speed {
+        if let Some(Mu::Speed {
             stat,
             kinetic,
             speed,
-        } = c.mu
+        }) = c.mu
         {
             check(
                 (0.0..=stat).contains(&kinetic),

@@ -529,10 +529,13 @@ section! {
     pub struct ContactSection {
         /// Line group on which friction acts.
         "group" group: String,
-        /// Prescribed normal pressure F_n (friction bound g = μ F_n).
-        "pressure" pressure: f64,
-        /// Coulomb coefficient μ, or μ falling with the slip speed.
-        "mu" mu: Mu,
+        /// Prescribed normal pressure F_n (friction bound g = μ F_n);
+        /// required by the law `"pressure"`, refused by `"compliance"`.
+        "pressure" pressure: Option<f64>,
+        /// Coulomb coefficient μ, or μ falling with the slip speed; with
+        /// `"compliance"` (constant only) c_T = μ c_n and m_T = m_n (or
+        /// `ct`, `mt`).
+        "mu" mu: Option<Mu>,
         /// Regularization ε of the friction law (each surface its own).
         "eps" eps: f64,
         /// Time factor of the pressure (the normal load and g = μ p);
@@ -556,6 +559,54 @@ section! {
         /// Iteration cap per step (default 100).
         #[serde(default = "default_max_iterations")]
         "max_iterations" max_iterations: usize,
+        /// The normal law: a prescribed pressure (default) or a compliant
+        /// foundation (METHOD.md §10).
+        #[serde(default)]
+        "law" law: ContactLaw,
+        /// The rigid foundation of `law = "compliance"`.
+        "foundation" foundation: Option<FoundationLine>,
+        /// c_n > 0: σ_n = c_n δ^{m_n}.
+        "cn" cn: Option<f64>,
+        /// m_n ≥ 1.
+        "mn" mn: Option<f64>,
+        /// c_T ≥ 0: the friction bound c_T δ^{m_T} (in place of μ).
+        "ct" ct: Option<f64>,
+        /// m_T ≥ 1 (with `ct`).
+        "mt" mt: Option<f64>,
+    }
+}
+
+impl ContactSection {
+    /// μ at rest (0 where the surface gives none: a compliance surface
+    /// with `ct`).
+    pub fn mu_at_rest(&self) -> f64 {
+        self.mu.as_ref().map_or(0.0, Mu::at_rest)
+    }
+}
+
+/// The normal law of a contact surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactLaw {
+    /// The paper's prescribed normal pressure.
+    #[default]
+    Pressure,
+    /// Normal compliance against a rigid foundation.
+    Compliance,
+}
+
+impl Schema for ContactLaw {
+    const KIND: Kind = Kind::Variant("pressure");
+}
+
+section! {
+    /// `foundation = { point = [x, y], normal = [nx, ny] }`: a straight
+    /// rigid foundation.
+    pub struct FoundationLine {
+        /// A point of the line.
+        "point" point: [f64; 2],
+        /// Its normal, pointing towards the body (normalized on loading).
+        "normal" normal: [f64; 2],
     }
 }
 

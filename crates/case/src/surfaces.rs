@@ -9,7 +9,8 @@ use stickslip_fem::{boundary_quadrature, traction_load, traction_load_with, DofM
 use stickslip_mesh::Mesh;
 use stickslip_time::{History as TimeHistory, Load};
 
-use crate::schema::{Case, ContactSection, History, Mu};
+use crate::compliance::compliant_surface;
+use crate::schema::{Case, ContactLaw, ContactSection, History, Mu};
 
 /// What the contact surfaces add to a scene.
 #[derive(Debug, Default)]
@@ -57,6 +58,16 @@ pub(crate) fn surfaces(
                 continue;
             }
         };
+        if c.law == ContactLaw::Compliance {
+            // The foundation computes the normal traction: no pressure load.
+            match compliant_surface(mesh, dofs, c, &at, problems) {
+                Ok(s) if problems.len() == before => built.push((i, s)),
+                Ok(_) => {}
+                Err(e) => problems.push(format!("{}[contact]: {e}", at("group"))),
+            }
+            out.histories.push(history(&c.pressure_history));
+            continue;
+        }
         let length = line.last().map_or(0.0, |b| b.s);
         if let Some(p) = &c.pressure_profile {
             if let Some(last) = p.table.last().filter(|r| r[0] > length * (1.0 + 1e-12)) {
@@ -69,15 +80,16 @@ pub(crate) fn surfaces(
                 ));
             }
         }
+        let pressure = c.pressure.unwrap_or(0.0);
         // The prescribed normal traction on Γ_C is a load like any other,
         // by default present before t = 0 (it makes the initial static
         // state, METHOD.md §3).
         full.iter_mut().for_each(|x| *x = 0.0);
         let load = match &profile {
-            None => traction_load(mesh, &c.group, Traction::Pressure(c.pressure), &mut full),
+            None => traction_load(mesh, &c.group, Traction::Pressure(pressure), &mut full),
             Some(f) => {
                 let arc = ArcLength::new(mesh, &line);
-                let p = c.pressure;
+                let p = pressure;
                 let hint = std::cell::Cell::new(0);
                 traction_load_with(
                     mesh,
@@ -132,12 +144,12 @@ pub(crate) fn surfaces(
     let weakening: Vec<Option<Weakening>> = built
         .iter()
         .map(|(i, _)| match case.contact[*i].mu {
-            Mu::Constant(_) => None,
-            Mu::Speed {
+            None | Some(Mu::Constant(_)) => None,
+            Some(Mu::Speed {
                 stat,
                 kinetic,
                 speed,
-            } => Some(Weakening {
+            }) => Some(Weakening {
                 ratio: if stat > 0.0 { kinetic / stat } else { 1.0 },
                 speed,
             }),
@@ -180,8 +192,14 @@ fn surface(
     c: &ContactSection,
     profile: Option<&History>,
 ) -> Result<ContactSurface, ContactError> {
-    let mut s =
-        ContactSurface::from_group(mesh, dofs, &c.group, c.pressure, c.mu.at_rest(), c.eps)?;
+    let mut s = ContactSurface::from_group(
+        mesh,
+        dofs,
+        &c.group,
+        c.pressure.unwrap_or(0.0),
+        c.mu_at_rest(),
+        c.eps,
+    )?;
     if let Some(f) = profile {
         let built: Vec<(f64, f64)> = s.nodes.iter().map(|n| (n.bound, n.s)).collect();
         s.set_bounds(|j| built[j].0 * f.value(built[j].1));

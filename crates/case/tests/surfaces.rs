@@ -81,7 +81,7 @@ fn one_table_and_a_list_are_both_surfaces() {
     let two = load(&slab(&format!("{BOTTOM}{TOP}"))).unwrap();
     assert_eq!(two.contact.len(), 2);
     assert_eq!(
-        (two.contact[1].group.as_str(), two.contact[1].mu.at_rest()),
+        (two.contact[1].group.as_str(), two.contact[1].mu_at_rest()),
         ("support", 0.2)
     );
     let none = load(&slab("")).unwrap();

@@ -79,6 +79,13 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         ),
         None => println!("contact     none (no friction code runs)"),
     }
+    if let Some(c) = i.contact().filter(|c| c.is_compliant()) {
+        println!(
+            "foundation  {} of them on a compliant foundation (law = \"compliance\"); dt_crit \
+             below includes its springs",
+            c.compliance.len()
+        );
+    }
     if let Some(why) = friction_off(case, i).filter(|_| i.contact().is_some()) {
         println!("friction    off: {why}; the steps run no friction code");
     }

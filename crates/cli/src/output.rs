@@ -90,9 +90,12 @@ pub struct Record<'a> {
     pub damped: f64,
     /// A moving foundation's work through friction so far (0 at rest).
     pub foundation: f64,
-    /// kinetic + strain − rᵀR(t) (the paper's Fig. 9).
+    /// The energy a compliant foundation stores (0 without one).
+    pub foundation_stored: f64,
+    /// kinetic + strain + foundation_stored − rᵀR(t) (the paper's Fig. 9).
     pub total: f64,
-    /// kinetic + strain − initial − work + dissipated + damped − foundation.
+    /// kinetic + strain + foundation_stored − initial − work +
+    /// dissipated + damped − foundation.
     pub balance: f64,
     /// The step that led here.
     pub dt: f64,
@@ -136,7 +139,7 @@ struct Series {
     frame_time: Dataset,
     frame_row: Dataset,
     contact: Option<ContactSeries>,
-    energy: [Dataset; 8],
+    energy: [Dataset; ENERGY_NAMES.len()],
     dt: Dataset,
     iterations: Dataset,
 }
@@ -200,7 +203,7 @@ struct Pending {
     friction_stress: Vec<f64>,
     slip_velocity: Vec<f64>,
     state: Vec<i8>,
-    energy: [Vec<f64>; 8],
+    energy: [Vec<f64>; ENERGY_NAMES.len()],
     dt: Vec<f64>,
     iterations: Vec<u32>,
 }
@@ -241,7 +244,7 @@ impl Pending {
         self.friction_stress.extend_from_slice(rec.friction_stress);
         self.slip_velocity.extend_from_slice(rec.slip_velocity);
         self.state.extend_from_slice(rec.state);
-        let e = [
+        let e: [f64; ENERGY_NAMES.len()] = [
             rec.kinetic,
             rec.strain,
             rec.external_work,
@@ -250,6 +253,7 @@ impl Pending {
             rec.balance,
             rec.damped,
             rec.foundation,
+            rec.foundation_stored,
         ];
         for (series, v) in self.energy.iter_mut().zip(e) {
             series.push(v);
@@ -389,7 +393,7 @@ fn scalar_attr<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<
 pub const DEFLATE_LEVEL: u8 = 0;
 
 /// Names of the `/energy` series, in [`Record`] order.
-const ENERGY_NAMES: [&str; 8] = [
+const ENERGY_NAMES: [&str; 9] = [
     "kinetic",
     "strain",
     "external_work",
@@ -398,6 +402,7 @@ const ENERGY_NAMES: [&str; 8] = [
     "balance",
     "damped",
     "foundation",
+    "foundation_stored",
 ];
 
 /// Rows of the histories kept in memory at most before they are written
@@ -517,7 +522,8 @@ pub(crate) const SLOTS: [&str; 2] = ["a", "b"];
 
 /// Order of `/checkpoint/energy`.
 const ENERGY_ORDER: &str =
-    "kinetic, strain, external_work, dissipated, total, balance, damped, foundation";
+    "kinetic, strain, external_work, dissipated, total, balance, damped, foundation, \
+     foundation_stored";
 
 /// `/contact/surface` and the attribute `groups`: which surface of the
 /// case each contact node is on.
@@ -653,7 +659,8 @@ impl ResultsWriter {
         for name in ENERGY_NAMES {
             energy.push(series_1d::<f64>(&e, name, level)?);
         }
-        let energy: [Dataset; 8] = energy.try_into().expect("eight energy series");
+        let energy: [Dataset; ENERGY_NAMES.len()] =
+            energy.try_into().expect("one dataset a series");
         let solver = file.create_group("solver")?;
         let frames = file.create_group("frames")?;
         string_attr(
@@ -750,9 +757,12 @@ impl ResultsWriter {
         for name in ENERGY_NAMES {
             let at = format!("energy/{name}");
             // Files written before damping have no /energy/damped, nor
-            // before moving foundations /energy/foundation: made here, the
+            // before moving foundations /energy/foundation, nor before
+            // compliant ones /energy/foundation_stored: made here, the
             // resize below gives their rows the fill value 0.
-            if matches!(name, "damped" | "foundation") && !file.link_exists(&at) {
+            if matches!(name, "damped" | "foundation" | "foundation_stored")
+                && !file.link_exists(&at)
+            {
                 energy.push(series_1d::<f64>(&file.group("energy")?, name, 0)?);
                 continue;
             }
@@ -783,7 +793,7 @@ impl ResultsWriter {
             frame_time: ds("frames/time")?,
             frame_row: ds("frames/row")?,
             contact,
-            energy: energy.try_into().expect("eight energy series"),
+            energy: energy.try_into().expect("one dataset a series"),
             dt: ds("solver/dt")?,
             iterations: ds("solver/iterations")?,
         };
@@ -999,16 +1009,17 @@ impl ResultsWriter {
             e.balance,
             e.damped,
             e.foundation,
+            e.foundation_stored,
         ];
         // A slot written before damping holds six values, before moving
-        // foundations seven; it keeps them while the values it has no room
-        // for are 0.
+        // foundations seven, before compliant ones eight; it keeps them
+        // while the values it has no room for are 0.
         let held = g
             .dataset("energy")
             .ok()
             .map_or(values.len(), |d| d.shape().iter().product());
         let kept = match held {
-            6 | 7 if values[held..].iter().all(|&v| v == 0.0) => held,
+            6..=8 if values[held..].iter().all(|&v| v == 0.0) => held,
             _ => values.len(),
         };
         put_vector(&g, "energy", &values[..kept])?;
@@ -1324,6 +1335,7 @@ pub(crate) mod tests {
                 dissipated: 4.0 + k as f64,
                 damped: 0.0,
                 foundation: 0.0,
+                foundation_stored: 0.0,
                 total: 5.0 + k as f64,
                 balance: 6.0 + k as f64,
                 dt: 0.1,
@@ -1672,6 +1684,7 @@ pub(crate) mod tests {
                     dissipated: 0.0,
                     damped: 0.0,
                     foundation: 0.0,
+                    foundation_stored: 0.0,
                     total: 0.0,
                     balance: 0.0,
                     dt: 0.5,
@@ -1741,6 +1754,7 @@ pub(crate) mod tests {
             dissipated: 0.0,
             damped: 0.0,
             foundation: 0.0,
+            foundation_stored: 0.0,
             total: 0.0,
             balance: 0.0,
             dt: 0.1,
@@ -1929,6 +1943,7 @@ pub(crate) mod tests {
             dissipated: 0.0,
             damped: 0.0,
             foundation: 0.0,
+            foundation_stored: 0.0,
             total: 0.0,
             balance: 0.0,
             dt: 0.0,
@@ -1979,6 +1994,7 @@ pub(crate) mod tests {
                 dissipated: 0.0,
                 damped: 0.0,
                 foundation: 0.0,
+                foundation_stored: 0.0,
                 total: 0.0,
                 balance: 0.0,
                 dt: 1.0,
@@ -2039,6 +2055,7 @@ pub(crate) mod tests {
                 dissipated: 0.0,
                 damped: 0.0,
                 foundation: 0.0,
+                foundation_stored: 0.0,
                 total: 0.0,
                 balance: 0.0,
                 dt: 1.0,

@@ -972,6 +972,7 @@ mod tests {
                 dissipated: 0.0,
                 damped: 0.0,
                 foundation: 0.0,
+                foundation_stored: 0.0,
                 total: 0.0,
                 balance: 0.0,
                 dt: 0.25,

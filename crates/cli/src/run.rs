@@ -174,9 +174,12 @@ pub(crate) fn friction_off(case: &Case, i: &Integrator) -> Option<String> {
     let surfaces = &case.contact;
     Some(if surfaces.is_empty() {
         "the case has no [contact]".to_string()
-    } else if surfaces.iter().all(|c| c.mu.at_rest() == 0.0) {
+    } else if surfaces
+        .iter()
+        .all(|c| c.mu.is_some() && c.mu_at_rest() == 0.0)
+    {
         "contact.mu = 0".to_string()
-    } else if surfaces.iter().all(|c| c.pressure == 0.0) {
+    } else if surfaces.iter().all(|c| c.pressure == Some(0.0)) {
         "contact.pressure = 0".to_string()
     } else {
         "no node of the contact surfaces carries friction (w g = 0)".to_string()
@@ -405,6 +408,7 @@ pub(crate) fn record<'a>(
         dissipated: e.dissipated,
         damped: e.damped,
         foundation: e.foundation,
+        foundation_stored: e.foundation_stored,
         total: e.total,
         balance: e.balance,
         dt,
@@ -942,6 +946,10 @@ impl Session<'_> {
             if case.contact.iter().any(|c| c.foundation_velocity != 0.0) {
                 rayleigh.push_str(&format!(", foundation {:.6}", e.foundation));
             }
+            // A compliant foundation's stored energy, where the case has one.
+            if i.contact().is_some_and(|c| c.is_compliant()) {
+                rayleigh.push_str(&format!(", foundation stored {:.6}", e.foundation_stored));
+            }
             say!(
                 "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}{rayleigh}); largest |balance| {:.3e}{damped}",
                 e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
@@ -985,6 +993,8 @@ impl Session<'_> {
                     "external_work": e.external_work,
                     "dissipated": e.dissipated,
                     "damped": e.damped,
+                    "foundation": e.foundation,
+                    "foundation_stored": e.foundation_stored,
                     "total": e.total,
                     "balance": e.balance,
                     "max_abs_balance": self.max_balance,

@@ -69,10 +69,12 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         .context("/checkpoint: the current slot is missing")?;
     let e: Vec<f64> = get_vector(&g, "energy")?;
     // Six in files written before damping (damped = 0 then), seven before
-    // moving foundations (foundation = 0 then).
+    // moving foundations (foundation = 0 then), eight before compliant
+    // foundations (their stored energy 0 then, and set again from the
+    // displacement on restore).
     ensure!(
-        (6..=8).contains(&e.len()),
-        "/checkpoint/energy has {} values, expected 8",
+        (6..=9).contains(&e.len()),
+        "/checkpoint/energy has {} values, expected 9",
         e.len()
     );
     let checkpoint = Checkpoint {
@@ -90,6 +92,7 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
             dissipated: e[3],
             damped: e.get(6).copied().unwrap_or(0.0),
             foundation: e.get(7).copied().unwrap_or(0.0),
+            foundation_stored: e.get(8).copied().unwrap_or(0.0),
             total: e[4],
             balance: e[5],
         },

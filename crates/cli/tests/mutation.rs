@@ -399,11 +399,19 @@ fn broken_promises(c: &Case) -> Vec<String> {
     }
     numbers.extend(c.body_force.iter().flatten().map(|&x| ("body_force", x)));
     for ct in c.contact.iter() {
-        numbers.extend([
-            ("contact.pressure", ct.pressure),
-            ("contact.mu", ct.mu.at_rest()),
-            ("contact.eps", ct.eps),
-        ]);
+        numbers.extend(
+            [
+                ("contact.pressure", ct.pressure),
+                ("contact.mu", ct.mu.as_ref().map(|m| m.at_rest())),
+                ("contact.cn", ct.cn),
+                ("contact.mn", ct.mn),
+                ("contact.ct", ct.ct),
+                ("contact.mt", ct.mt),
+            ]
+            .into_iter()
+            .filter_map(|(k, v)| v.map(|v| (k, v))),
+        );
+        numbers.push(("contact.eps", ct.eps));
     }
     numbers.extend(
         c.time
@@ -426,7 +434,10 @@ fn broken_promises(c: &Case) -> Vec<String> {
     promise(m.e > 0.0 && m.rho > 0.0, "E and rho must be > 0");
     promise(m.nu > -1.0 && m.nu < 0.5, "nu must lie in (-1, 0.5)");
     for ct in c.contact.iter() {
-        promise(ct.pressure >= 0.0, "contact.pressure must be >= 0");
+        promise(
+            ct.pressure.unwrap_or(0.0) >= 0.0,
+            "contact.pressure must be >= 0",
+        );
         promise(ct.eps > 0.0, "contact.eps must be > 0");
     }
     for t in &c.traction {

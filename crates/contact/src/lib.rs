@@ -20,6 +20,7 @@
 
 #![forbid(unsafe_code)]
 
+mod compliance;
 mod foundation;
 mod iteration;
 mod law;
@@ -29,6 +30,7 @@ mod nodal;
 mod regularization;
 mod surface;
 
+pub use compliance::{Compliance, CompliantNode, Foundation};
 pub use iteration::{iterate, IterationFailure, IterationOptions, IterationReport, StepSystem};
 pub use law::{FrictionLaw, SlipState};
 pub use ledger::stick_events;

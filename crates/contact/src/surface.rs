@@ -4,6 +4,7 @@
 use stickslip_fem::{boundary_quadrature, DofMap, FemError};
 use stickslip_mesh::Mesh;
 
+use crate::compliance::CompliantNode;
 use crate::law::{FrictionLaw, SlipState};
 
 /// Why a contact surface could not be built.
@@ -162,6 +163,10 @@ pub struct ContactSurface {
     /// Each node's ε where joined surfaces have different ones, empty
     /// where all share `law.eps` (`regularization.rs`).
     pub node_eps: Vec<f64>,
+    /// The nodes a compliant foundation holds (METHOD.md §10), in node
+    /// order; their bounds follow the approach. Empty where every surface
+    /// has a prescribed pressure.
+    pub compliance: Vec<CompliantNode>,
 }
 
 impl ContactSurface {
@@ -221,6 +226,7 @@ impl ContactSurface {
             foundation: Vec::new(),
             weakening: Vec::new(),
             node_eps: Vec::new(),
+            compliance: Vec::new(),
         })
     }
 
@@ -247,6 +253,7 @@ impl ContactSurface {
             foundation: Vec::new(),
             weakening: Vec::new(),
             node_eps: Vec::new(),
+            compliance: Vec::new(),
         })
     }
 
@@ -380,6 +387,7 @@ impl ContactSurface {
             foundation: self.foundation.clone(),
             weakening: self.weakening.clone(),
             node_eps: self.node_eps.clone(),
+            compliance: self.compliance.clone(),
         }
     }
 
@@ -411,6 +419,12 @@ impl ContactSurface {
             }
             joined.join_eps(&s);
             let start = joined.nodes.len();
+            joined
+                .compliance
+                .extend(s.compliance.iter().map(|c| CompliantNode {
+                    index: c.index + start,
+                    ..*c
+                }));
             joined.parts.push(SurfacePart {
                 group: s.group,
                 nodes: start..start + s.nodes.len(),

@@ -3,7 +3,7 @@
 //! §4), K·x by stencil types where the mesh has them; stable below
 //! Δt_crit = 2/ω_max.
 
-use stickslip_contact::{iterate, ContactSurface, DiagonalStep, SlipState};
+use stickslip_contact::{iterate, ContactSurface, DiagonalStep, Foundation, SlipState};
 use stickslip_linalg::chunks;
 use stickslip_linalg::{csr, Product, Stencils};
 
@@ -54,6 +54,10 @@ pub(crate) struct CentralDifference {
     /// `ku` is not K r of the current state (before the first step, after
     /// a restore): the next step forms it first.
     ku_stale: bool,
+    /// A compliant foundation's nodal forces at r_K, per contact DOF in the
+    /// closed form's order (empty without one), and what else it found.
+    normal: Vec<f64>,
+    foundation: Foundation,
 }
 
 /// Builds the stepper and the initial state. The critical step is
@@ -78,10 +82,20 @@ pub(crate) fn start(
         ..
     } = dynamics;
     let types = if stencils { Stencils::new(&k) } else { None };
+    // A compliant foundation with m_n = 1 is a spring w c_n ννᵀ at every
+    // node in contact; with all of them in contact ω_max is largest
+    // (a positive semi-definite term raises every eigenvalue), so that
+    // bound holds whatever the contact does. Stiffer-with-depth nodes
+    // (m_n > 1) are checked step by step (`contact_stable`).
     let dt_crit = critical_step_with(
-        |x, y| match &types {
-            Some(s) => s.spmv(x, y),
-            None => csr::spmv(&k, x, y),
+        |x, y| {
+            match &types {
+                Some(s) => s.spmv(x, y),
+                None => csr::spmv(&k, x, y),
+            }
+            if let Some(c) = contact.filter(|c| c.is_compliant()) {
+                c.add_linear_stiffness(x, y);
+            }
         },
         &mass,
     );
@@ -134,6 +148,8 @@ pub(crate) fn start(
         ku: if damped { vec![0.0; n] } else { Vec::new() },
         ku_new: if damped { vec![0.0; n] } else { Vec::new() },
         ku_stale: true,
+        normal: Vec::new(),
+        foundation: Foundation::default(),
     };
     Ok((Box::new(stepper), state))
 }
@@ -160,19 +176,29 @@ impl CentralDifference {
                 &mut self.friction,
                 &self.friction_slots,
             );
-            self.nodal.closed_form().velocities(
-                |i, k| data.rhs(i, ku[k]),
-                |j, c, _, v| {
-                    if let Some(slot) = slots[j][c] {
-                        friction[slot].1 = v;
-                    }
-                },
-            );
+            let mut out = |j: usize, c: usize, _, v| {
+                if let Some(slot) = slots[j][c] {
+                    friction[slot].1 = v;
+                }
+            };
+            // The foundation's force at the known r_K joins R̂_K (METHOD.md
+            // §10); without one R̂_K keeps its bits.
+            let closed_form = self.nodal.closed_form();
+            if self.normal.is_empty() {
+                closed_form.velocities(|i, k| data.rhs(i, ku[k]), &mut out);
+            } else {
+                let normal = &self.normal;
+                closed_form.velocities(|i, k| data.rhs(i, ku[k]) + normal[k], &mut out);
+            }
             return Ok(1);
         }
         self.product.spmv(data.r_new, &mut self.b);
         for (i, b) in self.b.iter_mut().enumerate() {
             *b = data.rhs(i, *b);
+        }
+        let dofs = contact.nodes.iter().flat_map(|n| n.dofs).flatten();
+        for (i, f) in dofs.zip(&self.normal) {
+            self.b[i] += f;
         }
         for (d, m) in self.diagonal.iter_mut().zip(data.mass) {
             *d = m * data.dscale;
@@ -294,7 +320,7 @@ type Outputs<'a> = (
 );
 
 impl Stepper for CentralDifference {
-    fn step(&mut self, run: &Run, state: &mut State) -> Result<StepInfo, TimeError> {
+    fn step(&mut self, run: &mut Run, state: &mut State) -> Result<StepInfo, TimeError> {
         let settings = &run.settings;
         let (dt, t_new) = state.next_step(settings);
         let step = state.steps + 1;
@@ -314,6 +340,11 @@ impl Stepper for CentralDifference {
             );
         }
         self.predicted = None;
+        if let Some(c) = run.contact.as_mut().filter(|c| c.is_compliant()) {
+            self.foundation = c.comply(&state.r_new, &self.mass, &mut self.normal);
+            self.contact_stable(c, dt, (step, t_new))?;
+        }
+        let run = &*run;
         if self.ku_stale && !self.ku.is_empty() {
             self.product.spmv(&state.r, &mut self.ku);
         }
@@ -370,6 +401,7 @@ impl Stepper for CentralDifference {
             dissipated,
             damped,
             foundation,
+            foundation_stored: self.foundation.stored,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))
@@ -466,6 +498,35 @@ fn damped_critical_step(undamped: f64, settings: &Settings) -> Result<f64, TimeE
 }
 
 impl CentralDifference {
+    /// Stops a step whose foundation is stiffer than its Δt allows: m_n >
+    /// 1 makes the stiffness w c_n m_n δ^{m_n−1} grow with the approach,
+    /// and by Weyl's inequality ω_max² ≤ (2/Δt_crit)² + max_J k_J νᵀM_J⁻¹ν
+    /// (Δt_crit with the m_n = 1 springs in), so the step is stable while
+    /// that stays ≤ (2/Δt)². Nothing to check with m_n = 1 only.
+    fn contact_stable(
+        &self,
+        contact: &ContactSurface,
+        dt: f64,
+        (step, t): (u64, f64),
+    ) -> Result<(), TimeError> {
+        let f = &self.foundation;
+        if !contact.has_nonlinear_compliance() || f.stiffness_over_mass == 0.0 {
+            return Ok(());
+        }
+        let omega2 = (2.0 / self.dt_crit).powi(2) + f.stiffness_over_mass;
+        let limit = 2.0 / omega2.sqrt();
+        if dt <= limit {
+            return Ok(());
+        }
+        Err(TimeError::Settings(format!(
+            "step {step} (t = {t:.6e}): the foundation's contact stiffness c_n m_n δ^(m_n−1) grows \
+             with the approach δ for m_n > 1, and at mesh node {} (approach up to {:.4e}) it may \
+             make time.dt = {dt:e} unstable: the critical step with it is bounded below by \
+             {limit:.4e}; reduce time.dt below that, or lower cn",
+            contact.nodes[f.stiffest].node, f.deepest
+        )))
+    }
+
     /// The step's NaN/infinity error, with the critical step as advice.
     fn non_finite(&self, step: u64, t: f64) -> TimeError {
         TimeError::NonFinite {

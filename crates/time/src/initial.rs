@@ -134,6 +134,7 @@ pub(crate) fn initial_state(
         dissipated: 0.0,
         damped: 0.0,
         foundation: 0.0,
+        foundation_stored: 0.0,
         total: kinetic + strain - dot(&state.r, &state.load),
         balance: 0.0,
     };

@@ -9,7 +9,7 @@ use crate::foundation::FoundationHistories;
 use crate::history::History;
 use crate::newmark::ImplicitFriction;
 use crate::pressure::BoundHistories;
-use crate::settings::{ImplicitSolver, MassKind, Scheme, Settings, TimeError};
+use crate::settings::{ImplicitSolver, InitialState, MassKind, Scheme, Settings, TimeError};
 use crate::state::{Checkpoint, Energy, State, StepInfo};
 use crate::stepper::{Run, Stepper};
 use crate::{central_difference, newmark, quasi_static};
@@ -76,10 +76,15 @@ impl Integrator {
         // one whose nodes carry none (μ = 0 or no pressure: w g = 0 at
         // every node), which then steps as a scene without a contact
         // surface, the surface kept for the observers.
+        // A compliant foundation's bounds follow the approach, so its
+        // surface runs the friction code whatever its bounds at t = 0.
         let (contact, surface) = match contact.filter(|c| !c.is_empty()) {
-            Some(c) if c.carries_friction() => (Some(c), None),
+            Some(c) if c.carries_friction() || c.is_compliant() => (Some(c), None),
             other => (None, other),
         };
+        if let Some(c) = contact.as_ref().filter(|c| c.is_compliant()) {
+            check_compliance(c, &settings)?;
+        }
         let loads = Loads {
             constant: dynamics.constant_load.clone(),
             loads,
@@ -134,7 +139,6 @@ impl Integrator {
         }
     }
 
-    /// Sets the bounds for time `t`, where they change in time.
     /// Makes each contact surface's foundation speed (built into the
     /// surface, [`ContactSurface::set_foundation`]) change in time: V_J of
     /// surface k times `histories[k]`(t), set before each step for the time
@@ -155,6 +159,8 @@ impl Integrator {
         }
     }
 
+    /// Sets the bounds and the foundation speeds for time `t`, where they
+    /// change in time.
     fn bounds_at(&mut self, t: f64) {
         if let (Some(b), Some(c)) = (&mut self.bounds, &mut self.run.contact) {
             b.apply(t, c);
@@ -176,15 +182,31 @@ impl Integrator {
     /// non-finite state. The state is left at the last completed step.
     pub fn step(&mut self) -> Result<StepInfo, TimeError> {
         if self.bounds.is_none() && self.foundations.is_none() {
-            return self.stepper.step(&self.run, &mut self.state);
+            let result = self.stepper.step(&mut self.run, &mut self.state);
+            if result.is_err() {
+                self.comply_at_state();
+            }
+            return result;
         }
         let t_new = self.state.next_step(&self.run.settings).1;
         self.bounds_at(t_new);
-        let result = self.stepper.step(&self.run, &mut self.state);
+        let result = self.stepper.step(&mut self.run, &mut self.state);
         if result.is_err() {
             self.bounds_at(self.state.t);
+            self.comply_at_state();
         }
         result
+    }
+
+    /// Sets a compliant foundation's bounds for the current displacement
+    /// (after a failed step or a restore, which leave the state a step
+    /// earlier than the bounds' last setting).
+    fn comply_at_state(&mut self) {
+        if let Some(c) = self.run.contact.as_mut().filter(|c| c.is_compliant()) {
+            let mut forces = Vec::new();
+            let f = c.comply(&self.state.r, &[], &mut forces);
+            self.state.energy.foundation_stored = f.stored;
+        }
     }
 
     /// Everything needed to continue this run bit-identically
@@ -226,6 +248,7 @@ impl Integrator {
         }
         self.run.loads.at(self.state.t, &mut self.state.load);
         self.bounds_at(self.state.t);
+        self.comply_at_state();
         Ok(())
     }
 
@@ -378,6 +401,14 @@ impl Integrator {
             c.friction_stress(&self.state.v, out);
         }
     }
+    /// The normal traction c_n δ^{m_n} a compliant foundation exerts at
+    /// each contact node (0 on prescribed-pressure surfaces).
+    pub fn normal_traction(&self, out: &mut [f64]) {
+        if let Some(c) = self.contact() {
+            c.normal_tractions(&self.state.r, out);
+        }
+    }
+
     /// The slip w = v_T − V at each contact node (v_T on a foundation at
     /// rest).
     pub fn slip_velocity(&self, out: &mut [f64]) {
@@ -387,4 +418,28 @@ impl Integrator {
             }
         }
     }
+}
+
+/// What the compliance law needs of the run: the explicit scheme (the
+/// implicit ones would solve the normal and friction terms together, which
+/// they do not yet), and a start at rest (the static preload would be the
+/// nonlinear problem with the compliance).
+fn check_compliance(contact: &ContactSurface, settings: &Settings) -> Result<(), TimeError> {
+    if settings.scheme != Scheme::CentralDifference {
+        return Err(TimeError::Settings(format!(
+            "surface {} has law = \"compliance\", which runs with time.scheme = \
+             \"central_difference\" only: the implicit schemes do not yet solve the normal and \
+             friction terms together; use central difference",
+            contact.names()
+        )));
+    }
+    if settings.initial_state != InitialState::Rest && !settings.restoring {
+        return Err(TimeError::Settings(format!(
+            "surface {} has law = \"compliance\", which starts at rest only ([initial] state = \
+             \"rest\"): the static preload with the compliance is a nonlinear problem not yet \
+             solved; start at rest, off or touching the foundation",
+            contact.names()
+        )));
+    }
+    Ok(())
 }

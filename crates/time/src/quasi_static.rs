@@ -95,7 +95,7 @@ pub(crate) fn start(
 }
 
 impl Stepper for QuasiStatic {
-    fn step(&mut self, run: &Run, state: &mut State) -> Result<StepInfo, TimeError> {
+    fn step(&mut self, run: &mut Run, state: &mut State) -> Result<StepInfo, TimeError> {
         let settings = &run.settings;
         let (dt, t_new) = state.next_step(settings);
         let step = state.steps + 1;
@@ -163,6 +163,7 @@ impl Stepper for QuasiStatic {
             dissipated,
             damped: 0.0,
             foundation,
+            foundation_stored: 0.0,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))

@@ -23,10 +23,15 @@ pub struct Energy {
     /// its mass part so, its stiffness part as the force it applies,
     /// (β/Δt)K(r_K − r_{K−1}), times r_K − r_{K−1}. 0 without damping.
     pub damped: f64,
-    /// kinetic + strain − rᵀR(t): the paper's total energy (Fig. 9).
+    /// Σ w_J c_n δ_J^{m_n+1}/(m_n+1): the energy a compliant foundation
+    /// stores (METHOD.md §10); 0 without one.
+    pub foundation_stored: f64,
+    /// kinetic + strain + foundation_stored − rᵀR(t): the paper's total
+    /// energy (Fig. 9).
     pub total: f64,
-    /// kinetic + strain − initial − work + dissipated + damped − foundation;
-    /// zero up to round-off for the trapezoidal rule (Newmark ¼, ½).
+    /// kinetic + strain + foundation_stored − initial − work +
+    /// dissipated + damped − foundation; zero up to round-off for the
+    /// trapezoidal rule (Newmark ¼, ½).
     pub balance: f64,
     /// W_f, the work a moving foundation did on the body through friction
     /// (METHOD.md §9): Σ −½(f_K + f_{K−1}) V Δt per node, `dissipated`
@@ -166,6 +171,8 @@ pub(crate) struct StepEnergies {
     pub damped: f64,
     /// The foundation's work over the step.
     pub foundation: f64,
+    /// A compliant foundation's stored energy at r_K.
+    pub foundation_stored: f64,
     /// r_K · R_K.
     pub load_dot: f64,
 }
@@ -260,14 +267,17 @@ impl State {
         l.dissipated += e.dissipated;
         l.damped += e.damped;
         l.foundation += e.foundation;
-        l.total = e.kinetic + e.strain - e.load_dot;
+        l.foundation_stored = e.foundation_stored;
+        // kinetic + strain ≥ +0, so adding a compliant foundation's +0
+        // keeps its bits.
+        let mechanical = e.kinetic + e.strain + e.foundation_stored;
+        l.total = mechanical - e.load_dot;
         // Without damping `+ l.damped` adds +0, and on a foundation at rest
         // `- l.foundation` subtracts +0 (+0 plus ±0 is +0): the same bits
         // as before.
-        l.balance = e.kinetic + e.strain - self.initial_mechanical - l.external_work
-            + l.dissipated
-            + l.damped
-            - l.foundation;
+        l.balance =
+            mechanical - self.initial_mechanical - l.external_work + l.dissipated + l.damped
+                - l.foundation;
         if let Some(r) = settings.stick_reduction {
             if stick_events > 0 {
                 self.reduced_remaining = r.steps;

@@ -30,7 +30,7 @@ pub(crate) trait Stepper: Send {
     /// # Errors
     /// A failed linear solve, a stick/slip iteration that hits its cap, or
     /// a non-finite state.
-    fn step(&mut self, run: &Run, state: &mut State) -> Result<StepInfo, TimeError>;
+    fn step(&mut self, run: &mut Run, state: &mut State) -> Result<StepInfo, TimeError>;
 
     /// The estimated critical step, for a conditionally stable scheme.
     fn dt_crit(&self) -> Option<f64> {

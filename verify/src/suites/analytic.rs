@@ -29,6 +29,7 @@ pub fn run(root: &Path, opts: &Options, r: &mut Report) {
     super::friction_held::run(opts, r);
     super::surfaces::run(root, opts, r);
     super::belt::run(root, r);
+    super::compliance::run(r);
 }
 
 fn coulomb_oscillator(opts: &Options, r: &mut Report) {

@@ -1,8 +1,9 @@
-//! The four suites of `verify` (`surfaces` and `belt` run within
-//! `analytic`).
+//! The four suites of `verify` (`surfaces`, `belt` and `compliance` run
+//! within `analytic`).
 
 pub mod analytic;
 pub mod belt;
+pub mod compliance;
 pub mod friction_held;
 pub mod paper;
 pub mod rates;

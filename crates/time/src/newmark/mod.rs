@@ -24,12 +24,11 @@ use crate::stepper::{Run, Stepper};
 use direct::{DirectOperator, ImplicitStep};
 use schur::SchurOperator;
 
-/// How a step solves.
-// One per run, so the variants' sizes cost nothing worth a box.
-#[allow(clippy::large_enum_variant)]
+/// How a step solves (each operator boxed: they are large and of unlike
+/// sizes, and one is made per run).
 enum Solver {
-    Schur(SchurOperator),
-    Direct(DirectOperator),
+    Schur(Box<SchurOperator>),
+    Direct(Box<DirectOperator>),
 }
 
 /// The velocity of an implicit step with its friction: for R̂ = b, the
@@ -140,14 +139,14 @@ impl ImplicitFriction {
         };
         let solver = match settings.implicit_solver {
             ImplicitSolver::Schur | ImplicitSolver::SchurPaths | ImplicitSolver::SchurReach => {
-                Solver::Schur(
+                Solver::Schur(Box::new(
                     SchurOperator::new(k, fill_order, contact, use_paths)
                         .map_err(TimeError::Static)?,
-                )
+                ))
             }
-            ImplicitSolver::Direct => Solver::Direct(
+            ImplicitSolver::Direct => Solver::Direct(Box::new(
                 DirectOperator::new(k, fill_order, contact).map_err(TimeError::Static)?,
-            ),
+            )),
         };
         let n_c = contact.map_or(0, |c| c.len());
         Ok(ImplicitFriction {
@@ -288,7 +287,7 @@ impl Newmark {
 }
 
 impl Stepper for Newmark {
-    fn step(&mut self, run: &Run, state: &mut State) -> Result<StepInfo, TimeError> {
+    fn step(&mut self, run: &mut Run, state: &mut State) -> Result<StepInfo, TimeError> {
         let settings = &run.settings;
         let (dt, t_new) = state.next_step(settings);
         let step = state.steps + 1;
@@ -378,6 +377,7 @@ impl Stepper for Newmark {
             dissipated,
             damped,
             foundation,
+            foundation_stored: 0.0,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))

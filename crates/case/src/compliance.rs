@@ -1,0 +1,258 @@
+//! The keys of a contact surface's normal law: a prescribed pressure
+//! (`law = "pressure"`, the default) takes `pressure` and `mu`; a
+//! compliant foundation (`law = "compliance"`, METHOD.md §10) takes
+//! `foundation`, `cn`, `mn` and `mu` or `ct`, `mt`. Each law refuses the
+//! other's keys, so that a key that would change nothing is never silently
+//! ignored.
+
+use stickslip_contact::{Compliance, ContactError, ContactSurface};
+use stickslip_fem::DofMap;
+use stickslip_mesh::Mesh;
+
+use crate::schema::{Case, ContactLaw, ContactSection, History, InitialState, Mu, Scheme};
+
+/// A key's dotted path on the surface, and whether a dotted key is in the
+/// case's text.
+type Keys<'a> = (&'a dyn Fn(&str) -> String, &'a dyn Fn(&str) -> bool);
+
+/// The compliance law's keys, refused on a prescribed-pressure surface.
+const COMPLIANCE_KEYS: [&str; 5] = ["foundation", "cn", "mn", "ct", "mt"];
+
+/// Checks surface `c`'s law keys through `check(ok, key, message)`;
+/// `key` gives a key's dotted path on this surface, `written` whether a
+/// dotted key is in the case's text.
+pub(crate) fn check_law(
+    case: &Case,
+    c: &ContactSection,
+    (key, written): Keys,
+    check: &mut dyn FnMut(bool, &str, String),
+) {
+    let given = |k: &str| match k {
+        "foundation" => c.foundation.is_some(),
+        "cn" => c.cn.is_some(),
+        "mn" => c.mn.is_some(),
+        "ct" => c.ct.is_some(),
+        "mt" => c.mt.is_some(),
+        _ => false,
+    };
+    if c.law == ContactLaw::Pressure {
+        for k in COMPLIANCE_KEYS.into_iter().filter(|k| given(k)) {
+            check(
+                false,
+                &key(k),
+                format!(
+                    "contact.{k} belongs to law = \"compliance\", but this surface has a prescribed \
+                     pressure (law = \"pressure\", the default): remove {k}, or set law = \"compliance\" \
+                     for a compliant foundation"
+                ),
+            );
+        }
+        for (k, v, what) in [
+            ("pressure", c.pressure.is_some(), "the normal pressure F_n"),
+            ("mu", c.mu.is_some(), "the Coulomb coefficient"),
+        ] {
+            check(
+                v,
+                &key("group"),
+                format!(
+                    "contact (group {:?}) needs {k} = ..., {what}, for its prescribed-pressure law; \
+                     or set law = \"compliance\" with a foundation",
+                    c.group
+                ),
+            );
+        }
+        return;
+    }
+    check_compliance(case, c, (key, written), check);
+}
+
+fn check_compliance(
+    case: &Case,
+    c: &ContactSection,
+    (key, written): Keys,
+    check: &mut dyn FnMut(bool, &str, String),
+) {
+    let law = key("law");
+    for (k, given) in [
+        ("pressure", c.pressure.is_some()),
+        ("pressure_profile", c.pressure_profile.is_some()),
+        ("pressure_history", c.pressure_history != History::Constant),
+    ] {
+        check(
+            !given,
+            &key(k),
+            format!(
+                "contact.{k} belongs to a prescribed pressure, but this surface has law = \
+                 \"compliance\": the foundation computes the normal traction; remove {k}"
+            ),
+        );
+    }
+    match &c.foundation {
+        None => check(
+            false,
+            &law,
+            "law = \"compliance\" needs foundation = { point = [x, y], normal = [nx, ny] } (a \
+             straight rigid foundation, its normal pointing towards the body)"
+                .into(),
+        ),
+        Some(f) => {
+            let [nx, ny] = f.normal;
+            check(
+                nx.hypot(ny) > 0.0,
+                &key("foundation"),
+                "contact.foundation.normal = [0, 0] has no direction; give the foundation's normal \
+                 pointing towards the body, e.g. [0.0, 1.0] for a floor below it"
+                    .into(),
+            );
+        }
+    }
+    match c.cn {
+        None => check(
+            false,
+            &law,
+            "law = \"compliance\" needs cn = ..., the foundation's stiffness c_n > 0 (σ_n = c_n δ^mn)"
+                .into(),
+        ),
+        Some(cn) => check(
+            cn > 0.0,
+            &key("cn"),
+            format!("contact.cn = {cn} must be > 0: the foundation's stiffness, σ_n = cn δ^mn"),
+        ),
+    }
+    for k in ["mn", "mt"] {
+        let v = if k == "mn" { c.mn } else { c.mt };
+        if let Some(m) = v {
+            check(
+                m >= 1.0,
+                &key(k),
+                format!(
+                    "contact.{k} = {m} must be >= 1: a power below 1 has an infinite stiffness at \
+                     first touch; 1 is a linear spring"
+                ),
+            );
+        }
+    }
+    // A moving compliant foundation and μ(w) against it are not built:
+    // the keys would otherwise change nothing, silently.
+    for (k, given) in [
+        ("foundation_velocity", c.foundation_velocity != 0.0),
+        (
+            "foundation_history",
+            c.foundation_history != History::Constant,
+        ),
+        ("mu", matches!(c.mu, Some(Mu::Speed { .. }))),
+    ] {
+        check(
+            !given,
+            &key(k),
+            format!(
+                "contact.{k}: law = \"compliance\" takes a foundation at rest and a constant mu \
+                 (a moving or speed-dependent friction runs with prescribed pressures); remove \
+                 {k}, or give a constant mu"
+            ),
+        );
+    }
+    match (c.mu.as_ref().map(Mu::at_rest), c.ct) {
+        (Some(_), Some(_)) => check(
+            false,
+            &key("ct"),
+            "contact: give mu (c_T = mu cn, mt = mn) or ct (with mt), not both".into(),
+        ),
+        (None, None) => check(
+            false,
+            &law,
+            "law = \"compliance\" needs mu = ... (c_T = mu cn, mt = mn) or ct = ... (the friction \
+             bound c_T δ^mt); mu = 0 for a frictionless foundation"
+                .into(),
+        ),
+        (_, Some(ct)) => check(
+            ct >= 0.0,
+            &key("ct"),
+            format!("contact.ct = {ct} must be >= 0: the friction bound is ct δ^mt"),
+        ),
+        (Some(_), None) => check(
+            c.mt.is_none(),
+            &key("mt"),
+            "contact.mt goes with ct; with mu the friction bound is mu cn δ^mn (mt = mn): remove mt, \
+             or give ct in place of mu"
+                .into(),
+        ),
+    }
+    // What the law runs with so far: central difference, from rest.
+    check(
+        case.initial.state == InitialState::Rest,
+        if written("initial.state") {
+            "initial.state"
+        } else {
+            &law
+        },
+        "law = \"compliance\" starts at rest only: set [initial] state = \"rest\" (the part starts \
+         off or touching the foundation); the static preload with the compliance is a nonlinear \
+         problem not yet solved"
+            .into(),
+    );
+    check(
+        case.time.scheme == Scheme::CentralDifference,
+        if written("time.scheme") {
+            "time.scheme"
+        } else {
+            &law
+        },
+        "law = \"compliance\" runs with time.scheme = \"central_difference\" only: the implicit \
+         schemes do not yet solve the normal and friction terms together"
+            .into(),
+    );
+}
+
+/// Surface `c` of `law = "compliance"` on its foundation, its keys checked
+/// already. A node that starts inside the foundation by more than a
+/// rounding of the mesh's size is a problem pushed to `problems` (a start
+/// at rest would release it with a jolt of c_n δ₀^{m_n}); one within
+/// rounding starts touching it.
+pub(crate) fn compliant_surface(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    c: &ContactSection,
+    at: &dyn Fn(&str) -> String,
+    problems: &mut Vec<String>,
+) -> Result<ContactSurface, ContactError> {
+    let f = c
+        .foundation
+        .as_ref()
+        .expect("checked: law = \"compliance\" has a foundation");
+    let length = f.normal[0].hypot(f.normal[1]);
+    let normal = [f.normal[0] / length, f.normal[1] / length];
+    let cn = c.cn.expect("checked: law = \"compliance\" has cn");
+    let mn = c.mn.unwrap_or(1.0);
+    let (ct, mt) = match c.ct {
+        Some(ct) => (ct, c.mt.unwrap_or(mn)),
+        None => (c.mu_at_rest() * cn, mn),
+    };
+    let law = Compliance { cn, mn, ct, mt };
+    let mut s = ContactSurface::on_foundation(mesh, dofs, &c.group, (f.point, normal), law, c.eps)?;
+    let size = mesh
+        .nodes
+        .iter()
+        .flat_map(|x| x.iter())
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    let tolerance = 1e-9 * size.max(f.point[0].abs()).max(f.point[1].abs());
+    for k in &mut s.compliance {
+        if k.gap < -tolerance {
+            let node = s.nodes[k.index].node;
+            let x = mesh.nodes[node];
+            problems.push(format!(
+                "{}[contact]: node {} at ({}, {}) of group {:?} starts {:e} inside the foundation, \
+                 and [initial] state = \"rest\" would release it with the foundation's full push; \
+                 start the part off or touching the foundation (move foundation.point, or the mesh)",
+                at("foundation"),
+                mesh.node_tags.get(node).copied().unwrap_or(node as u64),
+                x[0],
+                x[1],
+                c.group,
+                -k.gap
+            ));
+        }
+        k.gap = k.gap.max(0.0);
+    }
+    Ok(s)
+}

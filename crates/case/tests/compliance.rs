@@ -1,0 +1,163 @@
+//! The compliance law's keys from the case file (docs/case-file.md, "A
+//! compliant foundation"): a good surface builds its foundation's nodes,
+//! and every bad input is named at its line with what to do.
+
+use std::path::Path;
+
+use stickslip_case::{assemble, load_str, Case};
+use stickslip_testkit::meshes_dir;
+
+/// The paper's slab (8 × 1, "contact" the bottom y = 0) with `contact`
+/// as its surfaces, started at rest.
+fn slab(contact: &str, initial: &str) -> String {
+    format!(
+        r#"[mesh]
+file = "{}"
+[material]
+E = 1000.0
+nu = 0.3
+rho = 1.0
+{contact}
+{initial}
+[time]
+scheme = "central_difference"
+dt = 1e-3
+t_end = 0.01
+"#,
+        meshes_dir().join("slab-q2-8x2.msh").display()
+    )
+}
+
+const REST: &str = "[initial]\nstate = \"rest\"\n";
+
+const FLOOR: &str = r#"[contact]
+group = "contact"
+law = "compliance"
+foundation = { point = [0.0, -0.01], normal = [0.0, 2.0] }
+cn = 1e4
+mu = 0.3
+eps = 1e-3
+"#;
+
+fn load(text: &str) -> Result<Case, String> {
+    load_str(Path::new("case.toml"), text, &[]).map_err(|e| e.to_string())
+}
+
+/// The 1-based line of the first line of `text` containing `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines()
+        .position(|l| l.contains(needle))
+        .expect("needle in text")
+        + 1
+}
+
+fn assert_at(e: &str, text: &str, needle: &str, what: &str) {
+    let at = format!("case.toml:{}:", line_of(text, needle));
+    assert!(
+        e.lines().any(|l| l.contains(&at) && l.contains(what)),
+        "no {what:?} at {at} in:\n{e}"
+    );
+}
+
+/// The floor below the slab's bottom: every bottom node 0.01 off it (the
+/// normal's length does not matter), friction c_T = μ c_n with m_T = m_n
+/// = 1, friction along +x (the bottom's tangent), no pressure load.
+#[test]
+fn a_floor_builds_its_nodes_gaps_and_law() {
+    let case = load(&slab(FLOOR, REST)).unwrap();
+    let scene = assemble(&case).unwrap();
+    let c = scene.contact.as_ref().unwrap();
+    // Q2 8 × 2 slab: 17 nodes on the bottom, all free.
+    assert_eq!(c.compliance.len(), 17);
+    for k in &c.compliance {
+        assert!((k.gap - 0.01).abs() < 1e-15, "{k:?}");
+        assert_eq!(k.normal, [0.0, 1.0]);
+        assert_eq!(
+            (k.law.cn, k.law.mn, k.law.ct, k.law.mt),
+            (1e4, 1.0, 0.3 * 1e4, 1.0)
+        );
+        assert_eq!(c.nodes[k.index].tangent, [1.0, 0.0]);
+        assert_eq!(c.nodes[k.index].bound, 0.0);
+    }
+    assert!(scene
+        .loads
+        .iter()
+        .all(|l| l.vector.iter().all(|&x| x == 0.0)));
+}
+
+#[test]
+fn bad_compliance_input_is_named_at_its_line() {
+    let bad = FLOOR
+        .replace("normal = [0.0, 2.0]", "normal = [0.0, 0.0]")
+        .replace("cn = 1e4", "cn = 0.0\nmn = 0.5\nct = 1.0\npressure = 3.0");
+    let text = slab(&bad, REST);
+    let e = load(&text).unwrap_err();
+    for (needle, what) in [
+        ("foundation =", "has no direction"),
+        ("cn = 0.0", "contact.cn = 0 must be > 0"),
+        ("mn = 0.5", "contact.mn = 0.5 must be >= 1"),
+        ("ct = 1.0", "give mu (c_T = mu cn, mt = mn) or ct"),
+        (
+            "pressure = 3.0",
+            "contact.pressure belongs to a prescribed pressure",
+        ),
+    ] {
+        assert_at(&e, &text, needle, what);
+    }
+    // Compliance keys on a prescribed-pressure surface.
+    let text = slab(
+        "[contact]\ngroup = \"contact\"\npressure = 300.0\nmu = 0.3\neps = 1e-2\ncn = 1e4\n",
+        "",
+    );
+    let e = load(&text).unwrap_err();
+    assert_at(
+        &e,
+        &text,
+        "cn = 1e4",
+        "contact.cn belongs to law = \"compliance\"",
+    );
+    // A compliance surface with neither cn nor a foundation nor friction.
+    let text = slab(
+        "[contact]\ngroup = \"contact\"\nlaw = \"compliance\"\neps = 1e-2\n",
+        REST,
+    );
+    let e = load(&text).unwrap_err();
+    for what in ["needs foundation", "needs cn", "needs mu"] {
+        assert_at(&e, &text, "law = \"compliance\"", what);
+    }
+}
+
+/// The static preload and the implicit schemes are not there yet for the
+/// law: refused at the key that asks for them.
+#[test]
+fn the_law_runs_from_rest_with_central_difference() {
+    let text = slab(FLOOR, "[initial]\nstate = \"static\"\n").replace(
+        "\"central_difference\"",
+        "\"newmark\"\nmass = \"consistent\"",
+    );
+    let e = load(&text).unwrap_err();
+    assert_at(&e, &text, "state = \"static\"", "starts at rest only");
+    assert_at(
+        &e,
+        &text,
+        "scheme = \"newmark\"",
+        "runs with time.scheme = \"central_difference\" only",
+    );
+}
+
+/// A node that starts inside the foundation is refused with its place.
+#[test]
+fn a_node_inside_the_foundation_is_refused() {
+    let text = slab(
+        &FLOOR.replace("point = [0.0, -0.01]", "point = [0.0, 0.02]"),
+        REST,
+    );
+    let e = assemble(&load(&text).unwrap()).unwrap_err().to_string();
+    assert_at(
+        &e,
+        &text,
+        "foundation =",
+        "starts 2e-2 inside the foundation",
+    );
+    assert!(e.contains("node 1 at (0, 0)"), "{e}");
+}
