@@ -161,3 +161,31 @@ fn a_node_inside_the_foundation_is_refused() {
     );
     assert!(e.contains("node 1 at (0, 0)"), "{e}");
 }
+
+/// A moving foundation or a speed-dependent μ on a compliance surface is
+/// not built: each is refused at its line rather than ignored.
+#[test]
+fn a_compliant_foundation_refuses_motion_and_a_falling_mu() {
+    for (swap, needle) in [
+        ("mu = 0.3\n", "foundation_velocity = 0.5"),
+        (
+            "mu = 0.3\n",
+            "mu = { static = 0.3, kinetic = 0.2, speed = 0.1 }",
+        ),
+    ] {
+        let surface = FLOOR.replace(swap, &format!("{needle}\n"));
+        let surface = if needle.starts_with("foundation_velocity") {
+            format!("{surface}mu = 0.3\n")
+        } else {
+            surface
+        };
+        let text = slab(&surface, REST);
+        let e = load(&text).unwrap_err();
+        assert_at(
+            &e,
+            &text,
+            needle,
+            "law = \"compliance\" takes a foundation at rest",
+        );
+    }
+}
