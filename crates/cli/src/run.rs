@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use stickslip_case::{self as case, Case, InputError, Prepared, Running, Scene};
 use stickslip_contact::ContactSurface;
-use stickslip_fem::DofMap;
+use stickslip_fem::{DofMap, SetupTimes};
 use stickslip_mesh::Mesh;
 use stickslip_time::{Integrator, Scheme};
 
@@ -545,6 +545,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         mesh,
         dofs,
         mut integrator,
+        setup: setup_parts,
     } = prepare_run(case, options.restart, !quiet)?;
     let n_c = integrator.contact().map_or(0, |c| c.len());
     // A signal during the setup: stop before the file is touched (with
@@ -608,6 +609,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         wall_before: opened.wall_before,
         initial_mechanical: opened.initial_mechanical,
         started,
+        setup_parts,
     };
     session.writer.auto_flush = false;
     session.writer.flush_every_steps = case.output.flush_every.max(1);
@@ -630,6 +632,28 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     let ending = session.step_to_end(&mut progress)?;
     progress.finish();
     session.conclude(ending, setup_s, stepping, progress.steps_before)
+}
+
+/// The setup's parts in seconds, and what is left of `setup_s` beside
+/// them (the results file's creation, the first checkpoint) as "other".
+fn setup_line(parts: &SetupTimes, setup_s: f64) -> String {
+    let mut line: Vec<String> = parts
+        .parts()
+        .iter()
+        .map(|(name, s)| format!("{name} {s:.3} s"))
+        .collect();
+    line.push(format!("other {:.3} s", (setup_s - parts.total()).max(0.0)));
+    line.join(", ")
+}
+
+/// [`setup_line`] as a JSON object, its keys with underscores.
+fn setup_json(parts: &SetupTimes, setup_s: f64) -> serde_json::Value {
+    let mut map = serde_json::Map::new();
+    for (name, s) in parts.parts() {
+        map.insert(name.replace(' ', "_"), (*s).into());
+    }
+    map.insert("other".into(), (setup_s - parts.total()).max(0.0).into());
+    map.into()
 }
 
 /// How the stepping ended.
@@ -736,6 +760,9 @@ struct Session<'a> {
     wall_before: f64,
     initial_mechanical: f64,
     started: Instant,
+    /// The setup's parts (mesh read, assembly, preload, critical step,
+    /// operators), for the summary.
+    setup_parts: SetupTimes,
 }
 
 impl Session<'_> {
@@ -937,6 +964,7 @@ impl Session<'_> {
             } else {
                 String::new()
             };
+            say!("setup: {}", setup_line(&self.setup_parts, setup_s));
             say!(
                 "energy: total {:.6} (kinetic {:.6}, strain {:.6}, work {:.6}, dissipated {:.6}{rayleigh}); largest |balance| {:.3e}{damped}",
                 e.total, e.kinetic, e.strain, e.external_work, e.dissipated, self.max_balance
@@ -967,6 +995,7 @@ impl Session<'_> {
                 "friction": friction_off.as_ref().map_or("on".to_string(), |why| format!("off: {why}")),
                 "wall_time_s": summary.wall_time_s,
                 "setup_s": setup_s,
+                "setup_parts": setup_json(&self.setup_parts, setup_s),
                 "step_s": step_s,
                 "iterations": i.total_iterations(),
                 "factorizations": i.factorizations(),

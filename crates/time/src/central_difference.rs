@@ -7,8 +7,10 @@ use stickslip_contact::{iterate, ContactSurface, DiagonalStep, SlipState};
 use stickslip_linalg::chunks;
 use stickslip_linalg::{csr, Product, Stencils};
 
+use stickslip_fem::SetupTimes;
+
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Mass};
+use crate::initial::{initial_state, Mass, Statics};
 use crate::nodal::NodalFriction;
 use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError, MAX_STABLE_STEPS};
 use crate::stability::critical_step_with;
@@ -68,6 +70,7 @@ pub(crate) fn start(
     contact: Option<&ContactSurface>,
     loads: &Loads,
     settings: &Settings,
+    times: &mut SetupTimes,
 ) -> Result<(Box<dyn Stepper>, State), TimeError> {
     let Dynamics {
         stiffness: k,
@@ -77,20 +80,34 @@ pub(crate) fn start(
         rigid_modes,
         ..
     } = dynamics;
-    let types = if stencils { Stencils::new(&k) } else { None };
-    let dt_crit = critical_step_with(
-        |x, y| match &types {
-            Some(s) => s.spmv(x, y),
-            None => csr::spmv(&k, x, y),
+    let types = times.time(
+        "operators",
+        || {
+            if stencils {
+                Stencils::new(&k)
+            } else {
+                None
+            }
         },
-        &mass,
     );
+    let dt_crit = times.time("critical step", || {
+        critical_step_with(
+            |x, y| match &types {
+                Some(s) => s.spmv(x, y),
+                None => csr::spmv(&k, x, y),
+            },
+            &mass,
+        )
+    });
     let dt_crit = damped_critical_step(dt_crit, settings)?;
     let state = initial_state(
         &k,
         Mass::Lumped(&mass),
-        &rigid_modes,
-        &fill_order,
+        Statics {
+            fill_order: &fill_order,
+            modes: &rigid_modes,
+            times,
+        },
         contact,
         loads,
         settings,
