@@ -56,6 +56,9 @@ pub(crate) struct Statics<'a> {
     pub fill_order: &'a FillOrder,
     pub modes: &'a [RigidMode],
     pub times: &'a mut SetupTimes,
+    /// K is factorized here only (the explicit scheme): the dissection is
+    /// kept without AMD's analysis ([`FillOrder::keep_dissection`]).
+    pub single_factor: bool,
 }
 
 /// K⁻¹ r in place by sparse Cholesky, the analysis (the ordering and
@@ -105,6 +108,7 @@ pub(crate) fn initial_state(
         fill_order,
         modes,
         times,
+        single_factor,
     } = statics;
     let n = k.nrows();
     let mut state = State::new(n, contact.map_or(0, |c| c.len()), settings.dt);
@@ -113,10 +117,15 @@ pub(crate) fn initial_state(
         r.fill(0.0);
     } else if r.iter().all(|&x| x == 0.0) {
         // Nothing acts before t = 0: r₀ = 0, no factorization.
-    } else if !modes.is_empty() {
-        crate::floating::solve(k, mass, fill_order, modes, &mut r, times)?;
     } else {
-        cholesky_solve(k, fill_order, &mut r, times)?;
+        if single_factor {
+            fill_order.keep_dissection();
+        }
+        if modes.is_empty() {
+            cholesky_solve(k, fill_order, &mut r, times)?;
+        } else {
+            crate::floating::solve(k, mass, fill_order, modes, &mut r, times)?;
+        }
     }
     state.r = r;
     if let Some(v0) = &settings.initial_velocity {

@@ -106,6 +106,7 @@ pub(crate) fn start(
             fill_order: &fill_order,
             modes: &rigid_modes,
             times,
+            single_factor: false,
         },
         contact,
         loads,
