@@ -25,7 +25,10 @@
 //! (its row-sum lumped mass is HRZ's on rectangular cells only): the paper
 //! mesh, q2-64x16, q1-128x32, q1-352x88, q2-352x88 and q1-708x177; the
 //! 500k and 1M rungs are ours alone. The table and the CSV give each
-//! peer's median, its ratio to ours (peer / ours) and its agreement.
+//! peer's median, its ratio to ours (peer / ours) and its agreement;
+//! ours are run with `--json`, and a second table and the CSV's
+//! `setup_s` and `setup_parts` give the median of each part of our setup
+//! (mesh read, assembly, preload, critical step, operators, ...).
 //! `--peers scipy,fenicsx` or `none` chooses them; by default both, and
 //! none when `--against` compares another binary.
 //!
