@@ -25,7 +25,10 @@
 //! (its row-sum lumped mass is HRZ's on rectangular cells only): the paper
 //! mesh, q2-64x16, q1-128x32, q1-352x88, q2-352x88 and q1-708x177; the
 //! 500k and 1M rungs are ours alone. The table and the CSV give each
-//! peer's median, its ratio to ours (peer / ours) and its agreement.
+//! peer's median, its ratio to ours (peer / ours) and its agreement;
+//! ours are run with `--json`, and a second table and the CSV's
+//! `setup_s` and `setup_parts` give the median of each part of our setup
+//! (mesh read, assembly, preload, critical step, operators, ...).
 //! `--peers scipy,fenicsx` or `none` chooses them; by default both, and
 //! none when `--against` compares another binary.
 //!
@@ -277,7 +280,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         if e == 1 {
             cmd.envs(against_env.iter().map(|(k, v)| (k, v)));
         }
-        let flags = ["--quiet", "--force"];
+        let flags = ["--quiet", "--force", "--json"];
         let result = crate::bench::timed_run(cmd, root, &flags, &out, case, sets);
         for ext in ["h5", "xdmf"] {
             let _ = std::fs::remove_file(out.with_extension(ext));
@@ -299,6 +302,8 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     }
     // times[run][exe, then peer]
     let mut times = vec![vec![Vec::new(); exes.len() + peers.len()]; runs.len()];
+    // Our runs' setup parts, per run and round (the run's --json summary).
+    let mut setups: Vec<Vec<Vec<(String, f64)>>> = vec![Vec::new(); runs.len()];
     for round in 0..rounds {
         eprintln!("bench run: round {} of {rounds}", round + 1);
         for (r, (label, case, sets, fits)) in runs.iter().enumerate() {
@@ -316,6 +321,9 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
                         continue;
                     }
                     times[r][e].push(secs);
+                    if e == 0 {
+                        setups[r].push(setup_parts(&String::from_utf8_lossy(&o.stdout)));
+                    }
                 }
             }
             for (p, peer) in peers.iter().enumerate().filter(|(p, _)| fits[*p]) {
@@ -340,7 +348,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         t.sort_by(f64::total_cmp);
         t.get(t.len() / 2).copied().unwrap_or(f64::NAN)
     };
-    let mut csv = String::from("run,median_s,fastest_s,rounds,samples");
+    let mut csv = String::from("run,median_s,fastest_s,rounds,samples,setup_s,setup_parts");
     if compared {
         csv.push_str(",against_median_s,ratio");
     }
@@ -374,12 +382,27 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
     } else {
         println!();
     }
+    let mut setup_lines = Vec::new();
     for (r, (label, _, _, fits)) in runs.iter().enumerate() {
         let m = median(&mut times[r][0]);
         let fastest = times[r][0].first().copied().unwrap_or(f64::NAN);
         let samples = times[r][0].len();
         print!("{label:<32} {m:>10.4} {fastest:>10.4} {samples:>7}");
-        csv.push_str(&format!("{label},{m:.5},{fastest:.5},{rounds},{samples}"));
+        let parts = median_parts(&setups[r], median);
+        let setup = parts
+            .iter()
+            .find(|(n, _)| n == "setup")
+            .map_or(f64::NAN, |p| p.1);
+        let listed: Vec<String> = parts
+            .iter()
+            .filter(|(n, _)| n != "setup")
+            .map(|(n, s)| format!("{n}={s:.3}"))
+            .collect();
+        csv.push_str(&format!(
+            "{label},{m:.5},{fastest:.5},{rounds},{samples},{setup:.4},{}",
+            listed.join(";")
+        ));
+        setup_lines.push(format!("{label:<32} {setup:>8.3}  {}", listed.join(" ")));
         let mut peer_csv = String::new();
         for p in 0..peers.len() {
             if fits[p] {
@@ -400,6 +423,11 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         println!();
         csv.push('\n');
     }
+    println!("\nour setup (median s of each part over the rounds; the run's --json summary):\n");
+    println!("{:<32} {:>8}  parts", "run", "setup s");
+    for line in &setup_lines {
+        println!("{line}");
+    }
     let path = root.join("target/bench/run.csv");
     std::fs::write(&path, &csv).map_err(|e| format!("{}: {e}", path.display()))?;
     println!("wrote {}", path.display());
@@ -414,6 +442,58 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
 
 /// A figure per run and peer: `[run][peer]`.
 type PerPeer = Vec<Vec<f64>>;
+
+/// The setup of a run's `--json` summary: ("setup", setup_s), then each
+/// of `setup_parts` (mesh_read, assembly, preload_factor, ...); empty
+/// where the summary has none (an older binary).
+fn setup_parts(stdout: &str) -> Vec<(String, f64)> {
+    let number = |s: &str| -> Option<f64> {
+        let end = s
+            .find(|c: char| !(c.is_ascii_digit() || "+-.eE".contains(c)))
+            .unwrap_or(s.len());
+        s[..end].parse().ok()
+    };
+    let mut out = Vec::new();
+    let Some(setup) = stdout
+        .find("\"setup_s\":")
+        .and_then(|i| number(&stdout[i + 10..]))
+    else {
+        return out;
+    };
+    out.push(("setup".to_string(), setup));
+    if let Some(i) = stdout.find("\"setup_parts\":{") {
+        let body = &stdout[i + 15..];
+        let body = &body[..body.find('}').unwrap_or(body.len())];
+        for entry in body.split(',') {
+            if let Some((k, v)) = entry.split_once(':') {
+                if let Some(v) = number(v.trim()) {
+                    out.push((k.trim().trim_matches('"').to_string(), v));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Each part's median over the rounds, in the first round's order.
+fn median_parts(
+    rounds: &[Vec<(String, f64)>],
+    median: impl Fn(&mut Vec<f64>) -> f64,
+) -> Vec<(String, f64)> {
+    let Some(first) = rounds.first() else {
+        return Vec::new();
+    };
+    first
+        .iter()
+        .map(|(name, _)| {
+            let mut v: Vec<f64> = rounds
+                .iter()
+                .filter_map(|r| r.iter().find(|(n, _)| n == name).map(|p| p.1))
+                .collect();
+            (name.clone(), median(&mut v))
+        })
+        .collect()
+}
 
 /// Each peer's agreement with stickslip on each run it makes
 /// (`checks[run][peer]`, NaN where it does not run it), before anything is
@@ -555,6 +635,21 @@ mod tests {
     }
 
     /// The rungs each peer runs, as the module doc lists them.
+    #[test]
+    fn the_setup_parts_are_read_from_the_json_summary() {
+        let stdout = r#"{"status":"complete","setup_parts":{"assembly":1.5,"mesh_read":0.25,"other":0.01},"setup_s":1.76,"step_s":0.0066}"#;
+        assert_eq!(
+            setup_parts(stdout),
+            vec![
+                ("setup".to_string(), 1.76),
+                ("assembly".to_string(), 1.5),
+                ("mesh_read".to_string(), 0.25),
+                ("other".to_string(), 0.01)
+            ]
+        );
+        assert!(setup_parts("not json").is_empty());
+    }
+
     #[test]
     fn the_peers_run_the_rungs_the_doc_names() {
         let runs = |name| -> Vec<&str> {

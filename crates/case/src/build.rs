@@ -9,7 +9,7 @@
 use stickslip_contact::{ContactSurface, IterationOptions};
 use stickslip_fem::{
     body_force_load, traction_load, Dirichlet, DofMap, Hypothesis as FemHypothesis, Material,
-    Model, Traction,
+    Model, SetupTimes, Traction,
 };
 use stickslip_mesh::Mesh;
 use stickslip_time::{
@@ -42,6 +42,8 @@ pub struct Scene {
     pub loads: Vec<Load>,
     /// Scheme, Δt, mass, iteration, step reduction.
     pub settings: Settings,
+    /// How long the mesh read, the model's parts and the loads took.
+    pub setup: SetupTimes,
 }
 
 /// A case turned into the objects that run it, with the model kept for
@@ -67,6 +69,9 @@ pub struct Running {
     pub dofs: DofMap,
     /// The integrator at t = 0 (initial state computed).
     pub integrator: Integrator,
+    /// How long the setup's parts took: the scene's, then the
+    /// integrator's ([`Integrator::setup_times`]).
+    pub setup: SetupTimes,
 }
 
 /// [`assemble`] and the integrator, the model kept.
@@ -125,10 +130,13 @@ impl Scene {
             .map_err(|e| refused(case, e))?;
         integrator.set_pressure_histories(&self.pressure_histories);
         integrator.set_foundation_histories(&self.foundation_histories);
+        let mut setup = self.setup;
+        setup.extend(integrator.setup_times());
         Ok(Running {
             mesh: self.mesh,
             dofs,
             integrator,
+            setup,
         })
     }
 }
@@ -288,7 +296,9 @@ fn check_group(
 /// # Errors
 /// Every input problem found, as one [`InputError`].
 pub fn assemble(case: &Case) -> Result<Scene, InputError> {
-    let mesh = Mesh::from_file(&case.mesh.file)
+    let mut setup = SetupTimes::default();
+    let mesh = setup
+        .time("mesh read", || Mesh::from_file(&case.mesh.file))
         .map_err(|e| InputError(format!("{}{e}", case.at("mesh.file"))))?;
     let mut problems = Vec::new();
 
@@ -411,6 +421,8 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
         return Err(InputError(listed(problems)));
     };
 
+    setup.extend(&model.setup);
+    let loads_started = std::time::Instant::now();
     let n_full = 2 * mesh.nodes.len();
     let n_free = model.dofs.n_free();
     let mut full = vec![0.0; n_full];
@@ -461,6 +473,7 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
     }
     let mut settings = settings(case);
     settings.initial_velocity = initial_velocity(case, &mesh, &model.dofs);
+    setup.add("loads", loads_started.elapsed().as_secs_f64());
     Ok(Scene {
         mesh,
         model,
@@ -469,6 +482,7 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
         foundation_histories: surfaces.foundation_histories,
         loads,
         settings,
+        setup,
     })
 }
 

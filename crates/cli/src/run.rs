@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use stickslip_case::{self as case, Case, InputError, Prepared, Running, Scene};
 use stickslip_contact::ContactSurface;
-use stickslip_fem::DofMap;
+use stickslip_fem::{DofMap, SetupTimes};
 use stickslip_mesh::Mesh;
 use stickslip_time::{Integrator, Scheme};
 
@@ -550,6 +550,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         mesh,
         dofs,
         mut integrator,
+        setup: setup_parts,
     } = prepare_run(case, options.restart, !quiet)?;
     let n_c = integrator.contact().map_or(0, |c| c.len());
     // A signal during the setup: stop before the file is touched (with
@@ -613,6 +614,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         wall_before: opened.wall_before,
         initial_mechanical: opened.initial_mechanical,
         started,
+        setup_parts,
     };
     session.writer.auto_flush = false;
     session.writer.flush_every_steps = case.output.flush_every.max(1);
@@ -635,6 +637,28 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     let ending = session.step_to_end(&mut progress)?;
     progress.finish();
     session.conclude(ending, setup_s, stepping, progress.steps_before)
+}
+
+/// The setup's parts in seconds, and what is left of `setup_s` beside
+/// them (the results file's creation, the first checkpoint) as "other".
+fn setup_line(parts: &SetupTimes, setup_s: f64) -> String {
+    let mut line: Vec<String> = parts
+        .parts()
+        .iter()
+        .map(|(name, s)| format!("{name} {s:.3} s"))
+        .collect();
+    line.push(format!("other {:.3} s", (setup_s - parts.total()).max(0.0)));
+    line.join(", ")
+}
+
+/// [`setup_line`] as a JSON object, its keys with underscores.
+fn setup_json(parts: &SetupTimes, setup_s: f64) -> serde_json::Value {
+    let mut map = serde_json::Map::new();
+    for (name, s) in parts.parts() {
+        map.insert(name.replace(' ', "_"), (*s).into());
+    }
+    map.insert("other".into(), (setup_s - parts.total()).max(0.0).into());
+    map.into()
 }
 
 /// How the stepping ended.
@@ -741,6 +765,9 @@ struct Session<'a> {
     wall_before: f64,
     initial_mechanical: f64,
     started: Instant,
+    /// The setup's parts (mesh read, assembly, preload, critical step,
+    /// operators), for the summary.
+    setup_parts: SetupTimes,
 }
 
 impl Session<'_> {
@@ -927,6 +954,7 @@ impl Session<'_> {
                 summary.wall_time_s,
                 human_seconds(step_s)
             );
+            say!("setup: {}", setup_line(&self.setup_parts, setup_s));
             // Newmark's γ > ½ dissipates by design, outside the ledger.
             let damped = if case.time.scheme == case::Scheme::Newmark && case.time.gamma > 0.5 {
                 format!(
@@ -980,6 +1008,7 @@ impl Session<'_> {
                 "friction": friction_off.as_ref().map_or("on".to_string(), |why| format!("off: {why}")),
                 "wall_time_s": summary.wall_time_s,
                 "setup_s": setup_s,
+                "setup_parts": setup_json(&self.setup_parts, setup_s),
                 "step_s": step_s,
                 "iterations": i.total_iterations(),
                 "factorizations": i.factorizations(),

@@ -1106,6 +1106,29 @@ fn json_summary_is_one_object_on_stdout() {
     );
     assert!(!out.with_extension("xdmf").exists());
     assert!(j["energy"]["total"].is_f64() && j["dt_crit"].is_f64());
+    // The setup's parts: the slab is preloaded (the contact pressure acts
+    // before t = 0), so the preload's factor is among them; they and the
+    // rest ("other") add up to setup_s, to the printed rounding.
+    let parts = j["setup_parts"].as_object().expect("setup_parts");
+    for part in [
+        "mesh_read",
+        "assembly",
+        "critical_step",
+        "preload_factor",
+        "operators",
+        "other",
+    ] {
+        assert!(
+            parts[part].as_f64().is_some_and(|s| s >= 0.0),
+            "{part}: {parts:?}"
+        );
+    }
+    let sum: f64 = parts.values().map(|v| v.as_f64().unwrap()).sum();
+    let setup = j["setup_s"].as_f64().unwrap();
+    assert!(
+        (sum - setup).abs() <= 1e-9 * setup.max(1.0),
+        "{sum} against {setup}"
+    );
 }
 
 /// A run stored in one node order continues in another

@@ -29,6 +29,7 @@ pub mod model;
 pub mod ordering;
 pub mod quadrature;
 pub mod reference;
+mod setup_times;
 pub mod statics;
 
 pub use assembly::{free_dof_pattern, node_adjacency};
@@ -40,6 +41,7 @@ pub use loads::{
 };
 pub use material::{Hypothesis, Material};
 pub use model::Model;
+pub use setup_times::SetupTimes;
 pub use statics::{
     gauss_point_stresses, nodal_stresses, static_solve, stress_at_node, von_mises, GaussPointStress,
 };

@@ -9,6 +9,7 @@ use crate::assembly::{assemble, free_dof_pattern, Assembly};
 use crate::dofs::{Dirichlet, DofMap};
 use crate::error::FemError;
 use crate::material::Material;
+use crate::setup_times::SetupTimes;
 use stickslip_linalg::FillOrder;
 
 /// K, M and lumped M of a mesh and material under Dirichlet conditions,
@@ -31,6 +32,8 @@ pub struct Model {
     /// The ordering of the Cholesky factors of K, M and their sums (AMD
     /// or nested dissection, by the mesh: `ordering.rs`).
     pub fill_order: FillOrder,
+    /// How long the DOF map, the pattern, the assembly and the ordering took.
+    pub setup: SetupTimes,
 }
 
 impl Model {
@@ -44,7 +47,9 @@ impl Model {
         material: &Material,
         conditions: &[Dirichlet],
     ) -> Result<Model, FemError> {
-        Model::with_dofs(mesh, material, DofMap::new(mesh, conditions)?)
+        let mut setup = SetupTimes::default();
+        let dofs = setup.time("DOF map", || DofMap::new(mesh, conditions))?;
+        Model::build(mesh, material, dofs, setup)
     }
 
     /// [`Model::new`] on a DOF map of `mesh` made already (e.g. one
@@ -53,7 +58,18 @@ impl Model {
     /// # Errors
     /// [`FemError::InvertedCell`].
     pub fn with_dofs(mesh: &Mesh, material: &Material, dofs: DofMap) -> Result<Model, FemError> {
-        let pattern = free_dof_pattern(mesh, &dofs);
+        Model::build(mesh, material, dofs, SetupTimes::default())
+    }
+
+    /// [`Model::with_dofs`], its parts' times added to `setup`.
+    fn build(
+        mesh: &Mesh,
+        material: &Material,
+        dofs: DofMap,
+        mut setup: SetupTimes,
+    ) -> Result<Model, FemError> {
+        let pattern = setup.time("pattern", || free_dof_pattern(mesh, &dofs));
+        let started = std::time::Instant::now();
         let nnz = pattern.nnz();
         let mut k = vec![0.0; nnz];
         let mut m = vec![0.0; nnz];
@@ -78,8 +94,10 @@ impl Model {
             .expect("one value per pattern entry");
         let mass = CsrMatrix::try_from_pattern_and_values(pattern, m)
             .expect("one value per pattern entry");
-        let fill_order = crate::ordering::choose(mesh, &dofs);
+        setup.add("assembly", started.elapsed().as_secs_f64());
+        let fill_order = setup.time("ordering", || crate::ordering::choose(mesh, &dofs));
         Ok(Model {
+            setup,
             fill_order,
             dofs,
             stiffness,

@@ -199,5 +199,15 @@ fn amd_on_small_meshes_the_smaller_factor_on_large_ones() {
         assert_eq!(copy.name(), want, "{nd} against AMD's {amd}");
         assert_eq!(copy.decided_name(), Some(want));
         assert_eq!(values(&copy), kept);
+        // A run that factorizes once (the explicit preload) keeps the
+        // dissection without analysing AMD's order, where AMD wins too.
+        let once = choose(&mesh, &model.dofs);
+        once.keep_dissection();
+        assert_eq!(once.decided_name(), Some("nested dissection"));
+        assert_eq!(values(&once), nd);
+        // AMD by size stays AMD.
+        let amd_order = FillOrder::amd();
+        amd_order.keep_dissection();
+        assert_eq!(values(&amd_order), amd);
     }
 }

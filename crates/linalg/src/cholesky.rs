@@ -23,6 +23,15 @@ use faer::{Par, Side, Spec};
 
 use crate::{FillOrder, Supernodal};
 use faer::perm::PermRef;
+
+/// Factors from this many values are factorized by faer on every thread
+/// of the pool; below it the threads' dispatch costs more than it saves.
+const PARALLEL_MIN: usize = 1 << 20;
+
+/// faer's dense kernels on every thread of rayon's pool.
+fn parallel() -> Par {
+    Par::rayon(rayon::current_num_threads())
+}
 use nalgebra_sparse::CsrMatrix;
 
 /// Why a factorization failed.
@@ -123,9 +132,12 @@ pub fn analyze_symbolic(
         Some(false) => symbolic_in(a, None),
         // The first analysis of the run: both, AMD's kept only where its
         // factor is clearly the smaller (`fill_order.rs`, AMD_MARGIN).
+        // The two analyses at once, each on its own thread (AMD's is the
+        // longer: docs/performance.md).
         None => {
-            let dissected = symbolic_in(a, Some(forward))?;
-            let amd = symbolic_in(a, None)?;
+            let (dissected, amd) =
+                rayon::join(|| symbolic_in(a, Some(forward)), || symbolic_in(a, None));
+            let (dissected, amd) = (dissected?, amd?);
             let dissection_won =
                 dissected.len_val() as f64 <= crate::AMD_MARGIN * amd.len_val() as f64;
             let _ = chosen.set(dissection_won);
@@ -186,7 +198,7 @@ impl SparseCholesky {
         }
         let symbolic = analyze_symbolic(a, order)?;
         let factor_scratch = MemBuffer::new(
-            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+            symbolic.factorize_numeric_llt_scratch::<f64>(parallel(), Default::default()),
         );
         let solver = RefCell::new(Supernodal::new(&symbolic).ok_or_else(|| {
             SolverError::Analysis("faer returned a factor layout this solver does not know".into())
@@ -219,6 +231,18 @@ impl SparseCholesky {
     /// [`SolverError::NotPositiveDefinite`] for a singular or indefinite
     /// matrix, [`SolverError::PatternChanged`] for another pattern.
     pub fn factorize(&mut self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
+        let par = if self.l_values.len() >= PARALLEL_MIN {
+            parallel()
+        } else {
+            Par::Seq
+        };
+        self.factorize_in(a, par)
+    }
+
+    /// [`SparseCholesky::factorize`] with faer's dense kernels run by
+    /// `par`: they split their products by blocks of the result, never
+    /// a sum, so the factor's bits do not depend on it (tested).
+    fn factorize_in(&mut self, a: &CsrMatrix<f64>, par: Par) -> Result<(), SolverError> {
         if a.nrows() != self.n || a.nnz() != self.nnz {
             return Err(SolverError::PatternChanged {
                 analysed: self.nnz,
@@ -231,7 +255,7 @@ impl SparseCholesky {
             as_csc(a),
             Side::Lower,
             Default::default(),
-            Par::Seq,
+            par,
             MemStack::new(&mut self.factor_scratch),
             Spec::<LltParams, f64>::default(),
         );
@@ -259,5 +283,53 @@ impl SparseCholesky {
         );
         assert_eq!(x.len(), self.n, "right-hand side length");
         self.solver.borrow_mut().solve(&self.l_values, x);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra_sparse::CooMatrix;
+
+    /// The 5-point Laplacian of an n×n grid plus the identity.
+    fn grid(n: usize) -> CsrMatrix<f64> {
+        let mut coo = CooMatrix::new(n * n, n * n);
+        for i in 0..n {
+            for j in 0..n {
+                let p = i * n + j;
+                coo.push(p, p, 5.0);
+                if i + 1 < n {
+                    coo.push(p, p + n, -1.0);
+                    coo.push(p + n, p, -1.0);
+                }
+                if j + 1 < n {
+                    coo.push(p, p + 1, -1.0);
+                    coo.push(p + 1, p, -1.0);
+                }
+            }
+        }
+        CsrMatrix::from(&coo)
+    }
+
+    #[test]
+    fn the_factor_has_the_same_bits_on_one_thread_and_on_four() {
+        let a = grid(300);
+        let mut seq = SparseCholesky::analyze(&a, &FillOrder::amd()).unwrap();
+        // Large enough for `factorize` to take the parallel path.
+        assert!(seq.factor_nnz() >= PARALLEL_MIN, "{}", seq.factor_nnz());
+        let mut par = SparseCholesky::analyze(&a, &FillOrder::amd()).unwrap();
+        seq.factorize_in(&a, Par::Seq).unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap();
+        pool.install(|| par.factorize_in(&a, Par::rayon(4)))
+            .unwrap();
+        let same = seq
+            .l_values
+            .iter()
+            .zip(&par.l_values)
+            .all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same, "the factor's values differ between 1 and 4 threads");
     }
 }

@@ -67,6 +67,17 @@ impl FillOrder {
         (!undecided).then(|| self.name())
     }
 
+    /// Decides for the dissection where the comparison with AMD is still
+    /// open, without AMD's analysis: for a run that factorizes once (the
+    /// explicit scheme's preload) AMD's analysis costs about what its
+    /// smaller factor saves where it wins, and all of it where it does
+    /// not (docs/performance.md).
+    pub fn keep_dissection(&self) {
+        if let Some(chosen) = self.comparison() {
+            let _ = chosen.set(true);
+        }
+    }
+
     /// The dissection's order, if it is a candidate.
     pub fn dissection_order(&self) -> Option<&[usize]> {
         self.dissection.as_deref().map(Vec::as_slice)

@@ -7,8 +7,10 @@ use stickslip_contact::{iterate, ContactSurface, DiagonalStep, Foundation, SlipS
 use stickslip_linalg::chunks;
 use stickslip_linalg::{csr, Product, Stencils};
 
+use stickslip_fem::SetupTimes;
+
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Mass};
+use crate::initial::{initial_state, Mass, Statics};
 use crate::nodal::NodalFriction;
 use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError, MAX_STABLE_STEPS};
 use crate::stability::critical_step_with;
@@ -72,6 +74,7 @@ pub(crate) fn start(
     contact: Option<&ContactSurface>,
     loads: &Loads,
     settings: &Settings,
+    times: &mut SetupTimes,
 ) -> Result<(Box<dyn Stepper>, State), TimeError> {
     let Dynamics {
         stiffness: k,
@@ -81,30 +84,45 @@ pub(crate) fn start(
         rigid_modes,
         ..
     } = dynamics;
-    let types = if stencils { Stencils::new(&k) } else { None };
+    let types = times.time(
+        "operators",
+        || {
+            if stencils {
+                Stencils::new(&k)
+            } else {
+                None
+            }
+        },
+    );
     // A compliant foundation with m_n = 1 is a spring w c_n ννᵀ at every
     // node in contact; with all of them in contact ω_max is largest
     // (a positive semi-definite term raises every eigenvalue), so that
     // bound holds whatever the contact does. Stiffer-with-depth nodes
     // (m_n > 1) are checked step by step (`contact_stable`).
-    let dt_crit = critical_step_with(
-        |x, y| {
-            match &types {
-                Some(s) => s.spmv(x, y),
-                None => csr::spmv(&k, x, y),
-            }
-            if let Some(c) = contact.filter(|c| c.is_compliant()) {
-                c.add_linear_stiffness(x, y);
-            }
-        },
-        &mass,
-    );
+    let dt_crit = times.time("critical step", || {
+        critical_step_with(
+            |x, y| {
+                match &types {
+                    Some(s) => s.spmv(x, y),
+                    None => csr::spmv(&k, x, y),
+                }
+                if let Some(c) = contact.filter(|c| c.is_compliant()) {
+                    c.add_linear_stiffness(x, y);
+                }
+            },
+            &mass,
+        )
+    });
     let dt_crit = damped_critical_step(dt_crit, settings)?;
     let state = initial_state(
         &k,
         Mass::Lumped(&mass),
-        &rigid_modes,
-        &fill_order,
+        Statics {
+            fill_order: &fill_order,
+            modes: &rigid_modes,
+            times,
+            single_factor: true,
+        },
         contact,
         loads,
         settings,

@@ -12,8 +12,8 @@
 //! invertible), so x solves K x = R, and r₀ = x − Z (ZᵀMZ)⁻¹ ZᵀM x.
 
 use nalgebra_sparse::CsrMatrix;
-use stickslip_fem::RigidMode;
-use stickslip_linalg::{FillOrder, SparseCholesky};
+use stickslip_fem::{RigidMode, SetupTimes};
+use stickslip_linalg::FillOrder;
 
 use crate::initial::Mass;
 use crate::settings::TimeError;
@@ -35,6 +35,7 @@ pub(crate) fn solve(
     fill_order: &FillOrder,
     modes: &[RigidMode],
     r: &mut [f64],
+    times: &mut SetupTimes,
 ) -> Result<(), TimeError> {
     let unbalanced: Vec<(String, f64)> = modes
         .iter()
@@ -64,10 +65,7 @@ pub(crate) fn solve(
     for &i in &pins {
         r[i] = 0.0;
     }
-    let mut solver = SparseCholesky::analyze(&pinned, fill_order).map_err(TimeError::Static)?;
-    solver.factorize(&pinned).map_err(TimeError::Static)?;
-    drop(pinned);
-    solver.solve_in_place(r);
+    crate::initial::cholesky_solve(&pinned, fill_order, r, times)?;
     remove_rigid_motion(mass, modes, r);
     Ok(())
 }

@@ -6,7 +6,7 @@
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
-use stickslip_fem::RigidMode;
+use stickslip_fem::{RigidMode, SetupTimes};
 use stickslip_linalg::csr::{dot, quadratic_form, spmv};
 use stickslip_linalg::{chunks, FillOrder, SparseCholesky};
 
@@ -49,6 +49,41 @@ impl Mass<'_> {
     }
 }
 
+/// How the initial state's static problems are solved: the ordering of
+/// their factors, the rigid motions the supports leave free (`modes`),
+/// and where the preload's times go.
+pub(crate) struct Statics<'a> {
+    pub fill_order: &'a FillOrder,
+    pub modes: &'a [RigidMode],
+    pub times: &'a mut SetupTimes,
+    /// K is factorized here only (the explicit scheme): the dissection is
+    /// kept without AMD's analysis ([`FillOrder::keep_dissection`]).
+    pub single_factor: bool,
+}
+
+/// K⁻¹ r in place by sparse Cholesky, the analysis (the ordering and
+/// the symbolic factor), the factor and the solve timed as the preload's.
+///
+/// # Errors
+/// [`TimeError::Static`] when K is not positive definite.
+pub(crate) fn cholesky_solve(
+    k: &CsrMatrix<f64>,
+    fill_order: &FillOrder,
+    r: &mut [f64],
+    times: &mut SetupTimes,
+) -> Result<(), TimeError> {
+    let mut solver = times
+        .time("preload ordering", || {
+            SparseCholesky::analyze(k, fill_order)
+        })
+        .map_err(TimeError::Static)?;
+    times
+        .time("preload factor", || solver.factorize(k))
+        .map_err(TimeError::Static)?;
+    times.time("preload solve", || solver.solve_in_place(r));
+    Ok(())
+}
+
 /// The state at t = 0 for a scheme with mass `mass`: Remark 4.1's r₀ (no
 /// factorization where nothing acts before t = 0, where the run starts at
 /// rest, or where the state will come from a checkpoint: r₀ = 0 then), ṙ₀, r̈₀, R(0), the contact
@@ -64,12 +99,17 @@ impl Mass<'_> {
 pub(crate) fn initial_state(
     k: &CsrMatrix<f64>,
     mass: Mass,
-    modes: &[RigidMode],
-    fill_order: &FillOrder,
+    statics: Statics,
     contact: Option<&ContactSurface>,
     loads: &Loads,
     settings: &Settings,
 ) -> Result<State, TimeError> {
+    let Statics {
+        fill_order,
+        modes,
+        times,
+        single_factor,
+    } = statics;
     let n = k.nrows();
     let mut state = State::new(n, contact.map_or(0, |c| c.len()), settings.dt);
     let mut r = loads.before_start();
@@ -77,12 +117,15 @@ pub(crate) fn initial_state(
         r.fill(0.0);
     } else if r.iter().all(|&x| x == 0.0) {
         // Nothing acts before t = 0: r₀ = 0, no factorization.
-    } else if !modes.is_empty() {
-        crate::floating::solve(k, mass, fill_order, modes, &mut r)?;
     } else {
-        let mut solver = SparseCholesky::analyze(k, fill_order).map_err(TimeError::Static)?;
-        solver.factorize(k).map_err(TimeError::Static)?;
-        solver.solve_in_place(&mut r);
+        if single_factor {
+            fill_order.keep_dissection();
+        }
+        if modes.is_empty() {
+            cholesky_solve(k, fill_order, &mut r, times)?;
+        } else {
+            crate::floating::solve(k, mass, fill_order, modes, &mut r, times)?;
+        }
     }
     state.r = r;
     if let Some(v0) = &settings.initial_velocity {

@@ -2,6 +2,7 @@
 //! what an observer reads after each step.
 
 use stickslip_contact::{ContactSurface, SlipState};
+use stickslip_fem::SetupTimes;
 use stickslip_linalg::FillOrder;
 
 use crate::dynamics::{Dynamics, Load, Loads};
@@ -28,6 +29,9 @@ pub struct Integrator {
     bounds: Option<BoundHistories>,
     /// The foundations' speeds that change in time.
     foundations: Option<FoundationHistories>,
+    /// How long the setup's parts took (the preload, the critical step,
+    /// the step's operators).
+    setup: SetupTimes,
 }
 
 impl std::fmt::Debug for Integrator {
@@ -90,9 +94,12 @@ impl Integrator {
             loads,
         };
         let fill_order = dynamics.fill_order.clone();
+        let mut setup = SetupTimes::default();
+        let started = std::time::Instant::now();
+        let times = &mut setup;
         let (stepper, state) = match settings.scheme {
             Scheme::CentralDifference => {
-                central_difference::start(dynamics, contact.as_ref(), &loads, &settings)?
+                central_difference::start(dynamics, contact.as_ref(), &loads, &settings, times)?
             }
             Scheme::Newmark { beta, gamma } => newmark::start(
                 dynamics,
@@ -101,11 +108,16 @@ impl Integrator {
                 contact.as_ref(),
                 &loads,
                 &settings,
+                times,
             )?,
             Scheme::QuasiStatic => {
-                quasi_static::start(dynamics, contact.as_ref(), &loads, &settings)?
+                quasi_static::start(dynamics, contact.as_ref(), &loads, &settings, times)?
             }
         };
+        // What a scheme's start did beside its timed parts: its step's
+        // operators (stencil types, factors, friction's constants).
+        let rest = started.elapsed().as_secs_f64() - setup.total();
+        setup.add("operators", rest.max(0.0));
         Ok(Integrator {
             surface,
             run: Run {
@@ -118,7 +130,14 @@ impl Integrator {
             fill_order,
             bounds: None,
             foundations: None,
+            setup,
         })
+    }
+
+    /// How long the setup's parts took: the preload's ordering, factor
+    /// and solve, the critical step, the step's operators.
+    pub fn setup_times(&self) -> &SetupTimes {
+        &self.setup
     }
 
     /// Makes each contact surface's pressure change in time: the bounds of

@@ -25,8 +25,10 @@ use stickslip_contact::{stick_events, ContactSurface};
 use stickslip_linalg::chunks;
 use stickslip_linalg::csr::{dot, quadratic_form, spmv};
 
+use stickslip_fem::SetupTimes;
+
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Mass};
+use crate::initial::{initial_state, Mass, Statics};
 use crate::newmark::ImplicitFriction;
 use crate::settings::{InitialState, MassKind, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
@@ -51,6 +53,7 @@ pub(crate) fn start(
     contact: Option<&ContactSurface>,
     loads: &Loads,
     settings: &Settings,
+    times: &mut SetupTimes,
 ) -> Result<(Box<dyn Stepper>, State), TimeError> {
     let Dynamics {
         stiffness: k,
@@ -70,8 +73,12 @@ pub(crate) fn start(
     let mut state = initial_state(
         &k,
         Mass::Massless,
-        &rigid_modes,
-        &fill_order,
+        Statics {
+            fill_order: &fill_order,
+            modes: &rigid_modes,
+            times,
+            single_factor: false,
+        },
         contact,
         loads,
         settings,

@@ -15,8 +15,10 @@ use stickslip_contact::{iterate, stick_events, ContactSurface, SlipState};
 use stickslip_linalg::csr::{load_minus_k_plus_m, same_pattern, two_forms};
 use stickslip_linalg::{chunks, FillOrder};
 
+use stickslip_fem::SetupTimes;
+
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Mass};
+use crate::initial::{initial_state, Mass, Statics};
 use crate::settings::{ImplicitSolver, MassKind, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
@@ -67,6 +69,7 @@ pub(crate) fn start(
     contact: Option<&ContactSurface>,
     loads: &Loads,
     settings: &Settings,
+    times: &mut SetupTimes,
 ) -> Result<(Box<dyn Stepper>, State), TimeError> {
     let Dynamics {
         stiffness: k,
@@ -100,8 +103,12 @@ pub(crate) fn start(
     let state = initial_state(
         &k,
         mass,
-        &rigid_modes,
-        &fill_order,
+        Statics {
+            fill_order: &fill_order,
+            modes: &rigid_modes,
+            times,
+            single_factor: false,
+        },
         contact,
         loads,
         settings,
