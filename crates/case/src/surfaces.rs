@@ -65,7 +65,11 @@ pub(crate) fn surfaces(
                 Ok(_) => {}
                 Err(e) => problems.push(format!("{}[contact]: {e}", at("group"))),
             }
+            // One history of each kind a surface, so that each stays with
+            // its part (a compliant foundation is at rest: constant).
             out.histories.push(history(&c.pressure_history));
+            out.foundation_histories
+                .push(history(&c.foundation_history));
             continue;
         }
         let length = line.last().map_or(0.0, |b| b.s);

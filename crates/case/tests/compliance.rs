@@ -189,3 +189,34 @@ fn a_compliant_foundation_refuses_motion_and_a_falling_mu() {
         );
     }
 }
+
+/// A compliant floor listed before a belt whose speed follows a table:
+/// the belt's history stays the belt's. Expected: the table [[0, 0], [1,
+/// 1]] is θ(t) = t, so after one step of Δt = 1e-3 the belt's nodes move
+/// at V θ = 2 · 1e-3 and the floor's stay at rest.
+#[test]
+fn a_belt_after_a_compliant_floor_keeps_its_history() {
+    let belt = r#"[[contact]]
+group = "support"
+pressure = 200.0
+mu = 0.2
+eps = 1e-2
+foundation_velocity = 2.0
+foundation_history = { table = [[0.0, 0.0], [1.0, 1.0]] }
+"#;
+    let floor = FLOOR.replace("[contact]", "[[contact]]");
+    let case = load(&slab(&format!("{floor}{belt}"), REST)).unwrap();
+    let scene = assemble(&case).unwrap();
+    assert_eq!(scene.foundation_histories.len(), 2);
+    let mut integrator = scene.integrator().unwrap();
+    integrator.step().unwrap();
+    let c = integrator.contact().unwrap();
+    assert_eq!(c.parts.len(), 2);
+    for j in c.parts[1].nodes.clone() {
+        let v = c.foundation_speed(j);
+        assert!((v - 2.0e-3).abs() <= 1e-15, "belt node {j}: V = {v}");
+    }
+    for j in c.parts[0].nodes.clone() {
+        assert_eq!(c.foundation_speed(j), 0.0, "floor node {j}");
+    }
+}

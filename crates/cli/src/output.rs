@@ -903,7 +903,7 @@ impl ResultsWriter {
         // allocated), so the next write may take a chunk of every series.
         let frame_bytes = (6 * self.n_nodes + 2) * 8;
         let fields = self.block_rows.max(PENDING_BYTES / frame_bytes + 1) * frame_bytes;
-        let histories = HISTORY_BLOCK * (3 * self.n_c + 9) * 8;
+        let histories = HISTORY_BLOCK * (3 * self.n_c + 2 + ENERGY_NAMES.len()) * 8;
         let checkpoint = 5 * n_free * 8;
         (2 * (fields + histories + checkpoint) + (1 << 20)) as u64
     }
@@ -919,7 +919,9 @@ impl ResultsWriter {
 
     /// Bytes a record adds to [`Pending`], a frame's if `frame`.
     fn row_bytes(&self, frame: bool) -> usize {
-        let histories = 8 * (9 + 2 * self.n_c) + self.n_c + 4;
+        // time, dt and the energies; friction stress and slip a node
+        // (f64), its state (i8); the iterations (u32).
+        let histories = 8 * (2 + ENERGY_NAMES.len() + 2 * self.n_c) + self.n_c + 4;
         let fields = if frame { 8 * (6 * self.n_nodes + 2) } else { 0 };
         histories + fields
     }
@@ -1022,6 +1024,12 @@ impl ResultsWriter {
             6..=8 if values[held..].iter().all(|&v| v == 0.0) => held,
             _ => values.len(),
         };
+        // A short slot whose run now books one of its missing values (a
+        // restart that added damping or a moving foundation) gets every
+        // value, in a dataset made anew with the full order.
+        if (6..=8).contains(&held) && kept > held {
+            g.unlink("energy")?;
+        }
         put_vector(&g, "energy", &values[..kept])?;
         let energy = g.dataset("energy")?;
         if energy.attr("order").is_err() {
@@ -1781,9 +1789,11 @@ pub(crate) mod tests {
     /// `append_writes` (which the run's check of free disk space relies
     /// on) is true exactly before the appends that write their block.
     /// Expected: a 20 × 20 node grid's frame is 8 (6·400 + 2) = 19,216
-    /// bytes and the histories of 3 contact nodes 8 (9 + 6) + 3 + 4 = 127
-    /// bytes a row, so 55 frame rows reach PENDING_BYTES
-    /// (⌈1,048,576 / 19,343⌉): rows 54, 109, 164; the 35 frames left and
+    /// bytes and the histories of 3 contact nodes 8 (11 + 6) + 3 + 4 = 143
+    /// bytes a row (time, dt and 9 energies, stress and slip a node, as
+    /// f64; the states as i8; the iterations as u32), which every append
+    /// adds to the pending rows; so 55 frame rows reach PENDING_BYTES
+    /// (⌈1,048,576 / 19,359⌉): rows 54, 109, 164; the 35 frames left and
     /// rows without fields then reach HISTORY_BLOCK (1,024 rows) at row
     /// 164 + 1,024 = 1,188 before 1 MiB.
     #[test]
@@ -1799,17 +1809,76 @@ pub(crate) mod tests {
         for k in 0..1500 {
             let frame = k < 200;
             let predicted = w.append_writes(frame);
+            let before = w.pending.bytes();
             let d: Vec<f64> = (0..n).map(|i| u(k, i)).collect();
             let f: &[f64] = if frame { &d } else { &[] };
             w.append(&record_of(0.1 * k as f64, [f, f, f], &[k as f64; 3]))
                 .unwrap();
             let wrote = w.pending.rows() == 0;
             assert_eq!(predicted, wrote, "row {k}");
+            let row = if frame { 19_216 + 143 } else { 143 };
+            assert_eq!(w.row_bytes(frame), row, "row {k}'s bytes foreseen");
+            if !wrote {
+                assert_eq!(w.pending.bytes() - before, row, "row {k}'s bytes held");
+            }
             if wrote {
                 writes.push(k);
             }
         }
         assert_eq!(writes, [54, 109, 164, 1188]);
+        drop(w);
+        std::fs::remove_file(&path).ok();
+    }
+
+    /// A slot of seven energy values (a file written before moving
+    /// foundations) keeps seven while the foundation's work is 0, and
+    /// takes all nine, in `order`, once it is not (a restart that added a
+    /// belt), instead of failing on the slot's shape. Expected: the
+    /// values the test wrote.
+    #[test]
+    fn a_short_energy_slot_takes_a_new_value() {
+        let _guard = h5_lock();
+        let path = scratch("short-slot");
+        let mesh = tiny_mesh();
+        let header = test_header(&mesh, true);
+        let mut w = ResultsWriter::create(&path, &header).unwrap();
+        let n = 2 * mesh.nodes.len();
+        let mut cp = Checkpoint {
+            t: 0.0,
+            steps: 0,
+            displacement: vec![0.0; n],
+            velocity: vec![0.0; n],
+            acceleration: vec![0.0; n],
+            classes: vec![0; 3],
+            forces: vec![0.0; 3],
+            energy: stickslip_time::Energy::default(),
+            initial_mechanical: 0.0,
+            reduced_remaining: 0,
+            clock: None,
+            total_iterations: 0,
+            factorizations: 0,
+        };
+        let extra = CheckpointExtra::default();
+        // Both slots written, then cut to an old file's seven values.
+        w.write_checkpoint(&cp, &extra).unwrap();
+        w.write_checkpoint(&cp, &extra).unwrap();
+        for slot in SLOTS {
+            let g = w.file.group(&format!("checkpoint/{slot}")).unwrap();
+            g.unlink("energy").unwrap();
+            put_vector(&g, "energy", &[1.0; 7]).unwrap();
+        }
+        let held = |w: &ResultsWriter| -> Vec<f64> {
+            let cg = w.file.group("checkpoint").unwrap();
+            let slot: u8 = get_scalar(&cg, "slot").unwrap();
+            let g = cg.group(SLOTS[usize::from(slot)]).unwrap();
+            g.dataset("energy").unwrap().read_raw::<f64>().unwrap()
+        };
+        cp.energy.kinetic = 2.0;
+        w.write_checkpoint(&cp, &extra).unwrap();
+        assert_eq!(held(&w), [2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        cp.energy.foundation = -3.0;
+        w.write_checkpoint(&cp, &extra).unwrap();
+        assert_eq!(held(&w), [2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -3.0, 0.0]);
         drop(w);
         std::fs::remove_file(&path).ok();
     }

@@ -5,6 +5,7 @@
 use stickslip_contact::ContactSurface;
 
 use crate::history::History;
+use crate::pressure::changing_parts;
 
 /// The foundation speeds' histories of a run's surfaces, applied before
 /// each step for the time it ends at.
@@ -26,20 +27,7 @@ impl FoundationHistories {
         if !surface.foundation_moves() {
             return None;
         }
-        let mut kept = Vec::new();
-        let mut node_history = vec![None; surface.len()];
-        for (part, history) in surface.parts.iter().zip(histories) {
-            if matches!(history, History::Constant | History::Step) {
-                continue;
-            }
-            node_history[part.nodes.clone()]
-                .iter_mut()
-                .for_each(|h| *h = Some(kept.len()));
-            kept.push(history.clone());
-        }
-        if kept.is_empty() {
-            return None;
-        }
+        let (node_history, kept) = changing_parts(surface, histories)?;
         Some(FoundationHistories {
             base: surface.foundation.clone(),
             node_history,

@@ -7,6 +7,28 @@ use stickslip_contact::ContactSurface;
 
 use crate::history::History;
 
+/// The histories of `surface`'s parts (one per part, in part order) that
+/// change after t = 0 (constant and step histories are 1 for t ≥ 0), and
+/// each node's index into them (`None` on a part that keeps its value);
+/// `None` when no part changes.
+pub(crate) fn changing_parts(
+    surface: &ContactSurface,
+    histories: &[History],
+) -> Option<(Vec<Option<usize>>, Vec<History>)> {
+    let mut kept = Vec::new();
+    let mut node_history = vec![None; surface.len()];
+    for (part, history) in surface.parts.iter().zip(histories) {
+        if matches!(history, History::Constant | History::Step) {
+            continue;
+        }
+        node_history[part.nodes.clone()]
+            .iter_mut()
+            .for_each(|h| *h = Some(kept.len()));
+        kept.push(history.clone());
+    }
+    (!kept.is_empty()).then_some((node_history, kept))
+}
+
 /// The histories of the surfaces whose pressure changes, and the bounds at
 /// θ = 1.
 #[derive(Clone, Debug)]
@@ -27,20 +49,7 @@ impl BoundHistories {
     /// are 1 for t ≥ 0): such a run keeps its bounds and forms nothing
     /// per step.
     pub fn new(surface: &ContactSurface, histories: &[History]) -> Option<BoundHistories> {
-        let mut kept = Vec::new();
-        let mut node_history = vec![None; surface.len()];
-        for (part, history) in surface.parts.iter().zip(histories) {
-            if matches!(history, History::Constant | History::Step) {
-                continue;
-            }
-            node_history[part.nodes.clone()]
-                .iter_mut()
-                .for_each(|h| *h = Some(kept.len()));
-            kept.push(history.clone());
-        }
-        if kept.is_empty() {
-            return None;
-        }
+        let (node_history, kept) = changing_parts(surface, histories)?;
         Some(BoundHistories {
             base: surface.nodes.iter().map(|n| n.bound).collect(),
             node_history,
