@@ -43,41 +43,6 @@ impl ContactSurface {
         }
         (dissipated, foundation)
     }
-
-    /// [`ContactSurface::step_dissipation`] with the nodes' tangential
-    /// velocities given (`u_new`, `u`: one per node), as a step that solves
-    /// for them forms them (the modal step); on a moving foundation its sum
-    /// is the friction's net work on the body, dissipated less the
-    /// foundation's.
-    pub fn step_dissipation_tangential(
-        &self,
-        u_new: &[f64],
-        u: &[f64],
-        dt: f64,
-        forces_old: &[f64],
-        forces: &mut [f64],
-    ) -> f64 {
-        let mut dissipated = 0.0;
-        for (j, (((n, f), f_old), (u_new, u))) in self
-            .nodes
-            .iter()
-            .zip(forces.iter_mut())
-            .zip(forces_old)
-            .zip(u_new.iter().zip(u))
-            .enumerate()
-        {
-            *f = n.force(&self.law_of(j), self.slip(j, *u_new));
-            dissipated += work(*f, *f_old, 0.5 * dt * (u_new + u));
-        }
-        dissipated
-    }
-}
-
-/// The work of a nodal force going from `f_old` to `f` over the tangential
-/// increment `increment`, by the trapezoid rule.
-#[inline]
-pub(crate) fn work(f: f64, f_old: f64, increment: f64) -> f64 {
-    0.5 * (f + f_old) * increment
 }
 
 /// Nodes stuck in `new` that were slipping in `old`: the step's slip → stick

@@ -418,7 +418,9 @@ impl ContactSurface {
                 }
             }
             joined.join_eps(&s);
-            let start = joined.nodes.len();
+            let (start, added) = (joined.nodes.len(), s.nodes.len());
+            join_per_node(&mut joined.foundation, start, &s.foundation, added, 0.0);
+            join_per_node(&mut joined.weakening, start, &s.weakening, added, None);
             joined
                 .compliance
                 .extend(s.compliance.iter().map(|c| CompliantNode {
@@ -487,4 +489,58 @@ fn check_parameters(pressure: f64, mu: f64, eps: f64) -> Result<(), ContactError
         )));
     }
     Ok(())
+}
+
+/// Joins a per-node list that is empty where every node has `rest` (a
+/// foundation at rest, a constant μ): `mine` of `my_len` nodes, then
+/// `theirs` of `their_len`, kept empty where both are.
+fn join_per_node<T: Clone>(
+    mine: &mut Vec<T>,
+    my_len: usize,
+    theirs: &[T],
+    their_len: usize,
+    rest: T,
+) {
+    if mine.is_empty() && theirs.is_empty() {
+        return;
+    }
+    mine.resize(my_len, rest.clone());
+    if theirs.is_empty() {
+        mine.resize(my_len + their_len, rest);
+    } else {
+        mine.extend_from_slice(theirs);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn surface(group: &str, n: usize) -> ContactSurface {
+        let nodes = (0..n)
+            .map(|j| ContactNode {
+                node: j + 10 * group.len(),
+                dofs: [Some(2 * j), Some(2 * j + 1)],
+                weight: 1.0,
+                tangent: [1.0, 0.0],
+                s: j as f64,
+                bound: 1.0,
+            })
+            .collect();
+        ContactSurface::from_nodes(group, nodes, 1e-3).unwrap()
+    }
+
+    /// A later surface's foundation speeds survive a join after one at
+    /// rest, and an earlier one's are kept beside a later one at rest.
+    #[test]
+    fn joined_surfaces_keep_each_one_s_foundation_speeds() {
+        let mut belt = surface("belt", 2);
+        belt.set_foundation(|_| 0.5);
+        let joined = ContactSurface::join(vec![surface("floor", 3), belt.clone()]).unwrap();
+        assert_eq!(joined.foundation, vec![0.0, 0.0, 0.0, 0.5, 0.5]);
+        let joined = ContactSurface::join(vec![belt, surface("floor", 3)]).unwrap();
+        assert_eq!(joined.foundation, vec![0.5, 0.5, 0.0, 0.0, 0.0]);
+        let rest = ContactSurface::join(vec![surface("a", 1), surface("bb", 1)]).unwrap();
+        assert!(rest.foundation.is_empty() && rest.weakening.is_empty());
+    }
 }
