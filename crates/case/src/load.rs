@@ -936,7 +936,7 @@ t_end = 0.5
         }
         // A --set of another rule than the file's replaces it.
         let c = load_text(
-            "set",
+            "set-rule",
             &format!("{GOOD}[output]\nevery = 1\n"),
             &["output.frames=10"],
         )
