@@ -1237,6 +1237,35 @@ impl Drop for ResultsWriter {
 }
 
 #[cfg(test)]
+impl<'a> Record<'a> {
+    /// A test's record at `t` with fields `[d, v, a]`, no contact arrays,
+    /// every energy 0, Δt 1 and one iteration; a test sets the rest by
+    /// struct update.
+    pub(crate) fn zeros(t: f64, [d, v, a]: [&'a [f64]; 3]) -> Record<'a> {
+        Record {
+            t,
+            displacement: d,
+            velocity: v,
+            acceleration: a,
+            friction_stress: &[],
+            slip_velocity: &[],
+            state: &[],
+            kinetic: 0.0,
+            strain: 0.0,
+            external_work: 0.0,
+            dissipated: 0.0,
+            damped: 0.0,
+            foundation: 0.0,
+            foundation_stored: 0.0,
+            total: 0.0,
+            balance: 0.0,
+            dt: 1.0,
+            iterations: 1,
+        }
+    }
+}
+
+#[cfg(test)]
 pub(crate) mod tests {
     use super::*;
     use stickslip_mesh::{CellKind, Edge, Group, Mesh, SourceInfo};
@@ -1330,10 +1359,6 @@ pub(crate) mod tests {
             let sv = [0.5 * k as f64, 0.0, -1.0];
             let st: [i8; 3] = [0, 1, -1];
             w.append(&Record {
-                t: 0.1 * k as f64,
-                displacement: &d,
-                velocity: &v,
-                acceleration: &a,
                 friction_stress: &fs,
                 slip_velocity: &sv,
                 state: &st,
@@ -1341,13 +1366,11 @@ pub(crate) mod tests {
                 strain: 2.0 + k as f64,
                 external_work: 3.0 + k as f64,
                 dissipated: 4.0 + k as f64,
-                damped: 0.0,
-                foundation: 0.0,
-                foundation_stored: 0.0,
                 total: 5.0 + k as f64,
                 balance: 6.0 + k as f64,
                 dt: 0.1,
                 iterations: k as u32 + 1,
+                ..Record::zeros(0.1 * k as f64, [&d, &v, &a])
             })
             .unwrap();
         }
@@ -1679,24 +1702,13 @@ pub(crate) mod tests {
                 let fs = [k as f64, -(k as f64), 0.5];
                 let st: [i8; 3] = [(k % 3) as i8 - 1, 0, 1];
                 w.append(&Record {
-                    t: k as f64,
-                    displacement: &d,
-                    velocity: &d,
-                    acceleration: &d,
                     friction_stress: &fs,
                     slip_velocity: &fs,
                     state: &st,
                     kinetic: k as f64,
-                    strain: 0.0,
-                    external_work: 0.0,
-                    dissipated: 0.0,
-                    damped: 0.0,
-                    foundation: 0.0,
-                    foundation_stored: 0.0,
-                    total: 0.0,
-                    balance: 0.0,
                     dt: 0.5,
                     iterations: k as u32,
+                    ..Record::zeros(k as f64, [&d, &d, &d])
                 })
                 .unwrap();
                 if k == 20 {
@@ -1749,24 +1761,11 @@ pub(crate) mod tests {
     /// friction stress `fs`, the rest 0.
     fn record_of<'a>(t: f64, [d, v, a]: [&'a [f64]; 3], fs: &'a [f64]) -> Record<'a> {
         Record {
-            t,
-            displacement: d,
-            velocity: v,
-            acceleration: a,
             friction_stress: fs,
             slip_velocity: &[0.0; 3],
             state: &[0; 3],
-            kinetic: 0.0,
-            strain: 0.0,
-            external_work: 0.0,
-            dissipated: 0.0,
-            damped: 0.0,
-            foundation: 0.0,
-            foundation_stored: 0.0,
-            total: 0.0,
-            balance: 0.0,
             dt: 0.1,
-            iterations: 1,
+            ..Record::zeros(t, [d, v, a])
         }
     }
 
@@ -1999,24 +1998,9 @@ pub(crate) mod tests {
         let mut w = ResultsWriter::create(&path, &header).unwrap();
         let z = vec![0.0; 12];
         let mut rec = Record {
-            t: 0.0,
-            displacement: &z,
-            velocity: &z,
-            acceleration: &z[..10],
-            friction_stress: &[],
-            slip_velocity: &[],
-            state: &[],
-            kinetic: 0.0,
-            strain: 0.0,
-            external_work: 0.0,
-            dissipated: 0.0,
-            damped: 0.0,
-            foundation: 0.0,
-            foundation_stored: 0.0,
-            total: 0.0,
-            balance: 0.0,
             dt: 0.0,
             iterations: 0,
+            ..Record::zeros(0.0, [&z, &z, &z[..10]])
         };
         assert!(w
             .append(&rec)
@@ -2049,26 +2033,7 @@ pub(crate) mod tests {
         w.flush_every_secs = f64::INFINITY;
         let z = vec![0.5; 12];
         for k in 0..2 {
-            let rec = Record {
-                t: k as f64,
-                displacement: &z,
-                velocity: &z,
-                acceleration: &z,
-                friction_stress: &[],
-                slip_velocity: &[],
-                state: &[],
-                kinetic: 0.0,
-                strain: 0.0,
-                external_work: 0.0,
-                dissipated: 0.0,
-                damped: 0.0,
-                foundation: 0.0,
-                foundation_stored: 0.0,
-                total: 0.0,
-                balance: 0.0,
-                dt: 1.0,
-                iterations: 1,
-            };
+            let rec = Record::zeros(k as f64, [&z, &z, &z]);
             w.append(&rec).unwrap();
         }
         let script = "import sys\ntry:\n import h5py\nexcept ImportError:\n sys.exit(3)\nf = h5py.File(sys.argv[1], 'r')\nprint(f['time'].shape[0], f['displacement'][1, 5, 1], bool(f.attrs['complete']))";
@@ -2110,26 +2075,7 @@ pub(crate) mod tests {
         let t0 = Instant::now();
         for k in 0..steps {
             d[0] = k as f64;
-            let rec = Record {
-                t: k as f64,
-                displacement: &d,
-                velocity: &d,
-                acceleration: &d,
-                friction_stress: &[],
-                slip_velocity: &[],
-                state: &[],
-                kinetic: 0.0,
-                strain: 0.0,
-                external_work: 0.0,
-                dissipated: 0.0,
-                damped: 0.0,
-                foundation: 0.0,
-                foundation_stored: 0.0,
-                total: 0.0,
-                balance: 0.0,
-                dt: 1.0,
-                iterations: 1,
-            };
+            let rec = Record::zeros(k as f64, [&d, &d, &d]);
             w.append(&rec).unwrap();
         }
         w.finish(true, &Summary::default()).unwrap();

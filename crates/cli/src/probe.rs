@@ -959,24 +959,11 @@ mod tests {
                 .collect();
             let fs: Vec<f64> = (0..3).map(|j| k as f64 - j as f64).collect();
             w.append(&Record {
-                t: 0.25 * k as f64,
-                displacement: &d,
-                velocity: &v,
-                acceleration: &d,
                 friction_stress: &fs,
                 slip_velocity: &[0.0; 3],
                 state: &[0; 3],
-                kinetic: 0.0,
-                strain: 0.0,
-                external_work: 0.0,
-                dissipated: 0.0,
-                damped: 0.0,
-                foundation: 0.0,
-                foundation_stored: 0.0,
-                total: 0.0,
-                balance: 0.0,
                 dt: 0.25,
-                iterations: 1,
+                ..Record::zeros(0.25 * k as f64, [&d, &v, &d])
             })
             .unwrap();
         }
