@@ -30,6 +30,7 @@
 //! its types): such tests live in the crate's `tests/` folder.
 
 pub mod block;
+pub mod case_text;
 pub mod damping;
 pub mod grid;
 pub mod impact;

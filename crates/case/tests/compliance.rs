@@ -5,26 +5,20 @@
 use std::path::Path;
 
 use stickslip_case::{assemble, load_str, Case};
-use stickslip_testkit::meshes_dir;
+use stickslip_testkit::case_text::paper_slab_head;
 
 /// The paper's slab (8 × 1, "contact" the bottom y = 0) with `contact`
 /// as its surfaces, started at rest.
 fn slab(contact: &str, initial: &str) -> String {
     format!(
-        r#"[mesh]
-file = "{}"
-[material]
-E = 1000.0
-nu = 0.3
-rho = 1.0
-{contact}
+        r#"{head}{contact}
 {initial}
 [time]
 scheme = "central_difference"
 dt = 1e-3
 t_end = 0.01
 "#,
-        meshes_dir().join("slab-q2-8x2.msh").display()
+        head = paper_slab_head()
     )
 }
 

@@ -6,20 +6,14 @@
 use std::path::Path;
 
 use stickslip_case::{assemble, load_str, Case};
-use stickslip_testkit::meshes_dir;
+use stickslip_testkit::case_text::paper_slab_head;
 
 /// The paper's slab (8 × 1, "contact" the bottom, "support" the top with
 /// rollers, "left" held in x, "load" the right end) with `contact` as its
 /// friction tables.
 fn slab(contact: &str) -> String {
     format!(
-        r#"[mesh]
-file = "{}"
-[material]
-E = 1000.0
-nu = 0.3
-rho = 1.0
-[[dirichlet]]
+        r#"{head}[[dirichlet]]
 group = "support"
 uy = 0.0
 [[dirichlet]]
@@ -34,7 +28,7 @@ scheme = "central_difference"
 dt = 1e-3
 t_end = 0.01
 "#,
-        meshes_dir().join("slab-q2-8x2.msh").display()
+        head = paper_slab_head()
     )
 }
 

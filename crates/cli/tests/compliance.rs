@@ -4,7 +4,8 @@
 
 mod common;
 
-use common::{bin, root, scratch, succeeded};
+use common::{bin, scratch, succeeded};
+use stickslip_testkit::case_text::paper_slab_head;
 
 /// The paper's slab (mass 8) dropped at 0.5 from 0.01 above a floor of
 /// c_n = 1e4: it lands after 0.02 and the floor stores energy while it is
@@ -14,13 +15,7 @@ use common::{bin, root, scratch, succeeded};
 fn a_dropped_slab_lands_and_the_ledger_books_the_floor() {
     let dir = scratch("compliance-run");
     let text = format!(
-        r#"[mesh]
-file = "{}"
-[material]
-E = 1000.0
-nu = 0.3
-rho = 1.0
-[contact]
+        r#"{head}[contact]
 group = "contact"
 law = "compliance"
 foundation = {{ point = [0.0, -0.01], normal = [0.0, 1.0] }}
@@ -35,7 +30,7 @@ scheme = "central_difference"
 dt = 1e-3
 t_end = 0.2
 "#,
-        root().join("cases/meshes/slab-q2-8x2.msh").display()
+        head = paper_slab_head()
     );
     let case = dir.join("drop.toml");
     std::fs::write(&case, text).unwrap();

@@ -6,20 +6,15 @@ mod common;
 
 use std::path::Path;
 
-use common::{bin, probe, root, scratch, stderr, succeeded};
+use common::{bin, probe, scratch, stderr, succeeded};
 use hdf5::types::VarLenUnicode;
+use stickslip_testkit::case_text::paper_slab_head;
 
 /// The paper's slab (bottom "contact", top "support" on rollers) gripped
 /// on both faces for 20 steps, with `extra` appended.
 fn case(dir: &Path, extra: &str) -> std::path::PathBuf {
     let text = format!(
-        r#"[mesh]
-file = "{}"
-[material]
-E = 1000.0
-nu = 0.3
-rho = 1.0
-[[dirichlet]]
+        r#"{head}[[dirichlet]]
 group = "support"
 uy = 0.0
 [[dirichlet]]
@@ -45,7 +40,7 @@ scheme = "central_difference"
 dt = 1e-3
 t_end = 0.02
 "#,
-        root().join("cases/meshes/slab-q2-8x2.msh").display()
+        head = paper_slab_head()
     );
     let path = dir.join("case.toml");
     std::fs::write(&path, text).unwrap();
