@@ -116,17 +116,17 @@ pub fn iterate<S: StepSystem>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::surface::ContactNode;
 
     /// Nodes with one unknown each, m v = b − w g sign when slipping and
     /// (m + w g/ε) v = b when stuck: the system of METHOD.md §4 for a mass
     /// m on a frictional line, written out here.
-    struct Masses {
-        mass: Vec<f64>,
-        b: Vec<f64>,
-        solves: usize,
+    pub(crate) struct Masses {
+        pub mass: Vec<f64>,
+        pub b: Vec<f64>,
+        pub solves: usize,
     }
 
     impl StepSystem for Masses {

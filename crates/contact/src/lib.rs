@@ -23,6 +23,7 @@
 mod compliance;
 mod foundation;
 mod iteration;
+mod lagged_mu;
 mod law;
 mod ledger;
 mod mu_speed;
