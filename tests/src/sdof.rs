@@ -76,6 +76,19 @@ pub fn with_surface(
     surface: ContactSurface,
     settings: Settings,
 ) -> Result<Integrator, SceneError> {
+    with_load(p, History::Step, surface, settings)
+}
+
+/// The oscillator with friction on `surface` and the force P·θ(t).
+///
+/// # Errors
+/// Settings the integrator refuses.
+pub fn with_load(
+    p: f64,
+    history: History,
+    surface: ContactSurface,
+    settings: Settings,
+) -> Result<Integrator, SceneError> {
     let scalar = |v: f64| {
         let mut coo = CooMatrix::new(1, 1);
         coo.push(0, 0, v);
@@ -92,7 +105,7 @@ pub fn with_surface(
     };
     let loads = vec![Load {
         vector: vec![p],
-        history: History::Step,
+        history,
     }];
     Ok(Integrator::new(dynamics, Some(surface), loads, settings)?)
 }

@@ -63,16 +63,16 @@ impl Integrator {
         settings: Settings,
     ) -> Result<Integrator, TimeError> {
         let mass_kind = settings.check(dynamics.n())?;
-        // μ falling with the slip speed is solved node by node in the
-        // explicit closed form only: the stick/slip iteration's slip
-        // forces are constant per class, which μ(w) is not.
-        let explicit = settings.scheme == Scheme::CentralDifference
-            && settings.explicit_friction == crate::settings::ExplicitFriction::ClosedForm;
-        if contact.as_ref().is_some_and(ContactSurface::weakens) && !explicit {
+        // μ falling with the slip speed: the explicit closed form solves
+        // each node's equation, the implicit steps iterate with μ lagged
+        // by a step; the explicit iteration, the closed form's reference
+        // for the constant law, has neither.
+        let iterated = settings.scheme == Scheme::CentralDifference
+            && settings.explicit_friction == crate::settings::ExplicitFriction::Iterate;
+        if contact.as_ref().is_some_and(ContactSurface::weakens) && iterated {
             return Err(TimeError::Settings(
                 "a friction coefficient that falls with the slip speed (mu = { static, kinetic, speed }) \
-                 runs with the explicit scheme's nodal closed form only: use time.scheme = \
-                 \"central_difference\", or a constant mu"
+                 runs with central difference's nodal closed form, not its iteration"
                     .into(),
             ));
         }

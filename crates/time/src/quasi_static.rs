@@ -112,6 +112,7 @@ impl Stepper for QuasiStatic {
             *b = l - *b;
         }
         state.classes_new.copy_from_slice(&state.classes);
+        self.friction.lag_mu(run, &state.v);
         let mut v_new = std::mem::take(&mut state.v_new);
         // The operator Δt K + 0·K: Newmark's with β/γ = 1 and no mass.
         let result = self.friction.velocity(
@@ -147,7 +148,7 @@ impl Stepper for QuasiStatic {
         let (work, load_dot) = state.load_work();
         // Friction's work over the increment Δr = Δt ṙ_K: the ledger's
         // ½Δt(v + v_new) with both velocities the increment's rate.
-        let ((dissipated, foundation), stick_events) = match &run.contact {
+        let ((dissipated, foundation), stick_events) = match self.friction.surface(run) {
             Some(c) => {
                 state.friction_passes += 1;
                 let d = c.step_dissipation(

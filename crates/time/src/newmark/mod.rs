@@ -38,6 +38,10 @@ enum Solver {
 /// run's solver.
 pub(crate) struct ImplicitFriction {
     solver: Solver,
+    /// Where μ falls with the slip speed: the surface with μ at each
+    /// node's slip of the last step, on which the step iterates
+    /// (`stickslip_contact`'s `lagged_mu.rs`).
+    lagged: Option<ContactSurface>,
     /// The Schur path's nodal tangential velocities.
     nodal_velocity: Vec<f64>,
     iter_scratch: Vec<SlipState>,
@@ -158,9 +162,25 @@ impl ImplicitFriction {
         let n_c = contact.map_or(0, |c| c.len());
         Ok(ImplicitFriction {
             solver,
+            lagged: contact.filter(|c| c.weakens()).map(ContactSurface::lagged),
             nodal_velocity: vec![0.0; n_c],
             iter_scratch: vec![SlipState::Stuck; n_c],
         })
+    }
+
+    /// Takes μ at each node's slip at velocity `v` (the last step's)
+    /// where it falls with the slip speed, for the next [`Self::velocity`].
+    pub(crate) fn lag_mu(&mut self, run: &Run, v: &[f64]) {
+        if let (Some(lagged), Some(c)) = (&mut self.lagged, &run.contact) {
+            lagged.lag_bounds(c, v);
+        }
+    }
+
+    /// The surface the step's friction acts with: the run's, or where μ
+    /// falls with the slip speed its lagged copy (the forces the step
+    /// applied, for the ledger).
+    pub(crate) fn surface<'a>(&'a self, run: &'a Run) -> Option<&'a ContactSurface> {
+        self.lagged.as_ref().or(run.contact.as_ref())
     }
 
     /// ṙ into `v_new` for the right-hand side `b` and the operator
@@ -182,11 +202,12 @@ impl ImplicitFriction {
                 TimeError::Solve { step, t, source }
             })
         };
+        let contact = self.lagged.as_ref().or(run.contact.as_ref());
         match &mut self.solver {
             Solver::Schur(op) => {
                 op.set_dt(dt, c_k, k, c_m, m)
                     .map_err(|source| TimeError::Solve { step, t, source })?;
-                if run.contact.is_none() {
+                if contact.is_none() {
                     op.solve_plain(b, v_new);
                     return Ok(1);
                 }
@@ -195,15 +216,11 @@ impl ImplicitFriction {
                     .reduced
                     .take()
                     .expect("a contact surface has its nodal surface");
-                if let Some(c) = run
-                    .contact
-                    .as_ref()
-                    .filter(|c| c.revision != reduced.revision)
-                {
+                if let Some(c) = contact.filter(|c| c.revision != reduced.revision) {
                     reduced.set_bounds(|j| c.nodes[j].bound);
                     reduced.revision = c.revision;
                 }
-                if let Some(c) = run.contact.as_ref().filter(|c| !c.foundation.is_empty()) {
+                if let Some(c) = contact.filter(|c| !c.foundation.is_empty()) {
                     reduced.foundation.clone_from(&c.foundation);
                 }
                 let result = iterate(
@@ -221,7 +238,7 @@ impl ImplicitFriction {
             }
             Solver::Direct(op) => {
                 op.set_dt(dt, c_k, k, c_m, m);
-                let Some(contact) = &run.contact else {
+                let Some(contact) = contact else {
                     op.solve_plain(b, v_new)
                         .map_err(|source| TimeError::Solve { step, t, source })?;
                     return Ok(1);
@@ -325,6 +342,7 @@ impl Stepper for Newmark {
             &mut self.b,
         );
         state.classes_new.copy_from_slice(&state.classes);
+        self.friction.lag_mu(run, &state.v);
         let mut v_new = std::mem::take(&mut state.v_new);
         // Rayleigh damping C = αM + βK joins A₀ (METHOD.md §8); R̂_K is
         // unchanged, as ṙ_K is the unknown.
@@ -367,7 +385,7 @@ impl Stepper for Newmark {
             });
         }
         let (work, load_dot) = state.load_work();
-        let ((dissipated, foundation), stick_events) = match &run.contact {
+        let ((dissipated, foundation), stick_events) = match self.friction.surface(run) {
             Some(c) => {
                 state.friction_passes += 1;
                 friction_ledger(c, state, dt)
