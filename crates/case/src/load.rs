@@ -404,11 +404,6 @@ fn complete(
                 &key("mu"),
                 format!("contact.mu: speed = {speed} must be > 0 and finite (the slip speed over which mu falls from static towards kinetic, in the model's units)"),
             );
-            check(
-                case.time.scheme == crate::schema::Scheme::CentralDifference,
-                &key("mu"),
-                "contact.mu = { static, kinetic, speed } runs with the explicit scheme only (its nodal closed form; the implicit stick/slip iteration takes a constant mu): set [time] scheme = \"central_difference\", or give a constant mu".into(),
-            );
         }
         check(eps > 0.0 && eps.is_finite(), &key("eps"), format!("contact.eps = {eps} must be > 0 and finite (the friction law's regularization; the paper uses 1e-4 to 1)"));
         check(

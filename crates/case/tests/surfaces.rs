@@ -306,8 +306,22 @@ fn bad_speed_dependent_mus_are_named_at_their_line() {
         let e = load(&text).unwrap_err();
         assert_at(&e, &text, mu, what);
     }
-    let text = with("mu = { static = 0.3, kinetic = 0.2, speed = 1e-2 }")
-        .replace("scheme = \"central_difference\"", "scheme = \"newmark\"");
-    let e = load(&text).unwrap_err();
-    assert_at(&e, &text, "mu = {", "runs with the explicit scheme only");
+}
+
+/// Every scheme takes a speed-dependent mu (the implicit ones with μ
+/// lagged by a step).
+#[test]
+fn a_speed_dependent_mu_runs_with_every_scheme() {
+    let text = slab(&BOTTOM.replace(
+        "mu = 0.3",
+        "mu = { static = 0.3, kinetic = 0.2, speed = 1e-2 }",
+    ));
+    for scheme in ["central_difference", "newmark", "quasi_static"] {
+        let text = text.replace(
+            "scheme = \"central_difference\"",
+            &format!("scheme = \"{scheme}\""),
+        );
+        let scene = assemble(&load(&text).unwrap()).unwrap();
+        assert!(scene.integrator().is_ok(), "{scheme}");
+    }
 }
