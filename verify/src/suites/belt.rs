@@ -23,7 +23,6 @@ const P: f64 = 300.0;
 const MU: f64 = 0.3;
 const V: f64 = 1.0;
 
-/// Runs the check on both schemes.
 /// Runs the checks: the held slab on both schemes, stick-slip on the
 /// oscillator. e^{−αt/2} = e^{−10} of the slab's start is left at t = 10
 /// with α = 2, in quick mode as in full (a 148-DOF slab: a fraction of a
@@ -143,11 +142,11 @@ const CYCLES: usize = 6;
 /// next; `None` when it no longer sticks once the start's motion has died
 /// out (after t = 6: e^{−αt/2} = 0.22 of it is left, below the cycles'
 /// amplitude).
-fn cycles(ratio: f64, dt: f64, eps: f64) -> Result<Option<(f64, f64)>, String> {
+fn cycles(scheme: Scheme, ratio: f64, dt: f64, eps: f64) -> Result<Option<(f64, f64)>, String> {
     let mut surface = sdof::surface(eps).map_err(|e| e.to_string())?;
     surface.set_foundation(|_| BELT);
     surface.set_weakening(|_| Some(Weakening { ratio, speed: VS }));
-    let mut settings = Settings::new(Scheme::CentralDifference, dt, T_END);
+    let mut settings = Settings::new(scheme, dt, T_END);
     settings.damping = Rayleigh {
         alpha: ALPHA,
         beta: 0.0,
@@ -176,16 +175,62 @@ fn cycles(ratio: f64, dt: f64, eps: f64) -> Result<Option<(f64, f64)>, String> {
     Ok(Some((period, hi - lo)))
 }
 
+/// Newmark ¼, ½, the implicit scheme the stick-slip is compared on.
+const NEWMARK: Scheme = Scheme::Newmark {
+    beta: 0.25,
+    gamma: 0.5,
+};
+
 /// μs > μk: stick-slip cycles, their period and amplitude at four levels
-/// of (Δt, ε) halved together. Converged when each change from a level to
-/// the next is at most the one before it and the last is below 1% of the
-/// finest value. μs = μk: no stick after the start.
+/// of (Δt, ε) halved together, by central difference (μ at the step's own
+/// slip, the nodal closed form) and by Newmark (μ at the last step's slip,
+/// `stickslip_contact`'s `lagged_mu.rs`). Central difference converged
+/// when each change from a level to the next is at most the one before it
+/// and the last is below 1% of the finest value; Newmark against it when
+/// their difference shrinks as Δt halves, to below 0.5% at the finest
+/// level (the lag is first order in Δt: the difference halves). μs = μk: no stick after the start, on
+/// both.
 fn stick_slip(r: &mut Report) {
     let levels = [(4e-4, 1e-4), (2e-4, 5e-5), (1e-4, 2.5e-5), (5e-5, 1.25e-5)];
+    let explicit = table(r, "central difference", Scheme::CentralDifference, &levels);
+    if let Some(found) = &explicit {
+        converged(r, found);
+    }
+    let implicit = table(r, "Newmark", NEWMARK, &levels);
+    if let (Some(cd), Some(nm)) = (&explicit, &implicit) {
+        agree(r, cd, nm);
+    }
+    for (name, scheme) in [
+        ("central difference", Scheme::CentralDifference),
+        ("Newmark", NEWMARK),
+    ] {
+        let case = format!("μs = μk on a belt, {name}");
+        match cycles(scheme, 1.0, levels[0].0, levels[0].1) {
+            Ok(None) => r.holds(&case, "sticks after t = 6", "never".into(), "never", true),
+            Ok(Some((period, _))) => r.holds(
+                &case,
+                "sticks after t = 6",
+                format!("every {}", crate::report::num(period)),
+                "never",
+                false,
+            ),
+            Err(e) => r.holds(&case, "runs", e, "runs", false),
+        }
+    }
+}
+
+/// The (period, amplitude) rows of `scheme` at each level, `None` unless
+/// every level cycles.
+fn table(
+    r: &mut Report,
+    name: &str,
+    scheme: Scheme,
+    levels: &[(f64, f64)],
+) -> Option<Vec<(f64, f64)>> {
     let mut found = Vec::new();
-    for (dt, eps) in levels {
-        let case = format!("stick-slip on a belt, Δt = {dt:e}, ε = {eps:e}");
-        match cycles(RATIO, dt, eps) {
+    for &(dt, eps) in levels {
+        let case = format!("stick-slip on a belt, {name}, Δt = {dt:e}, ε = {eps:e}");
+        match cycles(scheme, RATIO, dt, eps) {
             Ok(Some((period, amplitude))) => {
                 r.holds(
                     &case,
@@ -204,39 +249,58 @@ fn stick_slip(r: &mut Report) {
             Err(e) => r.holds(&case, "runs", e, "runs", false),
         }
     }
-    if found.len() == levels.len() {
-        let periods: Vec<f64> = found.iter().map(|f| f.0).collect();
-        let amplitudes: Vec<f64> = found.iter().map(|f| f.1).collect();
-        for (what, x) in [("period", periods), ("amplitude", amplitudes)] {
-            let changes: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
-            let (last, finest) = (changes[changes.len() - 1], x[x.len() - 1]);
-            r.at_most(
-                "stick-slip on a belt, convergence",
-                &format!("{what}: last change / finest"),
-                last / finest,
-                0.01,
-                "converged to 1%",
-            );
-            let listed: Vec<String> = changes.iter().map(|c| crate::report::num(*c)).collect();
-            r.holds(
-                "stick-slip on a belt, convergence",
-                &format!("{what}: changes as Δt, ε halve"),
-                listed.join(", "),
-                "each ≤ the one before",
-                changes.windows(2).all(|w| w[1] <= w[0]),
-            );
-        }
+    (found.len() == levels.len()).then_some(found)
+}
+
+/// Period and amplitude, each as a list over the levels.
+fn columns(found: &[(f64, f64)]) -> [(&'static str, Vec<f64>); 2] {
+    [
+        ("period", found.iter().map(|f| f.0).collect()),
+        ("amplitude", found.iter().map(|f| f.1).collect()),
+    ]
+}
+
+fn converged(r: &mut Report, found: &[(f64, f64)]) {
+    for (what, x) in columns(found) {
+        let changes: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
+        let (last, finest) = (changes[changes.len() - 1], x[x.len() - 1]);
+        r.at_most(
+            "stick-slip on a belt, convergence",
+            &format!("{what}: last change / finest"),
+            last / finest,
+            0.01,
+            "converged to 1%",
+        );
+        let listed: Vec<String> = changes.iter().map(|c| crate::report::num(*c)).collect();
+        r.holds(
+            "stick-slip on a belt, convergence",
+            &format!("{what}: changes as Δt, ε halve"),
+            listed.join(", "),
+            "each ≤ the one before",
+            changes.windows(2).all(|w| w[1] <= w[0]),
+        );
     }
-    let case = "μs = μk on a belt";
-    match cycles(1.0, levels[0].0, levels[0].1) {
-        Ok(None) => r.holds(case, "sticks after t = 6", "never".into(), "never", true),
-        Ok(Some((period, _))) => r.holds(
+}
+
+/// Newmark against central difference, level by level: |NM − CD| / CD.
+fn agree(r: &mut Report, cd: &[(f64, f64)], nm: &[(f64, f64)]) {
+    let case = "stick-slip on a belt, Newmark against central difference";
+    for ((what, a), (_, b)) in columns(cd).into_iter().zip(columns(nm)) {
+        let gaps: Vec<f64> = a.iter().zip(&b).map(|(a, b)| (b - a).abs() / a).collect();
+        let listed: Vec<String> = gaps.iter().map(|g| crate::report::num(*g)).collect();
+        r.holds(
             case,
-            "sticks after t = 6",
-            format!("every {}", crate::report::num(period)),
-            "never",
-            false,
-        ),
-        Err(e) => r.holds(case, "runs", e, "runs", false),
+            &format!("{what}: |NM − CD| / CD as Δt, ε halve"),
+            listed.join(", "),
+            "each < the one before",
+            gaps.windows(2).all(|w| w[1] < w[0]),
+        );
+        r.at_most(
+            case,
+            &format!("{what}: |NM − CD| / CD at the finest level"),
+            gaps[gaps.len() - 1],
+            0.005,
+            "within 0.5%",
+        );
     }
 }
