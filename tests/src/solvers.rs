@@ -1,7 +1,7 @@
 //! Every way the integrator solves a step with friction, for tests that
 //! hold them all to one expected motion.
 
-use stickslip_time::{ExplicitFriction, ImplicitSolver, Scheme, Settings};
+use stickslip_time::{ExplicitFriction, ImplicitSolver, Integrator, Scheme, Settings};
 
 /// The explicit closed form, the explicit iteration, Newmark ¼, ½ by the
 /// Schur complement and by refactorization (direct), at Δt to `t_end`.
@@ -25,4 +25,27 @@ pub fn every_solver(dt: f64, t_end: f64) -> Vec<(&'static str, Settings)> {
         ("Schur", nm),
         ("direct", direct),
     ]
+}
+
+/// Steps two runs together to the end, asserting their classes equal at
+/// every step, with `each(a, b)` after each step; returns the slipping
+/// nodes counted over the run (a comparison where nothing slips tests no
+/// friction).
+///
+/// # Panics
+/// A failed step or classes that differ, as a test should.
+pub fn in_step(
+    mut a: Integrator,
+    mut b: Integrator,
+    mut each: impl FnMut(&Integrator, &Integrator),
+) -> usize {
+    let mut slipping = 0;
+    while !a.done() {
+        a.step().unwrap();
+        b.step().unwrap();
+        assert_eq!(a.classes(), b.classes(), "t = {}", a.time());
+        slipping += a.classes().iter().filter(|c| !c.is_stuck()).count();
+        each(&a, &b);
+    }
+    slipping
 }

@@ -152,7 +152,7 @@ pub(crate) mod tests {
     }
 
     /// Node j on unknown j, w = 1 and g = 1.
-    fn unit_node(j: usize) -> ContactNode {
+    pub(crate) fn unit_node(j: usize) -> ContactNode {
         ContactNode {
             node: j,
             dofs: [Some(j), None],

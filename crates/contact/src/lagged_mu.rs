@@ -61,8 +61,9 @@ impl ContactSurface {
 
 #[cfg(test)]
 mod tests {
+    use crate::iteration::tests::{unit_node, Masses};
+    use crate::iteration::StepSystem;
     use crate::iteration::{iterate, IterationFailure, IterationOptions, IterationReport};
-    use crate::iteration::{tests::Masses, StepSystem};
     use crate::law::SlipState;
     use crate::surface::{ContactNode, ContactSurface};
     use crate::Weakening;
@@ -107,15 +108,7 @@ mod tests {
     #[test]
     fn a_lagged_mu_ends_the_cycle_mu_per_iterate_runs() {
         let eps = 0.01;
-        let node = ContactNode {
-            node: 0,
-            dofs: [Some(0), None],
-            weight: 1.0,
-            tangent: [1.0, 0.0],
-            s: 0.0,
-            bound: 1.0,
-        };
-        let mut base = ContactSurface::from_nodes("mass", vec![node], eps).unwrap();
+        let mut base = ContactSurface::from_nodes("mass", vec![unit_node(0)], eps).unwrap();
         base.set_weakening(|_| {
             Some(Weakening {
                 ratio: 0.2,
@@ -186,12 +179,9 @@ mod tests {
     #[test]
     fn lagged_bounds_are_the_law_at_the_last_slip() {
         let node = |j: usize| ContactNode {
-            node: j,
-            dofs: [Some(j), None],
             weight: 0.5,
-            tangent: [1.0, 0.0],
-            s: j as f64,
             bound: 0.3,
+            ..unit_node(j)
         };
         let mut base = ContactSurface::from_nodes("line", vec![node(0), node(1)], 1e-3).unwrap();
         base.set_weakening(|_| {

@@ -11,6 +11,7 @@
 //!   load, and then slides at the kinetic one's μ(U)·p·w.
 
 use stickslip_contact::Weakening;
+use stickslip_testkit::solvers::in_step;
 use stickslip_testkit::{paper_slab, sdof};
 use stickslip_time::{History, ImplicitSolver, Integrator, Scheme, Settings};
 
@@ -38,25 +39,6 @@ fn slab(ratio: Option<f64>, settings: Settings) -> Integrator {
     i
 }
 
-/// Steps `a` and `b` together to the end, the classes equal at every
-/// step, with `each(a, b)` after each step; returns the slipping nodes
-/// counted over the run.
-fn together(
-    mut a: Integrator,
-    mut b: Integrator,
-    mut each: impl FnMut(&Integrator, &Integrator),
-) -> usize {
-    let mut slipping = 0;
-    while !a.done() {
-        a.step().unwrap();
-        b.step().unwrap();
-        assert_eq!(a.classes(), b.classes(), "t = {}", a.time());
-        slipping += a.classes().iter().filter(|c| !c.is_stuck()).count();
-        each(&a, &b);
-    }
-    slipping
-}
-
 #[test]
 fn equal_static_and_kinetic_mu_is_the_constant_law_bit_for_bit() {
     let mut direct = newmark(5e-3, 0.3);
@@ -70,7 +52,7 @@ fn equal_static_and_kinetic_mu_is_the_constant_law_bit_for_bit() {
         ),
     ] {
         let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-        let slipping = together(
+        let slipping = in_step(
             slab(None, settings.clone()),
             slab(Some(1.0), settings),
             |a, b| {
@@ -93,7 +75,7 @@ fn schur_equals_direct_with_a_falling_mu() {
     let mut direct = newmark(5e-3, 0.5);
     direct.implicit_solver = ImplicitSolver::Direct;
     let mut worst: f64 = 0.0;
-    let slipping = together(
+    let slipping = in_step(
         slab(Some(0.5), newmark(5e-3, 0.5)),
         slab(Some(0.5), direct),
         |a, b| {
