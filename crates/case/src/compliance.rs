@@ -9,7 +9,7 @@ use stickslip_contact::{Compliance, ContactError, ContactSurface};
 use stickslip_fem::DofMap;
 use stickslip_mesh::Mesh;
 
-use crate::schema::{Case, ContactLaw, ContactSection, History, InitialState, Mu, Scheme};
+use crate::schema::{Case, ContactLaw, ContactSection, History, Mu, Scheme};
 
 /// A key's dotted path on the surface, and whether a dotted key is in the
 /// case's text.
@@ -178,19 +178,7 @@ fn check_compliance(
                 .into(),
         ),
     }
-    // What the law runs with so far: central difference, from rest.
-    check(
-        case.initial.state == InitialState::Rest,
-        if written("initial.state") {
-            "initial.state"
-        } else {
-            &law
-        },
-        "law = \"compliance\" starts at rest only: set [initial] state = \"rest\" (the part starts \
-         off or touching the foundation); the static preload with the compliance is a nonlinear \
-         problem not yet solved"
-            .into(),
-    );
+    // What the law runs with so far: central difference.
     check(
         case.time.scheme == Scheme::CentralDifference,
         if written("time.scheme") {
