@@ -53,7 +53,10 @@ impl NormalStress {
         NormalStress {
             base,
             surface,
-            histories: sections.iter().map(|s| s.pressure_history.clone()).collect(),
+            histories: sections
+                .iter()
+                .map(|s| s.pressure_history.clone())
+                .collect(),
             compliant: c.is_compliant(),
         }
     }

@@ -1817,13 +1817,13 @@ pub(crate) mod tests {
     /// `append_writes` (which the run's check of free disk space relies
     /// on) is true exactly before the appends that write their block.
     /// Expected: a 20 × 20 node grid's frame is 8 (6·400 + 2) = 19,216
-    /// bytes and the histories of 3 contact nodes 8 (11 + 6) + 3 + 4 = 143
-    /// bytes a row (time, dt and 9 energies, stress and slip a node, as
-    /// f64; the states as i8; the iterations as u32), which every append
-    /// adds to the pending rows; so 55 frame rows reach PENDING_BYTES
-    /// (⌈1,048,576 / 19,359⌉): rows 54, 109, 164; the 35 frames left and
-    /// rows without fields then reach HISTORY_BLOCK (1,024 rows) at row
-    /// 164 + 1,024 = 1,188 before 1 MiB.
+    /// bytes and the histories of 3 contact nodes 8 (11 + 9) + 3 + 4 = 167
+    /// bytes a row (time, dt and 9 energies, friction stress, slip and
+    /// normal stress a node, as f64; the states as i8; the iterations as
+    /// u32), which every append adds to the pending rows; so 55 frame rows
+    /// reach PENDING_BYTES (⌈1,048,576 / 19,383⌉): rows 54, 109, 164; the
+    /// 35 frames left and rows without fields then reach HISTORY_BLOCK
+    /// (1,024 rows) at row 164 + 1,024 = 1,188 before 1 MiB.
     #[test]
     fn append_writes_says_which_appends_write() {
         let _guard = h5_lock();
@@ -1844,7 +1844,7 @@ pub(crate) mod tests {
                 .unwrap();
             let wrote = w.pending.rows() == 0;
             assert_eq!(predicted, wrote, "row {k}");
-            let row = if frame { 19_216 + 143 } else { 143 };
+            let row = if frame { 19_216 + 167 } else { 167 };
             assert_eq!(w.row_bytes(frame), row, "row {k}'s bytes foreseen");
             if !wrote {
                 assert_eq!(w.pending.bytes() - before, row, "row {k}'s bytes held");

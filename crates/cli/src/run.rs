@@ -23,8 +23,8 @@ use stickslip_mesh::Mesh;
 use stickslip_time::{Integrator, Scheme};
 
 use crate::frames::Schedule;
-use crate::output::{self, CheckpointExtra, Record, ResultsWriter, Summary};
 use crate::normal_stress::NormalStress;
+use crate::output::{self, CheckpointExtra, Record, ResultsWriter, Summary};
 use crate::start;
 
 /// How a run ended.
@@ -602,11 +602,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     } else {
         crate::results_file::claim(out)?
     };
-    let mut full = FullState::new(
-        mesh.nodes.len(),
-        n_c,
-        NormalStress::new(case, &integrator),
-    );
+    let mut full = FullState::new(mesh.nodes.len(), n_c, NormalStress::new(case, &integrator));
     let opened = if options.restart {
         start::resume(case, out, quiet, &mesh, &dofs, &mut integrator)?
     } else {
