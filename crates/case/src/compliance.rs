@@ -194,9 +194,9 @@ fn check_compliance(
 
 /// Surface `c` of `law = "compliance"` on its foundation, its keys checked
 /// already. A node that starts inside the foundation by more than a
-/// rounding of the mesh's size is a problem pushed to `problems` (a start
-/// at rest would release it with a jolt of c_n δ₀^{m_n}); one within
-/// rounding starts touching it.
+/// rounding of the mesh's size is a problem pushed to `problems`, for
+/// either start (at rest it would be released with a jolt of c_n
+/// δ₀^{m_n}); one within rounding starts touching it.
 pub(crate) fn compliant_surface(
     mesh: &Mesh,
     dofs: &DofMap,
@@ -229,9 +229,9 @@ pub(crate) fn compliant_surface(
             let node = s.nodes[k.index].node;
             let x = mesh.nodes[node];
             problems.push(format!(
-                "{}[contact]: node {} at ({}, {}) of group {:?} starts {:e} inside the foundation, \
-                 and [initial] state = \"rest\" would release it with the foundation's full push; \
-                 start the part off or touching the foundation (move foundation.point, or the mesh)",
+                "{}[contact]: node {} at ({}, {}) of group {:?} starts {:e} inside the foundation \
+                 (a start at rest would release it with the foundation's full push); start the part \
+                 off or touching the foundation (move foundation.point, or the mesh)",
                 at("foundation"),
                 mesh.node_tags.get(node).copied().unwrap_or(node as u64),
                 x[0],

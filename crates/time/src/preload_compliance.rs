@@ -193,10 +193,13 @@ fn search(
         gt.iter().zip(d).map(|(g, d)| g * d).sum::<f64>()
     };
     let start = g.iter().zip(d).map(|(g, d)| g * d).sum::<f64>();
+    // A step that is no descent (start ≥ 0 or NaN) is only round-off.
+    if start.is_nan() || start >= 0.0 {
+        return Some(1.0);
+    }
     let close = |s: f64| s.abs() <= SEARCH_TOLERANCE * start.abs();
     let mut hi = (1.0, slope(1.0));
-    // A step that is no descent (start ≥ 0 or NaN) is only round-off.
-    if start.is_nan() || start >= 0.0 || close(hi.1) {
+    if close(hi.1) {
         return Some(1.0);
     }
     let mut lo = (0.0, start);
