@@ -157,7 +157,12 @@ pub(crate) fn solve(
         .map(|h| {
             let z = combine(modes, h);
             let work = z.iter().zip(&preload).map(|(z, p)| z * p).sum::<f64>();
-            (label(modes, h), work)
+            let why = format!(
+                ", which the foundation of surface {} holds only against loads pressing the part \
+                 into it (it only pushes)",
+                contact.names()
+            );
+            (label(modes, h) + &why, work)
         })
         .collect();
     if work.is_empty() {

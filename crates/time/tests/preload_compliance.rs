@@ -55,6 +55,7 @@ fn a_preload_pulling_off_the_foundation_is_refused() {
                 motions.iter().any(|(m, _)| m.contains("translation in y")),
                 "{e}"
             );
+            assert!(e.to_string().contains("it only pushes"), "{e}");
         }
         _ => panic!("{e}"),
     }
