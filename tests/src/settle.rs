@@ -4,12 +4,14 @@
 //! t = 0; mass-proportional damping brings it to rest, where every bottom
 //! node carries the foundation's traction c_n δ^{m_n} = p (the pressure
 //! passes through the block unchanged), so the approach is (p/c_n)^{1/m_n}.
+//! The same block preloaded statically (the pressure present before t = 0)
+//! starts there.
 
 use stickslip_contact::{Compliance, ContactSurface};
 use stickslip_fem::{traction_load, Hypothesis, Material, Model, Traction};
 use stickslip_mesh::CellKind;
 use stickslip_time::{
-    Dynamics, History, InitialState, Integrator, Load, Rayleigh, Scheme, Settings,
+    Dynamics, History, InitialState, Integrator, Load, Rayleigh, Scheme, Settings, TimeError,
 };
 
 use crate::grid::rectangle;
@@ -26,25 +28,7 @@ pub const P: f64 = 10.0;
 /// # Errors
 /// The scene's or the integrator's.
 pub fn settle(nx: usize, cn: f64, mn: f64) -> Result<(f64, f64), SceneError> {
-    let mesh = rectangle(CellKind::Quad4, nx, nx / 2, [0.0, 0.0], [1.0, 0.5]);
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain)?;
-    let model = Model::new(&mesh, &material, &[])?;
-    let law = Compliance {
-        cn,
-        mn,
-        ct: 0.0,
-        mt: mn,
-    };
-    let floor = ([0.0, 0.0], [0.0, 1.0]);
-    let contact = ContactSurface::on_foundation(&mesh, &model.dofs, "bottom", floor, law, 1e-3)?;
-    let mut full = vec![0.0; 2 * mesh.nodes.len()];
-    traction_load(&mesh, "top", Traction::Pressure(P), &mut full)?;
-    let mut vector = vec![0.0; model.dofs.n_free()];
-    model.dofs.restrict(&full, &mut vector);
-    let loads = vec![Load {
-        vector,
-        history: History::Constant,
-    }];
+    let block = Block::new(nx, cn, mn)?;
     let build = |dt: f64| {
         let mut s = Settings::new(Scheme::CentralDifference, dt, 4.0);
         s.initial_state = InitialState::Rest;
@@ -52,23 +36,133 @@ pub fn settle(nx: usize, cn: f64, mn: f64) -> Result<(f64, f64), SceneError> {
             alpha: 40.0,
             beta: 0.0,
         };
-        Integrator::new(
-            Dynamics::from_model(&model),
-            Some(contact.clone()),
-            loads.clone(),
-            s,
-        )
+        block.integrator(s)
     };
     let dt_crit = build(1e-6)?.dt_crit().unwrap_or(f64::NAN);
     let mut run = build(0.5 * dt_crit)?;
     while !run.done() {
         run.step()?;
     }
-    let (mut most, mut least) = (f64::NEG_INFINITY, f64::INFINITY);
-    for n in &contact.nodes {
-        let d = n.dofs[1].map_or(0.0, |d| -run.displacement()[d]);
-        most = most.max(d);
-        least = least.min(d);
+    Ok(block.approaches(run.displacement()))
+}
+
+/// The bottom nodes' largest and smallest approach in the static preload
+/// (`[initial] state = "static"`, the pressure present before t = 0) of
+/// the same block, and the run after `steps` steps of half the critical
+/// step from it, undamped: a preload in equilibrium with the foundation
+/// stays where it is.
+///
+/// # Errors
+/// The scene's or the integrator's.
+pub fn preload(nx: usize, cn: f64, mn: f64, steps: usize) -> Result<Preload, SceneError> {
+    let block = Block::new(nx, cn, mn)?;
+    let build = |dt: f64| block.integrator(Settings::new(Scheme::CentralDifference, dt, 1.0));
+    let dt_crit = build(1e-6)?.dt_crit().unwrap_or(f64::NAN);
+    let mut run = build(0.5 * dt_crit)?;
+    let initial = block.approaches(run.displacement());
+    for _ in 0..steps {
+        run.step()?;
     }
-    Ok((most, least))
+    Ok(Preload {
+        initial,
+        after: block.approaches(run.displacement()),
+        largest_speed: run.velocity().iter().fold(0.0, |m, v| m.max(v.abs())),
+        run,
+    })
+}
+
+/// What [`preload`] found.
+#[derive(Debug)]
+pub struct Preload {
+    /// The largest and smallest approach at t = 0.
+    pub initial: (f64, f64),
+    /// The same after the steps.
+    pub after: (f64, f64),
+    /// The largest |ṙ| of a free DOF after them.
+    pub largest_speed: f64,
+    /// The run.
+    pub run: Integrator,
+}
+
+/// The block's model, floor and load on its top.
+#[derive(Debug)]
+pub struct Block {
+    model: Model,
+    contact: ContactSurface,
+    loads: Vec<Load>,
+}
+
+impl Block {
+    /// The block of `nx` × `nx/2` cells on a frictionless floor of `cn`,
+    /// `mn`, pressed by P on its top.
+    ///
+    /// # Errors
+    /// The scene's.
+    pub fn new(nx: usize, cn: f64, mn: f64) -> Result<Block, SceneError> {
+        Block::loaded(nx, cn, mn, Traction::Pressure(P), 0.0)
+    }
+
+    /// The same block with `top` on its top, constant from before t = 0,
+    /// `gap` above the floor.
+    ///
+    /// # Errors
+    /// The scene's.
+    pub fn loaded(
+        nx: usize,
+        cn: f64,
+        mn: f64,
+        top: Traction,
+        gap: f64,
+    ) -> Result<Block, SceneError> {
+        let mesh = rectangle(CellKind::Quad4, nx, nx / 2, [0.0, 0.0], [1.0, 0.5]);
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain)?;
+        let model = Model::new(&mesh, &material, &[])?;
+        let law = Compliance {
+            cn,
+            mn,
+            ct: 0.0,
+            mt: mn,
+        };
+        let floor = ([0.0, -gap], [0.0, 1.0]);
+        let contact =
+            ContactSurface::on_foundation(&mesh, &model.dofs, "bottom", floor, law, 1e-3)?;
+        let mut full = vec![0.0; 2 * mesh.nodes.len()];
+        traction_load(&mesh, "top", top, &mut full)?;
+        let mut vector = vec![0.0; model.dofs.n_free()];
+        model.dofs.restrict(&full, &mut vector);
+        let loads = vec![Load {
+            vector,
+            history: History::Constant,
+        }];
+        Ok(Block {
+            model,
+            contact,
+            loads,
+        })
+    }
+
+    /// Its integrator.
+    ///
+    /// # Errors
+    /// The integrator's.
+    pub fn integrator(&self, settings: Settings) -> Result<Integrator, TimeError> {
+        Integrator::new(
+            Dynamics::from_model(&self.model),
+            Some(self.contact.clone()),
+            self.loads.clone(),
+            settings,
+        )
+    }
+
+    /// The bottom nodes' largest and smallest approach −r_y − gap.
+    pub fn approaches(&self, r: &[f64]) -> (f64, f64) {
+        let (mut most, mut least) = (f64::NEG_INFINITY, f64::INFINITY);
+        for n in &self.contact.nodes {
+            let d = n.dofs[1].map_or(0.0, |d| -r[d]);
+            let d = d - self.contact.compliance[0].gap;
+            most = most.max(d);
+            least = least.min(d);
+        }
+        (most, least)
+    }
 }

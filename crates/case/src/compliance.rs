@@ -9,7 +9,7 @@ use stickslip_contact::{Compliance, ContactError, ContactSurface};
 use stickslip_fem::DofMap;
 use stickslip_mesh::Mesh;
 
-use crate::schema::{Case, ContactLaw, ContactSection, History, InitialState, Mu, Scheme};
+use crate::schema::{Case, ContactLaw, ContactSection, History, Mu, Scheme};
 
 /// A key's dotted path on the surface, and whether a dotted key is in the
 /// case's text.
@@ -178,19 +178,7 @@ fn check_compliance(
                 .into(),
         ),
     }
-    // What the law runs with so far: central difference, from rest.
-    check(
-        case.initial.state == InitialState::Rest,
-        if written("initial.state") {
-            "initial.state"
-        } else {
-            &law
-        },
-        "law = \"compliance\" starts at rest only: set [initial] state = \"rest\" (the part starts \
-         off or touching the foundation); the static preload with the compliance is a nonlinear \
-         problem not yet solved"
-            .into(),
-    );
+    // What the law runs with so far: central difference.
     check(
         case.time.scheme == Scheme::CentralDifference,
         if written("time.scheme") {
@@ -206,9 +194,9 @@ fn check_compliance(
 
 /// Surface `c` of `law = "compliance"` on its foundation, its keys checked
 /// already. A node that starts inside the foundation by more than a
-/// rounding of the mesh's size is a problem pushed to `problems` (a start
-/// at rest would release it with a jolt of c_n δ₀^{m_n}); one within
-/// rounding starts touching it.
+/// rounding of the mesh's size is a problem pushed to `problems`, for
+/// either start (at rest it would be released with a jolt of c_n
+/// δ₀^{m_n}); one within rounding starts touching it.
 pub(crate) fn compliant_surface(
     mesh: &Mesh,
     dofs: &DofMap,
@@ -241,9 +229,9 @@ pub(crate) fn compliant_surface(
             let node = s.nodes[k.index].node;
             let x = mesh.nodes[node];
             problems.push(format!(
-                "{}[contact]: node {} at ({}, {}) of group {:?} starts {:e} inside the foundation, \
-                 and [initial] state = \"rest\" would release it with the foundation's full push; \
-                 start the part off or touching the foundation (move foundation.point, or the mesh)",
+                "{}[contact]: node {} at ({}, {}) of group {:?} starts {:e} inside the foundation \
+                 (a start at rest would release it with the foundation's full push); start the part \
+                 off or touching the foundation (move foundation.point, or the mesh)",
                 at("foundation"),
                 mesh.node_tags.get(node).copied().unwrap_or(node as u64),
                 x[0],

@@ -45,6 +45,7 @@ pub mod advise;
 pub mod check_cmd;
 pub mod frames;
 pub mod mesh_cmd;
+mod normal_stress;
 pub mod output;
 pub mod probe;
 pub mod results_file;

@@ -76,6 +76,9 @@ pub struct Record<'a> {
     pub friction_stress: &'a [f64],
     /// Slip velocity v_T along τ at each contact node.
     pub slip_velocity: &'a [f64],
+    /// The normal traction at each contact node: the prescribed pressure
+    /// p(s, t), or a compliant foundation's c_n δ^{m_n}.
+    pub normal_stress: &'a [f64],
     /// 0 stuck, +1 / −1 slipping.
     pub state: &'a [i8],
     /// ½ṙᵀMṙ.
@@ -163,7 +166,12 @@ impl Series {
             results.push(d.resize((frames, n, 2)));
         }
         if let Some(c) = &self.contact {
-            for d in [&c.friction_stress, &c.slip_velocity, &c.state] {
+            for d in [
+                &c.friction_stress,
+                &c.slip_velocity,
+                &c.state,
+                &c.normal_stress,
+            ] {
                 results.push(d.resize((rows, n_c)));
             }
         }
@@ -176,6 +184,7 @@ struct ContactSeries {
     friction_stress: Dataset,
     slip_velocity: Dataset,
     state: Dataset,
+    normal_stress: Dataset,
 }
 
 /// Rows appended since the last write into the datasets, row after row.
@@ -203,6 +212,7 @@ struct Pending {
     friction_stress: Vec<f64>,
     slip_velocity: Vec<f64>,
     state: Vec<i8>,
+    normal_stress: Vec<f64>,
     energy: [Vec<f64>; ENERGY_NAMES.len()],
     dt: Vec<f64>,
     iterations: Vec<u32>,
@@ -226,6 +236,7 @@ impl Pending {
             + self.acceleration.len()
             + self.friction_stress.len()
             + self.slip_velocity.len()
+            + self.normal_stress.len()
             + self.dt.len()
             + self.energy.iter().map(Vec::len).sum::<usize>();
         8 * (f64s + self.frame_row.len()) + self.state.len() + 4 * self.iterations.len()
@@ -244,6 +255,7 @@ impl Pending {
         self.friction_stress.extend_from_slice(rec.friction_stress);
         self.slip_velocity.extend_from_slice(rec.slip_velocity);
         self.state.extend_from_slice(rec.state);
+        self.normal_stress.extend_from_slice(rec.normal_stress);
         let e: [f64; ENERGY_NAMES.len()] = [
             rec.kinetic,
             rec.strain,
@@ -271,6 +283,7 @@ impl Pending {
             &mut self.acceleration,
             &mut self.friction_stress,
             &mut self.slip_velocity,
+            &mut self.normal_stress,
             &mut self.dt,
         ]
         .into_iter()
@@ -650,6 +663,7 @@ impl ResultsWriter {
                 friction_stress: series_2d::<f64>(&c, "friction_stress", n_c, level)?,
                 slip_velocity: series_2d::<f64>(&c, "slip_velocity", n_c, level)?,
                 state: series_2d::<i8>(&c, "state", n_c, level)?,
+                normal_stress: series_2d::<f64>(&c, "normal_stress", n_c, level)?,
             })
         } else {
             None
@@ -736,10 +750,19 @@ impl ResultsWriter {
             nodes.first().copied().unwrap_or(0)
         );
         let contact = if file.link_exists("contact") {
+            // Files written before /contact/normal_stress: made here, the
+            // resize below gives its rows the fill value 0.
+            let normal_stress = if file.link_exists("contact/normal_stress") {
+                ds("contact/normal_stress")?
+            } else {
+                let n = ds("contact/state")?.shape().get(1).copied().unwrap_or(0);
+                series_2d::<f64>(&file.group("contact")?, "normal_stress", n, 0)?
+            };
             ContactSeries {
                 friction_stress: ds("contact/friction_stress")?,
                 slip_velocity: ds("contact/slip_velocity")?,
                 state: ds("contact/state")?,
+                normal_stress,
             }
             .into()
         } else {
@@ -903,7 +926,7 @@ impl ResultsWriter {
         // allocated), so the next write may take a chunk of every series.
         let frame_bytes = (6 * self.n_nodes + 2) * 8;
         let fields = self.block_rows.max(PENDING_BYTES / frame_bytes + 1) * frame_bytes;
-        let histories = HISTORY_BLOCK * (3 * self.n_c + 2 + ENERGY_NAMES.len()) * 8;
+        let histories = HISTORY_BLOCK * (4 * self.n_c + 2 + ENERGY_NAMES.len()) * 8;
         let checkpoint = 5 * n_free * 8;
         (2 * (fields + histories + checkpoint) + (1 << 20)) as u64
     }
@@ -919,9 +942,9 @@ impl ResultsWriter {
 
     /// Bytes a record adds to [`Pending`], a frame's if `frame`.
     fn row_bytes(&self, frame: bool) -> usize {
-        // time, dt and the energies; friction stress and slip a node
-        // (f64), its state (i8); the iterations (u32).
-        let histories = 8 * (2 + ENERGY_NAMES.len() + 2 * self.n_c) + self.n_c + 4;
+        // time, dt and the energies; friction stress, slip and normal
+        // stress a node (f64), its state (i8); the iterations (u32).
+        let histories = 8 * (2 + ENERGY_NAMES.len() + 3 * self.n_c) + self.n_c + 4;
         let fields = if frame { 8 * (6 * self.n_nodes + 2) } else { 0 };
         histories + fields
     }
@@ -1119,6 +1142,7 @@ impl ResultsWriter {
             for (ds, v) in [
                 (&c.friction_stress, &p.friction_stress),
                 (&c.slip_velocity, &p.slip_velocity),
+                (&c.normal_stress, &p.normal_stress),
             ] {
                 ds.resize((k1, n_c))?;
                 ds.write_slice(ArrayView2::from_shape((m, n_c), &v[..])?, s![k0..k1, ..])?;
@@ -1158,6 +1182,7 @@ impl ResultsWriter {
             ("friction_stress", rec.friction_stress.len()),
             ("slip_velocity", rec.slip_velocity.len()),
             ("state", rec.state.len()),
+            ("normal_stress", rec.normal_stress.len()),
         ] {
             ensure!(
                 len == n_c,
@@ -1250,6 +1275,7 @@ impl<'a> Record<'a> {
             friction_stress: &[],
             slip_velocity: &[],
             state: &[],
+            normal_stress: &[],
             kinetic: 0.0,
             strain: 0.0,
             external_work: 0.0,
@@ -1362,6 +1388,7 @@ pub(crate) mod tests {
                 friction_stress: &fs,
                 slip_velocity: &sv,
                 state: &st,
+                normal_stress: &sv,
                 kinetic: 1.0 + k as f64,
                 strain: 2.0 + k as f64,
                 external_work: 3.0 + k as f64,
@@ -1705,6 +1732,7 @@ pub(crate) mod tests {
                     friction_stress: &fs,
                     slip_velocity: &fs,
                     state: &st,
+                    normal_stress: &fs,
                     kinetic: k as f64,
                     dt: 0.5,
                     iterations: k as u32,
@@ -1764,6 +1792,7 @@ pub(crate) mod tests {
             friction_stress: fs,
             slip_velocity: &[0.0; 3],
             state: &[0; 3],
+            normal_stress: &[0.0; 3],
             dt: 0.1,
             ..Record::zeros(t, [d, v, a])
         }
@@ -1788,13 +1817,13 @@ pub(crate) mod tests {
     /// `append_writes` (which the run's check of free disk space relies
     /// on) is true exactly before the appends that write their block.
     /// Expected: a 20 × 20 node grid's frame is 8 (6·400 + 2) = 19,216
-    /// bytes and the histories of 3 contact nodes 8 (11 + 6) + 3 + 4 = 143
-    /// bytes a row (time, dt and 9 energies, stress and slip a node, as
-    /// f64; the states as i8; the iterations as u32), which every append
-    /// adds to the pending rows; so 55 frame rows reach PENDING_BYTES
-    /// (⌈1,048,576 / 19,359⌉): rows 54, 109, 164; the 35 frames left and
-    /// rows without fields then reach HISTORY_BLOCK (1,024 rows) at row
-    /// 164 + 1,024 = 1,188 before 1 MiB.
+    /// bytes and the histories of 3 contact nodes 8 (11 + 9) + 3 + 4 = 167
+    /// bytes a row (time, dt and 9 energies, friction stress, slip and
+    /// normal stress a node, as f64; the states as i8; the iterations as
+    /// u32), which every append adds to the pending rows; so 55 frame rows
+    /// reach PENDING_BYTES (⌈1,048,576 / 19,383⌉): rows 54, 109, 164; the
+    /// 35 frames left and rows without fields then reach HISTORY_BLOCK
+    /// (1,024 rows) at row 164 + 1,024 = 1,188 before 1 MiB.
     #[test]
     fn append_writes_says_which_appends_write() {
         let _guard = h5_lock();
@@ -1815,7 +1844,7 @@ pub(crate) mod tests {
                 .unwrap();
             let wrote = w.pending.rows() == 0;
             assert_eq!(predicted, wrote, "row {k}");
-            let row = if frame { 19_216 + 143 } else { 143 };
+            let row = if frame { 19_216 + 167 } else { 167 };
             assert_eq!(w.row_bytes(frame), row, "row {k}'s bytes foreseen");
             if !wrote {
                 assert_eq!(w.pending.bytes() - before, row, "row {k}'s bytes held");

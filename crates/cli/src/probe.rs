@@ -962,6 +962,7 @@ mod tests {
                 friction_stress: &fs,
                 slip_velocity: &[0.0; 3],
                 state: &[0; 3],
+                normal_stress: &[0.0; 3],
                 dt: 0.25,
                 ..Record::zeros(0.25 * k as f64, [&d, &v, &d])
             })

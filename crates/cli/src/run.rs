@@ -23,6 +23,7 @@ use stickslip_mesh::Mesh;
 use stickslip_time::{Integrator, Scheme};
 
 use crate::frames::Schedule;
+use crate::normal_stress::NormalStress;
 use crate::output::{self, CheckpointExtra, Record, ResultsWriter, Summary};
 use crate::start;
 
@@ -149,7 +150,7 @@ pub(crate) fn output_size(case: &Case, nodes: usize, contact_nodes: usize) -> Ou
     };
     let up = |n: f64, chunk: usize| (n / chunk as f64).ceil() * chunk as f64;
     let (nodes_f, n_c) = (nodes as f64, contact_nodes as f64);
-    let contact = up(rows, output::contact_chunk_rows(contact_nodes, 8)) * 16.0 * n_c
+    let contact = up(rows, output::contact_chunk_rows(contact_nodes, 8)) * 24.0 * n_c
         + up(rows, output::contact_chunk_rows(contact_nodes, 1)) * n_c;
     let bytes = up(frames, output::vector_chunk_rows(nodes)) * 48.0 * nodes_f
         + up(frames, output::SERIES_CHUNK) * 16.0
@@ -359,11 +360,14 @@ pub(crate) struct FullState {
     stress: Vec<f64>,
     slip: Vec<f64>,
     state: Vec<i8>,
+    normal: Vec<f64>,
+    normal_stress: NormalStress,
 }
 
 impl FullState {
-    /// Buffers for `nodes` mesh nodes and `n_c` contact nodes.
-    pub(crate) fn new(nodes: usize, n_c: usize) -> FullState {
+    /// Buffers for `nodes` mesh nodes and `n_c` contact nodes, whose
+    /// normal traction `normal_stress` forms.
+    pub(crate) fn new(nodes: usize, n_c: usize, normal_stress: NormalStress) -> FullState {
         FullState {
             u: vec![0.0; 2 * nodes],
             v: vec![0.0; 2 * nodes],
@@ -371,6 +375,8 @@ impl FullState {
             stress: vec![0.0; n_c],
             slip: vec![0.0; n_c],
             state: vec![0; n_c],
+            normal: vec![0.0; n_c],
+            normal_stress,
         }
     }
 }
@@ -392,6 +398,7 @@ pub(crate) fn record<'a>(
     i.friction_stress(&mut s.stress);
     i.slip_velocity(&mut s.slip);
     i.slip_states(&mut s.state);
+    s.normal_stress.fill(i, &mut s.normal);
     let e = i.energy();
     let fields = |v: &'a [f64]| if frame { v } else { &[] };
     Record {
@@ -402,6 +409,7 @@ pub(crate) fn record<'a>(
         friction_stress: &s.stress,
         slip_velocity: &s.slip,
         state: &s.state,
+        normal_stress: &s.normal,
         kinetic: e.kinetic,
         strain: e.strain,
         external_work: e.external_work,
@@ -594,7 +602,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     } else {
         crate::results_file::claim(out)?
     };
-    let mut full = FullState::new(mesh.nodes.len(), n_c);
+    let mut full = FullState::new(mesh.nodes.len(), n_c, NormalStress::new(case, &integrator));
     let opened = if options.restart {
         start::resume(case, out, quiet, &mesh, &dofs, &mut integrator)?
     } else {

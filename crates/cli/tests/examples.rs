@@ -184,6 +184,50 @@ fn example_05_belt_sticks_and_slips() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+#[test]
+fn example_06_block_lands_on_a_slope() {
+    let Some((out, dir)) = run_example("06-block-lands-on-a-slope", "slope.png") else {
+        return;
+    };
+    // examples/06's docstring: m = 0.5, g = 9.81, a slope of 20 degrees.
+    let angle = 20f64.to_radians();
+    let weight = 0.5 * 9.81;
+    // The fall to the first touch, D = 0.05 along the slope's normal under
+    // a = g cos 20 and the drag alpha = 20: D = (a/alpha)(t - (1 -
+    // e^(-alpha t))/alpha), solved by bisection; read at the rows every
+    // 2e-3 (the first row with a force is within one row after it).
+    let (a, alpha) = (9.81 * angle.cos(), 20.0);
+    let fallen = |t: f64| (a / alpha) * (t - (1.0 - (-alpha * t).exp()) / alpha);
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if fallen(mid) < 0.05 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let first = number(&out, "first touch:");
+    assert!(first >= lo - 2e-4 && first <= lo + 2.2e-3, "{lo}: {out}");
+    // It bounces: contact opens and closes again.
+    assert!(number(&out, "touchdowns:") >= 2.0, "{out}");
+    // It sticks: the regularized law's creep below eps = 1e-3, and the
+    // statics of a block held on the slope: the normal force m g cos 20
+    // (0.1%), the friction m g sin 20 less the drag on the creep (1%).
+    assert!(number(&out, "final speed along the slope:") < 1e-3, "{out}");
+    let normal = number(&out, "final normal force:");
+    assert!(
+        (normal / (weight * angle.cos()) - 1.0).abs() < 1e-3,
+        "{out}"
+    );
+    let friction = number(&out, "final friction force:");
+    assert!(
+        (friction / (weight * angle.sin()) - 1.0).abs() < 1e-2,
+        "{out}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// examples/warp_pyvista.py: PyVista reads a run's XDMF, warps the mesh
 /// by the displacement and writes a PNG without a display. Expected
 /// values from the hdf5 crate's reading of the .h5: the last record's

@@ -37,6 +37,37 @@ pub(crate) fn solve(
     r: &mut [f64],
     times: &mut SetupTimes,
 ) -> Result<(), TimeError> {
+    balanced(modes, r)?;
+    let pins = pins(modes);
+    let mut pinned = k.clone();
+    pin(&mut pinned, &pins);
+    for &i in &pins {
+        r[i] = 0.0;
+    }
+    crate::initial::cholesky_solve(&pinned, fill_order, r, times)?;
+    remove_rigid_motion(mass, modes, r);
+    Ok(())
+}
+
+/// Decouples the DOFs `pins` (ascending) from the others in `k`: their
+/// rows and columns keep only the diagonal.
+pub(crate) fn pin(k: &mut CsrMatrix<f64>, pins: &[usize]) {
+    let (offsets, cols, values) = k.csr_data_mut();
+    let is_pin = |i: usize| pins.binary_search(&i).is_ok();
+    for i in 0..offsets.len() - 1 {
+        for p in offsets[i]..offsets[i + 1] {
+            if (is_pin(i) || is_pin(cols[p])) && cols[p] != i {
+                values[p] = 0.0;
+            }
+        }
+    }
+}
+
+/// Loads `r` that do no work along any of `modes`.
+///
+/// # Errors
+/// [`TimeError::Unbalanced`] naming each motion they do work along.
+pub(crate) fn balanced(modes: &[RigidMode], r: &[f64]) -> Result<(), TimeError> {
     let unbalanced: Vec<(String, f64)> = modes
         .iter()
         .filter_map(|m| {
@@ -51,29 +82,13 @@ pub(crate) fn solve(
     if !unbalanced.is_empty() {
         return Err(TimeError::Unbalanced(unbalanced));
     }
-    let pins = pins(modes);
-    let mut pinned = k.clone();
-    let (offsets, cols, values) = pinned.csr_data_mut();
-    let is_pin = |i: usize| pins.binary_search(&i).is_ok();
-    for i in 0..offsets.len() - 1 {
-        for p in offsets[i]..offsets[i + 1] {
-            if (is_pin(i) || is_pin(cols[p])) && cols[p] != i {
-                values[p] = 0.0;
-            }
-        }
-    }
-    for &i in &pins {
-        r[i] = 0.0;
-    }
-    crate::initial::cholesky_solve(&pinned, fill_order, r, times)?;
-    remove_rigid_motion(mass, modes, r);
     Ok(())
 }
 
 /// One DOF per mode by complete pivoting on the modes' columns: the
 /// largest entry of what is left of them, then that entry eliminated from
 /// the others. Ascending.
-fn pins(modes: &[RigidMode]) -> Vec<usize> {
+pub(crate) fn pins(modes: &[RigidMode]) -> Vec<usize> {
     let mut left: Vec<Vec<f64>> = modes.iter().map(|m| m.vector.clone()).collect();
     let mut done = vec![false; left.len()];
     let mut pins = Vec::with_capacity(left.len());

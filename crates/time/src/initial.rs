@@ -113,6 +113,11 @@ pub(crate) fn initial_state(
     let n = k.nrows();
     let mut state = State::new(n, contact.map_or(0, |c| c.len()), settings.dt);
     let mut r = loads.before_start();
+    // A compliant foundation's preload is the nonlinear static problem
+    // with its forces; its r₀, r̈₀ and energies count them.
+    let compliant = contact.filter(|c| c.is_compliant() && !r.iter().all(|&x| x == 0.0));
+    let compliant =
+        compliant.filter(|_| !settings.restoring && settings.initial_state == InitialState::Static);
     if settings.restoring || settings.initial_state == InitialState::Rest {
         r.fill(0.0);
     } else if r.iter().all(|&x| x == 0.0) {
@@ -121,7 +126,9 @@ pub(crate) fn initial_state(
         if single_factor {
             fill_order.keep_dissection();
         }
-        if modes.is_empty() {
+        if let Some(c) = compliant {
+            crate::preload_compliance::solve(k, (mass, fill_order, modes), c, &mut r, times)?;
+        } else if modes.is_empty() {
             cholesky_solve(k, fill_order, &mut r, times)?;
         } else {
             crate::floating::solve(k, mass, fill_order, modes, &mut r, times)?;
@@ -138,6 +145,9 @@ pub(crate) fn initial_state(
     for (x, l) in rhs.iter_mut().zip(&state.load) {
         *x = l - *x;
     }
+    let stored = compliant.map_or(0.0, |c| {
+        crate::preload_compliance::add_foundation_forces(c, &state.r, &mut rhs)
+    });
     // With damping and an initial velocity, M r̈₀ = R(0) − K r₀ − C ṙ₀.
     let damping = settings.damping;
     if damping.is_on() && settings.initial_velocity.is_some() {
@@ -169,7 +179,10 @@ pub(crate) fn initial_state(
     let mut partials = chunks::partials(n);
     let kinetic = 0.5 * mass.form(&state.v, &mut partials);
     let strain = 0.5 * quadratic_form(k, &state.r, &mut partials);
-    state.initial_mechanical = kinetic + strain;
+    // kinetic + strain ≥ +0, so adding 0.0 (no compliant preload) keeps
+    // its bits.
+    let mechanical = kinetic + strain + stored;
+    state.initial_mechanical = mechanical;
     state.energy = Energy {
         kinetic,
         strain,
@@ -177,8 +190,8 @@ pub(crate) fn initial_state(
         dissipated: 0.0,
         damped: 0.0,
         foundation: 0.0,
-        foundation_stored: 0.0,
-        total: kinetic + strain - dot(&state.r, &state.load),
+        foundation_stored: stored,
+        total: mechanical - dot(&state.r, &state.load),
         balance: 0.0,
     };
     Ok(state)

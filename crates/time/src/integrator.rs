@@ -118,7 +118,7 @@ impl Integrator {
         // operators (stencil types, factors, friction's constants).
         let rest = started.elapsed().as_secs_f64() - setup.total();
         setup.add("operators", rest.max(0.0));
-        Ok(Integrator {
+        let mut integrator = Integrator {
             surface,
             run: Run {
                 contact,
@@ -131,7 +131,16 @@ impl Integrator {
             bounds: None,
             foundations: None,
             setup,
-        })
+        };
+        // A static preload pressed the part into a compliant foundation:
+        // its bounds follow that approach from t = 0.
+        if integrator.run.settings.initial_state == InitialState::Static {
+            integrator.comply_at_state();
+            if let Some(c) = integrator.run.contact.as_ref().filter(|c| c.is_compliant()) {
+                c.nodal_forces(&integrator.state.v, &mut integrator.state.forces);
+            }
+        }
+        Ok(integrator)
     }
 
     /// How long the setup's parts took: the preload's ordering, factor
@@ -441,22 +450,14 @@ impl Integrator {
 
 /// What the compliance law needs of the run: the explicit scheme (the
 /// implicit ones would solve the normal and friction terms together, which
-/// they do not yet), and a start at rest (the static preload would be the
-/// nonlinear problem with the compliance).
+/// they do not yet). Either start works: at rest, or from the static
+/// preload with the compliance (`preload_compliance.rs`).
 fn check_compliance(contact: &ContactSurface, settings: &Settings) -> Result<(), TimeError> {
     if settings.scheme != Scheme::CentralDifference {
         return Err(TimeError::Settings(format!(
             "surface {} has law = \"compliance\", which runs with time.scheme = \
              \"central_difference\" only: the implicit schemes do not yet solve the normal and \
              friction terms together; use central difference",
-            contact.names()
-        )));
-    }
-    if settings.initial_state != InitialState::Rest && !settings.restoring {
-        return Err(TimeError::Settings(format!(
-            "surface {} has law = \"compliance\", which starts at rest only ([initial] state = \
-             \"rest\"): the static preload with the compliance is a nonlinear problem not yet \
-             solved; start at rest, off or touching the foundation",
             contact.names()
         )));
     }

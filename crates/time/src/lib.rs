@@ -30,6 +30,7 @@ mod initial;
 mod integrator;
 mod newmark;
 mod nodal;
+mod preload_compliance;
 mod pressure;
 mod quasi_static;
 mod settings;

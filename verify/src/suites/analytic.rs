@@ -30,6 +30,7 @@ pub fn run(root: &Path, opts: &Options, r: &mut Report) {
     super::surfaces::run(root, opts, r);
     super::belt::run(root, r);
     super::compliance::run(r);
+    super::consistency::run(root, r);
 }
 
 fn coulomb_oscillator(opts: &Options, r: &mut Report) {
