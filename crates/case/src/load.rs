@@ -614,12 +614,15 @@ fn complete(
             );
         }
     }
-    check(
-        o.flush_every > 0,
-        "output.flush_every",
-        "output.flush_every must be >= 1 (steps between flushes of the results file; default 100)"
-            .into(),
-    );
+    if let Some(n) = o.flush_every {
+        check(
+            n > 0,
+            "output.flush_every",
+            "output.flush_every must be >= 1 (steps between flushes of the results file; \
+             default: none, by output.flush_seconds only)"
+                .into(),
+        );
+    }
     check(
         o.flush_seconds > 0.0 && !o.flush_seconds.is_nan(),
         "output.flush_seconds",

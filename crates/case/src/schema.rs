@@ -745,10 +745,6 @@ section! {
 /// (docs/results.md, "What is written, and why").
 pub const DEFAULT_FRAMES: usize = 200;
 
-fn default_flush_every() -> usize {
-    100
-}
-
 fn default_flush_seconds() -> f64 {
     5.0
 }
@@ -769,10 +765,12 @@ section! {
         /// ... or at every `every`-th step.
         "every" every: Option<usize>,
         /// Flush the file (and rewrite the checkpoint) at least every this
-        /// many steps (default 100).
-        #[serde(default = "default_flush_every")]
-        "flush_every" flush_every: usize,
-        /// ... and at least every this many seconds (default 5).
+        /// many steps (default: none, by wall time only: a run's steps
+        /// may take microseconds or minutes, its wall time is what a crash
+        /// loses).
+        "flush_every" flush_every: Option<usize>,
+        /// ... and at least every this many seconds of wall time (default
+        /// 5), counted from the start of the run, its setup included.
         #[serde(default = "default_flush_seconds")]
         "flush_seconds" flush_seconds: f64,
         /// Deflate level of the growing datasets, 0 to 9 (`None`: the
@@ -789,7 +787,7 @@ impl Default for OutputSection {
             frames: None,
             interval: None,
             every: None,
-            flush_every: default_flush_every(),
+            flush_every: None,
             flush_seconds: default_flush_seconds(),
             compression: None,
         }

@@ -906,6 +906,16 @@ impl ResultsWriter {
             .unwrap_or_default()
     }
 
+    /// Counts [`ResultsWriter::flush_every_secs`] from `start` (a run's
+    /// start, its setup included, rather than the file's creation: what a
+    /// crash before the next flush loses is the wall time since then) and
+    /// [`ResultsWriter::flush_every_steps`] from the next step (the
+    /// initial record is none).
+    pub fn flush_clock_from(&mut self, start: Instant) {
+        self.last_flush = start;
+        self.since_flush = 0;
+    }
+
     /// True when [`ResultsWriter::flush_every_steps`] rows or
     /// [`ResultsWriter::flush_every_secs`] seconds have gone by since the
     /// last flush.

@@ -162,6 +162,30 @@ pub fn being_written(path: &Path) -> bool {
 #[derive(Debug)]
 pub struct RunLock {
     _file: std::fs::File,
+    /// The closing of the old results file `claim` removed, on its own
+    /// thread (see [`free_aside`]); joined when the lock is dropped.
+    freeing: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Drop for RunLock {
+    fn drop(&mut self) {
+        if let Some(t) = self.freeing.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// Closes `old`, a removed file's last descriptor, on another thread:
+/// the file system frees a removed file's blocks (and drops its cached
+/// pages, still dirty for a file a run has just written) at the last
+/// close, not at the removal, and that took as long as a small run's
+/// steps. Should the process end first, its exit closes the file all
+/// the same: nothing is left behind.
+fn free_aside(old: std::fs::File) -> Option<std::thread::JoinHandle<()>> {
+    std::thread::Builder::new()
+        .name("free old results".into())
+        .spawn(move || drop(old))
+        .ok()
 }
 
 impl RunLock {
@@ -203,7 +227,10 @@ impl RunLock {
             .map_err(|e| InputError(format!("cannot open {}: {e}", path.display())))?;
         match ofd_lock(&f, true) {
             Err(e) if lock_held(&e) => Err(busy(path)),
-            _ => Ok(RunLock { _file: f }),
+            _ => Ok(RunLock {
+                _file: f,
+                freeing: None,
+            }),
         }
     }
 
@@ -214,7 +241,10 @@ impl RunLock {
             // A file system without such locks (ENOLCK, EINVAL on some
             // network mounts): the run goes on unprotected, as HDF5's own
             // locking would let it.
-            _ => Ok(RunLock { _file: f }),
+            _ => Ok(RunLock {
+                _file: f,
+                freeing: None,
+            }),
         }
     }
 }
@@ -303,10 +333,14 @@ pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
     ] {
         let _ = std::fs::remove_file(out.with_extension(stale));
     }
+    let mut old = None;
     for path in [out.to_path_buf(), out.with_extension("xdmf")] {
         if path.exists() {
             if in_use(&path) {
                 return Err(busy(&path));
+            }
+            if path == out {
+                old = std::fs::File::open(&path).ok();
             }
             std::fs::remove_file(&path).map_err(|e| {
                 InputError(format!(
@@ -335,7 +369,8 @@ pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
                 ))
             }
         })?;
-    let lock = RunLock::on(f, out)?;
+    let mut lock = RunLock::on(f, out)?;
+    lock.freeing = old.and_then(free_aside);
     // Another run's claim may have removed our new file between its
     // creation and the lock: then the name is that run's.
     use std::os::unix::fs::MetadataExt;

@@ -544,8 +544,9 @@ fn blow_up(i: &Integrator, initial: f64) -> Option<f64> {
 
 /// `stickslip run`: integrate to t_end writing the histories at every
 /// step and the fields at frames (`output.frames`, `output.interval`,
-/// `output.every`); flush and checkpoint every `output.flush_every` steps or
-/// `output.flush_seconds` seconds; stop cleanly on SIGINT, SIGTERM or SIGHUP; with
+/// `output.every`); flush and checkpoint every `output.flush_seconds`
+/// seconds from the run's start (and every `output.flush_every` steps, if
+/// given); stop cleanly on SIGINT, SIGTERM or SIGHUP; with
 /// `options.restart`, continue the file `out` from its checkpoint.
 ///
 /// # Errors
@@ -558,7 +559,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         mesh,
         dofs,
         mut integrator,
-        setup: setup_parts,
+        setup: mut setup_parts,
     } = prepare_run(case, options.restart, !quiet)?;
     let n_c = integrator.contact().map_or(0, |c| c.len());
     // A signal during the setup: stop before the file is touched (with
@@ -595,6 +596,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     // Held until this run returns, from before its first write: a second
     // run's --force or --restart, or a probe, sees the file in use
     // ([`crate::results_file::in_use`]).
+    let file_started = Instant::now();
     let _lock = if options.restart {
         let lock = crate::results_file::RunLock::take(out)?;
         forget_companions(out, quiet);
@@ -608,6 +610,7 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     } else {
         start::fresh(case, out, &mesh, &dofs, &integrator, &mut full)?
     };
+    setup_parts.add("results file", file_started.elapsed().as_secs_f64());
     let mut session = Session {
         case,
         out,
@@ -625,11 +628,22 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
         setup_parts,
     };
     session.writer.auto_flush = false;
-    session.writer.flush_every_steps = case.output.flush_every.max(1);
+    session.writer.flush_every_steps = case.output.flush_every.unwrap_or(usize::MAX);
     session.writer.flush_every_secs = case.output.flush_seconds;
-    // A state to continue from exists from the start (the initial state, or
-    // the restored one).
-    session.checkpoint(None)?;
+    session.writer.flush_clock_from(started);
+    // The initial state is checkpointed where its setup took flush_seconds
+    // or more: a crash then loses no more than a flush interval, as at
+    // every later flush. A shorter setup is cheaper to redo than its
+    // state is to write (r, v, a on every free DOF and two flushes); a
+    // restart's state is already the file's checkpoint.
+    if !options.restart && session.writer.flush_due() {
+        let checkpoint_started = Instant::now();
+        session.checkpoint(None)?;
+        session.setup_parts.add(
+            "first checkpoint",
+            checkpoint_started.elapsed().as_secs_f64(),
+        );
+    }
     let setup_s = started.elapsed().as_secs_f64();
     let mut progress = Progress::new(quiet, &session.integrator);
     if progress.log {
@@ -647,8 +661,9 @@ pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<
     session.conclude(ending, setup_s, stepping, progress.steps_before)
 }
 
-/// The setup's parts in seconds, and what is left of `setup_s` beside
-/// them (the results file's creation, the first checkpoint) as "other".
+/// The setup's parts in seconds (the results file's creation and the
+/// first checkpoint among them), and what is left of `setup_s` beside
+/// them as "other".
 fn setup_line(parts: &SetupTimes, setup_s: f64) -> String {
     let mut line: Vec<String> = parts
         .parts()

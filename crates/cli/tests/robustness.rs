@@ -840,6 +840,41 @@ fn ok(o: &Output) {
     );
 }
 
+/// Checkpoints go by wall time: a run of milliseconds (tests/data/slab.toml,
+/// 50 steps) writes one, its last, where `flush_every = 100` wrote one
+/// before the first step and one at the end. Each checkpoint goes into the
+/// slot the one before did not use, the first into a (0), so the current
+/// slot counts them: one checkpoint leaves slot a; with `flush_every = 25`
+/// a flush after step 25 and the last make two, slot b; with
+/// `flush_seconds` below any setup's time, the initial state's checkpoint
+/// and one after each step (the last step's flush is the last
+/// checkpoint) make 1 + 49 + 1 = 51, slot a.
+#[test]
+fn a_short_run_checkpoints_by_wall_time() {
+    let dir = scratch("flush-by-time");
+    let (case, _) = slab_case(&dir, "flush", |t| t);
+    let slot_of = |o: &Path| {
+        let f = hdf5::File::open(o).unwrap();
+        let c = f.group("checkpoint").unwrap();
+        c.attr("slot").unwrap().read_scalar::<u8>().unwrap()
+    };
+    for (sets, slot) in [
+        (vec![], 0),
+        (vec!["--set", "output.flush_every=25"], 1),
+        (vec!["--set", "output.flush_seconds=1e-9"], 0),
+    ] {
+        let out = dir.join("f.h5");
+        ok(&run(&case, &out, &sets));
+        assert_eq!(slot_of(&out), slot, "{sets:?}");
+        // Whatever the checkpoints, the restart to a later t_end starts
+        // from the last (the state before the last step) and the file holds
+        // every record.
+        assert_eq!(checkpoint_attr::<u64>(&out, "steps"), 49, "{sets:?}");
+        let f = hdf5::File::open(&out).unwrap();
+        assert_eq!(f.dataset("time").unwrap().size(), 51, "{sets:?}");
+    }
+}
+
 #[test]
 fn restart_after_an_earlier_t_end_is_bit_identical_central_difference() {
     // t_end = 0.1374 is not on the Δt grid: the short run's last step is
@@ -1662,8 +1697,16 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
         .arg(&out)
         // 801 records of 4.5 kB: they fit the 4 MB when the run starts
         // (a run whose records cannot fit is refused before it starts),
-        // but not with the room each write keeps (1.2 MB here).
-        .args(["--quiet", "--set", "time.t_end=0.8"])
+        // but not with the room each write keeps (1.2 MB here). Flushes
+        // every 100 steps: a run this short makes none by time, and it
+        // is the room a flush needs that stops it.
+        .args([
+            "--quiet",
+            "--set",
+            "time.t_end=0.8",
+            "--set",
+            "output.flush_every=100",
+        ])
         .output()
         .unwrap();
     let read = hdf5::File::open(&out).map(|f| {

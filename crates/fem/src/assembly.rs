@@ -23,6 +23,16 @@ const NO_POSITION: usize = usize::MAX;
 /// small enough that the chunk's buffers (≈ 8 KB per Q2 element) stay modest.
 const CHUNK: usize = 1024;
 
+/// Cells from which the element kernels run on rayon's pool: below, its
+/// threads' start (at the first parallel loop of a run) and their
+/// spinning after each job cost more than the cells (the paper's slab
+/// has 16).
+const PARALLEL_CELLS: usize = 64;
+
+/// Values from which zeroing a value array is shared out between the
+/// pool's threads (one block of its chunks).
+const PARALLEL_ZEROING: usize = 1 << 16;
+
 /// Node → its places in the connectivity, by counting: node p's entries
 /// are `entries[offsets[p]..offsets[p + 1]]`, each an index k into
 /// `mesh.cells` (cell k / nodes per cell, local node k % nodes per cell),
@@ -172,8 +182,15 @@ pub fn assemble(
     assert_eq!(dirichlet_load.len(), dofs.n_free());
     // Zeroing touches every page of the value arrays (hundreds of MB at
     // 500k DOFs); in parallel, so the page faults are shared out too.
-    stiffness.par_chunks_mut(1 << 16).for_each(|c| c.fill(0.0));
-    mass.par_chunks_mut(1 << 16).for_each(|c| c.fill(0.0));
+    for values in [&mut *stiffness, &mut *mass] {
+        if values.len() > PARALLEL_ZEROING {
+            values
+                .par_chunks_mut(PARALLEL_ZEROING)
+                .for_each(|c| c.fill(0.0));
+        } else {
+            values.fill(0.0);
+        }
+    }
     lumped_nodal.fill(0.0);
     dirichlet_load.fill(0.0);
 
@@ -194,7 +211,7 @@ pub fn assemble(
     let mut first = 0;
     while first < n_cells {
         let count = CHUNK.min(n_cells - first);
-        work[..count].par_iter_mut().enumerate().for_each(|(i, w)| {
+        let kernels = |(i, w): (usize, &mut ElementWork)| {
             let cell = mesh.cell(first + i);
             let mut coords = [[0.0; 2]; MAX_NODES];
             for (c, &v) in coords.iter_mut().zip(cell) {
@@ -263,7 +280,14 @@ pub fn assemble(
                     }
                 }
             }
-        });
+        };
+        // Each cell's kernels write its own work only: the same bits on
+        // the pool or not.
+        if n_cells >= PARALLEL_CELLS {
+            work[..count].par_iter_mut().enumerate().for_each(kernels);
+        } else {
+            work[..count].iter_mut().enumerate().for_each(kernels);
+        }
         // Sequential scatter in element order: deterministic sums.
         for (i, w) in work[..count].iter().enumerate() {
             let c = first + i;

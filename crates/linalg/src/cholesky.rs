@@ -197,9 +197,16 @@ impl SparseCholesky {
             });
         }
         let symbolic = analyze_symbolic(a, order)?;
-        let factor_scratch = MemBuffer::new(
-            symbolic.factorize_numeric_llt_scratch::<f64>(parallel(), Default::default()),
-        );
+        // Scratch for the kernels `factorize` will run: asking for the
+        // pool's size below PARALLEL_MIN would start its threads for a
+        // factor they never touch.
+        let par = if symbolic.len_val() >= PARALLEL_MIN {
+            parallel()
+        } else {
+            Par::Seq
+        };
+        let factor_scratch =
+            MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
         let solver = RefCell::new(Supernodal::new(&symbolic).ok_or_else(|| {
             SolverError::Analysis("faer returned a factor layout this solver does not know".into())
         })?);

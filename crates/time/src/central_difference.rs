@@ -5,15 +5,15 @@
 
 use stickslip_contact::{iterate, ContactSurface, DiagonalStep, Foundation, SlipState};
 use stickslip_linalg::chunks;
-use stickslip_linalg::{csr, Product, Stencils};
+use stickslip_linalg::{csr, Product, SparseCholesky, Stencils};
 
 use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Mass, Statics};
+use crate::initial::{initial_state_analyzed, Mass, Statics};
 use crate::nodal::NodalFriction;
 use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError, MAX_STABLE_STEPS};
-use crate::stability::critical_step_with;
+use crate::stability::{critical_step_with, gershgorin_bound};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
 use crate::sweep::{loads_at, predict, sweep, Damped, Partials, SparseLoads, StepData, Sums};
@@ -63,8 +63,9 @@ pub(crate) struct CentralDifference {
 }
 
 /// Builds the stepper and the initial state. The critical step is
-/// estimated first, on the step's own product, so that a Δt above it is
-/// refused before any factorization.
+/// estimated on the step's own product before the preload's factorization,
+/// so that a Δt above it is refused before any; where no Δt can be refused
+/// ([`beside_the_preload`]), during it.
 ///
 /// # Errors
 /// Δt above the critical step (unless allowed), or a singular static
@@ -99,7 +100,7 @@ pub(crate) fn start(
     // (a positive semi-definite term raises every eigenvalue), so that
     // bound holds whatever the contact does. Stiffer-with-depth nodes
     // (m_n > 1) are checked step by step (`contact_stable`).
-    let dt_crit = times.time("critical step", || {
+    let critical = || {
         critical_step_with(
             |x, y| {
                 match &types {
@@ -112,21 +113,61 @@ pub(crate) fn start(
             },
             &mass,
         )
-    });
-    let dt_crit = damped_critical_step(dt_crit, settings)?;
-    let state = initial_state(
-        &k,
-        Mass::Lumped(&mass),
-        Statics {
-            fill_order: &fill_order,
-            modes: &rigid_modes,
-            times,
-            single_factor: true,
-        },
-        contact,
-        loads,
-        settings,
-    )?;
+    };
+    let initial = |times: &mut SetupTimes, analyzed| {
+        initial_state_analyzed(
+            &k,
+            Mass::Lumped(&mass),
+            Statics {
+                fill_order: &fill_order,
+                modes: &rigid_modes,
+                times,
+                single_factor: true,
+            },
+            contact,
+            loads,
+            settings,
+            analyzed,
+        )
+    };
+    let (dt_crit, state) = match beside_the_preload(&k, &mass, &rigid_modes, loads, settings) {
+        Beside::Nothing => {
+            let dt_crit = times.time("critical step", critical);
+            let dt_crit = damped_critical_step(dt_crit, settings)?;
+            (dt_crit, initial(times, None)?)
+        }
+        beside => {
+            // Lanczos on its own thread while this one analyses K for the
+            // preload, or (where no Δt can be refused) forms its whole
+            // initial state; they share only K. The critical step's part
+            // is the wall time it adds after that work, so that the parts
+            // still add up to the setup.
+            fill_order.keep_dissection();
+            let (done, (dt_crit, added)) = std::thread::scope(|s| {
+                let lanczos = s.spawn(critical);
+                let done = if beside == Beside::Preload {
+                    Done::State(Box::new(initial(times, None)))
+                } else {
+                    match times.time("preload ordering", || {
+                        SparseCholesky::analyze(&k, &fill_order)
+                    }) {
+                        Ok(analysis) => Done::Analysis(Box::new(analysis)),
+                        Err(e) => Done::State(Box::new(Err(TimeError::Static(e)))),
+                    }
+                };
+                let waited = std::time::Instant::now();
+                let dt_crit = lanczos.join().expect("the critical step's thread");
+                (done, (dt_crit, waited.elapsed().as_secs_f64()))
+            });
+            times.add("critical step", added);
+            let dt_crit = damped_critical_step(dt_crit, settings)?;
+            let state = match done {
+                Done::State(state) => (*state)?,
+                Done::Analysis(analysis) => initial(times, Some(*analysis))?,
+            };
+            (dt_crit, state)
+        }
+    };
     let product = Product::with_types(types, k);
     let n = mass.len();
     let vectors: Vec<&[f64]> = loads.loads.iter().map(|l| &l.vector[..]).collect();
@@ -477,6 +518,61 @@ impl Stepper for CentralDifference {
 ///
 /// # Errors
 /// Δt above it (unless allowed), or no usable stable step at all.
+/// Free DOFs from which the critical step's Lanczos runs beside the
+/// preload: below, a thread costs more than it saves.
+const BESIDE_MIN: usize = 100_000;
+
+/// What the critical step's Lanczos runs beside.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Beside {
+    /// Nothing: it runs first.
+    Nothing,
+    /// The preload's analysis (its ordering and symbolic factor): a Δt
+    /// above the critical step is still refused before any factorization.
+    Analysis,
+    /// The whole initial state, its factorization included.
+    Preload,
+}
+
+/// The work the critical step's thread has run beside.
+enum Done {
+    State(Box<Result<State, TimeError>>),
+    Analysis(Box<SparseCholesky>),
+}
+
+/// What the critical step may be estimated beside: for a large model
+/// (from [`BESIDE_MIN`] free DOFs) whose initial state factorizes K
+/// (loads before t = 0, no free rigid motion, a fresh start), the
+/// preload's analysis, or its whole initial state where no estimate can
+/// refuse the run's Δt (allowed above it, or within Gershgorin's bound on
+/// ω_max, [`gershgorin_bound`]), so that no factorization is spent on a
+/// run refused for its Δt.
+fn beside_the_preload(
+    k: &nalgebra_sparse::CsrMatrix<f64>,
+    mass: &[f64],
+    modes: &[stickslip_fem::RigidMode],
+    loads: &Loads,
+    settings: &Settings,
+) -> Beside {
+    use crate::settings::InitialState;
+    let preload = !settings.restoring
+        && settings.initial_state != InitialState::Rest
+        && modes.is_empty()
+        && loads.before_start().iter().any(|&x| x != 0.0);
+    if !preload || mass.len() < BESIDE_MIN {
+        return Beside::Nothing;
+    }
+    let refusable = !settings.allow_unstable && {
+        let bound = gershgorin_bound(k, mass);
+        !(bound > 0.0 && damped_critical_step(2.0 / bound.sqrt(), settings).is_ok())
+    };
+    if refusable {
+        Beside::Analysis
+    } else {
+        Beside::Preload
+    }
+}
+
 fn damped_critical_step(undamped: f64, settings: &Settings) -> Result<f64, TimeError> {
     let beta = settings.damping.beta;
     if beta == 0.0 {

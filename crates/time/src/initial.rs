@@ -72,11 +72,21 @@ pub(crate) fn cholesky_solve(
     r: &mut [f64],
     times: &mut SetupTimes,
 ) -> Result<(), TimeError> {
-    let mut solver = times
+    let solver = times
         .time("preload ordering", || {
             SparseCholesky::analyze(k, fill_order)
         })
         .map_err(TimeError::Static)?;
+    factor_solve(solver, k, r, times)
+}
+
+/// [`cholesky_solve`] with K's analysis done (by `analyze`).
+fn factor_solve(
+    mut solver: SparseCholesky,
+    k: &CsrMatrix<f64>,
+    r: &mut [f64],
+    times: &mut SetupTimes,
+) -> Result<(), TimeError> {
     times
         .time("preload factor", || solver.factorize(k))
         .map_err(TimeError::Static)?;
@@ -104,6 +114,20 @@ pub(crate) fn initial_state(
     loads: &Loads,
     settings: &Settings,
 ) -> Result<State, TimeError> {
+    initial_state_analyzed(k, mass, statics, contact, loads, settings, None)
+}
+
+/// [`initial_state`] given K's analysis for the preload (`analyzed`,
+/// where the caller made it beside other work), if it has one.
+pub(crate) fn initial_state_analyzed(
+    k: &CsrMatrix<f64>,
+    mass: Mass,
+    statics: Statics,
+    contact: Option<&ContactSurface>,
+    loads: &Loads,
+    settings: &Settings,
+    analyzed: Option<SparseCholesky>,
+) -> Result<State, TimeError> {
     let Statics {
         fill_order,
         modes,
@@ -128,6 +152,8 @@ pub(crate) fn initial_state(
         }
         if let Some(c) = compliant {
             crate::preload_compliance::solve(k, (mass, fill_order, modes), c, &mut r, times)?;
+        } else if let (Some(solver), true) = (analyzed, modes.is_empty()) {
+            factor_solve(solver, k, &mut r, times)?;
         } else if modes.is_empty() {
             cholesky_solve(k, fill_order, &mut r, times)?;
         } else {

@@ -136,6 +136,28 @@ fn tridiagonal_max_eigenvalue(a: &[f64], b: &[f64]) -> f64 {
     hi
 }
 
+/// An upper bound on ω_max², the largest eigenvalue of M⁻¹K for a
+/// diagonal (lumped) mass: Gershgorin's, the largest row sum of
+/// |M^{-1/2} K M^{-1/2}|, max_i Σ_j |K_ij| / √(m_i m_j). Safe but loose
+/// (above [`largest_eigenvalue`]'s estimate), for deciding what no Δt
+/// below 2/√bound can be refused for.
+pub fn gershgorin_bound(stiffness: &CsrMatrix<f64>, lumped_mass: &[f64]) -> f64 {
+    let scale: Vec<f64> = lumped_mass.iter().map(|m| 1.0 / m.sqrt()).collect();
+    stiffness
+        .row_iter()
+        .zip(&scale)
+        .map(|(row, si)| {
+            let sum: f64 = row
+                .col_indices()
+                .iter()
+                .zip(row.values())
+                .map(|(&j, v)| v.abs() * scale[j])
+                .sum();
+            sum * si
+        })
+        .fold(0.0, f64::max)
+}
+
 /// Δt_crit = 2/ω_max for central difference with the lumped mass.
 pub fn critical_step(stiffness: &CsrMatrix<f64>, lumped_mass: &[f64]) -> f64 {
     critical_step_with(|x, y| spmv(stiffness, x, y), lumped_mass)
@@ -200,6 +222,28 @@ mod tests {
         let m4 = vec![4.0; n];
         let ratio = critical_step(&k, &m4) / critical_step(&k, &m);
         assert!((ratio - 2.0).abs() < 1e-6, "ratio {ratio}");
+    }
+
+    #[test]
+    fn gershgorin_bounds_the_chain_from_above() {
+        // Fixed-fixed chain: every row of K is (−1, 2, −1), masses m, so
+        // each row sum of |M^{-1/2} K M^{-1/2}| is 4/m, the bound; above
+        // λ_max = 4 sin²(nπ/(2(n+1)))/m, by 1.5e-5 of it at n = 400.
+        let n = 400;
+        let k = chain(n, true);
+        for m in [1.0, 4.0] {
+            let exact = 4.0
+                * (n as f64 * std::f64::consts::PI / (2.0 * (n as f64 + 1.0)))
+                    .sin()
+                    .powi(2)
+                / m;
+            let bound = gershgorin_bound(&k, &vec![m; n]);
+            assert_eq!(bound, 4.0 / m);
+            assert!(
+                bound > exact && bound - exact < 2e-5 * exact,
+                "{bound} {exact}"
+            );
+        }
     }
 
     #[test]

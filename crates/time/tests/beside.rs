@@ -1,0 +1,127 @@
+//! From 100k free DOFs the explicit scheme estimates its critical step
+//! (Lanczos) on a thread of its own beside the static preload: beside the
+//! preload's analysis where the run's Δt could be refused, beside the
+//! whole preload where it cannot (within Gershgorin's bound on ω_max, or
+//! `allow_unstable`). Either way the critical step and the initial state
+//! have the bits of the sequential computation, written out here with the
+//! crates' public functions, and a Δt above the critical step is still
+//! refused.
+
+use stickslip_linalg::SparseCholesky;
+use stickslip_testkit::{structured_slab, Slab};
+use stickslip_time::stability::{critical_step, gershgorin_bound, largest_eigenvalue};
+use stickslip_time::{Dynamics, History, Integrator, Scheme, Settings, TimeError};
+
+/// The paper's slab on a Q1 grid of 102,770 free DOFs (above the 100k
+/// from which the critical step runs beside the preload).
+fn slab() -> Slab {
+    let s = Slab::paper(structured_slab(456, 112, false), 1e-4, History::Step, true).unwrap();
+    assert!(
+        s.model.dofs.n_free() >= 100_000,
+        "{}",
+        s.model.dofs.n_free()
+    );
+    s
+}
+
+/// The scene's dynamics, its K·x the assembled CSR's (no stencil types),
+/// which `critical_step` forms too.
+fn dynamics(s: &Slab) -> Dynamics {
+    let mut d = Dynamics::from_model(&s.model);
+    d.stencils = false;
+    d
+}
+
+fn integrator(s: &Slab, settings: Settings) -> Result<Integrator, TimeError> {
+    Integrator::new(dynamics(s), s.contact.clone(), s.loads.clone(), settings)
+}
+
+/// The names of an integrator's setup parts, in the order taken.
+fn parts(i: &Integrator) -> Vec<&'static str> {
+    i.setup_times().parts().iter().map(|(n, _)| *n).collect()
+}
+
+#[test]
+fn the_critical_step_beside_the_preload_has_the_sequential_bits() {
+    let s = slab();
+    let d = dynamics(&s);
+    let (k, m) = (&d.stiffness, &d.lumped_mass);
+    // Sequentially: Lanczos on K and the lumped mass, then Remark 4.1's
+    // r₀ = K⁻¹ R(0⁻) by Cholesky on the dissection's order (the preload:
+    // the pressure, constant; the end load is a step, 0 before t = 0).
+    let dt_crit = critical_step(k, m);
+    let mut r0 = d.constant_load.clone();
+    for l in &s.loads {
+        let theta = l.history.before_start();
+        for (r, f) in r0.iter_mut().zip(&l.vector) {
+            *r += theta * f;
+        }
+    }
+    d.fill_order.keep_dissection();
+    let mut chol = SparseCholesky::analyze(k, &d.fill_order).unwrap();
+    chol.factorize(k).unwrap();
+    chol.solve_in_place(&mut r0);
+
+    // Gershgorin's bound is above the estimate (ω_max² from below), so
+    // its Δt is below the critical step: this one can be refused.
+    let bound = gershgorin_bound(k, m);
+    let lambda = largest_eigenvalue(k, m, 300);
+    assert!(bound >= lambda, "{bound} < {lambda}");
+    let refusable = 0.99 * dt_crit;
+    assert!(refusable > 2.0 / bound.sqrt());
+    let cd = |dt| Settings::new(Scheme::CentralDifference, dt, 0.5);
+    let analysis = integrator(&s, cd(refusable)).unwrap();
+    // Within the bound, or allowed above it: nothing to refuse.
+    let within = integrator(&s, cd(1e-9)).unwrap();
+    let mut unstable = cd(2.0 * dt_crit);
+    unstable.allow_unstable = true;
+    let allowed = integrator(&s, unstable).unwrap();
+    for (what, i, order) in [
+        (
+            "beside the analysis",
+            &analysis,
+            [
+                "preload ordering",
+                "critical step",
+                "preload factor",
+                "preload solve",
+            ],
+        ),
+        (
+            "beside the preload (within the bound)",
+            &within,
+            [
+                "preload ordering",
+                "preload factor",
+                "preload solve",
+                "critical step",
+            ],
+        ),
+        (
+            "beside the preload (allowed)",
+            &allowed,
+            [
+                "preload ordering",
+                "preload factor",
+                "preload solve",
+                "critical step",
+            ],
+        ),
+    ] {
+        assert_eq!(
+            i.dt_crit().map(f64::to_bits),
+            Some(dt_crit.to_bits()),
+            "{what}"
+        );
+        assert!(i.displacement() == &r0[..], "{what}: r₀");
+        let taken: Vec<_> = parts(i).into_iter().filter(|p| order.contains(p)).collect();
+        assert_eq!(taken, order, "{what}: the parts' order");
+    }
+    // Above the critical step: refused, its Δt_crit the same.
+    match integrator(&s, cd(1.01 * dt_crit)) {
+        Err(TimeError::Unstable { dt_crit: said, .. }) => {
+            assert_eq!(said.to_bits(), dt_crit.to_bits());
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+}
