@@ -121,22 +121,30 @@ fn bad_compliance_input_is_named_at_its_line() {
     }
 }
 
-/// The static preload and the implicit schemes are not there yet for the
-/// law: refused at the key that asks for them.
+/// The static preload and the quasi-static increments are not there yet
+/// for the law: refused at the key that asks for them.
 #[test]
 fn the_law_runs_from_rest_with_central_difference() {
-    let text = slab(FLOOR, "[initial]\nstate = \"static\"\n").replace(
-        "\"central_difference\"",
-        "\"newmark\"\nmass = \"consistent\"",
-    );
+    let text = slab(FLOOR, "[initial]\nstate = \"static\"\n")
+        .replace("\"central_difference\"", "\"quasi_static\"");
     let e = load(&text).unwrap_err();
     assert_at(&e, &text, "state = \"static\"", "starts at rest only");
     assert_at(
         &e,
         &text,
-        "scheme = \"newmark\"",
-        "runs with time.scheme = \"central_difference\" only",
+        "scheme = \"quasi_static\"",
+        "runs with time.scheme = \"central_difference\" or \"newmark\"",
     );
+}
+
+/// Newmark takes the law from rest.
+#[test]
+fn the_law_runs_with_newmark() {
+    let text = slab(FLOOR, REST).replace(
+        "\"central_difference\"",
+        "\"newmark\"\nmass = \"consistent\"",
+    );
+    assemble(&load(&text).unwrap()).unwrap();
 }
 
 /// A node that starts inside the foundation is refused with its place.
