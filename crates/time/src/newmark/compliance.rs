@@ -8,7 +8,9 @@
 //! per compliant node (`schur.rs`), and with x = (u_T, u_N) the step's
 //! nodal system is
 //!
-//!     R(x) = x + S f(x) − p = 0,
+//! ```text
+//! R(x) = x + S f(x) − p = 0,
+//! ```
 //!
 //! f_N,J = −w_J c_n δ_J^{m_n} (the foundation pushes along +ν; f enters as
 //! −Pᵀf) and f_T,J the friction of the node's class with the bound
