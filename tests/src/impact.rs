@@ -97,7 +97,20 @@ impl Bar {
     /// # Errors
     /// The integrator's.
     pub fn integrator(&self, dt: f64, allow_unstable: bool) -> Result<Integrator, TimeError> {
-        let mut s = Settings::new(Scheme::CentralDifference, dt, 3.0 * L / C);
+        self.integrator_with(Scheme::CentralDifference, dt, allow_unstable)
+    }
+
+    /// [`Bar::integrator`] by `scheme` (Newmark with the consistent mass).
+    ///
+    /// # Errors
+    /// The integrator's.
+    pub fn integrator_with(
+        &self,
+        scheme: Scheme,
+        dt: f64,
+        allow_unstable: bool,
+    ) -> Result<Integrator, TimeError> {
+        let mut s = Settings::new(scheme, dt, 3.0 * L / C);
         s.initial_state = InitialState::Rest;
         s.initial_velocity = Some(self.v0.clone());
         s.allow_unstable = allow_unstable;
@@ -141,7 +154,35 @@ pub fn run_with(
 ) -> Result<Impact, SceneError> {
     let bar = Bar::new(nx, law)?;
     let dt_crit = bar.dt_crit()?;
-    let mut run = bar.integrator(courant * dt_crit, allow_unstable)?;
+    let run = bar.integrator(courant * dt_crit, allow_unstable)?;
+    measure(&bar, run, dt_crit, allow_unstable)
+}
+
+/// The bar of `nx` Q1 cells against a wall of law `law` by Newmark
+/// (β, γ) with the consistent mass and step `dt`, run to 3L/c
+/// ([`Impact::dt_crit`] is the explicit one's, for scale).
+///
+/// # Errors
+/// The scene's or the integrator's.
+pub fn run_newmark(
+    nx: usize,
+    law: Compliance,
+    (beta, gamma): (f64, f64),
+    dt: f64,
+) -> Result<Impact, SceneError> {
+    let bar = Bar::new(nx, law)?;
+    let dt_crit = bar.dt_crit()?;
+    let run = bar.integrator_with(Scheme::Newmark { beta, gamma }, dt, false)?;
+    measure(&bar, run, dt_crit, false)
+}
+
+/// Steps `run` to its end and measures the impact.
+fn measure(
+    bar: &Bar,
+    mut run: Integrator,
+    dt_crit: f64,
+    allow_unstable: bool,
+) -> Result<Impact, SceneError> {
     let (mesh, model, contact) = (&bar.mesh, &bar.model, &bar.contact);
     let mut growth: f64 = 1.0;
     let e0 = run.energy().kinetic;

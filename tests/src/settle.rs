@@ -28,9 +28,28 @@ pub const P: f64 = 10.0;
 /// # Errors
 /// The scene's or the integrator's.
 pub fn settle(nx: usize, cn: f64, mn: f64) -> Result<(f64, f64), SceneError> {
+    settle_by(nx, cn, mn, None)
+}
+
+/// [`settle`] by Newmark (β, γ) with step Δt where `newmark` is `Some(((β,
+/// γ), Δt))`, by central difference at half its critical step where
+/// `None`.
+///
+/// # Errors
+/// The scene's or the integrator's.
+pub fn settle_by(
+    nx: usize,
+    cn: f64,
+    mn: f64,
+    newmark: Option<((f64, f64), f64)>,
+) -> Result<(f64, f64), SceneError> {
     let block = Block::new(nx, cn, mn)?;
     let build = |dt: f64| {
-        let mut s = Settings::new(Scheme::CentralDifference, dt, 4.0);
+        let scheme = match newmark {
+            Some(((beta, gamma), _)) => Scheme::Newmark { beta, gamma },
+            None => Scheme::CentralDifference,
+        };
+        let mut s = Settings::new(scheme, dt, 4.0);
         s.initial_state = InitialState::Rest;
         s.damping = Rayleigh {
             alpha: 40.0,
@@ -38,8 +57,13 @@ pub fn settle(nx: usize, cn: f64, mn: f64) -> Result<(f64, f64), SceneError> {
         };
         block.integrator(s)
     };
-    let dt_crit = build(1e-6)?.dt_crit().unwrap_or(f64::NAN);
-    let mut run = build(0.5 * dt_crit)?;
+    let mut run = match newmark {
+        Some((_, dt)) => build(dt)?,
+        None => {
+            let dt_crit = build(1e-6)?.dt_crit().unwrap_or(f64::NAN);
+            build(0.5 * dt_crit)?
+        }
+    };
     while !run.done() {
         run.step()?;
     }

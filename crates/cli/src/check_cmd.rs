@@ -81,9 +81,13 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     }
     if let Some(c) = i.contact().filter(|c| c.is_compliant()) {
         println!(
-            "foundation  {} of them on a compliant foundation (law = \"compliance\"); dt_crit \
-             below includes its springs",
-            c.compliance.len()
+            "foundation  {} of them on a compliant foundation (law = \"compliance\"); {}",
+            c.compliance.len(),
+            if i.is_explicit() {
+                "dt_crit below includes its springs"
+            } else {
+                "each step solves its normal and friction forces together (Newton)"
+            }
         );
     }
     if let Some(why) = friction_off(case, i).filter(|_| i.contact().is_some()) {

@@ -961,6 +961,11 @@ impl Session<'_> {
         if !self.options.quiet {
             let friction = match &friction_off {
                 Some(why) => format!("friction off ({why})"),
+                None if i.normal_iterations() > 0 => format!(
+                    "{} stick/slip iterations, {} compliance Newton iterations",
+                    i.total_iterations(),
+                    i.normal_iterations()
+                ),
                 None => format!("{} stick/slip iterations", i.total_iterations()),
             };
             say!(

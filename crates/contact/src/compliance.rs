@@ -61,6 +61,17 @@ impl Compliance {
         }
     }
 
+    /// The friction bound's slope dg/dδ = c_T m_T δ^{m_T−1}, c_T at every
+    /// δ for m_T = 1 (the implicit step's Newton matrix needs it).
+    #[inline]
+    pub fn bound_slope(&self, delta: f64) -> f64 {
+        if self.mt == 1.0 {
+            self.ct
+        } else {
+            self.ct * self.mt * power(delta, self.mt - 1.0)
+        }
+    }
+
     /// The stored energy per unit length, c_n δ^{m_n+1}/(m_n+1).
     #[inline]
     pub fn energy(&self, delta: f64) -> f64 {

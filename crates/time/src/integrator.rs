@@ -362,6 +362,13 @@ impl Integrator {
     pub fn total_iterations(&self) -> u64 {
         self.state.total_iterations
     }
+    /// Newton iterations of a compliant foundation's implicit solves so
+    /// far (0 for explicit runs and prescribed pressures).
+    pub fn normal_iterations(&self) -> u64 {
+        self.stepper
+            .implicit()
+            .map_or(0, ImplicitFriction::normal_iterations)
+    }
     /// Numeric factorizations of the implicit operator so far.
     pub fn factorizations(&self) -> u64 {
         self.stepper
@@ -448,16 +455,16 @@ impl Integrator {
     }
 }
 
-/// What the compliance law needs of the run: the explicit scheme (the
-/// implicit ones would solve the normal and friction terms together, which
-/// they do not yet). Either start works: at rest, or from the static
-/// preload with the compliance (`preload_compliance.rs`).
+/// What the compliance law needs of the run: a dynamic scheme (quasi-static
+/// increments would solve the normal and friction terms together without
+/// inertia, which they do not yet). Either start works: at rest, or from
+/// the static preload with the compliance (`preload_compliance.rs`).
 fn check_compliance(contact: &ContactSurface, settings: &Settings) -> Result<(), TimeError> {
-    if settings.scheme != Scheme::CentralDifference {
+    if settings.scheme == Scheme::QuasiStatic {
         return Err(TimeError::Settings(format!(
             "surface {} has law = \"compliance\", which runs with time.scheme = \
-             \"central_difference\" only: the implicit schemes do not yet solve the normal and \
-             friction terms together; use central difference",
+             \"central_difference\" or \"newmark\": the quasi-static increments do not yet solve \
+             the normal and friction terms together; use one of the dynamic schemes",
             contact.names()
         )));
     }

@@ -348,6 +348,25 @@ pub enum TimeError {
         /// Extra advice (the critical step of an explicit run).
         hint: String,
     },
+    /// The Newton solve of a compliant foundation's normal and friction
+    /// forces did not converge (Newmark).
+    #[error(
+        "step {step} (t = {t:.6e}): the normal-compliance Newton solve did not converge in \
+         {iterations} iterations (residual {residual:.3e} of scale {scale:.3e}); reduce time.dt, \
+         or soften the foundation (contact.cn)"
+    )]
+    NormalSolve {
+        /// Step number (1-based).
+        step: u64,
+        /// Time the step was going to.
+        t: f64,
+        /// Newton iterations performed.
+        iterations: usize,
+        /// The largest residual left.
+        residual: f64,
+        /// The size the residual is measured against.
+        scale: f64,
+    },
 }
 
 /// "translation in x: net force F_x = …; rotation about (x, y): moment

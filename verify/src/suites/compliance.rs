@@ -1,31 +1,46 @@
 //! The normal-compliance law (METHOD.md §10) against closed forms: the bar
 //! impact of Hughes et al. approaching the rigid wall's contact time 2L/c,
 //! stress ρcv₀ and exit velocity −v₀ as the wall stiffens (a table against
-//! c_n and h), and a block pressed onto a compliant floor settling at the
-//! approach (p/c_n)^{1/m_n}, by a damped run and by the static preload.
-//! All cheap: milliseconds a run.
+//! c_n and h, central difference and Newmark ¼, ½), and a block pressed
+//! onto a compliant floor settling at the approach (p/c_n)^{1/m_n}, by
+//! damped runs of both schemes and by the static preload. All cheap:
+//! milliseconds a run.
 
-use stickslip_testkit::impact::{self, wall, C, L, V0};
+use stickslip_testkit::impact::{self, wall, Impact, C, L, V0};
+use stickslip_testkit::scene::SceneError;
 use stickslip_testkit::settle;
 
 use crate::report::{num, Report};
 
 /// Runs the checks.
 pub fn run(r: &mut Report) {
-    bar_impact(r);
-    settling(r);
+    bar_impact(r, "", |nx, law| impact::run(nx, law, 0.5));
+    // Newmark at Δt = h/(2c), about the explicit run's step.
+    bar_impact(r, " by Newmark", |nx, law| {
+        impact::run_newmark(nx, law, (0.25, 0.5), 0.5 * L / nx as f64 / C)
+    });
+    settling(r, "", None);
+    // Newmark's numerical damping (γ = 0.6) for the high modes, which the
+    // mass-proportional damping leaves ringing at ωΔt ≫ 1.
+    settling(r, " by Newmark 0.3025, 0.6", Some(((0.3025, 0.6), 0.01)));
 }
 
 /// The wall's stiffness relative to a cell's, E/h.
 const WALLS: [f64; 4] = [0.1, 0.3, 1.0, 3.0];
 
-fn bar_impact(r: &mut Report) {
+/// The table against c_n and h for one scheme (`by`, appended to the
+/// case's name, "" for central difference), run by `run`.
+fn bar_impact(
+    r: &mut Report,
+    by: &str,
+    run: impl Fn(usize, stickslip_contact::Compliance) -> Result<Impact, SceneError>,
+) {
     let rigid = 2.0 * L / C;
     for nx in [20, 40] {
         let mut softer = f64::INFINITY;
         for cn in WALLS {
-            let case = format!("bar impact {nx} cells, c_n = {cn} E/h");
-            let run = match impact::run(nx, wall(nx, cn), 0.5) {
+            let case = format!("bar impact {nx} cells, c_n = {cn} E/h{by}");
+            let run = match run(nx, wall(nx, cn)) {
                 Ok(run) => run,
                 Err(e) => {
                     r.holds(&case, "runs", e.to_string(), "runs", false);
@@ -86,11 +101,11 @@ fn bar_impact(r: &mut Report) {
     }
 }
 
-fn settling(r: &mut Report) {
+fn settling(r: &mut Report, by: &str, newmark: Option<((f64, f64), f64)>) {
     for (cn, mn) in [(1e3, 1.0), (1e5, 2.0)] {
-        let case = format!("block settling on c_n = {cn:e}, m_n = {mn}");
+        let case = format!("block settling on c_n = {cn:e}, m_n = {mn}{by}");
         let expected = (settle::P / cn).powf(1.0 / mn);
-        match settle::settle(8, cn, mn) {
+        match settle::settle_by(8, cn, mn, newmark) {
             Ok((most, least)) => {
                 for (what, d) in [("largest approach", most), ("smallest approach", least)] {
                     r.close(&case, what, d, expected, "(p/c_n)^(1/m_n)", 1e-9);

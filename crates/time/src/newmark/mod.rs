@@ -7,6 +7,7 @@
 //! step's velocity with its friction, which the quasi-static increments
 //! share (`quasi_static.rs`: the same system with M = 0).
 
+mod compliance;
 mod direct;
 mod schur;
 
@@ -23,6 +24,7 @@ use crate::settings::{ImplicitSolver, MassKind, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
 
+use compliance::{CompliantSolve, CompliantStep};
 use direct::{DirectOperator, ImplicitStep};
 use schur::SchurOperator;
 
@@ -45,6 +47,9 @@ pub(crate) struct ImplicitFriction {
     /// The Schur path's nodal tangential velocities.
     nodal_velocity: Vec<f64>,
     iter_scratch: Vec<SlipState>,
+    /// A compliant foundation's Newton solve (Schur path; `None` without
+    /// one).
+    compliant: Option<Box<CompliantSolve>>,
 }
 
 /// The Newmark stepper.
@@ -60,6 +65,9 @@ pub(crate) struct Newmark {
     b: Vec<f64>,
     tmp: Vec<f64>,
     partials: Vec<[f64; 2]>,
+    /// A compliant foundation's nodal forces at r_K (`comply`'s output,
+    /// unused here: the step's forces come from its Newton solve).
+    normal: Vec<f64>,
 }
 
 /// Builds the stepper and the initial state.
@@ -127,6 +135,7 @@ pub(crate) fn start(
         b: vec![0.0; n],
         tmp: vec![0.0; n],
         partials: chunks::partials(n),
+        normal: Vec::new(),
     };
     Ok((Box::new(stepper), state))
 }
@@ -160,11 +169,24 @@ impl ImplicitFriction {
             )),
         };
         let n_c = contact.map_or(0, |c| c.len());
+        let compliant = match (&solver, contact.filter(|c| c.is_compliant())) {
+            (Solver::Schur(_), Some(c)) => Some(Box::new(CompliantSolve::new(c))),
+            (Solver::Direct(_), Some(c)) => {
+                return Err(TimeError::Settings(format!(
+                    "surface {} has law = \"compliance\", which the implicit schemes solve on the \
+                     Schur complement only (ImplicitSolver::Schur, the case's), not the direct \
+                     reference",
+                    c.names()
+                )))
+            }
+            _ => None,
+        };
         Ok(ImplicitFriction {
             solver,
             lagged: contact.filter(|c| c.weakens()).map(ContactSurface::lagged),
             nodal_velocity: vec![0.0; n_c],
             iter_scratch: vec![SlipState::Stuck; n_c],
+            compliant,
         })
     }
 
@@ -223,6 +245,24 @@ impl ImplicitFriction {
                 if let Some(c) = contact.filter(|c| !c.foundation.is_empty()) {
                     reduced.foundation.clone_from(&c.foundation);
                 }
+                if let Some(solve) = self.compliant.as_deref_mut() {
+                    let result = iterate(
+                        &reduced,
+                        &mut CompliantStep { op, solve },
+                        classes_new,
+                        &mut self.iter_scratch,
+                        &mut self.nodal_velocity,
+                        options,
+                    );
+                    op.reduced = Some(reduced);
+                    let report = result.map_err(|f| {
+                        TimeError::from_iteration(f, (step, t, options.remark_4_2), |e| {
+                            e.into_error(step, t)
+                        })
+                    })?;
+                    op.finish(v_new);
+                    return Ok(report.iterations);
+                }
                 let result = iterate(
                     &reduced,
                     &mut op.nodal_system(),
@@ -256,6 +296,26 @@ impl ImplicitFriction {
                 Ok(report.iterations)
             }
         }
+    }
+
+    /// A compliant foundation's step: its nodes' approach follows the
+    /// predictor `r_pred` and r_K = r_pred + c3 ṙ_K; the Newton solve
+    /// starts from the last velocity `v`. Nothing without one.
+    pub(crate) fn predict_normal(
+        &mut self,
+        contact: &ContactSurface,
+        r_pred: &[f64],
+        v: &[f64],
+        c3: f64,
+    ) {
+        if let Some(solve) = self.compliant.as_deref_mut() {
+            solve.predict(contact, r_pred, v, c3);
+        }
+    }
+
+    /// Newton iterations of a compliant foundation's solves so far.
+    pub(crate) fn normal_iterations(&self) -> u64 {
+        self.compliant.as_deref().map_or(0, |s| s.newton)
     }
 
     /// Numeric factorizations so far.
@@ -344,6 +404,10 @@ impl Stepper for Newmark {
         state.classes_new.copy_from_slice(&state.classes);
         self.friction.lag_mu(run, &state.v);
         let mut v_new = std::mem::take(&mut state.v_new);
+        let c3 = beta / gamma * dt;
+        if let Some(c) = run.contact.as_ref().filter(|c| c.is_compliant()) {
+            self.friction.predict_normal(c, &state.r_new, &state.v, c3);
+        }
         // Rayleigh damping C = αM + βK joins A₀ (METHOD.md §8); R̂_K is
         // unchanged, as ṙ_K is the unknown.
         let c = run.settings.damping;
@@ -364,7 +428,6 @@ impl Stepper for Newmark {
 
         // Corrector and r̈_K, with the finiteness check (a flag, not a
         // branch per entry).
-        let c3 = beta / gamma * dt;
         let ka = (1.0 - gamma) / gamma;
         let mut finite = true;
         for ((r, v_new), (a_new, (v, a))) in state
@@ -384,6 +447,13 @@ impl Stepper for Newmark {
                 hint: String::new(),
             });
         }
+        // The compliant nodes' bounds at r_K for the ledger's friction
+        // forces, and the foundation's stored energy.
+        let foundation_stored = match run.contact.as_mut().filter(|c| c.is_compliant()) {
+            Some(c) => c.comply(&state.r_new, &[], &mut self.normal).stored,
+            None => 0.0,
+        };
+        let settings = &run.settings;
         let (work, load_dot) = state.load_work();
         let ((dissipated, foundation), stick_events) = match self.friction.surface(run) {
             Some(c) => {
@@ -402,7 +472,7 @@ impl Stepper for Newmark {
             dissipated,
             damped,
             foundation,
-            foundation_stored: 0.0,
+            foundation_stored,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))

@@ -31,7 +31,7 @@ use faer::linalg::cholesky::llt::factor::{LltError, LltParams};
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::{MatMut, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
-use stickslip_contact::{ContactNode, ContactSurface, SlipState, StepSystem};
+use stickslip_contact::{CompliantNode, ContactNode, ContactSurface, SlipState, StepSystem};
 use stickslip_linalg::{
     analyze_symbolic, csc_view, FillOrder, PathOperator, SolverError, Supernodal,
 };
@@ -108,14 +108,17 @@ pub(crate) struct SchurOperator {
     use_paths: Option<bool>,
     /// The contact nodes as seen by P.
     nodes: Vec<ContactNode>,
+    /// A compliant foundation's nodes: P gains a row ν_J after the n_c
+    /// tangential ones for each (`compliance.rs`); empty otherwise.
+    pub(super) compliant: Vec<CompliantNode>,
     /// The same nodes as unit nodes on the n_c nodal unknowns, for the
     /// iteration.
     pub reduced: Option<ContactSurface>,
     dense: DenseFactor,
     /// p = P v₀.
-    p: Vec<f64>,
+    pub(super) p: Vec<f64>,
     /// f of the last solve of the iteration.
-    f: Vec<f64>,
+    pub(super) f: Vec<f64>,
     pub factorizations: u64,
 }
 
@@ -146,6 +149,8 @@ impl SchurOperator {
             .collect();
         sn.set_reach(&contact_dofs);
         let n_c = nodes.len();
+        let compliant = contact.map(|c| c.compliance.clone()).unwrap_or_default();
+        let rows = n_c + compliant.len();
         let reduced = contact
             .filter(|_| n_c > 0)
             .map(ContactSurface::on_tangential_unknowns);
@@ -180,10 +185,11 @@ impl SchurOperator {
             next_id: 0,
             use_paths,
             nodes,
+            compliant,
             reduced,
             dense,
-            p: vec![0.0; n_c],
-            f: vec![0.0; n_c],
+            p: vec![0.0; rows],
+            f: vec![0.0; rows],
             factorizations: 0,
         })
     }
@@ -303,7 +309,7 @@ impl SchurOperator {
     /// contact DOFs' paths, eight columns per pass
     /// (`Supernodal::schur_complement`).
     fn build_schur(&mut self, slot: usize) {
-        let n_c = self.nodes.len();
+        let n_c = self.rows();
         let entry = &mut self.entries[slot];
         entry.s.clear();
         entry.s.resize(n_c * n_c, 0.0);
@@ -311,16 +317,22 @@ impl SchurOperator {
         if n_c == 0 {
             return;
         }
+        let row = |node: &ContactNode, along: [f64; 2]| -> Vec<(usize, f64)> {
+            node.dofs
+                .iter()
+                .zip(along)
+                .filter_map(|(d, t)| d.map(|i| (self.perm[i], t)))
+                .collect()
+        };
         let rows: Vec<Vec<(usize, f64)>> = self
             .nodes
             .iter()
-            .map(|node| {
-                node.dofs
+            .map(|node| row(node, node.tangent))
+            .chain(
+                self.compliant
                     .iter()
-                    .zip(node.tangent)
-                    .filter_map(|(d, t)| d.map(|i| (self.perm[i], t)))
-                    .collect()
-            })
+                    .map(|c| row(&self.nodes[c.index], c.normal)),
+            )
             .collect();
         let mut op = self.sn.schur_complement(&entry.l_values, &rows);
         entry.s = std::mem::take(&mut op.s);
@@ -331,6 +343,17 @@ impl SchurOperator {
             .use_paths
             .unwrap_or(12 * op.w_len() < 8 * self.sn.reach_len());
         entry.paths = paths.then_some(op);
+    }
+
+    /// Rows of P: the n_c tangential ones, then a compliant node's normal.
+    pub(super) fn rows(&self) -> usize {
+        self.nodes.len() + self.compliant.len()
+    }
+
+    /// S = P A₀⁻¹ Pᵀ of the current Δt, column-major, [`Self::rows`]
+    /// square.
+    pub(super) fn schur(&self) -> &[f64] {
+        &self.entries[self.current].s
     }
 
     fn solve(&mut self, x: &mut [f64]) {
@@ -362,6 +385,17 @@ impl SchurOperator {
             }
             *p = sum;
         }
+        let n_c = self.nodes.len();
+        for (p, c) in self.p[n_c..].iter_mut().zip(&self.compliant) {
+            let node = &self.nodes[c.index];
+            let mut sum = 0.0;
+            for (d, n) in node.dofs.iter().zip(c.normal) {
+                if let Some(i) = d {
+                    sum += n * self.sn.reach_value(self.perm[*i]);
+                }
+            }
+            *p = sum;
+        }
     }
 
     /// The nodal system of this step for the iteration.
@@ -381,6 +415,14 @@ impl SchurOperator {
             for (d, t) in node.dofs.iter().zip(node.tangent) {
                 if let Some(i) = d {
                     self.correction.push((self.perm[*i], f * t));
+                }
+            }
+        }
+        let n_c = self.nodes.len();
+        for (c, f) in self.compliant.iter().zip(&self.f[n_c..]) {
+            for (d, n) in self.nodes[c.index].dofs.iter().zip(c.normal) {
+                if let Some(i) = d {
+                    self.correction.push((self.perm[*i], f * n));
                 }
             }
         }
