@@ -1673,7 +1673,7 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
     let small = dir.join("small");
     std::fs::create_dir_all(&small).unwrap();
     let mounted = Command::new("mount")
-        .args(["-t", "tmpfs", "-o", "size=4M", "tmpfs"])
+        .args(["-t", "tmpfs", "-o", "size=6M", "tmpfs"])
         .arg(&small)
         .stderr(Stdio::null())
         .status()
@@ -1695,11 +1695,12 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
         .arg(&case)
         .arg("-o")
         .arg(&out)
-        // 801 records of 4.5 kB: they fit the 4 MB when the run starts
+        // 801 records of 4.6 kB: they fit the 6 MB when the run starts
         // (a run whose records cannot fit is refused before it starts),
-        // but not with the room each write keeps (1.2 MB here). Flushes
-        // every 100 steps: a run this short makes none by time, and it
-        // is the room a flush needs that stops it.
+        // but not with the room each write keeps (4.4 MB here: a MiB of
+        // pending rows, twice, and HDF5's own). Flushes every 100 steps:
+        // a run this short makes none by time, and it is the room a
+        // flush needs that stops it, after flushes that left a checkpoint.
         .args([
             "--quiet",
             "--set",
