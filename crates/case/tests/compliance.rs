@@ -228,6 +228,39 @@ fn a_static_start_settles_a_node_inside_the_foundation() {
     }
 }
 
+/// An interference with nothing holding the part against the foundation:
+/// the slab, its left end held in x only (free to translate in y), starts
+/// with its bottom 0.02 inside the floor and no load; the only static
+/// state is the slab lifted rigidly until it just touches (closed form:
+/// u_y = 0.02 everywhere, no traction). To 1e-9 of 0.02 and of c_n·0.02.
+#[test]
+fn a_static_start_lifts_a_free_part_out_of_the_foundation() {
+    let d = 0.02;
+    let floor = FLOOR.replace("point = [0.0, -0.01]", "point = [0.0, 0.02]");
+    let text = slab(
+        &format!("[[dirichlet]]\ngroup = \"left\"\nux = 0.0\n{floor}"),
+        "[initial]\nstate = \"static\"\n",
+    );
+    let case = load(&text).unwrap();
+    let running = assemble(&case).unwrap().running(&case).unwrap();
+    let run = &running.integrator;
+    let contact = run.contact().unwrap();
+    let mut traction = vec![0.0; contact.len()];
+    run.normal_traction(&mut traction);
+    for (n, t) in contact.nodes.iter().zip(&traction) {
+        assert!(t.abs() <= 1e-9 * 1e4 * d, "node {}: traction {t}", n.node);
+    }
+    let u = run.displacement();
+    for node in 0..running.mesh.nodes.len() {
+        for (c, expected) in [(0, 0.0), (1, d)] {
+            if let Some(i) = running.dofs.free(node, c) {
+                let v = u[i];
+                assert!((v - expected).abs() <= 1e-9 * d, "node {node}, u_{c}: {v}");
+            }
+        }
+    }
+}
+
 /// A moving foundation or a speed-dependent μ on a compliance surface is
 /// not built: each is refused at its line rather than ignored.
 #[test]
