@@ -71,9 +71,10 @@ const SOFT: [f64; 5] = [1e4, 1e3, 1e2, 1e1, 1e0];
 /// The bound on the difference at the softest floor, relative to the
 /// history's size: the friction bound's relative change there, c_n
 /// |Δu_y| / p, with |Δu_y| ≤ 2 ν (1 + ν) |t_x| H / E (the end load's
-/// Poisson swell of the thickness, doubled by the step load's dynamics):
-/// a difference of the friction force of that fraction moves the
-/// displacement history by no more than that fraction of itself.
+/// Poisson swell of the thickness, doubled by the step load's dynamics).
+/// The friction force differs from the paper's by that fraction at most,
+/// and the displacement history, which it drives, is held to the same
+/// fraction of itself.
 fn soft_limit(cn: f64) -> f64 {
     let (p, tx, e, nu, h) = (300.0, 150.0, 1000.0, 0.3, 1.0);
     cn * 2.0 * nu * (1.0 + nu) * tx * h / e / p
