@@ -9,7 +9,7 @@ use stickslip_contact::{Compliance, ContactError, ContactSurface};
 use stickslip_fem::DofMap;
 use stickslip_mesh::Mesh;
 
-use crate::schema::{Case, ContactLaw, ContactSection, History, Mu, Scheme};
+use crate::schema::{Case, ContactLaw, ContactSection, History, InitialState, Mu, Scheme};
 
 /// A key's dotted path on the surface, and whether a dotted key is in the
 /// case's text.
@@ -194,13 +194,15 @@ fn check_compliance(
 
 /// Surface `c` of `law = "compliance"` on its foundation, its keys checked
 /// already. A node that starts inside the foundation by more than a
-/// rounding of the mesh's size is a problem pushed to `problems`, for
-/// either start (at rest it would be released with a jolt of c_n
-/// δ₀^{m_n}); one within rounding starts touching it.
+/// rounding of the mesh's size is, for a start at `rest`, a problem pushed
+/// to `problems` (it would be released with a jolt of c_n δ₀^{m_n}); one
+/// within rounding starts touching it. The static start keeps such an
+/// interference: its preload (the frictionless static problem with the
+/// foundation, convex) settles it into equilibrium before t = 0.
 pub(crate) fn compliant_surface(
     mesh: &Mesh,
     dofs: &DofMap,
-    c: &ContactSection,
+    (c, start): (&ContactSection, InitialState),
     at: &dyn Fn(&str) -> String,
     problems: &mut Vec<String>,
 ) -> Result<ContactSurface, ContactError> {
@@ -225,13 +227,16 @@ pub(crate) fn compliant_surface(
         .fold(0.0_f64, |m, v| m.max(v.abs()));
     let tolerance = 1e-9 * size.max(f.point[0].abs()).max(f.point[1].abs());
     for k in &mut s.compliance {
-        if k.gap < -tolerance {
+        if k.gap >= -tolerance {
+            k.gap = k.gap.max(0.0);
+        } else if start == InitialState::Rest {
             let node = s.nodes[k.index].node;
             let x = mesh.nodes[node];
             problems.push(format!(
                 "{}[contact]: node {} at ({}, {}) of group {:?} starts {:e} inside the foundation \
                  (a start at rest would release it with the foundation's full push); start the part \
-                 off or touching the foundation (move foundation.point, or the mesh)",
+                 off or touching the foundation (move foundation.point, or the mesh), or start from \
+                 the static state ([initial] state = \"static\"), which settles the interference",
                 at("foundation"),
                 mesh.node_tags.get(node).copied().unwrap_or(node as u64),
                 x[0],
@@ -240,7 +245,6 @@ pub(crate) fn compliant_surface(
                 -k.gap
             ));
         }
-        k.gap = k.gap.max(0.0);
     }
     Ok(s)
 }

@@ -60,7 +60,7 @@ pub(crate) fn surfaces(
         };
         if c.law == ContactLaw::Compliance {
             // The foundation computes the normal traction: no pressure load.
-            match compliant_surface(mesh, dofs, c, &at, problems) {
+            match compliant_surface(mesh, dofs, (c, case.initial.state), &at, problems) {
                 Ok(s) if problems.len() == before => built.push((i, s)),
                 Ok(_) => {}
                 Err(e) => problems.push(format!("{}[contact]: {e}", at("group"))),

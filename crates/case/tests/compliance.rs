@@ -175,7 +175,8 @@ fn the_law_runs_with_newmark() {
     assemble(&load(&text).unwrap()).unwrap();
 }
 
-/// A node that starts inside the foundation is refused with its place.
+/// A node that starts inside the foundation is refused, for a start at
+/// rest, with its place.
 #[test]
 fn a_node_inside_the_foundation_is_refused() {
     let text = slab(
@@ -190,6 +191,82 @@ fn a_node_inside_the_foundation_is_refused() {
         "starts 2e-2 inside the foundation",
     );
     assert!(e.contains("node 1 at (0, 0)"), "{e}");
+}
+
+/// With `state = "static"` a node inside the foundation is an
+/// interference the preload settles. The slab (rollers on its top y = H
+/// = 1, its left end held in x, no load at all) starts with its bottom
+/// d = 0.02 inside a floor of c_n = 1e4. Closed form: the preloaded state
+/// is uniform uniaxial stress σ_yy = −σ (σ_xx = 0: the right end is free;
+/// the Q2 cells hold the field exactly), the bottom moves up by u =
+/// σ (1 − ν²) H / E (plane strain) and the floor's traction is
+/// σ = c_n (d − u), so σ = c_n d / (1 + c_n (1 − ν²) H / E) = 200 / 10.1.
+/// Every bottom node's traction to 1e-9 of σ, its uy to 1e-9 of u.
+#[test]
+fn a_static_start_settles_a_node_inside_the_foundation() {
+    let (cn, d, compliance) = (1e4, 0.02, (1.0 - 0.3 * 0.3) * 1.0 / 1000.0);
+    let sigma = cn * d / (1.0 + cn * compliance);
+    let floor = FLOOR.replace("point = [0.0, -0.01]", "point = [0.0, 0.02]");
+    let text = slab(
+        &format!(
+            "[[dirichlet]]\ngroup = \"left\"\nux = 0.0\n[[dirichlet]]\ngroup = \"support\"\n\
+             uy = 0.0\n{floor}"
+        ),
+        "[initial]\nstate = \"static\"\n",
+    );
+    let case = load(&text).unwrap();
+    let scene = assemble(&case).unwrap();
+    let c = scene.contact.as_ref().unwrap();
+    assert!(c.compliance.iter().all(|k| (k.gap + d).abs() < 1e-15));
+    let running = scene.running(&case).unwrap();
+    let run = &running.integrator;
+    let contact = run.contact().unwrap();
+    let mut traction = vec![0.0; contact.len()];
+    run.normal_traction(&mut traction);
+    assert_eq!(contact.nodes.len(), 17);
+    for (n, t) in contact.nodes.iter().zip(&traction) {
+        assert!(
+            (t - sigma).abs() < 1e-9 * sigma,
+            "node {}: {t} ≠ {sigma}",
+            n.node
+        );
+        let uy = run.displacement()[n.dofs[1].unwrap()];
+        let u = sigma * compliance;
+        assert!((uy - u).abs() < 1e-9 * u, "node {}: {uy} ≠ {u}", n.node);
+    }
+}
+
+/// An interference with nothing holding the part against the foundation:
+/// the slab, its left end held in x only (free to translate in y), starts
+/// with its bottom 0.02 inside the floor and no load; the only static
+/// state is the slab lifted rigidly until it just touches (closed form:
+/// u_y = 0.02 everywhere, no traction). To 1e-9 of 0.02 and of c_n·0.02.
+#[test]
+fn a_static_start_lifts_a_free_part_out_of_the_foundation() {
+    let d = 0.02;
+    let floor = FLOOR.replace("point = [0.0, -0.01]", "point = [0.0, 0.02]");
+    let text = slab(
+        &format!("[[dirichlet]]\ngroup = \"left\"\nux = 0.0\n{floor}"),
+        "[initial]\nstate = \"static\"\n",
+    );
+    let case = load(&text).unwrap();
+    let running = assemble(&case).unwrap().running(&case).unwrap();
+    let run = &running.integrator;
+    let contact = run.contact().unwrap();
+    let mut traction = vec![0.0; contact.len()];
+    run.normal_traction(&mut traction);
+    for (n, t) in contact.nodes.iter().zip(&traction) {
+        assert!(t.abs() <= 1e-9 * 1e4 * d, "node {}: traction {t}", n.node);
+    }
+    let u = run.displacement();
+    for node in 0..running.mesh.nodes.len() {
+        for (c, expected) in [(0, 0.0), (1, d)] {
+            if let Some(i) = running.dofs.free(node, c) {
+                let v = u[i];
+                assert!((v - expected).abs() <= 1e-9 * d, "node {node}, u_{c}: {v}");
+            }
+        }
+    }
 }
 
 /// A moving foundation or a speed-dependent μ on a compliance surface is

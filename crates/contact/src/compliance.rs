@@ -86,8 +86,8 @@ pub struct CompliantNode {
     pub index: usize,
     /// The foundation's unit normal ν, pointing towards the body.
     pub normal: [f64; 2],
-    /// The initial gap g₀ = (X_J − P)·ν (≥ 0: the node starts on or off
-    /// the foundation).
+    /// The initial gap g₀ = (X_J − P)·ν (< 0: the node starts inside the
+    /// foundation, an interference only a static start settles).
     pub gap: f64,
     /// The law.
     pub law: Compliance,

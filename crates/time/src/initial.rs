@@ -137,14 +137,18 @@ pub(crate) fn initial_state_analyzed(
     let n = k.nrows();
     let mut state = State::new(n, contact.map_or(0, |c| c.len()), settings.dt);
     let mut r = loads.before_start();
+    let unloaded = r.iter().all(|&x| x == 0.0);
     // A compliant foundation's preload is the nonlinear static problem
-    // with its forces; its r₀, r̈₀ and energies count them.
-    let compliant = contact.filter(|c| c.is_compliant() && !r.iter().all(|&x| x == 0.0));
+    // with its forces; its r₀, r̈₀ and energies count them. It is solved
+    // where loads act before t = 0 or where nodes start inside the
+    // foundation (an interference: the foundation alone presses).
+    let compliant = contact
+        .filter(|c| c.is_compliant() && (!unloaded || c.compliance.iter().any(|k| k.gap < 0.0)));
     let compliant =
         compliant.filter(|_| !settings.restoring && settings.initial_state == InitialState::Static);
     if settings.restoring || settings.initial_state == InitialState::Rest {
         r.fill(0.0);
-    } else if r.iter().all(|&x| x == 0.0) {
+    } else if unloaded && compliant.is_none() {
         // Nothing acts before t = 0: r₀ = 0, no factorization.
     } else {
         if single_factor {

@@ -6,7 +6,9 @@
 //! nodes in contact) and a line search on Π's slope along the step, which
 //! only rises (Π convex): every step lowers Π. For m_n = 1 Π is piecewise
 //! quadratic, and the iteration ends once the nodes in contact stop
-//! changing.
+//! changing. Nodes may start inside the foundation (g₀ < 0, an
+//! interference): Π is the same convex function, F_c(0) ≠ 0, and the
+//! preload settles them even where no load acts before t = 0.
 //!
 //! A floating part: the rigid motions the supports leave free split into
 //! those the foundation never holds (they move no compliant node along ν,
@@ -29,7 +31,7 @@ use crate::initial::Mass;
 use crate::settings::TimeError;
 
 /// The residual ‖K r − R₀ − F_c(r)‖ that ends the iteration, relative to
-/// ‖R₀‖.
+/// ‖R₀‖ or, where larger, to ‖F_c(0)‖ (nodes starting inside).
 const TOLERANCE: f64 = 1e-11;
 /// Newton steps before the preload is declared without equilibrium.
 const MAX_STEPS: usize = 100;
@@ -94,7 +96,11 @@ pub(crate) fn solve(
     let diagonal: Vec<f64> = (0..k.nrows())
         .map(|i| slot(k, i, i).map_or(0.0, |p| k.values()[p]))
         .collect();
-    let scale = norm(&preload);
+    // Against R₀, or the foundation's push at r = 0 where nodes start
+    // inside it (with R₀ = 0 an interference is all that presses).
+    let (zero, mut pushed) = (vec![0.0; r.len()], vec![0.0; r.len()]);
+    add_foundation_forces(contact, &zero, &mut pushed);
+    let scale = norm(&preload).max(norm(&pushed));
     let mut solver = times
         .time("preload ordering", || {
             SparseCholesky::analyze(&tangent, fill_order)

@@ -1,21 +1,33 @@
 //! The compliance law against the paper's (METHOD.md §10): the paper's
 //! slab (`cases/martins-oden/cd-step-eps1e-2.toml`: rollers on its top,
 //! its left end held in x, pressed on its bottom by the prescribed
-//! F_n = 300, μ = 0.3, the end load t_x = −150 H(t)) against the same slab
-//! pressed by 300 on its top onto a compliant floor of c_n (c_T = μ c_n,
-//! m_n = 1) from the static preload, which starts every bottom node at the
-//! approach 300/c_n with the traction 300.
+//! F_n = 300, μ = 0.3, the end load t_x = −150 H(t)) against the slab on a
+//! compliant floor (c_T = μ c_n, m_n = 1), both measured by the difference
+//! of the bottom's tangential displacement histories, in two limits.
 //!
-//! A table against c_n of the difference of the bottom's tangential
-//! displacement histories from the prescribed-pressure run, reported: it
-//! does not vanish as c_n grows. The stiff floor's limit is a rigid floor,
-//! which holds the bottom still in y where the paper's model holds the
-//! top, so the end load's Poisson and inertial motion across the
-//! thickness moves the floor's traction away from 300 (the table gives its
-//! range): the two models differ by that much, about a tenth. The
-//! criterion is on the compliance runs: their change from one floor to
-//! the next ten times stiffer falls like 1/c_n (at least fivefold a
-//! decade), and the last is below 0.2% of the history: the runs converge
+//! The soft limit reproduces the paper, and is the one checked. The
+//! paper's slab is kept exactly (rollers on top, the same loads) and only
+//! its prescribed bottom pressure is replaced by a floor pre-compressed so
+//! that its traction is 300 at the start: the static preload (Remark 4.1,
+//! frictionless) is then uniform uniaxial stress σ_yy = −300, whose
+//! compression lifts the bottom by u₀ = 300 (1 − ν²) H / E (plane strain),
+//! so the floor's line is placed an interference d = 300/c_n + u₀ above
+//! the bottom (the closed form, [`interference`]). The floor's traction
+//! is then 300 − c_n Δu_y (Δu_y the bottom's motion from the preload), so
+//! as c_n → 0 with c_n (d − u₀) = 300 the run tends to the paper's, the
+//! difference ∝ c_n: the criterion is that it falls at least fivefold a
+//! decade of c_n and is below a stated bound at the softest floor.
+//!
+//! The stiff limit does not reproduce it, and is reported: the slab pressed
+//! by 300 on its top onto a floor of growing c_n from the static preload
+//! (every bottom node at the approach 300/c_n, traction 300). The stiff
+//! floor's limit is a rigid floor, which holds the bottom still in y where
+//! the paper's model holds the top, so the end load's Poisson and inertial
+//! motion across the thickness moves the floor's traction away from 300
+//! (the table gives its range): the two models differ by that much, about
+//! a tenth. Its criterion is on the compliance runs: their change from one
+//! floor to the next ten times stiffer falls like 1/c_n (at least fivefold
+//! a decade), and the last is below 0.2% of the history: the runs converge
 //! to the rigid floor's.
 
 use std::path::Path;
@@ -30,22 +42,102 @@ const FLOORS: [f64; 4] = [1e3, 1e4, 1e5, 1e6];
 const DT: f64 = 2.5e-4;
 const T_END: f64 = 0.5;
 
-/// Runs the check (2,000 steps of a 148-DOF slab a run: well under a
-/// second in all).
+/// Runs the check (2,000 steps of a 148-DOF slab a run: about a second
+/// in all).
 pub fn run(root: &Path, r: &mut Report) {
-    let held = |law: &str| slab(root, &format!("{LEFT}{LOAD}{law}"), T_END);
     let name = "paper's slab";
     let mut nodes = Vec::new();
-    let reference = match history(root, &held(PRESSED), &mut nodes) {
+    let reference = match history(root, &held(root, PRESSED), &mut nodes) {
         Ok((h, _)) => h,
         Err(e) => return r.holds(name, "runs", e, "runs", false),
     };
-    let size = norm(&reference, &vec![0.0; reference.len()]);
+    soft(root, r, (&reference, &mut nodes));
+    stiff(root, r, (&reference, &mut nodes));
+}
+
+/// The paper's slab with its left end held and its end load, `law` its
+/// support and contact.
+fn held(root: &Path, law: &str) -> String {
+    slab(root, &format!("{LEFT}{LOAD}{law}"), T_END)
+}
+
+/// The pre-compressed floors' stiffness c_n, stiffest first. The first
+/// is reported only: there the floor's traction 300 − c_n Δu_y departs
+/// from 300 by some 40% (the table's range), outside the regime where
+/// the difference is linear in c_n; each floor after the second is
+/// checked against the one before.
+const SOFT: [f64; 5] = [1e4, 1e3, 1e2, 1e1, 1e0];
+
+/// The bound on the difference at the softest floor, relative to the
+/// history's size: the friction bound's relative change there, c_n
+/// |Δu_y| / p, with |Δu_y| ≤ 2 ν (1 + ν) |t_x| H / E (the end load's
+/// Poisson swell of the thickness, doubled by the step load's dynamics).
+/// The friction force differs from the paper's by that fraction at most,
+/// and the displacement history, which it drives, is held to the same
+/// fraction of itself.
+fn soft_limit(cn: f64) -> f64 {
+    let (p, tx, e, nu, h) = (300.0, 150.0, 1000.0, 0.3, 1.0);
+    cn * 2.0 * nu * (1.0 + nu) * tx * h / e / p
+}
+
+/// The soft limit: the paper's slab with its bottom pressure replaced by a
+/// pre-compressed floor (see the module's comment).
+fn soft(root: &Path, r: &mut Report, (reference, nodes): (&[f64], &mut Vec<usize>)) {
+    let name = "paper's slab";
+    let size = norm(reference, &vec![0.0; reference.len()]);
+    let mut stiffer = f64::INFINITY;
+    for (i, cn) in SOFT.into_iter().enumerate() {
+        let case = format!("{name}, its pressure a floor of c_n = {cn:e} pre-compressed to 300");
+        let text = held(root, &pre_compressed(cn));
+        let (run, range) = match history(root, &text, nodes) {
+            Ok(h) => h,
+            Err(e) => return r.holds(&case, "runs", e, "runs", false),
+        };
+        let now = norm(&run, reference) / size;
+        let quantity = format!(
+            "‖u_T − u_T(p)‖ / ‖u_T(p)‖ (floor's traction {:.2} to {:.2}, p = 300)",
+            range[0], range[1]
+        );
+        if i < 2 {
+            let why = if i == 0 {
+                "table: outside the linear regime"
+            } else {
+                "table: falls like c_n from here"
+            };
+            r.row(
+                &case,
+                &quantity,
+                num(now),
+                why.into(),
+                "reported".into(),
+                true,
+            );
+        } else {
+            let why = "the stiffer floor's difference / 5 (∝ c_n: / 10)";
+            r.at_most(&case, &quantity, now, RATE * stiffer, why);
+        }
+        stiffer = now;
+    }
+    let softest = SOFT[SOFT.len() - 1];
+    r.at_most(
+        &format!("{name}, its pressure a floor of c_n = {softest:e}"),
+        "‖u_T − u_T(p)‖ / ‖u_T(p)‖",
+        stiffer,
+        soft_limit(softest),
+        "c_n·2ν(1+ν)|t_x|H/E / p: the prescribed pressure's limit reached",
+    );
+}
+
+/// The stiff limit, reported: the slab pressed on its top onto floors of
+/// growing c_n (see the module's comment).
+fn stiff(root: &Path, r: &mut Report, (reference, nodes): (&[f64], &mut Vec<usize>)) {
+    let name = "paper's slab";
+    let size = norm(reference, &vec![0.0; reference.len()]);
     let mut softer: Option<Vec<f64>> = None;
     let mut change = f64::INFINITY;
     for cn in FLOORS {
         let case = format!("{name} on a floor of c_n = {cn:e}");
-        let (run, range) = match history(root, &held(&floor(cn)), &mut nodes) {
+        let (run, range) = match history(root, &held(root, &floor(cn)), nodes) {
             Ok(h) => h,
             Err(e) => {
                 r.holds(&case, "runs", e, "runs", false);
@@ -58,7 +150,7 @@ pub fn run(root: &Path, r: &mut Report) {
                 "‖u_T − u_T(p)‖ / ‖u_T(p)‖ (floor's traction {:.1} to {:.1}, p = 300)",
                 range[0], range[1]
             ),
-            num(norm(&run, &reference) / size),
+            num(norm(&run, reference) / size),
             "table against c_n: the models' difference".into(),
             "reported".into(),
             true,
@@ -136,6 +228,28 @@ const LOAD: &str = "[[traction]]\ngroup = \"load\"\nt = [-150.0, 0.0]\nhistory =
 /// The paper's contact: rollers on the top, the prescribed pressure.
 const PRESSED: &str = "[[dirichlet]]\ngroup = \"support\"\nuy = 0.0\n[contact]\n\
     group = \"contact\"\npressure = 300.0\nmu = 0.3\neps = 1e-2\n";
+
+/// The paper's rollers on the top, its bottom on a floor of `cn` whose
+/// line lies [`interference`] above the bottom y = 0.
+fn pre_compressed(cn: f64) -> String {
+    format!(
+        "[[dirichlet]]\ngroup = \"support\"\nuy = 0.0\n\
+         [contact]\ngroup = \"contact\"\nlaw = \"compliance\"\n\
+         foundation = {{ point = [0.0, {:e}], normal = [0.0, 1.0] }}\ncn = {cn:e}\n\
+         mu = 0.3\neps = 1e-2\n",
+        interference(cn)
+    )
+}
+
+/// The interference d of a floor of `cn` whose preloaded traction is
+/// p = 300: the preload is uniform uniaxial stress σ_yy = −p (rollers on
+/// the top, σ_xx = 0 with the right end free), ε_yy = −p (1 − ν²)/E in
+/// plane strain, so the bottom rises by u₀ = p (1 − ν²) H / E (E = 1000,
+/// ν = 0.3, H = 1) and the approach d − u₀ must be p/c_n.
+fn interference(cn: f64) -> f64 {
+    let (p, e, nu, h) = (300.0, 1000.0, 0.3, 1.0);
+    p / cn + p * (1.0 - nu * nu) * h / e
+}
 
 /// The top pressed by 300 onto a floor of `cn` under the bottom.
 fn floor(cn: f64) -> String {
