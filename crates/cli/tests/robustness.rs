@@ -775,6 +775,7 @@ fn assert_same_datasets(a: &Path, b: &Path) {
         "rows",
         "reduced_remaining",
         "total_iterations",
+        "normal_iterations",
     ] {
         let (x, y) = (sa.attr(attr).unwrap(), sb.attr(attr).unwrap());
         let bits = |a: &hdf5::Attribute| match a.dtype().unwrap().to_descriptor().unwrap() {

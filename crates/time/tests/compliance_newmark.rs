@@ -248,7 +248,9 @@ fn a_sliding_block_keeps_coulombs_momentum_balance() {
 
 /// A Newmark run restored from a checkpoint taken in contact continues
 /// bit for bit: each step's Newton solve starts from the restored
-/// velocity, and the bounds follow the restored displacement.
+/// velocity, and the bounds follow the restored displacement. Its count
+/// of Newton iterations continues the checkpoint's, as the uninterrupted
+/// run's does.
 #[test]
 fn a_restored_newmark_run_continues_bit_identically() {
     let nx = 20;
@@ -262,14 +264,17 @@ fn a_restored_newmark_run_continues_bit_identically() {
     while a.time() < 1.0 {
         a.step().unwrap();
     }
+    assert!(a.normal_iterations() > 0);
     let mut b = bar.integrator_with(scheme, dt, false).unwrap();
     b.restore(&a.checkpoint()).unwrap();
+    assert_eq!(b.normal_iterations(), a.normal_iterations());
     let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     while !a.done() {
         a.step().unwrap();
         b.step().unwrap();
         assert_eq!(bits(a.velocity()), bits(b.velocity()), "t = {}", a.time());
         assert_eq!(a.energy(), b.energy());
+        assert_eq!(a.normal_iterations(), b.normal_iterations());
     }
 }
 

@@ -318,6 +318,13 @@ impl ImplicitFriction {
         self.compliant.as_deref().map_or(0, |s| s.newton)
     }
 
+    /// Continues that count from a checkpoint's.
+    pub(crate) fn set_normal_iterations(&mut self, count: u64) {
+        if let Some(s) = self.compliant.as_deref_mut() {
+            s.newton = count;
+        }
+    }
+
     /// Numeric factorizations so far.
     pub(crate) fn factorizations(&self) -> u64 {
         match &self.solver {
