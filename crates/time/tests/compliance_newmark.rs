@@ -327,3 +327,83 @@ fn both_schur_paths_carry_the_normal_rows() {
     let e = build(ImplicitSolver::Direct).unwrap_err().to_string();
     assert!(e.contains("Schur complement only"), "{e}");
 }
+
+/// A compliant floor beside a surface whose μ falls with the slip speed
+/// (`mu = { static, kinetic, speed }` on another `[[contact]]`): with μs =
+/// μk that μ is the constant law's, so the run, its ledger included, is
+/// bit for bit the run with a constant μ on that surface. The ledger books
+/// the forces on the lagged surface, whose compliant nodes must carry the
+/// bounds at the step's end as the run's do. The block of the test above
+/// slides on the rough floor with a rough top (pressure p, μ = 0.2).
+#[test]
+fn a_compliant_floor_beside_a_lagged_mu_keeps_the_constant_law_bits() {
+    use stickslip_contact::{Compliance, ContactSurface, Weakening};
+    use stickslip_fem::{traction_load, Hypothesis, Material, Model, Traction};
+    use stickslip_mesh::CellKind;
+    use stickslip_testkit::grid::rectangle;
+    use stickslip_time::{Dynamics, History, InitialState, Integrator, Load, MassKind, Settings};
+
+    let (q, p, mu) = (5.0, 10.0, 0.3);
+    let mesh = rectangle(CellKind::Quad4, 4, 2, [0.0, 0.0], [1.0, 0.5]);
+    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let model = Model::new(&mesh, &material, &[]).unwrap();
+    let law = Compliance {
+        cn: 1e4,
+        mn: 1.0,
+        ct: mu * 1e4,
+        mt: 1.0,
+    };
+    let floor = ([0.0, 0.0], [0.0, 1.0]);
+    let mut full = vec![0.0; 2 * mesh.nodes.len()];
+    traction_load(&mesh, "top", Traction::Vector([q, -p]), &mut full).unwrap();
+    let mut vector = vec![0.0; model.dofs.n_free()];
+    model.dofs.restrict(&full, &mut vector);
+    let mut velocity = vec![0.0; model.dofs.n_free()];
+    for node in 0..mesh.nodes.len() {
+        if let Some(d) = model.dofs.free(node, 0) {
+            velocity[d] = 1.0;
+        }
+    }
+    let build = |weakening: Option<Weakening>| {
+        let bottom =
+            ContactSurface::on_foundation(&mesh, &model.dofs, "bottom", floor, law, 1e-3).unwrap();
+        let mut top = ContactSurface::from_group(&mesh, &model.dofs, "top", p, 0.2, 1e-3).unwrap();
+        top.set_weakening(|_| weakening);
+        let contact = ContactSurface::join(vec![bottom, top]).unwrap();
+        let mut s = Settings::new(
+            Scheme::Newmark {
+                beta: AVERAGE.0,
+                gamma: AVERAGE.1,
+            },
+            1e-3,
+            0.5,
+        );
+        s.mass = Some(MassKind::Lumped);
+        s.initial_state = InitialState::Rest;
+        s.initial_velocity = Some(velocity.clone());
+        let load = Load {
+            vector: vector.clone(),
+            history: History::Constant,
+        };
+        Integrator::new(Dynamics::from_model(&model), Some(contact), vec![load], s).unwrap()
+    };
+    let mut lagged = build(Some(Weakening {
+        ratio: 1.0,
+        speed: 0.5,
+    }));
+    let mut constant = build(None);
+    assert!(lagged.contact().unwrap().weakens());
+    let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    while !constant.done() {
+        constant.step().unwrap();
+        lagged.step().unwrap();
+        let t = constant.time();
+        assert_eq!(
+            bits(constant.velocity()),
+            bits(lagged.velocity()),
+            "t = {t}"
+        );
+        assert_eq!(constant.energy(), lagged.energy(), "t = {t}");
+    }
+    assert!(constant.energy().dissipated > 0.0);
+}
