@@ -1079,6 +1079,7 @@ impl ResultsWriter {
         }
         put_scalar(&g, "total_iterations", cp.total_iterations)?;
         put_scalar(&g, "factorizations", cp.factorizations)?;
+        put_scalar(&g, "normal_iterations", cp.normal_iterations)?;
         put_scalar(&g, "rows", extra.rows as u64)?;
         put_scalar(&g, "frames", extra.frames as u64)?;
         put_scalar(&g, "wall_time_s", extra.wall_time_s)?;
@@ -1895,6 +1896,7 @@ pub(crate) mod tests {
             clock: None,
             total_iterations: 0,
             factorizations: 0,
+            normal_iterations: 0,
         };
         let extra = CheckpointExtra::default();
         // Both slots written, then cut to an old file's seven values.

@@ -1039,6 +1039,7 @@ impl Session<'_> {
                 "setup_parts": setup_json(&self.setup_parts, setup_s),
                 "step_s": step_s,
                 "iterations": i.total_iterations(),
+                "normal_iterations": i.normal_iterations(),
                 "factorizations": i.factorizations(),
                 "stiffness_product": summary.stiffness_product,
                 "fill_order": summary.fill_order,

@@ -111,6 +111,12 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         },
         total_iterations: get_scalar(&g, "total_iterations")?,
         factorizations: get_scalar(&g, "factorizations")?,
+        // Absent in files written before the compliant Newmark step.
+        normal_iterations: if g.attr("normal_iterations").is_ok() {
+            get_scalar(&g, "normal_iterations")?
+        } else {
+            0
+        },
     };
     let rows = get_scalar::<u64>(&g, "rows")? as usize;
     let extra = CheckpointExtra {

@@ -68,6 +68,16 @@ t_end = 0.2
         assert!(said_out.contains(s), "no {s:?} in:\n{said_out}");
     }
     let f = hdf5::File::open(&out).unwrap();
+    // The checkpoint keeps the Newton count (Newmark's, the one whose
+    // summary names it; 0 for central difference) for a restart.
+    let c = f.group("checkpoint").unwrap();
+    let k = c.attr("slot").unwrap().read_scalar::<u8>().unwrap();
+    let newton = c
+        .group(["a", "b"][k as usize])
+        .unwrap()
+        .attr("normal_iterations");
+    let newton = newton.unwrap().read_scalar::<u64>().unwrap();
+    assert_eq!(newton > 0, !said.is_empty(), "{newton} Newton iterations");
     let read = |name: &str| f.dataset(name).unwrap().read_raw::<f64>().unwrap();
     let (time, stored, kinetic) = (
         read("time"),

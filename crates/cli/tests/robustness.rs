@@ -775,6 +775,7 @@ fn assert_same_datasets(a: &Path, b: &Path) {
         "rows",
         "reduced_remaining",
         "total_iterations",
+        "normal_iterations",
     ] {
         let (x, y) = (sa.attr(attr).unwrap(), sb.attr(attr).unwrap());
         let bits = |a: &hdf5::Attribute| match a.dtype().unwrap().to_descriptor().unwrap() {
@@ -1141,6 +1142,9 @@ fn json_summary_is_one_object_on_stdout() {
     );
     assert!(!out.with_extension("xdmf").exists());
     assert!(j["energy"]["total"].is_f64() && j["dt_crit"].is_f64());
+    // The compliance Newton count of the text summary: none on the
+    // paper's prescribed pressure.
+    assert_eq!(j["normal_iterations"], 0);
     // The setup's parts: the slab is preloaded (the contact pressure acts
     // before t = 0), so the preload's factor is among them; they and the
     // rest ("other") add up to setup_s, to the printed rounding.

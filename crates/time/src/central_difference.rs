@@ -130,7 +130,8 @@ pub(crate) fn start(
             analyzed,
         )
     };
-    let (dt_crit, state) = match beside_the_preload(&k, &mass, &rigid_modes, loads, settings) {
+    let beside = beside_the_preload(&k, &mass, (&rigid_modes, contact), loads, settings);
+    let (dt_crit, state) = match beside {
         Beside::Nothing => {
             let dt_crit = times.time("critical step", critical);
             let dt_crit = damped_critical_step(dt_crit, settings)?;
@@ -508,16 +509,6 @@ impl Stepper for CentralDifference {
     }
 }
 
-/// The critical step with Rayleigh damping from the undamped one,
-/// 2/ω_max: Δt_crit = (2/ω_max)(√(1+ξ²) − ξ), ξ = βω_max/2 (METHOD.md §8).
-/// The mass part, centred, does not lower it: for a mode ω the step's
-/// characteristic polynomial (1 + αΔt/2)z² − (2 − Ω² − 2ξΩ)z + 1 − αΔt/2
-/// − 2ξΩ, Ω = ωΔt, has its root at z = −1 where Ω² + 4ξΩ = 4, whatever
-/// α; the bound falls with ω, so ω_max sets it. Zero modes (a floating
-/// part) bound nothing.
-///
-/// # Errors
-/// Δt above it (unless allowed), or no usable stable step at all.
 /// Free DOFs from which the critical step's Lanczos runs beside the
 /// preload: below, a thread costs more than it saves.
 const BESIDE_MIN: usize = 100_000;
@@ -546,11 +537,12 @@ enum Done {
 /// preload's analysis, or its whole initial state where no estimate can
 /// refuse the run's Δt (allowed above it, or within Gershgorin's bound on
 /// ω_max, [`gershgorin_bound`]), so that no factorization is spent on a
-/// run refused for its Δt.
+/// run refused for its Δt. That bound is K's alone: with a compliant
+/// foundation, whose springs the estimate adds, any Δt may be refused.
 fn beside_the_preload(
     k: &nalgebra_sparse::CsrMatrix<f64>,
     mass: &[f64],
-    modes: &[stickslip_fem::RigidMode],
+    (modes, contact): (&[stickslip_fem::RigidMode], Option<&ContactSurface>),
     loads: &Loads,
     settings: &Settings,
 ) -> Beside {
@@ -562,10 +554,12 @@ fn beside_the_preload(
     if !preload || mass.len() < BESIDE_MIN {
         return Beside::Nothing;
     }
-    let refusable = !settings.allow_unstable && {
-        let bound = gershgorin_bound(k, mass);
-        !(bound > 0.0 && damped_critical_step(2.0 / bound.sqrt(), settings).is_ok())
-    };
+    let springs = contact.is_some_and(ContactSurface::is_compliant);
+    let refusable = !settings.allow_unstable
+        && (springs || {
+            let bound = gershgorin_bound(k, mass);
+            !(bound > 0.0 && damped_critical_step(2.0 / bound.sqrt(), settings).is_ok())
+        });
     if refusable {
         Beside::Analysis
     } else {
@@ -573,6 +567,16 @@ fn beside_the_preload(
     }
 }
 
+/// The critical step with Rayleigh damping from the undamped one,
+/// 2/ω_max: Δt_crit = (2/ω_max)(√(1+ξ²) − ξ), ξ = βω_max/2 (METHOD.md §8).
+/// The mass part, centred, does not lower it: for a mode ω the step's
+/// characteristic polynomial (1 + αΔt/2)z² − (2 − Ω² − 2ξΩ)z + 1 − αΔt/2
+/// − 2ξΩ, Ω = ωΔt, has its root at z = −1 where Ω² + 4ξΩ = 4, whatever
+/// α; the bound falls with ω, so ω_max sets it. Zero modes (a floating
+/// part) bound nothing.
+///
+/// # Errors
+/// Δt above it (unless allowed), or no usable stable step at all.
 fn damped_critical_step(undamped: f64, settings: &Settings) -> Result<f64, TimeError> {
     let beta = settings.damping.beta;
     if beta == 0.0 {

@@ -155,7 +155,14 @@ pub(crate) fn initial_state_analyzed(
             fill_order.keep_dissection();
         }
         if let Some(c) = compliant {
-            crate::preload_compliance::solve(k, (mass, fill_order, modes), c, &mut r, times)?;
+            crate::preload_compliance::solve(
+                k,
+                (mass, fill_order, modes),
+                c,
+                &mut r,
+                times,
+                analyzed,
+            )?;
         } else if let (Some(solver), true) = (analyzed, modes.is_empty()) {
             factor_solve(solver, k, &mut r, times)?;
         } else if modes.is_empty() {

@@ -240,7 +240,8 @@ impl Integrator {
     /// Everything needed to continue this run bit-identically
     /// ([`Integrator::restore`] on a fresh integrator of the same case).
     pub fn checkpoint(&self) -> Checkpoint {
-        self.state.checkpoint(self.factorizations())
+        self.state
+            .checkpoint((self.factorizations(), self.normal_iterations()))
     }
 
     /// Replaces the state of a freshly built integrator (same case) by the
@@ -273,6 +274,7 @@ impl Integrator {
         self.stepper.state_replaced();
         if let Some(f) = self.stepper.implicit_mut() {
             f.set_factorizations(c.factorizations);
+            f.set_normal_iterations(c.normal_iterations);
         }
         self.run.loads.at(self.state.t, &mut self.state.load);
         self.bounds_at(self.state.t);

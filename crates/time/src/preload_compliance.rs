@@ -68,7 +68,9 @@ pub(crate) fn add_foundation_forces(contact: &ContactSurface, r: &[f64], out: &m
     stored
 }
 
-/// r₀ in place of the preload `r` (see the module's comment).
+/// r₀ in place of the preload `r` (see the module's comment), with K's
+/// analysis if the caller made it (`analyzed`: the tangent has K's
+/// pattern, the springs sitting in each node's block of it).
 ///
 /// # Errors
 /// [`TimeError::Unbalanced`] when the preload does work along a rigid
@@ -81,6 +83,7 @@ pub(crate) fn solve(
     contact: &ContactSurface,
     r: &mut [f64],
     times: &mut SetupTimes,
+    analyzed: Option<SparseCholesky>,
 ) -> Result<(), TimeError> {
     let preload = r.to_vec();
     let along = along_normal(contact, modes);
@@ -101,11 +104,14 @@ pub(crate) fn solve(
     let (zero, mut pushed) = (vec![0.0; r.len()], vec![0.0; r.len()]);
     add_foundation_forces(contact, &zero, &mut pushed);
     let scale = norm(&preload).max(norm(&pushed));
-    let mut solver = times
-        .time("preload ordering", || {
-            SparseCholesky::analyze(&tangent, fill_order)
-        })
-        .map_err(TimeError::Static)?;
+    let mut solver = match analyzed {
+        Some(solver) => solver,
+        None => times
+            .time("preload ordering", || {
+                SparseCholesky::analyze(&tangent, fill_order)
+            })
+            .map_err(TimeError::Static)?,
+    };
     let (mut g, mut trial, mut gt) = (vec![0.0; r.len()], vec![0.0; r.len()], vec![0.0; r.len()]);
     let x = r;
     x.fill(0.0);

@@ -84,6 +84,9 @@ pub struct Checkpoint {
     pub total_iterations: u64,
     /// Numeric factorizations so far.
     pub factorizations: u64,
+    /// Newton iterations of a compliant foundation's implicit solves so
+    /// far (0 in files written before them).
+    pub normal_iterations: u64,
 }
 
 /// The time of each step without drift: over a run of steps of one Δt
@@ -292,9 +295,9 @@ impl State {
         }
     }
 
-    /// The checkpoint of this state, the scheme's factorization count
-    /// beside it.
-    pub fn checkpoint(&self, factorizations: u64) -> Checkpoint {
+    /// The checkpoint of this state, the scheme's factorization and
+    /// compliance Newton counts beside it.
+    pub fn checkpoint(&self, (factorizations, normal_iterations): (u64, u64)) -> Checkpoint {
         Checkpoint {
             t: self.t,
             steps: self.steps,
@@ -309,6 +312,7 @@ impl State {
             clock: Some((self.clock.t0, self.clock.dt, self.clock.k)),
             total_iterations: self.total_iterations,
             factorizations,
+            normal_iterations,
         }
     }
 

@@ -125,3 +125,49 @@ fn the_critical_step_beside_the_preload_has_the_sequential_bits() {
         other => panic!("not refused: {other:?}"),
     }
 }
+
+/// With a compliant foundation the estimate adds its springs w_J c_n ννᵀ,
+/// which Gershgorin's bound on K does not hold: a Δt within that bound may
+/// still be refused, so only the preload's analysis runs beside Lanczos
+/// (its parts in that order) and a Δt between the springs' critical step
+/// and K's bound is refused. The foundation lies 1 below the slab's bottom
+/// (out of reach: the preload is K r₀ = R(0⁻)), c_n = 1e8, whose springs
+/// (about c_n h/m per node) raise ω_max² far above K's bound.
+#[test]
+fn with_a_compliant_foundation_only_the_analysis_runs_beside() {
+    use stickslip_contact::{Compliance, ContactSurface};
+    let mut s = slab();
+    let law = Compliance {
+        cn: 1e8,
+        mn: 1.0,
+        ct: 0.0,
+        mt: 1.0,
+    };
+    let floor = ([0.0, -1.0], [0.0, 1.0]);
+    s.contact = Some(
+        ContactSurface::on_foundation(&s.mesh, &s.model.dofs, "contact", floor, law, 1e-4).unwrap(),
+    );
+    let d = dynamics(&s);
+    let k_step = 2.0 / gershgorin_bound(&d.stiffness, &d.lumped_mass).sqrt();
+    let cd = |dt| Settings::new(Scheme::CentralDifference, dt, 0.5);
+    let within = integrator(&s, cd(1e-9)).unwrap();
+    let dt_crit = within.dt_crit().unwrap();
+    assert!(dt_crit < 0.1 * k_step, "{dt_crit} vs K's {k_step}");
+    let order = [
+        "preload ordering",
+        "critical step",
+        "preload factor",
+        "preload solve",
+    ];
+    let taken: Vec<_> = parts(&within)
+        .into_iter()
+        .filter(|p| order.contains(p))
+        .collect();
+    assert_eq!(taken, order);
+    match integrator(&s, cd((dt_crit * k_step).sqrt())) {
+        Err(TimeError::Unstable { dt_crit: said, .. }) => {
+            assert_eq!(said.to_bits(), dt_crit.to_bits());
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+}

@@ -167,56 +167,19 @@ fn a_stiffening_wall_conserves_to_second_order() {
 /// approach of the converged step, not of the predictor or the last step.
 #[test]
 fn a_sliding_block_keeps_coulombs_momentum_balance() {
-    use stickslip_contact::{Compliance, ContactSurface, SlipState};
-    use stickslip_fem::{traction_load, Hypothesis, Material, Model, Traction};
-    use stickslip_mesh::CellKind;
-    use stickslip_testkit::grid::rectangle;
-    use stickslip_time::{Dynamics, History, InitialState, Integrator, Load, MassKind, Settings};
+    use stickslip_contact::SlipState;
+    use stickslip_time::{Dynamics, Integrator};
 
     let (q, p, mu) = (5.0, 10.0, 0.3);
-    let mesh = rectangle(CellKind::Quad4, 4, 2, [0.0, 0.0], [1.0, 0.5]);
-    let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
-    let model = Model::new(&mesh, &material, &[]).unwrap();
-    let law = Compliance {
-        cn: 1e4,
-        mn: 1.0,
-        ct: mu * 1e4,
-        mt: 1.0,
-    };
-    let floor = ([0.0, 0.0], [0.0, 1.0]);
-    let contact =
-        ContactSurface::on_foundation(&mesh, &model.dofs, "bottom", floor, law, 1e-3).unwrap();
-    let mut full = vec![0.0; 2 * mesh.nodes.len()];
-    traction_load(&mesh, "top", Traction::Vector([q, -p]), &mut full).unwrap();
-    let mut vector = vec![0.0; model.dofs.n_free()];
-    model.dofs.restrict(&full, &mut vector);
-    let v0 = 1.0;
-    let mut velocity = vec![0.0; model.dofs.n_free()];
+    let block = SlidingBlock::new(q, p, mu);
     let (mut xs, mut ys) = (Vec::new(), Vec::new());
-    for node in 0..mesh.nodes.len() {
-        xs.extend(model.dofs.free(node, 0));
-        ys.extend(model.dofs.free(node, 1));
+    for node in 0..block.mesh.nodes.len() {
+        xs.extend(block.model.dofs.free(node, 0));
+        ys.extend(block.model.dofs.free(node, 1));
     }
-    for &d in &xs {
-        velocity[d] = v0;
-    }
-    let mut s = Settings::new(
-        Scheme::Newmark {
-            beta: AVERAGE.0,
-            gamma: AVERAGE.1,
-        },
-        1e-3,
-        0.5,
-    );
-    s.mass = Some(MassKind::Lumped);
-    s.initial_state = InitialState::Rest;
-    s.initial_velocity = Some(velocity);
-    let dynamics = Dynamics::from_model(&model);
+    let (contact, load, s) = (block.floor.clone(), block.load.clone(), block.settings());
+    let dynamics = Dynamics::from_model(&block.model);
     let mass = dynamics.lumped_mass.clone();
-    let load = Load {
-        vector,
-        history: History::Constant,
-    };
     let mut run = Integrator::new(dynamics, Some(contact), vec![load], s).unwrap();
     let momentum = |v: &[f64], dofs: &[usize]| dofs.iter().map(|&d| mass[d] * v[d]).sum::<f64>();
     let start = momentum(run.velocity(), &xs) + mu * momentum(run.velocity(), &ys);
@@ -248,7 +211,9 @@ fn a_sliding_block_keeps_coulombs_momentum_balance() {
 
 /// A Newmark run restored from a checkpoint taken in contact continues
 /// bit for bit: each step's Newton solve starts from the restored
-/// velocity, and the bounds follow the restored displacement.
+/// velocity, and the bounds follow the restored displacement. Its count
+/// of Newton iterations continues the checkpoint's, as the uninterrupted
+/// run's does.
 #[test]
 fn a_restored_newmark_run_continues_bit_identically() {
     let nx = 20;
@@ -262,14 +227,17 @@ fn a_restored_newmark_run_continues_bit_identically() {
     while a.time() < 1.0 {
         a.step().unwrap();
     }
+    assert!(a.normal_iterations() > 0);
     let mut b = bar.integrator_with(scheme, dt, false).unwrap();
     b.restore(&a.checkpoint()).unwrap();
+    assert_eq!(b.normal_iterations(), a.normal_iterations());
     let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     while !a.done() {
         a.step().unwrap();
         b.step().unwrap();
         assert_eq!(bits(a.velocity()), bits(b.velocity()), "t = {}", a.time());
         assert_eq!(a.energy(), b.energy());
+        assert_eq!(a.normal_iterations(), b.normal_iterations());
     }
 }
 
@@ -321,4 +289,120 @@ fn both_schur_paths_carry_the_normal_rows() {
     assert!(touched);
     let e = build(ImplicitSolver::Direct).unwrap_err().to_string();
     assert!(e.contains("Schur complement only"), "{e}");
+}
+
+/// A compliant floor beside a surface whose μ falls with the slip speed
+/// (`mu = { static, kinetic, speed }` on another `[[contact]]`): with μs =
+/// μk that μ is the constant law's, so the run, its ledger included, is
+/// bit for bit the run with a constant μ on that surface. The ledger books
+/// the forces on the lagged surface, whose compliant nodes must carry the
+/// bounds at the step's end as the run's do. The block of the test above
+/// slides on the rough floor with a rough top (pressure p, μ = 0.2).
+#[test]
+fn a_compliant_floor_beside_a_lagged_mu_keeps_the_constant_law_bits() {
+    use stickslip_contact::{ContactSurface, Weakening};
+    use stickslip_time::{Dynamics, Integrator};
+
+    let block = SlidingBlock::new(5.0, 10.0, 0.3);
+    let build = |weakening: Option<Weakening>| {
+        let (mesh, dofs) = (&block.mesh, &block.model.dofs);
+        let mut top = ContactSurface::from_group(mesh, dofs, "top", 10.0, 0.2, 1e-3).unwrap();
+        top.set_weakening(|_| weakening);
+        let contact = ContactSurface::join(vec![block.floor.clone(), top]).unwrap();
+        let dynamics = Dynamics::from_model(&block.model);
+        let load = vec![block.load.clone()];
+        Integrator::new(dynamics, Some(contact), load, block.settings()).unwrap()
+    };
+    let mut lagged = build(Some(Weakening {
+        ratio: 1.0,
+        speed: 0.5,
+    }));
+    let mut constant = build(None);
+    assert!(lagged.contact().unwrap().weakens());
+    let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    while !constant.done() {
+        constant.step().unwrap();
+        lagged.step().unwrap();
+        let t = constant.time();
+        assert_eq!(
+            bits(constant.velocity()),
+            bits(lagged.velocity()),
+            "t = {t}"
+        );
+        assert_eq!(constant.energy(), lagged.energy(), "t = {t}");
+    }
+    assert!(constant.energy().dissipated > 0.0);
+}
+
+/// The block (1 × ½, Q1 4 × 2, E = 1000, ν = 0.3, ρ = 1) of the sliding
+/// tests on a rough compliant floor (c_n = 1e4, c_T = μ c_n, m = 1) under
+/// the top traction (q, −p), launched along x at 1 from rest's shape.
+struct SlidingBlock {
+    mesh: stickslip_mesh::Mesh,
+    model: stickslip_fem::Model,
+    floor: stickslip_contact::ContactSurface,
+    load: stickslip_time::Load,
+    velocity: Vec<f64>,
+}
+
+impl SlidingBlock {
+    fn new(q: f64, p: f64, mu: f64) -> SlidingBlock {
+        use stickslip_contact::{Compliance, ContactSurface};
+        use stickslip_fem::{traction_load, Hypothesis, Material, Model, Traction};
+        use stickslip_mesh::CellKind;
+        use stickslip_testkit::grid::rectangle;
+        use stickslip_time::{History, Load};
+
+        let mesh = rectangle(CellKind::Quad4, 4, 2, [0.0, 0.0], [1.0, 0.5]);
+        let material = Material::new(1000.0, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+        let model = Model::new(&mesh, &material, &[]).unwrap();
+        let law = Compliance {
+            cn: 1e4,
+            mn: 1.0,
+            ct: mu * 1e4,
+            mt: 1.0,
+        };
+        let at = ([0.0, 0.0], [0.0, 1.0]);
+        let floor =
+            ContactSurface::on_foundation(&mesh, &model.dofs, "bottom", at, law, 1e-3).unwrap();
+        let mut full = vec![0.0; 2 * mesh.nodes.len()];
+        traction_load(&mesh, "top", Traction::Vector([q, -p]), &mut full).unwrap();
+        let mut vector = vec![0.0; model.dofs.n_free()];
+        model.dofs.restrict(&full, &mut vector);
+        let mut velocity = vec![0.0; model.dofs.n_free()];
+        for node in 0..mesh.nodes.len() {
+            if let Some(d) = model.dofs.free(node, 0) {
+                velocity[d] = 1.0;
+            }
+        }
+        let load = Load {
+            vector,
+            history: History::Constant,
+        };
+        SlidingBlock {
+            mesh,
+            model,
+            floor,
+            load,
+            velocity,
+        }
+    }
+
+    /// Newmark ¼, ½, Δt = 1e-3 to t = 0.5, the lumped mass, from rest's
+    /// shape at the launch velocity.
+    fn settings(&self) -> stickslip_time::Settings {
+        use stickslip_time::{InitialState, MassKind, Settings};
+        let mut s = Settings::new(
+            Scheme::Newmark {
+                beta: AVERAGE.0,
+                gamma: AVERAGE.1,
+            },
+            1e-3,
+            0.5,
+        );
+        s.mass = Some(MassKind::Lumped);
+        s.initial_state = InitialState::Rest;
+        s.initial_velocity = Some(self.velocity.clone());
+        s
+    }
 }

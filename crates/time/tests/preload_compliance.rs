@@ -95,3 +95,36 @@ fn a_preload_carries_a_block_from_off_the_foundation_onto_it() {
         }
     }
 }
+
+/// The same preload started by Newmark (¼, ½): r₀ at (p/c_n)^{1/m_n}, the
+/// foundation's force in r̈₀ and the bounds set at r₀, so 200 undamped
+/// steps leave every bottom node at that approach to 1e-9 and the ledger's
+/// balance within 1e-9 of the stored energy c_n δ^{m_n+1}/(m_n+1).
+#[test]
+fn a_preloaded_block_stays_at_the_static_approach_under_newmark() {
+    for (cn, mn) in LAWS {
+        let block = Block::new(8, cn, mn).unwrap();
+        let scheme = Scheme::Newmark {
+            beta: 0.25,
+            gamma: 0.5,
+        };
+        let mut run = block.integrator(Settings::new(scheme, 1e-3, 1.0)).unwrap();
+        let expected = (P / cn).powf(1.0 / mn);
+        let stored = cn * expected.powf(mn + 1.0) / (mn + 1.0);
+        let e0 = run.energy();
+        assert!(
+            (e0.foundation_stored - stored).abs() < 1e-9 * stored,
+            "m_n = {mn}: {} vs {stored}",
+            e0.foundation_stored
+        );
+        for _ in 0..200 {
+            run.step().unwrap();
+        }
+        let (most, least) = block.approaches(run.displacement());
+        for d in [most, least] {
+            assert!((d - expected).abs() < 1e-9, "m_n = {mn}: {d} vs {expected}");
+        }
+        let e = run.energy();
+        assert!(e.balance.abs() < 1e-9 * stored, "m_n = {mn}: {e:?}");
+    }
+}

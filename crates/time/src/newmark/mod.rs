@@ -198,6 +198,29 @@ impl ImplicitFriction {
         }
     }
 
+    /// Where μ is lagged, gives the lagged surface the bounds `comply` has
+    /// just set at r_K on `contact`'s compliant nodes: the ledger books the
+    /// step's forces on the lagged surface, on which those nodes would
+    /// otherwise keep the bounds at r_{K−1} (their μ is constant, so the
+    /// lag takes their bounds as they are).
+    pub(crate) fn follow_compliance(&mut self, contact: &ContactSurface) {
+        let Some(lagged) = &mut self.lagged else {
+            return;
+        };
+        let mut changed = false;
+        for k in &contact.compliance {
+            let (to, from) = (
+                &mut lagged.nodes[k.index].bound,
+                contact.nodes[k.index].bound,
+            );
+            changed |= to.to_bits() != from.to_bits();
+            *to = from;
+        }
+        if changed {
+            lagged.revision += 1;
+        }
+    }
+
     /// The surface the step's friction acts with: the run's, or where μ
     /// falls with the slip speed its lagged copy (the forces the step
     /// applied, for the ledger).
@@ -316,6 +339,13 @@ impl ImplicitFriction {
     /// Newton iterations of a compliant foundation's solves so far.
     pub(crate) fn normal_iterations(&self) -> u64 {
         self.compliant.as_deref().map_or(0, |s| s.newton)
+    }
+
+    /// Continues that count from a checkpoint's.
+    pub(crate) fn set_normal_iterations(&mut self, count: u64) {
+        if let Some(s) = self.compliant.as_deref_mut() {
+            s.newton = count;
+        }
     }
 
     /// Numeric factorizations so far.
@@ -450,7 +480,11 @@ impl Stepper for Newmark {
         // The compliant nodes' bounds at r_K for the ledger's friction
         // forces, and the foundation's stored energy.
         let foundation_stored = match run.contact.as_mut().filter(|c| c.is_compliant()) {
-            Some(c) => c.comply(&state.r_new, &[], &mut self.normal).stored,
+            Some(c) => {
+                let stored = c.comply(&state.r_new, &[], &mut self.normal).stored;
+                self.friction.follow_compliance(c);
+                stored
+            }
             None => 0.0,
         };
         let settings = &run.settings;
