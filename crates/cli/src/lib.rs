@@ -47,6 +47,7 @@ pub mod frames;
 pub mod mesh_cmd;
 mod normal_stress;
 pub mod output;
+mod pending;
 pub mod probe;
 pub mod results_file;
 pub mod run;
