@@ -34,6 +34,9 @@ pub enum Field {
     /// Slip velocity v_T along τ (contact nodes only).
     #[value(name = "slip_velocity")]
     SlipVelocity,
+    /// Normal traction pressing the node (contact nodes only).
+    #[value(name = "normal_stress")]
+    NormalStress,
     /// Stress σ_xx at the node (the average of its cells' values there),
     /// from the stored displacement and the case's material.
     Sxx,
@@ -57,6 +60,7 @@ impl Field {
             Field::Ay => "ay",
             Field::FrictionStress => "friction_stress",
             Field::SlipVelocity => "slip_velocity",
+            Field::NormalStress => "normal_stress",
             Field::Sxx => "sxx",
             Field::Syy => "syy",
             Field::Sxy => "sxy",
@@ -78,7 +82,10 @@ impl Field {
 
     /// A field of the contact nodes only.
     fn on_contact(self) -> bool {
-        matches!(self, Field::FrictionStress | Field::SlipVelocity)
+        matches!(
+            self,
+            Field::FrictionStress | Field::SlipVelocity | Field::NormalStress
+        )
     }
 
     /// The node dataset and component of a node field; `None` for the
@@ -958,11 +965,12 @@ mod tests {
                 .map(|i| if i % 2 == 1 { 0.5 * k as f64 } else { 0.0 })
                 .collect();
             let fs: Vec<f64> = (0..3).map(|j| k as f64 - j as f64).collect();
+            let ns: Vec<f64> = (0..3).map(|j| 300.0 + 10.0 * k as f64 + j as f64).collect();
             w.append(&Record {
                 friction_stress: &fs,
                 slip_velocity: &[0.0; 3],
                 state: &[0; 3],
-                normal_stress: &[0.0; 3],
+                normal_stress: &ns,
                 dt: 0.25,
                 ..Record::zeros(0.25 * k as f64, [&d, &v, &d])
             })
@@ -1005,6 +1013,9 @@ mod tests {
             "{}",
             fs.table
         );
+        // Its normal traction as written: 300 + 10 k + j at row k.
+        let ns = probe(&path, "1,0", Field::NormalStress, false).unwrap();
+        assert_eq!(ns.values, vec![301.0, 311.0, 321.0, 331.0]);
         // Node 4 at (1, 1) is not on the contact line.
         let e = probe(&path, "1,1", Field::FrictionStress, false)
             .unwrap_err()
