@@ -237,3 +237,23 @@ pub struct Trace {
     /// Why the run stopped before t_end, if it did.
     pub error: Option<String>,
 }
+
+/// A case on the paper's mesh (Q2 8×2, E = 1000, ν = 0.3, ρ = 1):
+/// `material` adds lines to its `[material]`, `rest` holds its supports,
+/// loads and contact, `time` the lines of its `[time]`.
+pub fn paper_slab(root: &Path, material: &str, rest: &str, time: &str) -> String {
+    format!(
+        "[mesh]\nfile = \"{}\"\n[material]\nE = 1000.0\nnu = 0.3\nrho = 1.0\n{material}{rest}\n\
+         [time]\n{time}",
+        root.join("cases/meshes/slab-q2-8x2.msh").display()
+    )
+}
+
+/// The integrator of case text `text`, read as if from `root/name` (the
+/// path only names it in messages).
+pub fn integrator_of(root: &Path, name: &str, text: &str) -> Result<Integrator, String> {
+    let path = root.join(name);
+    let case = stickslip_case::load_str(&path, text, &[]).map_err(|e| e.to_string())?;
+    let scene = stickslip_case::assemble(&case).map_err(|e| e.to_string())?;
+    scene.integrator().map_err(|e| e.to_string())
+}

@@ -23,7 +23,7 @@
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{RigidMode, SetupTimes};
-use stickslip_linalg::csr::spmv;
+use stickslip_linalg::csr::{dot, spmv};
 use stickslip_linalg::{FillOrder, SparseCholesky};
 
 use crate::floating;
@@ -310,7 +310,7 @@ fn holds(springs: &[f64], along: &[Vec<f64>], held: &[Vec<f64>]) -> bool {
             }
         }
     }
-    let (values, _) = eigen(b);
+    let (values, _) = eigen(&b);
     let largest = values.iter().fold(0.0_f64, |m, v| m.max(*v));
     largest > 0.0 && values.iter().all(|v| *v > NULL * largest)
 }
@@ -350,7 +350,7 @@ fn split(modes: &[RigidMode], along: &[Vec<f64>]) -> (Vec<RigidMode>, Vec<Vec<f6
             }
         }
     }
-    let (values, vectors) = eigen(a);
+    let (values, vectors) = eigen(&a);
     let largest = values.iter().fold(0.0_f64, |m, v| m.max(*v));
     let (mut never, mut held) = (Vec::new(), Vec::new());
     for (value, v) in values.iter().zip(vectors) {
@@ -393,52 +393,21 @@ fn label(modes: &[RigidMode], v: &[f64]) -> String {
     }
 }
 
-/// Eigenvalues and unit eigenvectors of a small symmetric matrix by
-/// cyclic Jacobi rotations.
-fn eigen(mut a: Vec<Vec<f64>>) -> (Vec<f64>, Vec<Vec<f64>>) {
+/// Eigenvalues and unit eigenvectors of a small symmetric matrix (faer's
+/// self-adjoint eigendecomposition). Should it fail (entries not finite),
+/// the values are NaN: no comparison holds, so nothing counts as held.
+fn eigen(a: &[Vec<f64>]) -> (Vec<f64>, Vec<Vec<f64>>) {
     let n = a.len();
-    let mut v: Vec<Vec<f64>> = (0..n)
-        .map(|i| (0..n).map(|j| f64::from(u8::from(i == j))).collect())
+    let m = faer::Mat::from_fn(n, n, |i, j| a[i][j]);
+    let Ok(e) = m.self_adjoint_eigen(faer::Side::Lower) else {
+        let unit = |j: usize| (0..n).map(|i| f64::from(u8::from(i == j))).collect();
+        return (vec![f64::NAN; n], (0..n).map(unit).collect());
+    };
+    let (s, u) = (e.S(), e.U());
+    let values = (0..n).map(|i| s[i]).collect();
+    let vectors = (0..n)
+        .map(|j| (0..n).map(|i| u[(i, j)]).collect())
         .collect();
-    for _ in 0..50 {
-        let off: f64 = (0..n)
-            .flat_map(|i| (0..n).filter(move |&j| j != i).map(move |j| (i, j)))
-            .map(|(i, j)| a[i][j] * a[i][j])
-            .sum();
-        let diag: f64 = (0..n).map(|i| a[i][i] * a[i][i]).sum();
-        if off <= 1e-32 * diag || off == 0.0 {
-            break;
-        }
-        for p in 0..n {
-            for q in p + 1..n {
-                if a[p][q] == 0.0 {
-                    continue;
-                }
-                let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-                let t = theta.signum() / (theta.abs() + theta.hypot(1.0));
-                let t = if theta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / t.hypot(1.0);
-                let s = t * c;
-                for k in 0..n {
-                    let (akp, akq) = (a[k][p], a[k][q]);
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for k in 0..n {
-                    let (apk, aqk) = (a[p][k], a[q][k]);
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-                for row in &mut v {
-                    let (vp, vq) = (row[p], row[q]);
-                    row[p] = c * vp - s * vq;
-                    row[q] = s * vp + c * vq;
-                }
-            }
-        }
-    }
-    let values = (0..n).map(|i| a[i][i]).collect();
-    let vectors = (0..n).map(|j| (0..n).map(|i| v[i][j]).collect()).collect();
     (values, vectors)
 }
 
@@ -468,14 +437,14 @@ fn slot(k: &CsrMatrix<f64>, i: usize, j: usize) -> Option<usize> {
 }
 
 fn norm(x: &[f64]) -> f64 {
-    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+    dot(x, x).sqrt()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// The Jacobi rotations diagonalize [[2, 1, 0], [1, 2, 0], [0, 0, 0]]:
+    /// The decomposition of [[2, 1, 0], [1, 2, 0], [0, 0, 0]]:
     /// eigenvalues 3, 1, 0 (the closed form of a 2×2 block [[a, b], [b, a]]
     /// is a ± b), each A v = λ v.
     #[test]
@@ -485,7 +454,7 @@ mod tests {
             vec![1.0, 2.0, 0.0],
             vec![0.0, 0.0, 0.0],
         ];
-        let (values, vectors) = eigen(a.clone());
+        let (values, vectors) = eigen(&a);
         let mut sorted = values.clone();
         sorted.sort_by(f64::total_cmp);
         for (got, want) in sorted.iter().zip([0.0, 1.0, 3.0]) {

@@ -17,6 +17,7 @@ use stickslip_testkit::sdof;
 use stickslip_time::{Integrator, Rayleigh, Scheme, Settings};
 
 use crate::report::Report;
+use crate::scene::{integrator_of, paper_slab};
 
 /// Pressure, μ, the belt's speed.
 const P: f64 = 300.0;
@@ -54,35 +55,21 @@ fn held_slab(root: &Path, r: &mut Report) {
 /// The case text: the slab, left end held in x, top in y, pressed on its
 /// bottom ("contact") by P, with `bottom` as the bottom's tables.
 fn slab(root: &Path, bottom: &str, scheme: &str, dt: f64, t_end: f64) -> String {
-    format!(
-        r#"[mesh]
-file = "{}"
-[material]
-E = 1000.0
-nu = 0.3
-rho = 1.0
-damping = {{ alpha = 2.0, beta = 0.0 }}
-[[dirichlet]]
-group = "left"
-ux = 0.0
-[[dirichlet]]
-group = "support"
-uy = 0.0
-{bottom}
-[time]
-scheme = "{scheme}"
-dt = {dt}
-t_end = {t_end}
-"#,
-        root.join("cases/meshes/slab-q2-8x2.msh").display()
+    let rest = format!(
+        "[[dirichlet]]\ngroup = \"left\"\nux = 0.0\n[[dirichlet]]\ngroup = \"support\"\nuy = 0.0\n\
+         {bottom}\n"
+    );
+    let time = format!("scheme = \"{scheme}\"\ndt = {dt}\nt_end = {t_end}\n");
+    paper_slab(
+        root,
+        "damping = { alpha = 2.0, beta = 0.0 }\n",
+        &rest,
+        &time,
     )
 }
 
 fn integrator(root: &Path, text: &str) -> Result<Integrator, String> {
-    let path = root.join("belt.toml");
-    let case = stickslip_case::load_str(&path, text, &[]).map_err(|e| e.to_string())?;
-    let scene = stickslip_case::assemble(&case).map_err(|e| e.to_string())?;
-    scene.integrator().map_err(|e| e.to_string())
+    integrator_of(root, "belt.toml", text)
 }
 
 /// max |u(t_end) − u_static| over max |u_static − u₀|, u₀ the belt run's

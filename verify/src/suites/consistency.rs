@@ -35,6 +35,7 @@ use std::path::Path;
 use stickslip_time::Integrator;
 
 use crate::report::{num, Report};
+use crate::scene::{integrator_of, paper_slab};
 
 /// The floors' stiffness c_n.
 const FLOORS: [f64; 4] = [1e3, 1e4, 1e5, 1e6];
@@ -204,21 +205,8 @@ const LIMIT: f64 = 2e-3;
 /// The slab's mesh and material, `rest` (its supports, loads and contact)
 /// and the run to `t_end`.
 fn slab(root: &Path, rest: &str, t_end: f64) -> String {
-    format!(
-        r#"[mesh]
-file = "{}"
-[material]
-E = 1000.0
-nu = 0.3
-rho = 1.0
-{rest}
-[time]
-scheme = "central_difference"
-dt = {DT}
-t_end = {t_end}
-"#,
-        root.join("cases/meshes/slab-q2-8x2.msh").display()
-    )
+    let time = format!("scheme = \"central_difference\"\ndt = {DT}\nt_end = {t_end}\n");
+    paper_slab(root, "", rest, &time)
 }
 
 /// The paper's left end held in x, and its end load.
@@ -298,8 +286,5 @@ fn history(
 }
 
 fn integrator(root: &Path, text: &str) -> Result<Integrator, String> {
-    let path = root.join("consistency.toml");
-    let case = stickslip_case::load_str(&path, text, &[]).map_err(|e| e.to_string())?;
-    let scene = stickslip_case::assemble(&case).map_err(|e| e.to_string())?;
-    scene.integrator().map_err(|e| e.to_string())
+    integrator_of(root, "consistency.toml", text)
 }
