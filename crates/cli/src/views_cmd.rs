@@ -24,10 +24,10 @@ use crate::views::{ContactLine, Layout};
 use crate::xdmf::{ContactInfo, XdmfInfo};
 
 /// About the bytes per record the command writes beside the results:
-/// the XML of both files (1,150 and 1,377 for the slab's `st.h5`; each
-/// character of a longer file name adds about ten) and six views in
-/// `OUT.views.h5` (3,048 together).
-const BYTES_PER_RECORD: usize = 5600;
+/// the XML of both files (each character of a longer file name adds about
+/// ten) and seven views in `OUT.views.h5`, as measured on the paper's slab
+/// (docs/performance.md, "The viewers' files").
+const BYTES_PER_RECORD: usize = 6500;
 
 /// What [`write()`] wrote.
 #[derive(Clone, Debug, PartialEq, Eq)]
