@@ -292,8 +292,15 @@ fn a_file_without_normal_stress_shows_the_rest_and_gains_it_on_restart() {
     }
     let xml = std::fs::read_to_string(out.with_extension("contact.xdmf")).unwrap();
     assert!(!xml.contains("normal_stress"));
-    let views = hdf5::File::open(out.with_extension("views.h5")).unwrap();
+    let views = hdf5::File::open_rw(out.with_extension("views.h5")).unwrap();
     assert!(!views.link_exists("contact/normal_stress"));
+    // A mark that stays only if `views` adds to this file, not a new one.
+    views
+        .new_attr::<u8>()
+        .create("mark")
+        .unwrap()
+        .write_scalar(&7)
+        .unwrap();
     drop(views);
 
     let case = out.with_file_name("case.toml");
@@ -310,6 +317,7 @@ fn a_file_without_normal_stress_shows_the_rest_and_gains_it_on_restart() {
     assert_eq!(shown.len(), 31);
     let views = hdf5::File::open(out.with_extension("views.h5")).unwrap();
     assert_eq!(views.group("contact/normal_stress").unwrap().len(), 31);
+    assert_eq!(views.attr("mark").unwrap().read_scalar::<u8>().unwrap(), 7);
     // The restart takes the checkpoint of the state before the last step
     // (docs/results.md), so it writes the rows from t = 0.02 on.
     for (t, values) in shown {
