@@ -125,7 +125,7 @@ Exit codes: 0 a configuration meets the tolerance (estimated), 1 none of the lad
     /// Write OUT.xdmf, OUT.contact.xdmf and OUT.views.h5 beside a results file, for ParaView,
     /// meshio and PyVista (the run itself does not: their cost grows with the records).
     #[command(after_help = "Example:\n  stickslip views slab.h5\n\n\
-Open slab.xdmf in ParaView (any of its XDMF readers) and slab.contact.xdmf for the friction fields along \
+Open slab.xdmf in ParaView (any of its XDMF readers) and slab.contact.xdmf for the friction and normal stresses along \
 the contact surface; meshio.xdmf.TimeSeriesReader and pyvista.read read them too. Works on a finished, \
 interrupted or failed run's file; run it again after a --restart (it adds the new records).")]
     Views {

@@ -37,12 +37,49 @@ use stickslip_mesh::Mesh;
 /// The body's node vectors, as the results file names them.
 pub const VECTORS: [&str; 3] = ["displacement", "velocity", "acceleration"];
 
-/// The contact fields under `/contact`: (name, stored as i8).
-pub const CONTACT_FIELDS: [(&str, bool); 3] = [
-    ("friction_stress", false),
-    ("slip_velocity", false),
-    ("state", true),
+/// A per-node history under `/contact` that `OUT.contact.xdmf` shows, one
+/// view a record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ContactField {
+    /// Its name under `/contact`, in the results file and the views file.
+    pub name: &'static str,
+    /// Stored as i8 (the state), else f64.
+    pub small: bool,
+}
+
+/// The contact fields a run writes, in the order the XDMF lists them.
+pub const CONTACT_FIELDS: [ContactField; 4] = [
+    ContactField {
+        name: "friction_stress",
+        small: false,
+    },
+    ContactField {
+        name: "slip_velocity",
+        small: false,
+    },
+    ContactField {
+        name: "state",
+        small: true,
+    },
+    ContactField {
+        name: "normal_stress",
+        small: false,
+    },
 ];
+
+/// The [`CONTACT_FIELDS`] the results file `f` holds for its `n_c` contact
+/// nodes down to row `rows - 1`: files of versions before
+/// `/contact/normal_stress` lack it. A view of a dataset that is not there
+/// reads as HDF5's fill value, so the views and the XML list only these.
+pub fn held_contact_fields(f: &File, n_c: usize, rows: usize) -> Vec<ContactField> {
+    CONTACT_FIELDS
+        .into_iter()
+        .filter(|c| {
+            f.dataset(&format!("contact/{}", c.name))
+                .is_ok_and(|d| matches!(d.shape()[..], [r, n] if r >= rows && n == n_c))
+        })
+        .collect()
+}
 
 /// The views file of the results file `out`: OUT.views.h5 beside it.
 pub fn views_path(out: &Path) -> PathBuf {
@@ -97,6 +134,8 @@ pub struct Layout<'a> {
     pub n_nodes: usize,
     /// The contact surface's line, if the case has friction nodes.
     pub contact: Option<&'a ContactLine>,
+    /// The contact fields the results file holds ([`held_contact_fields`]).
+    pub fields: &'a [ContactField],
 }
 
 /// Makes `OUT.views.h5` hold the views of the frames of the results file
@@ -124,12 +163,18 @@ pub fn update(out: &Path, layout: &Layout, frame_rows: &[usize]) -> anyhow::Resu
             }
         }
         if n_c > 0 && f.group("contact").is_ok() {
-            for (name, small) in CONTACT_FIELDS {
-                let g = f.group(&format!("contact/{name}"))?;
-                let src = format!("contact/{name}");
+            for field in layout.fields {
+                let src = format!("contact/{}", field.name);
+                // A views file made before the results file held the
+                // field (a restart of an older file adds
+                // /contact/normal_stress) gets its group now.
+                let g = match f.group(&src) {
+                    Ok(g) => g,
+                    Err(_) => f.create_group(&src)?,
+                };
                 for k in g.len() as usize..rows {
                     let at = (k, frame_rows[k]);
-                    if small {
+                    if field.small {
                         row_view::<i8>(&g, source, &src, n_c, at)?;
                     } else {
                         row_view::<f64>(&g, source, &src, n_c, at)?;
@@ -195,9 +240,6 @@ fn create(path: &Path, source: &str, layout: &Layout) -> anyhow::Result<File> {
             .create("points")?;
         let lines = Array2::from_shape_fn((c.lines.len(), 2), |(i, k)| c.lines[i][k] as i64);
         g.new_dataset_builder().with_data(&lines).create("lines")?;
-        for (name, _) in CONTACT_FIELDS {
-            g.create_group(name)?;
-        }
     }
     Ok(f)
 }

@@ -21,13 +21,13 @@ use stickslip_case::InputError;
 use stickslip_mesh::CellKind;
 
 use crate::views::{ContactLine, Layout};
-use crate::xdmf::XdmfInfo;
+use crate::xdmf::{ContactInfo, XdmfInfo};
 
 /// About the bytes per record the command writes beside the results:
-/// the XML of both files (1,150 and 1,377 for the slab's `st.h5`; each
-/// character of a longer file name adds about ten) and six views in
-/// `OUT.views.h5` (3,048 together).
-const BYTES_PER_RECORD: usize = 5600;
+/// the XML of both files (each character of a longer file name adds about
+/// ten) and seven views in `OUT.views.h5`, as measured on the paper's slab
+/// (docs/performance.md, "The viewers' files").
+const BYTES_PER_RECORD: usize = 6500;
 
 /// What [`write()`] wrote.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -104,6 +104,14 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         .len()
         .min(shape("displacement")?.first().copied().unwrap_or(0));
     let (contact, note) = contact_line(&f, out)?;
+    // The histories' rows the frames name, which every contact field
+    // listed must hold.
+    let history_rows = frames.row[..rows].iter().max().map_or(0, |&r| r + 1);
+    let fields = crate::views::held_contact_fields(
+        &f,
+        contact.as_ref().map_or(0, |c| c.points.len()),
+        history_rows,
+    );
     // Files written before it have no /contact/surface: one surface.
     let surface = f.link_exists("contact/surface");
     let stress = stress_name(out, rows);
@@ -125,6 +133,7 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
     let layout = Layout {
         n_nodes,
         contact: contact.as_ref(),
+        fields: &fields,
     };
     crate::views::update(out, &layout, &frames.row[..rows])?;
     let info = XdmfInfo {
@@ -144,8 +153,12 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         Some(c) => crate::xdmf::write_contact_xdmf(
             out,
             &times[..rows],
-            c.points.len(),
-            (c.lines.len(), surface),
+            &ContactInfo {
+                n_c: c.points.len(),
+                n_lines: c.lines.len(),
+                surface,
+                fields: &fields,
+            },
         )
         .with_context(|| format!("cannot write {}", contact_path.display()))?,
         // One of an earlier results file would list other records.

@@ -8,7 +8,9 @@
 //! The body's grid has the mesh (`/mesh/cells`, `/mesh/nodes`) and the
 //! node vectors displacement, velocity and acceleration; the contact
 //! grid has the friction nodes joined by segments, their arc length `s`
-//! and the friction stress, slip velocity and state. Every per-record
+//! and the contact fields the results file holds (friction stress, slip
+//! velocity, state and normal stress; files of earlier versions lack the
+//! last, and their XML omits it). Every per-record
 //! array is a whole dataset of `OUT.views.h5` (a view of one row of the
 //! results file, [`crate::views`]), so that no reader needs XDMF's
 //! HyperSlab items: ParaView's three XDMF readers, meshio's
@@ -25,7 +27,7 @@ use std::path::{Path, PathBuf};
 
 use stickslip_mesh::CellKind;
 
-use crate::views::{views_path, CONTACT_FIELDS, VECTORS};
+use crate::views::{views_path, ContactField, VECTORS};
 
 /// What the XML needs to know about a results file: its sizes and times.
 #[derive(Clone, Copy, Debug)]
@@ -43,6 +45,20 @@ pub struct XdmfInfo<'a> {
     /// record K as scalars (ParaView would call a 3-vector's third
     /// component "Z").
     pub stress: Option<&'a str>,
+}
+
+/// What the contact XML needs to know about a results file's contact line.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactInfo<'a> {
+    /// Rows of `/contact/nodes`.
+    pub n_c: usize,
+    /// Rows of `/contact/lines`.
+    pub n_lines: usize,
+    /// The file has `/contact/surface`.
+    pub surface: bool,
+    /// The contact fields the file holds, whose views the XML names
+    /// ([`crate::views::held_contact_fields`]).
+    pub fields: &'a [ContactField],
 }
 
 /// The body's XDMF file of the results file `out`: OUT.xdmf beside it.
@@ -79,18 +95,11 @@ pub fn xdmf_text(h5_name: &str, info: &XdmfInfo) -> String {
     String::from_utf8(x).expect("the XML is UTF-8")
 }
 
-/// The XML of `OUT.contact.xdmf` for the results file named `h5_name`,
-/// whose contact line has `n_c` nodes and `n_lines` segments, and each
-/// node's surface where the file has `/contact/surface` (`surface`).
-pub fn contact_text(
-    h5_name: &str,
-    times: &[f64],
-    n_c: usize,
-    n_lines: usize,
-    surface: bool,
-) -> String {
-    let mut x = Vec::with_capacity(1024 + times.len() * 1400);
-    write_contact(&mut x, h5_name, times, (n_c, n_lines, surface)).expect("writing to memory");
+/// The XML of `OUT.contact.xdmf` for the results file named `h5_name`
+/// and its contact line `info`.
+pub fn contact_text(h5_name: &str, times: &[f64], info: &ContactInfo) -> String {
+    let mut x = Vec::with_capacity(1024 + times.len() * 1600);
+    write_contact(&mut x, h5_name, times, info).expect("writing to memory");
     String::from_utf8(x).expect("the XML is UTF-8")
 }
 
@@ -197,8 +206,14 @@ fn write_contact(
     x: &mut impl Write,
     h5_name: &str,
     times: &[f64],
-    (n_c, n_lines, surface): (usize, usize, bool),
+    info: &ContactInfo,
 ) -> std::io::Result<()> {
+    let ContactInfo {
+        n_c,
+        n_lines,
+        surface,
+        fields,
+    } = *info;
     let h5 = xml_escape(h5_name);
     let views = xml_escape(&views_name(h5_name));
     let (lines, points) = (
@@ -216,10 +231,14 @@ fn write_contact(
             let path = format!("{h5}:/contact/surface");
             attribute(x, "surface", "Scalar", &dims, ("Int", 8), &path)?;
         }
-        for (name, small) in CONTACT_FIELDS {
-            let number = if small { ("Int", 1) } else { ("Float", 8) };
-            let path = format!("{views}:/contact/{name}/{k}");
-            attribute(x, name, "Scalar", &dims, number, &path)?;
+        for field in fields {
+            let number = if field.small {
+                ("Int", 1)
+            } else {
+                ("Float", 8)
+            };
+            let path = format!("{views}:/contact/{}/{k}", field.name);
+            attribute(x, field.name, "Scalar", &dims, number, &path)?;
         }
         x.write_all(b"      </Grid>\n")?;
     }
@@ -247,21 +266,16 @@ pub fn write_xdmf(out: &Path, info: &XdmfInfo) -> std::io::Result<()> {
     replace(&xdmf_path(out), |w| write_body(w, name, info))
 }
 
-/// Writes `OUT.contact.xdmf` for the results file `out`: the contact line
-/// of `n_c` nodes and `n_lines` segments at `times`, as [`write_xdmf`].
+/// Writes `OUT.contact.xdmf` for the results file `out`: its contact line
+/// `info` at `times`, as [`write_xdmf`] (after the views of `info.fields`).
 ///
 /// # Errors
 /// As [`write_xdmf`].
-pub fn write_contact_xdmf(
-    out: &Path,
-    times: &[f64],
-    n_c: usize,
-    (n_lines, surface): (usize, bool),
-) -> std::io::Result<()> {
+pub fn write_contact_xdmf(out: &Path, times: &[f64], info: &ContactInfo) -> std::io::Result<()> {
     let name = crate::views::file_name(out)
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.to_string()))?;
     replace(&contact_xdmf_path(out), |w| {
-        write_contact(w, name, times, (n_c, n_lines, surface))
+        write_contact(w, name, times, info)
     })
 }
 
@@ -334,9 +348,20 @@ mod tests {
         assert!(with.contains(">slab.stress.h5:/views/von_mises/1<"));
     }
 
+    /// The slab's contact line (16 nodes, 15 segments) with every field a
+    /// run writes, and `/contact/surface` where `surface`.
+    fn contact(surface: bool) -> ContactInfo<'static> {
+        ContactInfo {
+            n_c: 16,
+            n_lines: 15,
+            surface,
+            fields: &crate::views::CONTACT_FIELDS,
+        }
+    }
+
     #[test]
     fn the_contact_file_has_lines_and_the_friction_fields() {
-        let x = contact_text("slab.h5", &[0.0, 0.25], 16, 15, false);
+        let x = contact_text("slab.h5", &[0.0, 0.25], &contact(false));
         assert_eq!(count(&x, "GridType=\"Uniform\""), 2);
         assert_eq!(
             count(
@@ -353,8 +378,32 @@ mod tests {
         ));
         assert_eq!(count(&x, "<DataItem"), count(&x, "</DataItem>"));
         assert_eq!(count(&x, "/contact/surface<"), 0);
+        // The normal traction: each record its own view, 16 doubles.
+        for k in 0..2 {
+            assert_eq!(
+                count(
+                    &x,
+                    &format!(
+                        "<Attribute Name=\"normal_stress\" AttributeType=\"Scalar\" Center=\"Node\">\n\
+                         \x20         <DataItem Dimensions=\"16\" NumberType=\"Float\" Precision=\"8\" \
+                         Format=\"HDF\">slab.views.h5:/contact/normal_stress/{k}<"
+                    )
+                ),
+                1,
+                "{x}"
+            );
+        }
+        // A file without it (an earlier version's): the XML names it nowhere.
+        let older = ContactInfo {
+            fields: &crate::views::CONTACT_FIELDS[..3],
+            ..contact(false)
+        };
+        let y = contact_text("slab.h5", &[0.0, 0.25], &older);
+        assert_eq!(count(&y, "normal_stress"), 0);
+        assert_eq!(count(&y, "<Attribute "), 2 * 4);
+        assert_eq!(count(&y, "<DataItem"), count(&y, "</DataItem>"));
         // With /contact/surface, each record names it once, as 64-bit ints.
-        let x = contact_text("slab.h5", &[0.0, 0.25], 16, 15, true);
+        let x = contact_text("slab.h5", &[0.0, 0.25], &contact(true));
         assert_eq!(
             count(
                 &x,
@@ -372,14 +421,14 @@ mod tests {
         let times = [0.0, 0.25, 0.5];
         let out = dir.join("slab.h5");
         write_xdmf(&out, &info(&times)).unwrap();
-        write_contact_xdmf(&out, &times, 16, (15, false)).unwrap();
+        write_contact_xdmf(&out, &times, &contact(false)).unwrap();
         assert_eq!(
             std::fs::read_to_string(dir.join("slab.xdmf")).unwrap(),
             xdmf_text("slab.h5", &info(&times))
         );
         assert_eq!(
             std::fs::read_to_string(dir.join("slab.contact.xdmf")).unwrap(),
-            contact_text("slab.h5", &times, 16, 15, false)
+            contact_text("slab.h5", &times, &contact(false))
         );
         assert!(!dir.join("slab.xdmf.part").exists());
         assert!(!dir.join("slab.contact.xdmf.part").exists());
