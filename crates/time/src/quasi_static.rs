@@ -30,8 +30,8 @@
 //! work: with the previous increment in equilibrium the balance moves by
 //! ΔU_f + ½(F_K + F_{K−1})·Δr per increment (F the foundation's nodal
 //! forces), zero for m_n = 1 while the nodes in contact stay in contact
-//! (a linear spring); a node that enters or leaves contact adds ½ w c_n
-//! (δ_{K−1} g_K⁺ − δ_K g_{K−1}⁺) (g its gap), and m_n > 1 the trapezoid
+//! (a linear spring); a node that enters or leaves contact adds, for m_n =
+//! 1, ½ w c_n (δ_{K−1} g_K⁺ − δ_K g_{K−1}⁺) (g its gap), and m_n > 1 the trapezoid
 //! rule's error on the spring's work, of third order in the increment of
 //! the approach: the balance is not round-off there.
 
