@@ -394,8 +394,8 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
         // A part's free rigid motions are the integrator's to handle (the
         // static preload on their complement, or a start at rest); a node
         // of no cell has no stiffness at all, and nothing can hold it.
-        // Quasi-static increments factorize Δt K, and friction does not
-        // stand in for a support there.
+        // Quasi-static increments factorize Δt K, and neither friction nor
+        // a compliant foundation stands in for a support there.
         let free = m.dofs.free_rigid_motions();
         let quasi_static = case.time.scheme == Scheme::QuasiStatic;
         let refused: Vec<&String> = free
@@ -405,7 +405,8 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
         if quasi_static && !refused.is_empty() {
             problems.push(format!(
                 "{dirichlet_at}the supports leave a rigid-body motion free for the initial static solve \
-                 and for the quasi-static increments (friction does not hold a body without supports): {}; \
+                 and for the quasi-static increments, each of which factorizes dt K, singular along it \
+                 (neither friction nor a compliant foundation holds a body without supports): {}; \
                  add [[dirichlet]] conditions that prevent it (e.g. uy = 0 on a bottom or top group and ux = 0 on an end)",
                 refused.iter().map(|l| l.as_str()).collect::<Vec<_>>().join(", ")
             ));

@@ -9,22 +9,16 @@ use stickslip_contact::{Compliance, ContactError, ContactSurface};
 use stickslip_fem::DofMap;
 use stickslip_mesh::Mesh;
 
-use crate::schema::{Case, ContactLaw, ContactSection, History, InitialState, Mu, Scheme};
-
-/// A key's dotted path on the surface, and whether a dotted key is in the
-/// case's text.
-type Keys<'a> = (&'a dyn Fn(&str) -> String, &'a dyn Fn(&str) -> bool);
+use crate::schema::{ContactLaw, ContactSection, History, InitialState, Mu};
 
 /// The compliance law's keys, refused on a prescribed-pressure surface.
 const COMPLIANCE_KEYS: [&str; 5] = ["foundation", "cn", "mn", "ct", "mt"];
 
 /// Checks surface `c`'s law keys through `check(ok, key, message)`;
-/// `key` gives a key's dotted path on this surface, `written` whether a
-/// dotted key is in the case's text.
+/// `key` gives a key's dotted path on this surface.
 pub(crate) fn check_law(
-    case: &Case,
     c: &ContactSection,
-    (key, written): Keys,
+    key: &dyn Fn(&str) -> String,
     check: &mut dyn FnMut(bool, &str, String),
 ) {
     let given = |k: &str| match k {
@@ -63,13 +57,12 @@ pub(crate) fn check_law(
         }
         return;
     }
-    check_compliance(case, c, (key, written), check);
+    check_compliance(c, key, check);
 }
 
 fn check_compliance(
-    case: &Case,
     c: &ContactSection,
-    (key, written): Keys,
+    key: &dyn Fn(&str) -> String,
     check: &mut dyn FnMut(bool, &str, String),
 ) {
     let law = key("law");
@@ -178,18 +171,6 @@ fn check_compliance(
                 .into(),
         ),
     }
-    // What the law runs with so far: the dynamic schemes.
-    check(
-        case.time.scheme != Scheme::QuasiStatic,
-        if written("time.scheme") {
-            "time.scheme"
-        } else {
-            &law
-        },
-        "law = \"compliance\" runs with time.scheme = \"central_difference\" or \"newmark\": the \
-         quasi-static increments do not yet solve the normal and friction terms together"
-            .into(),
-    );
 }
 
 /// Surface `c` of `law = "compliance"` on its foundation, its keys checked

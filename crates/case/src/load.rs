@@ -374,12 +374,7 @@ fn complete(
     // [contact]
     for (i, c) in case.contact.iter().enumerate() {
         let key = |k: &str| crate::schema::contact_key_in(spans.keys(), i, k);
-        crate::compliance::check_law(
-            &case,
-            c,
-            (&key, &|k: &str| spans.contains_key(k)),
-            &mut check,
-        );
+        crate::compliance::check_law(c, &key, &mut check);
         // A key the law lacks is refused above; 0 checks nothing here.
         let (p, mu, eps) = (c.pressure.unwrap_or(0.0), c.mu_at_rest(), c.eps);
         check(p >= 0.0 && p.is_finite(), &key("pressure"), format!("contact.pressure = {p} must be >= 0 and finite (it presses the body onto the surface; g = mu * pressure)"));

@@ -98,3 +98,81 @@ t_end = 0.2
     let worst = balance.iter().fold(0.0_f64, |m, b| m.max(b.abs()));
     assert!(worst < 1e-2, "largest |balance| {worst}");
 }
+
+/// Quasi-static increments on a floor: the paper's slab held on its top
+/// (rollers) and its left end, its bottom 0.03 inside a floor of c_n =
+/// 1e4 (the static start presses it), its end load ramped to t_x = −30
+/// over 20 increments (docs/case-file.md's example). The run completes,
+/// its summary counts the Newton iterations, the checkpoint keeps them,
+/// the floor stores energy at every record, and the ledger closes to
+/// round-off (each increment in equilibrium; m_n = 1 and no node leaves
+/// the floor, so the trapezoid books the foundation's work exactly:
+/// within 1e-9 of the strain energy).
+#[test]
+fn quasi_static_increments_on_a_floor_report_their_newton_iterations() {
+    let dir = scratch("compliance-quasi-static");
+    let text = format!(
+        r#"{head}[[dirichlet]]
+group = "support"
+uy = 0.0
+[[dirichlet]]
+group = "left"
+ux = 0.0
+[[traction]]
+group = "load"
+t = [-30.0, 0.0]
+history = {{ table = [[0.0, 0.0], [1.0, 1.0]] }}
+[contact]
+group = "contact"
+law = "compliance"
+foundation = {{ point = [0.0, 0.03], normal = [0.0, 1.0] }}
+cn = 1e4
+mu = 0.3
+eps = 1e-4
+[initial]
+state = "static"
+[time]
+scheme = "quasi_static"
+dt = 0.05
+t_end = 1.0
+"#,
+        head = paper_slab_head()
+    );
+    let case = dir.join("floor.toml");
+    std::fs::write(&case, text).unwrap();
+    let out = dir.join("floor.h5");
+    let o = bin()
+        .args(["run", "--force", "-o"])
+        .arg(&out)
+        .arg(&case)
+        .output()
+        .unwrap();
+    succeeded(&o, "run");
+    let said = String::from_utf8_lossy(&o.stderr) + String::from_utf8_lossy(&o.stdout);
+    assert!(said.contains("compliance Newton iterations"), "{said}");
+    let f = hdf5::File::open(&out).unwrap();
+    let c = f.group("checkpoint").unwrap();
+    let k = c.attr("slot").unwrap().read_scalar::<u8>().unwrap();
+    let newton = c
+        .group(["a", "b"][k as usize])
+        .unwrap()
+        .attr("normal_iterations")
+        .unwrap()
+        .read_scalar::<u64>()
+        .unwrap();
+    assert!(newton > 0);
+    let read = |name: &str| f.dataset(name).unwrap().read_raw::<f64>().unwrap();
+    let (stored, strain, balance) = (
+        read("energy/foundation_stored"),
+        read("energy/strain"),
+        read("energy/balance"),
+    );
+    assert_eq!(stored.len(), 21);
+    assert!(stored.iter().all(|&s| s > 0.0), "{stored:?}");
+    let largest = strain.iter().fold(0.0_f64, |m, s| m.max(*s));
+    let worst = balance.iter().fold(0.0_f64, |m, b| m.max(b.abs()));
+    assert!(
+        worst <= 1e-9 * largest,
+        "|balance| {worst} of strain {largest}"
+    );
+}

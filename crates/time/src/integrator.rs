@@ -86,9 +86,6 @@ impl Integrator {
             Some(c) if c.carries_friction() || c.is_compliant() => (Some(c), None),
             other => (None, other),
         };
-        if let Some(c) = contact.as_ref().filter(|c| c.is_compliant()) {
-            check_compliance(c, &settings)?;
-        }
         let loads = Loads {
             constant: dynamics.constant_load.clone(),
             loads,
@@ -455,20 +452,4 @@ impl Integrator {
             }
         }
     }
-}
-
-/// What the compliance law needs of the run: a dynamic scheme (quasi-static
-/// increments would solve the normal and friction terms together without
-/// inertia, which they do not yet). Either start works: at rest, or from
-/// the static preload with the compliance (`preload_compliance.rs`).
-fn check_compliance(contact: &ContactSurface, settings: &Settings) -> Result<(), TimeError> {
-    if settings.scheme == Scheme::QuasiStatic {
-        return Err(TimeError::Settings(format!(
-            "surface {} has law = \"compliance\", which runs with time.scheme = \
-             \"central_difference\" or \"newmark\": the quasi-static increments do not yet solve \
-             the normal and friction terms together; use one of the dynamic schemes",
-            contact.names()
-        )));
-    }
-    Ok(())
 }

@@ -19,6 +19,21 @@
 //! increment was in equilibrium; hence R_0 is the load of the initial
 //! static state (R(0⁻), Remark 4.1), and a load switched on at t = 0 enters
 //! with the first increment.
+//!
+//! A compliant foundation (METHOD.md §10) joins each increment as in
+//! Newmark's step (`newmark/compliance.rs`) with the predictor r_{K−1} and
+//! c3 = Δt: its forces are those of the end point, f_n(r_K), so that
+//! K r_K + f_n(r_K) + J(ṙ_K) = R(t_K) holds (statics in equilibrium, not a
+//! lagged approach). The start is the compliant static preload
+//! (`preload_compliance.rs`). The ledger gains the foundation's stored
+//! energy Σ w_J c_n δ_J^{m_n+1}/(m_n+1), and the trapezoid rule books its
+//! work: with the previous increment in equilibrium the balance moves by
+//! ΔU_f + ½(F_K + F_{K−1})·Δr per increment (F the foundation's nodal
+//! forces), zero for m_n = 1 while the nodes in contact stay in contact
+//! (a linear spring); a node that enters or leaves contact adds, for m_n =
+//! 1, ½ w c_n (δ_{K−1} g_K⁺ − δ_K g_{K−1}⁺) (g its gap), and m_n > 1 the trapezoid
+//! rule's error on the spring's work, of third order in the increment of
+//! the approach: the balance is not round-off there.
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{stick_events, ContactSurface};
@@ -41,6 +56,9 @@ pub(crate) struct QuasiStatic {
     /// R(t_K) − K r_{K−1}.
     b: Vec<f64>,
     partials: Vec<[f64; 2]>,
+    /// A compliant foundation's nodal forces at r_K (`comply`'s output,
+    /// unused here: the increment's forces come from its Newton solve).
+    normal: Vec<f64>,
 }
 
 /// Builds the stepper and the initial state: r₀ the frictionless static
@@ -63,10 +81,16 @@ pub(crate) fn start(
     } = dynamics;
     if !rigid_modes.is_empty() {
         // Each increment factorizes Δt K, and nothing holds a free motion
-        // without inertia (the case file refuses such a part earlier).
-        return Err(TimeError::Settings(
-            "quasi-static increments need supports that hold every rigid-body motion".into(),
-        ));
+        // without inertia (the case file refuses such a part earlier): a
+        // compliant foundation's springs and friction's stuck damping act
+        // on the Schur complement's nodal unknowns, not in that factor.
+        let motions: Vec<&str> = rigid_modes.iter().map(|m| m.label.as_str()).collect();
+        return Err(TimeError::Settings(format!(
+            "quasi-static increments need supports that hold every rigid-body motion: each \
+             factorizes dt K, which is singular along {} (neither friction nor a compliant \
+             foundation enters that factor)",
+            motions.join(", ")
+        )));
     }
     let n = k.nrows();
     let friction = ImplicitFriction::new(&k, &fill_order, contact, settings)?;
@@ -90,13 +114,16 @@ pub(crate) fn start(
             InitialState::Static => loads.before_start(),
             InitialState::Rest => vec![0.0; n],
         };
-        state.energy.total = state.energy.strain - dot(&state.r, &state.load);
+        // strain ≥ +0, so adding no foundation's +0 keeps its bits.
+        state.energy.total =
+            state.energy.strain + state.energy.foundation_stored - dot(&state.r, &state.load);
     }
     let stepper = QuasiStatic {
         k,
         friction,
         b: vec![0.0; n],
         partials: chunks::partials(n),
+        normal: Vec::new(),
     };
     Ok((Box::new(stepper), state))
 }
@@ -113,6 +140,10 @@ impl Stepper for QuasiStatic {
         }
         state.classes_new.copy_from_slice(&state.classes);
         self.friction.lag_mu(run, &state.v);
+        // A compliant foundation at the end point: r_K = r_{K−1} + Δt ṙ_K.
+        if let Some(c) = run.contact.as_ref().filter(|c| c.is_compliant()) {
+            self.friction.predict_normal(c, &state.r, &state.v, dt);
+        }
         let mut v_new = std::mem::take(&mut state.v_new);
         // The operator Δt K + 0·K: Newmark's with β/γ = 1 and no mass.
         let result = self.friction.velocity(
@@ -145,6 +176,17 @@ impl Stepper for QuasiStatic {
                 hint: String::new(),
             });
         }
+        // The compliant nodes' bounds at r_K for the ledger's friction
+        // forces, and the foundation's stored energy.
+        let foundation_stored = match run.contact.as_mut().filter(|c| c.is_compliant()) {
+            Some(c) => {
+                let stored = c.comply(&state.r_new, &[], &mut self.normal).stored;
+                self.friction.follow_compliance(c);
+                stored
+            }
+            None => 0.0,
+        };
+        let settings = &run.settings;
         let (work, load_dot) = state.load_work();
         // Friction's work over the increment Δr = Δt ṙ_K: the ledger's
         // ½Δt(v + v_new) with both velocities the increment's rate.
@@ -171,7 +213,7 @@ impl Stepper for QuasiStatic {
             dissipated,
             damped: 0.0,
             foundation,
-            foundation_stored: 0.0,
+            foundation_stored,
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))
