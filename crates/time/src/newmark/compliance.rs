@@ -788,6 +788,58 @@ mod tests {
         }
     }
 
+    /// The energy-consistent form: one node whose approach at the step's
+    /// start is a0 and whose carried excess is e solves u + S f(u) = p with
+    /// f_N = −(2w(Φ(a₊) − Φ(a0₊))/(a − a0) − w σ(a0₊) − e), a = −(g + c3
+    /// u), Φ = c_n d^{m+1}/(m+1) and σ = c_n d^m written here, for touches,
+    /// releases and steps in contact, m_n = 1 and 1.5.
+    #[test]
+    fn newton_solves_the_energy_consistent_force() {
+        for (mn, a0, e, p_n) in [
+            (1.0, -1e-3, 0.0, -1.0),
+            (1.0, 2e-3, 3.0, 1.0),
+            (1.0, 2e-3, -1.0, -0.5),
+            (1.5, -5e-4, 0.0, -2.0),
+            (1.5, 3e-3, 2.0, 1.5),
+            (1.5, 1e-3, 0.5, -1.0),
+        ] {
+            let law = Compliance {
+                cn: 1e4,
+                mn,
+                ct: 0.0,
+                mt: mn,
+            };
+            let (w, c3, gap) = (0.5, 0.01, 1e-3);
+            let s_mat = [1.0, 0.0, 0.0, 0.5];
+            let p = [0.0, p_n];
+            let surface = node(w, law);
+            let mut solve = solver(&surface, gap, c3);
+            solve.form = NormalForm::EnergyConsistent;
+            solve.before[0] = a0;
+            solve.excess[0] = e;
+            let (mut f, mut v) = (vec![0.0; 2], vec![0.0; 1]);
+            solve
+                .solve(&surface, &FRICTIONLESS, (&s_mat, &p), &mut f, &mut v)
+                .unwrap();
+            let u = solve.x[1];
+            let a = -(gap + c3 * u);
+            let phi = |a: f64| law.cn * a.max(0.0).powf(mn + 1.0) / (mn + 1.0);
+            let f_n =
+                -(2.0 * w * (phi(a) - phi(a0)) / (a - a0) - w * law.cn * a0.max(0.0).powf(mn) - e);
+            let r = u + s_mat[3] * f_n - p[1];
+            let size = u.abs() + p[1].abs() + (s_mat[3] * f_n).abs();
+            assert!(
+                r.abs() <= 1e-11 * size,
+                "m = {mn}, a0 = {a0}: residual {r:e}"
+            );
+            assert!(
+                (f[1] - f_n).abs() <= 1e-9 * f_n.abs().max(1e-12),
+                "{} vs {f_n}",
+                f[1]
+            );
+        }
+    }
+
     /// With friction the bound follows the iterate's approach: a stuck
     /// node on a coupled S solves both rows of u + S f(u) = p, f_T = w
     /// c_T δ (u_T/ε) and f_N = −w c_n δ, checked by the equations written
