@@ -925,6 +925,11 @@ impl ResultsWriter {
         put_vector(&g, "acceleration", &cp.acceleration)?;
         put_vector(&g, "forces", &cp.forces)?;
         put_vector(&g, "classes", &cp.classes)?;
+        // Only where the run carries it (Newmark ¼, ½ on a compliant
+        // foundation), so other runs' files are as before.
+        if !cp.normal_excess.is_empty() {
+            put_vector(&g, "normal_excess", &cp.normal_excess)?;
+        }
         let e = &cp.energy;
         let values = [
             e.kinetic,
@@ -1788,6 +1793,7 @@ pub(crate) mod tests {
             total_iterations: 0,
             factorizations: 0,
             normal_iterations: 0,
+            normal_excess: Vec::new(),
         };
         let extra = CheckpointExtra::default();
         // Both slots written, then cut to an old file's seven values.

@@ -117,6 +117,13 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
         } else {
             0
         },
+        // Absent in files written before the energy-consistent normal
+        // force, and where the run does not carry it.
+        normal_excess: if g.link_exists("normal_excess") {
+            get_vector(&g, "normal_excess")?
+        } else {
+            Vec::new()
+        },
     };
     let rows = get_scalar::<u64>(&g, "rows")? as usize;
     let extra = CheckpointExtra {

@@ -228,9 +228,7 @@ impl Integrator {
     /// earlier than the bounds' last setting).
     fn comply_at_state(&mut self) {
         if let Some(c) = self.run.contact.as_mut().filter(|c| c.is_compliant()) {
-            let mut forces = Vec::new();
-            let f = c.comply(&self.state.r, &[], &mut forces);
-            self.state.energy.foundation_stored = f.stored;
+            self.state.energy.foundation_stored = c.comply_bounds(&self.state.r);
         }
     }
 

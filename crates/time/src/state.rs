@@ -87,6 +87,10 @@ pub struct Checkpoint {
     /// Newton iterations of a compliant foundation's implicit solves so
     /// far (0 in files written before them).
     pub normal_iterations: u64,
+    /// The energy-consistent normal force's excess over the end-point
+    /// one per compliant node, φ̃ − w σ (Newmark ¼, ½; empty otherwise, and
+    /// in files written before it: 0 then).
+    pub normal_excess: Vec<f64>,
 }
 
 /// The time of each step without drift: over a run of steps of one Δt
@@ -144,6 +148,10 @@ pub(crate) struct State {
     pub classes: Vec<SlipState>,
     /// Nodal friction forces f_J = w_J g_J φ_ε(v_TJ).
     pub forces: Vec<f64>,
+    /// Newmark ¼, ½ with a compliant foundation: per compliant node the
+    /// excess e = φ̃ − w σ of the step's energy-consistent normal force
+    /// over the end-point one (`newmark/algorithmic.rs`); empty otherwise.
+    pub normal_excess: Vec<f64>,
     pub energy: Energy,
     pub initial_mechanical: f64,
     pub reduced_remaining: usize,
@@ -158,6 +166,7 @@ pub(crate) struct State {
     pub load_new: Vec<f64>,
     pub classes_new: Vec<SlipState>,
     pub forces_new: Vec<f64>,
+    pub normal_excess_new: Vec<f64>,
 }
 
 /// The energies of a step, for [`State::close_step`].
@@ -193,6 +202,7 @@ impl State {
             load: vec![0.0; n],
             classes: vec![SlipState::Stuck; n_c],
             forces: vec![0.0; n_c],
+            normal_excess: Vec::new(),
             energy: Energy::default(),
             initial_mechanical: 0.0,
             reduced_remaining: 0,
@@ -204,6 +214,7 @@ impl State {
             load_new: vec![0.0; n],
             classes_new: vec![SlipState::Stuck; n_c],
             forces_new: vec![0.0; n_c],
+            normal_excess_new: Vec::new(),
         }
     }
 
@@ -247,6 +258,7 @@ impl State {
         std::mem::swap(&mut self.a, &mut self.a_new);
         std::mem::swap(&mut self.load, &mut self.load_new);
         std::mem::swap(&mut self.forces, &mut self.forces_new);
+        std::mem::swap(&mut self.normal_excess, &mut self.normal_excess_new);
         self.classes.copy_from_slice(&self.classes_new);
         self.clock.tick(self.t, dt);
         self.t = t_new;
@@ -313,6 +325,7 @@ impl State {
             total_iterations: self.total_iterations,
             factorizations,
             normal_iterations,
+            normal_excess: self.normal_excess.clone(),
         }
     }
 
@@ -347,6 +360,14 @@ impl State {
                 ));
             }
         }
+        let excess = c.normal_excess.len();
+        if excess != 0 && excess != self.normal_excess.len() {
+            return bad(format!(
+                "normal_excess has {excess} entries, the run {} compliant nodes of Newmark ¼, ½: \
+                 restart from a checkpoint of the same case (contact and scheme)",
+                self.normal_excess.len()
+            ));
+        }
         if !(c.t.is_finite() && c.t >= 0.0) {
             return bad(format!("t = {} is not a time ≥ 0", c.t));
         }
@@ -356,6 +377,7 @@ impl State {
             .chain(&c.velocity)
             .chain(&c.acceleration)
             .chain(&c.forces)
+            .chain(&c.normal_excess)
             .all(|x| x.is_finite());
         if !finite {
             return bad("the state holds NaN or infinity".into());
@@ -384,6 +406,13 @@ impl State {
         self.a.copy_from_slice(&c.acceleration);
         self.classes.copy_from_slice(&classes);
         self.forces.copy_from_slice(&c.forces);
+        // A checkpoint without the excess (an older file): the end-point
+        // force, whose excess is 0, as at t = 0.
+        if excess == 0 {
+            self.normal_excess.fill(0.0);
+        } else {
+            self.normal_excess.copy_from_slice(&c.normal_excess);
+        }
         self.energy = c.energy;
         self.initial_mechanical = c.initial_mechanical;
         self.reduced_remaining = usize::try_from(c.reduced_remaining).unwrap_or(usize::MAX);

@@ -42,6 +42,14 @@
 //! iterate, then x = p − S f) is a contraction only while the spring's
 //! stiffness times S stays below one, and oscillates or diverges beyond:
 //! the tests show both.
+//!
+//! The normal force takes one of two forms ([`NormalForm`]): the law's at
+//! the step's end, or Newmark ¼, ½'s energy-consistent one (`algorithmic.rs`),
+//! f_N,J = −(w_J(σ(δ_J) + D_J) − e_J) with D the trapezoid's defect
+//! against the step's starting approach and e the carried excess. Both
+//! are monotone in u_N (D's divided difference of the convex stored energy
+//! grows with either end), so the argument above holds for either; the
+//! friction bound follows the physical approach δ_J in both.
 
 use stickslip_contact::{ContactSurface, SlipState, StepSystem};
 use stickslip_linalg::SolverError;
@@ -57,6 +65,18 @@ const MAX_PASSES: usize = 200;
 const MAX_HALVINGS: usize = 40;
 /// The residual, relative to the system's scale, taken as converged.
 const TOLERANCE: f64 = 1e-12;
+
+/// How the compliant nodes' normal force enters the step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum NormalForm {
+    /// The law's force at the step's end, w σ(δ_K): what statics needs (K r
+    /// + f(r) = R exactly) and every Newmark but ¼, ½.
+    EndPoint,
+    /// Newmark ¼, ½'s energy-consistent force w(σ(δ_K) + D) − e, from the
+    /// signed approaches at the step's start and the excesses e carried
+    /// ([`CompliantSolve::energy_consistent`]).
+    EnergyConsistent,
+}
 
 /// Why a nodal solve failed.
 #[derive(Debug)]
@@ -125,6 +145,12 @@ pub(crate) struct CompliantSolve {
     start: Vec<f64>,
     /// Newton iterations over the run.
     pub(crate) newton: u64,
+    /// The normal force's form for this step.
+    form: NormalForm,
+    /// Energy-consistent: each compliant node's signed approach at the
+    /// step's start, and its excess e carried from the last step.
+    before: Vec<f64>,
+    excess: Vec<f64>,
 }
 
 impl CompliantSolve {
@@ -153,6 +179,9 @@ impl CompliantSolve {
             freeze: false,
             start: vec![0.0; rows],
             newton: 0,
+            form: NormalForm::EndPoint,
+            before: vec![0.0; contact.compliance.len()],
+            excess: vec![0.0; contact.compliance.len()],
         }
     }
 
@@ -179,6 +208,35 @@ impl CompliantSolve {
         }
     }
 
+    /// Makes this step's normal force `form`; energy-consistent, from the
+    /// step's starting displacement `r` and the excesses `excess` per
+    /// compliant node.
+    pub(crate) fn set_form(
+        &mut self,
+        form: NormalForm,
+        contact: &ContactSurface,
+        (r, excess): (&[f64], &[f64]),
+    ) {
+        self.form = form;
+        if form == NormalForm::EnergyConsistent {
+            for (k, c) in contact.compliance.iter().enumerate() {
+                self.before[k] = c.signed_approach(&contact.nodes[c.index], r);
+            }
+            self.excess.copy_from_slice(excess);
+        }
+    }
+
+    /// The excess e_K = w D − e_{K−1} per compliant node at the converged
+    /// x, into `out` (energy-consistent form).
+    pub(crate) fn excess_after(&self, contact: &ContactSurface, out: &mut [f64]) {
+        let n_c = contact.len();
+        for (k, c) in contact.compliance.iter().enumerate() {
+            let a = self.signed_approach(k, &self.x, n_c);
+            let (defect, _) = c.law.energy_consistent(self.before[k], a);
+            out[k] = contact.nodes[c.index].weight * defect - self.excess[k];
+        }
+    }
+
     /// f(x) into `f` and, when `slope` is given, its derivative per node;
     /// `reduced` is the surface on the nodal unknowns (its bounds those of
     /// the pressure-law nodes).
@@ -196,7 +254,8 @@ impl CompliantSolve {
             // The bound and its slope in u_N: dg/du_N = −c3 dg/dδ inside.
             let (g, dg, f_n, df_n) = match reduced.compliance.get(k) {
                 Some(c) => {
-                    let delta = self.approach(k, x, n_c);
+                    let signed = self.signed_approach(k, x, n_c);
+                    let delta = signed.max(0.0);
                     let inside = if delta > 0.0 { 1.0 } else { 0.0 };
                     let (g, dg) = if self.freeze {
                         (self.frozen[k], 0.0)
@@ -206,12 +265,21 @@ impl CompliantSolve {
                             -inside * self.c3 * c.law.bound_slope(delta),
                         )
                     };
-                    (
-                        g,
-                        dg,
-                        -node.weight * c.law.traction(delta),
-                        inside * node.weight * self.c3 * c.law.stiffness(delta),
-                    )
+                    let (f_n, df_n) = match self.form {
+                        NormalForm::EndPoint => (
+                            -node.weight * c.law.traction(delta),
+                            inside * node.weight * self.c3 * c.law.stiffness(delta),
+                        ),
+                        NormalForm::EnergyConsistent => {
+                            let (defect, slope) = c.law.energy_consistent(self.before[k], signed);
+                            let w = node.weight;
+                            (
+                                -(w * (c.law.traction(delta) + defect) - self.excess[k]),
+                                w * self.c3 * slope,
+                            )
+                        }
+                    };
+                    (g, dg, f_n, df_n)
                 }
                 None => (node.bound, 0.0, 0.0, 0.0),
             };
@@ -236,7 +304,12 @@ impl CompliantSolve {
 
     /// Compliant node k's approach at x.
     fn approach(&self, k: usize, x: &[f64], n_c: usize) -> f64 {
-        (-(self.gap[k] + self.c3 * x[n_c + k])).max(0.0)
+        self.signed_approach(k, x, n_c).max(0.0)
+    }
+
+    /// Compliant node k's approach at x, negative off the foundation.
+    fn signed_approach(&self, k: usize, x: &[f64], n_c: usize) -> f64 {
+        -(self.gap[k] + self.c3 * x[n_c + k])
     }
 
     /// The compliant nodes' bounds at x into `frozen`; returns the largest
@@ -712,6 +785,58 @@ mod tests {
                     "case {case} row {i}: residual {r:e}"
                 );
             }
+        }
+    }
+
+    /// The energy-consistent form: one node whose approach at the step's
+    /// start is a0 and whose carried excess is e solves u + S f(u) = p with
+    /// f_N = −(2w(Φ(a₊) − Φ(a0₊))/(a − a0) − w σ(a0₊) − e), a = −(g + c3
+    /// u), Φ = c_n d^{m+1}/(m+1) and σ = c_n d^m written here, for touches,
+    /// releases and steps in contact, m_n = 1 and 1.5.
+    #[test]
+    fn newton_solves_the_energy_consistent_force() {
+        for (mn, a0, e, p_n) in [
+            (1.0, -1e-3, 0.0, -1.0),
+            (1.0, 2e-3, 3.0, 1.0),
+            (1.0, 2e-3, -1.0, -0.5),
+            (1.5, -5e-4, 0.0, -2.0),
+            (1.5, 3e-3, 2.0, 1.5),
+            (1.5, 1e-3, 0.5, -1.0),
+        ] {
+            let law = Compliance {
+                cn: 1e4,
+                mn,
+                ct: 0.0,
+                mt: mn,
+            };
+            let (w, c3, gap) = (0.5, 0.01, 1e-3);
+            let s_mat = [1.0, 0.0, 0.0, 0.5];
+            let p = [0.0, p_n];
+            let surface = node(w, law);
+            let mut solve = solver(&surface, gap, c3);
+            solve.form = NormalForm::EnergyConsistent;
+            solve.before[0] = a0;
+            solve.excess[0] = e;
+            let (mut f, mut v) = (vec![0.0; 2], vec![0.0; 1]);
+            solve
+                .solve(&surface, &FRICTIONLESS, (&s_mat, &p), &mut f, &mut v)
+                .unwrap();
+            let u = solve.x[1];
+            let a = -(gap + c3 * u);
+            let phi = |a: f64| law.cn * a.max(0.0).powf(mn + 1.0) / (mn + 1.0);
+            let f_n =
+                -(2.0 * w * (phi(a) - phi(a0)) / (a - a0) - w * law.cn * a0.max(0.0).powf(mn) - e);
+            let r = u + s_mat[3] * f_n - p[1];
+            let size = u.abs() + p[1].abs() + (s_mat[3] * f_n).abs();
+            assert!(
+                r.abs() <= 1e-11 * size,
+                "m = {mn}, a0 = {a0}: residual {r:e}"
+            );
+            assert!(
+                (f[1] - f_n).abs() <= 1e-9 * f_n.abs().max(1e-12),
+                "{} vs {f_n}",
+                f[1]
+            );
         }
     }
 

@@ -7,6 +7,7 @@
 //! step's velocity with its friction, which the quasi-static increments
 //! share (`quasi_static.rs`: the same system with M = 0).
 
+mod algorithmic;
 mod compliance;
 mod direct;
 mod schur;
@@ -24,7 +25,8 @@ use crate::settings::{ImplicitSolver, MassKind, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
 
-use compliance::{CompliantSolve, CompliantStep};
+use algorithmic::AlgorithmicNormal;
+use compliance::{CompliantSolve, CompliantStep, NormalForm};
 use direct::{DirectOperator, ImplicitStep};
 use schur::SchurOperator;
 
@@ -65,9 +67,10 @@ pub(crate) struct Newmark {
     b: Vec<f64>,
     tmp: Vec<f64>,
     partials: Vec<[f64; 2]>,
-    /// A compliant foundation's nodal forces at r_K (`comply`'s output,
-    /// unused here: the step's forces come from its Newton solve).
-    normal: Vec<f64>,
+    /// Newmark ¼, ½ on a compliant foundation: the energy-consistent
+    /// normal force's part of the step (`algorithmic.rs`); `None` where
+    /// the step takes the end-point force.
+    algorithmic: Option<Box<AlgorithmicNormal>>,
 }
 
 /// Builds the stepper and the initial state.
@@ -112,7 +115,7 @@ pub(crate) fn start(
         MassKind::Consistent => Mass::Consistent(&m),
         MassKind::Lumped => Mass::Lumped(&lumped_mass),
     };
-    let state = initial_state(
+    let mut state = initial_state(
         &k,
         mass,
         Statics {
@@ -125,6 +128,17 @@ pub(crate) fn start(
         loads,
         settings,
     )?;
+    // The energy-consistent normal force where the scheme is the
+    // trapezoidal rule (METHOD.md §10): its excess starts at 0, r̈₀ being
+    // the end-point force's.
+    let algorithmic = match contact.filter(|c| c.is_compliant()) {
+        Some(c) if (beta, gamma) == (0.25, 0.5) && friction.compliant.is_some() => {
+            state.normal_excess = vec![0.0; c.compliance.len()];
+            state.normal_excess_new = vec![0.0; c.compliance.len()];
+            Some(Box::new(AlgorithmicNormal::new(&m, mass_kind, &fill_order)))
+        }
+        _ => None,
+    };
     let stepper = Newmark {
         beta,
         gamma,
@@ -135,7 +149,7 @@ pub(crate) fn start(
         b: vec![0.0; n],
         tmp: vec![0.0; n],
         partials: chunks::partials(n),
-        normal: Vec::new(),
+        algorithmic,
     };
     Ok((Box::new(stepper), state))
 }
@@ -336,6 +350,28 @@ impl ImplicitFriction {
         }
     }
 
+    /// Makes the compliant solve's normal force `form` for this step
+    /// (energy-consistent: from the step's starting displacement `r` and
+    /// the excesses `excess`).
+    fn normal_form(
+        &mut self,
+        form: NormalForm,
+        contact: &ContactSurface,
+        (r, excess): (&[f64], &[f64]),
+    ) {
+        if let Some(solve) = self.compliant.as_deref_mut() {
+            solve.set_form(form, contact, (r, excess));
+        }
+    }
+
+    /// The energy-consistent form's excess at the step's end per
+    /// compliant node, into `out`.
+    fn normal_excess(&self, contact: &ContactSurface, out: &mut [f64]) {
+        if let Some(solve) = self.compliant.as_deref() {
+            solve.excess_after(contact, out);
+        }
+    }
+
     /// Newton iterations of a compliant foundation's solves so far.
     pub(crate) fn normal_iterations(&self) -> u64 {
         self.compliant.as_deref().map_or(0, |s| s.newton)
@@ -431,12 +467,24 @@ impl Stepper for Newmark {
             &self.tmp,
             &mut self.b,
         );
+        let energy_consistent = match (&self.algorithmic, &run.contact) {
+            (Some(_), Some(c)) => {
+                AlgorithmicNormal::correct_rhs(c, &state.normal_excess, ca, &mut self.b);
+                Some(c)
+            }
+            _ => None,
+        };
         state.classes_new.copy_from_slice(&state.classes);
         self.friction.lag_mu(run, &state.v);
         let mut v_new = std::mem::take(&mut state.v_new);
         let c3 = beta / gamma * dt;
         if let Some(c) = run.contact.as_ref().filter(|c| c.is_compliant()) {
             self.friction.predict_normal(c, &state.r_new, &state.v, c3);
+            if energy_consistent.is_some() {
+                let form = NormalForm::EnergyConsistent;
+                self.friction
+                    .normal_form(form, c, (&state.r, &state.normal_excess));
+            }
         }
         // Rayleigh damping C = αM + βK joins A₀ (METHOD.md §8); R̂_K is
         // unchanged, as ṙ_K is the unknown.
@@ -455,6 +503,9 @@ impl Stepper for Newmark {
         );
         state.v_new = v_new;
         let iterations = result?;
+        if let Some(c) = energy_consistent {
+            self.friction.normal_excess(c, &mut state.normal_excess_new);
+        }
 
         // Corrector and r̈_K, with the finiteness check (a flag, not a
         // branch per entry).
@@ -477,11 +528,20 @@ impl Stepper for Newmark {
                 hint: String::new(),
             });
         }
+        if let (Some(alg), Some(c)) = (&mut self.algorithmic, energy_consistent) {
+            let excess = (ca, &state.normal_excess[..], &state.normal_excess_new[..]);
+            alg.correct_acceleration(c, &self.m, excess, &mut state.a_new)
+                .map_err(|source| TimeError::Solve {
+                    step,
+                    t: t_new,
+                    source,
+                })?;
+        }
         // The compliant nodes' bounds at r_K for the ledger's friction
         // forces, and the foundation's stored energy.
         let foundation_stored = match run.contact.as_mut().filter(|c| c.is_compliant()) {
             Some(c) => {
-                let stored = c.comply(&state.r_new, &[], &mut self.normal).stored;
+                let stored = c.comply_bounds(&state.r_new);
                 self.friction.follow_compliance(c);
                 stored
             }
