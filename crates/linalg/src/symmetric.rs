@@ -52,6 +52,9 @@ pub struct Symmetric {
     /// Chunk c's halo (the rows from its end its blocks reach):
     /// halos[c]..halos[c + 1] of the halo scratch.
     halos: Vec<usize>,
+    /// The last product [`Symmetric::form`] formed, and its halo scratch.
+    formed: Vec<f64>,
+    halo: Vec<f64>,
 }
 
 impl Symmetric {
@@ -100,6 +103,8 @@ impl Symmetric {
             values: Vec::new(),
             chunk_groups: Vec::new(),
             halos: vec![0],
+            formed: Vec::new(),
+            halo: Vec::new(),
         };
         k.group_blocks.push(0);
         for g in 0..groups {
@@ -176,6 +181,21 @@ impl Symmetric {
 
     fn block_range(&self, g: usize) -> std::ops::Range<usize> {
         self.group_blocks[g] as usize..self.group_blocks[g + 1] as usize
+    }
+
+    /// Forms K x whole, for [`Symmetric::formed`].
+    pub fn form(&mut self, x: &[f64]) {
+        let mut formed = std::mem::take(&mut self.formed);
+        let mut halo = std::mem::take(&mut self.halo);
+        formed.resize(self.n(), 0.0);
+        halo.resize(self.halo_len(), 0.0);
+        self.spmv_with(x, &mut formed, &mut halo);
+        (self.formed, self.halo) = (formed, halo);
+    }
+
+    /// The product [`Symmetric::form`] formed last.
+    pub fn formed(&self) -> &[f64] {
+        &self.formed
     }
 
     /// y = K x (allocating its halo scratch).
