@@ -54,6 +54,7 @@ fn main() {
             .sum();
     }
     let mut halo = vec![0.0; sym.halo_len()];
+    let mut scratch = Vec::new();
     let mut bits: Option<Vec<u64>> = None;
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -68,7 +69,7 @@ fn main() {
                 csr::spmv(k, &x, &mut yb);
                 tb.push(t.elapsed().as_secs_f64());
                 let t = Instant::now();
-                sym.spmv_with(&x, &mut ys, &mut halo);
+                sym.spmv_with(&x, &mut ys, &mut halo, &mut scratch);
                 ts.push(t.elapsed().as_secs_f64());
             }
         });

@@ -55,6 +55,8 @@ pub struct Symmetric {
     /// The last product [`Symmetric::form`] formed, and its halo scratch.
     formed: Vec<f64>,
     halo: Vec<f64>,
+    /// A chunk's sums on this thread.
+    scratch: Vec<f64>,
 }
 
 impl Symmetric {
@@ -105,6 +107,7 @@ impl Symmetric {
             halos: vec![0],
             formed: Vec::new(),
             halo: Vec::new(),
+            scratch: Vec::new(),
         };
         k.group_blocks.push(0);
         for g in 0..groups {
@@ -187,10 +190,11 @@ impl Symmetric {
     pub fn form(&mut self, x: &[f64]) {
         let mut formed = std::mem::take(&mut self.formed);
         let mut halo = std::mem::take(&mut self.halo);
+        let mut scratch = std::mem::take(&mut self.scratch);
         formed.resize(self.n(), 0.0);
         halo.resize(self.halo_len(), 0.0);
-        self.spmv_with(x, &mut formed, &mut halo);
-        (self.formed, self.halo) = (formed, halo);
+        self.spmv_with(x, &mut formed, &mut halo, &mut scratch);
+        (self.formed, self.halo, self.scratch) = (formed, halo, scratch);
     }
 
     /// The product [`Symmetric::form`] formed last.
@@ -201,24 +205,16 @@ impl Symmetric {
     /// y = K x (allocating its halo scratch).
     pub fn spmv(&self, x: &[f64], y: &mut [f64]) {
         let mut halo = vec![0.0; self.halo_len()];
-        self.spmv_with(x, y, &mut halo);
+        self.spmv_with(x, y, &mut halo, &mut Vec::new());
     }
 
-    /// y = K x, with `halo` (at least [`Symmetric::halo_len`] doubles) as
-    /// scratch.
-    pub fn spmv_with(&self, x: &[f64], y: &mut [f64], halo: &mut [f64]) {
+    /// y = K x, with `halo` (at least [`Symmetric::halo_len`] doubles) and
+    /// `scratch` as scratch.
+    pub fn spmv_with(&self, x: &[f64], y: &mut [f64], halo: &mut [f64], scratch: &mut Vec<f64>) {
         let n = self.n();
         assert!(x.len() == n && y.len() == n && halo.len() >= self.halo_len());
         let halo = &mut halo[..self.halo_len()];
-        // Each chunk's halo slice, in chunk order.
-        let mut slices: Vec<&mut [f64]> = Vec::with_capacity(chunks(n));
-        let mut rest = halo;
-        for c in 0..chunks(n) {
-            let (h, r) = rest.split_at_mut(self.halos[c + 1] - self.halos[c]);
-            slices.push(h);
-            rest = r;
-        }
-        let body = |scratch: &mut Vec<f64>, (c, (y, h)): (usize, (&mut [f64], &mut &mut [f64]))| {
+        let body = |scratch: &mut Vec<f64>, c: usize, y: &mut [f64], h: &mut [f64]| {
             scratch.clear();
             scratch.resize(y.len() + h.len(), 0.0);
             crate::simd::vectorized(Chunk {
@@ -231,21 +227,32 @@ impl Symmetric {
             h.copy_from_slice(&scratch[y.len()..]);
         };
         if parallel(n) {
+            // Each chunk's halo slice, in chunk order.
+            let mut slices: Vec<&mut [f64]> = Vec::with_capacity(chunks(n));
+            let mut rest = &mut *halo;
+            for c in 0..chunks(n) {
+                let (h, r) = rest.split_at_mut(self.halos[c + 1] - self.halos[c]);
+                slices.push(h);
+                rest = r;
+            }
             y.par_chunks_mut(CHUNK)
                 .zip(slices.par_iter_mut())
                 .enumerate()
-                .for_each_init(Vec::new, body);
+                .for_each_init(Vec::new, |s, (c, (y, h))| body(s, c, y, h));
         } else {
-            let mut scratch = Vec::new();
-            for item in y.chunks_mut(CHUNK).zip(slices.iter_mut()).enumerate() {
-                body(&mut scratch, item);
+            // On this thread, without allocating (a small model's steps).
+            let mut rest = &mut *halo;
+            for (c, y) in y.chunks_mut(CHUNK).enumerate() {
+                let (h, r) = rest.split_at_mut(self.halos[c + 1] - self.halos[c]);
+                body(scratch, c, y, h);
+                rest = r;
             }
         }
         // The halos into the rows they reach, in chunk order.
         for c in 0..chunks(n) {
             let end = ((c + 1) * CHUNK).min(n);
-            let h = &slices[c];
-            for (yi, hi) in y[end..end + h.len()].iter_mut().zip(h.iter()) {
+            let h = &halo[self.halos[c]..self.halos[c + 1]];
+            for (yi, hi) in y[end..end + h.len()].iter_mut().zip(h) {
                 *yi += hi;
             }
         }

@@ -25,6 +25,8 @@ const GAMMA: f64 = 0.5;
 pub(crate) struct CentralDifference {
     /// K as the step reads it.
     product: Product,
+    /// An empty product standing in for `product` while a step reads it.
+    idle: Option<Product>,
     mass: Vec<f64>,
     dt_crit: f64,
     /// The constant load and the loads on their nonzero rows.
@@ -192,6 +194,7 @@ pub(crate) fn start(
     let n_c = contact.map_or(0, |c| c.len());
     let stepper = CentralDifference {
         product,
+        idle: Some(Product::default()),
         dt_crit,
         sparse_loads: SparseLoads::new(&loads.constant, &vectors),
         thetas: vec![0.0; loads.loads.len()],
@@ -306,7 +309,10 @@ impl CentralDifference {
         let ku = std::mem::take(&mut self.ku);
         // K r_K, formed before the rows are read (whole where the product
         // needs it).
-        let mut product = std::mem::take(&mut self.product);
+        // The product moves out for the step, an empty one (made once,
+        // so that a step allocates nothing) in its place.
+        let empty = self.idle.take().unwrap_or_default();
+        let mut product = std::mem::replace(&mut self.product, empty);
         let formed = product.form(&state.r_new);
         let result = self.velocities_with(
             run,
@@ -317,7 +323,7 @@ impl CentralDifference {
             outputs,
         );
         (self.mass, self.sparse_loads, self.ku) = (mass, loads, ku);
-        self.product = product;
+        self.idle = Some(std::mem::replace(&mut self.product, product));
         result
     }
 
