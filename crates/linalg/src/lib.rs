@@ -20,9 +20,11 @@ mod product;
 pub mod simd;
 mod stencils;
 mod supernodal;
+mod symmetric;
 
 pub use cholesky::{analyze_symbolic, csc_view, SolverError, SparseCholesky};
 pub use fill_order::{FillOrder, AMD_MARGIN};
-pub use product::Product;
+pub use product::{Formed, Product};
 pub use stencils::{Stencils, BATCH, TOLERANCE};
 pub use supernodal::{PathOperator, Supernodal};
+pub use symmetric::Symmetric;

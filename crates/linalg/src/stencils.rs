@@ -102,26 +102,16 @@ impl Stencils {
         // The types may hold at most 1/8 of the stored blocks: then they
         // and the 8 bytes per group are at most about a quarter of the
         // blocks' stream.
-        Stencils::build(a, Some(tol), Some((a.nnz() / 32).max(64)))
+        Stencils::build(a, tol, (a.nnz() / 32).max(64))
     }
 
-    /// Every node row its own type: K as 2×2 blocks with 32-bit column
-    /// offsets, 36 bytes a block against the CSR's 64 (unstructured
-    /// meshes), summed as the types are.
-    pub fn node_blocks(a: &CsrMatrix<f64>) -> Option<Stencils> {
-        Stencils::build(a, None, None)
-    }
-
-    /// The types at tolerance `tol` (`None`: no two groups merged), or
-    /// `None` where they would hold more blocks than `limit`.
-    fn build(a: &CsrMatrix<f64>, tol: Option<f64>, limit: Option<usize>) -> Option<Stencils> {
+    /// The types at tolerance `tol`, or `None` where they would hold more
+    /// blocks than `limit`.
+    fn build(a: &CsrMatrix<f64>, tol: f64, limit: usize) -> Option<Stencils> {
         let n = a.nrows();
         if n < 2 || a.ncols() != n || n >= i32::MAX as usize {
             return None;
         }
-        let merge = tol.is_some();
-        let tol = tol.unwrap_or(0.0);
-        let limit = limit.unwrap_or(usize::MAX);
         let max = a.values().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let tol = tol * max;
         let grid = if tol > 0.0 { COARSE * tol } else { f64::NAN };
@@ -132,13 +122,6 @@ impl Stencils {
         let mut declined = false;
         let group_rows = row_groups(a, |r0, r1, cols, vals| {
             if declined {
-                return;
-            }
-            if !merge {
-                offsets.extend(cols.iter().map(|&c| (c as i64 - r0 as i64) as i32));
-                values.extend_from_slice(vals);
-                type_blocks.push(values.len() as u32);
-                types.push((type_blocks.len() - 2) as u32);
                 return;
             }
             key.clear();
@@ -193,7 +176,7 @@ impl Stencils {
             units: None,
         };
         let width = crate::simd::lanes();
-        if merge && width >= 4 && width.is_multiple_of(2) {
+        if width >= 4 && width.is_multiple_of(2) {
             k.units = Some(k.units(width));
         }
         Some(k)

@@ -5,7 +5,7 @@
 use nalgebra_sparse::{CooMatrix, CsrMatrix};
 use stickslip_linalg::chunks::{chunks, partials, sum_chunks, CHUNK};
 use stickslip_linalg::csr::{index, load_minus_k_plus_m, quadratic_form, spmv, two_forms};
-use stickslip_linalg::{Stencils, TOLERANCE};
+use stickslip_linalg::{Product, Stencils, Symmetric, TOLERANCE};
 use stickslip_testkit::{on_threads, plain_spmv, spread};
 
 /// The chunked sum of a long vector is the same on one thread and on
@@ -246,35 +246,100 @@ fn vectors_have_the_scalar_bits_on_the_slabs() {
     }
 }
 
-/// Where types do not pay, node blocks (every node row its own stencil)
-/// give the assembled product to rounding, with the same bits by rows, by
-/// the scalar batches and by the CPU's vectors.
-#[test]
-fn node_blocks_are_the_assembled_product() {
-    let a = grid(100, 20, 1e-6, false);
-    let b = Stencils::node_blocks(&a).expect("square");
+/// `grid`'s matrix made symmetric ((A + Aᵀ)/2: both triangles the same
+/// bits) without the DOFs `drop` names: single rows among the node pairs.
+fn symmetric_grid(nx: usize, ny: usize, drop: impl Fn(usize) -> bool) -> CsrMatrix<f64> {
+    let a = grid(nx, ny, 1e-6, false);
+    let t = a.transpose();
     let n = a.nrows();
-    let x = spread(n);
-    let want = plain_spmv(&a, &x);
-    let mut y = vec![0.0; n];
-    b.spmv(&x, &mut y);
-    let mut scalar = vec![f64::NAN; n];
-    for c in 0..chunks(n) {
-        b.batches(pulp::Scalar::new(), c, &x, &mut |r0: usize, ku: &[f64]| {
-            scalar[r0..r0 + ku.len()].copy_from_slice(ku)
-        });
+    let mut index = vec![usize::MAX; n];
+    let mut kept = 0;
+    for (i, slot) in index.iter_mut().enumerate() {
+        if !drop(i) {
+            *slot = kept;
+            kept += 1;
+        }
     }
-    for (i, r) in a.row_iter().enumerate() {
-        // Sums of the same products in another order: a few roundings of
-        // the terms' magnitude.
-        let scale: f64 = r
-            .col_indices()
-            .iter()
-            .zip(r.values())
-            .map(|(&j, v)| (v * x[j]).abs())
-            .sum();
-        assert!((y[i] - want[i]).abs() <= 1e-14 * scale, "row {i}");
-        assert_eq!(y[i].to_bits(), scalar[i].to_bits(), "row {i}");
-        assert_eq!(y[i].to_bits(), b.row(i, &x).to_bits(), "row {i}");
+    let mut coo = CooMatrix::new(kept, kept);
+    for (m, factor) in [(&a, 0.5), (&t, 0.5)] {
+        for (i, j, v) in m.triplet_iter() {
+            if index[i] != usize::MAX && index[j] != usize::MAX {
+                coo.push(index[i], index[j], factor * v);
+            }
+        }
     }
+    CsrMatrix::from(&coo)
+}
+
+/// The upper node blocks give the assembled product to rounding, with the
+/// same bits on one thread and on two, and by the formed product's
+/// batches and rows; on a narrow band and on one wider than a chunk (its
+/// halos reach past the next chunk), with single rows among the pairs.
+#[test]
+fn symmetric_blocks_are_the_assembled_product() {
+    for (nx, ny) in [(300, 60), (5000, 4)] {
+        let a = symmetric_grid(nx, ny, |i| (i % 2 == 1 && i % 74 == 37) || i == 0);
+        let n = a.nrows();
+        assert!(n > 2 * CHUNK);
+        let x = spread(n);
+        let want = plain_spmv(&a, &x);
+        let form = |threads: usize| {
+            on_threads(threads, || {
+                let mut p = Product::new(a.clone());
+                assert_eq!(p.name(), "symmetric node blocks");
+                let mut y = vec![0.0; n];
+                p.spmv(&x, &mut y);
+                let formed = p.form(&x);
+                let mut whole = vec![f64::NAN; n];
+                formed.spmv(&mut whole);
+                let mut batches = vec![f64::NAN; n];
+                for c in 0..chunks(n) {
+                    formed.batches(pulp::Scalar::new(), c, &mut |r0: usize, ku: &[f64]| {
+                        batches[r0..r0 + ku.len()].copy_from_slice(ku)
+                    });
+                }
+                let all: Vec<usize> = (0..n).rev().collect();
+                let mut rows = vec![f64::NAN; n];
+                formed.rows(&all, &mut rows);
+                rows.reverse();
+                for i in 0..n {
+                    for (way, v) in [
+                        ("formed", whole[i]),
+                        ("batches", batches[i]),
+                        ("rows", rows[i]),
+                    ] {
+                        assert_eq!(y[i].to_bits(), v.to_bits(), "row {i} by {way}");
+                    }
+                }
+                y
+            })
+        };
+        let (one, two) = (form(1), form(2));
+        for (i, r) in a.row_iter().enumerate() {
+            // The same products summed in another order: well within
+            // 1e-13 of Σ|K_ij x_j|.
+            let scale: f64 = r
+                .col_indices()
+                .iter()
+                .zip(r.values())
+                .map(|(&j, v)| (v * x[j]).abs())
+                .sum();
+            assert!(
+                (one[i] - want[i]).abs() <= 1e-13 * scale,
+                "row {i}: {} against {}",
+                one[i],
+                want[i]
+            );
+            assert_eq!(one[i].to_bits(), two[i].to_bits(), "row {i}");
+        }
+    }
+}
+
+/// An unsymmetric matrix is not taken for a symmetric one: its product
+/// is then the CSR.
+#[test]
+fn unsymmetric_matrices_keep_the_csr() {
+    let a = grid(300, 40, 1e-6, false);
+    assert!(Symmetric::new(&a).is_none());
+    assert_eq!(Product::new(a).name(), "assembled CSR");
 }

@@ -5,7 +5,7 @@
 
 use stickslip_contact::{iterate, ContactSurface, DiagonalStep, Foundation, SlipState};
 use stickslip_linalg::chunks;
-use stickslip_linalg::{csr, Product, SparseCholesky, Stencils};
+use stickslip_linalg::{csr, Formed, Product, SparseCholesky, Stencils};
 
 use stickslip_fem::SetupTimes;
 
@@ -25,6 +25,8 @@ const GAMMA: f64 = 0.5;
 pub(crate) struct CentralDifference {
     /// K as the step reads it.
     product: Product,
+    /// An empty product standing in for `product` while a step reads it.
+    idle: Option<Product>,
     mass: Vec<f64>,
     dt_crit: f64,
     /// The constant load and the loads on their nonzero rows.
@@ -192,6 +194,7 @@ pub(crate) fn start(
     let n_c = contact.map_or(0, |c| c.len());
     let stepper = CentralDifference {
         product,
+        idle: Some(Product::default()),
         dt_crit,
         sparse_loads: SparseLoads::new(&loads.constant, &vectors),
         thetas: vec![0.0; loads.loads.len()],
@@ -222,6 +225,7 @@ impl CentralDifference {
     /// iterations.
     fn friction_velocities(
         &mut self,
+        k: &Formed,
         contact: &ContactSurface,
         data: &StepData,
         settings: &Settings,
@@ -230,7 +234,7 @@ impl CentralDifference {
     ) -> Result<usize, TimeError> {
         self.nodal.prepare(contact, data.mass, data.dscale);
         if settings.explicit_friction == ExplicitFriction::ClosedForm {
-            self.nodal.form_products(&self.product, data.r_new);
+            self.nodal.form_products(k);
             let (ku, friction, slots) = (
                 self.nodal.products(),
                 &mut self.friction,
@@ -252,7 +256,7 @@ impl CentralDifference {
             }
             return Ok(1);
         }
-        self.product.spmv(data.r_new, &mut self.b);
+        k.spmv(&mut self.b);
         for (i, b) in self.b.iter_mut().enumerate() {
             *b = data.rhs(i, *b);
         }
@@ -303,8 +307,23 @@ impl CentralDifference {
         let mass = std::mem::take(&mut self.mass);
         let loads = std::mem::take(&mut self.sparse_loads);
         let ku = std::mem::take(&mut self.ku);
-        let result = self.velocities_with(run, state, (&mass, loads.rows(), &ku), dt, at, outputs);
+        // K r_K, formed before the rows are read (whole where the product
+        // needs it).
+        // The product moves out for the step, an empty one (made once,
+        // so that a step allocates nothing) in its place.
+        let empty = self.idle.take().unwrap_or_default();
+        let mut product = std::mem::replace(&mut self.product, empty);
+        let formed = product.form(&state.r_new);
+        let result = self.velocities_with(
+            run,
+            state,
+            (&formed, &mass, loads.rows(), &ku),
+            dt,
+            at,
+            outputs,
+        );
         (self.mass, self.sparse_loads, self.ku) = (mass, loads, ku);
+        self.idle = Some(std::mem::replace(&mut self.product, product));
         result
     }
 
@@ -312,7 +331,7 @@ impl CentralDifference {
         &mut self,
         run: &Run,
         state: &State,
-        (mass, load_rows, ku): (&[f64], &[usize], &[f64]),
+        (k, mass, load_rows, ku): (&Formed, &[f64], &[usize], &[f64]),
         dt: f64,
         at: (u64, f64),
         (v_new, a_new, r_next, classes_new): Outputs,
@@ -351,6 +370,7 @@ impl CentralDifference {
         let mut iterations = 1;
         if let Some(contact) = &run.contact {
             iterations = self.friction_velocities(
+                k,
                 contact,
                 &data,
                 &run.settings,
@@ -360,7 +380,7 @@ impl CentralDifference {
         }
         let ku_new = (!self.ku_new.is_empty()).then_some(&mut self.ku_new[..]);
         let sums = sweep(
-            &self.product,
+            k,
             &data,
             &self.friction,
             [v_new, a_new, r_next],
@@ -491,7 +511,7 @@ impl Stepper for CentralDifference {
     fn stencil_types(&self) -> Option<usize> {
         match &self.product {
             Product::Stencils(s) => Some(s.types()),
-            Product::Blocks(_) | Product::Csr(_) => None,
+            Product::Symmetric(_) | Product::Csr(_) => None,
         }
     }
 

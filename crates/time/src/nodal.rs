@@ -4,7 +4,7 @@
 //! this crate knows the step's K·x product.
 
 use stickslip_contact::{ContactSurface, NodalClosedForm};
-use stickslip_linalg::Product;
+use stickslip_linalg::Formed;
 
 /// The closed-form nodal friction of the explicit step and a slot per
 /// contact DOF for K r_K there.
@@ -23,11 +23,11 @@ impl NodalFriction {
         self.ku.resize(self.closed_form.dofs().len(), 0.0);
     }
 
-    /// K x at the contact nodes' free DOFs, with the bits the product's
+    /// K x (formed) at the contact nodes' free DOFs, with the bits the product's
     /// batches give them: `b`'s k-th call in [`NodalClosedForm::velocities`]
     /// is for `self.products()[k]`. [`NodalFriction::prepare`] first.
-    pub(crate) fn form_products(&mut self, k: &Product, x: &[f64]) {
-        k.rows(self.closed_form.dofs(), x, &mut self.ku);
+    pub(crate) fn form_products(&mut self, k: &Formed) {
+        k.rows(self.closed_form.dofs(), &mut self.ku);
     }
 
     /// What [`NodalFriction::form_products`] formed.

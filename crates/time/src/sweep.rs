@@ -23,7 +23,7 @@
 
 use stickslip_linalg::chunks::{each_chunk, each_chunk_of, CHUNK};
 use stickslip_linalg::simd::{load, store, vectorized, Batches, Kernel, Simd};
-use stickslip_linalg::Product;
+use stickslip_linalg::Formed;
 
 /// The loads on the rows where the constant load or any load vector is
 /// nonzero (bit for bit: a −0 counts): tractions act on a boundary, so a
@@ -202,12 +202,12 @@ impl Lanes {
 /// ṙ_K) sorted by DOF) — then r̈_K into `a_new`, the next predictor into
 /// `r_next` and the sums. R̂_K is formed with R_K = +0 (the same bits as
 /// from the +0 stored there) and again at the load rows. K r_K comes
-/// in batches that stay in L1 ([`Product::batches`]), and each batch's
+/// in batches that stay in L1 ([`Formed::batches`]), and each batch's
 /// rows go in loops over the batch: no dependence between rows, so their
 /// divisions overlap. Each chunk is a dispatched kernel
 /// (`stickslip_linalg::simd`).
 pub(crate) fn sweep(
-    k: &Product,
+    k: &Formed,
     s: &StepData,
     friction: &[(usize, f64)],
     [v_new, a_new, r_next]: [&mut [f64]; 3],
@@ -236,7 +236,7 @@ pub(crate) fn sweep(
 
 /// Chunk `c` of [`sweep`] (its outputs' rows, and K r_K's where kept).
 fn chunk(
-    k: &Product,
+    k: &Formed,
     s: &StepData,
     friction: &[(usize, f64)],
     c: usize,
@@ -247,7 +247,6 @@ fn chunk(
     vectorized(Chunk {
         k,
         c,
-        x: s.r_new,
         rows: ChunkRows {
             s,
             friction,
@@ -264,9 +263,8 @@ fn chunk(
 
 /// One chunk of the sweep, as a dispatched kernel.
 struct Chunk<'a, 'b> {
-    k: &'a Product,
+    k: &'a Formed<'a>,
     c: usize,
-    x: &'a [f64],
     rows: ChunkRows<'a, 'b>,
 }
 
@@ -285,7 +283,7 @@ impl Kernel for Chunk<'_, '_> {
             finite: simd.splat_f64s(0.0),
             damped_sums: [0.0; 5],
         };
-        self.k.batches(simd, self.c, self.x, &mut rows);
+        self.k.batches(simd, self.c, &mut rows);
         rows.finish()
     }
 }
