@@ -270,3 +270,37 @@ pub(crate) fn initial_state_analyzed(
     };
     Ok(state)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra_sparse::CooMatrix;
+
+    /// A preload whose K f32 cannot factorize is solved by the double
+    /// factor, with its bits: [[1, c], [c, 1]], c = 1 − 2⁻³⁰, is positive
+    /// definite (determinant 1 − c² ≈ 2⁻²⁹), but c rounds to 1 in f32.
+    #[test]
+    fn a_preload_single_precision_cannot_factorize_is_solved_in_double() {
+        let c = 1.0 - 2.0_f64.powi(-30);
+        let mut coo = CooMatrix::new(2, 2);
+        for (i, j, v) in [(0, 0, 1.0), (0, 1, c), (1, 0, c), (1, 1, 1.0)] {
+            coo.push(i, j, v);
+        }
+        let k = CsrMatrix::from(&coo);
+        let order = FillOrder::amd();
+        let solve = |single: bool| {
+            let mut times = SetupTimes::default();
+            let mut r = vec![1.0, 2.0];
+            let solver = analyze(&k, &order, &mut times).unwrap();
+            factor_solve(solver, &k, &mut r, &mut times, single).unwrap();
+            r
+        };
+        let (single, double) = (solve(true), solve(false));
+        assert_eq!(single, double);
+        // K⁻¹(1, 2) = (1 − 2c, 2 − c)/(1 − c²), κ(K) ≈ 2³¹: good to ~1e-6.
+        let det = 1.0 - c * c;
+        for (x, want) in single.iter().zip([(1.0 - 2.0 * c) / det, (2.0 - c) / det]) {
+            assert!((x - want).abs() <= 1e-6 * want.abs(), "{x} against {want}");
+        }
+    }
+}
