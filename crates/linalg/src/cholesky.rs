@@ -77,6 +77,10 @@ pub struct SparseCholesky {
     nnz: usize,
     factor_scratch: MemBuffer,
     solver: RefCell<Supernodal>,
+    /// The factor in single precision ([`SparseCholesky::factorize_single`]),
+    /// of A scaled by `single_scale`; empty until then.
+    single: Vec<f32>,
+    single_scale: f64,
 }
 
 impl std::fmt::Debug for SparseCholesky {
@@ -86,6 +90,7 @@ impl std::fmt::Debug for SparseCholesky {
             .field("nnz", &self.nnz)
             .field("factor_nnz", &self.l_values.len())
             .field("factorized", &self.factorized)
+            .field("single", &!self.single.is_empty())
             .finish()
     }
 }
@@ -218,6 +223,8 @@ impl SparseCholesky {
             nnz: a.nnz(),
             factor_scratch,
             solver,
+            single: Vec::new(),
+            single_scale: 1.0,
         })
     }
 
@@ -232,7 +239,8 @@ impl SparseCholesky {
     }
 
     /// Numeric factorization of `a`, which must have the analysed pattern.
-    /// Allocates nothing: the factor and the scratch space are reused.
+    /// Allocates nothing: the factor and the scratch space are reused (a
+    /// single factor, if any, is dropped).
     ///
     /// # Errors
     /// [`SolverError::NotPositiveDefinite`] for a singular or indefinite
@@ -250,13 +258,9 @@ impl SparseCholesky {
     /// `par`: they split their products by blocks of the result, never
     /// a sum, so the factor's bits do not depend on it (tested).
     fn factorize_in(&mut self, a: &CsrMatrix<f64>, par: Par) -> Result<(), SolverError> {
-        if a.nrows() != self.n || a.nnz() != self.nnz {
-            return Err(SolverError::PatternChanged {
-                analysed: self.nnz,
-                given: a.nnz(),
-            });
-        }
+        self.check_pattern(a)?;
         self.factorized = false;
+        self.single = Vec::new();
         let result = self.symbolic.factorize_numeric_llt(
             &mut self.l_values,
             as_csc(a),
@@ -275,6 +279,106 @@ impl SparseCholesky {
                 pivot: index,
                 n: self.n,
             }),
+        }
+    }
+
+    fn check_pattern(&self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
+        if a.nrows() != self.n || a.nnz() != self.nnz {
+            return Err(SolverError::PatternChanged {
+                analysed: self.nnz,
+                given: a.nnz(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Numeric factorization of `a` in single precision, on the analysed
+    /// structure, for a solve refined to double's accuracy
+    /// ([`SparseCholesky::solve_refined`]): half the bytes of the double
+    /// factor and twice the values a vector register holds. `a` is scaled
+    /// by the power of two that brings its largest value (a diagonal one,
+    /// A being positive definite) into [1/2, 1], so that f32's range holds
+    /// every value of any units; values below f32's smallest become zero
+    /// or subnormal, a perturbation the refinement corrects like the
+    /// rounding. The double factor, if any, is kept.
+    ///
+    /// # Errors
+    /// [`SolverError::NotPositiveDefinite`] where a pivot fails in single
+    /// precision (A singular, or too ill-conditioned for f32: the double
+    /// factor may still succeed), [`SolverError::PatternChanged`] for
+    /// another pattern.
+    pub fn factorize_single(&mut self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
+        let par = if self.symbolic.len_val() >= PARALLEL_MIN {
+            parallel()
+        } else {
+            Par::Seq
+        };
+        self.factorize_single_in(a, par)
+    }
+
+    fn factorize_single_in(&mut self, a: &CsrMatrix<f64>, par: Par) -> Result<(), SolverError> {
+        self.check_pattern(a)?;
+        self.single.clear();
+        let largest = a.values().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if !(largest.is_finite() && largest > 0.0) {
+            return Err(SolverError::NotPositiveDefinite {
+                pivot: 0,
+                n: self.n,
+            });
+        }
+        // A power of two: the scaling itself rounds nothing.
+        let scale = 2.0_f64.powi(-(largest.log2().ceil() as i32));
+        let values: Vec<f32> = a.values().iter().map(|v| (v * scale) as f32).collect();
+        let sym = SymbolicSparseColMatRef::new_checked(
+            a.nrows(),
+            a.ncols(),
+            a.row_offsets(),
+            None,
+            a.col_indices(),
+        );
+        let mut l = vec![0.0_f32; self.symbolic.len_val()];
+        let mut scratch = MemBuffer::new(
+            self.symbolic
+                .factorize_numeric_llt_scratch::<f32>(par, Default::default()),
+        );
+        let result = self.symbolic.factorize_numeric_llt(
+            &mut l,
+            SparseColMatRef::new(sym, &values),
+            Side::Lower,
+            Default::default(),
+            par,
+            MemStack::new(&mut scratch),
+            Spec::<LltParams, f32>::default(),
+        );
+        match result {
+            Ok(_) => {
+                self.single = l;
+                self.single_scale = scale;
+                Ok(())
+            }
+            Err(LltError::NonPositivePivot { index }) => Err(SolverError::NotPositiveDefinite {
+                pivot: index,
+                n: self.n,
+            }),
+        }
+    }
+
+    /// x ← A⁻¹x approximately, by the single factor (read in double:
+    /// [`crate::FactorValue`]), its scaling undone (exactly: a power of
+    /// two).
+    ///
+    /// # Panics
+    /// Before a successful [`SparseCholesky::factorize_single`], or with
+    /// `x.len() != n`.
+    pub(crate) fn solve_single_in_place(&self, x: &mut [f64]) {
+        assert!(
+            !self.single.is_empty() || self.n == 0,
+            "SparseCholesky::solve_single_in_place before factorize_single"
+        );
+        assert_eq!(x.len(), self.n, "right-hand side length");
+        self.solver.borrow_mut().solve(&self.single, x);
+        for v in x.iter_mut() {
+            *v *= self.single_scale;
         }
     }
 

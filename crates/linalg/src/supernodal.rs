@@ -23,6 +23,17 @@
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use rayon::prelude::*;
 
+/// A value of the factor the solves read: f64, or f32 for a factor
+/// computed in single precision (the preconditioner of a refined solve,
+/// `refine.rs`), each read as f64 and the arithmetic done in double: for
+/// f64 the conversion is the identity, so a double factor's solves keep
+/// their bits.
+pub trait FactorValue: Copy + Into<f64> + Send + Sync {}
+
+impl FactorValue for f64 {}
+
+impl FactorValue for f32 {}
+
 /// P A⁻¹ Pᵀ and W = L⁻¹ Perm Pᵀ for the rows of P given to
 /// [`Supernodal::schur_complement`]: S dense (column-major p × p), W by
 /// columns on the permuted indices. Each column of W is nonzero only on the
@@ -681,8 +692,9 @@ impl Supernodal {
         !self.full.bins[0].is_empty()
     }
 
-    /// x ← A⁻¹x with the factor values `l`.
-    pub fn solve(&mut self, l: &[f64], x: &mut [f64]) {
+    /// x ← A⁻¹x with the factor values `l` (double, or single read as
+    /// double: [`FactorValue`]).
+    pub fn solve<T: FactorValue>(&mut self, l: &[T], x: &mut [f64]) {
         let mut xp = std::mem::take(&mut self.xp);
         permute_in(&self.fwd, x, &mut xp);
         self.forward(l, false, &mut xp);
@@ -742,7 +754,7 @@ impl Supernodal {
     }
 
     /// The forward solve L y = x over the plan's supernodes, in place.
-    fn forward(&mut self, l: &[f64], reach: bool, x: &mut [f64]) {
+    fn forward<T: FactorValue>(&mut self, l: &[T], reach: bool, x: &mut [f64]) {
         if !self.full.bins[0].is_empty() {
             let scratch = self.run_bins(reach, x, |me, b, list, x, sc| {
                 me.bin_forward(b, l, list, x, sc)
@@ -799,7 +811,14 @@ impl Supernodal {
 
     /// One group's forward solve on its own copy of its columns; pushes
     /// into the top columns are summed in `sc.acc`.
-    fn bin_forward(&self, b: usize, l: &[f64], list: &[u32], x: &[f64], sc: &mut BinScratch) {
+    fn bin_forward<T: FactorValue>(
+        &self,
+        b: usize,
+        l: &[T],
+        list: &[u32],
+        x: &[f64],
+        sc: &mut BinScratch,
+    ) {
         for (v, &c) in sc.x.iter_mut().zip(&self.bin_cols[b]) {
             *v = x[c as usize];
         }
@@ -828,7 +847,7 @@ impl Supernodal {
     }
 
     /// The back solve Lᵀ x = y over the plan's supernodes, in place.
-    fn backward(&mut self, l: &[f64], reach: bool, x: &mut [f64]) {
+    fn backward<T: FactorValue>(&mut self, l: &[T], reach: bool, x: &mut [f64]) {
         let plan = if reach { &self.reach } else { &self.full };
         for &s in plan.top.iter().rev() {
             let s = s as usize;
@@ -853,7 +872,14 @@ impl Supernodal {
 
     /// One group's back solve on its own copy of its columns, reading the
     /// (finished) top columns from `x`.
-    fn bin_backward(&self, b: usize, l: &[f64], list: &[u32], x: &[f64], sc: &mut BinScratch) {
+    fn bin_backward<T: FactorValue>(
+        &self,
+        b: usize,
+        l: &[T],
+        list: &[u32],
+        x: &[f64],
+        sc: &mut BinScratch,
+    ) {
         for (v, &c) in sc.x.iter_mut().zip(&self.bin_cols[b]) {
             *v = x[c as usize];
         }
@@ -896,9 +922,9 @@ fn permute_out(fwd: &[u32], xp: &[f64], x: &mut [f64]) {
 /// `xs`, then tmp = L_bot xs (m rows; one contiguous axpy per column). The
 /// block is column-major (k + m) × k. Dispatched (`crate::simd`): the
 /// loops vectorize as wide as the CPU allows, with the same operations.
-fn block_forward(block: &[f64], xs: &mut [f64], tmp: &mut [f64]) {
-    struct Forward<'a>(&'a [f64], &'a mut [f64], &'a mut [f64]);
-    impl crate::simd::Kernel for Forward<'_> {
+fn block_forward<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &mut [f64]) {
+    struct Forward<'a, T>(&'a [T], &'a mut [f64], &'a mut [f64]);
+    impl<T: FactorValue> crate::simd::Kernel for Forward<'_, T> {
         type Output = ();
         #[inline(always)]
         fn run<S: crate::simd::Simd>(self, _simd: S) {
@@ -909,15 +935,15 @@ fn block_forward(block: &[f64], xs: &mut [f64], tmp: &mut [f64]) {
 }
 
 #[inline(always)]
-fn block_forward_body(block: &[f64], xs: &mut [f64], tmp: &mut [f64]) {
+fn block_forward_body<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &mut [f64]) {
     let k = xs.len();
     let ld = k + tmp.len();
     for j in 0..k {
         let col = &block[j * ld..j * ld + k];
-        let xj = xs[j] / col[j];
+        let xj = xs[j] / col[j].into();
         xs[j] = xj;
         for (xi, lij) in xs[j + 1..].iter_mut().zip(&col[j + 1..]) {
-            *xi -= lij * xj;
+            *xi -= (*lij).into() * xj;
         }
     }
     if tmp.is_empty() {
@@ -927,7 +953,7 @@ fn block_forward_body(block: &[f64], xs: &mut [f64], tmp: &mut [f64]) {
     for j in 0..k {
         let xj = xs[j];
         for (t, lij) in tmp.iter_mut().zip(&block[j * ld + k..(j + 1) * ld]) {
-            *t += lij * xj;
+            *t += (*lij).into() * xj;
         }
     }
 }
@@ -935,9 +961,9 @@ fn block_forward_body(block: &[f64], xs: &mut [f64], tmp: &mut [f64]) {
 /// A supernode's back step: xs −= L_botᵀ tmp (tmp = the pattern rows of
 /// x), then the k × k transposed triangle. Dispatched as
 /// [`block_forward`].
-fn block_backward(block: &[f64], xs: &mut [f64], tmp: &[f64]) {
-    struct Backward<'a>(&'a [f64], &'a mut [f64], &'a [f64]);
-    impl crate::simd::Kernel for Backward<'_> {
+fn block_backward<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &[f64]) {
+    struct Backward<'a, T>(&'a [T], &'a mut [f64], &'a [f64]);
+    impl<T: FactorValue> crate::simd::Kernel for Backward<'_, T> {
         type Output = ();
         #[inline(always)]
         fn run<S: crate::simd::Simd>(self, _simd: S) {
@@ -948,7 +974,7 @@ fn block_backward(block: &[f64], xs: &mut [f64], tmp: &[f64]) {
 }
 
 #[inline(always)]
-fn block_backward_body(block: &[f64], xs: &mut [f64], tmp: &[f64]) {
+fn block_backward_body<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &[f64]) {
     let k = xs.len();
     let ld = k + tmp.len();
     if !tmp.is_empty() {
@@ -959,26 +985,26 @@ fn block_backward_body(block: &[f64], xs: &mut [f64], tmp: &[f64]) {
     for j in (0..k).rev() {
         let col = &block[j * ld..j * ld + k];
         let s = dot(&col[j + 1..], &xs[j + 1..]);
-        xs[j] = (xs[j] - s) / col[j];
+        xs[j] = (xs[j] - s) / col[j].into();
     }
 }
 
 /// Σ aᵢbᵢ with four independent partial sums (the adder's latency, not
 /// memory, would bind a single chain).
 #[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+fn dot<T: FactorValue>(a: &[T], b: &[f64]) -> f64 {
     let mut acc = [0.0; 4];
     let (a4, ar) = a.split_at(a.len() - a.len() % 4);
     let (b4, br) = b.split_at(a4.len());
     for (x, y) in a4.chunks_exact(4).zip(b4.chunks_exact(4)) {
-        acc[0] += x[0] * y[0];
-        acc[1] += x[1] * y[1];
-        acc[2] += x[2] * y[2];
-        acc[3] += x[3] * y[3];
+        acc[0] += x[0].into() * y[0];
+        acc[1] += x[1].into() * y[1];
+        acc[2] += x[2].into() * y[2];
+        acc[3] += x[3].into() * y[3];
     }
     let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
     for (x, y) in ar.iter().zip(br) {
-        s += x * y;
+        s += (*x).into() * y;
     }
     s
 }

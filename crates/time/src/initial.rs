@@ -8,7 +8,7 @@ use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{RigidMode, SetupTimes};
 use stickslip_linalg::csr::{dot, quadratic_form, spmv};
-use stickslip_linalg::{chunks, FillOrder, SparseCholesky};
+use stickslip_linalg::{chunks, FillOrder, SparseCholesky, BACKWARD_ERROR};
 
 use crate::dynamics::Loads;
 use crate::settings::{InitialState, Settings, TimeError};
@@ -57,9 +57,19 @@ pub(crate) struct Statics<'a> {
     pub modes: &'a [RigidMode],
     pub times: &'a mut SetupTimes,
     /// K is factorized here only (the explicit scheme): the dissection is
-    /// kept without AMD's analysis ([`FillOrder::keep_dissection`]).
+    /// kept without AMD's analysis ([`FillOrder::keep_dissection`]), and
+    /// from [`SINGLE_MIN`] free DOFs the factor is computed in single
+    /// precision.
     pub single_factor: bool,
 }
+
+/// Free DOFs from which a preload whose factor serves it alone (the
+/// explicit scheme's) is factorized in single precision and refined to
+/// double's accuracy ([`SparseCholesky::solve_refined`]): where the
+/// factorization is most of the setup (docs/performance.md, "The preload
+/// in single precision"). Below, and so in every reference case, the
+/// double factor's solve, bit for bit.
+pub(crate) const SINGLE_MIN: usize = 100_000;
 
 /// K⁻¹ r in place by sparse Cholesky, the analysis (the ordering and
 /// the symbolic factor), the factor and the solve timed as the preload's.
@@ -72,21 +82,45 @@ pub(crate) fn cholesky_solve(
     r: &mut [f64],
     times: &mut SetupTimes,
 ) -> Result<(), TimeError> {
-    let solver = times
+    factor_solve(analyze(k, fill_order, times)?, k, r, times, false)
+}
+
+/// K's analysis, timed as the preload's ordering.
+fn analyze(
+    k: &CsrMatrix<f64>,
+    fill_order: &FillOrder,
+    times: &mut SetupTimes,
+) -> Result<SparseCholesky, TimeError> {
+    times
         .time("preload ordering", || {
             SparseCholesky::analyze(k, fill_order)
         })
-        .map_err(TimeError::Static)?;
-    factor_solve(solver, k, r, times)
+        .map_err(TimeError::Static)
 }
 
-/// [`cholesky_solve`] with K's analysis done (by `analyze`).
+/// [`cholesky_solve`] with K's analysis done (by `analyze`); `single`:
+/// factorized in single precision and refined, or where f32's precision
+/// or range does not serve K (a pivot fails, or the refinement stalls),
+/// as in double after all, which only the time tells.
 fn factor_solve(
     mut solver: SparseCholesky,
     k: &CsrMatrix<f64>,
     r: &mut [f64],
     times: &mut SetupTimes,
+    single: bool,
 ) -> Result<(), TimeError> {
+    if single
+        && times
+            .time("preload factor", || solver.factorize_single(k))
+            .is_ok()
+        && times
+            .time("preload solve", || {
+                solver.solve_refined(k, r, BACKWARD_ERROR)
+            })
+            .is_ok()
+    {
+        return Ok(());
+    }
     times
         .time("preload factor", || solver.factorize(k))
         .map_err(TimeError::Static)?;
@@ -163,10 +197,13 @@ pub(crate) fn initial_state_analyzed(
                 times,
                 analyzed,
             )?;
-        } else if let (Some(solver), true) = (analyzed, modes.is_empty()) {
-            factor_solve(solver, k, &mut r, times)?;
         } else if modes.is_empty() {
-            cholesky_solve(k, fill_order, &mut r, times)?;
+            let solver = match analyzed {
+                Some(solver) => solver,
+                None => analyze(k, fill_order, times)?,
+            };
+            let single = single_factor && n >= SINGLE_MIN;
+            factor_solve(solver, k, &mut r, times, single)?;
         } else {
             crate::floating::solve(k, mass, fill_order, modes, &mut r, times)?;
         }
@@ -232,4 +269,38 @@ pub(crate) fn initial_state_analyzed(
         balance: 0.0,
     };
     Ok(state)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra_sparse::CooMatrix;
+
+    /// A preload whose K f32 cannot factorize is solved by the double
+    /// factor, with its bits: [[1, c], [c, 1]], c = 1 − 2⁻³⁰, is positive
+    /// definite (determinant 1 − c² ≈ 2⁻²⁹), but c rounds to 1 in f32.
+    #[test]
+    fn a_preload_single_precision_cannot_factorize_is_solved_in_double() {
+        let c = 1.0 - 2.0_f64.powi(-30);
+        let mut coo = CooMatrix::new(2, 2);
+        for (i, j, v) in [(0, 0, 1.0), (0, 1, c), (1, 0, c), (1, 1, 1.0)] {
+            coo.push(i, j, v);
+        }
+        let k = CsrMatrix::from(&coo);
+        let order = FillOrder::amd();
+        let solve = |single: bool| {
+            let mut times = SetupTimes::default();
+            let mut r = vec![1.0, 2.0];
+            let solver = analyze(&k, &order, &mut times).unwrap();
+            factor_solve(solver, &k, &mut r, &mut times, single).unwrap();
+            r
+        };
+        let (single, double) = (solve(true), solve(false));
+        assert_eq!(single, double);
+        // K⁻¹(1, 2) = (1 − 2c, 2 − c)/(1 − c²), κ(K) ≈ 2³¹: good to ~1e-6.
+        let det = 1.0 - c * c;
+        for (x, want) in single.iter().zip([(1.0 - 2.0 * c) / det, (2.0 - c) / det]) {
+            assert!((x - want).abs() <= 1e-6 * want.abs(), "{x} against {want}");
+        }
+    }
 }

@@ -4,10 +4,10 @@
 //! whole preload where it cannot (within Gershgorin's bound on ω_max, or
 //! `allow_unstable`). Either way the critical step and the initial state
 //! have the bits of the sequential computation, written out here with the
-//! crates' public functions, and a Δt above the critical step is still
-//! refused.
+//! crates' public functions (the preload's factor in single precision,
+//! refined), and a Δt above the critical step is still refused.
 
-use stickslip_linalg::SparseCholesky;
+use stickslip_linalg::{backward_error, SparseCholesky, BACKWARD_ERROR};
 use stickslip_testkit::{structured_slab, Slab};
 use stickslip_time::stability::{critical_step, gershgorin_bound, largest_eigenvalue};
 use stickslip_time::{Dynamics, History, Integrator, Scheme, Settings, TimeError};
@@ -57,10 +57,26 @@ fn the_critical_step_beside_the_preload_has_the_sequential_bits() {
             *r += theta * f;
         }
     }
+    // From 100k free DOFs the factor is single precision, refined by CG
+    // to backward error 2u.
     d.fill_order.keep_dissection();
+    let load = r0.clone();
     let mut chol = SparseCholesky::analyze(k, &d.fill_order).unwrap();
+    chol.factorize_single(k).unwrap();
+    chol.solve_refined(k, &mut r0, BACKWARD_ERROR).unwrap();
+    assert!(backward_error(k, &r0, &load) <= BACKWARD_ERROR);
+    // The double factor's solve: two solutions of backward errors η₁, η₂
+    // differ by at most κ(K)(η₁ + η₂) relative, and the slab's K (Q1, h =
+    // 1/112 of its height) has κ(K) well under 1e6: 1e-9 holds that.
+    let mut double = load.clone();
     chol.factorize(k).unwrap();
-    chol.solve_in_place(&mut r0);
+    chol.solve_in_place(&mut double);
+    let norm = double.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let apart = double
+        .iter()
+        .zip(&r0)
+        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(apart <= 1e-9 * norm, "{apart:e} of {norm:e}");
 
     // Gershgorin's bound is above the estimate (ω_max² from below), so
     // its Δt is below the critical step: this one can be refused.
