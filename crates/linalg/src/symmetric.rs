@@ -313,7 +313,7 @@ fn symmetric(a: &CsrMatrix<f64>) -> bool {
     let vals = a.values();
     let max = vals.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let tol = ASYMMETRY * max;
-    let lower = (0..a.nrows()).into_par_iter().map(|i| {
+    let twins = |i: usize| {
         let mut count = 0usize;
         for p in offsets[i]..offsets[i + 1] {
             let c = cols[p];
@@ -327,8 +327,14 @@ fn symmetric(a: &CsrMatrix<f64>) -> bool {
             }
         }
         Some(count)
-    });
-    let lower: Option<usize> = lower.sum();
+    };
+    // A small model stays on this thread: starting rayon's pool costs more
+    // than its whole run of products.
+    let lower: Option<usize> = if parallel(a.nrows()) {
+        (0..a.nrows()).into_par_iter().map(twins).sum()
+    } else {
+        (0..a.nrows()).map(twins).sum()
+    };
     // Every lower entry has its upper twin; as many upper entries as
     // lower ones then means no upper entry lacks its twin.
     let upper = (0..a.nrows())
