@@ -400,26 +400,10 @@ impl SparseCholesky {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra_sparse::CooMatrix;
 
     /// The 5-point Laplacian of an n×n grid plus the identity.
     fn grid(n: usize) -> CsrMatrix<f64> {
-        let mut coo = CooMatrix::new(n * n, n * n);
-        for i in 0..n {
-            for j in 0..n {
-                let p = i * n + j;
-                coo.push(p, p, 5.0);
-                if i + 1 < n {
-                    coo.push(p, p + n, -1.0);
-                    coo.push(p + n, p, -1.0);
-                }
-                if j + 1 < n {
-                    coo.push(p, p + 1, -1.0);
-                    coo.push(p + 1, p, -1.0);
-                }
-            }
-        }
-        CsrMatrix::from(&coo)
+        crate::refine::tests::grid(n, 1.0)
     }
 
     #[test]

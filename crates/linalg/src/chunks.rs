@@ -141,6 +141,23 @@ fn add_in_order<const S: usize>(partials: &[[f64; S]]) -> [f64; S] {
     total
 }
 
+/// For rows in groups (group g's first row `group_rows[g]`, then the row
+/// count): the first group of each chunk of n rows, then the number of
+/// groups.
+pub fn chunk_groups(group_rows: &[u32], n: usize) -> Vec<u32> {
+    let groups = group_rows.len() - 1;
+    let mut out = Vec::with_capacity(chunks(n) + 1);
+    for (g, &r) in group_rows.iter().enumerate() {
+        while out.len() * CHUNK <= r as usize && out.len() <= chunks(n) {
+            out.push(g as u32);
+        }
+    }
+    while out.len() <= chunks(n) {
+        out.push(groups as u32);
+    }
+    out
+}
+
 /// Partial sums for [`sum_chunks`] over n rows.
 pub fn partials<const S: usize>(n: usize) -> Vec<[f64; S]> {
     vec![[0.0; S]; chunks(n)]

@@ -166,13 +166,13 @@ pub fn backward_error(a: &CsrMatrix<f64>, x: &[f64], b: &[f64]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::FillOrder;
     use nalgebra_sparse::CooMatrix;
 
     /// The 5-point Laplacian of an n×n grid (Dirichlet) plus `shift` I.
-    fn grid(n: usize, shift: f64) -> CsrMatrix<f64> {
+    pub(crate) fn grid(n: usize, shift: f64) -> CsrMatrix<f64> {
         let mut coo = CooMatrix::new(n * n, n * n);
         for i in 0..n {
             for j in 0..n {

@@ -28,7 +28,7 @@ use std::collections::HashMap;
 
 use nalgebra_sparse::CsrMatrix;
 
-use crate::chunks::{chunks, each_chunk, CHUNK};
+use crate::chunks::{chunk_groups, each_chunk, CHUNK};
 use crate::simd::{Batches, Kernel};
 
 /// Block values within this fraction of max |K_ij| of a type's are the
@@ -603,19 +603,4 @@ fn row_groups(
         visit(r0, r1, &block_cols, &block_vals);
     }
     group_rows
-}
-
-/// The first group of each chunk of n rows, then the number of groups.
-fn chunk_groups(group_rows: &[u32], n: usize) -> Vec<u32> {
-    let groups = group_rows.len() - 1;
-    let mut chunk_groups = Vec::with_capacity(chunks(n) + 1);
-    for (g, &r) in group_rows.iter().enumerate() {
-        while chunk_groups.len() * CHUNK <= r as usize && chunk_groups.len() <= chunks(n) {
-            chunk_groups.push(g as u32);
-        }
-    }
-    while chunk_groups.len() <= chunks(n) {
-        chunk_groups.push(groups as u32);
-    }
-    chunk_groups
 }

@@ -22,7 +22,7 @@
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
 
-use crate::chunks::{chunks, parallel, CHUNK};
+use crate::chunks::{chunk_groups, chunks, parallel, CHUNK};
 use crate::simd::Kernel;
 
 /// Two entries K_ij and K_ji differing by more than this fraction of
@@ -346,21 +346,6 @@ fn symmetric(a: &CsrMatrix<f64>) -> bool {
         })
         .sum::<usize>();
     lower == Some(upper)
-}
-
-/// The first group of each chunk of n rows, then the number of groups.
-fn chunk_groups(group_rows: &[u32], n: usize) -> Vec<u32> {
-    let groups = group_rows.len() - 1;
-    let mut out = Vec::with_capacity(chunks(n) + 1);
-    for (g, &r) in group_rows.iter().enumerate() {
-        while out.len() * CHUNK <= r as usize && out.len() <= chunks(n) {
-            out.push(g as u32);
-        }
-    }
-    while out.len() <= chunks(n) {
-        out.push(groups as u32);
-    }
-    out
 }
 
 /// Chunk c's sums as a dispatched kernel (so that the fused terms are the

@@ -76,6 +76,23 @@ impl Integrator {
                     .into(),
             ));
         }
+        // A compliant node's bound is c_T δ^{m_T} (METHOD.md §10): μ
+        // falling with the slip speed is not built there, so a scene
+        // refuses it as case files do rather than run something else.
+        if let Some(c) = contact.as_ref() {
+            if let Some(k) = c
+                .compliance
+                .iter()
+                .find(|k| c.weakening_of(k.index).is_some())
+            {
+                return Err(TimeError::Settings(format!(
+                    "surface {} has law = \"compliance\" at node {} with a friction coefficient \
+                     that falls with the slip speed; a compliant foundation takes a constant mu",
+                    c.names(),
+                    c.nodes[k.index].node
+                )));
+            }
+        }
         // A scene without friction nodes runs no friction code; nor does
         // one whose nodes carry none (μ = 0 or no pressure: w g = 0 at
         // every node), which then steps as a scene without a contact

@@ -56,9 +56,6 @@ pub(crate) struct QuasiStatic {
     /// R(t_K) − K r_{K−1}.
     b: Vec<f64>,
     partials: Vec<[f64; 2]>,
-    /// A compliant foundation's nodal forces at r_K (`comply`'s output,
-    /// unused here: the increment's forces come from its Newton solve).
-    normal: Vec<f64>,
 }
 
 /// Builds the stepper and the initial state: r₀ the frictionless static
@@ -123,7 +120,6 @@ pub(crate) fn start(
         friction,
         b: vec![0.0; n],
         partials: chunks::partials(n),
-        normal: Vec::new(),
     };
     Ok((Box::new(stepper), state))
 }
@@ -178,14 +174,7 @@ impl Stepper for QuasiStatic {
         }
         // The compliant nodes' bounds at r_K for the ledger's friction
         // forces, and the foundation's stored energy.
-        let foundation_stored = match run.contact.as_mut().filter(|c| c.is_compliant()) {
-            Some(c) => {
-                let stored = c.comply(&state.r_new, &[], &mut self.normal).stored;
-                self.friction.follow_compliance(c);
-                stored
-            }
-            None => 0.0,
-        };
+        let foundation_stored = self.friction.comply(run.contact.as_mut(), &state.r_new);
         let settings = &run.settings;
         let (work, load_dot) = state.load_work();
         // Friction's work over the increment Δr = Δt ṙ_K: the ledger's

@@ -363,7 +363,7 @@ impl State {
         let excess = c.normal_excess.len();
         if excess != 0 && excess != self.normal_excess.len() {
             return bad(format!(
-                "normal_excess has {excess} entries, the run {} compliant nodes of Newmark ¼, ½: \
+                "normal_excess has {excess} entries, the run has {} compliant nodes of Newmark ¼, ½: \
                  restart from a checkpoint of the same case (contact and scheme)",
                 self.normal_excess.len()
             ));

@@ -452,6 +452,33 @@ fn a_compliant_floor_beside_a_lagged_mu_keeps_the_constant_law_bits() {
     assert!(constant.energy().dissipated > 0.0);
 }
 
+/// A μ falling with the slip speed on the compliant floor's own nodes is
+/// not built (their bound is c_T δ^{m_T}): the scene is refused at the
+/// start, as a case file's `mu = { static, kinetic, speed }` with `law =
+/// "compliance"` is.
+#[test]
+fn a_speed_dependent_mu_on_compliant_nodes_is_refused() {
+    use stickslip_contact::Weakening;
+    use stickslip_time::{Dynamics, Integrator, TimeError};
+
+    let block = SlidingBlock::new(5.0, 10.0, 0.3);
+    let mut floor = block.floor.clone();
+    floor.set_weakening(|_| {
+        Some(Weakening {
+            ratio: 0.5,
+            speed: 0.5,
+        })
+    });
+    let dynamics = Dynamics::from_model(&block.model);
+    let load = vec![block.load.clone()];
+    match Integrator::new(dynamics, Some(floor), load, block.settings()) {
+        Err(TimeError::Settings(m)) => {
+            assert!(m.contains("compliance") && m.contains("constant mu"), "{m}");
+        }
+        other => panic!("expected the refusal, got {:?}", other.map(|_| ())),
+    }
+}
+
 /// The block (1 × ½, Q1 4 × 2, E = 1000, ν = 0.3, ρ = 1) of the sliding
 /// tests on a rough compliant floor (c_n = 1e4, c_T = μ c_n, m = 1) under
 /// the top traction (q, −p), launched along x at 1 from rest's shape.

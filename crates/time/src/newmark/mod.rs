@@ -212,12 +212,26 @@ impl ImplicitFriction {
         }
     }
 
+    /// A compliant foundation's bounds at the step's end `r` on `contact`
+    /// (and on the lagged surface), for the ledger's friction forces;
+    /// returns the foundation's stored energy, 0 without one.
+    pub(crate) fn comply(&mut self, contact: Option<&mut ContactSurface>, r: &[f64]) -> f64 {
+        match contact.filter(|c| c.is_compliant()) {
+            Some(c) => {
+                let stored = c.comply_bounds(r);
+                self.follow_compliance(c);
+                stored
+            }
+            None => 0.0,
+        }
+    }
+
     /// Where μ is lagged, gives the lagged surface the bounds `comply` has
     /// just set at r_K on `contact`'s compliant nodes: the ledger books the
     /// step's forces on the lagged surface, on which those nodes would
     /// otherwise keep the bounds at r_{K−1} (their μ is constant, so the
     /// lag takes their bounds as they are).
-    pub(crate) fn follow_compliance(&mut self, contact: &ContactSurface) {
+    fn follow_compliance(&mut self, contact: &ContactSurface) {
         let Some(lagged) = &mut self.lagged else {
             return;
         };
@@ -539,14 +553,7 @@ impl Stepper for Newmark {
         }
         // The compliant nodes' bounds at r_K for the ledger's friction
         // forces, and the foundation's stored energy.
-        let foundation_stored = match run.contact.as_mut().filter(|c| c.is_compliant()) {
-            Some(c) => {
-                let stored = c.comply_bounds(&state.r_new);
-                self.friction.follow_compliance(c);
-                stored
-            }
-            None => 0.0,
-        };
+        let foundation_stored = self.friction.comply(run.contact.as_mut(), &state.r_new);
         let settings = &run.settings;
         let (work, load_dot) = state.load_work();
         let ((dissipated, foundation), stick_events) = match self.friction.surface(run) {
