@@ -57,9 +57,6 @@ pub(crate) struct AlgorithmicNormal {
     mass: MassInverse,
     /// M⁻¹'s right-hand side.
     rhs: Vec<f64>,
-    /// Steps whose acceleration needed M⁻¹ (a touch or a release for
-    /// m_n = 1).
-    pub(crate) corrections: u64,
 }
 
 impl AlgorithmicNormal {
@@ -76,7 +73,6 @@ impl AlgorithmicNormal {
         AlgorithmicNormal {
             mass,
             rhs: Vec::new(),
-            corrections: 0,
         }
     }
 
@@ -107,7 +103,6 @@ impl AlgorithmicNormal {
         if (0..before.len()).all(|k| jump(k) == 0.0) {
             return Ok(());
         }
-        self.corrections += 1;
         self.rhs.clear();
         self.rhs.resize(a.len(), 0.0);
         for (k, node) in contact.compliance.iter().enumerate() {
