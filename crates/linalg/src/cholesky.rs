@@ -246,12 +246,17 @@ impl SparseCholesky {
     /// [`SolverError::NotPositiveDefinite`] for a singular or indefinite
     /// matrix, [`SolverError::PatternChanged`] for another pattern.
     pub fn factorize(&mut self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
-        let par = if self.l_values.len() >= PARALLEL_MIN {
+        self.factorize_in(a, self.kernels_par())
+    }
+
+    /// The dense kernels' parallelism: rayon's pool from [`PARALLEL_MIN`]
+    /// factor values, this thread below.
+    fn kernels_par(&self) -> Par {
+        if self.l_values.len() >= PARALLEL_MIN {
             parallel()
         } else {
             Par::Seq
-        };
-        self.factorize_in(a, par)
+        }
     }
 
     /// [`SparseCholesky::factorize`] with faer's dense kernels run by
@@ -308,12 +313,7 @@ impl SparseCholesky {
     /// factor may still succeed), [`SolverError::PatternChanged`] for
     /// another pattern.
     pub fn factorize_single(&mut self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
-        let par = if self.symbolic.len_val() >= PARALLEL_MIN {
-            parallel()
-        } else {
-            Par::Seq
-        };
-        self.factorize_single_in(a, par)
+        self.factorize_single_in(a, self.kernels_par())
     }
 
     fn factorize_single_in(&mut self, a: &CsrMatrix<f64>, par: Par) -> Result<(), SolverError> {
