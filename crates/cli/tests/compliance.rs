@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{bin, scratch, succeeded};
+use common::{scratch, succeeded};
 use stickslip_testkit::case_text::paper_slab_head;
 
 /// The paper's slab (mass 8) dropped at 0.5 from 0.01 above a floor of
@@ -120,12 +120,7 @@ fn drop_slab(name: &str, time: &str, said: &[&str]) {
     let dir = scratch(name);
     let case = drop_case(&dir, time);
     let out = dir.join("drop.h5");
-    let o = bin()
-        .args(["run", "--force", "-o"])
-        .arg(&out)
-        .arg(&case)
-        .output()
-        .unwrap();
+    let o = common::run(&case, &out, &["--force"]);
     succeeded(&o, "run");
     let said_out = String::from_utf8_lossy(&o.stderr) + String::from_utf8_lossy(&o.stdout);
     for s in said {
@@ -205,12 +200,7 @@ t_end = 1.0
     let case = dir.join("floor.toml");
     std::fs::write(&case, text).unwrap();
     let out = dir.join("floor.h5");
-    let o = bin()
-        .args(["run", "--force", "-o"])
-        .arg(&out)
-        .arg(&case)
-        .output()
-        .unwrap();
+    let o = common::run(&case, &out, &["--force"]);
     succeeded(&o, "run");
     let said = String::from_utf8_lossy(&o.stderr) + String::from_utf8_lossy(&o.stdout);
     assert!(said.contains("compliance Newton iterations"), "{said}");

@@ -17,12 +17,7 @@ fn run(name: &str, text: &str) -> PathBuf {
     let case = dir.join("case.toml");
     std::fs::write(&case, text).unwrap();
     let out = dir.join("out.h5");
-    let o = bin()
-        .args(["run", "--force", "--quiet", "-o"])
-        .arg(&out)
-        .arg(&case)
-        .output()
-        .unwrap();
+    let o = common::run(&case, &out, &["--force", "--quiet"]);
     succeeded(&o, "run");
     out
 }
