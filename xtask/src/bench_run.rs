@@ -190,7 +190,18 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
             }
             "--rungs" => {
                 let list = it.next().ok_or("--rungs needs names, comma-separated")?;
-                rungs = Some(list.split(',').map(str::to_string).collect());
+                let names: Vec<String> = list.split(',').map(str::to_string).collect();
+                if let Some(bad) = names
+                    .iter()
+                    .find(|n| RUNGS.iter().all(|r| r.name != n.as_str()))
+                {
+                    let known: Vec<&str> = RUNGS.iter().map(|r| r.name).collect();
+                    return Err(format!(
+                        "--rungs: no rung named {bad:?}; the rungs are {}",
+                        known.join(", ")
+                    ));
+                }
+                rungs = Some(names);
             }
             "--only" => only = Some(it.next().ok_or("--only needs cd or newmark")?.clone()),
             "--peers" => {
