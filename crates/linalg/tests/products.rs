@@ -4,7 +4,9 @@
 
 use nalgebra_sparse::{CooMatrix, CsrMatrix};
 use stickslip_linalg::chunks::{chunks, partials, sum_chunks, CHUNK};
-use stickslip_linalg::csr::{index, load_minus_k_plus_m, quadratic_form, spmv, two_forms};
+use stickslip_linalg::csr::{
+    index, load_minus_k_plus_m, quadratic_form, spmv, two_forms, two_forms_and_products,
+};
 use stickslip_linalg::{Product, Stencils, Symmetric, TOLERANCE};
 use stickslip_testkit::{on_threads, plain_spmv, spread};
 
@@ -78,6 +80,30 @@ fn products_and_forms_against_plain_sums() {
     spmv(&a, &y, &mut ay);
     for i in 0..n {
         assert_eq!(out[i].to_bits(), (l[i] - ax[i] + ay[i]).to_bits());
+    }
+    // The fused pass: the forms of (x, y) and the products of (y, x), each
+    // with the bits of the passes it replaces, on one thread and on two.
+    let mut m = a.clone();
+    for v in m.values_mut() {
+        *v *= 0.75;
+    }
+    let l0 = vec![0.0; n];
+    let mut want = vec![0.0; n];
+    load_minus_k_plus_m(&l0, &a, &y, &m, &x, &mut want);
+    let forms = two_forms(&a, &x, &m, &y, &mut partials);
+    for threads in [1, 2] {
+        let (kx, mx, f) = on_threads(threads, || {
+            let (mut kx, mut mx) = (vec![0.0; n], vec![0.0; n]);
+            let mut sums = vec![[0.0; 2]; chunks(n)];
+            let f =
+                two_forms_and_products(&a, [&x, &y], &m, [&y, &x], [&mut kx, &mut mx], &mut sums);
+            (kx, mx, f)
+        });
+        assert_eq!(f.0.to_bits(), forms.0.to_bits());
+        assert_eq!(f.1.to_bits(), forms.1.to_bits());
+        for i in 0..n {
+            assert_eq!(want[i].to_bits(), (l0[i] - kx[i] + mx[i]).to_bits());
+        }
     }
     assert_eq!(index(&a, 0, 5), Some(2));
     assert_eq!(index(&a, 0, 2), None);
