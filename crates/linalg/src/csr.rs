@@ -78,12 +78,19 @@ fn row_dots<const V: usize>(vals: [&[f64]; V], x: [&[f64]; V], cols: &[usize]) -
     let split = len - len % 4;
     let mut acc = [[0.0; 4]; V];
     for (g, c) in cols[..split].chunks_exact(4).enumerate() {
+        // Sorted distinct columns: four consecutive ones (a run of nodes
+        // along a grid row) are one load of each vector.
+        let run = c[3] == c[0] + 3;
         for (acc, (vals, x)) in acc.iter_mut().zip(vals.iter().zip(&x)) {
             let v = &vals[4 * g..4 * g + 4];
-            acc[0] += v[0] * x[c[0]];
-            acc[1] += v[1] * x[c[1]];
-            acc[2] += v[2] * x[c[2]];
-            acc[3] += v[3] * x[c[3]];
+            let xs: [f64; 4] = if run {
+                x[c[0]..c[0] + 4].try_into().expect("four values")
+            } else {
+                [x[c[0]], x[c[1]], x[c[2]], x[c[3]]]
+            };
+            for l in 0..4 {
+                acc[l] += v[l] * xs[l];
+            }
         }
     }
     let mut s = acc.map(|a| (a[0] + a[1]) + (a[2] + a[3]));
