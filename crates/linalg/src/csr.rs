@@ -3,7 +3,7 @@
 
 use nalgebra_sparse::CsrMatrix;
 
-use crate::chunks::{each_chunk, sum_chunks, CHUNK};
+use crate::chunks::{each_chunk, each_chunk_of, sum_chunks, CHUNK};
 
 /// Σ_k vals[k]·x[cols[k]] over one row, in four interleaved partial sums
 /// (one chain of additions waits on the adder's latency).
@@ -64,7 +64,42 @@ impl crate::simd::Kernel for Rows<'_> {
 /// Row sums of two matrices on one pattern, each with [`row_dot`]'s bits.
 #[inline]
 fn row_dot2(a: &[f64], x: &[f64], b: &[f64], y: &[f64], cols: &[usize]) -> (f64, f64) {
-    (row_dot(a, cols, x), row_dot(b, cols, y))
+    let [s, t] = row_dots([a, b], [x, y], cols);
+    (s, t)
+}
+
+/// Row sums Σ_k vals[v][k]·x[v][cols[k]] for V (values, vector) pairs on
+/// one pattern in one loop over it, each with [`row_dot`]'s four
+/// interleaved partial sums and so its bits: the row's indices are read
+/// once for all V.
+#[inline(always)]
+fn row_dots<const V: usize>(vals: [&[f64]; V], x: [&[f64]; V], cols: &[usize]) -> [f64; V] {
+    let len = cols.len();
+    let split = len - len % 4;
+    let mut acc = [[0.0; 4]; V];
+    for (g, c) in cols[..split].chunks_exact(4).enumerate() {
+        // Sorted distinct columns: four consecutive ones (a run of nodes
+        // along a grid row) are one load of each vector.
+        let run = c[3] == c[0] + 3;
+        for (acc, (vals, x)) in acc.iter_mut().zip(vals.iter().zip(&x)) {
+            let v = &vals[4 * g..4 * g + 4];
+            let xs: [f64; 4] = if run {
+                x[c[0]..c[0] + 4].try_into().expect("four values")
+            } else {
+                [x[c[0]], x[c[1]], x[c[2]], x[c[3]]]
+            };
+            for l in 0..4 {
+                acc[l] += v[l] * xs[l];
+            }
+        }
+    }
+    let mut s = acc.map(|a| (a[0] + a[1]) + (a[2] + a[3]));
+    for (k, &c) in cols.iter().enumerate().skip(split) {
+        for (s, (vals, x)) in s.iter_mut().zip(vals.iter().zip(&x)) {
+            *s += vals[k] * x[c];
+        }
+    }
+    s
 }
 
 /// True when A and B store the same pattern.
@@ -128,6 +163,65 @@ pub fn two_forms(
         *s = [a, b];
     });
     (s, t)
+}
+
+/// (xᵀK x, yᵀM y) with the bits of [`two_forms`], and in the same pass over
+/// the shared pattern K x' into `kx` and M y' into `my`, each row with the
+/// bits of [`load_minus_k_plus_m`]'s: an implicit step's energies and the
+/// next step's products read K and M once. `partials` as [`two_forms`]'.
+pub fn two_forms_and_products(
+    k: &CsrMatrix<f64>,
+    [x, x2]: [&[f64]; 2],
+    m: &CsrMatrix<f64>,
+    [y, y2]: [&[f64]; 2],
+    [kx, my]: [&mut [f64]; 2],
+    partials: &mut [[f64; 2]],
+) -> (f64, f64) {
+    let offsets = k.row_offsets();
+    let cols = k.col_indices();
+    let (kv, mv) = (k.values(), m.values());
+    let [s, t] = each_chunk_of([kx, my], partials, |c, [kc, mc], s| {
+        *s = crate::simd::vectorized(FourRows {
+            rows: c * CHUNK,
+            k: (offsets, cols, kv),
+            m: mv,
+            x: [x, x2, y, y2],
+            out: [kc, mc],
+        });
+    });
+    (s, t)
+}
+
+/// Rows `rows..` of [`two_forms_and_products`], as a dispatched kernel:
+/// (x·Kx, y·My) over them, and K x', M y' into `out`.
+struct FourRows<'a> {
+    rows: usize,
+    k: (&'a [usize], &'a [usize], &'a [f64]),
+    m: &'a [f64],
+    x: [&'a [f64]; 4],
+    out: [&'a mut [f64]; 2],
+}
+
+impl crate::simd::Kernel for FourRows<'_> {
+    type Output = [f64; 2];
+
+    #[inline(always)]
+    fn run<S: crate::simd::Simd>(self, _simd: S) -> [f64; 2] {
+        let (offsets, cols, kv) = self.k;
+        let [x, x2, y, y2] = self.x;
+        let [kc, mc] = self.out;
+        let (mut a, mut b) = (0.0, 0.0);
+        for (j, (ko, mo)) in kc.iter_mut().zip(mc.iter_mut()).enumerate() {
+            let i = self.rows + j;
+            let (p, q) = (offsets[i], offsets[i + 1]);
+            let (k, m) = (&kv[p..q], &self.m[p..q]);
+            let [kx, kx2, my, my2] = row_dots([k, k, m, m], [x, x2, y, y2], &cols[p..q]);
+            a += x[i] * kx;
+            b += y[i] * my;
+            (*ko, *mo) = (kx2, my2);
+        }
+        [a, b]
+    }
 }
 
 /// x · y.

@@ -4,7 +4,9 @@
 
 use nalgebra_sparse::{CooMatrix, CsrMatrix};
 use stickslip_linalg::chunks::{chunks, partials, sum_chunks, CHUNK};
-use stickslip_linalg::csr::{index, load_minus_k_plus_m, quadratic_form, spmv, two_forms};
+use stickslip_linalg::csr::{
+    index, load_minus_k_plus_m, quadratic_form, spmv, two_forms, two_forms_and_products,
+};
 use stickslip_linalg::{Product, Stencils, Symmetric, TOLERANCE};
 use stickslip_testkit::{on_threads, plain_spmv, spread};
 
@@ -79,6 +81,30 @@ fn products_and_forms_against_plain_sums() {
     for i in 0..n {
         assert_eq!(out[i].to_bits(), (l[i] - ax[i] + ay[i]).to_bits());
     }
+    // The fused pass: the forms of (x, y) and the products of (y, x), each
+    // with the bits of the passes it replaces, on one thread and on two.
+    let mut m = a.clone();
+    for v in m.values_mut() {
+        *v *= 0.75;
+    }
+    let l0 = vec![0.0; n];
+    let mut want = vec![0.0; n];
+    load_minus_k_plus_m(&l0, &a, &y, &m, &x, &mut want);
+    let forms = two_forms(&a, &x, &m, &y, &mut partials);
+    for threads in [1, 2] {
+        let (kx, mx, f) = on_threads(threads, || {
+            let (mut kx, mut mx) = (vec![0.0; n], vec![0.0; n]);
+            let mut sums = vec![[0.0; 2]; chunks(n)];
+            let f =
+                two_forms_and_products(&a, [&x, &y], &m, [&y, &x], [&mut kx, &mut mx], &mut sums);
+            (kx, mx, f)
+        });
+        assert_eq!(f.0.to_bits(), forms.0.to_bits());
+        assert_eq!(f.1.to_bits(), forms.1.to_bits());
+        for i in 0..n {
+            assert_eq!(want[i].to_bits(), (l0[i] - kx[i] + mx[i]).to_bits());
+        }
+    }
     assert_eq!(index(&a, 0, 5), Some(2));
     assert_eq!(index(&a, 0, 2), None);
 }
@@ -132,6 +158,61 @@ fn grid(nx: usize, ny: usize, wobble: f64, fixed: bool) -> CsrMatrix<f64> {
         }
     }
     CsrMatrix::from(&coo)
+}
+
+/// On a grid's pattern, where most groups of four columns are consecutive
+/// (runs of nodes along a row, read as one load), the fused rows keep the
+/// bits of the plain row sums (`spmv`, `quadratic_form`), on one thread
+/// and on two.
+#[test]
+fn fused_rows_keep_the_row_sums_bits_on_runs_of_columns() {
+    let k = grid(300, 40, 1e-6, true);
+    let mut m = k.clone();
+    for (i, v) in m.values_mut().iter_mut().enumerate() {
+        *v *= 0.5 + (i % 3) as f64 * 0.125;
+    }
+    let n = k.nrows();
+    assert!(chunks(n) > 2);
+    // The case the loads serve must occur: groups of four consecutive
+    // columns at a row's start.
+    let runs = (0..n)
+        .filter(|&i| {
+            let c = &k.col_indices()[k.row_offsets()[i]..k.row_offsets()[i + 1]];
+            c.len() >= 4 && c[3] == c[0] + 3
+        })
+        .count();
+    assert!(runs > n / 2, "{runs} of {n} rows");
+    let x = spread(n);
+    let y: Vec<f64> = x.iter().map(|v| 1.0 - 0.3 * v).collect();
+    let (mut kx, mut my) = (vec![0.0; n], vec![0.0; n]);
+    spmv(&k, &x, &mut kx);
+    spmv(&m, &y, &mut my);
+    let mut sums = partials(n);
+    let forms = (
+        quadratic_form(&k, &y, &mut sums),
+        quadratic_form(&m, &x, &mut sums),
+    );
+    let l: Vec<f64> = (0..n).map(|i| (i % 5) as f64 - 2.0).collect();
+    let mut b = vec![0.0; n];
+    load_minus_k_plus_m(&l, &k, &x, &m, &y, &mut b);
+    for i in 0..n {
+        assert_eq!(b[i].to_bits(), (l[i] - kx[i] + my[i]).to_bits(), "row {i}");
+    }
+    for threads in [1, 2] {
+        let (fk, fm, f) = on_threads(threads, || {
+            let (mut fk, mut fm) = (vec![0.0; n], vec![0.0; n]);
+            let mut sums = vec![[0.0; 2]; chunks(n)];
+            let f =
+                two_forms_and_products(&k, [&y, &x], &m, [&x, &y], [&mut fk, &mut fm], &mut sums);
+            (fk, fm, f)
+        });
+        assert_eq!(f.0.to_bits(), forms.0.to_bits());
+        assert_eq!(f.1.to_bits(), forms.1.to_bits());
+        for i in 0..n {
+            assert_eq!(fk[i].to_bits(), kx[i].to_bits(), "row {i}");
+            assert_eq!(fm[i].to_bits(), my[i].to_bits(), "row {i}");
+        }
+    }
 }
 
 /// Within TOLERANCE · max|K| · Σ|x| of the assembled product, row by

@@ -14,7 +14,7 @@ mod schur;
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{iterate, stick_events, ContactSurface, SlipState};
-use stickslip_linalg::csr::{load_minus_k_plus_m, same_pattern, two_forms};
+use stickslip_linalg::csr::{load_minus_k_plus_m, same_pattern, two_forms, two_forms_and_products};
 use stickslip_linalg::{chunks, FillOrder};
 
 use stickslip_fem::SetupTimes;
@@ -66,6 +66,13 @@ pub(crate) struct Newmark {
     /// R̂_K, and M's vector of it.
     b: Vec<f64>,
     tmp: Vec<f64>,
+    /// K r_pred and M[ṙ/(γΔt) + (1/γ − 1) r̈] of the next step, formed in
+    /// the last step's pass for its energies (the predictor into
+    /// `State::r_new`), for the Δt of that step.
+    next_products: [Vec<f64>; 2],
+    /// (steps, Δt bits) of the state `next_products` were formed for: a
+    /// next step of that Δt reads them instead of K and M.
+    predicted: Option<(u64, u64)>,
     partials: Vec<[f64; 2]>,
     /// Newmark ¼, ½ on a compliant foundation: the energy-consistent
     /// normal force's part of the step (`algorithmic.rs`); `None` where
@@ -148,6 +155,8 @@ pub(crate) fn start(
         friction,
         b: vec![0.0; n],
         tmp: vec![0.0; n],
+        next_products: [vec![0.0; n], vec![0.0; n]],
+        predicted: None,
         partials: chunks::partials(n),
         algorithmic,
     };
@@ -433,6 +442,56 @@ impl ImplicitFriction {
 }
 
 impl Newmark {
+    /// The predictor's and R̂_K's coefficients for a step of `dt`: r_pred =
+    /// r + c1 ṙ + c2 r̈ and M's vector cv ṙ + ca r̈.
+    fn coefficients(&self, dt: f64) -> [f64; 4] {
+        let (beta, gamma) = (self.beta, self.gamma);
+        [
+            dt * (1.0 - beta / gamma),
+            0.5 * dt * dt * (1.0 - 2.0 * beta / gamma),
+            1.0 / (gamma * dt),
+            1.0 / gamma - 1.0,
+        ]
+    }
+
+    /// The predictor of a step of `dt` from the state into `state.r_new`,
+    /// and M's vector of R̂_K into `tmp`, in one pass.
+    fn predict(&mut self, state: &mut State, dt: f64) {
+        let [c1, c2, cv, ca] = self.coefficients(dt);
+        for (((rn, t), r), (v, a)) in state
+            .r_new
+            .iter_mut()
+            .zip(self.tmp.iter_mut())
+            .zip(&state.r)
+            .zip(state.v.iter().zip(&state.a))
+        {
+            *rn = r + c1 * v + c2 * a;
+            *t = cv * v + ca * a;
+        }
+    }
+
+    /// (r_Kᵀ K r_K, ṙ_Kᵀ M ṙ_K) of the committed state; where a step
+    /// follows (`more`), K and M are read once for these and for the next
+    /// step's products as well, formed for a step of this `dt` (its
+    /// predictor into `state.r_new`, which the commit freed).
+    fn energy_pass(&mut self, state: &mut State, dt: f64, more: bool) -> (f64, f64) {
+        if !more {
+            return two_forms(&self.k, &state.r, &self.m, &state.v, &mut self.partials);
+        }
+        self.predict(state, dt);
+        let [kr, mt] = &mut self.next_products;
+        let forms = two_forms_and_products(
+            &self.k,
+            [&state.r, &state.r_new],
+            &self.m,
+            [&state.v, &self.tmp],
+            [kr, mt],
+            &mut self.partials,
+        );
+        self.predicted = Some((state.steps, dt.to_bits()));
+        forms
+    }
+
     /// The damping's dissipation over the step, Δt ṙ̄ᵀCṙ̄ with ṙ̄ = ½(ṙ_K +
     /// ṙ_{K−1}) (before the commit): ½(Cṙ_K + Cṙ_{K−1})·½Δt(ṙ_K + ṙ_{K−1}),
     /// the friction's trapezoidal rule, exact for Newmark ¼, ½. 0 without
@@ -459,28 +518,25 @@ impl Stepper for Newmark {
         run.loads.at(t_new, &mut state.load_new);
         // Predictor: r_K = r_pred + (β/γ)Δt ṙ_K; and for R̂_K = R_K − K
         // r_pred + M[ṙ/(γΔt) + (1/γ − 1) r̈] the bracket, in one pass.
-        let c1 = dt * (1.0 - beta / gamma);
-        let c2 = 0.5 * dt * dt * (1.0 - 2.0 * beta / gamma);
-        let cv = 1.0 / (gamma * dt);
-        let ca = 1.0 / gamma - 1.0;
-        for (((rn, t), r), (v, a)) in state
-            .r_new
-            .iter_mut()
-            .zip(self.tmp.iter_mut())
-            .zip(&state.r)
-            .zip(state.v.iter().zip(&state.a))
-        {
-            *rn = r + c1 * v + c2 * a;
-            *t = cv * v + ca * a;
+        let [_, _, cv, ca] = self.coefficients(dt);
+        if self.predicted.take() == Some((state.steps, dt.to_bits())) {
+            // The last step's energy pass formed the products (and the
+            // predictor in r_new) for this Δt, with these operations.
+            let [kr, mt] = &self.next_products;
+            for (((b, l), kr), mt) in self.b.iter_mut().zip(&state.load_new).zip(kr).zip(mt) {
+                *b = l - kr + mt;
+            }
+        } else {
+            self.predict(state, dt);
+            load_minus_k_plus_m(
+                &state.load_new,
+                &self.k,
+                &state.r_new,
+                &self.m,
+                &self.tmp,
+                &mut self.b,
+            );
         }
-        load_minus_k_plus_m(
-            &state.load_new,
-            &self.k,
-            &state.r_new,
-            &self.m,
-            &self.tmp,
-            &mut self.b,
-        );
         let energy_consistent = match (&self.algorithmic, &run.contact) {
             (Some(_), Some(c)) => {
                 AlgorithmicNormal::correct_rhs(c, &state.normal_excess, ca, &mut self.b);
@@ -565,7 +621,7 @@ impl Stepper for Newmark {
         };
         let damped = self.damped(settings, state, dt);
         state.commit(dt, t_new, iterations);
-        let (rkr, vmv) = two_forms(&self.k, &state.r, &self.m, &state.v, &mut self.partials);
+        let (rkr, vmv) = self.energy_pass(state, dt, t_new < settings.t_end);
         let energies = StepEnergies {
             kinetic: 0.5 * vmv,
             strain: 0.5 * rkr,
@@ -577,6 +633,10 @@ impl Stepper for Newmark {
             load_dot,
         };
         Ok(state.close_step(energies, settings, dt, iterations, stick_events))
+    }
+
+    fn state_replaced(&mut self) {
+        self.predicted = None;
     }
 
     fn is_explicit(&self) -> bool {
