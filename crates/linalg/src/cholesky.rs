@@ -18,7 +18,7 @@ use faer::linalg::cholesky::llt::factor::LltParams;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
 };
-use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::{amd, SupernodalThreshold};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Par, Side, Spec};
 
@@ -154,31 +154,54 @@ pub fn analyze_symbolic(
     }
 }
 
+/// faer's AMD order of `a`'s pattern: `amd::order` on the pattern as it
+/// is, whose columns are sorted and without duplicates (nalgebra-sparse
+/// keeps them so) and whose transpose is itself (symmetric). The order
+/// `SymmetricOrdering::Amd` gives, without the sorted, deduplicated copy
+/// of the pattern it makes first for an input that may be neither: its
+/// time and its pages (docs/performance.md, "One analysis a run").
+fn amd_order(a: &CsrMatrix<f64>) -> Result<Vec<usize>, SolverError> {
+    let n = a.nrows();
+    let (mut forward, mut inverse) = (vec![0; n], vec![0; n]);
+    let mut scratch = MemBuffer::try_new(amd::order_scratch::<usize>(n, a.nnz()))
+        .map_err(|e| SolverError::Analysis(format!("{e:?}")))?;
+    amd::order(
+        &mut forward,
+        &mut inverse,
+        as_csc(a).symbolic(),
+        amd::Control::default(),
+        MemStack::new(&mut scratch),
+    )
+    .map_err(|e| SolverError::Analysis(format!("{e:?}")))?;
+    Ok(forward)
+}
+
 /// The symbolic analysis in the elimination order `forward` (AMD's when
 /// `None`).
 fn symbolic_in(
     a: &CsrMatrix<f64>,
     forward: Option<&[usize]>,
 ) -> Result<SymbolicCholesky<usize>, SolverError> {
-    let inverse;
-    let ordering = match forward {
-        None => SymmetricOrdering::Amd,
-        Some(forward) => {
-            if forward.len() != a.nrows() {
-                return Err(SolverError::Analysis(format!(
-                    "an ordering of {} rows for a matrix of {}",
-                    forward.len(),
-                    a.nrows()
-                )));
-            }
-            let mut inv = vec![0; forward.len()];
-            for (i, &row) in forward.iter().enumerate() {
-                inv[row] = i;
-            }
-            inverse = inv;
-            SymmetricOrdering::Custom(PermRef::new_checked(forward, &inverse, a.nrows()))
+    let amd;
+    let forward = match forward {
+        None => {
+            amd = amd_order(a)?;
+            amd.as_slice()
         }
+        Some(forward) => forward,
     };
+    if forward.len() != a.nrows() {
+        return Err(SolverError::Analysis(format!(
+            "an ordering of {} rows for a matrix of {}",
+            forward.len(),
+            a.nrows()
+        )));
+    }
+    let mut inverse = vec![0; forward.len()];
+    for (i, &row) in forward.iter().enumerate() {
+        inverse[row] = i;
+    }
+    let ordering = SymmetricOrdering::Custom(PermRef::new_checked(forward, &inverse, a.nrows()));
     factorize_symbolic_cholesky(
         as_csc(a).symbolic(),
         Side::Lower,
@@ -473,6 +496,34 @@ mod tests {
                 "{x} against {}",
                 v / lambda
             );
+        }
+    }
+
+    /// Our AMD order is faer's (`SymmetricOrdering::Amd`), without its
+    /// copy of the pattern: the same permutation, the same factor.
+    #[test]
+    fn the_amd_order_is_faers() {
+        for a in [
+            grid(1),
+            grid(7),
+            grid(40),
+            crate::refine::tests::grid(25, 0.5),
+        ] {
+            let faers = factorize_symbolic_cholesky(
+                as_csc(&a).symbolic(),
+                Side::Lower,
+                SymmetricOrdering::Amd,
+                CholeskySymbolicParams {
+                    supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let ours = symbolic_in(&a, None).unwrap();
+            let (faers_fwd, _) = faers.perm().unwrap().arrays();
+            let (ours_fwd, _) = ours.perm().unwrap().arrays();
+            assert_eq!(faers_fwd, ours_fwd);
+            assert_eq!(faers.len_val(), ours.len_val());
         }
     }
 
