@@ -28,7 +28,6 @@
 
 use std::sync::Arc;
 
-use crate::initial::Analysis;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{LltError, LltParams};
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
@@ -38,6 +37,8 @@ use stickslip_contact::{CompliantNode, ContactNode, ContactSurface, SlipState, S
 use stickslip_linalg::{
     analyze_symbolic, csc_view, FillOrder, PathOperator, SolverError, Supernodal,
 };
+
+use crate::initial::Analysis;
 
 /// How many Δt keep their factor (the normal and the reduced step).
 const CACHE: usize = 2;
