@@ -10,6 +10,7 @@
 //! [`Supernodal`]'s loops.
 
 use std::cell::RefCell;
+use std::sync::Arc;
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -17,7 +18,7 @@ use faer::linalg::cholesky::llt::factor::LltParams;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
 };
-use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::{amd, SupernodalThreshold};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Par, Side, Spec};
 
@@ -70,7 +71,9 @@ pub enum SolverError {
 /// CSR matrix (both triangles stored, columns sorted, as nalgebra-sparse
 /// keeps them), with the symbolic analysis kept for refactorization.
 pub struct SparseCholesky {
-    symbolic: SymbolicCholesky<usize>,
+    /// Shared with the other factorizations of the pattern (a run's
+    /// preload, A₀ and M: [`SparseCholesky::symbolic`]).
+    symbolic: Arc<SymbolicCholesky<usize>>,
     l_values: Vec<f64>,
     factorized: bool,
     n: usize,
@@ -151,31 +154,54 @@ pub fn analyze_symbolic(
     }
 }
 
+/// faer's AMD order of `a`'s pattern: `amd::order` on the pattern as it
+/// is, whose columns are sorted and without duplicates (nalgebra-sparse
+/// keeps them so) and whose transpose is itself (symmetric). The order
+/// `SymmetricOrdering::Amd` gives, without the sorted, deduplicated copy
+/// of the pattern it makes first for an input that may be neither: its
+/// time and its pages (docs/performance.md, "One analysis a run").
+fn amd_order(a: &CsrMatrix<f64>) -> Result<Vec<usize>, SolverError> {
+    let n = a.nrows();
+    let (mut forward, mut inverse) = (vec![0; n], vec![0; n]);
+    let mut scratch = MemBuffer::try_new(amd::order_scratch::<usize>(n, a.nnz()))
+        .map_err(|e| SolverError::Analysis(format!("{e:?}")))?;
+    amd::order(
+        &mut forward,
+        &mut inverse,
+        as_csc(a).symbolic(),
+        amd::Control::default(),
+        MemStack::new(&mut scratch),
+    )
+    .map_err(|e| SolverError::Analysis(format!("{e:?}")))?;
+    Ok(forward)
+}
+
 /// The symbolic analysis in the elimination order `forward` (AMD's when
 /// `None`).
 fn symbolic_in(
     a: &CsrMatrix<f64>,
     forward: Option<&[usize]>,
 ) -> Result<SymbolicCholesky<usize>, SolverError> {
-    let inverse;
-    let ordering = match forward {
-        None => SymmetricOrdering::Amd,
-        Some(forward) => {
-            if forward.len() != a.nrows() {
-                return Err(SolverError::Analysis(format!(
-                    "an ordering of {} rows for a matrix of {}",
-                    forward.len(),
-                    a.nrows()
-                )));
-            }
-            let mut inv = vec![0; forward.len()];
-            for (i, &row) in forward.iter().enumerate() {
-                inv[row] = i;
-            }
-            inverse = inv;
-            SymmetricOrdering::Custom(PermRef::new_checked(forward, &inverse, a.nrows()))
+    let amd;
+    let forward = match forward {
+        None => {
+            amd = amd_order(a)?;
+            amd.as_slice()
         }
+        Some(forward) => forward,
     };
+    if forward.len() != a.nrows() {
+        return Err(SolverError::Analysis(format!(
+            "an ordering of {} rows for a matrix of {}",
+            forward.len(),
+            a.nrows()
+        )));
+    }
+    let mut inverse = vec![0; forward.len()];
+    for (i, &row) in forward.iter().enumerate() {
+        inverse[row] = i;
+    }
+    let ordering = SymmetricOrdering::Custom(PermRef::new_checked(forward, &inverse, a.nrows()));
     factorize_symbolic_cholesky(
         as_csc(a).symbolic(),
         Side::Lower,
@@ -201,7 +227,35 @@ impl SparseCholesky {
                 cols: a.ncols(),
             });
         }
-        let symbolic = analyze_symbolic(a, order)?;
+        SparseCholesky::with_symbolic(Arc::new(analyze_symbolic(a, order)?), a)
+    }
+
+    /// A factorization of `a` on an analysis already made of its pattern
+    /// (`symbolic`, from [`analyze_symbolic`] or another factorization's
+    /// [`SparseCholesky::symbolic`]): the matrices of one model share one
+    /// pattern, so one analysis serves them all. Values are not read.
+    ///
+    /// # Errors
+    /// [`SolverError::NotSquare`], or [`SolverError::Analysis`] where
+    /// `symbolic` is of another size or a layout [`Supernodal`] does not
+    /// know.
+    pub fn with_symbolic(
+        symbolic: Arc<SymbolicCholesky<usize>>,
+        a: &CsrMatrix<f64>,
+    ) -> Result<SparseCholesky, SolverError> {
+        if a.nrows() != a.ncols() {
+            return Err(SolverError::NotSquare {
+                rows: a.nrows(),
+                cols: a.ncols(),
+            });
+        }
+        if symbolic.nrows() != a.nrows() {
+            return Err(SolverError::Analysis(format!(
+                "an analysis of {} rows for a matrix of {}",
+                symbolic.nrows(),
+                a.nrows()
+            )));
+        }
         // Scratch for the kernels `factorize` will run: asking for the
         // pool's size below PARALLEL_MIN would start its threads for a
         // factor they never touch.
@@ -226,6 +280,12 @@ impl SparseCholesky {
             single: Vec::new(),
             single_scale: 1.0,
         })
+    }
+
+    /// The symbolic analysis this factorization runs on, for another
+    /// matrix of the same pattern ([`SparseCholesky::with_symbolic`]).
+    pub fn symbolic(&self) -> &Arc<SymbolicCholesky<usize>> {
+        &self.symbolic
     }
 
     /// Matrix size.
@@ -404,6 +464,77 @@ mod tests {
     /// The 5-point Laplacian of an n×n grid plus the identity.
     fn grid(n: usize) -> CsrMatrix<f64> {
         crate::refine::tests::grid(n, 1.0)
+    }
+
+    /// One analysis serves another matrix of the pattern (a run's K, M
+    /// and A₀): its factor has the bits of the matrix's own analysis, and
+    /// its solve is the closed form's.
+    #[test]
+    fn a_shared_analysis_factorizes_another_matrix_of_the_pattern() {
+        let (n, shift) = (20, 3.0);
+        let (k, m) = (grid(n), crate::refine::tests::grid(n, shift));
+        let mut own = SparseCholesky::analyze(&m, &FillOrder::amd()).unwrap();
+        own.factorize(&m).unwrap();
+        let first = SparseCholesky::analyze(&k, &FillOrder::amd()).unwrap();
+        let mut shared = SparseCholesky::with_symbolic(Arc::clone(first.symbolic()), &m).unwrap();
+        shared.factorize(&m).unwrap();
+        assert!(Arc::ptr_eq(first.symbolic(), shared.symbolic()));
+        let same = own
+            .l_values
+            .iter()
+            .zip(&shared.l_values)
+            .all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same, "the shared analysis's factor differs");
+        // The grid's lowest mode v: M v = λ v in closed form
+        // (`refine.rs`), so M⁻¹v = v/λ, to a few ulps of κ ≈ 3.
+        let (v, lambda) = crate::refine::tests::lowest_mode(n, shift);
+        let mut x = v.clone();
+        shared.solve_in_place(&mut x);
+        for (x, v) in x.iter().zip(&v) {
+            assert!(
+                (x - v / lambda).abs() <= 1e-14,
+                "{x} against {}",
+                v / lambda
+            );
+        }
+    }
+
+    /// Our AMD order is faer's (`SymmetricOrdering::Amd`), without its
+    /// copy of the pattern: the same permutation, the same factor.
+    #[test]
+    fn the_amd_order_is_faers() {
+        for a in [
+            grid(1),
+            grid(7),
+            grid(40),
+            crate::refine::tests::grid(25, 0.5),
+        ] {
+            let faers = factorize_symbolic_cholesky(
+                as_csc(&a).symbolic(),
+                Side::Lower,
+                SymmetricOrdering::Amd,
+                CholeskySymbolicParams {
+                    supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let ours = symbolic_in(&a, None).unwrap();
+            let (faers_fwd, _) = faers.perm().unwrap().arrays();
+            let (ours_fwd, _) = ours.perm().unwrap().arrays();
+            assert_eq!(faers_fwd, ours_fwd);
+            assert_eq!(faers.len_val(), ours.len_val());
+        }
+    }
+
+    #[test]
+    fn an_analysis_of_another_size_is_refused() {
+        let first = SparseCholesky::analyze(&grid(4), &FillOrder::amd()).unwrap();
+        let refused = SparseCholesky::with_symbolic(Arc::clone(first.symbolic()), &grid(5));
+        assert!(
+            matches!(refused, Err(SolverError::Analysis(_))),
+            "{refused:?}"
+        );
     }
 
     #[test]

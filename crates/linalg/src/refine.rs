@@ -194,7 +194,7 @@ pub(crate) mod tests {
     /// The grid's lowest mode, v_ij = sin(π(i+1)/(n+1)) sin(π(j+1)/(n+1)),
     /// and its eigenvalue shift + 8 sin²(π/(2(n+1))): A x = v is solved by
     /// v/λ.
-    fn lowest_mode(n: usize, shift: f64) -> (Vec<f64>, f64) {
+    pub(crate) fn lowest_mode(n: usize, shift: f64) -> (Vec<f64>, f64) {
         let h = std::f64::consts::PI / (n + 1) as f64;
         let s = |i: usize| (h * (i + 1) as f64).sin();
         let v = (0..n * n).map(|p| s(p / n) * s(p % n)).collect();

@@ -125,6 +125,7 @@ pub(crate) fn start(
                 modes: &rigid_modes,
                 times,
                 single_factor: true,
+                analysis: None,
             },
             contact,
             loads,

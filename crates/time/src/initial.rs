@@ -4,6 +4,9 @@
 //! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀ − C ṙ₀ (C the Rayleigh
 //! damping), again without friction.
 
+use std::sync::Arc;
+
+use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{RigidMode, SetupTimes};
@@ -49,6 +52,11 @@ impl Mass<'_> {
     }
 }
 
+/// K's symbolic analysis (its ordering and symbolic factor), which K, M
+/// and the implicit steps' A₀ = c_K K + c_M M share: they have one
+/// pattern (fem), so a run analyses it once.
+pub(crate) type Analysis = Option<Arc<SymbolicCholesky<usize>>>;
+
 /// How the initial state's static problems are solved: the ordering of
 /// their factors, the rigid motions the supports leave free (`modes`),
 /// and where the preload's times go.
@@ -61,6 +69,10 @@ pub(crate) struct Statics<'a> {
     /// from [`SINGLE_MIN`] free DOFs the factor is computed in single
     /// precision.
     pub single_factor: bool,
+    /// Where K's analysis is kept once made here (by the preload or the
+    /// consistent mass), for the step's operators (the implicit schemes);
+    /// `None` where nothing after the initial state factorizes.
+    pub analysis: Option<&'a mut Analysis>,
 }
 
 /// Free DOFs from which a preload whose factor serves it alone (the
@@ -128,6 +140,13 @@ fn factor_solve(
     Ok(())
 }
 
+/// Keeps `solver`'s analysis in `slot`, if the caller asked for it.
+fn keep(slot: &mut Option<&mut Analysis>, solver: &SparseCholesky) {
+    if let Some(slot) = slot.as_deref_mut() {
+        *slot = Some(Arc::clone(solver.symbolic()));
+    }
+}
+
 /// The state at t = 0 for a scheme with mass `mass`: Remark 4.1's r₀ (no
 /// factorization where nothing acts before t = 0, where the run starts at
 /// rest, or where the state will come from a checkpoint: r₀ = 0 then), ṙ₀, r̈₀, R(0), the contact
@@ -167,6 +186,7 @@ pub(crate) fn initial_state_analyzed(
         modes,
         times,
         single_factor,
+        mut analysis,
     } = statics;
     let n = k.nrows();
     let mut state = State::new(n, contact.map_or(0, |c| c.len()), settings.dt);
@@ -202,6 +222,7 @@ pub(crate) fn initial_state_analyzed(
                 Some(solver) => solver,
                 None => analyze(k, fill_order, times)?,
             };
+            keep(&mut analysis, &solver);
             let single = single_factor && n >= SINGLE_MIN;
             factor_solve(solver, k, &mut r, times, single)?;
         } else {
@@ -239,7 +260,14 @@ pub(crate) fn initial_state_analyzed(
             }
         }
         Mass::Consistent(m) => {
-            let mut solver = SparseCholesky::analyze(m, fill_order).map_err(TimeError::Static)?;
+            // M has K's pattern (fem): K's analysis, where made, is M's.
+            let shared = analysis.as_deref().and_then(Option::clone);
+            let mut solver = match shared {
+                Some(symbolic) => SparseCholesky::with_symbolic(symbolic, m),
+                None => SparseCholesky::analyze(m, fill_order),
+            }
+            .map_err(TimeError::Static)?;
+            keep(&mut analysis, &solver);
             solver.factorize(m).map_err(TimeError::Static)?;
             state.a.copy_from_slice(&rhs);
             solver.solve_in_place(&mut state.a);

@@ -90,7 +90,9 @@ pub(crate) fn start(
         )));
     }
     let n = k.nrows();
-    let friction = ImplicitFriction::new(&k, &fill_order, contact, settings)?;
+    // The preload's analysis of K is the increments' (Δt K has its
+    // pattern): one analysis for the run.
+    let mut analysis = None;
     let mut state = initial_state(
         &k,
         Mass::Massless,
@@ -99,11 +101,13 @@ pub(crate) fn start(
             modes: &rigid_modes,
             times,
             single_factor: false,
+            analysis: Some(&mut analysis),
         },
         contact,
         loads,
         settings,
     )?;
+    let friction = ImplicitFriction::new(&k, &fill_order, analysis, contact, settings)?;
     if !settings.restoring {
         // The previous increment's load is the one r₀ equilibrates: the
         // loads before t = 0, or none for a start at rest (r₀ = 0).

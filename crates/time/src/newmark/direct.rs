@@ -9,6 +9,8 @@ use stickslip_linalg::{FillOrder, SolverError, SparseCholesky};
 
 use stickslip_linalg::csr::index as csr_index;
 
+use crate::initial::Analysis;
+
 /// The implicit operator and its factorization for the current (Δt, stuck
 /// set); `factorizations` counts numeric factorizations over the run.
 pub(crate) struct DirectOperator {
@@ -29,13 +31,18 @@ pub(crate) struct DirectOperator {
 }
 
 impl DirectOperator {
-    /// Analyses the pattern of K (which M shares) once for the run.
+    /// Analyses the pattern of K (which M shares) once for the run, or
+    /// takes its `analysis`, made already.
     pub fn new(
         stiffness: &CsrMatrix<f64>,
         order: &FillOrder,
+        analysis: Analysis,
         contact: Option<&ContactSurface>,
     ) -> Result<DirectOperator, SolverError> {
-        let cholesky = SparseCholesky::analyze(stiffness, order)?;
+        let cholesky = match analysis {
+            Some(symbolic) => SparseCholesky::with_symbolic(symbolic, stiffness)?,
+            None => SparseCholesky::analyze(stiffness, order)?,
+        };
         let entries = contact
             .map(|s| {
                 s.nodes

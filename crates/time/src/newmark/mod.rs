@@ -20,7 +20,7 @@ use stickslip_linalg::{chunks, FillOrder};
 use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Mass, Statics};
+use crate::initial::{initial_state, Analysis, Mass, Statics};
 use crate::settings::{ImplicitSolver, MassKind, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
@@ -117,11 +117,14 @@ pub(crate) fn start(
         }
     };
     assert!(same_pattern(&k, &m), "K and M share one pattern (fem)");
-    let friction = ImplicitFriction::new(&k, &fill_order, contact, settings)?;
     let mass = match mass_kind {
         MassKind::Consistent => Mass::Consistent(&m),
         MassKind::Lumped => Mass::Lumped(&lumped_mass),
     };
+    // K's analysis, made by the preload or the consistent mass's
+    // factor, is A₀'s (K, M and A₀ share one pattern): one analysis for
+    // the run.
+    let mut analysis = None;
     let mut state = initial_state(
         &k,
         mass,
@@ -130,11 +133,13 @@ pub(crate) fn start(
             modes: &rigid_modes,
             times,
             single_factor: false,
+            analysis: Some(&mut analysis),
         },
         contact,
         loads,
         settings,
     )?;
+    let friction = ImplicitFriction::new(&k, &fill_order, analysis, contact, settings)?;
     // The energy-consistent normal force where the scheme is the
     // trapezoidal rule (METHOD.md §10): its excess starts at 0, r̈₀ being
     // the end-point force's.
@@ -165,13 +170,14 @@ pub(crate) fn start(
 
 impl ImplicitFriction {
     /// The settings' solver for K's pattern (which M shares), analysed
-    /// once for the run.
+    /// once for the run: `analysis` where the initial state made it.
     ///
     /// # Errors
     /// [`TimeError::Static`] when the analysis fails.
     pub(crate) fn new(
         k: &CsrMatrix<f64>,
         fill_order: &FillOrder,
+        analysis: Analysis,
         contact: Option<&ContactSurface>,
         settings: &Settings,
     ) -> Result<ImplicitFriction, TimeError> {
@@ -183,12 +189,12 @@ impl ImplicitFriction {
         let solver = match settings.implicit_solver {
             ImplicitSolver::Schur | ImplicitSolver::SchurPaths | ImplicitSolver::SchurReach => {
                 Solver::Schur(Box::new(
-                    SchurOperator::new(k, fill_order, contact, use_paths)
+                    SchurOperator::new(k, fill_order, analysis, contact, use_paths)
                         .map_err(TimeError::Static)?,
                 ))
             }
             ImplicitSolver::Direct => Solver::Direct(Box::new(
-                DirectOperator::new(k, fill_order, contact).map_err(TimeError::Static)?,
+                DirectOperator::new(k, fill_order, analysis, contact).map_err(TimeError::Static)?,
             )),
         };
         let n_c = contact.map_or(0, |c| c.len());

@@ -26,6 +26,8 @@
 //! those paths only, where W's 12 bytes a value are fewer than the reach's
 //! part of L (8 bytes a value); else solves restricted to the reach.
 
+use std::sync::Arc;
+
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{LltError, LltParams};
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
@@ -35,6 +37,8 @@ use stickslip_contact::{CompliantNode, ContactNode, ContactSurface, SlipState, S
 use stickslip_linalg::{
     analyze_symbolic, csc_view, FillOrder, PathOperator, SolverError, Supernodal,
 };
+
+use crate::initial::Analysis;
 
 /// How many Δt keep their factor (the normal and the reduced step).
 const CACHE: usize = 2;
@@ -92,7 +96,7 @@ struct DenseFactor {
 /// A₀'s factors per Δt and the Schur complement on the contact DOFs.
 pub(crate) struct SchurOperator {
     n: usize,
-    symbolic: SymbolicCholesky<usize>,
+    symbolic: Arc<SymbolicCholesky<usize>>,
     /// The solves on the factor's layout.
     sn: Supernodal,
     /// Permuted index of every DOF (for the contact DOFs' values).
@@ -123,10 +127,12 @@ pub(crate) struct SchurOperator {
 }
 
 impl SchurOperator {
-    /// Analyses K's pattern (which M shares) once for the run.
+    /// Analyses K's pattern (which M shares) once for the run, or takes
+    /// its `analysis`, made already.
     pub fn new(
         stiffness: &CsrMatrix<f64>,
         order: &FillOrder,
+        analysis: Analysis,
         contact: Option<&ContactSurface>,
         use_paths: Option<bool>,
     ) -> Result<SchurOperator, SolverError> {
@@ -137,7 +143,11 @@ impl SchurOperator {
                 cols: stiffness.ncols(),
             });
         }
-        let symbolic = analyze_symbolic(stiffness, order)?;
+        let symbolic = match analysis {
+            Some(symbolic) if symbolic.nrows() == n => symbolic,
+            Some(_) => return Err(SolverError::Analysis("an analysis of another size".into())),
+            None => Arc::new(analyze_symbolic(stiffness, order)?),
+        };
         let mut sn = Supernodal::new(&symbolic).ok_or_else(|| {
             SolverError::Analysis("faer returned a factor layout this solver does not know".into())
         })?;
