@@ -23,11 +23,11 @@ use crate::material::Material;
 const NO_POSITION: usize = usize::MAX;
 
 /// Bytes of element data per chunk of cells (≈ 6 KB a Q2 cell, 1.2 KB a
-/// Q1): few enough that the chunk's buffers stay in a core's cache from
-/// the kernels to the scatter, and are reused by the allocator rather
-/// than mapped afresh; enough cells (about 90 Q2, 440 Q1) to amortise
-/// the two parallel loops a chunk costs.
-const CHUNK_BYTES: usize = 1 << 19;
+/// Q1): a chunk costs two parallel loops, each a wait for every thread of
+/// the pool, which on a host shared with other work can be a time slice
+/// long; about 3,500 Q1 or 700 Q2 cells a chunk keep those waits fewer
+/// than the cells' work.
+const CHUNK_BYTES: usize = 1 << 22;
 
 /// Cells from which the element kernels run on rayon's pool: below, its
 /// threads' start (at the first parallel loop of a run) and their

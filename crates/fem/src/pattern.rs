@@ -14,9 +14,10 @@ use stickslip_mesh::Mesh;
 
 use crate::dofs::DofMap;
 
-/// Rows from which a pattern is built on rayon's pool: below, starting
-/// its threads costs more than the rows (the paper's slab has 85 nodes).
-const PARALLEL_ROWS: usize = 4096;
+/// Rows from which a pattern is built on rayon's pool: below, a few
+/// milliseconds of rows at most, the wake of the pool's threads (or their
+/// start, when this is the run's first parallel loop) costs about as much.
+const PARALLEL_ROWS: usize = 1 << 16;
 
 /// Rows per block built on one thread.
 const BLOCK: usize = 2048;
@@ -214,7 +215,6 @@ fn rows<T: Copy + Send + Sync>(
 mod tests {
     use super::*;
     use crate::dofs::Dirichlet;
-    use std::collections::BTreeSet;
     use stickslip_mesh::CellKind;
 
     /// The pattern built in blocks on several threads is the one of sets
@@ -223,9 +223,9 @@ mod tests {
     #[test]
     fn the_pattern_is_the_cells_couplings() {
         for (kind, refine, bent) in [
-            (CellKind::Quad4, 8, false),
-            (CellKind::Quad4, 8, true),
-            (CellKind::Quad9, 8, true),
+            (CellKind::Quad4, 32, false),
+            (CellKind::Quad4, 32, true),
+            (CellKind::Quad9, 24, true),
         ] {
             let mut mesh = stickslip_testkit::slab(kind, refine);
             if bent {
@@ -237,7 +237,7 @@ mod tests {
             ];
             let dofs = DofMap::new(&mesh, &conditions).expect("valid conditions");
             assert!(dofs.n_free() >= PARALLEL_ROWS);
-            let mut rows = vec![BTreeSet::new(); dofs.n_free()];
+            let mut rows = vec![Vec::new(); dofs.n_free()];
             for c in 0..mesh.n_cells() {
                 let free: Vec<usize> = mesh
                     .cell(c)
@@ -248,6 +248,10 @@ mod tests {
                 for &r in &free {
                     rows[r].extend(free.iter().copied());
                 }
+            }
+            for row in &mut rows {
+                row.sort_unstable();
+                row.dedup();
             }
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(3)
