@@ -27,6 +27,7 @@
 use stickslip_mesh::Mesh;
 
 use crate::error::FemError;
+use crate::pattern::{shared_adjacency, Adjacency, SharedAdjacency};
 
 /// Marks a fixed DOF in the full → free index table.
 const FIXED: usize = usize::MAX;
@@ -137,6 +138,16 @@ impl DofMap {
     /// Unknown group (the error lists the mesh's groups), a component other
     /// than 0/1, a non-finite value, or one DOF given two different values.
     pub fn new(mesh: &Mesh, conditions: &[Dirichlet]) -> Result<DofMap, FemError> {
+        DofMap::with_adjacency(mesh, conditions, &SharedAdjacency::new())
+    }
+
+    /// [`DofMap::new`], the bandwidth order taking the mesh's node
+    /// adjacency from `adjacency` (built there if it is not yet).
+    pub(crate) fn with_adjacency(
+        mesh: &Mesh,
+        conditions: &[Dirichlet],
+        adjacency: &SharedAdjacency,
+    ) -> Result<DofMap, FemError> {
         let n_nodes = mesh.nodes.len();
         let mut source: Vec<usize> = vec![usize::MAX; 2 * n_nodes];
         let mut prescribed = vec![0.0; 2 * n_nodes];
@@ -179,7 +190,10 @@ impl DofMap {
         } else if let Some(nodes) = grid_order(&mesh.nodes) {
             (NodeOrder::Grid, nodes)
         } else {
-            (NodeOrder::Bandwidth, bandwidth_order(mesh))
+            (
+                NodeOrder::Bandwidth,
+                bandwidth_order(shared_adjacency(mesh, adjacency)),
+            )
         };
         let (free_index, free_to_full) = number(&fixed, &nodes);
         let any_nonzero_prescribed = prescribed.iter().any(|&v| v != 0.0);
@@ -219,7 +233,7 @@ impl DofMap {
     pub fn renumbered(&self, mesh: &Mesh, order: NodeOrder) -> Option<DofMap> {
         let nodes = match order {
             NodeOrder::Grid => grid_order(&mesh.nodes)?,
-            NodeOrder::Bandwidth => bandwidth_order(mesh),
+            NodeOrder::Bandwidth => bandwidth_order(&crate::node_adjacency(mesh)),
             NodeOrder::Mesh => (0..self.n_nodes).collect(),
         };
         let fixed: Vec<bool> = self.free_index.iter().map(|&i| i == FIXED).collect();
@@ -430,9 +444,8 @@ fn grid_order(nodes: &[[f64; 2]]) -> Option<Vec<usize>> {
 /// breadth-first search whose last node starts the search that counts
 /// (a pseudo-peripheral start), neighbours visited by ascending degree
 /// (stable: then by index), the part's order reversed.
-fn bandwidth_order(mesh: &Mesh) -> Vec<usize> {
-    let (offsets, neighbours) = crate::assembly::node_adjacency(mesh);
-    let n = mesh.nodes.len();
+fn bandwidth_order((offsets, neighbours): &Adjacency) -> Vec<usize> {
+    let n = offsets.len() - 1;
     let degree = |v: usize| offsets[v + 1] - offsets[v];
     let bfs = |start: usize, seen: &mut [bool], out: &mut Vec<usize>| {
         let first = out.len();

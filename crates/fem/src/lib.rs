@@ -27,12 +27,12 @@ pub mod loads;
 pub mod material;
 pub mod model;
 pub mod ordering;
+mod pattern;
 pub mod quadrature;
 pub mod reference;
 mod setup_times;
 pub mod statics;
 
-pub use assembly::{free_dof_pattern, node_adjacency};
 pub use boundary::{boundary_quadrature, BoundaryNode};
 pub use dofs::{Dirichlet, DofMap, NodeOrder, RigidMode};
 pub use error::FemError;
@@ -41,6 +41,7 @@ pub use loads::{
 };
 pub use material::{Hypothesis, Material};
 pub use model::Model;
+pub use pattern::{free_dof_pattern, node_adjacency, Adjacency};
 pub use setup_times::SetupTimes;
 pub use statics::{
     gauss_point_stresses, nodal_stresses, static_solve, stress_at_node, von_mises, GaussPointStress,

@@ -5,10 +5,11 @@
 use nalgebra_sparse::CsrMatrix;
 use stickslip_mesh::Mesh;
 
-use crate::assembly::{assemble, free_dof_pattern, Assembly};
+use crate::assembly::{assemble, Assembly};
 use crate::dofs::{Dirichlet, DofMap};
 use crate::error::FemError;
 use crate::material::Material;
+use crate::pattern::{pattern_of, shared_adjacency, SharedAdjacency};
 use crate::setup_times::SetupTimes;
 use stickslip_linalg::FillOrder;
 
@@ -48,8 +49,12 @@ impl Model {
         conditions: &[Dirichlet],
     ) -> Result<Model, FemError> {
         let mut setup = SetupTimes::default();
-        let dofs = setup.time("DOF map", || DofMap::new(mesh, conditions))?;
-        Model::build(mesh, material, dofs, setup)
+        // The DOF map's bandwidth order and the pattern read one adjacency.
+        let adjacency = SharedAdjacency::new();
+        let dofs = setup.time("DOF map", || {
+            DofMap::with_adjacency(mesh, conditions, &adjacency)
+        })?;
+        Model::build(mesh, material, dofs, &adjacency, setup)
     }
 
     /// [`Model::new`] on a DOF map of `mesh` made already (e.g. one
@@ -58,7 +63,8 @@ impl Model {
     /// # Errors
     /// [`FemError::InvertedCell`].
     pub fn with_dofs(mesh: &Mesh, material: &Material, dofs: DofMap) -> Result<Model, FemError> {
-        Model::build(mesh, material, dofs, SetupTimes::default())
+        let adjacency = SharedAdjacency::new();
+        Model::build(mesh, material, dofs, &adjacency, SetupTimes::default())
     }
 
     /// [`Model::with_dofs`], its parts' times added to `setup`.
@@ -66,9 +72,12 @@ impl Model {
         mesh: &Mesh,
         material: &Material,
         dofs: DofMap,
+        adjacency: &SharedAdjacency,
         mut setup: SetupTimes,
     ) -> Result<Model, FemError> {
-        let pattern = setup.time("pattern", || free_dof_pattern(mesh, &dofs));
+        let pattern = setup.time("pattern", || {
+            pattern_of(shared_adjacency(mesh, adjacency), &dofs)
+        });
         let started = std::time::Instant::now();
         let nnz = pattern.nnz();
         let mut k = vec![0.0; nnz];

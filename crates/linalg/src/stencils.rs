@@ -25,6 +25,7 @@
 //! every node is its own stencil.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use nalgebra_sparse::CsrMatrix;
 
@@ -115,15 +116,11 @@ impl Stencils {
         let max = a.values().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let tol = tol * max;
         let grid = if tol > 0.0 { COARSE * tol } else { f64::NAN };
-        let mut index: HashMap<Vec<i64>, Vec<u32>> = HashMap::new();
+        let mut index: HashMap<Vec<i64>, Vec<u32>, Keys> = HashMap::default();
         let mut key: Vec<i64> = Vec::new();
         let (mut types, mut type_blocks) = (Vec::with_capacity(n / 2 + 1), vec![0u32]);
         let (mut offsets, mut values): (Vec<i32>, Vec<[f64; 4]>) = (Vec::new(), Vec::new());
-        let mut declined = false;
         let group_rows = row_groups(a, |r0, r1, cols, vals| {
-            if declined {
-                return;
-            }
             key.clear();
             key.extend([(r1 - r0) as i64, cols.len() as i64]);
             for (&c, v) in cols.iter().zip(vals) {
@@ -155,15 +152,14 @@ impl Stencils {
                     values.extend_from_slice(vals);
                     type_blocks.push(values.len() as u32);
                     index.entry(key.clone()).or_default().push(t);
-                    declined = values.len() > limit;
                     t
                 }
             };
             types.push(t);
-        });
-        if declined {
-            return None;
-        }
+            // Past the limit the types are declined: the rest of the rows
+            // are not grouped (on an unstructured mesh, most of them).
+            values.len() <= limit
+        })?;
         let chunk_groups = chunk_groups(&group_rows, n);
         types.shrink_to_fit();
         let mut k = Stencils {
@@ -187,7 +183,7 @@ impl Stencils {
     fn units(&self, width: usize) -> Units {
         let (n, h) = (self.n(), width / 2);
         let groups = self.types.len();
-        let mut index: HashMap<&[u32], u32> = HashMap::new();
+        let mut index: HashMap<&[u32], u32, Keys> = HashMap::default();
         let mut u = Units {
             width,
             of_group: vec![NO_UNIT; groups],
@@ -540,11 +536,11 @@ fn unit_sums<S: crate::simd::Simd, const Q: usize>(
 /// in ascending column order (a block's first column is the pair start of
 /// its columns: a single DOF is padded into the block before it, the
 /// padding +0; values by columns), and returns the groups' first rows,
-/// then n.
+/// then n; `None` as soon as `visit` returns false.
 fn row_groups(
     a: &CsrMatrix<f64>,
-    mut visit: impl FnMut(usize, usize, &[u32], &[[f64; 4]]),
-) -> Vec<u32> {
+    mut visit: impl FnMut(usize, usize, &[u32], &[[f64; 4]]) -> bool,
+) -> Option<Vec<u32>> {
     let n = a.nrows();
     let offsets = a.row_offsets();
     let cols = a.col_indices();
@@ -600,7 +596,53 @@ fn row_groups(
                 block_vals[next][2 * (c - s as usize) + k] = vals[p];
             }
         }
-        visit(r0, r1, &block_cols, &block_vals);
+        if !visit(r0, r1, &block_cols, &block_vals) {
+            return None;
+        }
     }
-    group_rows
+    Some(group_rows)
+}
+
+/// The hash of the types' and units' keys: a multiply-rotate over 8-byte
+/// words (as rustc's FxHash). SipHash, the standard map's, resists keys
+/// chosen to collide, which K's stencils are not, and was most of the
+/// time [`Stencils::new`] took on a structured mesh.
+#[derive(Default)]
+struct KeyHasher(u64);
+
+type Keys = BuildHasherDefault<KeyHasher>;
+
+impl KeyHasher {
+    #[inline]
+    fn add(&mut self, word: u64) {
+        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+impl Hasher for KeyHasher {
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        let mut words = bytes.chunks_exact(8);
+        for w in &mut words {
+            self.add(u64::from_le_bytes(w.try_into().expect("8 bytes")));
+        }
+        for &b in words.remainder() {
+            self.add(u64::from(b));
+        }
+    }
+
+    #[inline]
+    fn write_u64(&mut self, word: u64) {
+        self.add(word);
+    }
+
+    #[inline]
+    fn write_usize(&mut self, word: usize) {
+        self.add(word as u64);
+    }
+
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0
+    }
 }
