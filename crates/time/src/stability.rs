@@ -20,7 +20,8 @@ pub const RESIDUAL: f64 = 1e-3;
 /// eigenvector), so an eigenvalue of A lies within r of θ: the one θ
 /// approximates, λ_max, as the top Ritz value converges to it first
 /// (no reorthogonalization is needed for the extreme eigenvalue). The
-/// estimate is θ + r, once r ≤ [`RESIDUAL`]·θ or after `max_steps`:
+/// estimate is θ + r, once r ≤ [`RESIDUAL`]·θ or after `max_steps` (one
+/// at least, n at most):
 /// above λ_max, where a stop on θ's own stagnation gave a θ below it.
 pub fn largest_eigenvalue(
     stiffness: &CsrMatrix<f64>,
@@ -65,7 +66,8 @@ pub fn largest_eigenvalue_with(
     // β_{j−1} and β_{j−2}; the start vector is q_1 = w_0 (β_0 = 1).
     let (mut beta, mut beta_prev) = (1.0_f64, 1.0_f64);
     let mut floor = f64::NEG_INFINITY;
-    for step in 0..max_steps.min(n) {
+    let steps = max_steps.clamp(1, n);
+    for step in 0..steps {
         product(&x, &mut y);
         let [xy] = each_chunk_summed(&mut y, &mut partials, |c, y, p| {
             p[0] = dot(y, &x[c * CHUNK..c * CHUNK + y.len()]);
@@ -94,7 +96,7 @@ pub fn largest_eigenvalue_with(
         // err on the safe side.
         let top = tridiagonal_top(&alphas, &betas, floor, 1e-3 * RESIDUAL);
         let r = beta * last_component_squared(&alphas, &betas, top).sqrt();
-        if r <= RESIDUAL * top || beta == 0.0 || step + 1 == max_steps.min(n) {
+        if r <= RESIDUAL * top || beta == 0.0 || step + 1 == steps {
             return top + r;
         }
         floor = top * (1.0 - 1e-3 * RESIDUAL);
