@@ -29,11 +29,17 @@ fn central_difference_is_stable_below_and_unstable_above_the_estimate() {
                 );
             }
             // The map's requirement: the observed threshold within 2% of
-            // the Lanczos estimate of 2/ω_max.
+            // the Lanczos estimate of 2/ω_max; and not below it (to the
+            // bisection's width, 1e-3), the estimate bounding ω_max from
+            // above.
             let observed = threshold(&s, 0.9, 1.1, 1e-3, STABILITY_STEPS).unwrap();
             assert!(
                 (observed - 1.0).abs() < 0.02,
                 "{tag}: observed threshold {observed} × estimate"
+            );
+            assert!(
+                observed >= 1.0 - 1e-3,
+                "{tag}: observed threshold {observed} below the estimate"
             );
         }
     }
