@@ -102,6 +102,13 @@ pub(crate) fn start(
     // (a positive semi-definite term raises every eigenvalue), so that
     // bound holds whatever the contact does. Stiffer-with-depth nodes
     // (m_n > 1) are checked step by step (`contact_stable`).
+    // Gershgorin's bound on K's ω_max² caps the estimate and decides what
+    // no Δt can be refused for, made once by whichever asks first; a
+    // compliant foundation's springs are not in it, so there is none with
+    // them.
+    let springs = contact.is_some_and(ContactSurface::is_compliant);
+    let k_bound = std::sync::OnceLock::new();
+    let bound = || (!springs).then(|| *k_bound.get_or_init(|| gershgorin_bound(&k, &mass)));
     let critical = || {
         critical_step_with(
             |x, y| {
@@ -114,6 +121,7 @@ pub(crate) fn start(
                 }
             },
             &mass,
+            bound(),
         )
     };
     let initial = |times: &mut SetupTimes, analyzed| {
@@ -133,7 +141,7 @@ pub(crate) fn start(
             analyzed,
         )
     };
-    let beside = beside_the_preload(&k, &mass, (&rigid_modes, contact), loads, settings);
+    let beside = beside_the_preload(bound, mass.len(), &rigid_modes, loads, settings);
     let (dt_crit, state) = match beside {
         Beside::Nothing => {
             let dt_crit = times.time("critical step", critical);
@@ -558,12 +566,13 @@ enum Done {
 /// preload's analysis, or its whole initial state where no estimate can
 /// refuse the run's Δt (allowed above it, or within Gershgorin's bound on
 /// ω_max, [`gershgorin_bound`]), so that no factorization is spent on a
-/// run refused for its Δt. That bound is K's alone: with a compliant
-/// foundation, whose springs the estimate adds, any Δt may be refused.
+/// run refused for its Δt. That bound (`bound`) is K's alone: with a
+/// compliant foundation, whose springs the estimate adds, there is none
+/// and any Δt may be refused.
 fn beside_the_preload(
-    k: &nalgebra_sparse::CsrMatrix<f64>,
-    mass: &[f64],
-    (modes, contact): (&[stickslip_fem::RigidMode], Option<&ContactSurface>),
+    bound: impl FnOnce() -> Option<f64>,
+    n: usize,
+    modes: &[stickslip_fem::RigidMode],
     loads: &Loads,
     settings: &Settings,
 ) -> Beside {
@@ -572,15 +581,12 @@ fn beside_the_preload(
         && settings.initial_state != InitialState::Rest
         && modes.is_empty()
         && loads.before_start().iter().any(|&x| x != 0.0);
-    if !preload || mass.len() < BESIDE_MIN {
+    if !preload || n < BESIDE_MIN {
         return Beside::Nothing;
     }
-    let springs = contact.is_some_and(ContactSurface::is_compliant);
     let refusable = !settings.allow_unstable
-        && (springs || {
-            let bound = gershgorin_bound(k, mass);
-            !(bound > 0.0 && damped_critical_step(2.0 / bound.sqrt(), settings).is_ok())
-        });
+        && bound()
+            .is_none_or(|b| !(b > 0.0 && damped_critical_step(2.0 / b.sqrt(), settings).is_ok()));
     if refusable {
         Beside::Analysis
     } else {

@@ -12,17 +12,19 @@ use stickslip_linalg::csr::{dot, spmv};
 pub const RESIDUAL: f64 = 1e-3;
 
 /// Largest eigenvalue of M⁻¹K for a diagonal (lumped) mass, by Lanczos on
-/// the symmetric A = M^{-1/2} K M^{-1/2}, from above.
+/// the symmetric A = M^{-1/2} K M^{-1/2}.
 ///
 /// The top Ritz value θ of a Krylov space is a Rayleigh quotient of A, so
 /// θ ≤ λ_max; its Ritz vector's residual has the norm r = β_k |s_k| (β_k
 /// the last Lanczos coefficient, s_k the last component of T_k's top
-/// eigenvector), so an eigenvalue of A lies within r of θ: the one θ
-/// approximates, λ_max, as the top Ritz value converges to it first
-/// (no reorthogonalization is needed for the extreme eigenvalue). The
-/// estimate is θ + r, once r ≤ [`RESIDUAL`]·θ or after `max_steps` (one
-/// at least, n at most):
-/// above λ_max, where a stop on θ's own stagnation gave a θ below it.
+/// eigenvector), so some eigenvalue of A lies within r of θ. The estimate
+/// is θ + r, once r ≤ [`RESIDUAL`]·θ or after `max_steps` (one at least,
+/// n at most). It is above λ_max where that eigenvalue is λ_max, which is
+/// what the top Ritz value converges to first (no reorthogonalization is
+/// needed for the extreme eigenvalue) unless the start vector all but
+/// lacks λ_max's mode: the standard assumption, not a proof, and the
+/// stability map measures the margin (`cargo xtask stability`). A stop on
+/// θ's own stagnation gave a θ below λ_max.
 pub fn largest_eigenvalue(
     stiffness: &CsrMatrix<f64>,
     lumped_mass: &[f64],
@@ -157,24 +159,31 @@ fn tridiagonal_top(a: &[f64], b: &[f64], floor: f64, rel: f64) -> f64 {
 /// pivots of T − xI (d_i = a_i − x − b_{i−1}²/d_{i−1}). Above θ,
 /// −1/d_k'(x) grows with x (d_k' = −1 − b²Σ_j w_j/(x − μ_j)², μ_j the
 /// eigenvalues of T_{k−1}, all below x), so an x above θ overestimates.
+///
+/// A zero pivot, or one whose square leaves f64's range, gives 1, the
+/// largest s_k² can be (the safe side: r = β_k): the recurrence there
+/// would give 0 or NaN, a false stop.
 fn last_component_squared(a: &[f64], b: &[f64], x: f64) -> f64 {
     let (mut d, mut slope) = (a[0] - x, -1.0_f64);
     for i in 1..a.len() {
-        if d == 0.0 {
-            d = -1e-300;
-        }
         let b2 = b[i - 1] * b[i - 1];
         slope = -1.0 + b2 * slope / (d * d);
         d = a[i] - x - b2 / d;
     }
-    -1.0 / slope
+    let s2 = -1.0 / slope;
+    if s2.is_finite() && s2 > 0.0 {
+        s2.min(1.0)
+    } else {
+        1.0
+    }
 }
 
 /// An upper bound on ω_max², the largest eigenvalue of M⁻¹K for a
 /// diagonal (lumped) mass: Gershgorin's, the largest row sum of
-/// |M^{-1/2} K M^{-1/2}|, max_i Σ_j |K_ij| / √(m_i m_j). Safe but loose
-/// (above [`largest_eigenvalue`]'s estimate), for deciding what no Δt
-/// below 2/√bound can be refused for.
+/// |M^{-1/2} K M^{-1/2}|, max_i Σ_j |K_ij| / √(m_i m_j). Safe but loose,
+/// for deciding what no Δt below 2/√bound can be refused for; it also
+/// caps [`critical_step`]'s estimate, θ + r, which on a clustered top
+/// spectrum can pass it (θ ≤ λ_max ≤ the bound: the cap stays above θ).
 pub fn gershgorin_bound(stiffness: &CsrMatrix<f64>, lumped_mass: &[f64]) -> f64 {
     let scale: Vec<f64> = lumped_mass.iter().map(|m| 1.0 / m.sqrt()).collect();
     stiffness
@@ -192,14 +201,27 @@ pub fn gershgorin_bound(stiffness: &CsrMatrix<f64>, lumped_mass: &[f64]) -> f64 
         .fold(0.0, f64::max)
 }
 
-/// Δt_crit = 2/ω_max for central difference with the lumped mass.
+/// Δt_crit = 2/ω_max for central difference with the lumped mass, from
+/// [`largest_eigenvalue`]'s estimate capped by [`gershgorin_bound`].
 pub fn critical_step(stiffness: &CsrMatrix<f64>, lumped_mass: &[f64]) -> f64 {
-    critical_step_with(|x, y| spmv(stiffness, x, y), lumped_mass)
+    critical_step_with(
+        |x, y| spmv(stiffness, x, y),
+        lumped_mass,
+        Some(gershgorin_bound(stiffness, lumped_mass)),
+    )
 }
 
-/// [`critical_step`] with y = K x formed by `product`.
-pub fn critical_step_with(product: impl FnMut(&[f64], &mut [f64]), lumped_mass: &[f64]) -> f64 {
-    let lambda = largest_eigenvalue_with(product, lumped_mass, 300);
+/// [`critical_step`] with y = K x formed by `product`, its estimate of
+/// ω_max² capped by `bound` where one is known (a safe upper bound of that
+/// product's M⁻¹K: [`gershgorin_bound`]), so that no Δt below 2/√bound
+/// is ever above the critical step.
+pub fn critical_step_with(
+    product: impl FnMut(&[f64], &mut [f64]),
+    lumped_mass: &[f64],
+    bound: Option<f64>,
+) -> f64 {
+    let estimate = largest_eigenvalue_with(product, lumped_mass, 300);
+    let lambda = bound.map_or(estimate, |b| estimate.min(b));
     if lambda > 0.0 {
         2.0 / lambda.sqrt()
     } else {
@@ -245,7 +267,7 @@ mod tests {
     fn spring_chain_eigenvalue_is_bounded_from_above() {
         // The upper spectrum is clustered (relative gap 2.5e-4), where the
         // Ritz value converges slowly from below; the estimate θ + r is
-        // above λ_max and within RESIDUAL of θ ≤ λ_max.
+        // above λ_max (θ has found it) and within RESIDUAL of θ ≤ λ_max.
         let n = 400;
         let k = chain(n, true);
         let m = vec![1.0; n];
@@ -256,11 +278,27 @@ mod tests {
             lambda <= exact * (1.0 + RESIDUAL),
             "λ = {lambda}, closed form {exact}"
         );
+        // Here θ + r passes Gershgorin's bound, 4: the critical step is
+        // the bound's, which no stable Δt is above.
+        let bound = gershgorin_bound(&k, &m);
+        assert!(lambda > bound, "{lambda} ≤ {bound}: the cap is not tested");
+        assert_eq!(critical_step(&k, &m), 2.0 / bound.sqrt());
+        assert!(critical_step(&k, &m) <= 2.0 / exact.sqrt());
         // Masses of 4 halve ω: Δt_crit doubles (the scaling by 1/2 is
         // exact in floating point, so every Lanczos step scales alike).
         let m4 = vec![4.0; n];
         let ratio = critical_step(&k, &m4) / critical_step(&k, &m);
         assert!((ratio - 2.0).abs() < 1e-12, "ratio {ratio}");
+    }
+
+    #[test]
+    fn a_zero_pivot_gives_the_largest_last_component() {
+        // T = [[2, 1], [1, 2]] at x = 2: the first pivot is 0, where the
+        // recurrence's s² would be 0 (a false stop) or NaN.
+        assert_eq!(last_component_squared(&[2.0, 2.0], &[1.0], 2.0), 1.0);
+        // A pivot whose square underflows, likewise.
+        let s2 = last_component_squared(&[1e-170, 2.0, 2.0], &[1.0, 1.0], 0.0);
+        assert_eq!(s2, 1.0);
     }
 
     #[test]

@@ -78,9 +78,10 @@ fn the_critical_step_beside_the_preload_has_the_sequential_bits() {
         .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
     assert!(apart <= 1e-9 * norm, "{apart:e} of {norm:e}");
 
-    // Gershgorin's bound is above the estimate (both above ω_max², the
-    // estimate by at most stability::RESIDUAL), so its Δt is below the
-    // critical step: this one can be refused.
+    // Gershgorin's bound is above the estimate (both at or above ω_max²
+    // here, the estimate by at most stability::RESIDUAL, and the critical
+    // step caps it by the bound), so its Δt is below the critical step:
+    // this one can be refused.
     let bound = gershgorin_bound(k, m);
     let lambda = largest_eigenvalue(k, m, 300);
     assert!(bound >= lambda, "{bound} < {lambda}");
