@@ -72,12 +72,10 @@ pub enum SolverError {
 /// keeps them), with the symbolic analysis kept for refactorization.
 pub struct SparseCholesky {
     /// Shared with the other factorizations of the pattern (a run's
-    /// preload, A₀ and M: [`SparseCholesky::symbolic`]).
-    symbolic: Arc<SymbolicCholesky<usize>>,
+    /// preload, A₀ and M: [`SparseCholesky::analysis`]).
+    analysis: Analysis,
     l_values: Vec<f64>,
     factorized: bool,
-    n: usize,
-    nnz: usize,
     factor_scratch: MemBuffer,
     solver: RefCell<Supernodal>,
     /// The factor in single precision ([`SparseCholesky::factorize_single`]),
@@ -89,8 +87,8 @@ pub struct SparseCholesky {
 impl std::fmt::Debug for SparseCholesky {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SparseCholesky")
-            .field("n", &self.n)
-            .field("nnz", &self.nnz)
+            .field("n", &self.analysis.n)
+            .field("nnz", &self.analysis.nnz)
             .field("factor_nnz", &self.l_values.len())
             .field("factorized", &self.factorized)
             .field("single", &!self.single.is_empty())
@@ -214,6 +212,79 @@ fn symbolic_in(
     .map_err(|e| SolverError::Analysis(format!("{e:?}")))
 }
 
+/// The symbolic analysis of one sparsity pattern (its ordering and
+/// symbolic factor), shared by the factorizations of the matrices that
+/// have it (a run's K, M and A₀): cloning it shares, not copies.
+#[derive(Clone, Debug)]
+pub struct Analysis {
+    symbolic: Arc<SymbolicCholesky<usize>>,
+    /// The analysed matrix's size and number of stored values, which a
+    /// matrix given later must have (its pattern itself is not kept: at
+    /// 500k DOFs it is 9M indices).
+    n: usize,
+    nnz: usize,
+}
+
+impl Analysis {
+    /// The analysis of `a`'s pattern in `order` ([`analyze_symbolic`]).
+    ///
+    /// # Errors
+    /// [`SolverError::NotSquare`], or [`SolverError::Analysis`] if faer
+    /// fails.
+    pub fn of(a: &CsrMatrix<f64>, order: &FillOrder) -> Result<Analysis, SolverError> {
+        if a.nrows() != a.ncols() {
+            return Err(SolverError::NotSquare {
+                rows: a.nrows(),
+                cols: a.ncols(),
+            });
+        }
+        Ok(Analysis {
+            symbolic: Arc::new(analyze_symbolic(a, order)?),
+            n: a.nrows(),
+            nnz: a.nnz(),
+        })
+    }
+
+    /// `shared` where it is given (made of `a`'s pattern already, by
+    /// another matrix of the model), else the analysis of `a` in `order`.
+    ///
+    /// # Errors
+    /// As [`Analysis::of`]; [`SolverError::PatternChanged`] where `shared`
+    /// is of another size or number of values than `a`.
+    pub fn shared_or_of(
+        shared: Option<Analysis>,
+        a: &CsrMatrix<f64>,
+        order: &FillOrder,
+    ) -> Result<Analysis, SolverError> {
+        match shared {
+            Some(analysis) => analysis.check(a).map(|()| analysis),
+            None => Analysis::of(a, order),
+        }
+    }
+
+    /// faer's symbolic factor.
+    pub fn symbolic(&self) -> &SymbolicCholesky<usize> {
+        &self.symbolic
+    }
+
+    /// Whether `other` is this very analysis (shared, not recomputed).
+    pub fn is(&self, other: &Analysis) -> bool {
+        Arc::ptr_eq(&self.symbolic, &other.symbolic)
+    }
+
+    /// `a` has the analysed size and number of values (the same check as
+    /// a refactorization's: comparing the patterns would read them).
+    fn check(&self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
+        if a.nrows() != self.n || a.ncols() != self.n || a.nnz() != self.nnz {
+            return Err(SolverError::PatternChanged {
+                analysed: self.nnz,
+                given: a.nnz(),
+            });
+        }
+        Ok(())
+    }
+}
+
 impl SparseCholesky {
     /// The symbolic factor of `a`'s pattern in `order` (AMD or a given
     /// permutation: [`FillOrder`]). Values are not read.
@@ -221,41 +292,18 @@ impl SparseCholesky {
     /// # Errors
     /// [`SolverError::NotSquare`], or [`SolverError::Analysis`] if faer fails.
     pub fn analyze(a: &CsrMatrix<f64>, order: &FillOrder) -> Result<SparseCholesky, SolverError> {
-        if a.nrows() != a.ncols() {
-            return Err(SolverError::NotSquare {
-                rows: a.nrows(),
-                cols: a.ncols(),
-            });
-        }
-        SparseCholesky::with_symbolic(Arc::new(analyze_symbolic(a, order)?), a)
+        SparseCholesky::on(Analysis::of(a, order)?)
     }
 
-    /// A factorization of `a` on an analysis already made of its pattern
-    /// (`symbolic`, from [`analyze_symbolic`] or another factorization's
-    /// [`SparseCholesky::symbolic`]): the matrices of one model share one
-    /// pattern, so one analysis serves them all. Values are not read.
+    /// A factorization on `analysis`, made already of the pattern of the
+    /// matrices it will factorize (by [`Analysis::of`], or another
+    /// factorization's [`SparseCholesky::analysis`]): the matrices of one
+    /// model share one pattern, so one analysis serves them all.
     ///
     /// # Errors
-    /// [`SolverError::NotSquare`], or [`SolverError::Analysis`] where
-    /// `symbolic` is of another size or a layout [`Supernodal`] does not
-    /// know.
-    pub fn with_symbolic(
-        symbolic: Arc<SymbolicCholesky<usize>>,
-        a: &CsrMatrix<f64>,
-    ) -> Result<SparseCholesky, SolverError> {
-        if a.nrows() != a.ncols() {
-            return Err(SolverError::NotSquare {
-                rows: a.nrows(),
-                cols: a.ncols(),
-            });
-        }
-        if symbolic.nrows() != a.nrows() {
-            return Err(SolverError::Analysis(format!(
-                "an analysis of {} rows for a matrix of {}",
-                symbolic.nrows(),
-                a.nrows()
-            )));
-        }
+    /// [`SolverError::Analysis`] for a layout [`Supernodal`] does not know.
+    pub fn on(analysis: Analysis) -> Result<SparseCholesky, SolverError> {
+        let symbolic = &analysis.symbolic;
         // Scratch for the kernels `factorize` will run: asking for the
         // pool's size below PARALLEL_MIN would start its threads for a
         // factor they never touch.
@@ -266,15 +314,13 @@ impl SparseCholesky {
         };
         let factor_scratch =
             MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
-        let solver = RefCell::new(Supernodal::new(&symbolic).ok_or_else(|| {
+        let solver = RefCell::new(Supernodal::new(symbolic).ok_or_else(|| {
             SolverError::Analysis("faer returned a factor layout this solver does not know".into())
         })?);
         Ok(SparseCholesky {
             l_values: vec![0.0; symbolic.len_val()],
-            symbolic,
+            analysis,
             factorized: false,
-            n: a.nrows(),
-            nnz: a.nnz(),
             factor_scratch,
             solver,
             single: Vec::new(),
@@ -282,15 +328,15 @@ impl SparseCholesky {
         })
     }
 
-    /// The symbolic analysis this factorization runs on, for another
-    /// matrix of the same pattern ([`SparseCholesky::with_symbolic`]).
-    pub fn symbolic(&self) -> &Arc<SymbolicCholesky<usize>> {
-        &self.symbolic
+    /// The analysis this factorization runs on, for another matrix of the
+    /// same pattern ([`SparseCholesky::on`]).
+    pub fn analysis(&self) -> &Analysis {
+        &self.analysis
     }
 
     /// Matrix size.
     pub fn n(&self) -> usize {
-        self.n
+        self.analysis.n
     }
 
     /// Number of stored values of the factor L (fill included).
@@ -323,10 +369,10 @@ impl SparseCholesky {
     /// `par`: they split their products by blocks of the result, never
     /// a sum, so the factor's bits do not depend on it (tested).
     fn factorize_in(&mut self, a: &CsrMatrix<f64>, par: Par) -> Result<(), SolverError> {
-        self.check_pattern(a)?;
+        self.analysis.check(a)?;
         self.factorized = false;
         self.single = Vec::new();
-        let result = self.symbolic.factorize_numeric_llt(
+        let result = self.analysis.symbolic.factorize_numeric_llt(
             &mut self.l_values,
             as_csc(a),
             Side::Lower,
@@ -342,19 +388,9 @@ impl SparseCholesky {
             }
             Err(LltError::NonPositivePivot { index }) => Err(SolverError::NotPositiveDefinite {
                 pivot: index,
-                n: self.n,
+                n: self.n(),
             }),
         }
-    }
-
-    fn check_pattern(&self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
-        if a.nrows() != self.n || a.nnz() != self.nnz {
-            return Err(SolverError::PatternChanged {
-                analysed: self.nnz,
-                given: a.nnz(),
-            });
-        }
-        Ok(())
     }
 
     /// Numeric factorization of `a` in single precision, on the analysed
@@ -377,13 +413,13 @@ impl SparseCholesky {
     }
 
     fn factorize_single_in(&mut self, a: &CsrMatrix<f64>, par: Par) -> Result<(), SolverError> {
-        self.check_pattern(a)?;
+        self.analysis.check(a)?;
         self.single.clear();
         let largest = a.values().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         if !(largest.is_finite() && largest > 0.0) {
             return Err(SolverError::NotPositiveDefinite {
                 pivot: 0,
-                n: self.n,
+                n: self.n(),
             });
         }
         // A power of two: the scaling itself rounds nothing.
@@ -396,12 +432,13 @@ impl SparseCholesky {
             None,
             a.col_indices(),
         );
-        let mut l = vec![0.0_f32; self.symbolic.len_val()];
+        let mut l = vec![0.0_f32; self.analysis.symbolic.len_val()];
         let mut scratch = MemBuffer::new(
-            self.symbolic
+            self.analysis
+                .symbolic
                 .factorize_numeric_llt_scratch::<f32>(par, Default::default()),
         );
-        let result = self.symbolic.factorize_numeric_llt(
+        let result = self.analysis.symbolic.factorize_numeric_llt(
             &mut l,
             SparseColMatRef::new(sym, &values),
             Side::Lower,
@@ -418,7 +455,7 @@ impl SparseCholesky {
             }
             Err(LltError::NonPositivePivot { index }) => Err(SolverError::NotPositiveDefinite {
                 pivot: index,
-                n: self.n,
+                n: self.n(),
             }),
         }
     }
@@ -432,10 +469,10 @@ impl SparseCholesky {
     /// `x.len() != n`.
     pub(crate) fn solve_single_in_place(&self, x: &mut [f64]) {
         assert!(
-            !self.single.is_empty() || self.n == 0,
+            !self.single.is_empty() || self.n() == 0,
             "SparseCholesky::solve_single_in_place before factorize_single"
         );
-        assert_eq!(x.len(), self.n, "right-hand side length");
+        assert_eq!(x.len(), self.n(), "right-hand side length");
         self.solver.borrow_mut().solve(&self.single, x);
         for v in x.iter_mut() {
             *v *= self.single_scale;
@@ -452,7 +489,7 @@ impl SparseCholesky {
             self.factorized,
             "SparseCholesky::solve_in_place before factorize"
         );
-        assert_eq!(x.len(), self.n, "right-hand side length");
+        assert_eq!(x.len(), self.n(), "right-hand side length");
         self.solver.borrow_mut().solve(&self.l_values, x);
     }
 }
@@ -476,9 +513,11 @@ mod tests {
         let mut own = SparseCholesky::analyze(&m, &FillOrder::amd()).unwrap();
         own.factorize(&m).unwrap();
         let first = SparseCholesky::analyze(&k, &FillOrder::amd()).unwrap();
-        let mut shared = SparseCholesky::with_symbolic(Arc::clone(first.symbolic()), &m).unwrap();
+        let analysis =
+            Analysis::shared_or_of(Some(first.analysis().clone()), &m, &FillOrder::amd());
+        let mut shared = SparseCholesky::on(analysis.unwrap()).unwrap();
         shared.factorize(&m).unwrap();
-        assert!(Arc::ptr_eq(first.symbolic(), shared.symbolic()));
+        assert!(first.analysis().is(shared.analysis()));
         let same = own
             .l_values
             .iter()
@@ -528,12 +567,28 @@ mod tests {
     }
 
     #[test]
-    fn an_analysis_of_another_size_is_refused() {
+    fn an_analysis_of_another_pattern_is_refused() {
         let first = SparseCholesky::analyze(&grid(4), &FillOrder::amd()).unwrap();
-        let refused = SparseCholesky::with_symbolic(Arc::clone(first.symbolic()), &grid(5));
+        let shared = || Some(first.analysis().clone());
+        let larger = Analysis::shared_or_of(shared(), &grid(5), &FillOrder::amd());
         assert!(
-            matches!(refused, Err(SolverError::Analysis(_))),
-            "{refused:?}"
+            matches!(larger, Err(SolverError::PatternChanged { .. })),
+            "{:?}",
+            larger.err()
+        );
+        // Of the size, with another number of values (one coupling less).
+        let mut coo = nalgebra_sparse::CooMatrix::new(16, 16);
+        for (i, j, &v) in nalgebra_sparse::CooMatrix::from(&grid(4)).triplet_iter() {
+            if i.min(j) != 0 || i.max(j) != 1 {
+                coo.push(i, j, v);
+            }
+        }
+        let fewer = CsrMatrix::from(&coo);
+        let other = Analysis::shared_or_of(shared(), &fewer, &FillOrder::amd());
+        assert!(
+            matches!(other, Err(SolverError::PatternChanged { .. })),
+            "{:?}",
+            other.err()
         );
     }
 

@@ -23,7 +23,7 @@ mod stencils;
 mod supernodal;
 mod symmetric;
 
-pub use cholesky::{analyze_symbolic, csc_view, SolverError, SparseCholesky};
+pub use cholesky::{analyze_symbolic, csc_view, Analysis, SolverError, SparseCholesky};
 pub use fill_order::{FillOrder, AMD_MARGIN};
 pub use product::{Formed, Product};
 pub use refine::{backward_error, Refined, BACKWARD_ERROR, MAX_ITERATIONS};

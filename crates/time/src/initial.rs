@@ -4,9 +4,6 @@
 //! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀ − C ṙ₀ (C the Rayleigh
 //! damping), again without friction.
 
-use std::sync::Arc;
-
-use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{RigidMode, SetupTimes};
@@ -55,7 +52,7 @@ impl Mass<'_> {
 /// K's symbolic analysis (its ordering and symbolic factor), which K, M
 /// and the implicit steps' A₀ = c_K K + c_M M share: they have one
 /// pattern (fem), so a run analyses it once.
-pub(crate) type Analysis = Option<Arc<SymbolicCholesky<usize>>>;
+pub(crate) type Analysis = Option<stickslip_linalg::Analysis>;
 
 /// How the initial state's static problems are solved: the ordering of
 /// their factors, the rigid motions the supports leave free (`modes`),
@@ -143,7 +140,7 @@ fn factor_solve(
 /// Keeps `solver`'s analysis in `slot`, if the caller asked for it.
 fn keep(slot: &mut Option<&mut Analysis>, solver: &SparseCholesky) {
     if let Some(slot) = slot.as_deref_mut() {
-        *slot = Some(Arc::clone(solver.symbolic()));
+        *slot = Some(solver.analysis().clone());
     }
 }
 
@@ -262,11 +259,9 @@ pub(crate) fn initial_state_analyzed(
         Mass::Consistent(m) => {
             // M has K's pattern (fem): K's analysis, where made, is M's.
             let shared = analysis.as_deref().and_then(Option::clone);
-            let mut solver = match shared {
-                Some(symbolic) => SparseCholesky::with_symbolic(symbolic, m),
-                None => SparseCholesky::analyze(m, fill_order),
-            }
-            .map_err(TimeError::Static)?;
+            let mut solver = stickslip_linalg::Analysis::shared_or_of(shared, m, fill_order)
+                .and_then(SparseCholesky::on)
+                .map_err(TimeError::Static)?;
             keep(&mut analysis, &solver);
             solver.factorize(m).map_err(TimeError::Static)?;
             state.a.copy_from_slice(&rhs);

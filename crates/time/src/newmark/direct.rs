@@ -39,10 +39,9 @@ impl DirectOperator {
         analysis: Analysis,
         contact: Option<&ContactSurface>,
     ) -> Result<DirectOperator, SolverError> {
-        let cholesky = match analysis {
-            Some(symbolic) => SparseCholesky::with_symbolic(symbolic, stiffness)?,
-            None => SparseCholesky::analyze(stiffness, order)?,
-        };
+        let cholesky = SparseCholesky::on(stickslip_linalg::Analysis::shared_or_of(
+            analysis, stiffness, order,
+        )?)?;
         let entries = contact
             .map(|s| {
                 s.nodes

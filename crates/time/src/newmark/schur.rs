@@ -26,17 +26,12 @@
 //! those paths only, where W's 12 bytes a value are fewer than the reach's
 //! part of L (8 bytes a value); else solves restricted to the reach.
 
-use std::sync::Arc;
-
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{LltError, LltParams};
-use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::{MatMut, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{CompliantNode, ContactNode, ContactSurface, SlipState, StepSystem};
-use stickslip_linalg::{
-    analyze_symbolic, csc_view, FillOrder, PathOperator, SolverError, Supernodal,
-};
+use stickslip_linalg::{csc_view, FillOrder, PathOperator, SolverError, Supernodal};
 
 use crate::initial::Analysis;
 
@@ -96,7 +91,7 @@ struct DenseFactor {
 /// A₀'s factors per Δt and the Schur complement on the contact DOFs.
 pub(crate) struct SchurOperator {
     n: usize,
-    symbolic: Arc<SymbolicCholesky<usize>>,
+    analysis: stickslip_linalg::Analysis,
     /// The solves on the factor's layout.
     sn: Supernodal,
     /// Permuted index of every DOF (for the contact DOFs' values).
@@ -143,12 +138,8 @@ impl SchurOperator {
                 cols: stiffness.ncols(),
             });
         }
-        let symbolic = match analysis {
-            Some(symbolic) if symbolic.nrows() == n => symbolic,
-            Some(_) => return Err(SolverError::Analysis("an analysis of another size".into())),
-            None => Arc::new(analyze_symbolic(stiffness, order)?),
-        };
-        let mut sn = Supernodal::new(&symbolic).ok_or_else(|| {
+        let analysis = stickslip_linalg::Analysis::shared_or_of(analysis, stiffness, order)?;
+        let mut sn = Supernodal::new(analysis.symbolic()).ok_or_else(|| {
             SolverError::Analysis("faer returned a factor layout this solver does not know".into())
         })?;
         let perm = sn.permuted_indices();
@@ -185,7 +176,7 @@ impl SchurOperator {
         };
         Ok(SchurOperator {
             n,
-            symbolic,
+            analysis,
             sn,
             perm,
             correction: Vec::with_capacity(contact_dofs.len()),
@@ -206,7 +197,7 @@ impl SchurOperator {
 
     /// Values of L held per Δt.
     pub fn factor_len(&self) -> usize {
-        self.symbolic.len_val()
+        self.analysis.symbolic().len_val()
     }
 
     /// (values of W the current Δt's step uses, 0 if it goes otherwise;
@@ -247,13 +238,14 @@ impl SchurOperator {
             .map(|(k, m)| c_k * k + c_m * m)
             .collect();
         let mut factor_scratch = MemBuffer::new(
-            self.symbolic
+            self.analysis
+                .symbolic()
                 .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
         );
         let slot = self.free_slot(bits);
         let entry = &mut self.entries[slot];
         entry.dt_bits = u64::MAX; // invalid until factorized
-        let result = self.symbolic.factorize_numeric_llt(
+        let result = self.analysis.symbolic().factorize_numeric_llt(
             &mut entry.l_values,
             csc_view(stiffness, &a0),
             Side::Lower,
@@ -297,7 +289,7 @@ impl SchurOperator {
         if self.entries.len() < CACHE {
             self.entries.push(Entry {
                 dt_bits: bits,
-                l_values: vec![0.0; self.symbolic.len_val()],
+                l_values: vec![0.0; self.analysis.symbolic().len_val()],
                 s: Vec::new(),
                 paths: None,
                 id: 0,
