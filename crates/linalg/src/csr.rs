@@ -6,25 +6,11 @@ use nalgebra_sparse::CsrMatrix;
 use crate::chunks::{each_chunk, each_chunk_of, sum_chunks, CHUNK};
 
 /// Σ_k vals[k]·x[cols[k]] over one row, in four interleaved partial sums
-/// (one chain of additions waits on the adder's latency).
+/// (one chain of additions waits on the adder's latency): [`row_dots`]
+/// for one pair.
 #[inline(always)]
 pub(crate) fn row_dot(vals: &[f64], cols: &[usize], x: &[f64]) -> f64 {
-    let split = vals.len() - vals.len() % 4;
-    let mut acc = [0.0; 4];
-    for (v, c) in vals[..split]
-        .chunks_exact(4)
-        .zip(cols[..split].chunks_exact(4))
-    {
-        acc[0] += v[0] * x[c[0]];
-        acc[1] += v[1] * x[c[1]];
-        acc[2] += v[2] * x[c[2]];
-        acc[3] += v[3] * x[c[3]];
-    }
-    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for (v, &c) in vals[split..].iter().zip(&cols[split..]) {
-        s += v * x[c];
-    }
-    s
+    row_dots([vals], [x], cols)[0]
 }
 
 /// Row i of A times x, in `row_dot`'s four interleaved partial sums: the
@@ -69,9 +55,10 @@ fn row_dot2(a: &[f64], x: &[f64], b: &[f64], y: &[f64], cols: &[usize]) -> (f64,
 }
 
 /// Row sums Σ_k vals[v][k]·x[v][cols[k]] for V (values, vector) pairs on
-/// one pattern in one loop over it, each with [`row_dot`]'s four
-/// interleaved partial sums and so its bits: the row's indices are read
-/// once for all V.
+/// one pattern in one loop over it, each in four interleaved partial sums
+/// (lane l takes the terms k ≡ l mod 4, the lanes added pairwise, then the
+/// row's last len mod 4 terms in order): the row's indices are read once
+/// for all V.
 #[inline(always)]
 fn row_dots<const V: usize>(vals: [&[f64]; V], x: [&[f64]; V], cols: &[usize]) -> [f64; V] {
     let len = cols.len();
