@@ -229,25 +229,23 @@ pub fn assemble(
             cell_positions(cell, free_index, row_offsets, cols, positions);
         };
         // Each cell's kernels write its own slots only: the same bits on
-        // the pool or not.
+        // the pool or not (one chain, by rayon's or std's chunks).
+        macro_rules! each_cell {
+            ($chunks:ident, $iter:ident) => {
+                work.ke[..count * nd * nd]
+                    .$chunks(nd * nd)
+                    .zip(work.me[..count * n * n].$chunks(n * n))
+                    .zip(work.lumped[..count * n].$chunks(n))
+                    .zip(work.positions[..count * nd * nd].$chunks(nd * nd))
+                    .zip(work.areas[..count].$iter())
+                    .enumerate()
+                    .for_each(kernels)
+            };
+        }
         if parallel {
-            work.ke[..count * nd * nd]
-                .par_chunks_mut(nd * nd)
-                .zip(work.me[..count * n * n].par_chunks_mut(n * n))
-                .zip(work.lumped[..count * n].par_chunks_mut(n))
-                .zip(work.positions[..count * nd * nd].par_chunks_mut(nd * nd))
-                .zip(work.areas[..count].par_iter_mut())
-                .enumerate()
-                .for_each(kernels);
+            each_cell!(par_chunks_mut, par_iter_mut);
         } else {
-            work.ke[..count * nd * nd]
-                .chunks_mut(nd * nd)
-                .zip(work.me[..count * n * n].chunks_mut(n * n))
-                .zip(work.lumped[..count * n].chunks_mut(n))
-                .zip(work.positions[..count * nd * nd].chunks_mut(nd * nd))
-                .zip(work.areas[..count].iter_mut())
-                .enumerate()
-                .for_each(kernels);
+            each_cell!(chunks_mut, iter_mut);
         }
         for (i, a) in work.areas[..count].iter().enumerate() {
             match *a {

@@ -177,37 +177,38 @@ fn rows<T: Copy + Send + Sync>(
     n: usize,
     block: impl Fn(std::ops::Range<usize>, &mut Vec<usize>, &mut Vec<T>) + Sync,
 ) -> (Vec<usize>, Vec<T>) {
+    let one = |range: std::ops::Range<usize>| {
+        let (mut lengths, mut entries) = (Vec::with_capacity(range.len()), Vec::new());
+        block(range, &mut lengths, &mut entries);
+        (lengths, entries)
+    };
+    let mut blocks: Vec<(Vec<usize>, Vec<T>)> = if n < PARALLEL_ROWS {
+        vec![one(0..n)]
+    } else {
+        (0..n.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|b| one(b * BLOCK..((b + 1) * BLOCK).min(n)))
+            .collect()
+    };
     let mut offsets = Vec::with_capacity(n + 1);
     offsets.push(0);
-    if n < PARALLEL_ROWS {
-        let (mut lengths, mut entries) = (Vec::with_capacity(n), Vec::new());
-        block(0..n, &mut lengths, &mut entries);
-        let mut end = 0;
-        offsets.extend(lengths.iter().map(|l| {
-            end += l;
-            end
-        }));
-        return (offsets, entries);
-    }
-    let blocks: Vec<(Vec<usize>, Vec<T>)> = (0..n.div_ceil(BLOCK))
-        .into_par_iter()
-        .map(|b| {
-            let range = b * BLOCK..((b + 1) * BLOCK).min(n);
-            let (mut lengths, mut entries) = (Vec::with_capacity(range.len()), Vec::new());
-            block(range, &mut lengths, &mut entries);
-            (lengths, entries)
-        })
-        .collect();
-    let total = blocks.iter().map(|(_, e)| e.len()).sum();
-    let mut entries = Vec::with_capacity(total);
     let mut end = 0;
-    for (lengths, block_entries) in &blocks {
+    for (lengths, _) in &blocks {
         offsets.extend(lengths.iter().map(|l| {
             end += l;
             end
         }));
-        entries.extend_from_slice(block_entries);
     }
+    let entries = match blocks.len() {
+        1 => blocks.pop().map(|(_, e)| e).unwrap_or_default(),
+        _ => {
+            let mut entries = Vec::with_capacity(end);
+            for (_, block_entries) in &blocks {
+                entries.extend_from_slice(block_entries);
+            }
+            entries
+        }
+    };
     (offsets, entries)
 }
 
