@@ -605,8 +605,8 @@ fn row_groups(
 
 /// The hash of the types' and units' keys: a multiply-rotate over 8-byte
 /// words (as rustc's FxHash). SipHash, the standard map's, resists keys
-/// chosen to collide, which K's stencils are not, and was most of the
-/// time [`Stencils::new`] took on a structured mesh.
+/// chosen to collide, which K's stencils are not, and costs more than
+/// that resistance is worth here (docs/performance.md).
 #[derive(Default)]
 struct KeyHasher(u64);
 
