@@ -1489,7 +1489,8 @@ fn of_two_runs_on_one_file_one_writes_it() {
             // A checkpoint to restart from.
             let c = start_long(&case, &out, &["--quiet"], 0.5);
             signal(&c, "-INT");
-            assert_eq!(c.wait_with_output().unwrap().status.code(), Some(130));
+            let o = c.wait_with_output().unwrap();
+            assert_eq!(o.status.code(), Some(130), "{:?}: {}", o.status, stderr(&o));
         }
         let mut runs = [spawn(&args), spawn(&args)];
         let t0 = Instant::now();
