@@ -43,7 +43,7 @@ use stickslip_linalg::csr::{dot, quadratic_form, spmv};
 use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Mass, Statics};
+use crate::initial::Mass;
 use crate::newmark::ImplicitFriction;
 use crate::settings::{InitialState, MassKind, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
@@ -90,24 +90,15 @@ pub(crate) fn start(
         )));
     }
     let n = k.nrows();
-    // The preload's analysis of K is the increments' (Δt K has its
-    // pattern): one analysis for the run.
-    let mut analysis = None;
-    let mut state = initial_state(
+    // Δt K has K's pattern: the preload's analysis is the increments'.
+    let (mut state, friction) = ImplicitFriction::with_initial_state(
         &k,
         Mass::Massless,
-        Statics {
-            fill_order: &fill_order,
-            modes: &rigid_modes,
-            times,
-            single_factor: false,
-            analysis: Some(&mut analysis),
-        },
+        (&fill_order, &rigid_modes, times),
         contact,
         loads,
         settings,
     )?;
-    let friction = ImplicitFriction::new(&k, &fill_order, analysis, contact, settings)?;
     if !settings.restoring {
         // The previous increment's load is the one r₀ equilibrates: the
         // loads before t = 0, or none for a start at rest (r₀ = 0).

@@ -121,25 +121,14 @@ pub(crate) fn start(
         MassKind::Consistent => Mass::Consistent(&m),
         MassKind::Lumped => Mass::Lumped(&lumped_mass),
     };
-    // K's analysis, made by the preload or the consistent mass's
-    // factor, is A₀'s (K, M and A₀ share one pattern): one analysis for
-    // the run.
-    let mut analysis = None;
-    let mut state = initial_state(
+    let (mut state, friction) = ImplicitFriction::with_initial_state(
         &k,
         mass,
-        Statics {
-            fill_order: &fill_order,
-            modes: &rigid_modes,
-            times,
-            single_factor: false,
-            analysis: Some(&mut analysis),
-        },
+        (&fill_order, &rigid_modes, times),
         contact,
         loads,
         settings,
     )?;
-    let friction = ImplicitFriction::new(&k, &fill_order, analysis, contact, settings)?;
     // The energy-consistent normal force where the scheme is the
     // trapezoidal rule (METHOD.md §10): its excess starts at 0, r̈₀ being
     // the end-point force's.
@@ -169,6 +158,35 @@ pub(crate) fn start(
 }
 
 impl ImplicitFriction {
+    /// The initial state with `mass` and the solver of the steps, on one
+    /// analysis of K's pattern for the run (K, M and the step's operator
+    /// share it): the one the preload or the consistent mass's factor
+    /// made, else the solver's own. `statics`: the factors' ordering, the
+    /// free rigid motions, where the setup's times go.
+    ///
+    /// # Errors
+    /// As [`initial_state`] and [`ImplicitFriction::new`].
+    pub(crate) fn with_initial_state(
+        k: &CsrMatrix<f64>,
+        mass: Mass,
+        (fill_order, modes, times): (&FillOrder, &[stickslip_fem::RigidMode], &mut SetupTimes),
+        contact: Option<&ContactSurface>,
+        loads: &Loads,
+        settings: &Settings,
+    ) -> Result<(State, ImplicitFriction), TimeError> {
+        let mut analysis = None;
+        let statics = Statics {
+            fill_order,
+            modes,
+            times,
+            single_factor: false,
+            analysis: Some(&mut analysis),
+        };
+        let state = initial_state(k, mass, statics, contact, loads, settings)?;
+        let friction = ImplicitFriction::new(k, fill_order, analysis, contact, settings)?;
+        Ok((state, friction))
+    }
+
     /// The settings' solver for K's pattern (which M shares), analysed
     /// once for the run: `analysis` where the initial state made it.
     ///
