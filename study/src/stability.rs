@@ -97,7 +97,8 @@ pub fn growth(slab: &Slab, ratio: f64, steps: usize) -> Result<Growth, String> {
     })
 }
 
-/// The time crate's estimate of Δt_crit (Lanczos on M_L⁻¹K).
+/// The time crate's estimate of Δt_crit (Lanczos on M_L⁻¹K, capped by
+/// Gershgorin's bound: `stickslip_time::stability::critical_step`).
 pub fn estimate(slab: &Slab) -> f64 {
     stickslip_time::stability::critical_step(&slab.model.stiffness, &slab.model.lumped_mass)
 }

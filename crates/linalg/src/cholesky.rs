@@ -215,7 +215,7 @@ fn symbolic_in(
 /// The symbolic analysis of one sparsity pattern (its ordering and
 /// symbolic factor), shared by the factorizations of the matrices that
 /// have it (a run's K, M and A₀): cloning it shares, not copies.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct Analysis {
     symbolic: Arc<SymbolicCholesky<usize>>,
     /// The analysed matrix's size and number of stored values, which a
@@ -223,6 +223,16 @@ pub struct Analysis {
     /// 500k DOFs it is 9M indices).
     n: usize,
     nnz: usize,
+}
+
+impl std::fmt::Debug for Analysis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Analysis")
+            .field("n", &self.n)
+            .field("nnz", &self.nnz)
+            .field("factor_nnz", &self.symbolic.len_val())
+            .finish()
+    }
 }
 
 impl Analysis {
@@ -249,8 +259,9 @@ impl Analysis {
     /// another matrix of the model), else the analysis of `a` in `order`.
     ///
     /// # Errors
-    /// As [`Analysis::of`]; [`SolverError::PatternChanged`] where `shared`
-    /// is of another size or number of values than `a`.
+    /// As [`Analysis::of`] (where `shared` is given: a non-square `a`);
+    /// [`SolverError::Analysis`] where `shared` is of another size,
+    /// [`SolverError::PatternChanged`] of another number of values.
     pub fn shared_or_of(
         shared: Option<Analysis>,
         a: &CsrMatrix<f64>,
@@ -275,7 +286,20 @@ impl Analysis {
     /// `a` has the analysed size and number of values (the same check as
     /// a refactorization's: comparing the patterns would read them).
     fn check(&self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
-        if a.nrows() != self.n || a.ncols() != self.n || a.nnz() != self.nnz {
+        if a.nrows() != a.ncols() {
+            return Err(SolverError::NotSquare {
+                rows: a.nrows(),
+                cols: a.ncols(),
+            });
+        }
+        if a.nrows() != self.n {
+            return Err(SolverError::Analysis(format!(
+                "an analysis of {} rows for a matrix of {}",
+                self.n,
+                a.nrows()
+            )));
+        }
+        if a.nnz() != self.nnz {
             return Err(SolverError::PatternChanged {
                 analysed: self.nnz,
                 given: a.nnz(),
@@ -350,7 +374,8 @@ impl SparseCholesky {
     ///
     /// # Errors
     /// [`SolverError::NotPositiveDefinite`] for a singular or indefinite
-    /// matrix, [`SolverError::PatternChanged`] for another pattern.
+    /// matrix, [`SolverError::PatternChanged`] for another pattern
+    /// ([`SolverError::Analysis`] for another size).
     pub fn factorize(&mut self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
         self.factorize_in(a, self.kernels_par())
     }
@@ -407,7 +432,7 @@ impl SparseCholesky {
     /// [`SolverError::NotPositiveDefinite`] where a pivot fails in single
     /// precision (A singular, or too ill-conditioned for f32: the double
     /// factor may still succeed), [`SolverError::PatternChanged`] for
-    /// another pattern.
+    /// another pattern ([`SolverError::Analysis`] for another size).
     pub fn factorize_single(&mut self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
         self.factorize_single_in(a, self.kernels_par())
     }
@@ -572,7 +597,7 @@ mod tests {
         let shared = || Some(first.analysis().clone());
         let larger = Analysis::shared_or_of(shared(), &grid(5), &FillOrder::amd());
         assert!(
-            matches!(larger, Err(SolverError::PatternChanged { .. })),
+            matches!(larger, Err(SolverError::Analysis(_))),
             "{:?}",
             larger.err()
         );

@@ -52,7 +52,7 @@ impl Mass<'_> {
 /// K's symbolic analysis (its ordering and symbolic factor), which K, M
 /// and the implicit steps' A₀ = c_K K + c_M M share: they have one
 /// pattern (fem), so a run analyses it once.
-pub(crate) type Analysis = Option<stickslip_linalg::Analysis>;
+pub(crate) type SharedAnalysis = Option<stickslip_linalg::Analysis>;
 
 /// How the initial state's static problems are solved: the ordering of
 /// their factors, the rigid motions the supports leave free (`modes`),
@@ -69,7 +69,7 @@ pub(crate) struct Statics<'a> {
     /// Where K's analysis is kept once made here (by the preload or the
     /// consistent mass), for the step's operators (the implicit schemes);
     /// `None` where nothing after the initial state factorizes.
-    pub analysis: Option<&'a mut Analysis>,
+    pub analysis: Option<&'a mut SharedAnalysis>,
 }
 
 /// Free DOFs from which a preload whose factor serves it alone (the
@@ -138,7 +138,7 @@ fn factor_solve(
 }
 
 /// Keeps `solver`'s analysis in `slot`, if the caller asked for it.
-fn keep(slot: &mut Option<&mut Analysis>, solver: &SparseCholesky) {
+fn keep(slot: &mut Option<&mut SharedAnalysis>, solver: &SparseCholesky) {
     if let Some(slot) = slot.as_deref_mut() {
         *slot = Some(solver.analysis().clone());
     }

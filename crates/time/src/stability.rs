@@ -23,7 +23,8 @@ pub const RESIDUAL: f64 = 1e-3;
 /// what the top Ritz value converges to first (no reorthogonalization is
 /// needed for the extreme eigenvalue) unless the start vector all but
 /// lacks λ_max's mode: the standard assumption, not a proof, and the
-/// stability map measures the margin (`cargo xtask stability`). A stop on
+/// stability map measures the margin of [`critical_step`] (`cargo xtask
+/// stability`; where Gershgorin's cap applies, the cap's). A stop on
 /// θ's own stagnation gave a θ below λ_max.
 pub fn largest_eigenvalue(
     stiffness: &CsrMatrix<f64>,

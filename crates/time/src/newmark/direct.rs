@@ -9,7 +9,7 @@ use stickslip_linalg::{FillOrder, SolverError, SparseCholesky};
 
 use stickslip_linalg::csr::index as csr_index;
 
-use crate::initial::Analysis;
+use crate::initial::SharedAnalysis;
 
 /// The implicit operator and its factorization for the current (Δt, stuck
 /// set); `factorizations` counts numeric factorizations over the run.
@@ -36,7 +36,7 @@ impl DirectOperator {
     pub fn new(
         stiffness: &CsrMatrix<f64>,
         order: &FillOrder,
-        analysis: Analysis,
+        analysis: SharedAnalysis,
         contact: Option<&ContactSurface>,
     ) -> Result<DirectOperator, SolverError> {
         let cholesky = SparseCholesky::on(stickslip_linalg::Analysis::shared_or_of(

@@ -20,7 +20,7 @@ use stickslip_linalg::{chunks, FillOrder};
 use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Analysis, Mass, Statics};
+use crate::initial::{initial_state, Mass, SharedAnalysis, Statics};
 use crate::settings::{ImplicitSolver, MassKind, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
@@ -161,7 +161,7 @@ impl ImplicitFriction {
     /// The initial state with `mass` and the solver of the steps, on one
     /// analysis of K's pattern for the run (K, M and the step's operator
     /// share it): the one the preload or the consistent mass's factor
-    /// made, else the solver's own. `statics`: the factors' ordering, the
+    /// made, else the solver's own. The tuple: the factors' ordering, the
     /// free rigid motions, where the setup's times go.
     ///
     /// # Errors
@@ -195,7 +195,7 @@ impl ImplicitFriction {
     pub(crate) fn new(
         k: &CsrMatrix<f64>,
         fill_order: &FillOrder,
-        analysis: Analysis,
+        analysis: SharedAnalysis,
         contact: Option<&ContactSurface>,
         settings: &Settings,
     ) -> Result<ImplicitFriction, TimeError> {

@@ -33,7 +33,7 @@ use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{CompliantNode, ContactNode, ContactSurface, SlipState, StepSystem};
 use stickslip_linalg::{csc_view, FillOrder, PathOperator, SolverError, Supernodal};
 
-use crate::initial::Analysis;
+use crate::initial::SharedAnalysis;
 
 /// How many Δt keep their factor (the normal and the reduced step).
 const CACHE: usize = 2;
@@ -127,7 +127,7 @@ impl SchurOperator {
     pub fn new(
         stiffness: &CsrMatrix<f64>,
         order: &FillOrder,
-        analysis: Analysis,
+        analysis: SharedAnalysis,
         contact: Option<&ContactSurface>,
         use_paths: Option<bool>,
     ) -> Result<SchurOperator, SolverError> {
