@@ -183,6 +183,7 @@ fn fail(e: &anyhow::Error) -> ExitCode {
 }
 
 fn main() -> ExitCode {
+    stickslip::sys::keep_freed_memory();
     let cli = Cli::parse();
     if !matches!(cli.command, Command::Run { .. }) {
         // Writing to a closed pipe ends the process quietly, as other Unix

@@ -18,6 +18,24 @@ pub fn default_sigpipe() {
     }
 }
 
+/// Keeps freed memory in the process for its next allocations: glibc's
+/// malloc serves blocks from 128 KiB (its default threshold, raised as
+/// blocks are freed) by fresh mappings and returns them, and the heap's
+/// top above 128 KiB, to the system when freed, so every factor, scratch
+/// buffer and vector of a setup faults its pages in again, zeroed by the
+/// kernel. Blocks up to 32 MiB (glibc's largest threshold) now come from
+/// the heap, which is kept up to 1 GiB (docs/performance.md, "The
+/// allocator's thresholds"). Call it before anything allocates much.
+pub fn keep_freed_memory() {
+    #[cfg(target_env = "gnu")]
+    // SAFETY: mallopt only sets two of malloc's parameters; no other
+    // thread allocates yet.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, 32 << 20);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, 1 << 30);
+    }
+}
+
 /// Adds an action on `sig` (beside any others registered with
 /// signal-hook): when it arrives while `armed` is set, writes `msg` to
 /// stderr and ends the process at once with exit code `code` (no
