@@ -47,13 +47,6 @@ impl crate::simd::Kernel for Rows<'_> {
     }
 }
 
-/// Row sums of two matrices on one pattern, each with [`row_dot`]'s bits.
-#[inline]
-fn row_dot2(a: &[f64], x: &[f64], b: &[f64], y: &[f64], cols: &[usize]) -> (f64, f64) {
-    let [s, t] = row_dots([a, b], [x, y], cols);
-    (s, t)
-}
-
 /// Row sums Σ_k vals[v][k]·x[v][cols[k]] for V (values, vector) pairs on
 /// one pattern in one loop over it, each in four interleaved partial sums
 /// (lane l takes the terms k ≡ l mod 4, the lanes added pairwise, then the
@@ -113,7 +106,7 @@ pub fn load_minus_k_plus_m(
         for (j, o) in out.iter_mut().enumerate() {
             let i = c * CHUNK + j;
             let (p, q) = (offsets[i], offsets[i + 1]);
-            let (kx, my) = row_dot2(&kv[p..q], x, &mv[p..q], y, &cols[p..q]);
+            let [kx, my] = row_dots([&kv[p..q], &mv[p..q]], [x, y], &cols[p..q]);
             *o = l[i] - kx + my;
         }
     });
@@ -143,7 +136,7 @@ pub fn two_forms(
         let (mut a, mut b) = (0.0, 0.0);
         for i in rows {
             let (p, q) = (offsets[i], offsets[i + 1]);
-            let (kx, my) = row_dot2(&kv[p..q], x, &mv[p..q], y, &cols[p..q]);
+            let [kx, my] = row_dots([&kv[p..q], &mv[p..q]], [x, y], &cols[p..q]);
             a += x[i] * kx;
             b += y[i] * my;
         }

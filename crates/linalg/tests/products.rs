@@ -92,13 +92,7 @@ fn products_and_forms_against_plain_sums() {
     load_minus_k_plus_m(&l0, &a, &y, &m, &x, &mut want);
     let forms = two_forms(&a, &x, &m, &y, &mut partials);
     for threads in [1, 2] {
-        let (kx, mx, f) = on_threads(threads, || {
-            let (mut kx, mut mx) = (vec![0.0; n], vec![0.0; n]);
-            let mut sums = vec![[0.0; 2]; chunks(n)];
-            let f =
-                two_forms_and_products(&a, [&x, &y], &m, [&y, &x], [&mut kx, &mut mx], &mut sums);
-            (kx, mx, f)
-        });
+        let (kx, mx, f) = fused(threads, &a, [&x, &y], &m, [&y, &x]);
         assert_eq!(f.0.to_bits(), forms.0.to_bits());
         assert_eq!(f.1.to_bits(), forms.1.to_bits());
         for i in 0..n {
@@ -160,6 +154,24 @@ fn grid(nx: usize, ny: usize, wobble: f64, fixed: bool) -> CsrMatrix<f64> {
     CsrMatrix::from(&coo)
 }
 
+/// [`two_forms_and_products`] on `threads` threads: K x', M y' and the
+/// forms (xᵀK x, yᵀM y).
+fn fused(
+    threads: usize,
+    k: &CsrMatrix<f64>,
+    x: [&[f64]; 2],
+    m: &CsrMatrix<f64>,
+    y: [&[f64]; 2],
+) -> (Vec<f64>, Vec<f64>, (f64, f64)) {
+    let n = k.nrows();
+    on_threads(threads, || {
+        let (mut kx, mut my) = (vec![0.0; n], vec![0.0; n]);
+        let mut sums = vec![[0.0; 2]; chunks(n)];
+        let f = two_forms_and_products(k, x, m, y, [&mut kx, &mut my], &mut sums);
+        (kx, my, f)
+    })
+}
+
 /// On a grid's pattern, where most groups of four columns are consecutive
 /// (runs of nodes along a row, read as one load), the fused rows keep the
 /// bits of the plain row sums (`spmv`, `quadratic_form`), on one thread
@@ -199,13 +211,7 @@ fn fused_rows_keep_the_row_sums_bits_on_runs_of_columns() {
         assert_eq!(b[i].to_bits(), (l[i] - kx[i] + my[i]).to_bits(), "row {i}");
     }
     for threads in [1, 2] {
-        let (fk, fm, f) = on_threads(threads, || {
-            let (mut fk, mut fm) = (vec![0.0; n], vec![0.0; n]);
-            let mut sums = vec![[0.0; 2]; chunks(n)];
-            let f =
-                two_forms_and_products(&k, [&y, &x], &m, [&x, &y], [&mut fk, &mut fm], &mut sums);
-            (fk, fm, f)
-        });
+        let (fk, fm, f) = fused(threads, &k, [&y, &x], &m, [&x, &y]);
         assert_eq!(f.0.to_bits(), forms.0.to_bits());
         assert_eq!(f.1.to_bits(), forms.1.to_bits());
         for i in 0..n {
