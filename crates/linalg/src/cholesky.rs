@@ -25,14 +25,12 @@ use faer::{Par, Side, Spec};
 use crate::{FillOrder, Supernodal};
 use faer::perm::PermRef;
 
-/// Factors from this many values are factorized by faer on every thread
-/// of the pool; below it the threads' dispatch costs more than it saves.
-const PARALLEL_MIN: usize = 1 << 20;
-
-/// faer's dense kernels on every thread of rayon's pool.
-fn parallel() -> Par {
-    Par::rayon(rayon::current_num_threads())
-}
+/// faer's dense kernels run on the calling thread. Given the pool, they
+/// split each supernode's products among its threads and wait for them
+/// supernode by supernode; the fronts of 2-D meshes are small, and that
+/// waiting made the factorizations slower than one thread
+/// (docs/performance.md). A run's cores go to independent work instead.
+const KERNELS: Par = Par::Seq;
 use nalgebra_sparse::CsrMatrix;
 
 /// Why a factorization failed.
@@ -328,16 +326,9 @@ impl SparseCholesky {
     /// [`SolverError::Analysis`] for a layout [`Supernodal`] does not know.
     pub fn on(analysis: Analysis) -> Result<SparseCholesky, SolverError> {
         let symbolic = &analysis.symbolic;
-        // Scratch for the kernels `factorize` will run: asking for the
-        // pool's size below PARALLEL_MIN would start its threads for a
-        // factor they never touch.
-        let par = if symbolic.len_val() >= PARALLEL_MIN {
-            parallel()
-        } else {
-            Par::Seq
-        };
-        let factor_scratch =
-            MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
+        let factor_scratch = MemBuffer::new(
+            symbolic.factorize_numeric_llt_scratch::<f64>(KERNELS, Default::default()),
+        );
         let solver = RefCell::new(Supernodal::new(symbolic).ok_or_else(|| {
             SolverError::Analysis("faer returned a factor layout this solver does not know".into())
         })?);
@@ -377,23 +368,6 @@ impl SparseCholesky {
     /// matrix, [`SolverError::PatternChanged`] for another pattern
     /// ([`SolverError::Analysis`] for another size).
     pub fn factorize(&mut self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
-        self.factorize_in(a, self.kernels_par())
-    }
-
-    /// The dense kernels' parallelism: rayon's pool from [`PARALLEL_MIN`]
-    /// factor values, this thread below.
-    fn kernels_par(&self) -> Par {
-        if self.l_values.len() >= PARALLEL_MIN {
-            parallel()
-        } else {
-            Par::Seq
-        }
-    }
-
-    /// [`SparseCholesky::factorize`] with faer's dense kernels run by
-    /// `par`: they split their products by blocks of the result, never
-    /// a sum, so the factor's bits do not depend on it (tested).
-    fn factorize_in(&mut self, a: &CsrMatrix<f64>, par: Par) -> Result<(), SolverError> {
         self.analysis.check(a)?;
         self.factorized = false;
         self.single = Vec::new();
@@ -402,7 +376,7 @@ impl SparseCholesky {
             as_csc(a),
             Side::Lower,
             Default::default(),
-            par,
+            KERNELS,
             MemStack::new(&mut self.factor_scratch),
             Spec::<LltParams, f64>::default(),
         );
@@ -434,10 +408,6 @@ impl SparseCholesky {
     /// factor may still succeed), [`SolverError::PatternChanged`] for
     /// another pattern ([`SolverError::Analysis`] for another size).
     pub fn factorize_single(&mut self, a: &CsrMatrix<f64>) -> Result<(), SolverError> {
-        self.factorize_single_in(a, self.kernels_par())
-    }
-
-    fn factorize_single_in(&mut self, a: &CsrMatrix<f64>, par: Par) -> Result<(), SolverError> {
         self.analysis.check(a)?;
         self.single.clear();
         let largest = a.values().iter().fold(0.0_f64, |m, v| m.max(v.abs()));
@@ -461,14 +431,14 @@ impl SparseCholesky {
         let mut scratch = MemBuffer::new(
             self.analysis
                 .symbolic
-                .factorize_numeric_llt_scratch::<f32>(par, Default::default()),
+                .factorize_numeric_llt_scratch::<f32>(KERNELS, Default::default()),
         );
         let result = self.analysis.symbolic.factorize_numeric_llt(
             &mut l,
             SparseColMatRef::new(sym, &values),
             Side::Lower,
             Default::default(),
-            par,
+            KERNELS,
             MemStack::new(&mut scratch),
             Spec::<LltParams, f32>::default(),
         );
@@ -615,27 +585,5 @@ mod tests {
             "{:?}",
             other.err()
         );
-    }
-
-    #[test]
-    fn the_factor_has_the_same_bits_on_one_thread_and_on_four() {
-        let a = grid(300);
-        let mut seq = SparseCholesky::analyze(&a, &FillOrder::amd()).unwrap();
-        // Large enough for `factorize` to take the parallel path.
-        assert!(seq.factor_nnz() >= PARALLEL_MIN, "{}", seq.factor_nnz());
-        let mut par = SparseCholesky::analyze(&a, &FillOrder::amd()).unwrap();
-        seq.factorize_in(&a, Par::Seq).unwrap();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(4)
-            .build()
-            .unwrap();
-        pool.install(|| par.factorize_in(&a, Par::rayon(4)))
-            .unwrap();
-        let same = seq
-            .l_values
-            .iter()
-            .zip(&par.l_values)
-            .all(|(x, y)| x.to_bits() == y.to_bits());
-        assert!(same, "the factor's values differ between 1 and 4 threads");
     }
 }
