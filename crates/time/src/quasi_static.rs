@@ -98,6 +98,7 @@ pub(crate) fn start(
         contact,
         loads,
         settings,
+        None,
     )?;
     if !settings.restoring {
         // The previous increment's load is the one r₀ equilibrates: the

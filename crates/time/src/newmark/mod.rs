@@ -15,13 +15,13 @@ mod schur;
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{iterate, stick_events, ContactSurface, SlipState};
 use stickslip_linalg::csr::{load_minus_k_plus_m, same_pattern, two_forms, two_forms_and_products};
-use stickslip_linalg::{chunks, FillOrder};
+use stickslip_linalg::{chunks, Analysis, FillOrder, SparseCholesky};
 
 use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Mass, SharedAnalysis, Statics};
-use crate::settings::{ImplicitSolver, MassKind, Settings, TimeError};
+use crate::initial::{initial_state, initial_state_analyzed, Mass, SharedAnalysis, Statics};
+use crate::settings::{ImplicitSolver, MassKind, Rayleigh, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
 
@@ -121,6 +121,15 @@ pub(crate) fn start(
         MassKind::Consistent => Mass::Consistent(&m),
         MassKind::Lumped => Mass::Lumped(&lumped_mass),
     };
+    // The first step's Δt and operator, as the step will form them.
+    let dt = State::new(0, 0, settings.dt).next_step(settings).0;
+    let (c_k, c_m) = operator_coefficients((beta, gamma), dt, settings.damping);
+    let first = FirstStep {
+        dt,
+        c_k,
+        c_m,
+        mass: &m,
+    };
     let (mut state, friction) = ImplicitFriction::with_initial_state(
         &k,
         mass,
@@ -128,6 +137,7 @@ pub(crate) fn start(
         contact,
         loads,
         settings,
+        Some(first),
     )?;
     // The energy-consistent normal force where the scheme is the
     // trapezoidal rule (METHOD.md §10): its excess starts at 0, r̈₀ being
@@ -157,12 +167,40 @@ pub(crate) fn start(
     Ok((Box::new(stepper), state))
 }
 
+/// (c_K, c_M) of a step's operator c_K K + c_M M for Δt `dt`: (β/γ)Δt
+/// and 1/(γΔt) (METHOD.md §4), Rayleigh damping C = αM + βK joining A₀
+/// (METHOD.md §8).
+fn operator_coefficients((beta, gamma): (f64, f64), dt: f64, damping: Rayleigh) -> (f64, f64) {
+    let (c_k, c_m) = (beta / gamma * dt, 1.0 / (gamma * dt));
+    if damping.is_on() {
+        (c_k + damping.beta, c_m + damping.alpha)
+    } else {
+        (c_k, c_m)
+    }
+}
+
+/// The operator c_K K + c_M M of a run's first step of Δt `dt`, which
+/// [`ImplicitFriction::with_initial_state`] factorizes beside the preload.
+pub(crate) struct FirstStep<'a> {
+    pub dt: f64,
+    pub c_k: f64,
+    pub c_m: f64,
+    pub mass: &'a CsrMatrix<f64>,
+}
+
 impl ImplicitFriction {
     /// The initial state with `mass` and the solver of the steps, on one
     /// analysis of K's pattern for the run (K, M and the step's operator
     /// share it): the one the preload or the consistent mass's factor
     /// made, else the solver's own. The tuple: the factors' ordering, the
     /// free rigid motions, where the setup's times go.
+    ///
+    /// With `first` (the Schur solver, a fresh start) the analysis comes
+    /// first, and the first step's operator is factorized, with its Schur
+    /// complement, on a thread of its own beside the initial state's
+    /// factorizations: each runs on one thread (faer's kernels, `cholesky.rs`),
+    /// and they share only the analysis. The step finds it in its solver's
+    /// cache; where it fails, the step meets the failure and reports it.
     ///
     /// # Errors
     /// As [`initial_state`] and [`ImplicitFriction::new`].
@@ -173,7 +211,44 @@ impl ImplicitFriction {
         contact: Option<&ContactSurface>,
         loads: &Loads,
         settings: &Settings,
+        first: Option<FirstStep>,
     ) -> Result<(State, ImplicitFriction), TimeError> {
+        let schur = matches!(
+            settings.implicit_solver,
+            ImplicitSolver::Schur | ImplicitSolver::SchurPaths | ImplicitSolver::SchurReach
+        );
+        let fresh = |f: &FirstStep| schur && !settings.restoring && f.dt > 0.0;
+        if let Some(first) = first.filter(fresh) {
+            let analysis = times
+                .time("analysis", || Analysis::of(k, fill_order))
+                .map_err(TimeError::Static)?;
+            let mut friction =
+                ImplicitFriction::new(k, fill_order, Some(analysis.clone()), contact, settings)?;
+            let mut shared = Some(analysis.clone());
+            let analyzed = SparseCholesky::on(analysis).map_err(TimeError::Static)?;
+            let state = std::thread::scope(|s| {
+                let operator = s.spawn(|| friction.prefactor(k, &first));
+                let statics = Statics {
+                    fill_order,
+                    modes,
+                    times,
+                    single_factor: false,
+                    analysis: Some(&mut shared),
+                };
+                let state = initial_state_analyzed(
+                    k,
+                    mass,
+                    statics,
+                    contact,
+                    loads,
+                    settings,
+                    Some(analyzed),
+                );
+                operator.join().expect("the first step's operator thread");
+                state
+            })?;
+            return Ok((state, friction));
+        }
         let mut analysis = None;
         let statics = Statics {
             fill_order,
@@ -235,6 +310,16 @@ impl ImplicitFriction {
             iter_scratch: vec![SlipState::Stuck; n_c],
             compliant,
         })
+    }
+
+    /// Factorizes the first step's operator ahead of the step, into the
+    /// Schur solver's cache of factors per Δt.
+    fn prefactor(&mut self, k: &CsrMatrix<f64>, first: &FirstStep) {
+        if let Solver::Schur(op) = &mut self.solver {
+            // A failure leaves no factor: the step factorizes again and
+            // reports it with its step and time.
+            let _ = op.set_dt(first.dt, first.c_k, k, first.c_m, first.mass);
+        }
     }
 
     /// Takes μ at each node's slip at velocity `v` (the last step's)
@@ -580,13 +665,9 @@ impl Stepper for Newmark {
                     .normal_form(form, c, (&state.r, &state.normal_excess));
             }
         }
-        // Rayleigh damping C = αM + βK joins A₀ (METHOD.md §8); R̂_K is
-        // unchanged, as ṙ_K is the unknown.
-        let c = run.settings.damping;
-        let (mut c_k, mut c_m) = (beta / gamma * dt, 1.0 / (gamma * dt));
-        if c.is_on() {
-            (c_k, c_m) = (c_k + c.beta, c_m + c.alpha);
-        }
+        // Rayleigh damping joins A₀; R̂_K is unchanged, as ṙ_K is the
+        // unknown.
+        let (c_k, c_m) = operator_coefficients((beta, gamma), dt, run.settings.damping);
         let result = self.friction.velocity(
             run,
             (dt, c_k, &self.k),
