@@ -44,7 +44,7 @@ use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
 use crate::initial::Mass;
-use crate::newmark::ImplicitFriction;
+use crate::newmark::{FirstStep, ImplicitFriction};
 use crate::settings::{InitialState, MassKind, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
@@ -91,6 +91,14 @@ pub(crate) fn start(
     }
     let n = k.nrows();
     // Δt K has K's pattern: the preload's analysis is the increments'.
+    // The first increment's operator, as the step forms it.
+    let dt = State::new(0, 0, settings.dt).next_step(settings).0;
+    let first = FirstStep {
+        dt,
+        c_k: dt,
+        c_m: 0.0,
+        mass: &k,
+    };
     let (mut state, friction) = ImplicitFriction::with_initial_state(
         &k,
         Mass::Massless,
@@ -98,7 +106,7 @@ pub(crate) fn start(
         contact,
         loads,
         settings,
-        None,
+        Some(first),
     )?;
     if !settings.restoring {
         // The previous increment's load is the one r₀ equilibrates: the

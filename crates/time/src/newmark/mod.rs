@@ -179,8 +179,9 @@ fn operator_coefficients((beta, gamma): (f64, f64), dt: f64, damping: Rayleigh) 
     }
 }
 
-/// The operator c_K K + c_M M of a run's first step of Δt `dt`, which
-/// [`ImplicitFriction::with_initial_state`] factorizes beside the preload.
+/// The operator c_K K + c_M M of a run's first step (or quasi-static
+/// increment) of Δt `dt`, which [`ImplicitFriction::with_initial_state`]
+/// factorizes beside the preload.
 pub(crate) struct FirstStep<'a> {
     pub dt: f64,
     pub c_k: f64,
