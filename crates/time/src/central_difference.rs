@@ -5,12 +5,12 @@
 
 use stickslip_contact::{iterate, ContactSurface, DiagonalStep, Foundation, SlipState};
 use stickslip_linalg::chunks;
-use stickslip_linalg::{csr, Formed, Product, SparseCholesky, Stencils};
+use stickslip_linalg::{csr, Analysis, Formed, Product, Stencils};
 
 use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state_analyzed, Mass, Statics};
+use crate::initial::{initial_state, Mass, Statics};
 use crate::nodal::NodalFriction;
 use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError, MAX_STABLE_STEPS};
 use crate::stability::{critical_step_with, gershgorin_bound};
@@ -125,7 +125,7 @@ pub(crate) fn start(
         )
     };
     let initial = |times: &mut SetupTimes, analyzed| {
-        initial_state_analyzed(
+        initial_state(
             &k,
             Mass::Lumped(&mass),
             Statics {
@@ -160,9 +160,7 @@ pub(crate) fn start(
                 let done = if beside == Beside::Preload {
                     Done::State(Box::new(initial(times, None)))
                 } else {
-                    match times.time("preload ordering", || {
-                        SparseCholesky::analyze(&k, &fill_order)
-                    }) {
+                    match times.time("preload ordering", || Analysis::of(&k, &fill_order)) {
                         Ok(analysis) => Done::Analysis(Box::new(analysis)),
                         Err(e) => Done::State(Box::new(Err(TimeError::Static(e)))),
                     }
@@ -557,7 +555,7 @@ enum Beside {
 /// The work the critical step's thread has run beside.
 enum Done {
     State(Box<Result<State, TimeError>>),
-    Analysis(Box<SparseCholesky>),
+    Analysis(Box<Analysis>),
 }
 
 /// What the critical step may be estimated beside: for a large model

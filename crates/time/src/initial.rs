@@ -8,7 +8,7 @@ use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{RigidMode, SetupTimes};
 use stickslip_linalg::csr::{dot, quadratic_form, spmv};
-use stickslip_linalg::{chunks, FillOrder, SparseCholesky, BACKWARD_ERROR};
+use stickslip_linalg::{chunks, Analysis, FillOrder, SparseCholesky, BACKWARD_ERROR};
 
 use crate::dynamics::Loads;
 use crate::settings::{InitialState, Settings, TimeError};
@@ -156,6 +156,9 @@ fn keep(slot: &mut Option<&mut SharedAnalysis>, solver: &SparseCholesky) {
 /// [`TimeError::Unbalanced`] when the preload does work along a free rigid
 /// motion; [`TimeError::Static`] when K (or a consistent M) is otherwise
 /// not positive definite.
+///
+/// `analyzed`: K's analysis for the preload, where the caller made it
+/// (beside other work, or for the step's operators too).
 pub(crate) fn initial_state(
     k: &CsrMatrix<f64>,
     mass: Mass,
@@ -163,20 +166,7 @@ pub(crate) fn initial_state(
     contact: Option<&ContactSurface>,
     loads: &Loads,
     settings: &Settings,
-) -> Result<State, TimeError> {
-    initial_state_analyzed(k, mass, statics, contact, loads, settings, None)
-}
-
-/// [`initial_state`] given K's analysis for the preload (`analyzed`,
-/// where the caller made it beside other work), if it has one.
-pub(crate) fn initial_state_analyzed(
-    k: &CsrMatrix<f64>,
-    mass: Mass,
-    statics: Statics,
-    contact: Option<&ContactSurface>,
-    loads: &Loads,
-    settings: &Settings,
-    analyzed: Option<SparseCholesky>,
+    analyzed: Option<Analysis>,
 ) -> Result<State, TimeError> {
     let Statics {
         fill_order,
@@ -216,7 +206,7 @@ pub(crate) fn initial_state_analyzed(
             )?;
         } else if modes.is_empty() {
             let solver = match analyzed {
-                Some(solver) => solver,
+                Some(analysis) => SparseCholesky::on(analysis).map_err(TimeError::Static)?,
                 None => analyze(k, fill_order, times)?,
             };
             keep(&mut analysis, &solver);

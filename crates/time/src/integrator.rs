@@ -158,7 +158,9 @@ impl Integrator {
     }
 
     /// How long the setup's parts took: the preload's ordering, factor
-    /// and solve, the critical step, the step's operators.
+    /// and solve (an implicit scheme's `analysis` of K's pattern where it
+    /// comes first, for its step's operator too), the critical step, the
+    /// step's operators.
     pub fn setup_times(&self) -> &SetupTimes {
         &self.setup
     }

@@ -24,7 +24,7 @@ use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{RigidMode, SetupTimes};
 use stickslip_linalg::csr::{dot, spmv};
-use stickslip_linalg::{FillOrder, SparseCholesky};
+use stickslip_linalg::{Analysis, FillOrder, SparseCholesky};
 
 use crate::floating;
 use crate::initial::Mass;
@@ -83,7 +83,7 @@ pub(crate) fn solve(
     contact: &ContactSurface,
     r: &mut [f64],
     times: &mut SetupTimes,
-    analyzed: Option<SparseCholesky>,
+    analyzed: Option<Analysis>,
 ) -> Result<(), TimeError> {
     let preload = r.to_vec();
     let along = along_normal(contact, modes);
@@ -105,7 +105,7 @@ pub(crate) fn solve(
     add_foundation_forces(contact, &zero, &mut pushed);
     let scale = norm(&preload).max(norm(&pushed));
     let mut solver = match analyzed {
-        Some(solver) => solver,
+        Some(analysis) => SparseCholesky::on(analysis).map_err(TimeError::Static)?,
         None => times
             .time("preload ordering", || {
                 SparseCholesky::analyze(&tangent, fill_order)

@@ -15,12 +15,12 @@ mod schur;
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{iterate, stick_events, ContactSurface, SlipState};
 use stickslip_linalg::csr::{load_minus_k_plus_m, same_pattern, two_forms, two_forms_and_products};
-use stickslip_linalg::{chunks, Analysis, FillOrder, SparseCholesky};
+use stickslip_linalg::{chunks, Analysis, FillOrder};
 
 use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, initial_state_analyzed, Mass, SharedAnalysis, Statics};
+use crate::initial::{initial_state, Mass, SharedAnalysis, Statics};
 use crate::settings::{ImplicitSolver, MassKind, Rayleigh, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
@@ -196,12 +196,14 @@ impl ImplicitFriction {
     /// made, else the solver's own. The tuple: the factors' ordering, the
     /// free rigid motions, where the setup's times go.
     ///
-    /// With `first` (the Schur solver, a fresh start) the analysis comes
-    /// first, and the first step's operator is factorized, with its Schur
-    /// complement, on a thread of its own beside the initial state's
-    /// factorizations: each runs on one thread (faer's kernels, `cholesky.rs`),
-    /// and they share only the analysis. The step finds it in its solver's
-    /// cache; where it fails, the step meets the failure and reports it.
+    /// With `first` on a fresh start the analysis comes first, and the
+    /// Schur solver factorizes the first step's operator on a thread of
+    /// its own while this one forms the initial state (its factorizations
+    /// too run on their calling thread, faer's kernels: `cholesky.rs`);
+    /// the operator's S and W, on the pool, follow. The step finds them in
+    /// its solver's cache; where the factorization fails, the step meets
+    /// the failure and reports it. An initial state that fails is reported
+    /// once that factorization has ended.
     ///
     /// # Errors
     /// As [`initial_state`] and [`ImplicitFriction::new`].
@@ -214,52 +216,44 @@ impl ImplicitFriction {
         settings: &Settings,
         first: Option<FirstStep>,
     ) -> Result<(State, ImplicitFriction), TimeError> {
-        let schur = matches!(
-            settings.implicit_solver,
-            ImplicitSolver::Schur | ImplicitSolver::SchurPaths | ImplicitSolver::SchurReach
-        );
-        let fresh = |f: &FirstStep| schur && !settings.restoring && f.dt > 0.0;
-        if let Some(first) = first.filter(fresh) {
+        let first = first.filter(|f| !settings.restoring && f.dt > 0.0);
+        let (mut shared, mut friction) = (None, None);
+        if first.is_some() {
             let analysis = times
                 .time("analysis", || Analysis::of(k, fill_order))
                 .map_err(TimeError::Static)?;
-            let mut friction =
+            let solver =
                 ImplicitFriction::new(k, fill_order, Some(analysis.clone()), contact, settings)?;
-            let mut shared = Some(analysis.clone());
-            let analyzed = SparseCholesky::on(analysis).map_err(TimeError::Static)?;
-            let state = std::thread::scope(|s| {
-                let operator = s.spawn(|| friction.prefactor(k, &first));
-                let statics = Statics {
-                    fill_order,
-                    modes,
-                    times,
-                    single_factor: false,
-                    analysis: Some(&mut shared),
-                };
-                let state = initial_state_analyzed(
-                    k,
-                    mass,
-                    statics,
-                    contact,
-                    loads,
-                    settings,
-                    Some(analyzed),
-                );
-                operator.join().expect("the first step's operator thread");
-                state
-            })?;
-            return Ok((state, friction));
+            (shared, friction) = (Some(analysis), Some(solver));
         }
-        let mut analysis = None;
+        let analyzed = shared.clone();
         let statics = Statics {
             fill_order,
             modes,
             times,
             single_factor: false,
-            analysis: Some(&mut analysis),
+            analysis: Some(&mut shared),
         };
-        let state = initial_state(k, mass, statics, contact, loads, settings)?;
-        let friction = ImplicitFriction::new(k, fill_order, analysis, contact, settings)?;
+        let (state, factored) = std::thread::scope(|s| {
+            let ahead = friction
+                .as_mut()
+                .zip(first.as_ref())
+                .map(|(f, first)| s.spawn(move || f.factorize_ahead(k, first)));
+            let state = initial_state(k, mass, statics, contact, loads, settings, analyzed);
+            let factored =
+                ahead.is_some_and(|h| h.join().expect("the first step's operator thread"));
+            (state, factored)
+        });
+        let state = state?;
+        let friction = match (friction, first) {
+            (Some(mut friction), Some(first)) => {
+                if factored {
+                    friction.finish_ahead(k, &first);
+                }
+                friction
+            }
+            _ => ImplicitFriction::new(k, fill_order, shared, contact, settings)?,
+        };
         Ok((state, friction))
     }
 
@@ -314,12 +308,25 @@ impl ImplicitFriction {
     }
 
     /// Factorizes the first step's operator ahead of the step, into the
-    /// Schur solver's cache of factors per Δt.
-    fn prefactor(&mut self, k: &CsrMatrix<f64>, first: &FirstStep) {
+    /// Schur solver's cache of factors per Δt, on this thread: true where
+    /// it did (false for the direct solver, which factorizes per stuck
+    /// set). A failure leaves no factor: the step factorizes again and
+    /// reports it with its step and time.
+    fn factorize_ahead(&mut self, k: &CsrMatrix<f64>, first: &FirstStep) -> bool {
+        match &mut self.solver {
+            Solver::Schur(op) => op
+                .factorize_dt(first.dt, first.c_k, k, first.c_m, first.mass)
+                .is_ok(),
+            Solver::Direct(_) => false,
+        }
+    }
+
+    /// S and W of the operator [`Self::factorize_ahead`] made (the cache
+    /// holds its factor, so nothing is factorized again).
+    fn finish_ahead(&mut self, k: &CsrMatrix<f64>, first: &FirstStep) {
         if let Solver::Schur(op) = &mut self.solver {
-            // A failure leaves no factor: the step factorizes again and
-            // reports it with its step and time.
-            let _ = op.set_dt(first.dt, first.c_k, k, first.c_m, first.mass);
+            let made = op.set_dt(first.dt, first.c_k, k, first.c_m, first.mass);
+            debug_assert!(made.is_ok(), "the factor is in the cache");
         }
     }
 

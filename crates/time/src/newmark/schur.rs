@@ -60,6 +60,9 @@ struct Entry {
     /// W = L⁻¹Pᵀ on its paths (`Supernodal::schur_complement`), when the
     /// step goes through it rather than through solves on the reach.
     paths: Option<PathOperator>,
+    /// S and W are made for this factor (a factor made ahead of its
+    /// step, [`SchurOperator::factorize_dt`], has them made later).
+    schur: bool,
     /// Distinguishes entries for the dense factor's cache.
     id: u64,
     last_used: u64,
@@ -212,8 +215,26 @@ impl SchurOperator {
     }
 
     /// Makes the factor of A₀ = c_k K + c_m M for this Δt current: from the
-    /// cache, or factorized (with S and Z) once.
+    /// cache, or factorized (with S and W) once.
     pub fn set_dt(
+        &mut self,
+        dt: f64,
+        c_k: f64,
+        stiffness: &CsrMatrix<f64>,
+        c_m: f64,
+        mass: &CsrMatrix<f64>,
+    ) -> Result<(), SolverError> {
+        self.factorize_dt(dt, c_k, stiffness, c_m, mass)?;
+        if !self.entries[self.current].schur {
+            self.build_schur(self.current);
+        }
+        Ok(())
+    }
+
+    /// [`Self::set_dt`] without S and W, which the next `set_dt` of this
+    /// Δt makes: the factorization alone runs on the calling thread
+    /// (faer's kernels), S and W on the pool.
+    pub fn factorize_dt(
         &mut self,
         dt: f64,
         c_k: f64,
@@ -266,7 +287,6 @@ impl SchurOperator {
         drop(factor_scratch);
         drop(a0);
         self.make_current(slot, bits);
-        self.build_schur(slot);
         Ok(())
     }
 
@@ -275,6 +295,7 @@ impl SchurOperator {
     fn make_current(&mut self, slot: usize, bits: u64) {
         let entry = &mut self.entries[slot];
         entry.dt_bits = bits;
+        entry.schur = false;
         entry.id = self.next_id;
         entry.last_used = self.clock;
         self.next_id += 1;
@@ -292,6 +313,7 @@ impl SchurOperator {
                 l_values: vec![0.0; self.analysis.symbolic().len_val()],
                 s: Vec::new(),
                 paths: None,
+                schur: false,
                 id: 0,
                 last_used: 0,
             });
@@ -313,6 +335,7 @@ impl SchurOperator {
     fn build_schur(&mut self, slot: usize) {
         let n_c = self.rows();
         let entry = &mut self.entries[slot];
+        entry.schur = true;
         entry.s.clear();
         entry.s.resize(n_c * n_c, 0.0);
         entry.paths = None;
