@@ -107,6 +107,19 @@ impl Report {
         );
     }
 
+    /// A figure shown for the table only (`why`: what it is read for); it
+    /// fails only where it is not a number.
+    pub fn reported(&mut self, case: &str, quantity: &str, measured: f64, why: &str) {
+        self.row(
+            case,
+            quantity,
+            num(measured),
+            why.to_string(),
+            "reported".into(),
+            measured.is_finite(),
+        );
+    }
+
     /// measured ≤ bound.
     pub fn at_most(&mut self, case: &str, quantity: &str, measured: f64, bound: f64, source: &str) {
         let pass = measured <= bound;

@@ -10,7 +10,7 @@ use stickslip_testkit::impact::{self, wall, Impact, C, L, V0};
 use stickslip_testkit::scene::SceneError;
 use stickslip_testkit::settle;
 
-use crate::report::{num, Report};
+use crate::report::Report;
 
 /// Runs the checks.
 pub fn run(r: &mut Report) {
@@ -64,14 +64,7 @@ fn bar_impact(
                 r.at_most(&case, &quantity, error, softer, "below the softer wall's");
             } else {
                 let start = "table: falls as c_n grows";
-                r.row(
-                    &case,
-                    &quantity,
-                    num(error),
-                    start.into(),
-                    "reported".into(),
-                    true,
-                );
+                r.reported(&case, &quantity, error, start);
             }
             softer = error;
             if nx == 40 && cn == 1.0 {

@@ -48,7 +48,7 @@ use std::path::Path;
 
 use stickslip_time::Integrator;
 
-use crate::report::{num, Report};
+use crate::report::Report;
 use crate::scene::{integrator_of, paper_slab};
 
 /// The floors' stiffness c_n.
@@ -120,14 +120,7 @@ fn soft(root: &Path, r: &mut Report, (reference, nodes): (&[f64], &mut Vec<usize
             } else {
                 "table: falls like c_n from here"
             };
-            r.row(
-                &case,
-                &quantity,
-                num(now),
-                why.into(),
-                "reported".into(),
-                true,
-            );
+            r.reported(&case, &quantity, now, why);
         } else {
             let why = "the stiffer floor's difference / 5 (∝ c_n: / 10)";
             r.at_most(&case, &quantity, now, RATE * stiffer, why);
@@ -191,23 +184,9 @@ fn ceiling(root: &Path, r: &mut Report, (reference, nodes): (&[f64], &mut Vec<us
             } else {
                 "table: falls like 1/c_n from here"
             };
-            r.row(
-                &case,
-                quantity,
-                num(now),
-                why.into(),
-                "reported".into(),
-                true,
-            );
+            r.reported(&case, quantity, now, why);
         } else {
-            r.row(
-                &case,
-                quantity,
-                num(now),
-                "table".into(),
-                "reported".into(),
-                true,
-            );
+            r.reported(&case, quantity, now, "table");
             r.close(
                 &case,
                 "difference / the softer ceiling's",
@@ -255,16 +234,14 @@ fn stiff(root: &Path, r: &mut Report, (reference, nodes): (&[f64], &mut Vec<usiz
                 return;
             }
         };
-        r.row(
+        r.reported(
             &case,
             &format!(
                 "‖u_T − u_T(p)‖ / ‖u_T(p)‖ (floor's traction {:.1} to {:.1}, p = 300)",
                 range[0], range[1]
             ),
-            num(norm(&run, reference) / size),
-            "table against c_n: the models' difference".into(),
-            "reported".into(),
-            true,
+            norm(&run, reference) / size,
+            "table against c_n: the models' difference",
         );
         if let Some(softer) = &softer {
             let now = norm(&run, softer) / size;
@@ -274,14 +251,7 @@ fn stiff(root: &Path, r: &mut Report, (reference, nodes): (&[f64], &mut Vec<usiz
                 r.at_most(&case, quantity, now, RATE * change, why);
             } else {
                 let why = "table: falls like 1/c_n";
-                r.row(
-                    &case,
-                    quantity,
-                    num(now),
-                    why.into(),
-                    "reported".into(),
-                    true,
-                );
+                r.reported(&case, quantity, now, why);
             }
             change = now;
         }

@@ -81,13 +81,11 @@ fn closed_form(opts: &Options, r: &mut Report) {
                     );
                     let u = strip.measured_end(&slab, integrator.displacement());
                     let rel = u / strip.end_displacement() - 1.0;
-                    r.row(
+                    r.reported(
                         &case,
                         "end displacement / P²/(2gE*H) − 1",
-                        num(rel),
-                        "table: → 0 as H/L → 0".into(),
-                        "reported".into(),
-                        rel.is_finite(),
+                        rel,
+                        "table: → 0 as H/L → 0",
                     );
                     if ny == *layers.last().unwrap_or(&1) {
                         finest.push((h_l, rel));
@@ -189,13 +187,11 @@ fn slow_ramp(opts: &Options, r: &mut Report) {
                 let u_qs = strip.measured_end(&slab, qs.displacement());
                 let u_cd = strip.measured_end(&slab, cd.displacement());
                 let rel = (u_cd - u_qs).abs() / u_qs.abs();
-                r.row(
+                r.reported(
                     &case,
                     "|u_CD − u_QS| / u_QS at the ramp's end",
-                    num(rel),
-                    "falls with the ramp time".into(),
-                    "reported".into(),
-                    rel.is_finite(),
+                    rel,
+                    "falls with the ramp time",
                 );
                 diffs.push(rel);
             }
