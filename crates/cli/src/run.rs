@@ -63,18 +63,27 @@ pub(crate) fn prepare(case: &Case, progress: bool) -> Result<Prepared, InputErro
     scene.prepared(case)
 }
 
-/// [`prepare`] for a run, which will [`Integrator::restore`] a checkpoint
-/// when `restoring` (no initial static solve: the checkpoint has the
-/// state). K and M move into the integrator.
-fn prepare_run(case: &Case, restoring: bool, progress: bool) -> Result<Running, InputError> {
+/// The model of [`prepare`] for a run, which will [`Integrator::restore`]
+/// a checkpoint when `restoring` (no initial static solve: the checkpoint
+/// has the state); [`Scene::running`] then moves K and M into the
+/// integrator.
+fn assemble_run(case: &Case, restoring: bool, progress: bool) -> Result<Scene, InputError> {
     let started = Instant::now();
     let mut scene = stickslip_case::assemble(case)?;
     scene.settings.restoring = restoring;
     if progress {
         setup_note(&scene, started);
     }
-    scene.running(case)
+    Ok(scene)
 }
+
+/// Free DOFs from which a run's setup, steps and output run on a thread
+/// of rayon's pool. Its parallel passes then split between this thread
+/// and one other, where from outside the pool this thread waits while
+/// two of the pool's do them and spin after: three threads on two cores
+/// between the passes (docs/performance.md). Below it nothing starts the
+/// pool (the paper's mesh, whose run takes about 14 ms).
+const POOL_MIN: usize = 4_096;
 
 /// A line on stderr before the integrator's setup where the model has
 /// [`SETUP_NOTE_DOFS`] free DOFs or more: its factorizations take seconds
@@ -554,13 +563,31 @@ fn blow_up(i: &Integrator, initial: f64) -> Option<f64> {
 /// physics); I/O failures of the results file.
 pub fn execute(case: &Case, out: &Path, options: &RunOptions) -> anyhow::Result<Outcome> {
     let started = Instant::now();
+    let scene = assemble_run(case, options.restart, !options.quiet)?;
+    if scene.model.dofs.n_free() >= POOL_MIN {
+        // Called from outside the pool, `scope` runs its body on one of
+        // the pool's threads.
+        rayon::scope(|_| run_scene(case, out, options, scene, started))
+    } else {
+        run_scene(case, out, options, scene, started)
+    }
+}
+
+/// [`execute`] from its assembled model.
+fn run_scene(
+    case: &Case,
+    out: &Path,
+    options: &RunOptions,
+    scene: Scene,
+    started: Instant,
+) -> anyhow::Result<Outcome> {
     let quiet = options.quiet;
     let Running {
         mesh,
         dofs,
         mut integrator,
         setup: mut setup_parts,
-    } = prepare_run(case, options.restart, !quiet)?;
+    } = scene.running(case)?;
     let n_c = integrator.contact().map_or(0, |c| c.len());
     // A signal during the setup: stop before the file is touched (with
     // --force the old results would otherwise be gone for a run of one
