@@ -44,7 +44,7 @@ use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
 use crate::initial::Mass;
-use crate::newmark::{FirstStep, ImplicitFriction};
+use crate::newmark::{ImplicitFriction, Operator};
 use crate::settings::{InitialState, MassKind, Settings, TimeError};
 use crate::state::{State, StepEnergies, StepInfo};
 use crate::stepper::{Run, Stepper};
@@ -93,12 +93,7 @@ pub(crate) fn start(
     // Δt K has K's pattern: the preload's analysis is the increments'.
     // The first increment's operator, as the step forms it.
     let dt = State::new(0, 0, settings.dt).next_step(settings).0;
-    let first = FirstStep {
-        dt,
-        c_k: dt,
-        c_m: 0.0,
-        mass: &k,
-    };
+    let first = Operator::increment(dt, &k);
     let (mut state, friction) = ImplicitFriction::with_initial_state(
         &k,
         Mass::Massless,
@@ -145,11 +140,9 @@ impl Stepper for QuasiStatic {
             self.friction.predict_normal(c, &state.r, &state.v, dt);
         }
         let mut v_new = std::mem::take(&mut state.v_new);
-        // The operator Δt K + 0·K: Newmark's with β/γ = 1 and no mass.
         let result = self.friction.velocity(
             run,
-            (dt, dt, &self.k),
-            (0.0, &self.k),
+            Operator::increment(dt, &self.k),
             &self.b,
             (&mut state.classes_new, &mut v_new),
             (step, t_new),

@@ -9,6 +9,7 @@ use stickslip_linalg::{FillOrder, SolverError, SparseCholesky};
 
 use stickslip_linalg::csr::index as csr_index;
 
+use super::Operator;
 use crate::initial::SharedAnalysis;
 
 /// The implicit operator and its factorization for the current (Δt, stuck
@@ -74,27 +75,14 @@ impl DirectOperator {
     }
 
     /// Sets A₀ = c_k K + c_m M for a new Δt (M has K's pattern).
-    pub fn set_dt(
-        &mut self,
-        dt: f64,
-        c_k: f64,
-        stiffness: &CsrMatrix<f64>,
-        c_m: f64,
-        mass: &CsrMatrix<f64>,
-    ) {
-        if dt == self.key_dt {
+    pub fn set_dt(&mut self, operator: Operator) {
+        if operator.dt == self.key_dt {
             return;
         }
-        for ((a, k), m) in self
-            .a0
-            .values_mut()
-            .iter_mut()
-            .zip(stiffness.values())
-            .zip(mass.values())
-        {
-            *a = c_k * k + c_m * m;
+        for (a, v) in self.a0.values_mut().iter_mut().zip(operator.values()) {
+            *a = v;
         }
-        self.key_dt = dt;
+        self.key_dt = operator.dt;
         self.valid = false;
     }
 

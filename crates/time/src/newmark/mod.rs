@@ -121,15 +121,9 @@ pub(crate) fn start(
         MassKind::Consistent => Mass::Consistent(&m),
         MassKind::Lumped => Mass::Lumped(&lumped_mass),
     };
-    // The first step's Δt and operator, as the step will form them.
+    // The first step's operator, as the step will form it.
     let dt = State::new(0, 0, settings.dt).next_step(settings).0;
-    let (c_k, c_m) = operator_coefficients((beta, gamma), dt, settings.damping);
-    let first = FirstStep {
-        dt,
-        c_k,
-        c_m,
-        mass: &m,
-    };
+    let first = Operator::newmark((beta, gamma), dt, settings.damping, (&k, &m));
     let (mut state, friction) = ImplicitFriction::with_initial_state(
         &k,
         mass,
@@ -167,26 +161,55 @@ pub(crate) fn start(
     Ok((Box::new(stepper), state))
 }
 
-/// (c_K, c_M) of a step's operator c_K K + c_M M for Δt `dt`: (β/γ)Δt
-/// and 1/(γΔt) (METHOD.md §4), Rayleigh damping C = αM + βK joining A₀
-/// (METHOD.md §8).
-fn operator_coefficients((beta, gamma): (f64, f64), dt: f64, damping: Rayleigh) -> (f64, f64) {
-    let (c_k, c_m) = (beta / gamma * dt, 1.0 / (gamma * dt));
-    if damping.is_on() {
-        (c_k + damping.beta, c_m + damping.alpha)
-    } else {
-        (c_k, c_m)
-    }
-}
-
-/// The operator c_K K + c_M M of a run's first step (or quasi-static
-/// increment) of Δt `dt`, which [`ImplicitFriction::with_initial_state`]
-/// factorizes beside the preload.
-pub(crate) struct FirstStep<'a> {
+/// A step's operator A₀ = c_K K + c_M M of Δt `dt` (M has K's pattern),
+/// as the solvers factorize it: once per Δt (`schur.rs`), or per stuck
+/// set (`direct.rs`).
+#[derive(Clone, Copy)]
+pub(crate) struct Operator<'a> {
     pub dt: f64,
     pub c_k: f64,
+    pub k: &'a CsrMatrix<f64>,
     pub c_m: f64,
-    pub mass: &'a CsrMatrix<f64>,
+    pub m: &'a CsrMatrix<f64>,
+}
+
+impl<'a> Operator<'a> {
+    /// Newmark (β, γ)'s: (β/γ)Δt K + M/(γΔt) (METHOD.md §4), Rayleigh
+    /// damping C = αM + βK joining it (METHOD.md §8).
+    fn newmark(
+        (beta, gamma): (f64, f64),
+        dt: f64,
+        damping: Rayleigh,
+        (k, m): (&'a CsrMatrix<f64>, &'a CsrMatrix<f64>),
+    ) -> Operator<'a> {
+        let (mut c_k, mut c_m) = (beta / gamma * dt, 1.0 / (gamma * dt));
+        if damping.is_on() {
+            (c_k, c_m) = (c_k + damping.beta, c_m + damping.alpha);
+        }
+        Operator { dt, c_k, k, c_m, m }
+    }
+
+    /// A₀'s values on K's pattern, c_K k + c_M m value by value.
+    pub(crate) fn values(&self) -> impl Iterator<Item = f64> + '_ {
+        let (c_k, c_m) = (self.c_k, self.c_m);
+        self.k
+            .values()
+            .iter()
+            .zip(self.m.values())
+            .map(move |(k, m)| c_k * k + c_m * m)
+    }
+
+    /// A quasi-static increment's: Δt K + 0·K, Newmark's with β/γ = 1 and
+    /// no mass.
+    pub(crate) fn increment(dt: f64, k: &'a CsrMatrix<f64>) -> Operator<'a> {
+        Operator {
+            dt,
+            c_k: dt,
+            k,
+            c_m: 0.0,
+            m: k,
+        }
+    }
 }
 
 impl ImplicitFriction {
@@ -214,7 +237,7 @@ impl ImplicitFriction {
         contact: Option<&ContactSurface>,
         loads: &Loads,
         settings: &Settings,
-        first: Option<FirstStep>,
+        first: Option<Operator>,
     ) -> Result<(State, ImplicitFriction), TimeError> {
         let first = first.filter(|f| !settings.restoring && f.dt > 0.0);
         let (mut shared, mut friction) = (None, None);
@@ -238,7 +261,7 @@ impl ImplicitFriction {
             let ahead = friction
                 .as_mut()
                 .zip(first.as_ref())
-                .map(|(f, first)| s.spawn(move || f.factorize_ahead(k, first)));
+                .map(|(f, &first)| s.spawn(move || f.factorize_ahead(first)));
             let state = initial_state(k, mass, statics, contact, loads, settings, analyzed);
             let factored =
                 ahead.is_some_and(|h| h.join().expect("the first step's operator thread"));
@@ -248,7 +271,7 @@ impl ImplicitFriction {
         let friction = match (friction, first) {
             (Some(mut friction), Some(first)) => {
                 if factored {
-                    friction.finish_ahead(k, &first);
+                    friction.finish_ahead(first);
                 }
                 friction
             }
@@ -312,20 +335,18 @@ impl ImplicitFriction {
     /// it did (false for the direct solver, which factorizes per stuck
     /// set). A failure leaves no factor: the step factorizes again and
     /// reports it with its step and time.
-    fn factorize_ahead(&mut self, k: &CsrMatrix<f64>, first: &FirstStep) -> bool {
+    fn factorize_ahead(&mut self, first: Operator) -> bool {
         match &mut self.solver {
-            Solver::Schur(op) => op
-                .factorize_dt(first.dt, first.c_k, k, first.c_m, first.mass)
-                .is_ok(),
+            Solver::Schur(op) => op.factorize_dt(first).is_ok(),
             Solver::Direct(_) => false,
         }
     }
 
     /// S and W of the operator [`Self::factorize_ahead`] made (the cache
     /// holds its factor, so nothing is factorized again).
-    fn finish_ahead(&mut self, k: &CsrMatrix<f64>, first: &FirstStep) {
+    fn finish_ahead(&mut self, first: Operator) {
         if let Solver::Schur(op) = &mut self.solver {
-            let made = op.set_dt(first.dt, first.c_k, k, first.c_m, first.mass);
+            let made = op.set_dt(first);
             debug_assert!(made.is_ok(), "the factor is in the cache");
         }
     }
@@ -389,8 +410,7 @@ impl ImplicitFriction {
     pub(crate) fn velocity(
         &mut self,
         run: &Run,
-        (dt, c_k, k): (f64, f64, &CsrMatrix<f64>),
-        (c_m, m): (f64, &CsrMatrix<f64>),
+        operator: Operator,
         b: &[f64],
         (classes_new, v_new): (&mut [SlipState], &mut [f64]),
         (step, t): (u64, f64),
@@ -404,7 +424,7 @@ impl ImplicitFriction {
         let contact = self.lagged.as_ref().or(run.contact.as_ref());
         match &mut self.solver {
             Solver::Schur(op) => {
-                op.set_dt(dt, c_k, k, c_m, m)
+                op.set_dt(operator)
                     .map_err(|source| TimeError::Solve { step, t, source })?;
                 if contact.is_none() {
                     op.solve_plain(b, v_new);
@@ -454,7 +474,7 @@ impl ImplicitFriction {
                 Ok(report.iterations)
             }
             Solver::Direct(op) => {
-                op.set_dt(dt, c_k, k, c_m, m);
+                op.set_dt(operator);
                 let Some(contact) = contact else {
                     op.solve_plain(b, v_new)
                         .map_err(|source| TimeError::Solve { step, t, source })?;
@@ -675,11 +695,11 @@ impl Stepper for Newmark {
         }
         // Rayleigh damping joins A₀; R̂_K is unchanged, as ṙ_K is the
         // unknown.
-        let (c_k, c_m) = operator_coefficients((beta, gamma), dt, run.settings.damping);
+        let operator =
+            Operator::newmark((beta, gamma), dt, run.settings.damping, (&self.k, &self.m));
         let result = self.friction.velocity(
             run,
-            (dt, c_k, &self.k),
-            (c_m, &self.m),
+            operator,
             &self.b,
             (&mut state.classes_new, &mut v_new),
             (step, t_new),

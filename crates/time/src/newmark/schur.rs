@@ -33,6 +33,7 @@ use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{CompliantNode, ContactNode, ContactSurface, SlipState, StepSystem};
 use stickslip_linalg::{csc_view, FillOrder, PathOperator, SolverError, Supernodal};
 
+use super::Operator;
 use crate::initial::SharedAnalysis;
 
 /// How many Δt keep their factor (the normal and the reduced step).
@@ -216,15 +217,8 @@ impl SchurOperator {
 
     /// Makes the factor of A₀ = c_k K + c_m M for this Δt current: from the
     /// cache, or factorized (with S and W) once.
-    pub fn set_dt(
-        &mut self,
-        dt: f64,
-        c_k: f64,
-        stiffness: &CsrMatrix<f64>,
-        c_m: f64,
-        mass: &CsrMatrix<f64>,
-    ) -> Result<(), SolverError> {
-        self.factorize_dt(dt, c_k, stiffness, c_m, mass)?;
+    pub fn set_dt(&mut self, operator: Operator) -> Result<(), SolverError> {
+        self.factorize_dt(operator)?;
         if !self.entries[self.current].schur {
             self.build_schur(self.current);
         }
@@ -234,16 +228,9 @@ impl SchurOperator {
     /// [`Self::set_dt`] without S and W, which the next `set_dt` of this
     /// Δt makes: the factorization alone runs on the calling thread
     /// (faer's kernels), S and W on the pool.
-    pub fn factorize_dt(
-        &mut self,
-        dt: f64,
-        c_k: f64,
-        stiffness: &CsrMatrix<f64>,
-        c_m: f64,
-        mass: &CsrMatrix<f64>,
-    ) -> Result<(), SolverError> {
+    pub fn factorize_dt(&mut self, operator: Operator) -> Result<(), SolverError> {
         self.clock += 1;
-        let bits = dt.to_bits();
+        let bits = operator.dt.to_bits();
         if let Some(k) = self.entries.iter().position(|e| e.dt_bits == bits) {
             self.current = k;
             self.entries[k].last_used = self.clock;
@@ -252,12 +239,7 @@ impl SchurOperator {
         // A₀'s values (K and M share one pattern) and the factorization's
         // workspace live only while it runs: the step holds K, M and the
         // factors, not a third matrix.
-        let a0: Vec<f64> = stiffness
-            .values()
-            .iter()
-            .zip(mass.values())
-            .map(|(k, m)| c_k * k + c_m * m)
-            .collect();
+        let a0: Vec<f64> = operator.values().collect();
         let mut factor_scratch = MemBuffer::new(
             self.analysis
                 .symbolic()
@@ -268,7 +250,7 @@ impl SchurOperator {
         entry.dt_bits = u64::MAX; // invalid until factorized
         let result = self.analysis.symbolic().factorize_numeric_llt(
             &mut entry.l_values,
-            csc_view(stiffness, &a0),
+            csc_view(operator.k, &a0),
             Side::Lower,
             Default::default(),
             Par::Seq,
