@@ -326,17 +326,17 @@ impl Stencils {
                     // give the sums independent chains.
                     let alike = |q: usize| g + (q + 1) * h <= g1 && u.of_group[g + q * h] == id;
                     let q = if (1..4).all(alike) {
-                        let sums = unit_sums(simd, u, id, [r, r + w, r + 2 * w, r + 3 * w], x);
+                        let sums = unit_sums::<S, 4>(simd, u, id, r, x);
                         store_units::<S, _>(&mut out[o..o + 4 * w], sums);
                         4
                     } else if alike(1) {
                         store_units::<S, _>(
                             &mut out[o..o + 2 * w],
-                            unit_sums(simd, u, id, [r, r + w], x),
+                            unit_sums::<S, 2>(simd, u, id, r, x),
                         );
                         2
                     } else {
-                        store_units::<S, _>(&mut out[o..o + w], unit_sums(simd, u, id, [r], x));
+                        store_units::<S, 1>(&mut out[o..o + w], unit_sums(simd, u, id, r, x));
                         1
                     };
                     g += q * h;
@@ -497,8 +497,8 @@ fn store_units<S: crate::simd::Simd, const Q: usize>(out: &mut [f64], sums: [S::
     }
 }
 
-/// The sums of the w rows of unit `id` from each row of `rows`, in
-/// lockstep (each block's lanes loaded once for all): per row its own
+/// The sums of the w rows of unit `id` from each of Q consecutive units'
+/// first rows r, r + w, …, in lockstep (each block's lanes loaded once for all): per row its own
 /// column's terms and the other column's in two fused sums, in the unit's
 /// block order, added at the end, as [`Stencils::lockstep`] sums them (a
 /// lane's zero terms add ±0 to a sum that started at +0, which changes no
@@ -509,7 +509,7 @@ fn unit_sums<S: crate::simd::Simd, const Q: usize>(
     simd: S,
     u: &Units,
     id: u32,
-    rows: [usize; Q],
+    r: usize,
     x: &[f64],
 ) -> [S::f64s; Q] {
     let w = S::F64_LANES;
@@ -519,9 +519,12 @@ fn unit_sums<S: crate::simd::Simd, const Q: usize>(
     let lanes = u.lanes[2 * w * b.start..2 * w * b.end].chunks_exact(2 * w);
     for (&o, l) in u.offsets[b].iter().zip(lanes) {
         let (diagonal, across) = (load(&l[..w]), load(&l[w..]));
+        // The Q units' x at this block, sliced once: each unit's part is
+        // then at a constant offset, its bounds known at compile time.
+        let c = (r as isize + o as isize) as usize;
+        let xs = &x[c..c + Q * w];
         for q in 0..Q {
-            let c = (rows[q] as isize + o as isize) as usize;
-            let xc = load(&x[c..c + w]);
+            let xc = load(&xs[q * w..(q + 1) * w]);
             own[q] = simd.mul_add_f64s(diagonal, xc, own[q]);
             other[q] = simd.mul_add_f64s(across, crate::simd::swap_pairs(simd, xc), other[q]);
         }
