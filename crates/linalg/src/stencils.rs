@@ -336,7 +336,10 @@ impl Stencils {
                         );
                         2
                     } else {
-                        store_units::<S, 1>(&mut out[o..o + w], unit_sums(simd, u, id, r, x));
+                        store_units::<S, _>(
+                            &mut out[o..o + w],
+                            unit_sums::<S, 1>(simd, u, id, r, x),
+                        );
                         1
                     };
                     g += q * h;
@@ -497,9 +500,9 @@ fn store_units<S: crate::simd::Simd, const Q: usize>(out: &mut [f64], sums: [S::
     }
 }
 
-/// The sums of the w rows of unit `id` from each of Q consecutive units'
-/// first rows r, r + w, …, in lockstep (each block's lanes loaded once for all): per row its own
-/// column's terms and the other column's in two fused sums, in the unit's
+/// The sums of Q consecutive units of type `id` whose first rows are r,
+/// r + w, … (the caller's to ensure), in lockstep (each block's lanes
+/// loaded once for all): per row its own column's terms and the other column's in two fused sums, in the unit's
 /// block order, added at the end, as [`Stencils::lockstep`] sums them (a
 /// lane's zero terms add ±0 to a sum that started at +0, which changes no
 /// bit), so the same bits whatever Q. The other column's x is the own
