@@ -281,15 +281,17 @@ impl Symmetric {
             let (mut own1, mut other1) = (d[2] * x1, d[1] * x0);
             let b = self.block_range(g);
             for (&o, v) in self.offsets[b.clone()].iter().zip(&self.values[b]) {
+                // The block's two columns and rows, each one bounds check.
                 let w = r + o as usize;
-                let (xa, xb) = (x[w], x[w + 1]);
+                let [xa, xb]: [f64; 2] = x[w..w + 2].try_into().expect("two columns");
                 own0 = v[0].mul_add(xa, own0);
                 other0 = v[2].mul_add(xb, other0);
                 other1 = v[1].mul_add(xa, other1);
                 own1 = v[3].mul_add(xb, own1);
                 let l = w - a;
-                acc[l] += v[1].mul_add(x1, v[0] * x0);
-                acc[l + 1] += v[3].mul_add(x1, v[2] * x0);
+                let rows: &mut [f64; 2] = (&mut acc[l..l + 2]).try_into().expect("two rows");
+                rows[0] += v[1].mul_add(x1, v[0] * x0);
+                rows[1] += v[3].mul_add(x1, v[2] * x0);
             }
             acc[r - a] += own0 + other0;
             if pair {
