@@ -502,11 +502,12 @@ fn store_units<S: crate::simd::Simd, const Q: usize>(out: &mut [f64], sums: [S::
 
 /// The sums of Q consecutive units of type `id` whose first rows are r,
 /// r + w, … (the caller's to ensure), in lockstep (each block's lanes
-/// loaded once for all): per row its own column's terms and the other column's in two fused sums, in the unit's
-/// block order, added at the end, as [`Stencils::lockstep`] sums them (a
-/// lane's zero terms add ±0 to a sum that started at +0, which changes no
-/// bit), so the same bits whatever Q. The other column's x is the own
-/// column's with each pair of lanes swapped.
+/// loaded once for all): per row its own column's terms and the other
+/// column's in two fused sums, in the unit's block order, added at the
+/// end, as [`Stencils::lockstep`] sums them (a lane's zero terms add ±0
+/// to a sum that started at +0, which changes no bit), so the same bits
+/// whatever Q. The other column's x is the own column's with each pair
+/// of lanes swapped.
 #[inline(always)]
 fn unit_sums<S: crate::simd::Simd, const Q: usize>(
     simd: S,
