@@ -92,8 +92,7 @@ pub(crate) fn start(
     let n = k.nrows();
     // Δt K has K's pattern: the preload's analysis is the increments'.
     // The first increment's operator, as the step forms it.
-    let dt = State::new(0, 0, settings.dt).next_step(settings).0;
-    let first = Operator::increment(dt, &k);
+    let first = Operator::increment(State::first_dt(settings), &k);
     let (mut state, friction) = ImplicitFriction::with_initial_state(
         &k,
         Mass::Massless,

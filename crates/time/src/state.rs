@@ -218,6 +218,13 @@ impl State {
         }
     }
 
+    /// The first step's Δt from a fresh start, as [`State::next_step`]
+    /// takes it (shortened where t_end comes first): the implicit schemes
+    /// factorize its operator during their setup.
+    pub fn first_dt(settings: &Settings) -> f64 {
+        State::new(0, 0, settings.dt).next_step(settings).0
+    }
+
     /// The size of the next step and the time it ends at: Remark 4.3's
     /// reduced step while its count runs ([`Clock`]); the last step lands
     /// on t_end, shortened where t_end is not within [`END_SLACK`] of a

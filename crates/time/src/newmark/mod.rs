@@ -122,7 +122,7 @@ pub(crate) fn start(
         MassKind::Lumped => Mass::Lumped(&lumped_mass),
     };
     // The first step's operator, as the step will form it.
-    let dt = State::new(0, 0, settings.dt).next_step(settings).0;
+    let dt = State::first_dt(settings);
     let first = Operator::newmark((beta, gamma), dt, settings.damping, (&k, &m));
     let (mut state, friction) = ImplicitFriction::with_initial_state(
         &k,
