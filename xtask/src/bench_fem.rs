@@ -178,6 +178,6 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         );
     }
     println!("K+M_s: K, consistent M and lumped M in one pass (pattern excluded); x_asm = scikit-fem K assembly / (pattern + K+M);");
-    println!("factor = ordering + symbolic + numeric Cholesky (faer; AMD, from 100k free DOFs a nested dissection of the cells unless AMD's factor is 10% smaller); x_fact = scipy splu (SuperLU, COLAMD) factor time / factor.");
+    println!("factor = ordering + symbolic + numeric Cholesky (faer; AMD, from 500 free DOFs a nested dissection of the cells unless AMD's factor is 10% smaller); x_fact = scipy splu (SuperLU, COLAMD) factor time / factor.");
     Ok(())
 }

@@ -323,7 +323,7 @@ fn oblique_supports(mesh: &Mesh, c: &ContactSurface) -> Option<String> {
 
 /// The `/solver` attribute `fill_order` a run writes: the decided ordering
 /// of its sparse Cholesky factors; where the choice is still open because
-/// the run factorized nothing (explicit, no preload, from 100k free DOFs),
+/// the run factorized nothing (explicit, no preload, from 500 free DOFs),
 /// `None` on a restart (the file keeps what the first run wrote) and
 /// "none" on a fresh run, so that every results file has the attribute.
 fn fill_order_attr(decided: Option<&str>, restart: bool) -> Option<String> {

@@ -55,7 +55,7 @@ fn main() {
     let pattern_s = t.elapsed().as_secs_f64();
     drop(pattern);
     // Model::new = DOF map + pattern + K, M, lumped M in one pass, and the
-    // factors' ordering (from 100k free DOFs a nested dissection): that
+    // factors' ordering (from 500 free DOFs a nested dissection): that
     // ordering is timed alone and counted with the factorization, as AMD's
     // is (and SuperLU's COLAMD in the peer's), not with the assembly.
     let t = Instant::now();

@@ -6,7 +6,7 @@
 //! fixed DOFs are eliminated and the rest numbered node by node (x before
 //! y), which keeps each node's DOFs adjacent (the assembly exploits it).
 //! Bandwidth is left to the Cholesky's fill-reducing ordering (AMD, or
-//! from 100k free DOFs a nested dissection of the cells: `ordering.rs`).
+//! from 500 free DOFs a nested dissection of the cells: `ordering.rs`).
 //!
 //! The node order ([`NodeOrder`]) is not the file's: where the nodes form
 //! a structured grid they are taken row by row, as a generator that knows

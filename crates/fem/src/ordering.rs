@@ -1,7 +1,8 @@
 //! The fill-reducing ordering of the Cholesky factors (the static solve,
-//! Newmark's A₀, the consistent mass): faer's AMD on small systems, a
-//! nested dissection by cells from [`DISSECTION_MIN_DOFS`] unless AMD's
-//! factor is clearly smaller ([`FillOrder`]).
+//! Newmark's A₀, the consistent mass): faer's AMD on the smallest systems
+//! (the paper's meshes), a nested dissection by cells from
+//! [`DISSECTION_MIN_DOFS`] unless AMD's factor is clearly smaller
+//! ([`FillOrder`]).
 //!
 //! Nested dissection: the cells are split at the median of their centroids
 //! across the longer side of their bounding box, the nodes the two halves
@@ -11,10 +12,14 @@
 //! Against AMD (faer's symbolic and numeric factorization of K), the
 //! dissection's factor has fewer values and factorizes faster on
 //! unstructured meshes of a few hundred thousand DOFs and more; on grids
-//! numbered row by row its fill is AMD's within a few per cent either way,
-//! and its larger supernodes make the Newmark step's solves as fast or
-//! faster. Below [`DISSECTION_MIN_DOFS`] AMD stays: there the dissection
-//! gains little or nothing. The figures are in docs/performance.md; `cargo
+//! numbered row by row its fill is AMD's within a few per cent either way
+//! (up to 13% more below 2k DOFs), its analysis costs a fraction of AMD's,
+//! and its larger supernodes make the Newmark step's solves faster: whole
+//! runs of the slabs from 552 DOFs take fewer instructions. Below
+//! [`DISSECTION_MIN_DOFS`] AMD stays: there the analysis and the factor
+//! cost well under a millisecond either way, and the paper's meshes keep
+//! the order their runs were verified in. The figures are in
+//! docs/performance.md; `cargo
 //! run --release -p stickslip-fem --example fill_order -- MESH...` prints
 //! them for any mesh.
 //!
@@ -38,10 +43,11 @@ use stickslip_mesh::Mesh;
 
 use crate::dofs::DofMap;
 
-/// Free DOFs from which the factors are ordered by nested dissection: at
-/// about 60k DOFs the two orderings' factors are within a few per cent of
-/// each other either way (docs/performance.md).
-pub const DISSECTION_MIN_DOFS: usize = 100_000;
+/// Free DOFs from which the factors are ordered by nested dissection
+/// (module documentation): whole runs take fewer instructions on every
+/// slab measured from 552 DOFs up; below lie the paper's meshes
+/// (docs/performance.md, "Nested dissection from 500 DOFs").
+pub const DISSECTION_MIN_DOFS: usize = 500;
 
 /// Environment variable that overrides the choice, for comparisons:
 /// `amd` or `nd` (as [`crate::dofs::ORDER_ENV`] keeps the file's node

@@ -147,11 +147,16 @@ fn amd_on_small_meshes_the_smaller_factor_on_large_ones() {
     if std::env::var_os(FILL_ORDER_ENV).is_some() {
         return;
     }
-    let (mesh, dofs) = slab_dofs(CellKind::Quad4, 4);
+    // The 16 × 4 slab: AMD; the 32 × 8 (552 free DOFs): the dissection.
+    let (mesh, dofs) = slab_dofs(CellKind::Quad4, 1);
+    assert!(dofs.n_free() < DISSECTION_MIN_DOFS);
     let small = choose(&mesh, &dofs);
     assert!(small.dissection_order().is_none());
     assert_eq!(small.name(), "AMD");
     assert_eq!(small.decided_name(), Some("AMD"));
+    let (mesh, dofs) = slab_dofs(CellKind::Quad4, 2);
+    assert!(dofs.n_free() >= DISSECTION_MIN_DOFS);
+    assert!(choose(&mesh, &dofs).dissection_order().is_some());
     // 28 × (16×4) cells: 100,912 free DOFs, the dissection a
     // candidate, kept; and a strip of 5000 × 10 cells (110k DOFs),
     // where AMD's factor is the smaller by more than the margin (1.23×,
