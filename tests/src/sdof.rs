@@ -96,7 +96,7 @@ pub fn with_load(
     };
     let dynamics = Dynamics {
         stiffness: scalar(K),
-        consistent_mass: scalar(1.0),
+        consistent_mass: Some(scalar(1.0)),
         lumped_mass: vec![1.0],
         constant_load: vec![0.0],
         stencils: true,

@@ -49,7 +49,11 @@ impl Fault {
             Fault::NoRemark42 => scene.settings.iteration.remark_4_2 = false,
             Fault::WrongMass => match scene.settings.scheme {
                 Scheme::CentralDifference => {
-                    let m = &scene.model.mass;
+                    let m = scene
+                        .model
+                        .mass
+                        .as_ref()
+                        .expect("case::assemble builds the consistent mass");
                     for (i, row) in m.row_iter().enumerate() {
                         let d = row
                             .col_indices()

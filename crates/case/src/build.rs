@@ -296,6 +296,25 @@ fn check_group(
 /// # Errors
 /// Every input problem found, as one [`InputError`].
 pub fn assemble(case: &Case) -> Result<Scene, InputError> {
+    assemble_with(case, true)
+}
+
+/// [`assemble`] for a run of the case's own scheme: the consistent mass
+/// only where that scheme reads it (Newmark with `time.mass` consistent,
+/// its default), so that a central-difference or quasi-static run neither
+/// assembles nor holds it. The scene then serves that scheme only: an
+/// integrator of Newmark with the consistent mass refuses it.
+///
+/// # Errors
+/// As [`assemble`].
+pub fn assemble_for_run(case: &Case) -> Result<Scene, InputError> {
+    let consistent =
+        case.time.scheme == Scheme::Newmark && case.time.mass != Some(MassKind::Lumped);
+    assemble_with(case, consistent)
+}
+
+/// [`assemble`], the consistent mass only `with_mass`.
+fn assemble_with(case: &Case, with_mass: bool) -> Result<Scene, InputError> {
     let mut setup = SetupTimes::default();
     let mesh = setup
         .time("mesh read", || Mesh::from_file(&case.mesh.file))
@@ -381,7 +400,11 @@ pub fn assemble(case: &Case) -> Result<Scene, InputError> {
     }
     let dirichlet_at = case.at("dirichlet.0.group");
     let model = match (&material, dirichlet_ok) {
-        (Some(material), true) => match Model::new(&mesh, material, &conditions) {
+        (Some(material), true) => match if with_mass {
+            Model::new(&mesh, material, &conditions)
+        } else {
+            Model::without_consistent_mass(&mesh, material, &conditions)
+        } {
             Ok(m) => Some(m),
             Err(e) => {
                 problems.push(format!("{dirichlet_at}[[dirichlet]]: {e}"));

@@ -31,7 +31,7 @@ pub mod schema;
 mod set;
 mod surfaces;
 
-pub use build::{assemble, prepare, settings, Prepared, Running, Scene};
+pub use build::{assemble, assemble_for_run, prepare, settings, Prepared, Running, Scene};
 pub use error::{listed, InputError, SHOWN};
 pub use load::{load, load_str, parse_str};
 pub use method::{Method, PAPER_REDUCTION};

@@ -65,11 +65,11 @@ pub(crate) fn prepare(case: &Case, progress: bool) -> Result<Prepared, InputErro
 
 /// The model of [`prepare`] for a run, which will [`Integrator::restore`]
 /// a checkpoint when `restoring` (no initial static solve: the checkpoint
-/// has the state); [`Scene::running`] then moves K and M into the
-/// integrator.
+/// has the state), the consistent mass only where the case's scheme reads
+/// it; [`Scene::running`] then moves K and M into the integrator.
 fn assemble_run(case: &Case, restoring: bool, progress: bool) -> Result<Scene, InputError> {
     let started = Instant::now();
-    let mut scene = stickslip_case::assemble(case)?;
+    let mut scene = stickslip_case::assemble_for_run(case)?;
     scene.settings.restoring = restoring;
     if progress {
         setup_note(&scene, started);

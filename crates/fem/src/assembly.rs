@@ -65,8 +65,8 @@ type Slots<'a> = (
 );
 
 /// What one part of the scatter owns: rows `rows` of K, M and the
-/// Dirichlet load (their values from `row_offsets[rows.start]`), and the
-/// lumped masses of nodes `nodes`.
+/// Dirichlet load (their values from `row_offsets[rows.start]`; `mass`
+/// empty where M is left out), and the lumped masses of nodes `nodes`.
 struct Part<'a> {
     rows: std::ops::Range<usize>,
     nodes: std::ops::Range<usize>,
@@ -81,10 +81,11 @@ struct Part<'a> {
 fn parts<'a>(out: Assembly<'a>, row_offsets: &[usize], count: usize) -> Vec<Part<'a>> {
     let Assembly {
         mut stiffness,
-        mut mass,
+        mass,
         mut lumped_nodal,
         mut dirichlet_load,
     } = out;
+    let mut mass = mass.unwrap_or_default();
     let (n_rows, n_nodes) = (dirichlet_load.len(), lumped_nodal.len());
     let nnz = stiffness.len();
     let (mut row, mut node) = (0, 0);
@@ -101,7 +102,11 @@ fn parts<'a>(out: Assembly<'a>, row_offsets: &[usize], count: usize) -> Vec<Part
         let end_node = n_nodes * t / count;
         let values = row_offsets[end_row] - row_offsets[row];
         let (k, k_rest) = std::mem::take(&mut stiffness).split_at_mut(values);
-        let (m, m_rest) = std::mem::take(&mut mass).split_at_mut(values);
+        let (m, m_rest) = if mass.is_empty() {
+            (&mut [][..], &mut [][..])
+        } else {
+            std::mem::take(&mut mass).split_at_mut(values)
+        };
         let (d, d_rest) = std::mem::take(&mut dirichlet_load).split_at_mut(end_row - row);
         let (l, l_rest) = std::mem::take(&mut lumped_nodal).split_at_mut(end_node - node);
         (stiffness, mass, dirichlet_load, lumped_nodal) = (k_rest, m_rest, d_rest, l_rest);
@@ -123,15 +128,16 @@ fn parts<'a>(out: Assembly<'a>, row_offsets: &[usize], count: usize) -> Vec<Part
 pub struct Assembly<'a> {
     /// K values (pattern of [`crate::free_dof_pattern`]), overwritten.
     pub stiffness: &'a mut [f64],
-    /// Consistent M values (same pattern), overwritten.
-    pub mass: &'a mut [f64],
+    /// Consistent M values (same pattern), overwritten; `None` leaves M
+    /// out (explicit and quasi-static runs never read it).
+    pub mass: Option<&'a mut [f64]>,
     /// HRZ lumped mass per node (same for both components), overwritten.
     pub lumped_nodal: &'a mut [f64],
     /// −K_fc u_c on free DOFs, overwritten.
     pub dirichlet_load: &'a mut [f64],
 }
 
-/// Assembles K, consistent M, HRZ-lumped nodal masses and the Dirichlet load
+/// Assembles K, consistent M (where asked), HRZ-lumped nodal masses and the Dirichlet load
 /// into `out` (values in the pattern `pattern`, which must be
 /// [`crate::free_dof_pattern`] of `mesh` and `dofs`). Returns the mesh area.
 ///
@@ -147,17 +153,17 @@ pub fn assemble(
 ) -> Result<f64, FemError> {
     let Assembly {
         stiffness,
-        mass,
+        mut mass,
         lumped_nodal,
         dirichlet_load,
     } = out;
     assert_eq!(stiffness.len(), pattern.nnz());
-    assert_eq!(mass.len(), pattern.nnz());
+    assert!(mass.as_ref().is_none_or(|m| m.len() == pattern.nnz()));
     assert_eq!(lumped_nodal.len(), mesh.nodes.len());
     assert_eq!(dirichlet_load.len(), dofs.n_free());
     // Zeroing touches every page of the value arrays (hundreds of MB at
     // 500k DOFs); in parallel, so the page faults are shared out too.
-    for values in [&mut *stiffness, &mut *mass] {
+    for values in std::iter::once(&mut *stiffness).chain(mass.as_deref_mut()) {
         if values.len() > PARALLEL_ZEROING {
             values
                 .par_chunks_mut(PARALLEL_ZEROING)
@@ -353,6 +359,7 @@ fn scatter(
     let n = mesh.kind.nodes_per_cell();
     let nd = 2 * n;
     let base = row_offsets[part.rows.start];
+    let with_mass = !part.mass.is_empty();
     let first = cells.start;
     for c in cells {
         let i = c - first;
@@ -381,7 +388,7 @@ fn scatter(
                     let p = prow[beta];
                     if p != NO_POSITION {
                         part.stiffness[p - base] += krow[beta];
-                        if j == comp {
+                        if j == comp && with_mass {
                             part.mass[p - base] += mrow[b];
                         }
                     } else if nonzero_prescribed {
@@ -461,17 +468,20 @@ mod tests {
         (k, m, lumped, load, area)
     }
 
+    /// [`assemble`] into arrays of ones (overwritten); M left at its ones
+    /// without `with_mass`.
     fn parallel(
         mesh: &Mesh,
         material: &Material,
         dofs: &DofMap,
         pattern: &SparsityPattern,
+        with_mass: bool,
     ) -> Assembled {
         let (mut k, mut m) = (vec![1.0; pattern.nnz()], vec![1.0; pattern.nnz()]);
         let (mut lumped, mut load) = (vec![1.0; mesh.nodes.len()], vec![1.0; dofs.n_free()]);
         let out = Assembly {
             stiffness: &mut k,
-            mass: &mut m,
+            mass: with_mass.then_some(&mut m[..]),
             lumped_nodal: &mut lumped,
             dirichlet_load: &mut load,
         };
@@ -503,7 +513,7 @@ mod tests {
 
     /// The scatter by parts gives every value the bits of the sequential
     /// scatter in element order, on one thread and on several (parts of
-    /// other sizes), for Q1 and Q2 cells.
+    /// other sizes), for Q1 and Q2 cells, with M or without it.
     #[test]
     fn parts_scatter_with_the_sequential_bits() {
         for (kind, refine) in [(CellKind::Quad4, 8), (CellKind::Quad9, 4)] {
@@ -517,12 +527,20 @@ mod tests {
                     .num_threads(threads)
                     .build()
                     .expect("a pool");
-                let got = pool.install(|| parallel(&mesh, &material, &dofs, &pattern));
-                assert_eq!(bits(&got.0), bits(&expected.0), "K, {threads} threads");
-                assert_eq!(bits(&got.1), bits(&expected.1), "M, {threads} threads");
-                assert_eq!(bits(&got.2), bits(&expected.2), "lumped M");
-                assert_eq!(bits(&got.3), bits(&expected.3), "Dirichlet load");
-                assert_eq!(got.4.to_bits(), expected.4.to_bits(), "area");
+                for with_mass in [true, false] {
+                    let got =
+                        pool.install(|| parallel(&mesh, &material, &dofs, &pattern, with_mass));
+                    let at = format!("{threads} threads, M assembled: {with_mass}");
+                    assert_eq!(bits(&got.0), bits(&expected.0), "K, {at}");
+                    if with_mass {
+                        assert_eq!(bits(&got.1), bits(&expected.1), "M, {at}");
+                    } else {
+                        assert!(got.1.iter().all(|&m| m == 1.0), "M untouched, {at}");
+                    }
+                    assert_eq!(bits(&got.2), bits(&expected.2), "lumped M, {at}");
+                    assert_eq!(bits(&got.3), bits(&expected.3), "Dirichlet load, {at}");
+                    assert_eq!(got.4.to_bits(), expected.4.to_bits(), "area, {at}");
+                }
             }
         }
     }

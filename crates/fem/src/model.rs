@@ -1,6 +1,6 @@
 //! The assembled model: DOF map, K and consistent M on the free DOFs (one
-//! sparsity pattern), HRZ-lumped mass, and the load of the prescribed
-//! displacements.
+//! sparsity pattern; M only where a run reads it), HRZ-lumped mass, and
+//! the load of the prescribed displacements.
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_mesh::Mesh;
@@ -22,8 +22,9 @@ pub struct Model {
     /// Stiffness K on free DOFs: symmetric, both triangles stored, columns sorted.
     pub stiffness: CsrMatrix<f64>,
     /// Consistent mass M with the same sparsity pattern as `stiffness`
-    /// (explicit zeros where only K couples, e.g. x-y entries).
-    pub mass: CsrMatrix<f64>,
+    /// (explicit zeros where only K couples, e.g. x-y entries); `None` for
+    /// a model built without it ([`Model::without_consistent_mass`]).
+    pub mass: Option<CsrMatrix<f64>>,
     /// HRZ lumped mass per free DOF (METHOD.md §3).
     pub lumped_mass: Vec<f64>,
     /// −K_fc u_c on free DOFs: the load of the prescribed displacements.
@@ -54,7 +55,27 @@ impl Model {
         let dofs = setup.time("DOF map", || {
             DofMap::with_adjacency(mesh, conditions, &adjacency)
         })?;
-        Model::build(mesh, material, dofs, &adjacency, setup)
+        Model::build(mesh, material, dofs, &adjacency, setup, true)
+    }
+
+    /// [`Model::new`] without the consistent mass (`mass` is `None`): the
+    /// explicit and quasi-static schemes never read it, and at 500k DOFs
+    /// its values and its copy of the pattern are a sixth of a run's
+    /// memory (docs/performance.md).
+    ///
+    /// # Errors
+    /// As [`Model::new`].
+    pub fn without_consistent_mass(
+        mesh: &Mesh,
+        material: &Material,
+        conditions: &[Dirichlet],
+    ) -> Result<Model, FemError> {
+        let mut setup = SetupTimes::default();
+        let adjacency = SharedAdjacency::new();
+        let dofs = setup.time("DOF map", || {
+            DofMap::with_adjacency(mesh, conditions, &adjacency)
+        })?;
+        Model::build(mesh, material, dofs, &adjacency, setup, false)
     }
 
     /// [`Model::new`] on a DOF map of `mesh` made already (e.g. one
@@ -64,16 +85,25 @@ impl Model {
     /// [`FemError::InvertedCell`].
     pub fn with_dofs(mesh: &Mesh, material: &Material, dofs: DofMap) -> Result<Model, FemError> {
         let adjacency = SharedAdjacency::new();
-        Model::build(mesh, material, dofs, &adjacency, SetupTimes::default())
+        Model::build(
+            mesh,
+            material,
+            dofs,
+            &adjacency,
+            SetupTimes::default(),
+            true,
+        )
     }
 
-    /// [`Model::with_dofs`], its parts' times added to `setup`.
+    /// [`Model::with_dofs`], its parts' times added to `setup`, M only
+    /// `with_mass`.
     fn build(
         mesh: &Mesh,
         material: &Material,
         dofs: DofMap,
         adjacency: &SharedAdjacency,
         mut setup: SetupTimes,
+        with_mass: bool,
     ) -> Result<Model, FemError> {
         let pattern = setup.time("pattern", || {
             pattern_of(shared_adjacency(mesh, adjacency), &dofs)
@@ -81,7 +111,11 @@ impl Model {
         let started = std::time::Instant::now();
         let nnz = pattern.nnz();
         let mut k = vec![0.0; nnz];
-        let mut m = vec![0.0; nnz];
+        let mut m = if with_mass {
+            vec![0.0; nnz]
+        } else {
+            Vec::new()
+        };
         let mut lumped_nodal = vec![0.0; mesh.nodes.len()];
         let mut dirichlet_load = vec![0.0; dofs.n_free()];
         let area = assemble(
@@ -91,7 +125,7 @@ impl Model {
             &pattern,
             Assembly {
                 stiffness: &mut k,
-                mass: &mut m,
+                mass: with_mass.then_some(&mut m[..]),
                 lumped_nodal: &mut lumped_nodal,
                 dirichlet_load: &mut dirichlet_load,
             },
@@ -99,10 +133,16 @@ impl Model {
         let lumped_mass = (0..dofs.n_free())
             .map(|f| lumped_nodal[dofs.full_of_free(f) / 2])
             .collect();
-        let stiffness = CsrMatrix::try_from_pattern_and_values(pattern.clone(), k)
-            .expect("one value per pattern entry");
-        let mass = CsrMatrix::try_from_pattern_and_values(pattern, m)
-            .expect("one value per pattern entry");
+        let matrix = |pattern, values| {
+            CsrMatrix::try_from_pattern_and_values(pattern, values)
+                .expect("one value per pattern entry")
+        };
+        // Without M, K takes the pattern itself rather than a copy.
+        let (stiffness, mass) = if with_mass {
+            (matrix(pattern.clone(), k), Some(matrix(pattern, m)))
+        } else {
+            (matrix(pattern, k), None)
+        };
         setup.add("assembly", started.elapsed().as_secs_f64());
         let fill_order = setup.time("ordering", || crate::ordering::choose(mesh, &dofs));
         Ok(Model {
@@ -122,8 +162,13 @@ impl Model {
     /// is allocated.
     ///
     /// # Panics
-    /// If `out` does not have as many entries as K.
+    /// If `out` does not have as many entries as K, or the model was built
+    /// without M.
     pub fn combine(&self, a: f64, b: f64, out: &mut CsrMatrix<f64>) {
+        let mass = self
+            .mass
+            .as_ref()
+            .expect("combine: the model was built without the consistent mass");
         assert_eq!(
             out.nnz(),
             self.stiffness.nnz(),
@@ -134,13 +179,14 @@ impl Model {
             .values_mut()
             .iter_mut()
             .zip(self.stiffness.values())
-            .zip(self.mass.values())
+            .zip(mass.values())
         {
             *o = a * k + b * m;
         }
     }
 
-    /// A new matrix `a·K + b·M` (allocates; use [`Model::combine`] to refill it).
+    /// A new matrix `a·K + b·M` (allocates; use [`Model::combine`] to refill
+    /// it). Panics as [`Model::combine`].
     pub fn combined(&self, a: f64, b: f64) -> CsrMatrix<f64> {
         let mut out = self.stiffness.clone();
         self.combine(a, b, &mut out);

@@ -179,7 +179,10 @@ fn permuted_model(file: &str, order: NodeOrder) {
         }
         d
     };
-    for (name, a, b) in [("K", &m.stiffness, &g.stiffness), ("M", &m.mass, &g.mass)] {
+    for (name, a, b) in [
+        ("K", &m.stiffness, &g.stiffness),
+        ("M", m.mass.as_ref().unwrap(), g.mass.as_ref().unwrap()),
+    ] {
         assert_eq!(a.nnz(), b.nnz(), "{name}");
         let (a, b) = (dense(a), dense(b));
         for i in 0..n {

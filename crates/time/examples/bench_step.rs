@@ -130,8 +130,9 @@ fn dump_problem(
     write_i64(&dir.join("indptr.i64"), k.row_offsets());
     write_i64(&dir.join("indices.i64"), k.col_indices());
     write_f64(&dir.join("k.f64"), k.values());
-    assert!(model.mass.pattern() == k.pattern(), "M has K's pattern");
-    write_f64(&dir.join("m.f64"), model.mass.values());
+    let m = model.mass.as_ref().expect("Model::new assembles M");
+    assert!(m.pattern() == k.pattern(), "M has K's pattern");
+    write_f64(&dir.join("m.f64"), m.values());
     write_f64(&dir.join("lumped.f64"), &model.lumped_mass);
     write_f64(&dir.join("constant.f64"), &model.dirichlet_load);
     let mut histories = Vec::new();

@@ -7,15 +7,16 @@ use stickslip_linalg::FillOrder;
 
 use crate::history::History;
 
-/// K, M (consistent, with K's sparsity pattern), the HRZ lumped mass, and
-/// a load that never changes (the lifting of nonzero prescribed
-/// displacements).
+/// K, M (consistent, with K's sparsity pattern, where assembled), the HRZ
+/// lumped mass, and a load that never changes (the lifting of nonzero
+/// prescribed displacements).
 #[derive(Clone, Debug)]
 pub struct Dynamics {
     /// Stiffness K.
     pub stiffness: CsrMatrix<f64>,
-    /// Consistent mass M, same pattern as K.
-    pub consistent_mass: CsrMatrix<f64>,
+    /// Consistent mass M, same pattern as K; `None` where the model was
+    /// built without it (only Newmark with the consistent mass reads it).
+    pub consistent_mass: Option<CsrMatrix<f64>>,
     /// Lumped mass, one value per free DOF.
     pub lumped_mass: Vec<f64>,
     /// A load acting at all times, also before t = 0.

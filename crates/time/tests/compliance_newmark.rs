@@ -103,7 +103,7 @@ fn frictionless_average_acceleration_closes_the_ledger_on_every_step() {
     ] {
         let bar = Bar::new(nx, law).unwrap();
         let m = match mass {
-            MassKind::Consistent => bar.model.mass.clone(),
+            MassKind::Consistent => bar.model.mass.clone().unwrap(),
             MassKind::Lumped => lumped(&bar.model),
         };
         let mut partials = stickslip_linalg::chunks::partials(bar.model.dofs.n_free());
@@ -199,7 +199,7 @@ fn the_reported_acceleration_is_the_end_points() {
         for mass in [MassKind::Consistent, MassKind::Lumped] {
             let bar = Bar::new(nx, law).unwrap();
             let m = match mass {
-                MassKind::Consistent => bar.model.mass.clone(),
+                MassKind::Consistent => bar.model.mass.clone().unwrap(),
                 MassKind::Lumped => lumped(&bar.model),
             };
             let mut run = bar_run(&bar, dt, mass);

@@ -22,7 +22,7 @@ fn pair(settings: Settings) -> Integrator {
     };
     let dynamics = Dynamics {
         stiffness: diagonal(K),
-        consistent_mass: diagonal(1.0),
+        consistent_mass: Some(diagonal(1.0)),
         lumped_mass: vec![1.0; 2],
         constant_load: vec![0.0; 2],
         stencils: true,

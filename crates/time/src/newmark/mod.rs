@@ -103,7 +103,14 @@ pub(crate) fn start(
     } = dynamics;
     let n = k.nrows();
     let m = match mass_kind {
-        MassKind::Consistent => consistent_mass,
+        MassKind::Consistent => consistent_mass.ok_or_else(|| {
+            TimeError::Settings(
+                "Newmark with the consistent mass on a model built without it \
+                 (stickslip_fem::Model::without_consistent_mass): build it with Model::new, \
+                 or set time.mass = \"lumped\""
+                    .into(),
+            )
+        })?,
         MassKind::Lumped => {
             drop(consistent_mass);
             let mut m = k.clone();
