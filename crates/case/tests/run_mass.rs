@@ -46,6 +46,8 @@ fn newmark_with_the_consistent_mass_refuses_a_scene_without_it() {
         beta: 0.25,
         gamma: 0.5,
     };
-    let err = scene.integrator().expect_err("no consistent mass to run with");
+    let err = scene
+        .integrator()
+        .expect_err("no consistent mass to run with");
     assert!(err.to_string().contains("consistent mass"), "{err}");
 }

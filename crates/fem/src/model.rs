@@ -49,13 +49,7 @@ impl Model {
         material: &Material,
         conditions: &[Dirichlet],
     ) -> Result<Model, FemError> {
-        let mut setup = SetupTimes::default();
-        // The DOF map's bandwidth order and the pattern read one adjacency.
-        let adjacency = SharedAdjacency::new();
-        let dofs = setup.time("DOF map", || {
-            DofMap::with_adjacency(mesh, conditions, &adjacency)
-        })?;
-        Model::build(mesh, material, dofs, &adjacency, setup, true)
+        Model::on_mesh(mesh, material, conditions, true)
     }
 
     /// [`Model::new`] without the consistent mass (`mass` is `None`): the
@@ -70,12 +64,23 @@ impl Model {
         material: &Material,
         conditions: &[Dirichlet],
     ) -> Result<Model, FemError> {
+        Model::on_mesh(mesh, material, conditions, false)
+    }
+
+    /// The DOF map, then [`Model::build`].
+    fn on_mesh(
+        mesh: &Mesh,
+        material: &Material,
+        conditions: &[Dirichlet],
+        with_mass: bool,
+    ) -> Result<Model, FemError> {
         let mut setup = SetupTimes::default();
+        // The DOF map's bandwidth order and the pattern read one adjacency.
         let adjacency = SharedAdjacency::new();
         let dofs = setup.time("DOF map", || {
             DofMap::with_adjacency(mesh, conditions, &adjacency)
         })?;
-        Model::build(mesh, material, dofs, &adjacency, setup, false)
+        Model::build(mesh, material, dofs, &adjacency, setup, with_mass)
     }
 
     /// [`Model::new`] on a DOF map of `mesh` made already (e.g. one
