@@ -27,7 +27,7 @@ use crate::schema::{Case, History, Hypothesis, InitialState, MassKind, Scheme};
 pub struct Scene {
     /// The mesh.
     pub mesh: Mesh,
-    /// K, M, lumped M, DOF map.
+    /// K, M (where assembled: [`assemble_for_run`]), lumped M, DOF map.
     pub model: Model,
     /// The friction nodes of the case's surfaces, if it has any.
     pub contact: Option<ContactSurface>,
@@ -58,9 +58,10 @@ pub struct Prepared {
     pub integrator: Integrator,
 }
 
-/// A case turned into the objects that run it, for a run: K and M have
-/// moved into the integrator (a copy left in a model would be held for the
-/// whole run, 24 bytes per stored entry of K beside the step's own data).
+/// A case turned into the objects that run it, for a run: K and M (where
+/// assembled) have moved into the integrator (a copy left in a model would
+/// be held for the whole run, 24 bytes per stored entry of K beside the
+/// step's own data).
 #[derive(Debug)]
 pub struct Running {
     /// The mesh.

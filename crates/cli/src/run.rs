@@ -1187,7 +1187,7 @@ fn blow_up_failure(i: &Integrator, bound: f64, case: &Case) -> String {
 mod tests {
     use super::*;
 
-    /// A fresh explicit run from 100k free DOFs without a preload
+    /// A fresh explicit run from 500 free DOFs without a preload
     /// factorizes nothing, so its ordering stays undecided: it wrote no
     /// `fill_order` at all and `--json` gave null (docs/results.md promised
     /// the attribute). Now it writes "none"; a restart keeps the stored one.

@@ -129,7 +129,8 @@ pub struct Assembly<'a> {
     /// K values (pattern of [`crate::free_dof_pattern`]), overwritten.
     pub stiffness: &'a mut [f64],
     /// Consistent M values (same pattern), overwritten; `None` leaves M
-    /// out (explicit and quasi-static runs never read it).
+    /// out (explicit, quasi-static and lumped-mass Newmark runs never read
+    /// it).
     pub mass: Option<&'a mut [f64]>,
     /// HRZ lumped mass per node (same for both components), overwritten.
     pub lumped_nodal: &'a mut [f64],

@@ -13,8 +13,8 @@ use crate::pattern::{pattern_of, shared_adjacency, SharedAdjacency};
 use crate::setup_times::SetupTimes;
 use stickslip_linalg::FillOrder;
 
-/// K, M and lumped M of a mesh and material under Dirichlet conditions,
-/// restricted to the free DOFs.
+/// K, M (unless built without it) and lumped M of a mesh and material
+/// under Dirichlet conditions, restricted to the free DOFs.
 #[derive(Clone, Debug)]
 pub struct Model {
     /// Full ↔ free DOF map with the prescribed values.
@@ -53,7 +53,8 @@ impl Model {
     }
 
     /// [`Model::new`] without the consistent mass (`mass` is `None`): the
-    /// explicit and quasi-static schemes never read it, and at 500k DOFs
+    /// explicit and quasi-static schemes and Newmark with the lumped mass
+    /// never read it, and at 500k DOFs
     /// its values and its copy of the pattern are a sixth of a run's
     /// memory (docs/performance.md).
     ///
