@@ -65,7 +65,14 @@ pub fn choose(mesh: &Mesh, dofs: &DofMap) -> FillOrder {
         Ok("amd") => FillOrder::amd(),
         Ok("nd") => FillOrder::dissection(nested_dissection(mesh, dofs)),
         _ if dofs.n_free() < DISSECTION_MIN_DOFS => FillOrder::amd(),
-        _ => FillOrder::dissection_unless_amd(nested_dissection(mesh, dofs)),
+        _ => {
+            let (order, halves) = dissection_with_halves(mesh, dofs);
+            let order = FillOrder::dissection_unless_amd(order);
+            match halves {
+                Some(h) => order.with_halves(h),
+                None => order,
+            }
+        }
     }
 }
 
@@ -73,6 +80,14 @@ pub fn choose(mesh: &Mesh, dofs: &DofMap) -> FillOrder {
 /// documentation), each node's DOFs together, x before y. Deterministic:
 /// the same mesh gives the same order.
 pub fn nested_dissection(mesh: &Mesh, dofs: &DofMap) -> Vec<usize> {
+    dissection_with_halves(mesh, dofs).0
+}
+
+/// [`nested_dissection`], with the free DOFs of the first split's two
+/// halves, which the order numbers first (the first half's, then the
+/// second's; its separator follows): `None` where the first split left a
+/// half empty.
+pub fn dissection_with_halves(mesh: &Mesh, dofs: &DofMap) -> (Vec<usize>, Option<[usize; 2]>) {
     let n_nodes = mesh.nodes.len();
     let centroid: Vec<[f64; 2]> = (0..mesh.n_cells())
         .map(|c| {
@@ -98,11 +113,19 @@ pub fn nested_dissection(mesh: &Mesh, dofs: &DofMap) -> Vec<usize> {
     enum Job {
         Split(Vec<u32>),
         Number(Vec<usize>),
+        /// Where the first split's second half begins, and where its
+        /// separator does: the nodes numbered so far.
+        Mark,
     }
     let mut jobs = vec![Job::Split((0..mesh.n_cells() as u32).collect())];
+    let mut marks = Vec::with_capacity(2);
     let mut split = 0u32;
     while let Some(job) = jobs.pop() {
         let mut cells = match job {
+            Job::Mark => {
+                marks.push(nodes.len());
+                continue;
+            }
             Job::Number(separator) => {
                 for v in separator {
                     state[v] = State::Numbered;
@@ -157,15 +180,33 @@ pub fn nested_dissection(mesh: &Mesh, dofs: &DofMap) -> Vec<usize> {
                 }
             }
         }
+        let first_split = split == 0;
         split += 1;
         jobs.push(Job::Number(separator));
+        if first_split {
+            jobs.push(Job::Mark);
+        }
         jobs.push(Job::Split(second));
+        if first_split {
+            jobs.push(Job::Mark);
+        }
         jobs.push(Job::Split(first));
     }
     // Nodes in no cell (a mesh may carry them) last.
     nodes.extend((0..n_nodes).filter(|&v| state[v] == State::Open));
-    nodes
-        .iter()
-        .flat_map(|&v| (0..2).filter_map(move |k| dofs.free(v, k)))
-        .collect()
+    let free_dofs = |nodes: &[usize]| {
+        nodes
+            .iter()
+            .flat_map(|&v| (0..2).filter_map(move |k| dofs.free(v, k)))
+            .collect::<Vec<usize>>()
+    };
+    let halves = match marks[..] {
+        [second, separator] => {
+            let first = free_dofs(&nodes[..second]).len();
+            let second = free_dofs(&nodes[second..separator]).len();
+            (first > 0 && second > 0).then_some([first, second])
+        }
+        _ => None,
+    };
+    (free_dofs(&nodes), halves)
 }

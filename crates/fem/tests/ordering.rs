@@ -2,7 +2,9 @@
 //! every free DOF once on any mesh, splits the slab at its middle line, is
 //! as good as AMD on a grid, and `choose` keeps the smaller factor.
 
-use stickslip_fem::ordering::{choose, nested_dissection, DISSECTION_MIN_DOFS, FILL_ORDER_ENV};
+use stickslip_fem::ordering::{
+    choose, dissection_with_halves, nested_dissection, DISSECTION_MIN_DOFS, FILL_ORDER_ENV,
+};
 use stickslip_fem::{Dirichlet, DofMap, Model, NodeOrder};
 use stickslip_linalg::{analyze_symbolic, FillOrder};
 use stickslip_mesh::{CellKind, Mesh};
@@ -108,6 +110,42 @@ fn the_last_dofs_are_the_middle_line() {
     let mut want = line.clone();
     want.sort_unstable();
     assert_eq!(last, want);
+}
+
+/// The first split's halves: the DOFs left and right of the middle line,
+/// numbered first (the left's, then the right's), and no entry of K
+/// couples them (a factorization may split there).
+#[test]
+fn the_halves_are_the_two_sides_of_the_middle_line() {
+    for kind in [CellKind::Quad4, CellKind::Quad9] {
+        let mesh = slab(kind, 4);
+        let model = Model::new(&mesh, &paper_material(), &paper_supports()).unwrap();
+        let (order, halves) = dissection_with_halves(&mesh, &model.dofs);
+        let [n1, n2] = halves.expect("two halves");
+        let side = |d: usize| {
+            let v = model.dofs.full_of_free(d) / 2;
+            mesh.nodes[v][0] - 4.0
+        };
+        assert!(order[..n1].iter().all(|&d| side(d) < -1e-12), "{kind:?}");
+        assert!(
+            order[n1..n1 + n2].iter().all(|&d| side(d) > 1e-12),
+            "{kind:?}"
+        );
+        assert!(
+            order[n1 + n2..].iter().all(|&d| side(d).abs() < 1e-12),
+            "{kind:?}"
+        );
+        assert_eq!(order, nested_dissection(&mesh, &model.dofs));
+        let k = &model.stiffness;
+        let left: Vec<bool> = {
+            let mut l = vec![false; k.nrows()];
+            order[..n1].iter().for_each(|&d| l[d] = true);
+            l
+        };
+        for &d in &order[n1..n1 + n2] {
+            assert!(k.row(d).col_indices().iter().all(|&j| !left[j]), "{kind:?}");
+        }
+    }
 }
 
 /// The dissection's quality where AMD is at its best, a grid numbered

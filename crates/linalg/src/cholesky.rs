@@ -193,13 +193,23 @@ fn symbolic_in(
             a.nrows()
         )));
     }
+    symbolic_in_order(as_csc(a).symbolic(), forward)
+}
+
+/// The supernodal symbolic factor of the pattern `a` (both triangles, a
+/// CSR pattern read as its own CSC transpose) in the elimination order
+/// `forward`.
+pub(crate) fn symbolic_in_order(
+    a: SymbolicSparseColMatRef<'_, usize>,
+    forward: &[usize],
+) -> Result<SymbolicCholesky<usize>, SolverError> {
     let mut inverse = vec![0; forward.len()];
     for (i, &row) in forward.iter().enumerate() {
         inverse[row] = i;
     }
     let ordering = SymmetricOrdering::Custom(PermRef::new_checked(forward, &inverse, a.nrows()));
     factorize_symbolic_cholesky(
-        as_csc(a).symbolic(),
+        a,
         Side::Lower,
         ordering,
         CholeskySymbolicParams {

@@ -24,6 +24,11 @@ pub struct FillOrder {
     compare: bool,
     /// The comparison's outcome, once made: true when the dissection won.
     chosen: Arc<OnceLock<bool>>,
+    /// The DOFs of the dissection's two first halves, which its order
+    /// numbers first (the first half's, then the second's) and its first
+    /// separator after them: a factorization may split there
+    /// (`split.rs`).
+    halves: Option<[usize; 2]>,
 }
 
 impl FillOrder {
@@ -47,6 +52,23 @@ impl FillOrder {
             compare: true,
             ..FillOrder::dissection(order)
         }
+    }
+
+    /// This order, its first `halves[0]` DOFs and the next `halves[1]`
+    /// the dissection's two first halves, uncoupled in the matrices
+    /// factorized (only the separator after them touches both).
+    pub fn with_halves(self, halves: [usize; 2]) -> FillOrder {
+        FillOrder {
+            halves: Some(halves),
+            ..self
+        }
+    }
+
+    /// The dissection's two first halves ([`FillOrder::with_halves`]),
+    /// where known and the dissection is the order (decided).
+    pub fn halves(&self) -> Option<[usize; 2]> {
+        let decided = !self.compare || self.chosen.get() == Some(&true);
+        self.halves.filter(|_| self.dissection.is_some() && decided)
     }
 
     /// "AMD" or "nested dissection" (what the factors use, once decided),

@@ -19,6 +19,7 @@ mod fill_order;
 mod product;
 mod refine;
 pub mod simd;
+mod split;
 mod stencils;
 mod supernodal;
 mod symmetric;
@@ -27,6 +28,7 @@ pub use cholesky::{analyze_symbolic, csc_view, Analysis, SolverError, SparseChol
 pub use fill_order::{FillOrder, AMD_MARGIN};
 pub use product::{Formed, Product};
 pub use refine::{backward_error, Refined, BACKWARD_ERROR, MAX_ITERATIONS};
+pub use split::SplitSingle;
 pub use stencils::{Stencils, BATCH, TOLERANCE};
 pub use supernodal::{FactorValue, PathOperator, Supernodal};
 pub use symmetric::Symmetric;

@@ -82,75 +82,83 @@ impl SparseCholesky {
         x: &mut [f64],
         tolerance: f64,
     ) -> Result<Refined, Refined> {
-        let n = x.len();
-        let b = x.to_vec();
-        let (norm_a, norm_b) = (norm_inf(a), max_abs(&b));
-        let eta = |r: &[f64], x: &[f64]| max_abs(r) / (norm_a * max_abs(x) + norm_b);
-        if norm_b == 0.0 {
-            x.fill(0.0);
-            return Ok(Refined {
-                iterations: 0,
-                backward_error: 0.0,
-            });
+        refine(a, x, tolerance, |z| self.solve_single_in_place(z))
+    }
+}
+
+/// [`SparseCholesky::solve_refined`] with the preconditioner `approx`,
+/// which replaces z by an approximation of A⁻¹z (a single factor's solve).
+pub(crate) fn refine(
+    a: &CsrMatrix<f64>,
+    x: &mut [f64],
+    tolerance: f64,
+    mut approx: impl FnMut(&mut [f64]),
+) -> Result<Refined, Refined> {
+    let n = x.len();
+    let b = x.to_vec();
+    let (norm_a, norm_b) = (norm_inf(a), max_abs(&b));
+    let eta = |r: &[f64], x: &[f64]| max_abs(r) / (norm_a * max_abs(x) + norm_b);
+    if norm_b == 0.0 {
+        x.fill(0.0);
+        return Ok(Refined {
+            iterations: 0,
+            backward_error: 0.0,
+        });
+    }
+    approx(x);
+    let mut q = vec![0.0; n];
+    let residual = |x: &[f64], q: &mut [f64], r: &mut [f64]| {
+        spmv(a, x, q);
+        for ((r, b), q) in r.iter_mut().zip(&b).zip(q.iter()) {
+            *r = b - q;
         }
-        self.solve_single_in_place(x);
-        let mut q = vec![0.0; n];
-        let residual = |x: &[f64], q: &mut [f64], r: &mut [f64]| {
-            spmv(a, x, q);
-            for ((r, b), q) in r.iter_mut().zip(&b).zip(q.iter()) {
-                *r = b - q;
-            }
+    };
+    let mut r = vec![0.0; n];
+    residual(x, &mut q, &mut r);
+    let (mut z, mut p) = (vec![0.0; n], vec![0.0; n]);
+    let (mut rz, mut fresh, mut true_residual) = (0.0, true, true);
+    let (mut iterations, mut restarts) = (0, 0);
+    loop {
+        let mut backward_error = eta(&r, x);
+        if backward_error <= tolerance && !true_residual {
+            // The recurrence drifts from the true residual by the
+            // rounding of its updates: confirm, or restart from it.
+            residual(x, &mut q, &mut r);
+            backward_error = eta(&r, x);
+            fresh = true;
+            restarts += usize::from(backward_error > tolerance);
+        }
+        let refined = Refined {
+            iterations,
+            backward_error,
         };
-        let mut r = vec![0.0; n];
-        residual(x, &mut q, &mut r);
-        let (mut z, mut p) = (vec![0.0; n], vec![0.0; n]);
-        let (mut rz, mut fresh, mut true_residual) = (0.0, true, true);
-        let (mut iterations, mut restarts) = (0, 0);
-        loop {
-            let mut backward_error = eta(&r, x);
-            if backward_error <= tolerance && !true_residual {
-                // The recurrence drifts from the true residual by the
-                // rounding of its updates: confirm, or restart from it.
-                residual(x, &mut q, &mut r);
-                backward_error = eta(&r, x);
-                fresh = true;
-                restarts += usize::from(backward_error > tolerance);
-            }
-            let refined = Refined {
-                iterations,
-                backward_error,
-            };
-            if backward_error <= tolerance {
-                return Ok(refined);
-            }
-            if iterations == MAX_ITERATIONS
-                || restarts == MAX_RESTARTS
-                || !backward_error.is_finite()
-            {
-                x.copy_from_slice(&b);
-                return Err(refined);
-            }
-            z.copy_from_slice(&r);
-            self.solve_single_in_place(&mut z);
-            let rz_next = dot(&r, &z);
-            if fresh {
-                p.copy_from_slice(&z);
-            } else {
-                let beta = rz_next / rz;
-                for (p, z) in p.iter_mut().zip(&z) {
-                    *p = z + beta * *p;
-                }
-            }
-            rz = rz_next;
-            spmv(a, &p, &mut q);
-            let alpha = rz / dot(&p, &q);
-            for ((x, r), (p, q)) in x.iter_mut().zip(r.iter_mut()).zip(p.iter().zip(&q)) {
-                *x += alpha * p;
-                *r -= alpha * q;
-            }
-            (true_residual, fresh) = (false, false);
-            iterations += 1;
+        if backward_error <= tolerance {
+            return Ok(refined);
         }
+        if iterations == MAX_ITERATIONS || restarts == MAX_RESTARTS || !backward_error.is_finite() {
+            x.copy_from_slice(&b);
+            return Err(refined);
+        }
+        z.copy_from_slice(&r);
+        approx(&mut z);
+        let rz_next = dot(&r, &z);
+        if fresh {
+            p.copy_from_slice(&z);
+        } else {
+            let beta = rz_next / rz;
+            for (p, z) in p.iter_mut().zip(&z) {
+                *p = z + beta * *p;
+            }
+        }
+        rz = rz_next;
+        spmv(a, &p, &mut q);
+        let alpha = rz / dot(&p, &q);
+        for ((x, r), (p, q)) in x.iter_mut().zip(r.iter_mut()).zip(p.iter().zip(&q)) {
+            *x += alpha * p;
+            *r -= alpha * q;
+        }
+        (true_residual, fresh) = (false, false);
+        iterations += 1;
     }
 }
 

@@ -569,6 +569,21 @@ impl Supernodal {
         )
     }
 
+    /// Where supernode s's block lies in the factor's values.
+    pub(crate) fn value_range(&self, s: usize) -> std::ops::Range<usize> {
+        self.val_ptr[s]..self.val_ptr[s + 1]
+    }
+
+    /// The forward solve L y = x on the permuted numbering, in place.
+    pub(crate) fn forward_permuted<T: FactorValue>(&mut self, l: &[T], x: &mut [f64]) {
+        self.forward(l, false, x);
+    }
+
+    /// The back solve Lᵀ x = y on the permuted numbering, in place.
+    pub(crate) fn backward_permuted<T: FactorValue>(&mut self, l: &[T], x: &mut [f64]) {
+        self.backward(l, false, x);
+    }
+
     /// Supernode s of the factor with values `l`, for solvers built on
     /// this layout: its first (permuted) column, its number of columns k,
     /// its pattern (the m permuted rows below its diagonal block) and its

@@ -10,7 +10,7 @@ use stickslip_linalg::{csr, Analysis, Formed, Product, Stencils};
 use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Mass, Statics};
+use crate::initial::{initial_state, Analyzed, Mass, Statics, SINGLE_MIN};
 use crate::nodal::NodalFriction;
 use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError, MAX_STABLE_STEPS};
 use crate::stability::{critical_step_with, gershgorin_bound};
@@ -141,7 +141,15 @@ pub(crate) fn start(
             analyzed,
         )
     };
-    let beside = beside_the_preload(bound, mass.len(), &rigid_modes, loads, settings);
+    // A preload factorized by halves keeps both threads busy (`split.rs`):
+    // the estimate is made before it, on both too.
+    let split = || {
+        !springs && mass.len() >= SINGLE_MIN && {
+            fill_order.keep_dissection();
+            fill_order.halves().is_some()
+        }
+    };
+    let beside = beside_the_preload(bound, split, mass.len(), &rigid_modes, loads, settings);
     let (dt_crit, state) = match beside {
         Beside::Nothing => {
             let dt_crit = times.time("critical step", critical);
@@ -160,8 +168,9 @@ pub(crate) fn start(
                 let done = if beside == Beside::Preload {
                     Done::State(Box::new(initial(times, None)))
                 } else {
+                    // Not by halves here (`split`): K's whole analysis.
                     match times.time("preload ordering", || Analysis::of(&k, &fill_order)) {
-                        Ok(analysis) => Done::Analysis(Box::new(analysis)),
+                        Ok(analysis) => Done::Analysis(Box::new(Analyzed::Whole(analysis))),
                         Err(e) => Done::State(Box::new(Err(TimeError::Static(e)))),
                     }
                 };
@@ -555,12 +564,13 @@ enum Beside {
 /// The work the critical step's thread has run beside.
 enum Done {
     State(Box<Result<State, TimeError>>),
-    Analysis(Box<Analysis>),
+    Analysis(Box<Analyzed>),
 }
 
 /// What the critical step may be estimated beside: for a large model
 /// (from [`BESIDE_MIN`] free DOFs) whose initial state factorizes K
-/// (loads before t = 0, no free rigid motion, a fresh start), the
+/// (loads before t = 0, no free rigid motion, a fresh start) on one
+/// thread (not by the dissection's halves: `split`), the
 /// preload's analysis, or its whole initial state where no estimate can
 /// refuse the run's Δt (allowed above it, or within Gershgorin's bound on
 /// ω_max, [`gershgorin_bound`]), so that no factorization is spent on a
@@ -569,6 +579,7 @@ enum Done {
 /// and any Δt may be refused.
 fn beside_the_preload(
     bound: impl FnOnce() -> Option<f64>,
+    split: impl FnOnce() -> bool,
     n: usize,
     modes: &[stickslip_fem::RigidMode],
     loads: &Loads,
@@ -579,7 +590,7 @@ fn beside_the_preload(
         && settings.initial_state != InitialState::Rest
         && modes.is_empty()
         && loads.before_start().iter().any(|&x| x != 0.0);
-    if !preload || n < BESIDE_MIN {
+    if !preload || n < BESIDE_MIN || split() {
         return Beside::Nothing;
     }
     let refusable = !settings.allow_unstable

@@ -8,7 +8,9 @@ use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{RigidMode, SetupTimes};
 use stickslip_linalg::csr::{dot, quadratic_form, spmv};
-use stickslip_linalg::{chunks, Analysis, FillOrder, SparseCholesky, BACKWARD_ERROR};
+use stickslip_linalg::{
+    chunks, Analysis, FillOrder, SolverError, SparseCholesky, SplitSingle, BACKWARD_ERROR,
+};
 
 use crate::dynamics::Loads;
 use crate::settings::{InitialState, Settings, TimeError};
@@ -94,6 +96,59 @@ pub(crate) fn cholesky_solve(
     factor_solve(analyze(k, fill_order, times)?, k, r, times, false)
 }
 
+/// K's analysis for the preload, made before the initial state is formed
+/// (beside other work, or for the step's operators too).
+pub(crate) enum Analyzed {
+    /// The analysis of K's whole factor.
+    Whole(Analysis),
+    /// The analyses of the dissection's two halves, for a single factor
+    /// factorized a half a thread ([`SplitSingle`]).
+    Split(Box<SplitSingle>),
+}
+
+impl Analyzed {
+    /// The whole analysis, if that is what this is.
+    fn whole(self) -> Option<Analysis> {
+        match self {
+            Analyzed::Whole(a) => Some(a),
+            Analyzed::Split(_) => None,
+        }
+    }
+}
+
+/// The halves' analysis where the preload's single factor may be split:
+/// from [`SINGLE_MIN`] free DOFs with a single factor (`single`), the
+/// dissection's halves known and uncoupled; else `None`.
+fn split_analysis(
+    k: &CsrMatrix<f64>,
+    fill_order: &FillOrder,
+    single: bool,
+) -> Result<Option<SplitSingle>, SolverError> {
+    match (fill_order.dissection_order(), fill_order.halves()) {
+        (Some(order), Some(halves)) if single && k.nrows() >= SINGLE_MIN => {
+            SplitSingle::analyze(k, order, halves)
+        }
+        _ => Ok(None),
+    }
+}
+
+/// The preload r ← K⁻¹r by the halves' single factors, refined to
+/// double's accuracy; `false` (r unchanged) where f32 does not serve K
+/// (a pivot fails, or the refinement stalls), which only the time tells.
+fn split_solve(
+    mut split: Box<SplitSingle>,
+    k: &CsrMatrix<f64>,
+    r: &mut [f64],
+    times: &mut SetupTimes,
+) -> bool {
+    times.time("preload factor", || split.factorize(k)).is_ok()
+        && times
+            .time("preload solve", || {
+                split.solve_refined(k, r, BACKWARD_ERROR)
+            })
+            .is_ok()
+}
+
 /// K's analysis, timed as the preload's ordering.
 fn analyze(
     k: &CsrMatrix<f64>,
@@ -166,7 +221,7 @@ pub(crate) fn initial_state(
     contact: Option<&ContactSurface>,
     loads: &Loads,
     settings: &Settings,
-    analyzed: Option<Analysis>,
+    analyzed: Option<Analyzed>,
 ) -> Result<State, TimeError> {
     let Statics {
         fill_order,
@@ -202,16 +257,35 @@ pub(crate) fn initial_state(
                 c,
                 &mut r,
                 times,
-                analyzed,
+                analyzed.and_then(Analyzed::whole),
             )?;
         } else if modes.is_empty() {
-            let solver = match analyzed {
-                Some(analysis) => SparseCholesky::on(analysis).map_err(TimeError::Static)?,
-                None => analyze(k, fill_order, times)?,
-            };
-            keep(&mut analysis, &solver);
             let single = single_factor && n >= SINGLE_MIN;
-            factor_solve(solver, k, &mut r, times, single)?;
+            let analyzed = match analyzed {
+                Some(a) => Some(a),
+                None => times
+                    .time("preload ordering", || split_analysis(k, fill_order, single))
+                    .map_err(TimeError::Static)?
+                    .map(|s| Analyzed::Split(Box::new(s))),
+            };
+            let whole = match analyzed {
+                Some(Analyzed::Whole(analysis)) => {
+                    Some(SparseCholesky::on(analysis).map_err(TimeError::Static)?)
+                }
+                // A split that does not serve: K's whole factor, as without.
+                Some(Analyzed::Split(split)) => {
+                    if split_solve(split, k, &mut r, times) {
+                        None
+                    } else {
+                        Some(analyze(k, fill_order, times)?)
+                    }
+                }
+                None => Some(analyze(k, fill_order, times)?),
+            };
+            if let Some(solver) = whole {
+                keep(&mut analysis, &solver);
+                factor_solve(solver, k, &mut r, times, single)?;
+            }
         } else {
             crate::floating::solve(k, mass, fill_order, modes, &mut r, times)?;
         }
@@ -288,6 +362,43 @@ pub(crate) fn initial_state(
 mod tests {
     use super::*;
     use nalgebra_sparse::CooMatrix;
+
+    /// The preload by the dissection's halves is the whole factor's solve
+    /// to the refinement's accuracy: a chain of springs split at its
+    /// middle unknown.
+    #[test]
+    fn a_preload_by_halves_solves_as_the_whole_factor() {
+        let n = 21;
+        let mut coo = CooMatrix::new(n, n);
+        for i in 0..n {
+            coo.push(i, i, 2.01);
+            if i + 1 < n {
+                coo.push(i, i + 1, -1.0);
+                coo.push(i + 1, i, -1.0);
+            }
+        }
+        let k = CsrMatrix::from(&coo);
+        let mid = n / 2;
+        let order: Vec<usize> = (0..mid).chain(mid + 1..n).chain([mid]).collect();
+        let halves = [mid, n - mid - 1];
+        let b: Vec<f64> = (0..n).map(|i| ((i * 5) % 9) as f64 - 4.0).collect();
+        let mut times = SetupTimes::default();
+        let split = SplitSingle::analyze(&k, &order, halves)
+            .unwrap()
+            .expect("the middle unknown separates");
+        let mut by_halves = b.clone();
+        assert!(split_solve(Box::new(split), &k, &mut by_halves, &mut times));
+        let names: Vec<&str> = times.parts().iter().map(|p| p.0).collect();
+        assert_eq!(names, ["preload factor", "preload solve"]);
+        let mut whole = b.clone();
+        let solver = analyze(&k, &FillOrder::dissection(order), &mut times).unwrap();
+        factor_solve(solver, &k, &mut whole, &mut times, false).unwrap();
+        let scale = whole.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        for (x, y) in by_halves.iter().zip(&whole) {
+            assert!((x - y).abs() <= 1e-14 * scale, "{x} against {y}");
+        }
+        assert!(stickslip_linalg::backward_error(&k, &by_halves, &b) <= BACKWARD_ERROR);
+    }
 
     /// A preload whose K f32 cannot factorize is solved by the double
     /// factor, with its bits: [[1, c], [c, 1]], c = 1 − 2⁻³⁰, is positive

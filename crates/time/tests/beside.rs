@@ -5,9 +5,11 @@
 //! `allow_unstable`). Either way the critical step and the initial state
 //! have the bits of the sequential computation, written out here with the
 //! crates' public functions (the preload's factor in single precision,
-//! refined), and a Δt above the critical step is still refused.
+//! refined), and a Δt above the critical step is still refused. Where the
+//! dissection's two first halves are known, the preload is factorized by
+//! them on both threads, and the critical step comes before it.
 
-use stickslip_linalg::{backward_error, SparseCholesky, BACKWARD_ERROR};
+use stickslip_linalg::{backward_error, FillOrder, SparseCholesky, SplitSingle, BACKWARD_ERROR};
 use stickslip_testkit::{structured_slab, Slab};
 use stickslip_time::stability::{critical_step, gershgorin_bound, largest_eigenvalue};
 use stickslip_time::{Dynamics, History, Integrator, Scheme, Settings, TimeError};
@@ -25,8 +27,18 @@ fn slab() -> Slab {
 }
 
 /// The scene's dynamics, its K·x the assembled CSR's (no stencil types),
-/// which `critical_step` forms too.
+/// which `critical_step` forms too; its fill order without the
+/// dissection's halves, so that the preload's factor is K's whole.
 fn dynamics(s: &Slab) -> Dynamics {
+    let mut d = halved_dynamics(s);
+    let order = d.fill_order.dissection_order().expect("a dissection");
+    d.fill_order = FillOrder::dissection_unless_amd(order.to_vec());
+    d
+}
+
+/// [`dynamics`] with the fill order the model chose, the dissection's
+/// halves known.
+fn halved_dynamics(s: &Slab) -> Dynamics {
     let mut d = Dynamics::from_model(&s.model);
     d.stencils = false;
     d
@@ -34,6 +46,93 @@ fn dynamics(s: &Slab) -> Dynamics {
 
 fn integrator(s: &Slab, settings: Settings) -> Result<Integrator, TimeError> {
     Integrator::new(dynamics(s), s.contact.clone(), s.loads.clone(), settings)
+}
+
+/// The preload R(0⁻): the pressure, constant; the end load is a step, 0
+/// before t = 0.
+fn preload(s: &Slab, d: &Dynamics) -> Vec<f64> {
+    let mut r0 = d.constant_load.clone();
+    for l in &s.loads {
+        let theta = l.history.before_start();
+        for (r, f) in r0.iter_mut().zip(&l.vector) {
+            *r += theta * f;
+        }
+    }
+    r0
+}
+
+/// With the dissection's halves the preload is `SplitSingle`'s refined
+/// solve, after the critical step (both take the two threads), whether
+/// the run's Δt could be refused or not; the bits are the sequential
+/// computation's, and the preload is the whole factor's to round-off.
+#[test]
+fn by_halves_the_critical_step_comes_first() {
+    let s = slab();
+    let d = halved_dynamics(&s);
+    let (k, m) = (&d.stiffness, &d.lumped_mass);
+    let dt_crit = critical_step(k, m);
+    let load = preload(&s, &d);
+    d.fill_order.keep_dissection();
+    let order = d.fill_order.dissection_order().unwrap();
+    let halves = d.fill_order.halves().expect("the slab's halves");
+    let mut split = SplitSingle::analyze(k, order, halves)
+        .unwrap()
+        .expect("the halves are uncoupled");
+    split.factorize(k).unwrap();
+    let mut r0 = load.clone();
+    split.solve_refined(k, &mut r0, BACKWARD_ERROR).unwrap();
+    assert!(backward_error(k, &r0, &load) <= BACKWARD_ERROR);
+    let mut whole = load.clone();
+    let mut chol = SparseCholesky::analyze(k, &d.fill_order).unwrap();
+    chol.factorize(k).unwrap();
+    chol.solve_in_place(&mut whole);
+    let norm = whole.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let apart = whole
+        .iter()
+        .zip(&r0)
+        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(apart <= 1e-9 * norm, "{apart:e} of {norm:e}");
+    let cd = |dt| Settings::new(Scheme::CentralDifference, dt, 0.5);
+    let halved = |settings| {
+        Integrator::new(
+            halved_dynamics(&s),
+            s.contact.clone(),
+            s.loads.clone(),
+            settings,
+        )
+    };
+    let mut allowed = cd(2.0 * dt_crit);
+    allowed.allow_unstable = true;
+    for (what, settings) in [
+        ("refusable", cd(0.99 * dt_crit)),
+        ("within the bound", cd(1e-9)),
+        ("allowed", allowed),
+    ] {
+        let i = halved(settings).unwrap();
+        assert_eq!(
+            i.dt_crit().map(f64::to_bits),
+            Some(dt_crit.to_bits()),
+            "{what}"
+        );
+        assert!(i.displacement() == &r0[..], "{what}: r₀");
+        let order = [
+            "critical step",
+            "preload ordering",
+            "preload factor",
+            "preload solve",
+        ];
+        let taken: Vec<_> = parts(&i)
+            .into_iter()
+            .filter(|p| order.contains(p))
+            .collect();
+        assert_eq!(taken, order, "{what}: the parts' order");
+    }
+    match halved(cd(1.01 * dt_crit)) {
+        Err(TimeError::Unstable { dt_crit: said, .. }) => {
+            assert_eq!(said.to_bits(), dt_crit.to_bits());
+        }
+        other => panic!("not refused: {other:?}"),
+    }
 }
 
 /// The names of an integrator's setup parts, in the order taken.
@@ -50,13 +149,7 @@ fn the_critical_step_beside_the_preload_has_the_sequential_bits() {
     // r₀ = K⁻¹ R(0⁻) by Cholesky on the dissection's order (the preload:
     // the pressure, constant; the end load is a step, 0 before t = 0).
     let dt_crit = critical_step(k, m);
-    let mut r0 = d.constant_load.clone();
-    for l in &s.loads {
-        let theta = l.history.before_start();
-        for (r, f) in r0.iter_mut().zip(&l.vector) {
-            *r += theta * f;
-        }
-    }
+    let mut r0 = preload(&s, &d);
     // From 100k free DOFs the factor is single precision, refined by CG
     // to backward error 2u.
     d.fill_order.keep_dissection();
