@@ -51,7 +51,8 @@ struct Half {
     solver: Supernodal,
     /// L_h in single precision, of B_h scaled as [`SplitSingle`] says.
     l: Vec<f32>,
-    /// T_h/√scale, its rows in the separator's order ([`SplitSingle`]'s
+    /// T_h of the unscaled B_h (the f32 factor's block over √scale), its
+    /// rows in the separator's order ([`SplitSingle`]'s
     /// `separator`), its columns in the factor's.
     t: Mat<f64>,
     /// The permuted right-hand side and solution.
@@ -333,7 +334,7 @@ impl SplitSingle {
 
 impl Half {
     /// L_h of A's `values` scaled by `scale`, in single precision, then
-    /// T_h/√scale and its T_hT_hᵀ (the separator's order).
+    /// T_h of the unscaled B_h and its T_hT_hᵀ (the separator's order).
     fn factorize(
         &mut self,
         values: &[f64],

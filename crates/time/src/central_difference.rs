@@ -10,7 +10,7 @@ use stickslip_linalg::{csr, Analysis, Formed, Product, Stencils};
 use stickslip_fem::SetupTimes;
 
 use crate::dynamics::{Dynamics, Loads};
-use crate::initial::{initial_state, Analyzed, Mass, Statics, SINGLE_MIN};
+use crate::initial::{initial_state, Mass, Statics, SINGLE_MIN};
 use crate::nodal::NodalFriction;
 use crate::settings::{ExplicitFriction, MassKind, Settings, TimeError, MAX_STABLE_STEPS};
 use crate::stability::{critical_step_with, gershgorin_bound};
@@ -67,7 +67,8 @@ pub(crate) struct CentralDifference {
 /// Builds the stepper and the initial state. The critical step is
 /// estimated on the step's own product before the preload's factorization,
 /// so that a Δt above it is refused before any; where no Δt can be refused
-/// ([`beside_the_preload`]), during it.
+/// ([`beside_the_preload`]), during it, unless the preload is factorized
+/// by halves (both threads).
 ///
 /// # Errors
 /// Δt above the critical step (unless allowed), or a singular static
@@ -170,7 +171,7 @@ pub(crate) fn start(
                 } else {
                     // Not by halves here (`split`): K's whole analysis.
                     match times.time("preload ordering", || Analysis::of(&k, &fill_order)) {
-                        Ok(analysis) => Done::Analysis(Box::new(Analyzed::Whole(analysis))),
+                        Ok(analysis) => Done::Analysis(Box::new(analysis)),
                         Err(e) => Done::State(Box::new(Err(TimeError::Static(e)))),
                     }
                 };
@@ -564,7 +565,7 @@ enum Beside {
 /// The work the critical step's thread has run beside.
 enum Done {
     State(Box<Result<State, TimeError>>),
-    Analysis(Box<Analyzed>),
+    Analysis(Box<Analysis>),
 }
 
 /// What the critical step may be estimated beside: for a large model

@@ -96,26 +96,6 @@ pub(crate) fn cholesky_solve(
     factor_solve(analyze(k, fill_order, times)?, k, r, times, false)
 }
 
-/// K's analysis for the preload, made before the initial state is formed
-/// (beside other work, or for the step's operators too).
-pub(crate) enum Analyzed {
-    /// The analysis of K's whole factor.
-    Whole(Analysis),
-    /// The analyses of the dissection's two halves, for a single factor
-    /// factorized a half a thread ([`SplitSingle`]).
-    Split(Box<SplitSingle>),
-}
-
-impl Analyzed {
-    /// The whole analysis, if that is what this is.
-    fn whole(self) -> Option<Analysis> {
-        match self {
-            Analyzed::Whole(a) => Some(a),
-            Analyzed::Split(_) => None,
-        }
-    }
-}
-
 /// The halves' analysis where the preload's single factor may be split:
 /// from [`SINGLE_MIN`] free DOFs with a single factor (`single`), the
 /// dissection's halves known and uncoupled; else `None`.
@@ -136,7 +116,7 @@ fn split_analysis(
 /// double's accuracy; `false` (r unchanged) where f32 does not serve K
 /// (a pivot fails, or the refinement stalls), which only the time tells.
 fn split_solve(
-    mut split: Box<SplitSingle>,
+    mut split: SplitSingle,
     k: &CsrMatrix<f64>,
     r: &mut [f64],
     times: &mut SetupTimes,
@@ -221,7 +201,7 @@ pub(crate) fn initial_state(
     contact: Option<&ContactSurface>,
     loads: &Loads,
     settings: &Settings,
-    analyzed: Option<Analyzed>,
+    analyzed: Option<Analysis>,
 ) -> Result<State, TimeError> {
     let Statics {
         fill_order,
@@ -257,32 +237,23 @@ pub(crate) fn initial_state(
                 c,
                 &mut r,
                 times,
-                analyzed.and_then(Analyzed::whole),
+                analyzed,
             )?;
         } else if modes.is_empty() {
             let single = single_factor && n >= SINGLE_MIN;
-            let analyzed = match analyzed {
-                Some(a) => Some(a),
+            // By the dissection's halves where they serve; else, or where
+            // f32 does not serve them, K's whole factor, as without.
+            let split = match analyzed {
+                Some(_) => None,
                 None => times
                     .time("preload ordering", || split_analysis(k, fill_order, single))
-                    .map_err(TimeError::Static)?
-                    .map(|s| Analyzed::Split(Box::new(s))),
+                    .map_err(TimeError::Static)?,
             };
-            let whole = match analyzed {
-                Some(Analyzed::Whole(analysis)) => {
-                    Some(SparseCholesky::on(analysis).map_err(TimeError::Static)?)
-                }
-                // A split that does not serve: K's whole factor, as without.
-                Some(Analyzed::Split(split)) => {
-                    if split_solve(split, k, &mut r, times) {
-                        None
-                    } else {
-                        Some(analyze(k, fill_order, times)?)
-                    }
-                }
-                None => Some(analyze(k, fill_order, times)?),
-            };
-            if let Some(solver) = whole {
+            if !split.is_some_and(|s| split_solve(s, k, &mut r, times)) {
+                let solver = match analyzed {
+                    Some(analysis) => SparseCholesky::on(analysis).map_err(TimeError::Static)?,
+                    None => analyze(k, fill_order, times)?,
+                };
                 keep(&mut analysis, &solver);
                 factor_solve(solver, k, &mut r, times, single)?;
             }
@@ -387,7 +358,7 @@ mod tests {
             .unwrap()
             .expect("the middle unknown separates");
         let mut by_halves = b.clone();
-        assert!(split_solve(Box::new(split), &k, &mut by_halves, &mut times));
+        assert!(split_solve(split, &k, &mut by_halves, &mut times));
         let names: Vec<&str> = times.parts().iter().map(|p| p.0).collect();
         assert_eq!(names, ["preload factor", "preload solve"]);
         let mut whole = b.clone();

@@ -256,7 +256,7 @@ impl ImplicitFriction {
                 ImplicitFriction::new(k, fill_order, Some(analysis.clone()), contact, settings)?;
             (shared, friction) = (Some(analysis), Some(solver));
         }
-        let analyzed = shared.clone().map(crate::initial::Analyzed::Whole);
+        let analyzed = shared.clone();
         let statics = Statics {
             fill_order,
             modes,
