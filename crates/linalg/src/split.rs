@@ -24,8 +24,8 @@
 //! The two halves' solves run at once too.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt;
 use faer::linalg::cholesky::llt::factor::LltParams;
-use faer::linalg::solvers::SolveCore;
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Accum, Conj, Mat, Par, Side, Spec};
@@ -65,8 +65,8 @@ pub struct SplitSingle {
     halves: [Half; 2],
     /// A's index of each separator unknown.
     separator: Vec<usize>,
-    /// S = T₁T₁ᵀ + T₂T₂ᵀ − A_S, factorized.
-    schur: Option<faer::linalg::solvers::Llt<f64>>,
+    /// The factor of S = T₁T₁ᵀ + T₂T₂ᵀ − A_S in its lower triangle.
+    schur: Option<Mat<f64>>,
     /// The power of two that scales A's values into f32's range (as
     /// [`crate::SparseCholesky::factorize_single`]), and its square root.
     scale: f64,
@@ -265,13 +265,25 @@ impl SplitSingle {
                 s[(i, j)] += p2[(i, j)];
             }
         }
-        let llt = s
-            .llt(Side::Lower)
-            .map_err(|_| SolverError::NotPositiveDefinite {
-                pivot: a.nrows() - ns,
-                n: a.nrows(),
-            })?;
-        self.schur = Some(llt);
+        // On this thread, as every factorization (the bits do not depend
+        // on the pool's size).
+        let mut scratch = MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(
+            ns,
+            Par::Seq,
+            Default::default(),
+        ));
+        llt::factor::cholesky_in_place(
+            s.as_mut(),
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut scratch),
+            Default::default(),
+        )
+        .map_err(|_| SolverError::NotPositiveDefinite {
+            pivot: a.nrows() - ns,
+            n: a.nrows(),
+        })?;
+        self.schur = Some(s);
         Ok(())
     }
 
@@ -297,7 +309,15 @@ impl SplitSingle {
         for (k, &i) in self.separator.iter().enumerate() {
             xs[(k, 0)] = x[i] + c1[k] + c2[k];
         }
-        schur.solve_in_place_with_conj(Conj::No, xs.as_mut());
+        llt::solve::solve_in_place_with_conj(
+            schur.as_ref(),
+            Conj::No,
+            xs.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut MemBuffer::new(
+                llt::solve::solve_in_place_scratch::<f64>(schur.nrows(), 1, Par::Seq),
+            )),
+        );
         let xs = xs.col(0);
         rayon::join(|| first.backward(xs, root), || second.backward(xs, root));
         for half in &self.halves {

@@ -143,7 +143,8 @@ pub(crate) fn start(
         )
     };
     // A preload factorized by halves keeps both threads busy (`split.rs`):
-    // the estimate is made before it, on both too.
+    // the estimate is made before it, on both too. Where the halves then
+    // prove unusable (`SplitSingle::analyze`), only the overlap is lost.
     let split = || {
         !springs && mass.len() >= SINGLE_MIN && {
             fill_order.keep_dissection();

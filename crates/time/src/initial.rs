@@ -8,9 +8,7 @@ use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{RigidMode, SetupTimes};
 use stickslip_linalg::csr::{dot, quadratic_form, spmv};
-use stickslip_linalg::{
-    chunks, Analysis, FillOrder, SolverError, SparseCholesky, SplitSingle, BACKWARD_ERROR,
-};
+use stickslip_linalg::{chunks, Analysis, FillOrder, SparseCholesky, SplitSingle, BACKWARD_ERROR};
 
 use crate::dynamics::Loads;
 use crate::settings::{InitialState, Settings, TimeError};
@@ -96,20 +94,47 @@ pub(crate) fn cholesky_solve(
     factor_solve(analyze(k, fill_order, times)?, k, r, times, false)
 }
 
-/// The halves' analysis where the preload's single factor may be split:
-/// from [`SINGLE_MIN`] free DOFs with a single factor (`single`), the
-/// dissection's halves known and uncoupled; else `None`.
-fn split_analysis(
+/// The halves' analysis where the preload's single factor (`single`) may
+/// be split: the dissection's halves known and uncoupled; else `None`,
+/// and where faer's analysis fails too: the whole factor's then reports.
+fn split_analysis(k: &CsrMatrix<f64>, fill_order: &FillOrder, single: bool) -> Option<SplitSingle> {
+    match (fill_order.dissection_order(), fill_order.halves()) {
+        (Some(order), Some(halves)) if single => {
+            SplitSingle::analyze(k, order, halves).ok().flatten()
+        }
+        _ => None,
+    }
+}
+
+/// r ← K⁻¹r, K with no free rigid motion: by the dissection's halves
+/// where they serve a single factor (`single`, and no analysis made by
+/// the caller: `analyzed`); else K's whole factor (single where `single`),
+/// and where f32 does not serve the halves, K's whole factor in double:
+/// K's condition, which f32 failed, is the same whole. K's analysis, where
+/// made, is kept in `slot`.
+fn preload(
     k: &CsrMatrix<f64>,
     fill_order: &FillOrder,
+    r: &mut [f64],
+    times: &mut SetupTimes,
     single: bool,
-) -> Result<Option<SplitSingle>, SolverError> {
-    match (fill_order.dissection_order(), fill_order.halves()) {
-        (Some(order), Some(halves)) if single && k.nrows() >= SINGLE_MIN => {
-            SplitSingle::analyze(k, order, halves)
-        }
-        _ => Ok(None),
+    analyzed: Option<Analysis>,
+    slot: &mut Option<&mut SharedAnalysis>,
+) -> Result<(), TimeError> {
+    let split = match analyzed {
+        Some(_) => None,
+        None => times.time("preload ordering", || split_analysis(k, fill_order, single)),
+    };
+    let tried = split.is_some();
+    if split.is_some_and(|s| split_solve(s, k, r, times)) {
+        return Ok(());
     }
+    let solver = match analyzed {
+        Some(analysis) => SparseCholesky::on(analysis).map_err(TimeError::Static)?,
+        None => analyze(k, fill_order, times)?,
+    };
+    keep(slot, &solver);
+    factor_solve(solver, k, r, times, single && !tried)
 }
 
 /// The preload r ← K⁻¹r by the halves' single factors, refined to
@@ -241,22 +266,15 @@ pub(crate) fn initial_state(
             )?;
         } else if modes.is_empty() {
             let single = single_factor && n >= SINGLE_MIN;
-            // By the dissection's halves where they serve; else, or where
-            // f32 does not serve them, K's whole factor, as without.
-            let split = match analyzed {
-                Some(_) => None,
-                None => times
-                    .time("preload ordering", || split_analysis(k, fill_order, single))
-                    .map_err(TimeError::Static)?,
-            };
-            if !split.is_some_and(|s| split_solve(s, k, &mut r, times)) {
-                let solver = match analyzed {
-                    Some(analysis) => SparseCholesky::on(analysis).map_err(TimeError::Static)?,
-                    None => analyze(k, fill_order, times)?,
-                };
-                keep(&mut analysis, &solver);
-                factor_solve(solver, k, &mut r, times, single)?;
-            }
+            preload(
+                k,
+                fill_order,
+                &mut r,
+                times,
+                single,
+                analyzed,
+                &mut analysis,
+            )?;
         } else {
             crate::floating::solve(k, mass, fill_order, modes, &mut r, times)?;
         }
@@ -369,6 +387,46 @@ mod tests {
             assert!((x - y).abs() <= 1e-14 * scale, "{x} against {y}");
         }
         assert!(stickslip_linalg::backward_error(&k, &by_halves, &b) <= BACKWARD_ERROR);
+    }
+
+    /// Where a half's single factor fails, the preload by halves falls
+    /// back to K's whole factor in double, with its bits: the first half
+    /// holds [[1, c], [c, 1]] (as below), joined to the separator by ε,
+    /// ε² below the pair's determinant 1 − c² ≈ 2⁻²⁹; no value over 1, so
+    /// that f32's pivot is 1 − 1 exactly.
+    #[test]
+    fn a_preload_whose_half_single_cannot_factorize_is_solved_in_double() {
+        let c = 1.0 - 2.0_f64.powi(-30);
+        let eps = 1e-5;
+        let mut coo = CooMatrix::new(5, 5);
+        let entries = [
+            (0, 0, 1.0),
+            (0, 1, c),
+            (1, 1, 1.0),
+            (1, 2, -eps),
+            (2, 2, 1.0),
+            (2, 3, -eps),
+            (3, 3, 1.0),
+            (3, 4, -0.5),
+            (4, 4, 1.0),
+        ];
+        for (i, j, v) in entries {
+            coo.push(i, j, v);
+            if i != j {
+                coo.push(j, i, v);
+            }
+        }
+        let k = CsrMatrix::from(&coo);
+        let order = FillOrder::dissection(vec![0, 1, 3, 4, 2]).with_halves([2, 2]);
+        let mut times = SetupTimes::default();
+        let split = split_analysis(&k, &order, true).expect("node 2 separates");
+        let mut r = vec![1.0, 2.0, 0.5, -1.0, 1.5];
+        assert!(!split_solve(split, &k, &mut r.clone(), &mut times));
+        let mut double = r.clone();
+        let solver = analyze(&k, &order, &mut times).unwrap();
+        factor_solve(solver, &k, &mut double, &mut times, false).unwrap();
+        preload(&k, &order, &mut r, &mut times, true, None, &mut None).unwrap();
+        assert_eq!(r, double);
     }
 
     /// A preload whose K f32 cannot factorize is solved by the double
