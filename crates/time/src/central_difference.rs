@@ -67,8 +67,8 @@ pub(crate) struct CentralDifference {
 /// Builds the stepper and the initial state. The critical step is
 /// estimated on the step's own product before the preload's factorization,
 /// so that a Δt above it is refused before any; where no Δt can be refused
-/// ([`beside_the_preload`]), during it, unless the preload is factorized
-/// by halves (both threads).
+/// ([`beside_the_preload`]), during it, except where the dissection's
+/// halves are known (the preload by halves takes both threads).
 ///
 /// # Errors
 /// Δt above the critical step (unless allowed), or a singular static
@@ -144,7 +144,8 @@ pub(crate) fn start(
     };
     // A preload factorized by halves keeps both threads busy (`split.rs`):
     // the estimate is made before it, on both too. Where the halves then
-    // prove unusable (`SplitSingle::analyze`), only the overlap is lost.
+    // prove unusable (`SplitSingle::analyze`, or their f32 factor), only
+    // the overlap is lost.
     let split = || {
         !springs && mass.len() >= SINGLE_MIN && {
             fill_order.keep_dissection();

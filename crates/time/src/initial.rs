@@ -91,12 +91,25 @@ pub(crate) fn cholesky_solve(
     r: &mut [f64],
     times: &mut SetupTimes,
 ) -> Result<(), TimeError> {
-    factor_solve(analyze(k, fill_order, times)?, k, r, times, false)
+    factor_solve(analyze(k, fill_order, times)?, k, r, times, false).map(|_| ())
+}
+
+/// Which factor solved a preload.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Served {
+    /// The dissection's halves in single precision, refined.
+    Halves,
+    /// K's whole factor in single precision, refined.
+    Single,
+    /// K's whole factor in double, after single precision failed
+    /// (`after_single`) or without trying it.
+    Double { after_single: bool },
 }
 
 /// The halves' analysis where the preload's single factor (`single`) may
 /// be split: the dissection's halves known and uncoupled; else `None`,
-/// and where faer's analysis fails too: the whole factor's then reports.
+/// `None` too where faer's analysis of a half fails (the whole analysis
+/// then runs, and reports its own failure).
 fn split_analysis(k: &CsrMatrix<f64>, fill_order: &FillOrder, single: bool) -> Option<SplitSingle> {
     match (fill_order.dissection_order(), fill_order.halves()) {
         (Some(order), Some(halves)) if single => {
@@ -112,6 +125,10 @@ fn split_analysis(k: &CsrMatrix<f64>, fill_order: &FillOrder, single: bool) -> O
 /// and where f32 does not serve the halves, K's whole factor in double:
 /// K's condition, which f32 failed, is the same whole. K's analysis, where
 /// made, is kept in `slot`.
+///
+/// # Errors
+/// [`TimeError::Static`] from the whole factor's analysis or its
+/// factorization in double.
 fn preload(
     k: &CsrMatrix<f64>,
     fill_order: &FillOrder,
@@ -120,14 +137,14 @@ fn preload(
     single: bool,
     analyzed: Option<Analysis>,
     slot: &mut Option<&mut SharedAnalysis>,
-) -> Result<(), TimeError> {
+) -> Result<Served, TimeError> {
     let split = match analyzed {
         Some(_) => None,
         None => times.time("preload ordering", || split_analysis(k, fill_order, single)),
     };
     let tried = split.is_some();
     if split.is_some_and(|s| split_solve(s, k, r, times)) {
-        return Ok(());
+        return Ok(Served::Halves);
     }
     let solver = match analyzed {
         Some(analysis) => SparseCholesky::on(analysis).map_err(TimeError::Static)?,
@@ -177,7 +194,7 @@ fn factor_solve(
     r: &mut [f64],
     times: &mut SetupTimes,
     single: bool,
-) -> Result<(), TimeError> {
+) -> Result<Served, TimeError> {
     if single
         && times
             .time("preload factor", || solver.factorize_single(k))
@@ -188,13 +205,15 @@ fn factor_solve(
             })
             .is_ok()
     {
-        return Ok(());
+        return Ok(Served::Single);
     }
     times
         .time("preload factor", || solver.factorize(k))
         .map_err(TimeError::Static)?;
     times.time("preload solve", || solver.solve_in_place(r));
-    Ok(())
+    Ok(Served::Double {
+        after_single: single,
+    })
 }
 
 /// Keeps `solver`'s analysis in `slot`, if the caller asked for it.
@@ -390,10 +409,11 @@ mod tests {
     }
 
     /// Where a half's single factor fails, the preload by halves falls
-    /// back to K's whole factor in double, with its bits: the first half
-    /// holds [[1, c], [c, 1]] (as below), joined to the separator by ε,
-    /// ε² below the pair's determinant 1 − c² ≈ 2⁻²⁹; no value over 1, so
-    /// that f32's pivot is 1 − 1 exactly.
+    /// back to K's whole factor in double, without trying it in single
+    /// (whose pivot fails alike), with the double factor's bits and K's
+    /// analysis kept: the first half holds [[1, c], [c, 1]] (as below),
+    /// joined to the separator by ε, ε² below the pair's determinant
+    /// 1 − c² ≈ 2⁻²⁹.
     #[test]
     fn a_preload_whose_half_single_cannot_factorize_is_solved_in_double() {
         let c = 1.0 - 2.0_f64.powi(-30);
@@ -425,8 +445,24 @@ mod tests {
         let mut double = r.clone();
         let solver = analyze(&k, &order, &mut times).unwrap();
         factor_solve(solver, &k, &mut double, &mut times, false).unwrap();
-        preload(&k, &order, &mut r, &mut times, true, None, &mut None).unwrap();
+        let mut kept: SharedAnalysis = None;
+        let served = preload(
+            &k,
+            &order,
+            &mut r,
+            &mut times,
+            true,
+            None,
+            &mut Some(&mut kept),
+        );
+        assert_eq!(
+            served.unwrap(),
+            Served::Double {
+                after_single: false
+            }
+        );
         assert_eq!(r, double);
+        assert!(kept.is_some(), "K's analysis kept");
     }
 
     /// A preload whose K f32 cannot factorize is solved by the double
@@ -445,7 +481,13 @@ mod tests {
             let mut times = SetupTimes::default();
             let mut r = vec![1.0, 2.0];
             let solver = analyze(&k, &order, &mut times).unwrap();
-            factor_solve(solver, &k, &mut r, &mut times, single).unwrap();
+            let served = factor_solve(solver, &k, &mut r, &mut times, single).unwrap();
+            assert_eq!(
+                served,
+                Served::Double {
+                    after_single: single
+                }
+            );
             r
         };
         let (single, double) = (solve(true), solve(false));
