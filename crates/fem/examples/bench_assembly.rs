@@ -62,7 +62,7 @@ fn main() {
     let model = Model::new(&mesh, &mat, &bcs).unwrap();
     let model_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let order = stickslip_fem::ordering::choose(&mesh, &model.dofs);
+    let order = stickslip_fem::ordering::choose(&mesh, &model.dofs, None);
     let order_s = t.elapsed().as_secs_f64();
     assert_eq!(
         order.dissection_order(),

@@ -9,9 +9,15 @@ use crate::assembly::{assemble, Assembly};
 use crate::dofs::{Dirichlet, DofMap};
 use crate::error::FemError;
 use crate::material::Material;
+use crate::ordering::NodeDissection;
 use crate::pattern::{pattern_of, shared_adjacency, SharedAdjacency};
 use crate::setup_times::SetupTimes;
 use stickslip_linalg::FillOrder;
+
+/// Nodes from which the DOF map's bandwidth order and the factors'
+/// dissection are made side by side: below, the two together take
+/// milliseconds, less than waking the second thread is worth.
+const BESIDE_MIN_NODES: usize = 10_000;
 
 /// K, M (unless built without it) and lumped M of a mesh and material
 /// under Dirichlet conditions, restricted to the free DOFs.
@@ -78,10 +84,24 @@ impl Model {
         let mut setup = SetupTimes::default();
         // The DOF map's bandwidth order and the pattern read one adjacency.
         let adjacency = SharedAdjacency::new();
-        let dofs = setup.time("DOF map", || {
-            DofMap::with_adjacency(mesh, conditions, &adjacency)
-        })?;
-        Model::build(mesh, material, dofs, &adjacency, setup, with_mass)
+        let dof_map = || DofMap::with_adjacency(mesh, conditions, &adjacency);
+        // Both the bandwidth order and the dissection run on one thread:
+        // on large meshes they run side by side, the part "DOF map" the
+        // wall time of both.
+        let (dofs, dissection) = setup.time("DOF map", || {
+            if mesh.nodes.len() >= BESIDE_MIN_NODES && crate::ordering::wanted(mesh.nodes.len()) {
+                std::thread::scope(|s| {
+                    let nodes = s.spawn(|| crate::ordering::dissection_nodes(mesh));
+                    let dofs = dof_map();
+                    (dofs, Some(nodes.join().expect("the dissection's thread")))
+                })
+            } else {
+                (dof_map(), None)
+            }
+        });
+        Model::build(
+            mesh, material, dofs?, &adjacency, setup, with_mass, dissection,
+        )
     }
 
     /// [`Model::new`] on a DOF map of `mesh` made already (e.g. one
@@ -98,11 +118,12 @@ impl Model {
             &adjacency,
             SetupTimes::default(),
             true,
+            None,
         )
     }
 
     /// [`Model::with_dofs`], its parts' times added to `setup`, M only
-    /// `with_mass`.
+    /// `with_mass`, the factors' ordering from `dissection` if made.
     fn build(
         mesh: &Mesh,
         material: &Material,
@@ -110,6 +131,7 @@ impl Model {
         adjacency: &SharedAdjacency,
         mut setup: SetupTimes,
         with_mass: bool,
+        dissection: Option<NodeDissection>,
     ) -> Result<Model, FemError> {
         let pattern = setup.time("pattern", || {
             pattern_of(shared_adjacency(mesh, adjacency), &dofs)
@@ -150,7 +172,9 @@ impl Model {
             (matrix(pattern, k), None)
         };
         setup.add("assembly", started.elapsed().as_secs_f64());
-        let fill_order = setup.time("ordering", || crate::ordering::choose(mesh, &dofs));
+        let fill_order = setup.time("ordering", || {
+            crate::ordering::choose(mesh, &dofs, dissection)
+        });
         Ok(Model {
             setup,
             fill_order,

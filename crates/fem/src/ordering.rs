@@ -60,13 +60,16 @@ pub const FILL_ORDER_ENV: &str = "STICKSLIP_FILL_ORDER";
 /// The ordering of the model's factors: AMD below [`DISSECTION_MIN_DOFS`]
 /// free DOFs, else the dissection or AMD by their factors
 /// ([`stickslip_linalg::AMD_MARGIN`]), unless [`FILL_ORDER_ENV`] says which.
-pub fn choose(mesh: &Mesh, dofs: &DofMap) -> FillOrder {
+/// `made`: the mesh's [`dissection_nodes`] if made already (beside the
+/// DOF map, [`wanted`]).
+pub fn choose(mesh: &Mesh, dofs: &DofMap, made: Option<NodeDissection>) -> FillOrder {
+    let dissection = || made.unwrap_or_else(|| dissection_nodes(mesh));
     match std::env::var(FILL_ORDER_ENV).as_deref() {
         Ok("amd") => FillOrder::amd(),
-        Ok("nd") => FillOrder::dissection(nested_dissection(mesh, dofs)),
+        Ok("nd") => FillOrder::dissection(dissection().of_dofs(dofs).0),
         _ if dofs.n_free() < DISSECTION_MIN_DOFS => FillOrder::amd(),
         _ => {
-            let (order, halves) = dissection_with_halves(mesh, dofs);
+            let (order, halves) = dissection().of_dofs(dofs);
             let order = FillOrder::dissection_unless_amd(order);
             match halves {
                 Some(h) => order.with_halves(h),
@@ -74,6 +77,13 @@ pub fn choose(mesh: &Mesh, dofs: &DofMap) -> FillOrder {
             }
         }
     }
+}
+
+/// Whether [`choose`] will read the dissection of a mesh of `n_nodes`
+/// nodes, at most 2 `n_nodes` of them free: false only where it surely
+/// will not.
+pub fn wanted(n_nodes: usize) -> bool {
+    std::env::var(FILL_ORDER_ENV).as_deref() != Ok("amd") && 2 * n_nodes >= DISSECTION_MIN_DOFS
 }
 
 /// The free DOFs of `dofs` in nested-dissection order (module
@@ -88,8 +98,45 @@ pub fn nested_dissection(mesh: &Mesh, dofs: &DofMap) -> Vec<usize> {
 /// second's; its separator follows): `None` where the first split left a
 /// half empty.
 pub fn dissection_with_halves(mesh: &Mesh, dofs: &DofMap) -> (Vec<usize>, Option<[usize; 2]>) {
+    dissection_nodes(mesh).of_dofs(dofs)
+}
+
+/// The dissection's order of the mesh's nodes, before the DOF map: it
+/// reads the cells only, so it can be made beside the DOF map.
+#[derive(Clone, Debug)]
+pub struct NodeDissection {
+    /// Every node once, in the order their DOFs are numbered.
+    nodes: Vec<usize>,
+    /// Where the first split's second half begins and where its
+    /// separator does, in `nodes`: `None` where the mesh has one cell.
+    marks: Option<[usize; 2]>,
+}
+
+impl NodeDissection {
+    /// The free DOFs in this order, each node's x before its y, and the
+    /// first split's halves ([`dissection_with_halves`]).
+    pub fn of_dofs(&self, dofs: &DofMap) -> (Vec<usize>, Option<[usize; 2]>) {
+        let free_dofs = |nodes: &[usize]| {
+            nodes
+                .iter()
+                .flat_map(|&v| (0..2).filter_map(move |k| dofs.free(v, k)))
+                .collect::<Vec<usize>>()
+        };
+        let halves = self.marks.and_then(|[second, separator]| {
+            let first = free_dofs(&self.nodes[..second]).len();
+            let second = free_dofs(&self.nodes[second..separator]).len();
+            (first > 0 && second > 0).then_some([first, second])
+        });
+        (free_dofs(&self.nodes), halves)
+    }
+}
+
+/// The nested dissection of the mesh's nodes (module documentation).
+pub fn dissection_nodes(mesh: &Mesh) -> NodeDissection {
     let n_nodes = mesh.nodes.len();
-    let centroid: Vec<[f64; 2]> = (0..mesh.n_cells())
+    // Each split reorders its range of `cells` in place: its first half,
+    // then its second. A cell carries its centroid, read at every level.
+    let mut cells: Vec<Placed> = (0..mesh.n_cells())
         .map(|c| {
             // Corners first in both cell kinds.
             let corners = &mesh.cell(c)[..4];
@@ -98,9 +145,29 @@ pub fn dissection_with_halves(mesh: &Mesh, dofs: &DofMap) -> (Vec<usize>, Option
                 x[0] += 0.25 * mesh.nodes[v][0];
                 x[1] += 0.25 * mesh.nodes[v][1];
             }
-            x
+            Placed { x, cell: c as u32 }
         })
         .collect();
+    // Two cells that share a node have centroids at most 2·reach apart
+    // along either axis (reach: how far a node lies from its cell's
+    // centroid), so a split's separator lies in the cells within that
+    // band of the split: only they are read for it. The band is widened
+    // beyond 2·reach against the rounding of the comparisons.
+    let mut reach = [0.0f64; 2];
+    for p in &cells {
+        for &v in mesh.cell(p.cell as usize) {
+            for d in 0..2 {
+                reach[d] = reach[d].max((mesh.nodes[v][d] - p.x[d]).abs());
+            }
+        }
+    }
+    let band = reach.map(|r| {
+        if (3.0 * r).is_finite() {
+            3.0 * r
+        } else {
+            f64::INFINITY
+        }
+    });
     #[derive(Clone, Copy, PartialEq)]
     enum State {
         Open,
@@ -111,17 +178,19 @@ pub fn dissection_with_halves(mesh: &Mesh, dofs: &DofMap) -> (Vec<usize>, Option
     let mut in_first = vec![u32::MAX; n_nodes];
     let mut nodes = Vec::with_capacity(n_nodes);
     enum Job {
-        Split(Vec<u32>),
+        /// Cells `cells[start..end]`.
+        Split(usize, usize),
         Number(Vec<usize>),
         /// Where the first split's second half begins, and where its
         /// separator does: the nodes numbered so far.
         Mark,
     }
-    let mut jobs = vec![Job::Split((0..mesh.n_cells() as u32).collect())];
+    let mut second_half = Vec::new();
+    let mut jobs = vec![Job::Split(0, cells.len())];
     let mut marks = Vec::with_capacity(2);
     let mut split = 0u32;
     while let Some(job) = jobs.pop() {
-        let mut cells = match job {
+        let (start, end) = match job {
             Job::Mark => {
                 marks.push(nodes.len());
                 continue;
@@ -133,11 +202,12 @@ pub fn dissection_with_halves(mesh: &Mesh, dofs: &DofMap) -> (Vec<usize>, Option
                 }
                 continue;
             }
-            Job::Split(cells) => cells,
+            Job::Split(start, end) => (start, end),
         };
-        if cells.len() <= 1 {
-            for &c in &cells {
-                for &v in mesh.cell(c as usize) {
+        let range = &mut cells[start..end];
+        if range.len() <= 1 {
+            for p in range.iter() {
+                for &v in mesh.cell(p.cell as usize) {
                     if state[v] == State::Open {
                         state[v] = State::Numbered;
                         nodes.push(v);
@@ -147,33 +217,47 @@ pub fn dissection_with_halves(mesh: &Mesh, dofs: &DofMap) -> (Vec<usize>, Option
             continue;
         }
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for &c in &cells {
+        for p in range.iter() {
             for d in 0..2 {
-                lo[d] = lo[d].min(centroid[c as usize][d]);
-                hi[d] = hi[d].max(centroid[c as usize][d]);
+                lo[d] = lo[d].min(p.x[d]);
+                hi[d] = hi[d].max(p.x[d]);
             }
         }
         let axis = usize::from(hi[1] - lo[1] > hi[0] - lo[0]);
-        let key = |c: &u32| centroid[*c as usize][axis];
-        let mid = cells.len() / 2;
-        cells.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)));
+        let key = |p: &Placed| p.x[axis];
+        let mid = range.len() / 2;
+        range.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)));
         // Split at a coordinate, so that cells of one row or column (equal
         // centroids on a grid) stay on one side and the separator is a
         // straight line; by position when none lies below the median.
-        let at = key(&cells[mid]);
-        let (first, second): (Vec<u32>, Vec<u32>) = if cells[..mid].iter().any(|c| key(c) < at) {
-            cells.iter().partition(|c| key(c) < at)
+        let at = key(&range[mid]);
+        let first_len = if range[..mid].iter().any(|c| key(c) < at) {
+            // A stable partition: the cells below `at`, then the others.
+            second_half.clear();
+            let mut below = 0;
+            for i in 0..range.len() {
+                let c = range[i];
+                if key(&c) < at {
+                    range[below] = c;
+                    below += 1;
+                } else {
+                    second_half.push(c);
+                }
+            }
+            range[below..].copy_from_slice(&second_half);
+            below
         } else {
-            (cells[..mid].to_vec(), cells[mid..].to_vec())
+            mid
         };
-        for &c in &first {
-            for &v in mesh.cell(c as usize) {
+        let (first, second) = range.split_at(first_len);
+        for p in first.iter().filter(|p| key(p) >= at - band[axis]) {
+            for &v in mesh.cell(p.cell as usize) {
                 in_first[v] = split;
             }
         }
         let mut separator = Vec::new();
-        for &c in &second {
-            for &v in mesh.cell(c as usize) {
+        for p in second.iter().filter(|p| key(p) <= at + band[axis]) {
+            for &v in mesh.cell(p.cell as usize) {
                 if in_first[v] == split && state[v] == State::Open {
                     state[v] = State::Separator;
                     separator.push(v);
@@ -186,27 +270,24 @@ pub fn dissection_with_halves(mesh: &Mesh, dofs: &DofMap) -> (Vec<usize>, Option
         if first_split {
             jobs.push(Job::Mark);
         }
-        jobs.push(Job::Split(second));
+        jobs.push(Job::Split(start + first_len, end));
         if first_split {
             jobs.push(Job::Mark);
         }
-        jobs.push(Job::Split(first));
+        jobs.push(Job::Split(start, start + first_len));
     }
     // Nodes in no cell (a mesh may carry them) last.
     nodes.extend((0..n_nodes).filter(|&v| state[v] == State::Open));
-    let free_dofs = |nodes: &[usize]| {
-        nodes
-            .iter()
-            .flat_map(|&v| (0..2).filter_map(move |k| dofs.free(v, k)))
-            .collect::<Vec<usize>>()
-    };
-    let halves = match marks[..] {
-        [second, separator] => {
-            let first = free_dofs(&nodes[..second]).len();
-            let second = free_dofs(&nodes[second..separator]).len();
-            (first > 0 && second > 0).then_some([first, second])
-        }
+    let marks = match marks[..] {
+        [second, separator] => Some([second, separator]),
         _ => None,
     };
-    (free_dofs(&nodes), halves)
+    NodeDissection { nodes, marks }
+}
+
+/// A cell as the dissection sorts it: its centroid and its index.
+#[derive(Clone, Copy)]
+struct Placed {
+    x: [f64; 2],
+    cell: u32,
 }

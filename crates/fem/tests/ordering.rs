@@ -8,7 +8,9 @@ use stickslip_fem::ordering::{
 use stickslip_fem::{Dirichlet, DofMap, Model, NodeOrder};
 use stickslip_linalg::{analyze_symbolic, FillOrder};
 use stickslip_mesh::{CellKind, Mesh};
-use stickslip_testkit::{add_point_group, paper_material, paper_supports, rectangle, slab};
+use stickslip_testkit::{
+    add_point_group, map_nodes, paper_material, paper_supports, read_mesh, rectangle, slab,
+};
 
 fn slab_dofs(kind: CellKind, refine: usize) -> (Mesh, DofMap) {
     let mesh = slab(kind, refine);
@@ -147,6 +149,43 @@ fn the_halves_are_the_two_sides_of_the_middle_line() {
     }
 }
 
+/// A split reads its separator only from the cells near it (within three
+/// times the farthest any node lies from its cell's centroid): on meshes
+/// whose cells differ in size by far (the slab graded along x, its cells
+/// from 1/27 to 79/27 of their width, and the committed unstructured
+/// slabs) the first split still leaves two halves that K does not couple,
+/// so no node the halves share was missed.
+#[test]
+fn the_halves_are_uncoupled_on_graded_and_unstructured_meshes() {
+    let mut meshes = Vec::new();
+    for kind in [CellKind::Quad4, CellKind::Quad9] {
+        let mut mesh = slab(kind, 4);
+        map_nodes(&mut mesh, |[x, y]| {
+            let s = x / 8.0;
+            [8.0 * (s + 26.0 * s.powi(3)) / 27.0, y]
+        });
+        meshes.push((format!("graded {kind:?}"), mesh));
+    }
+    for file in ["slab-unstructured-q1.msh", "slab-unstructured-q2.msh"] {
+        meshes.push((file.to_string(), read_mesh(file).unwrap()));
+    }
+    for (name, mesh) in meshes {
+        let model = Model::new(&mesh, &paper_material(), &paper_supports()).unwrap();
+        let (order, halves) = dissection_with_halves(&mesh, &model.dofs);
+        let [n1, n2] = halves.expect("two halves");
+        assert!(n1 > 0 && n2 > 0 && n1 + n2 < order.len(), "{name}");
+        let k = &model.stiffness;
+        let mut first = vec![false; k.nrows()];
+        order[..n1].iter().for_each(|&d| first[d] = true);
+        for &d in &order[n1..n1 + n2] {
+            assert!(
+                k.row(d).col_indices().iter().all(|&j| !first[j]),
+                "{name}: DOF {d}"
+            );
+        }
+    }
+}
+
 /// The dissection's quality where AMD is at its best, a grid numbered
 /// row by row: within 5% of AMD's factor values (1.003 for Q1 and 1.028
 /// for Q2 at these 101k DOFs), and the same factor whatever the
@@ -187,13 +226,13 @@ fn amd_on_small_meshes_the_smaller_factor_on_large_ones() {
     // The 16 × 4 slab: AMD; the 32 × 8 (552 free DOFs): the dissection.
     let (mesh, dofs) = slab_dofs(CellKind::Quad4, 1);
     assert!(dofs.n_free() < DISSECTION_MIN_DOFS);
-    let small = choose(&mesh, &dofs);
+    let small = choose(&mesh, &dofs, None);
     assert!(small.dissection_order().is_none());
     assert_eq!(small.name(), "AMD");
     assert_eq!(small.decided_name(), Some("AMD"));
     let (mesh, dofs) = slab_dofs(CellKind::Quad4, 2);
     assert!(dofs.n_free() >= DISSECTION_MIN_DOFS);
-    assert!(choose(&mesh, &dofs).dissection_order().is_some());
+    assert!(choose(&mesh, &dofs, None).dissection_order().is_some());
     // 28 × (16×4) cells: 100,912 free DOFs, the dissection a
     // candidate, kept; and a strip of 5000 × 10 cells (110k DOFs),
     // where AMD's factor is the smaller by more than the margin (1.23×,
@@ -211,7 +250,7 @@ fn amd_on_small_meshes_the_smaller_factor_on_large_ones() {
     let material = paper_material();
     for (mesh, dofs, amd_wins) in [(slab, slab_dofs, false), (strip, strip_dofs, true)] {
         assert!(dofs.n_free() >= DISSECTION_MIN_DOFS);
-        let order = choose(&mesh, &dofs);
+        let order = choose(&mesh, &dofs, None);
         assert_eq!(
             order.dissection_order(),
             Some(&nested_dissection(&mesh, &dofs)[..])
@@ -243,7 +282,7 @@ fn amd_on_small_meshes_the_smaller_factor_on_large_ones() {
         assert_eq!(values(&copy), kept);
         // A run that factorizes once (the explicit preload) keeps the
         // dissection without analysing AMD's order, where AMD wins too.
-        let once = choose(&mesh, &model.dofs);
+        let once = choose(&mesh, &model.dofs, None);
         once.keep_dissection();
         assert_eq!(once.decided_name(), Some("nested dissection"));
         assert_eq!(values(&once), nd);

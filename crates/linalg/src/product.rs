@@ -10,6 +10,12 @@ use crate::simd::Batches;
 use crate::stencils::{Stencils, BATCH};
 use crate::symmetric::Symmetric;
 
+/// Rows from which [`Product::without_csr`] makes the stencil types and
+/// the node blocks side by side rather than the blocks only where the
+/// types are declined: there each takes tens of milliseconds, and an
+/// unstructured mesh's types are declined only after a pass over K.
+const BOTH_MIN_ROWS: usize = 100_000;
+
 /// The product a step streams K from: every row's value is the same
 /// whichever batch, chunk or thread computes it.
 #[derive(Clone, Debug)]
@@ -36,17 +42,26 @@ impl Product {
     /// The fastest form `k` allows: stencil types, else the upper node
     /// blocks, else the CSR itself.
     pub fn new(k: CsrMatrix<f64>) -> Product {
-        Product::with_types(Stencils::new(&k), k)
+        Product::without_csr(&k, true).unwrap_or(Product::Csr(k))
     }
 
-    /// As [`Product::new`], with `k`'s stencil types formed already.
-    pub fn with_types(types: Option<Stencils>, k: CsrMatrix<f64>) -> Product {
+    /// Stencil types where `stencils` is asked and `k` has them, else the
+    /// upper node blocks: `None` where only `k` itself serves (then
+    /// `Product::Csr(k)`), so that `k` stays the caller's until then.
+    pub fn without_csr(k: &CsrMatrix<f64>, stencils: bool) -> Option<Product> {
+        let (types, symmetric) = if stencils && k.nrows() >= BOTH_MIN_ROWS {
+            // Each is made on one thread; the blocks are dropped where the
+            // types serve.
+            let (t, s) = rayon::join(|| Stencils::new(k), || Symmetric::new(k));
+            (t, Some(s))
+        } else {
+            (stencils.then(|| Stencils::new(k)).flatten(), None)
+        };
         match types {
-            Some(s) => Product::Stencils(s),
-            None => match Symmetric::new(&k) {
-                Some(s) => Product::Symmetric(s),
-                None => Product::Csr(k),
-            },
+            Some(t) => Some(Product::Stencils(t)),
+            None => symmetric
+                .unwrap_or_else(|| Symmetric::new(k))
+                .map(Product::Symmetric),
         }
     }
 

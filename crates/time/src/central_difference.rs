@@ -5,7 +5,7 @@
 
 use stickslip_contact::{iterate, ContactSurface, DiagonalStep, Foundation, SlipState};
 use stickslip_linalg::chunks;
-use stickslip_linalg::{csr, Analysis, Formed, Product, Stencils};
+use stickslip_linalg::{csr, Analysis, Formed, Product};
 
 use stickslip_fem::SetupTimes;
 
@@ -88,16 +88,9 @@ pub(crate) fn start(
         rigid_modes,
         ..
     } = dynamics;
-    let types = times.time(
-        "operators",
-        || {
-            if stencils {
-                Stencils::new(&k)
-            } else {
-                None
-            }
-        },
-    );
+    // The step's own product, made before the critical step so that
+    // Lanczos streams the same (and the smaller) matrix the steps do.
+    let formed = times.time("operators", || Product::without_csr(&k, stencils));
     // A compliant foundation with m_n = 1 is a spring w c_n ννᵀ at every
     // node in contact; with all of them in contact ω_max is largest
     // (a positive semi-definite term raises every eigenvalue), so that
@@ -113,8 +106,8 @@ pub(crate) fn start(
     let critical = || {
         critical_step_with(
             |x, y| {
-                match &types {
-                    Some(s) => s.spmv(x, y),
+                match &formed {
+                    Some(p) => p.spmv(x, y),
                     None => csr::spmv(&k, x, y),
                 }
                 if let Some(c) = contact.filter(|c| c.is_compliant()) {
@@ -190,7 +183,7 @@ pub(crate) fn start(
             (dt_crit, state)
         }
     };
-    let product = Product::with_types(types, k);
+    let product = formed.unwrap_or(Product::Csr(k));
     let n = mass.len();
     let vectors: Vec<&[f64]> = loads.loads.iter().map(|l| &l.vector[..]).collect();
     let (mut friction, mut friction_slots) = (Vec::new(), Vec::new());

@@ -9,9 +9,12 @@
 //! dissection's two first halves are known, the preload is factorized by
 //! them on both threads, and the critical step comes before it.
 
-use stickslip_linalg::{backward_error, FillOrder, SparseCholesky, SplitSingle, BACKWARD_ERROR};
+use nalgebra_sparse::CsrMatrix;
+use stickslip_linalg::{
+    backward_error, FillOrder, Product, SparseCholesky, SplitSingle, BACKWARD_ERROR,
+};
 use stickslip_testkit::{structured_slab, Slab};
-use stickslip_time::stability::{critical_step, gershgorin_bound, largest_eigenvalue};
+use stickslip_time::stability::{critical_step_with, gershgorin_bound, largest_eigenvalue};
 use stickslip_time::{Dynamics, History, Integrator, Scheme, Settings, TimeError};
 
 /// The paper's slab on a Q1 grid of 102,770 free DOFs (above the 100k
@@ -26,9 +29,9 @@ fn slab() -> Slab {
     s
 }
 
-/// The scene's dynamics, its K·x the assembled CSR's (no stencil types),
-/// which `critical_step` forms too; its fill order without the
-/// dissection's halves, so that the preload's factor is K's whole.
+/// The scene's dynamics, its K·x by K's symmetric node blocks (no stencil
+/// types: [`critical_step`] here forms the same); its fill order without
+/// the dissection's halves, so that the preload's factor is K's whole.
 fn dynamics(s: &Slab) -> Dynamics {
     let mut d = halved_dynamics(s);
     let order = d.fill_order.dissection_order().expect("a dissection");
@@ -42,6 +45,14 @@ fn halved_dynamics(s: &Slab) -> Dynamics {
     let mut d = Dynamics::from_model(&s.model);
     d.stencils = false;
     d
+}
+
+/// Δt_crit as a run estimates it, on one thread: Lanczos on the step's
+/// own product (the node blocks, `stencils` being off), capped by
+/// Gershgorin's bound.
+fn critical_step(k: &CsrMatrix<f64>, m: &[f64]) -> f64 {
+    let product = Product::without_csr(k, false).expect("K's node blocks");
+    critical_step_with(|x, y| product.spmv(x, y), m, Some(gershgorin_bound(k, m)))
 }
 
 fn integrator(s: &Slab, settings: Settings) -> Result<Integrator, TimeError> {
