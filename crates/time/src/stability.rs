@@ -4,7 +4,7 @@
 use nalgebra_sparse::CsrMatrix;
 use rayon::prelude::*;
 
-use stickslip_linalg::chunks::{each_chunk_of, each_chunk_summed, partials, CHUNK};
+use stickslip_linalg::chunks::{each_chunk_of, each_chunk_summed, parallel, partials, CHUNK};
 use stickslip_linalg::csr::{dot, spmv};
 
 /// Relative residual of the top Ritz pair at which Lanczos stops: the
@@ -193,20 +193,27 @@ pub fn gershgorin_bound(stiffness: &CsrMatrix<f64>, lumped_mass: &[f64]) -> f64 
         stiffness.col_indices(),
         stiffness.values(),
     );
-    // Rows by chunks on the pool: a maximum, the same whoever finds it.
-    (0..stiffness.nrows())
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(|i| {
-            let row = offsets[i]..offsets[i + 1];
-            let sum: f64 = cols[row.clone()]
-                .iter()
-                .zip(&values[row])
-                .map(|(&j, v)| v.abs() * scale[j])
-                .sum();
-            sum * scale[i]
-        })
-        .reduce(|| 0.0, f64::max)
+    let row_sum = |i: usize| {
+        let row = offsets[i]..offsets[i + 1];
+        let sum: f64 = cols[row.clone()]
+            .iter()
+            .zip(&values[row])
+            .map(|(&j, v)| v.abs() * scale[j])
+            .sum();
+        sum * scale[i]
+    };
+    // A maximum, the same whoever finds it: on the pool where the passes
+    // use it (a small model starts no threads).
+    let n = stiffness.nrows();
+    if parallel(n) {
+        (0..n)
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .map(row_sum)
+            .reduce(|| 0.0, f64::max)
+    } else {
+        (0..n).map(row_sum).fold(0.0, f64::max)
+    }
 }
 
 /// Δt_crit = 2/ω_max for central difference with the lumped mass, from
