@@ -15,8 +15,9 @@ use crate::setup_times::SetupTimes;
 use stickslip_linalg::FillOrder;
 
 /// Nodes from which the DOF map's bandwidth order and the factors'
-/// dissection are made side by side: below, the two together take
-/// milliseconds, less than waking the second thread is worth.
+/// dissection are made side by side: below, the dissection takes about
+/// 2 ms or less, and a thread's start and join are a visible part of it
+/// (docs/performance.md).
 const BESIDE_MIN_NODES: usize = 10_000;
 
 /// K, M (unless built without it) and lumped M of a mesh and material
@@ -85,7 +86,7 @@ impl Model {
         // The DOF map's bandwidth order and the pattern read one adjacency.
         let adjacency = SharedAdjacency::new();
         let dof_map = || DofMap::with_adjacency(mesh, conditions, &adjacency);
-        // Both the bandwidth order and the dissection run on one thread:
+        // The bandwidth order and the dissection each run on one thread:
         // on large meshes they run side by side, the part "DOF map" the
         // wall time of both.
         let (dofs, dissection) = setup.time("DOF map", || {

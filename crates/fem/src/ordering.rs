@@ -83,7 +83,11 @@ pub fn choose(mesh: &Mesh, dofs: &DofMap, made: Option<NodeDissection>) -> FillO
 /// nodes, at most 2 `n_nodes` of them free: false only where it surely
 /// will not.
 pub fn wanted(n_nodes: usize) -> bool {
-    std::env::var(FILL_ORDER_ENV).as_deref() != Ok("amd") && 2 * n_nodes >= DISSECTION_MIN_DOFS
+    match std::env::var(FILL_ORDER_ENV).as_deref() {
+        Ok("amd") => false,
+        Ok("nd") => true,
+        _ => 2 * n_nodes >= DISSECTION_MIN_DOFS,
+    }
 }
 
 /// The free DOFs of `dofs` in nested-dissection order (module
@@ -161,13 +165,10 @@ pub fn dissection_nodes(mesh: &Mesh) -> NodeDissection {
             }
         }
     }
-    let band = reach.map(|r| {
-        if (3.0 * r).is_finite() {
-            3.0 * r
-        } else {
-            f64::INFINITY
-        }
-    });
+    let band = reach.map(|r| 3.0 * r);
+    // A mesh file's coordinates are finite (the reader refuses others); a
+    // mesh built otherwise with some that are not has every cell read.
+    let finite = cells.iter().all(|p| p.x.iter().all(|v| v.is_finite()));
     #[derive(Clone, Copy, PartialEq)]
     enum State {
         Open,
@@ -250,13 +251,19 @@ pub fn dissection_nodes(mesh: &Mesh) -> NodeDissection {
             mid
         };
         let (first, second) = range.split_at(first_len);
-        for p in first.iter().filter(|p| key(p) >= at - band[axis]) {
+        for p in first
+            .iter()
+            .filter(|p| !finite || key(p) >= at - band[axis])
+        {
             for &v in mesh.cell(p.cell as usize) {
                 in_first[v] = split;
             }
         }
         let mut separator = Vec::new();
-        for p in second.iter().filter(|p| key(p) <= at + band[axis]) {
+        for p in second
+            .iter()
+            .filter(|p| !finite || key(p) <= at + band[axis])
+        {
             for &v in mesh.cell(p.cell as usize) {
                 if in_first[v] == split && state[v] == State::Open {
                     state[v] = State::Separator;

@@ -3,7 +3,7 @@
 //! as good as AMD on a grid, and `choose` keeps the smaller factor.
 
 use stickslip_fem::ordering::{
-    choose, dissection_with_halves, nested_dissection, DISSECTION_MIN_DOFS, FILL_ORDER_ENV,
+    choose, dissection_with_halves, nested_dissection, wanted, DISSECTION_MIN_DOFS, FILL_ORDER_ENV,
 };
 use stickslip_fem::{Dirichlet, DofMap, Model, NodeOrder};
 use stickslip_linalg::{analyze_symbolic, FillOrder};
@@ -150,19 +150,23 @@ fn the_halves_are_the_two_sides_of_the_middle_line() {
 }
 
 /// A split reads its separator only from the cells near it (within three
-/// times the farthest any node lies from its cell's centroid): on meshes
-/// whose cells differ in size by far (the slab graded along x, its cells
-/// from 1/27 to 79/27 of their width, and the committed unstructured
-/// slabs) the first split still leaves two halves that K does not couple,
-/// so no node the halves share was missed.
+/// times the farthest any node lies from its cell's centroid, `reach`):
+/// on meshes whose cells differ in size by far the first split still
+/// leaves two halves that K does not couple, so no node the halves share
+/// was missed. The graded slabs have their widest cells (29.5 times the
+/// narrowest) at the middle line, where the first split falls: there the
+/// centroids across it lie 2·reach apart, so a band below that fails.
+/// The committed unstructured slabs too.
 #[test]
 fn the_halves_are_uncoupled_on_graded_and_unstructured_meshes() {
     let mut meshes = Vec::new();
     for kind in [CellKind::Quad4, CellKind::Quad9] {
         let mut mesh = slab(kind, 4);
+        // x = 8 (1/2 + g(s)), s = x/8 − 1/2, g(s) = 1.475 s − 1.9 s³: g'
+        // is 1.475 at the middle and 0.05 at the ends.
         map_nodes(&mut mesh, |[x, y]| {
-            let s = x / 8.0;
-            [8.0 * (s + 26.0 * s.powi(3)) / 27.0, y]
+            let s = x / 8.0 - 0.5;
+            [8.0 * (0.5 + 1.475 * s - 1.9 * s.powi(3)), y]
         });
         meshes.push((format!("graded {kind:?}"), mesh));
     }
@@ -216,6 +220,26 @@ fn dissection_fill_is_amd_s_on_a_grid_whatever_the_numbering() {
             "{kind:?}: the numbering changed the factor"
         );
     }
+}
+
+/// From 10,000 nodes `Model::new` makes the nodes' dissection beside the
+/// DOF map: its factors' order is the one made from the finished DOF map.
+#[test]
+fn the_dissection_made_beside_the_dof_map_is_the_same() {
+    if std::env::var_os(FILL_ORDER_ENV).is_some() {
+        return;
+    }
+    assert!(!wanted(DISSECTION_MIN_DOFS / 2 - 1));
+    let mesh = slab(CellKind::Quad4, 28);
+    assert!(mesh.nodes.len() >= 10_000 && wanted(mesh.nodes.len()));
+    let model = Model::new(&mesh, &paper_material(), &paper_supports()).unwrap();
+    model.fill_order.keep_dissection();
+    assert_eq!(
+        model.fill_order.dissection_order(),
+        Some(&nested_dissection(&mesh, &model.dofs)[..])
+    );
+    let (_, halves) = dissection_with_halves(&mesh, &model.dofs);
+    assert_eq!(model.fill_order.halves(), halves);
 }
 
 #[test]

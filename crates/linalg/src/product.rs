@@ -12,8 +12,8 @@ use crate::symmetric::Symmetric;
 
 /// Rows from which [`Product::without_csr`] makes the stencil types and
 /// the node blocks side by side rather than the blocks only where the
-/// types are declined: there each takes tens of milliseconds, and an
-/// unstructured mesh's types are declined only after a pass over K.
+/// types are declined: an unstructured mesh's types are declined only
+/// after a pass over K, as long as the blocks take (docs/performance.md).
 const BOTH_MIN_ROWS: usize = 100_000;
 
 /// The product a step streams K from: every row's value is the same
@@ -50,8 +50,9 @@ impl Product {
     /// `Product::Csr(k)`), so that `k` stays the caller's until then.
     pub fn without_csr(k: &CsrMatrix<f64>, stencils: bool) -> Option<Product> {
         let (types, symmetric) = if stencils && k.nrows() >= BOTH_MIN_ROWS {
-            // Each is made on one thread; the blocks are dropped where the
-            // types serve.
+            // The types on one thread, the blocks beside them (their
+            // symmetry check on the pool); the blocks are dropped where
+            // the types serve.
             let (t, s) = rayon::join(|| Stencils::new(k), || Symmetric::new(k));
             (t, Some(s))
         } else {

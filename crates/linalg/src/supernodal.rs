@@ -409,59 +409,64 @@ impl Supernodal {
     /// side lives there: a forward and a back solve restricted to the
     /// reach. `GROUP` columns go through each supernode together (its
     /// values are read once per group and the inner loops run over the
-    /// group), groups in parallel; a column's arithmetic is the same on any
+    /// group), groups in parallel from [`PATHS_PARALLEL_MIN`] reach values
+    /// (p times the reach's DOFs); a column's arithmetic is the same on any
     /// thread.
     pub fn schur_complement(&self, l: &[f64], rows: &[Vec<(usize, f64)>]) -> PathOperator {
         let p = rows.len();
         let groups: Vec<usize> = (0..p).step_by(GROUP).collect();
-        let columns: Vec<(Vec<f64>, Vec<PathColumn>)> = groups
-            .par_iter()
-            .map_init(
-                || {
-                    (
-                        vec![0.0; self.reach_cols * GROUP],
-                        vec![0.0; self.tmp.len() * GROUP],
-                    )
-                },
-                |(x, tmp), &start| {
-                    let width = GROUP.min(p - start);
-                    x.fill(0.0);
-                    for c in 0..width {
-                        for &(i, v) in &rows[start + c] {
-                            x[self.reach_local[i] as usize * GROUP + c] += v;
-                        }
-                    }
-                    for &s in &self.reach_list {
-                        self.group_forward(l, s as usize, x, tmp);
-                    }
-                    // W's columns, L⁻¹Pᵀe_j: nonzero only on the paths
-                    // from the row's DOFs to the root.
-                    let w: Vec<PathColumn> = (0..width)
-                        .map(|c| {
-                            (0..self.reach_cols)
-                                .filter_map(|li| {
-                                    let v = x[li * GROUP + c];
-                                    (v != 0.0).then_some((li as u32, v))
-                                })
-                                .collect()
-                        })
-                        .collect();
-                    for &s in self.reach_list.iter().rev() {
-                        self.group_backward(l, s as usize, x, tmp);
-                    }
-                    let mut g = vec![0.0; width * p];
-                    for c in 0..width {
-                        for (a, row) in rows.iter().enumerate() {
-                            g[c * p + a] = row
-                                .iter()
-                                .map(|&(i, v)| v * x[self.reach_local[i] as usize * GROUP + c])
-                                .sum();
-                        }
-                    }
-                    (g, w)
-                },
+        let scratch = || {
+            (
+                vec![0.0; self.reach_cols * GROUP],
+                vec![0.0; self.tmp.len() * GROUP],
             )
-            .collect();
+        };
+        let column = |(x, tmp): &mut (Vec<f64>, Vec<f64>), &start: &usize| {
+            let width = GROUP.min(p - start);
+            x.fill(0.0);
+            for c in 0..width {
+                for &(i, v) in &rows[start + c] {
+                    x[self.reach_local[i] as usize * GROUP + c] += v;
+                }
+            }
+            for &s in &self.reach_list {
+                self.group_forward(l, s as usize, x, tmp);
+            }
+            // W's columns, L⁻¹Pᵀe_j: nonzero only on the paths
+            // from the row's DOFs to the root.
+            let w: Vec<PathColumn> = (0..width)
+                .map(|c| {
+                    (0..self.reach_cols)
+                        .filter_map(|li| {
+                            let v = x[li * GROUP + c];
+                            (v != 0.0).then_some((li as u32, v))
+                        })
+                        .collect()
+                })
+                .collect();
+            for &s in self.reach_list.iter().rev() {
+                self.group_backward(l, s as usize, x, tmp);
+            }
+            let mut g = vec![0.0; width * p];
+            for c in 0..width {
+                for (a, row) in rows.iter().enumerate() {
+                    g[c * p + a] = row
+                        .iter()
+                        .map(|&(i, v)| v * x[self.reach_local[i] as usize * GROUP + c])
+                        .sum();
+                }
+            }
+            (g, w)
+        };
+        // On the pool where the reach is large (as W's products): a small
+        // model starts no threads.
+        let columns: Vec<(Vec<f64>, Vec<PathColumn>)> = if p * self.reach_cols >= PATHS_PARALLEL_MIN
+        {
+            groups.par_iter().map_init(scratch, column).collect()
+        } else {
+            let mut state = scratch();
+            groups.iter().map(|g| column(&mut state, g)).collect()
+        };
         let mut op = PathOperator {
             s: Vec::with_capacity(p * p),
             w_ptr: vec![0],
