@@ -1,42 +1,56 @@
-//! A small model starts no threads: the paper's slab (148 free DOFs),
-//! built, set up and stepped by both schemes, leaves the process with the
-//! threads it had (rayon's pool, once started, keeps its workers; a start
-//! costs more than the paper's whole explicit run). Alone in its test
-//! binary, so that no other test starts the pool first.
+//! The explicit scheme's threaded passes give bit-identical runs on one
+//! thread and on several: the work is split into fixed chunks and
+//! sums are added in chunk order, whatever the number of threads.
 
-use stickslip_testkit::paper_slab;
-use stickslip_time::{History, Scheme, Settings};
+use stickslip_linalg::chunks::{CHUNK, PARALLEL_MIN};
+use stickslip_testkit::{on_threads, structured_slab, Slab};
+use stickslip_time::{History, Integrator, Scheme, Settings};
 
-/// The process's threads, from /proc (Linux).
-fn threads() -> Option<usize> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("Threads:"))
-        .and_then(|n| n.trim().parse().ok())
+fn run(s: &Slab, threads: usize, steps: usize) -> Integrator {
+    on_threads(threads, || {
+        assert_eq!(rayon::current_num_threads(), threads);
+        let probe = s
+            .integrator(Settings::new(Scheme::CentralDifference, 1e-9, 0.5))
+            .unwrap();
+        let dt = 0.9 * probe.dt_crit().unwrap();
+        let mut i = s
+            .integrator(Settings::new(Scheme::CentralDifference, dt, 0.5))
+            .unwrap();
+        for _ in 0..steps {
+            i.step().unwrap();
+        }
+        i
+    })
 }
 
 #[test]
-fn the_paper_slab_starts_no_threads() {
-    let Some(before) = threads() else {
-        eprintln!("no /proc/self/status: not checked");
-        return;
-    };
-    for (scheme, dt) in [
-        (Scheme::CentralDifference, 1e-4),
-        (
-            Scheme::Newmark {
-                beta: 0.25,
-                gamma: 0.5,
-            },
-            1e-3,
-        ),
-    ] {
-        let s = paper_slab("slab-q2-8x2.msh", 1e-4, History::Step);
-        let mut i = s.integrator(Settings::new(scheme, dt, 0.5)).unwrap();
-        for _ in 0..20 {
-            i.step().unwrap();
+fn one_thread_and_several_give_the_same_bits() {
+    // At least PARALLEL_MIN whole chunks of free DOFs (CHUNK), so
+    // that the passes go parallel with more than one thread (the committed
+    // 128×32 slabs, 8,352 DOFs, are below it).
+    for (nx, ny, q2) in [(192, 48, false), (96, 24, true)] {
+        let mesh = format!("{} {nx}x{ny}", if q2 { "Q2" } else { "Q1" });
+        let s = Slab::paper(structured_slab(nx, ny, q2), 1e-4, History::Step, true).unwrap();
+        let whole = s.model.dofs.n_free() / CHUNK;
+        assert!(whole >= PARALLEL_MIN, "{mesh} too small to thread");
+        let one = run(&s, 1, 400);
+        for threads in [2, 3] {
+            let many = run(&s, threads, 400);
+            assert_eq!(
+                one.displacement(),
+                many.displacement(),
+                "{mesh} {threads}: r"
+            );
+            assert_eq!(one.velocity(), many.velocity(), "{mesh} {threads}: ṙ");
+            assert_eq!(
+                one.acceleration(),
+                many.acceleration(),
+                "{mesh} {threads}: r̈"
+            );
+            assert_eq!(one.classes(), many.classes(), "{mesh} {threads}: classes");
+            assert_eq!(one.energy(), many.energy(), "{mesh} {threads}: energy");
         }
+        // The run did something: the end moved and friction slipped.
+        assert!(one.classes().iter().any(|c| !c.is_stuck()) || one.energy().dissipated > 0.0);
     }
-    assert_eq!(threads(), Some(before), "threads before the runs: {before}");
 }
