@@ -117,6 +117,11 @@ pub struct NodeDissection {
 }
 
 impl NodeDissection {
+    /// Every node once, in the order their DOFs are numbered.
+    pub fn nodes(&self) -> &[usize] {
+        &self.nodes
+    }
+
     /// The free DOFs in this order, each node's x before its y, and the
     /// first split's halves ([`dissection_with_halves`]).
     pub fn of_dofs(&self, dofs: &DofMap) -> (Vec<usize>, Option<[usize; 2]>) {
