@@ -19,6 +19,7 @@
 
 mod assembly;
 pub mod boundary;
+mod cut;
 pub mod dofs;
 pub mod element;
 mod error;

@@ -316,3 +316,54 @@ fn amd_on_small_meshes_the_smaller_factor_on_large_ones() {
         assert_eq!(values(&amd_order), amd);
     }
 }
+
+/// On an unstructured mesh the cells' centroids put a staircase between
+/// the halves; from `CUT_MIN_CELLS` cells a split takes the shortest path
+/// of cell sides across a band instead. A 256 × 64 grid whose rows of
+/// inner nodes are moved along x by up to 1.5 cells (less within 16
+/// cells of the ends), each row its
+/// own way (deterministically): its columns of nodes are still paths of
+/// cell sides, 65 nodes, which no path across the slab beats, while the
+/// rows' centroids move the split's staircase by a cell here and there. The first separator is a column (65 nodes, 129 free DOFs: the
+/// top node's y is held), and the halves it leaves are uncoupled.
+#[test]
+fn a_large_split_takes_the_shortest_path_across() {
+    let mut mesh = slab(CellKind::Quad4, 16);
+    assert_eq!(mesh.n_cells(), 256 * 64);
+    let (lo, hi) = mesh
+        .nodes
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p[0]), hi.max(p[0]))
+        });
+    let h = (hi - lo) / 256.0;
+    map_nodes(&mut mesh, |[x, y]| {
+        let i = ((x - lo) / h).round() as u64;
+        if i == 0 || i == 256 {
+            return [x, y];
+        }
+        let j = (y / h).round() as u64;
+        let mut s = (j * 7_919 + 13) | 1;
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        let r = (s % 1_000) as f64 / 1_000.0 - 0.5;
+        // Tapered over 16 cells from the ends, whose nodes stay.
+        let taper = (i.min(256 - i) as f64 / 16.0).min(1.0);
+        [x + 3.0 * r * taper * h, y]
+    });
+    let model = Model::new(&mesh, &paper_material(), &paper_supports()).unwrap();
+    let (order, halves) = dissection_with_halves(&mesh, &model.dofs);
+    let [n1, n2] = halves.expect("two halves");
+    assert_eq!(
+        order.len() - n1 - n2,
+        2 * 65 - 1,
+        "the first separator's DOFs"
+    );
+    let k = &model.stiffness;
+    let mut first = vec![false; k.nrows()];
+    order[..n1].iter().for_each(|&d| first[d] = true);
+    for &d in &order[n1..n1 + n2] {
+        assert!(k.row(d).col_indices().iter().all(|&j| !first[j]), "DOF {d}");
+    }
+}
