@@ -8,16 +8,18 @@
 //! dissection's separators against METIS's"). Here one breadth-first
 //! search along the sides of the band's cells goes from the nodes where
 //! the band meets the split range's rim on one end (below the band's
-//! middle, across the split) to those on the other end, through nodes not
-//! yet numbered (the rim: sides of one cell of the range, the mesh's
-//! boundary, and cells beside an earlier separator); the path found is the candidate separator. A second
+//! middle, across the split) to those on the other end, through open
+//! nodes (neither in an ancestor's separator nor numbered with a sibling
+//! half). The rim: sides of one cell of the range (the mesh's boundary)
+//! and cells beside a node not open. The path found is the candidate
+//! separator. A second
 //! search then collects the nodes reached from the cells before the band
 //! without crossing the path, the first side: a band cell with one of them
 //! goes first. Where a node of the cells after the band is reached the
 //! path does not separate (a range that is not convex, a band that meets
 //! the rim elsewhere), and the split keeps its staircase; so it does
-//! where the path is not shorter (a grid's split across its longer side,
-//! whose staircase is a line).
+//! where the path is not shorter (a split whose staircase is a straight
+//! line, as on an exact grid).
 
 use stickslip_mesh::{CellKind, Mesh};
 
@@ -79,7 +81,8 @@ impl Cut {
     /// fewer than `limit` nodes, where the path finds one: `cells` are the
     /// split's (index, centroid), `axis` and `at` the split, `width` the
     /// band's half-width, `near` how far from the band a cell that shares
-    /// a side with it can lie, `open` the nodes not yet numbered.
+    /// a node with it can lie, `open` the nodes in neither an ancestor's
+    /// separator nor a numbered half.
     #[allow(clippy::too_many_arguments)]
     pub fn shorter(
         &mut self,
@@ -149,8 +152,8 @@ impl Cut {
             if d <= width {
                 lo = lo.min(x[other]);
                 hi = hi.max(x[other]);
-                // Beside an earlier separator (numbered nodes): the rim
-                // of a range inside the mesh.
+                // Beside a node not open (an ancestor's separator, a
+                // numbered half): the rim of a range inside the mesh.
                 if cell.iter().any(|&v| !open(v)) {
                     for &v in cell {
                         let l = self.local[v];

@@ -319,13 +319,14 @@ fn amd_on_small_meshes_the_smaller_factor_on_large_ones() {
 
 /// On an unstructured mesh the cells' centroids put a staircase between
 /// the halves; from `CUT_MIN_CELLS` cells a split takes the shortest path
-/// of cell sides across a band instead. A 256 × 64 grid whose rows of
-/// inner nodes are moved along x by up to 1.5 cells (less within 16
-/// cells of the ends), each row its
-/// own way (deterministically): its columns of nodes are still paths of
-/// cell sides, 65 nodes, which no path across the slab beats, while the
-/// rows' centroids move the split's staircase by a cell here and there. The first separator is a column (65 nodes, 129 free DOFs: the
-/// top node's y is held), and the halves it leaves are uncoupled.
+/// of cell sides across a band instead. A 256 × 64 grid on [0, 8] × [0, 1]
+/// whose rows of nodes are moved along x by up to 1.5 cells (less within
+/// 16 cells of the ends), each row its own way (deterministically): its
+/// columns of nodes are still paths of cell sides, 65 nodes, which no
+/// path across the slab beats, while the rows' centroids move the
+/// centroid split's staircase by a cell here and there. The first
+/// separator is a column (65 nodes, 129 free DOFs: the top node's y is
+/// held), and the halves it leaves are uncoupled.
 #[test]
 fn a_large_split_takes_the_shortest_path_across() {
     let mut mesh = slab(CellKind::Quad4, 16);
@@ -342,7 +343,8 @@ fn a_large_split_takes_the_shortest_path_across() {
         if i == 0 || i == 256 {
             return [x, y];
         }
-        let j = (y / h).round() as u64;
+        // Rows are 1/64 apart.
+        let j = (y * 64.0).round() as u64;
         let mut s = (j * 7_919 + 13) | 1;
         s ^= s << 13;
         s ^= s >> 7;
