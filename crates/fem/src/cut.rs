@@ -63,6 +63,31 @@ pub(crate) struct Cut {
     sides: Vec<(u32, u32)>,
 }
 
+/// The band around a split: the cells whose centroids lie within `width`
+/// of `at` along `axis`.
+#[derive(Clone, Copy)]
+pub(crate) struct Band {
+    pub axis: usize,
+    pub at: f64,
+    pub width: f64,
+}
+
+impl Band {
+    /// How far a centroid lies from the split, along its axis.
+    fn distance(&self, x: [f64; 2]) -> f64 {
+        (x[self.axis] - self.at).abs()
+    }
+
+    fn contains(&self, x: [f64; 2]) -> bool {
+        self.distance(x) <= self.width
+    }
+
+    /// Whether a centroid lies before the split.
+    fn before(&self, x: [f64; 2]) -> bool {
+        x[self.axis] < self.at
+    }
+}
+
 const BEFORE: u8 = 1;
 const AFTER: u8 = 2;
 const RIM: u8 = 4;
@@ -79,18 +104,15 @@ impl Cut {
 
     /// The side of each cell of `cells` (`true`: first) for a separator of
     /// fewer than `limit` nodes, where the path finds one: `cells` are the
-    /// split's (index, centroid), `axis` and `at` the split, `width` the
-    /// band's half-width, `near` how far from the band a cell that shares
-    /// a node with it can lie, `open` the nodes in neither an ancestor's
-    /// separator nor a numbered half.
-    #[allow(clippy::too_many_arguments)]
+    /// split's (index, centroid), `band` the split and its band, `near`
+    /// how far from the band a cell that shares a node with it can lie,
+    /// `open` the nodes in neither an ancestor's separator nor a numbered
+    /// half.
     pub fn shorter(
         &mut self,
         mesh: &Mesh,
         cells: &[(u32, [f64; 2])],
-        axis: usize,
-        at: f64,
-        width: f64,
+        band: Band,
         near: f64,
         open: impl Fn(usize) -> bool,
         limit: usize,
@@ -98,11 +120,11 @@ impl Cut {
         self.nodes.clear();
         self.near.clear();
         for (i, &(c, x)) in cells.iter().enumerate() {
-            let d = (x[axis] - at).abs();
-            if d <= width + near {
+            let d = band.distance(x);
+            if d <= band.width + near {
                 self.near.push(i as u32);
             }
-            if d <= width {
+            if d <= band.width {
                 for &v in mesh.cell(c as usize) {
                     if open(v) && self.local[v] == NONE {
                         self.local[v] = self.nodes.len() as u32;
@@ -111,21 +133,18 @@ impl Cut {
                 }
             }
         }
-        let sides = self.path(mesh, cells, axis, at, width, &open, limit);
+        let sides = self.path(mesh, cells, band, &open, limit);
         for &v in &self.nodes {
             self.local[v] = NONE;
         }
         sides
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn path(
         &mut self,
         mesh: &Mesh,
         cells: &[(u32, [f64; 2])],
-        axis: usize,
-        at: f64,
-        width: f64,
+        band: Band,
         open: &impl Fn(usize) -> bool,
         limit: usize,
     ) -> Option<Vec<bool>> {
@@ -137,19 +156,17 @@ impl Cut {
             CellKind::Quad4 => &QUAD4_SIDES,
             CellKind::Quad9 => &QUAD9_SIDES,
         };
-        let in_band = |x: [f64; 2]| (x[axis] - at).abs() <= width;
         self.flags.clear();
         self.flags.resize(n, 0);
         // The sides of the band's cells and of the cells beside it, by
         // their end nodes: a side of one cell of the range is on its rim.
         self.sides.clear();
-        let other = 1 - axis;
+        let other = 1 - band.axis;
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for k in 0..self.near.len() {
             let (c, x) = cells[self.near[k] as usize];
-            let d = (x[axis] - at).abs();
             let cell = mesh.cell(c as usize);
-            if d <= width {
+            if band.contains(x) {
                 lo = lo.min(x[other]);
                 hi = hi.max(x[other]);
                 // Beside a node not open (an ancestor's separator, a
@@ -163,7 +180,7 @@ impl Cut {
                     }
                 }
             } else {
-                let end = if x[axis] < at { BEFORE } else { AFTER };
+                let end = if band.before(x) { BEFORE } else { AFTER };
                 for &v in cell {
                     let l = self.local[v];
                     if l != NONE {
@@ -217,7 +234,7 @@ impl Cut {
             for k in 0..self.near.len() {
                 let i = self.near[k] as usize;
                 let (c, x) = cells[i];
-                if !in_band(x) {
+                if !band.contains(x) {
                     continue;
                 }
                 let cell = mesh.cell(c as usize);
@@ -331,8 +348,8 @@ impl Cut {
             cells
                 .iter()
                 .map(|&(c, x)| {
-                    if !in_band(x) {
-                        return x[axis] < at;
+                    if !band.contains(x) {
+                        return band.before(x);
                     }
                     mesh.cell(c as usize).iter().any(|&v| {
                         let l = self.local[v];

@@ -49,7 +49,7 @@
 use stickslip_linalg::FillOrder;
 use stickslip_mesh::Mesh;
 
-use crate::cut::Cut;
+use crate::cut::{Band, Cut};
 use crate::dofs::DofMap;
 
 /// Free DOFs from which the factors are ordered by nested dissection
@@ -240,20 +240,7 @@ pub fn dissection_nodes(mesh: &Mesh) -> NodeDissection {
         // straight line; by position when none lies below the median.
         let at = key(&range[mid]);
         let first_len = if range[..mid].iter().any(|c| key(c) < at) {
-            // A stable partition: the cells below `at`, then the others.
-            second_half.clear();
-            let mut below = 0;
-            for i in 0..range.len() {
-                let c = range[i];
-                if key(&c) < at {
-                    range[below] = c;
-                    below += 1;
-                } else {
-                    second_half.push(c);
-                }
-            }
-            range[below..].copy_from_slice(&second_half);
-            below
+            stable_partition(range, &mut second_half, |_, c| key(c) < at)
         } else {
             mid
         };
@@ -280,24 +267,19 @@ pub fn dissection_nodes(mesh: &Mesh) -> NodeDissection {
             let open = |v: usize| state[v] == State::Open;
             let limit = separator.len();
             let sides = cut
-                .shorter(mesh, &placed, axis, at, width, band[axis], open, limit)
+                .shorter(
+                    mesh,
+                    &placed,
+                    Band { axis, at, width },
+                    band[axis],
+                    open,
+                    limit,
+                )
                 // Both halves keep cells, or the split would repeat.
                 .filter(|s| s.contains(&true) && s.contains(&false));
             match sides {
                 Some(sides) => {
-                    second_half.clear();
-                    let mut below = 0;
-                    for (i, &first) in sides.iter().enumerate() {
-                        let c = range[i];
-                        if first {
-                            range[below] = c;
-                            below += 1;
-                        } else {
-                            second_half.push(c);
-                        }
-                    }
-                    range[below..].copy_from_slice(&second_half);
-                    first_len = below;
+                    first_len = stable_partition(range, &mut second_half, |i, _| sides[i]);
                     reach_of_split = width + band[axis];
                     separator = shared_nodes(
                         mesh,
@@ -333,6 +315,29 @@ pub fn dissection_nodes(mesh: &Mesh) -> NodeDissection {
         _ => None,
     };
     NodeDissection { nodes, marks }
+}
+
+/// Reorders `range` stably: the cells `first` takes (by index and cell),
+/// then the others; returns how many `first` took. `scratch` holds the
+/// others meanwhile.
+fn stable_partition(
+    range: &mut [Placed],
+    scratch: &mut Vec<Placed>,
+    first: impl Fn(usize, &Placed) -> bool,
+) -> usize {
+    scratch.clear();
+    let mut taken = 0;
+    for i in 0..range.len() {
+        let c = range[i];
+        if first(i, &c) {
+            range[taken] = c;
+            taken += 1;
+        } else {
+            scratch.push(c);
+        }
+    }
+    range[taken..].copy_from_slice(scratch);
+    taken
 }
 
 /// A node in the dissection: not yet numbered, in the separator of the
