@@ -9,8 +9,10 @@ order (one node a line by its coordinates, matched to the mesh's nodes
 exactly), orders the same graph by METIS's nested dissection (pymetis),
 and prints for each order the exact symbolic fill of the node graph's
 Cholesky factor: nnz(L) with the diagonal (Σ c_j, c_j the column counts),
-the flop measure Σ c_j², and the sizes of the separators at the top of
-the elimination tree (single-child chains from the root, level by level).
+the flop measure Σ c_j², the sizes of the separators at the top of
+the elimination tree (single-child chains from the root, level by level),
+their mean size at each of the first 14 levels, and Σ c_j² split by the
+size of each column's subtree (where in the tree the flops lie).
 A DOF-level factor has about 4 Σ c_j values (faer's supernodal layout
 stores more: its relaxed supernodes' zeros).
 
@@ -96,6 +98,46 @@ def separators(parent, levels=5):
     return out
 
 
+def flops_by_subtree(c, parent, bounds=(64, 256, 1024, 4096, 16384, 65536)):
+    """Σ c_j² of the columns whose elimination subtree has a number of
+    nodes in each range: where in the tree an order's flops lie."""
+    size = np.ones(len(parent))
+    for j, p in enumerate(parent):  # children come before their parent
+        if p != -1:
+            size[p] += size[j]
+    edges = (0,) + tuple(bounds) + (np.inf,)
+    return [((lo, hi), float((c[(size >= lo) & (size < hi)] ** 2).sum())) for lo, hi in zip(edges[:-1], edges[1:])]
+
+
+def separator_means(parent, levels=14):
+    """Mean separator size and mean subtree size at each level of the tree
+    (separators as in `separators`)."""
+    children = [[] for _ in parent]
+    roots = []
+    for j, p in enumerate(parent):
+        (children[p] if p != -1 else roots).append(j)
+    size = np.ones(len(parent))
+    for j, p in enumerate(parent):
+        if p != -1:
+            size[p] += size[j]
+    frontier, out = roots, []
+    for _ in range(levels):
+        if not frontier:
+            break
+        seps, subs, below = [], [], []
+        for r in frontier:
+            s, v = 1, r
+            while len(children[v]) == 1:
+                v = children[v][0]
+                s += 1
+            seps.append(s)
+            subs.append(size[r])
+            below.extend(children[v])
+        out.append((len(seps), float(np.mean(seps)), float(np.mean(subs))))
+        frontier = below
+    return out
+
+
 def shortest_crossing(points, q, fractions):
     n = len(points)
     sides = np.unique(np.sort(np.vstack([np.stack([q[:, a], q[:, (a + 1) % 4]], 1) for a in range(4)]), 1), axis=0)
@@ -142,6 +184,10 @@ def main():
         print(f"{name}: nnz(L) {int(c.sum())}, sum c^2 {(c * c).sum():.3e}")
         for level, sizes in enumerate(separators(parent)):
             print(f"  separators at level {level}: {sizes}")
+        for level, (count, sep, sub) in enumerate(separator_means(parent)):
+            print(f"  level {level}: {count} separators, mean {sep:.1f} nodes, mean subtree {sub:.0f}")
+        for (lo, hi), flops in flops_by_subtree(c, parent):
+            print(f"  sum c^2 of columns with subtrees of [{lo}, {hi}) nodes: {flops:.3e}")
     print("fewest nodes on a path of cell sides from bottom to top, near the median x:")
     shortest_crossing(points, q, [1e-3, 4e-3, 2e-2, 5e-2])
 
