@@ -402,6 +402,7 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         println!();
     }
     let mut setup_lines = Vec::new();
+    let mut measured = Vec::with_capacity(runs.len());
     for (r, (label, _, _, fits)) in runs.iter().enumerate() {
         let m = median(&mut times[r][0]);
         let fastest = times[r][0].first().copied().unwrap_or(f64::NAN);
@@ -422,10 +423,20 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
             listed.join(";")
         ));
         setup_lines.push(format!("{label:<32} {setup:>8.3}  {}", listed.join(" ")));
+        let (rung, scheme) = label.rsplit_once(' ').unwrap_or((label, ""));
+        let mut run = crate::bench_targets::Measured {
+            rung,
+            scheme,
+            dofs: RUNGS.iter().find(|g| g.name == rung).map_or(0, |g| g.dofs),
+            median: m,
+            setup,
+            ratios: Vec::new(),
+        };
         let mut peer_csv = String::new();
         for p in 0..peers.len() {
             if fits[p] {
                 let mp = median(&mut times[r][exes.len() + p]);
+                run.ratios.push((peers[p].name, mp / m));
                 print!(" {mp:>12.4} {:>8.1}", mp / m);
                 peer_csv.push_str(&format!(",{mp:.5},{:.2},{:.1e}", mp / m, checks[r][p]));
             } else {
@@ -441,11 +452,20 @@ pub fn run(root: &Path, args: &[String]) -> Result<(), String> {
         csv.push_str(&peer_csv);
         println!();
         csv.push('\n');
+        measured.push(run);
     }
     println!("\nour setup (median s of each part over the rounds; the run's --json summary):\n");
     println!("{:<32} {:>8}  parts", "run", "setup s");
     for line in &setup_lines {
         println!("{line}");
+    }
+    let verdicts = crate::bench_targets::verdicts(&measured);
+    if !verdicts.is_empty() {
+        println!("\nthe whole-run targets this bench measured (bench_targets.rs):\n");
+        for line in &verdicts {
+            println!("{line}");
+        }
+        println!();
     }
     let path = root.join("target/bench/run.csv");
     std::fs::write(&path, &csv).map_err(|e| format!("{}: {e}", path.display()))?;

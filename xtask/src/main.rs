@@ -16,6 +16,7 @@ mod bench_output;
 mod bench_peers;
 mod bench_run;
 mod bench_step;
+mod bench_targets;
 mod meshes;
 mod python;
 mod study;
