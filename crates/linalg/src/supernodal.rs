@@ -66,6 +66,16 @@ type PathColumn = Vec<(u32, f64)>;
 /// Columns solved together by [`Supernodal::schur_complement`].
 const GROUP: usize = 8;
 
+/// One thread's scratch for [`Supernodal::schur_complement`]'s groups: the
+/// group's columns interleaved on the reach, a supernode's rows, and the
+/// supernodes on the group's paths to the root.
+struct GroupScratch {
+    x: Vec<f64>,
+    tmp: Vec<f64>,
+    on_path: Vec<bool>,
+    path: Vec<u32>,
+}
+
 /// Owner of a column that belongs to neither thread's subtrees.
 const TOP: u8 = 2;
 
@@ -406,8 +416,9 @@ impl Supernodal {
     /// DOFs given to [`Supernodal::set_reach`].
     ///
     /// Column j needs A⁻¹Pᵀe_j only at the reach's DOFs, and its right-hand
-    /// side lives there: a forward and a back solve restricted to the
-    /// reach. `GROUP` columns go through each supernode together (its
+    /// side lives there: a forward solve restricted to the paths from its
+    /// rows to the root (where W's column lies) and a back solve restricted
+    /// to the reach. `GROUP` columns go through each supernode together (its
     /// values are read once per group and the inner loops run over the
     /// group), groups in parallel from [`PATHS_PARALLEL_MIN`] reach values
     /// (p times the reach's DOFs); a column's arithmetic is the same on any
@@ -415,29 +426,55 @@ impl Supernodal {
     pub fn schur_complement(&self, l: &[f64], rows: &[Vec<(usize, f64)>]) -> PathOperator {
         let p = rows.len();
         let groups: Vec<usize> = (0..p).step_by(GROUP).collect();
-        let scratch = || {
-            (
-                vec![0.0; self.reach_cols * GROUP],
-                vec![0.0; self.tmp.len() * GROUP],
-            )
+        let parent = self.parents();
+        let mut owner = vec![0u32; self.n];
+        for s in 0..self.supernodes() {
+            owner[self.begin[s]..self.begin[s + 1]].fill(s as u32);
+        }
+        let scratch = || GroupScratch {
+            x: vec![0.0; self.reach_cols * GROUP],
+            tmp: vec![0.0; self.tmp.len() * GROUP],
+            on_path: vec![false; self.supernodes()],
+            path: Vec::new(),
         };
-        let column = |(x, tmp): &mut (Vec<f64>, Vec<f64>), &start: &usize| {
+        let column = |sc: &mut GroupScratch, &start: &usize| {
+            let GroupScratch {
+                x,
+                tmp,
+                on_path,
+                path,
+            } = sc;
             let width = GROUP.min(p - start);
             x.fill(0.0);
+            path.clear();
             for c in 0..width {
                 for &(i, v) in &rows[start + c] {
                     x[self.reach_local[i] as usize * GROUP + c] += v;
+                    let mut s = Some(owner[i] as usize);
+                    while let Some(k) = s.filter(|&k| !on_path[k]) {
+                        on_path[k] = true;
+                        path.push(k as u32);
+                        s = parent[k];
+                    }
                 }
             }
-            for &s in &self.reach_list {
+            // The forward solve's right-hand sides live on the paths from
+            // their rows to the root, and so does its solution (a column's
+            // pattern holds only its ancestors): the reach's other
+            // supernodes would only add zeros.
+            path.sort_unstable();
+            for &s in path.iter() {
+                on_path[s as usize] = false;
                 self.group_forward(l, s as usize, x, tmp);
             }
-            // W's columns, L⁻¹Pᵀe_j: nonzero only on the paths
-            // from the row's DOFs to the root.
+            // W's columns, L⁻¹Pᵀe_j, on those paths, by ascending local
+            // index (the reach numbers its supernodes' columns in order).
             let w: Vec<PathColumn> = (0..width)
                 .map(|c| {
-                    (0..self.reach_cols)
-                        .filter_map(|li| {
+                    path.iter()
+                        .flat_map(|&s| self.begin[s as usize]..self.begin[s as usize + 1])
+                        .filter_map(|col| {
+                            let li = self.reach_local[col] as usize;
                             let v = x[li * GROUP + c];
                             (v != 0.0).then_some((li as u32, v))
                         })
