@@ -20,7 +20,9 @@
 //! [`Supernodal::finish_reach`]), or with the rows' paths stored
 //! ([`PathOperator`]) one pass over W instead of the reach's solves.
 
+use faer::linalg::matmul::matmul;
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
+use faer::{Accum, Mat, Par};
 use rayon::prelude::*;
 
 /// A value of the factor the solves read: f64, or f32 for a factor
@@ -415,14 +417,13 @@ impl Supernodal {
     /// as (permuted index, value) lists, whose indices must lie in the
     /// DOFs given to [`Supernodal::set_reach`].
     ///
-    /// Column j needs A⁻¹Pᵀe_j only at the reach's DOFs, and its right-hand
-    /// side lives there: a forward solve restricted to the paths from its
-    /// rows to the root (where W's column lies) and a back solve restricted
-    /// to the reach. `GROUP` columns go through each supernode together (its
-    /// values are read once per group and the inner loops run over the
-    /// group), groups in parallel from [`PATHS_PARALLEL_MIN`] reach values
-    /// (p times the reach's DOFs); a column's arithmetic is the same on any
-    /// thread.
+    /// G = WᵀW with W = L⁻¹Pᵀ, whose column j lies on the paths from row
+    /// j's DOFs to the root: a forward solve restricted to those paths
+    /// ([`Supernodal::gram`] forms the product; no back solve). `GROUP`
+    /// columns go through each supernode together (its values are read
+    /// once per group and the inner loops run over the group), groups in
+    /// parallel from [`PATHS_PARALLEL_MIN`] reach values (p times the
+    /// reach's DOFs); a column's arithmetic is the same on any thread.
     pub fn schur_complement(&self, l: &[f64], rows: &[Vec<(usize, f64)>]) -> PathOperator {
         let p = rows.len();
         let groups: Vec<usize> = (0..p).step_by(GROUP).collect();
@@ -445,7 +446,6 @@ impl Supernodal {
                 path,
             } = sc;
             let width = GROUP.min(p - start);
-            x.fill(0.0);
             path.clear();
             for c in 0..width {
                 for &(i, v) in &rows[start + c] {
@@ -468,59 +468,123 @@ impl Supernodal {
                 self.group_forward(l, s as usize, x, tmp);
             }
             // W's columns, L⁻¹Pᵀe_j, on those paths, by ascending local
-            // index (the reach numbers its supernodes' columns in order).
+            // index (the reach numbers its supernodes' columns in order);
+            // x is zero again after them.
+            let local = |s: &u32| {
+                let (a, e) = (self.begin[*s as usize], self.begin[*s as usize + 1]);
+                let first = self.reach_local[a] as usize;
+                first..first + (e - a)
+            };
             let w: Vec<PathColumn> = (0..width)
                 .map(|c| {
                     path.iter()
-                        .flat_map(|&s| self.begin[s as usize]..self.begin[s as usize + 1])
-                        .filter_map(|col| {
-                            let li = self.reach_local[col] as usize;
+                        .flat_map(local)
+                        .filter_map(|li| {
                             let v = x[li * GROUP + c];
                             (v != 0.0).then_some((li as u32, v))
                         })
                         .collect()
                 })
                 .collect();
-            for &s in self.reach_list.iter().rev() {
-                self.group_backward(l, s as usize, x, tmp);
+            for li in path.iter().flat_map(local) {
+                x[li * GROUP..(li + 1) * GROUP].fill(0.0);
             }
-            let mut g = vec![0.0; width * p];
-            for c in 0..width {
-                for (a, row) in rows.iter().enumerate() {
-                    g[c * p + a] = row
-                        .iter()
-                        .map(|&(i, v)| v * x[self.reach_local[i] as usize * GROUP + c])
-                        .sum();
-                }
-            }
-            (g, w)
+            w
         };
         // On the pool where the reach is large (as W's products): a small
         // model starts no threads.
-        let columns: Vec<(Vec<f64>, Vec<PathColumn>)> = if p * self.reach_cols >= PATHS_PARALLEL_MIN
-        {
+        let columns: Vec<Vec<PathColumn>> = if p * self.reach_cols >= PATHS_PARALLEL_MIN {
             groups.par_iter().map_init(scratch, column).collect()
         } else {
             let mut state = scratch();
             groups.iter().map(|g| column(&mut state, g)).collect()
         };
+        let columns: Vec<PathColumn> = columns.into_iter().flatten().collect();
         let mut op = PathOperator {
-            s: Vec::with_capacity(p * p),
+            s: self.gram(&columns),
             w_ptr: vec![0],
             w_idx: Vec::new(),
             w_val: Vec::new(),
         };
-        for (g, w) in columns {
-            op.s.extend(g);
-            for col in w {
-                for (i, v) in col {
-                    op.w_idx.push(i);
-                    op.w_val.push(v);
-                }
-                op.w_ptr.push(op.w_idx.len());
+        for col in columns {
+            for (i, v) in col {
+                op.w_idx.push(i);
+                op.w_val.push(v);
             }
+            op.w_ptr.push(op.w_idx.len());
         }
         op
+    }
+
+    /// WᵀW (column-major, p × p) for W's p columns on the reach: P A⁻¹ Pᵀ =
+    /// (L⁻¹Pᵀ)ᵀ(L⁻¹Pᵀ). By the reach's supernodes in ascending order: the
+    /// rows of one supernode hold the columns whose paths pass it, a dense
+    /// block B, and BᵀB (faer's product, on this thread) is added to those
+    /// columns' entries, so the sums' order depends on the factor only.
+    fn gram(&self, w: &[PathColumn]) -> Vec<f64> {
+        let p = w.len();
+        // W by rows of the reach: (column, value), columns ascending.
+        let mut ptr = vec![0usize; self.reach_cols + 1];
+        for col in w {
+            for &(i, _) in col {
+                ptr[i as usize + 1] += 1;
+            }
+        }
+        for i in 0..self.reach_cols {
+            ptr[i + 1] += ptr[i];
+        }
+        let mut next = ptr.clone();
+        let mut entries = vec![(0u32, 0.0); ptr[self.reach_cols]];
+        for (j, col) in w.iter().enumerate() {
+            for &(i, v) in col {
+                entries[next[i as usize]] = (j as u32, v);
+                next[i as usize] += 1;
+            }
+        }
+        let mut s = vec![0.0; p * p];
+        let mut at = vec![u32::MAX; p];
+        let mut cols: Vec<u32> = Vec::new();
+        let mut first = 0;
+        for &sn in &self.reach_list {
+            let k = self.begin[sn as usize + 1] - self.begin[sn as usize];
+            let rows = first..first + k;
+            first += k;
+            let block = &entries[ptr[rows.start]..ptr[rows.end]];
+            if block.is_empty() {
+                continue;
+            }
+            cols.clear();
+            for &(j, _) in block {
+                if at[j as usize] == u32::MAX {
+                    at[j as usize] = cols.len() as u32;
+                    cols.push(j);
+                }
+            }
+            let mut b = Mat::<f64>::zeros(k, cols.len());
+            for (r, row) in rows.enumerate() {
+                for &(j, v) in &entries[ptr[row]..ptr[row + 1]] {
+                    b[(r, at[j as usize] as usize)] = v;
+                }
+            }
+            let mut g = Mat::<f64>::zeros(cols.len(), cols.len());
+            matmul(
+                g.as_mut(),
+                Accum::Replace,
+                b.transpose(),
+                b.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+            for (a, &ja) in cols.iter().enumerate() {
+                for (c, &jc) in cols.iter().enumerate() {
+                    s[jc as usize * p + ja as usize] += g[(a, c)];
+                }
+            }
+            for &j in &cols {
+                at[j as usize] = u32::MAX;
+            }
+        }
+        s
     }
 
     /// A restricted solve's start with a [`PathOperator`]: the forward solve
@@ -688,48 +752,6 @@ impl Supernodal {
             let at = self.reach_local[r as usize] as usize * GROUP;
             for (a, b) in x[at..at + GROUP].iter_mut().zip(t) {
                 *a -= b;
-            }
-        }
-    }
-
-    /// [`Supernodal::backward`]'s step for GROUP interleaved columns.
-    fn group_backward(&self, l: &[f64], s: usize, x: &mut [f64], tmp: &mut [f64]) {
-        let (c0, k, pattern, block) = self.supernode(l, s);
-        let m = pattern.len();
-        let ld = k + m;
-        let tmp = &mut tmp[..m * GROUP];
-        for (t, &r) in tmp.chunks_exact_mut(GROUP).zip(pattern) {
-            let at = self.reach_local[r as usize] as usize * GROUP;
-            t.copy_from_slice(&x[at..at + GROUP]);
-        }
-        let lo = self.reach_local[c0] as usize * GROUP;
-        let xs = &mut x[lo..lo + k * GROUP];
-        for j in 0..k {
-            let mut acc = [0.0; GROUP];
-            for (t, lrj) in tmp
-                .chunks_exact(GROUP)
-                .zip(&block[j * ld + k..(j + 1) * ld])
-            {
-                for (a, b) in acc.iter_mut().zip(t) {
-                    *a += lrj * b;
-                }
-            }
-            for (v, a) in xs[j * GROUP..(j + 1) * GROUP].iter_mut().zip(&acc) {
-                *v -= a;
-            }
-        }
-        for j in (0..k).rev() {
-            let col = &block[j * ld..j * ld + k];
-            let (head, tail) = xs.split_at_mut((j + 1) * GROUP);
-            let xj = &mut head[j * GROUP..];
-            let mut acc = [0.0; GROUP];
-            for (xi, lij) in tail.chunks_exact(GROUP).zip(&col[j + 1..]) {
-                for (a, b) in acc.iter_mut().zip(xi) {
-                    *a += lij * b;
-                }
-            }
-            for (v, a) in xj.iter_mut().zip(&acc) {
-                *v = (*v - a) / col[j];
             }
         }
     }
