@@ -78,64 +78,59 @@ def columns(order, xadj, adj):
     return np.array(count, dtype=np.float64), parent
 
 
-def separators(parent, levels=5):
-    children = [[] for _ in parent]
-    roots = []
-    for j, p in enumerate(parent):
-        (children[p] if p != -1 else roots).append(j)
-    frontier, out = roots, []
-    for _ in range(levels):
-        sizes, below = [], []
-        for r in frontier:
-            size, v = 1, r
-            while len(children[v]) == 1:
-                v = children[v][0]
-                size += 1
-            sizes.append(size)
-            below.extend(children[v])
-        out.append(sorted(sizes, reverse=True)[:8])
-        frontier = below
-    return out
-
-
-def flops_by_subtree(c, parent, bounds=(64, 256, 1024, 4096, 16384, 65536)):
-    """Σ c_j² of the columns whose elimination subtree has a number of
-    nodes in each range: where in the tree an order's flops lie."""
-    size = np.ones(len(parent))
-    for j, p in enumerate(parent):  # children come before their parent
-        if p != -1:
-            size[p] += size[j]
-    edges = (0,) + tuple(bounds) + (np.inf,)
-    return [((lo, hi), float((c[(size >= lo) & (size < hi)] ** 2).sum())) for lo, hi in zip(edges[:-1], edges[1:])]
-
-
-def separator_means(parent, levels=14):
-    """Mean separator size and mean subtree size at each level of the tree
-    (separators as in `separators`)."""
-    children = [[] for _ in parent]
-    roots = []
-    for j, p in enumerate(parent):
-        (children[p] if p != -1 else roots).append(j)
+def subtree_sizes(parent):
+    """Nodes in each column's elimination subtree (children come before
+    their parent)."""
     size = np.ones(len(parent))
     for j, p in enumerate(parent):
         if p != -1:
             size[p] += size[j]
+    return size
+
+
+def levels(parent, count):
+    """Per level of the tree, from the root, (separator size, subtree size)
+    of each separator: a single-child chain from the level's roots."""
+    children = [[] for _ in parent]
+    roots = []
+    for j, p in enumerate(parent):
+        (children[p] if p != -1 else roots).append(j)
+    size = subtree_sizes(parent)
     frontier, out = roots, []
-    for _ in range(levels):
+    for _ in range(count):
         if not frontier:
             break
-        seps, subs, below = [], [], []
+        level, below = [], []
         for r in frontier:
             s, v = 1, r
             while len(children[v]) == 1:
                 v = children[v][0]
                 s += 1
-            seps.append(s)
-            subs.append(size[r])
+            level.append((s, size[r]))
             below.extend(children[v])
-        out.append((len(seps), float(np.mean(seps)), float(np.mean(subs))))
+        out.append(level)
         frontier = below
     return out
+
+
+def separators(parent, count=5):
+    return [sorted((s for s, _ in level), reverse=True)[:8] for level in levels(parent, count)]
+
+
+def separator_means(parent, count=14):
+    """Per level: separators, their mean size, their subtrees' mean size."""
+    return [
+        (len(level), float(np.mean([s for s, _ in level])), float(np.mean([t for _, t in level])))
+        for level in levels(parent, count)
+    ]
+
+
+def flops_by_subtree(c, parent, bounds=(64, 256, 1024, 4096, 16384, 65536)):
+    """Σ c_j² of the columns whose elimination subtree has a number of
+    nodes in each range: where in the tree an order's flops lie."""
+    size = subtree_sizes(parent)
+    edges = (0,) + tuple(bounds) + (np.inf,)
+    return [((lo, hi), float((c[(size >= lo) & (size < hi)] ** 2).sum())) for lo, hi in zip(edges[:-1], edges[1:])]
 
 
 def shortest_crossing(points, q, fractions):
