@@ -253,3 +253,52 @@ fn schur_complement_matches_full_solves() {
         }
     }
 }
+
+/// A Schur complement large enough for its groups to go to the pool (p
+/// times the reach's DOFs from 2¹⁶, `PATHS_PARALLEL_MIN`): G = WᵀW equals
+/// P applied to full solves, and S and the step through W have the same
+/// bits on one thread and on two.
+#[test]
+fn schur_complement_on_the_pool_is_right_and_thread_independent() {
+    let a = operator(CellKind::Quad4, 80, 20);
+    let n = a.nrows();
+    let f = factor(&a);
+    let b = spread(n);
+    // 81 DOFs, as a contact row's (any set serves: S is P A⁻¹ Pᵀ).
+    let dofs: Vec<usize> = (0..=80).map(|i| 2 * i).collect();
+    let run = |threads: usize| {
+        on_threads(threads, || {
+            let mut sn = Supernodal::new(&f.symbolic).unwrap();
+            sn.set_reach(&dofs);
+            let perm = sn.permuted_indices();
+            let rows: Vec<Vec<(usize, f64)>> = dofs.iter().map(|&d| vec![(perm[d], 1.0)]).collect();
+            assert!(
+                rows.len() * sn.reach_columns() >= 1 << 16,
+                "the groups go to the pool"
+            );
+            let op = sn.schur_complement(&f.l, &rows);
+            let mut p = vec![0.0; rows.len()];
+            sn.begin_paths(&f.l, &op, &b, &mut p);
+            (op.s, p)
+        })
+    };
+    let (s1, p1) = run(1);
+    let (s2, p2) = run(2);
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&s1), bits(&s2), "S");
+    assert_eq!(bits(&p1), bits(&p2), "p through W");
+    let p = dofs.len();
+    for (j, &dj) in dofs.iter().enumerate() {
+        let mut x = vec![0.0; n];
+        x[dj] = 1.0;
+        faer_solve(&f, &mut x);
+        for (i, &di) in dofs.iter().enumerate() {
+            let want = x[di];
+            assert!(
+                (s1[j * p + i] - want).abs() <= 1e-12 * want.abs().max(1e-3),
+                "G[{i}, {j}] = {} against {want}",
+                s1[j * p + i]
+            );
+        }
+    }
+}

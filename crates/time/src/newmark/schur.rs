@@ -311,9 +311,9 @@ impl SchurOperator {
         }
     }
 
-    /// S = P A₀⁻¹ Pᵀ (and W) for entry `slot`: solves restricted to the
-    /// contact DOFs' paths, eight columns per pass
-    /// (`Supernodal::schur_complement`).
+    /// S = P A₀⁻¹ Pᵀ (and W) for entry `slot`: W = L⁻¹Pᵀ by forward solves
+    /// on the contact DOFs' paths, eight columns per pass, and S = WᵀW
+    /// (`Supernodal::schur_complement`; S is made exactly symmetric here).
     fn build_schur(&mut self, slot: usize) {
         let n_c = self.rows();
         let entry = &mut self.entries[slot];
