@@ -519,8 +519,9 @@ impl Supernodal {
     /// WᵀW (column-major, p × p) for W's p columns on the reach: P A⁻¹ Pᵀ =
     /// (L⁻¹Pᵀ)ᵀ(L⁻¹Pᵀ). By the reach's supernodes in ascending order: the
     /// rows of one supernode hold the columns whose paths pass it, a dense
-    /// block B, and BᵀB (faer's product, on this thread) is added to those
-    /// columns' entries, so the sums' order depends on the factor only.
+    /// block B (consecutive supernodes with the same columns together),
+    /// and BᵀB (faer's product, on this thread) is added to those columns'
+    /// entries, so the sums' order depends on the factor only.
     fn gram(&self, w: &[PathColumn]) -> Vec<f64> {
         let p = w.len();
         // W by rows of the reach: (column, value), columns ascending.
@@ -543,24 +544,13 @@ impl Supernodal {
         }
         let mut s = vec![0.0; p * p];
         let mut at = vec![u32::MAX; p];
-        let mut cols: Vec<u32> = Vec::new();
-        let mut first = 0;
-        for &sn in &self.reach_list {
-            let k = self.begin[sn as usize + 1] - self.begin[sn as usize];
-            let rows = first..first + k;
-            first += k;
-            let block = &entries[ptr[rows.start]..ptr[rows.end]];
-            if block.is_empty() {
-                continue;
+        // BᵀB of the block of rows `rows`, whose entries lie in `cols`
+        // (ascending), added to S.
+        let mut add = |rows: std::ops::Range<usize>, cols: &[u32]| {
+            for (a, &j) in cols.iter().enumerate() {
+                at[j as usize] = a as u32;
             }
-            cols.clear();
-            for &(j, _) in block {
-                if at[j as usize] == u32::MAX {
-                    at[j as usize] = cols.len() as u32;
-                    cols.push(j);
-                }
-            }
-            let mut b = Mat::<f64>::zeros(k, cols.len());
+            let mut b = Mat::<f64>::zeros(rows.len(), cols.len());
             for (r, row) in rows.enumerate() {
                 for &(j, v) in &entries[ptr[row]..ptr[row + 1]] {
                     b[(r, at[j as usize] as usize)] = v;
@@ -580,9 +570,41 @@ impl Supernodal {
                     s[jc as usize * p + ja as usize] += g[(a, c)];
                 }
             }
-            for &j in &cols {
-                at[j as usize] = u32::MAX;
+        };
+        // Consecutive supernodes whose rows hold the same columns (the
+        // chain at the top of the tree, every column's path) make one
+        // block: one product and one pass over S for the run.
+        let (mut run, mut run_cols): (Option<std::ops::Range<usize>>, Vec<u32>) =
+            (None, Vec::new());
+        let mut cols: Vec<u32> = Vec::new();
+        let mut first = 0;
+        for &sn in &self.reach_list {
+            let k = self.begin[sn as usize + 1] - self.begin[sn as usize];
+            let rows = first..first + k;
+            first += k;
+            cols.clear();
+            cols.extend(
+                entries[ptr[rows.start]..ptr[rows.end]]
+                    .iter()
+                    .map(|&(j, _)| j),
+            );
+            cols.sort_unstable();
+            cols.dedup();
+            match run.as_mut() {
+                Some(r) if cols == run_cols => r.end = rows.end,
+                _ => {
+                    if let Some(r) = run.take() {
+                        add(r, &run_cols);
+                    }
+                    if !cols.is_empty() {
+                        run = Some(rows);
+                        std::mem::swap(&mut run_cols, &mut cols);
+                    }
+                }
             }
+        }
+        if let Some(r) = run {
+            add(r, &run_cols);
         }
         s
     }
