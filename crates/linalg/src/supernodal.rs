@@ -78,6 +78,23 @@ struct GroupScratch {
     path: Vec<u32>,
 }
 
+/// Marks the supernodes from `from` up to the root of the tree `parent`,
+/// stopping at one marked already, and gives each newly marked one to
+/// `visit`.
+fn up_to_root(
+    parent: &[Option<usize>],
+    from: usize,
+    marked: &mut [bool],
+    mut visit: impl FnMut(usize),
+) {
+    let mut s = Some(from);
+    while let Some(k) = s.filter(|&k| !marked[k]) {
+        marked[k] = true;
+        visit(k);
+        s = parent[k];
+    }
+}
+
 /// Owner of a column that belongs to neither thread's subtrees.
 const TOP: u8 = 2;
 
@@ -254,12 +271,18 @@ impl Supernodal {
         self.val_ptr[s + 1] - self.val_ptr[s]
     }
 
-    /// The parent of each supernode: the one holding its first pattern row.
-    fn parents(&self) -> Vec<Option<usize>> {
+    /// The supernode owning each (permuted) column.
+    fn column_owners(&self) -> Vec<u32> {
         let mut owner = vec![0u32; self.n];
         for s in 0..self.supernodes() {
             owner[self.begin[s]..self.begin[s + 1]].fill(s as u32);
         }
+        owner
+    }
+
+    /// The parent of each supernode: the one holding its first pattern row
+    /// (`owner`: [`Supernodal::column_owners`]).
+    fn parents(&self, owner: &[u32]) -> Vec<Option<usize>> {
         (0..self.supernodes())
             .map(|s| {
                 let pattern = &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]];
@@ -278,7 +301,7 @@ impl Supernodal {
         let total: usize = self.val_ptr[ns];
         let mut group = vec![TOP; ns];
         if total >= split_min {
-            let parent = self.parents();
+            let parent = self.parents(&self.column_owners());
             let mut children = vec![Vec::new(); ns];
             let mut weight: Vec<usize> = (0..ns).map(|s| self.len(s)).collect();
             let mut roots = Vec::new();
@@ -368,22 +391,15 @@ impl Supernodal {
     /// (unpermuted indices) to the root.
     pub fn set_reach(&mut self, dofs: &[usize]) {
         let ns = self.supernodes();
-        let parent = self.parents();
-        let mut owner = vec![0u32; self.n];
-        for s in 0..ns {
-            owner[self.begin[s]..self.begin[s + 1]].fill(s as u32);
-        }
+        let owner = self.column_owners();
+        let parent = self.parents(&owner);
         let mut inv = vec![0usize; self.n];
         for (i, &f) in self.fwd.iter().enumerate() {
             inv[f as usize] = i;
         }
         let mut marked = vec![false; ns];
         for &d in dofs {
-            let mut s = Some(owner[inv[d]] as usize);
-            while let Some(k) = s.filter(|&k| !marked[k]) {
-                marked[k] = true;
-                s = parent[k];
-            }
+            up_to_root(&parent, owner[inv[d]] as usize, &mut marked, |_| {});
         }
         let keep = |list: &[u32]| -> Vec<u32> {
             list.iter()
@@ -427,11 +443,8 @@ impl Supernodal {
     pub fn schur_complement(&self, l: &[f64], rows: &[Vec<(usize, f64)>]) -> PathOperator {
         let p = rows.len();
         let groups: Vec<usize> = (0..p).step_by(GROUP).collect();
-        let parent = self.parents();
-        let mut owner = vec![0u32; self.n];
-        for s in 0..self.supernodes() {
-            owner[self.begin[s]..self.begin[s + 1]].fill(s as u32);
-        }
+        let owner = self.column_owners();
+        let parent = self.parents(&owner);
         let scratch = || GroupScratch {
             x: vec![0.0; self.reach_cols * GROUP],
             tmp: vec![0.0; self.tmp.len() * GROUP],
@@ -450,12 +463,7 @@ impl Supernodal {
             for c in 0..width {
                 for &(i, v) in &rows[start + c] {
                     x[self.reach_local[i] as usize * GROUP + c] += v;
-                    let mut s = Some(owner[i] as usize);
-                    while let Some(k) = s.filter(|&k| !on_path[k]) {
-                        on_path[k] = true;
-                        path.push(k as u32);
-                        s = parent[k];
-                    }
+                    up_to_root(&parent, owner[i] as usize, on_path, |k| path.push(k as u32));
                 }
             }
             // The forward solve's right-hand sides live on the paths from
