@@ -23,6 +23,8 @@
 
 use stickslip_mesh::{CellKind, Mesh};
 
+use crate::ordering::Placed;
+
 /// No node: an unset local index.
 const NONE: u32 = u32::MAX;
 
@@ -104,14 +106,14 @@ impl Cut {
 
     /// The side of each cell of `cells` (`true`: first) for a separator of
     /// fewer than `limit` nodes, where the path finds one: `cells` are the
-    /// split's (index, centroid), `band` the split and its band, `near`
+    /// split's, `band` the split and its band, `near`
     /// how far from the band a cell that shares a node with it can lie,
     /// `open` the nodes in neither an ancestor's separator nor a numbered
     /// half.
     pub fn shorter(
         &mut self,
         mesh: &Mesh,
-        cells: &[(u32, [f64; 2])],
+        cells: &[Placed],
         band: Band,
         near: f64,
         open: impl Fn(usize) -> bool,
@@ -119,7 +121,7 @@ impl Cut {
     ) -> Option<Vec<bool>> {
         self.nodes.clear();
         self.near.clear();
-        for (i, &(c, x)) in cells.iter().enumerate() {
+        for (i, &Placed { x, cell: c }) in cells.iter().enumerate() {
             let d = band.distance(x);
             if d <= band.width + near {
                 self.near.push(i as u32);
@@ -143,7 +145,7 @@ impl Cut {
     fn path(
         &mut self,
         mesh: &Mesh,
-        cells: &[(u32, [f64; 2])],
+        cells: &[Placed],
         band: Band,
         open: &impl Fn(usize) -> bool,
         limit: usize,
@@ -164,7 +166,7 @@ impl Cut {
         let other = 1 - band.axis;
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for k in 0..self.near.len() {
-            let (c, x) = cells[self.near[k] as usize];
+            let Placed { x, cell: c } = cells[self.near[k] as usize];
             let cell = mesh.cell(c as usize);
             if band.contains(x) {
                 lo = lo.min(x[other]);
@@ -233,7 +235,7 @@ impl Cut {
             }
             for k in 0..self.near.len() {
                 let i = self.near[k] as usize;
-                let (c, x) = cells[i];
+                let Placed { x, cell: c } = cells[i];
                 if !band.contains(x) {
                     continue;
                 }
@@ -334,7 +336,7 @@ impl Cut {
                 return None;
             }
             for k in self.cell_ptr[l]..self.cell_ptr[l + 1] {
-                let (c, _) = cells[self.cell_of[k as usize] as usize];
+                let c = cells[self.cell_of[k as usize] as usize].cell;
                 for &v in mesh.cell(c as usize) {
                     let m = self.local[v];
                     if m != NONE && self.flags[m as usize] & (PATH | REACHED) == 0 {
@@ -347,7 +349,7 @@ impl Cut {
         Some(
             cells
                 .iter()
-                .map(|&(c, x)| {
+                .map(|&Placed { x, cell: c }| {
                     if !band.contains(x) {
                         return band.before(x);
                     }

@@ -239,17 +239,15 @@ pub fn dissection_nodes(mesh: &Mesh) -> NodeDissection {
         // centroids on a grid) stay on one side and the separator is a
         // straight line; by position when none lies below the median.
         let at = key(&range[mid]);
-        let first_len = if range[..mid].iter().any(|c| key(c) < at) {
+        let mut first_len = if range[..mid].iter().any(|c| key(c) < at) {
             stable_partition(range, &mut second_half, |_, c| key(c) < at)
         } else {
             mid
         };
-        let mut first_len = first_len;
-        let mut reach_of_split = band[axis];
         let mut separator = shared_nodes(
             mesh,
             range.split_at(first_len),
-            |p| !finite || (key(p) - at).abs() <= reach_of_split,
+            |p| !finite || (key(p) - at).abs() <= band[axis],
             (&mut in_first, &mut stamp),
             &mut state,
         );
@@ -263,13 +261,12 @@ pub fn dissection_nodes(mesh: &Mesh) -> NodeDissection {
             for &v in &separator {
                 state[v] = State::Open;
             }
-            let placed: Vec<(u32, [f64; 2])> = range.iter().map(|p| (p.cell, p.x)).collect();
             let open = |v: usize| state[v] == State::Open;
             let limit = separator.len();
             let sides = cut
                 .shorter(
                     mesh,
-                    &placed,
+                    range,
                     Band { axis, at, width },
                     band[axis],
                     open,
@@ -280,11 +277,10 @@ pub fn dissection_nodes(mesh: &Mesh) -> NodeDissection {
             match sides {
                 Some(sides) => {
                     first_len = stable_partition(range, &mut second_half, |i, _| sides[i]);
-                    reach_of_split = width + band[axis];
                     separator = shared_nodes(
                         mesh,
                         range.split_at(first_len),
-                        |p| (key(p) - at).abs() <= reach_of_split,
+                        |p| (key(p) - at).abs() <= width + band[axis],
                         (&mut in_first, &mut stamp),
                         &mut state,
                     );
@@ -390,7 +386,7 @@ fn shared_nodes(
 
 /// A cell as the dissection sorts it: its centroid and its index.
 #[derive(Clone, Copy)]
-struct Placed {
-    x: [f64; 2],
-    cell: u32,
+pub(crate) struct Placed {
+    pub x: [f64; 2],
+    pub cell: u32,
 }
