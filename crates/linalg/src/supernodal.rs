@@ -1028,9 +1028,12 @@ fn permute_out(fwd: &[u32], xp: &[f64], x: &mut [f64]) {
 }
 
 /// A supernode's forward step: the k × k triangle solved on its columns
-/// `xs`, then tmp = L_bot xs (m rows; one contiguous axpy per column). The
-/// block is column-major (k + m) × k. Dispatched (`crate::simd`): the
-/// loops vectorize as wide as the CPU allows, with the same operations.
+/// `xs`, and tmp = L_bot xs (m rows). The block is column-major
+/// (k + m) × k, and each column is read once, in one run from its
+/// diagonal down (two passes, the triangle's and L_bot's, were a fifth
+/// slower at the same bits: docs/performance.md). Dispatched
+/// (`crate::simd`): the loops vectorize as wide as the CPU allows, with
+/// the same operations.
 fn block_forward<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &mut [f64]) {
     struct Forward<'a, T>(&'a [T], &'a mut [f64], &'a mut [f64]);
     impl<T: FactorValue> crate::simd::Kernel for Forward<'_, T> {
@@ -1047,29 +1050,25 @@ fn block_forward<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &mut [f64]) {
 fn block_forward_body<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &mut [f64]) {
     let k = xs.len();
     let ld = k + tmp.len();
+    tmp.fill(0.0);
+    // Column by column, each read once from its diagonal down: the
+    // triangle's rows update xs, the rows below it tmp.
     for j in 0..k {
-        let col = &block[j * ld..j * ld + k];
+        let col = &block[j * ld..(j + 1) * ld];
         let xj = xs[j] / col[j].into();
         xs[j] = xj;
-        for (xi, lij) in xs[j + 1..].iter_mut().zip(&col[j + 1..]) {
+        for (xi, lij) in xs[j + 1..].iter_mut().zip(&col[j + 1..k]) {
             *xi -= (*lij).into() * xj;
         }
-    }
-    if tmp.is_empty() {
-        return;
-    }
-    tmp.fill(0.0);
-    for j in 0..k {
-        let xj = xs[j];
-        for (t, lij) in tmp.iter_mut().zip(&block[j * ld + k..(j + 1) * ld]) {
+        for (t, lij) in tmp.iter_mut().zip(&col[k..]) {
             *t += (*lij).into() * xj;
         }
     }
 }
 
 /// A supernode's back step: xs −= L_botᵀ tmp (tmp = the pattern rows of
-/// x), then the k × k transposed triangle. Dispatched as
-/// [`block_forward`].
+/// x) and the k × k transposed triangle, each column read once below its
+/// diagonal, from the last. Dispatched as [`block_forward`].
 fn block_backward<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &[f64]) {
     struct Backward<'a, T>(&'a [T], &'a mut [f64], &'a [f64]);
     impl<T: FactorValue> crate::simd::Kernel for Backward<'_, T> {
@@ -1086,15 +1085,13 @@ fn block_backward<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &[f64]) {
 fn block_backward_body<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &[f64]) {
     let k = xs.len();
     let ld = k + tmp.len();
-    if !tmp.is_empty() {
-        for j in 0..k {
-            xs[j] -= dot(&block[j * ld + k..(j + 1) * ld], tmp);
-        }
-    }
+    // Column by column from the last, each read once below its diagonal:
+    // (x_j − L_botᵀ tmp − the triangle's row) / l_jj.
     for j in (0..k).rev() {
-        let col = &block[j * ld..j * ld + k];
-        let s = dot(&col[j + 1..], &xs[j + 1..]);
-        xs[j] = (xs[j] - s) / col[j].into();
+        let col = &block[j * ld..(j + 1) * ld];
+        let below = if tmp.is_empty() { 0.0 } else { dot(&col[k..], tmp) };
+        let s = dot(&col[j + 1..k], &xs[j + 1..]);
+        xs[j] = ((xs[j] - below) - s) / col[j].into();
     }
 }
 
