@@ -1089,7 +1089,11 @@ fn block_backward_body<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &[f64])
     // (x_j − L_botᵀ tmp − the triangle's row) / l_jj.
     for j in (0..k).rev() {
         let col = &block[j * ld..(j + 1) * ld];
-        let below = if tmp.is_empty() { 0.0 } else { dot(&col[k..], tmp) };
+        let below = if tmp.is_empty() {
+            0.0
+        } else {
+            dot(&col[k..], tmp)
+        };
         let s = dot(&col[j + 1..k], &xs[j + 1..]);
         xs[j] = ((xs[j] - below) - s) / col[j].into();
     }
