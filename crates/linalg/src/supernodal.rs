@@ -1030,10 +1030,9 @@ fn permute_out(fwd: &[u32], xp: &[f64], x: &mut [f64]) {
 /// A supernode's forward step: the k × k triangle solved on its columns
 /// `xs`, and tmp = L_bot xs (m rows). The block is column-major
 /// (k + m) × k, and each column is read once, in one run from its
-/// diagonal down (two passes, the triangle's and L_bot's, were a fifth
-/// slower at the same bits: docs/performance.md). Dispatched
-/// (`crate::simd`): the loops vectorize as wide as the CPU allows, with
-/// the same operations.
+/// diagonal down (rather than the triangle's pass, then L_bot's: same
+/// bits, docs/performance.md). Dispatched (`crate::simd`): the loops
+/// vectorize as wide as the CPU allows, with the same operations.
 fn block_forward<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &mut [f64]) {
     struct Forward<'a, T>(&'a [T], &'a mut [f64], &'a mut [f64]);
     impl<T: FactorValue> crate::simd::Kernel for Forward<'_, T> {
@@ -1089,11 +1088,8 @@ fn block_backward_body<T: FactorValue>(block: &[T], xs: &mut [f64], tmp: &[f64])
     // (x_j − L_botᵀ tmp − the triangle's row) / l_jj.
     for j in (0..k).rev() {
         let col = &block[j * ld..(j + 1) * ld];
-        let below = if tmp.is_empty() {
-            0.0
-        } else {
-            dot(&col[k..], tmp)
-        };
+        // An empty tmp (the root) gives +0, which changes no x_j.
+        let below = dot(&col[k..], tmp);
         let s = dot(&col[j + 1..k], &xs[j + 1..]);
         xs[j] = ((xs[j] - below) - s) / col[j].into();
     }
