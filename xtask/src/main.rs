@@ -2,7 +2,7 @@
 //!
 //! This crate has no dependencies on purpose: it must build on a fresh
 //! machine without HDF5 so that it can install HDF5 before anything that
-//! links it is compiled (DEVELOPERS.md, the set-up promise).
+//! links it is compiled (the set-up promise: README.md, "The two commands").
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
