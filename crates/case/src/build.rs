@@ -98,8 +98,8 @@ impl Scene {
             self.loads.clone(),
             self.settings.clone(),
         )?;
-        i.set_pressure_histories(&self.pressure_histories);
-        i.set_foundation_histories(&self.foundation_histories);
+        i.set_pressure_histories(&self.pressure_histories)?;
+        i.set_foundation_histories(&self.foundation_histories)?;
         Ok(i)
     }
 
@@ -111,8 +111,10 @@ impl Scene {
         let dynamics = Dynamics::from_model(&self.model);
         let mut integrator = Integrator::new(dynamics, self.contact, self.loads, self.settings)
             .map_err(|e| refused(case, e))?;
-        integrator.set_pressure_histories(&self.pressure_histories);
-        integrator.set_foundation_histories(&self.foundation_histories);
+        integrator
+            .set_pressure_histories(&self.pressure_histories)
+            .and_then(|()| integrator.set_foundation_histories(&self.foundation_histories))
+            .map_err(|e| refused(case, e))?;
         Ok(Prepared {
             mesh: self.mesh,
             model: self.model,
@@ -129,8 +131,10 @@ impl Scene {
         let dynamics = Dynamics::from_model_owned(self.model);
         let mut integrator = Integrator::new(dynamics, self.contact, self.loads, self.settings)
             .map_err(|e| refused(case, e))?;
-        integrator.set_pressure_histories(&self.pressure_histories);
-        integrator.set_foundation_histories(&self.foundation_histories);
+        integrator
+            .set_pressure_histories(&self.pressure_histories)
+            .and_then(|()| integrator.set_foundation_histories(&self.foundation_histories))
+            .map_err(|e| refused(case, e))?;
         let mut setup = self.setup;
         setup.extend(integrator.setup_times());
         Ok(Running {

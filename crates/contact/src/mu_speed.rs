@@ -30,14 +30,19 @@ impl Weakening {
         self.ratio + (1.0 - self.ratio) * (-s / self.speed).exp()
     }
 
-    /// The root of w + c m(|w|) φ_ε(w) = q (c ≥ 0): the stuck one, in
-    /// [−ε, ε], where |q| ≤ ε + c m(ε), else the slip one (module doc).
+    /// The root of w + c m(|w|) φ_ε(w) = q (c ≥ 0): a stuck one, in
+    /// [−ε, ε], where one exists, else the slip one (module doc).
     pub fn solve_nodal(&self, law: &FrictionLaw, q: f64, c: f64) -> f64 {
         let (a, eps) = (q.abs(), law.eps);
-        let w = if a <= eps + c * self.factor(eps) {
-            // h(w) = w (1 + c m(w)/ε) on [0, ε]: 0 at 0, at least a at
-            // min(a, ε) (h(w) ≥ w for w ≥ 0).
-            bisect(|w| w + c * self.factor(w) * w / eps - a, 0.0, a.min(eps))
+        // The stuck branch h(w) = w (1 + c m(w)/ε) on [0, ε], 0 at 0.
+        let stuck = |w: f64| w + c * self.factor(w) * w / eps;
+        let w = if a <= stuck(eps) {
+            // At least a at min(a, ε) (h(w) ≥ w for w ≥ 0).
+            bisect(|w| stuck(w) - a, 0.0, a.min(eps))
+        } else if let Some(peak) = self.stuck_peak(eps, c).filter(|&p| a <= stuck(p)) {
+            // h rises to a peak inside [0, ε] and falls again: a stuck
+            // root below the peak all the same.
+            bisect(|w| stuck(w) - a, 0.0, peak)
         } else {
             // w + c m(w) − a: ≤ 0 at max(ε, a − c) (m ≤ 1, and h(ε) < a),
             // ≥ 0 at a − c r (m ≥ r).
@@ -48,6 +53,26 @@ impl Weakening {
             )
         };
         w.copysign(q)
+    }
+
+    /// Where the stuck branch h(w) = w (1 + c m(w)/ε) peaks inside (0, ε),
+    /// if it does. h′ = 1 + (c/ε)(w m)′ with (w m)′ = r + (1 − r)
+    /// e^{−w/vs} (1 − w/vs), which falls on [0, 2vs] to its least value
+    /// at 2vs and rises after: h′ > 0 at 0, and where h′(2vs) < 0 its one
+    /// zero before 2vs is h's local maximum (where μk/μs is small and vs
+    /// below ε).
+    fn stuck_peak(&self, eps: f64, c: f64) -> Option<f64> {
+        let slope = |w: f64| {
+            let r = self.ratio;
+            1.0 + c / eps * (r + (1.0 - r) * (-w / self.speed).exp() * (1.0 - w / self.speed))
+        };
+        let low = 2.0 * self.speed;
+        if slope(low) >= 0.0 {
+            return None;
+        }
+        // −h′ rises from below 0 at 0 to above 0 at 2vs.
+        let peak = bisect(|w| -slope(w), 0.0, low);
+        (peak < eps).then_some(peak)
     }
 }
 
@@ -159,6 +184,43 @@ mod tests {
             }
         }
         assert!(three > 0, "some q with three roots");
+    }
+
+    /// With vs below ε and μk/μs small the stuck branch peaks inside
+    /// [0, ε] and falls to h(ε) = ε + c m(ε): for q between h(ε) and the
+    /// peak a stuck root exists all the same, and is taken. r = 0.01, vs =
+    /// 5e-4, ε = 1e-3, c = 0.1: h(ε) = ε + c (r + (1 − r) e⁻²) = 0.015398,
+    /// the peak 0.0192 near w = 5.3e-4 (h evaluated on a grid here, not by
+    /// the solver's search).
+    #[test]
+    fn a_stuck_root_past_the_stuck_branch_peak_is_taken() {
+        let law = FrictionLaw { eps: 1e-3 };
+        let k = Weakening {
+            ratio: 0.01,
+            speed: 5e-4,
+        };
+        let c = 0.1;
+        let h = |w: f64| w + c * k.factor(w.abs()) * law.phi(w);
+        let at_eps = h(law.eps);
+        let peak = (0..=10_000)
+            .map(|n| h(f64::from(n) * 1e-7))
+            .fold(0.0, f64::max);
+        assert!((at_eps - 0.0153982).abs() < 1e-7, "{at_eps}");
+        assert!(peak > 0.019 && peak < 0.0193, "{peak}");
+        for i in 1..10 {
+            let q = at_eps + (peak - at_eps) * f64::from(i) / 10.0;
+            for q in [q, -q] {
+                let w = k.solve_nodal(&law, q, c);
+                assert!(w.abs() <= law.eps, "q = {q}: took the slip root {w}");
+                assert!(
+                    (h(w) - q).abs() <= 1e-12 * (q.abs() + c),
+                    "q = {q}: residual"
+                );
+            }
+        }
+        // Above the peak only the slip root is left.
+        let w = k.solve_nodal(&law, 1.01 * peak, c);
+        assert!(w > law.eps && (h(w) - 1.01 * peak).abs() <= 1e-12);
     }
 
     #[test]

@@ -301,6 +301,22 @@ impl ContactSurface {
         }
     }
 
+    /// Subtracts the friction force vector J = Σ f_J τ_J of nodal forces
+    /// `forces` (as [`ContactSurface::nodal_forces`] gives them) from a
+    /// right-hand side on free DOFs; nodes with f_J = 0 leave it as it was.
+    pub fn subtract_forces(&self, forces: &[f64], rhs: &mut [f64]) {
+        for (n, &f) in self.nodes.iter().zip(forces) {
+            if f == 0.0 {
+                continue;
+            }
+            for a in 0..2 {
+                if let Some(i) = n.dofs[a] {
+                    rhs[i] -= f * n.tangent[a];
+                }
+            }
+        }
+    }
+
     /// Friction stress σ_T = −g φ_ε(v_T) at each node (paper eq. (4.10)),
     /// by [`ContactSurface::stress`].
     pub fn friction_stress(&self, velocity: &[f64], out: &mut [f64]) {

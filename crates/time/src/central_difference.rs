@@ -434,7 +434,9 @@ impl Stepper for CentralDifference {
         self.predicted = None;
         if let Some(c) = run.contact.as_mut().filter(|c| c.is_compliant()) {
             self.foundation = c.comply(&state.r_new, &self.mass, &mut self.normal);
-            self.contact_stable(c, dt, (step, t_new))?;
+            if !run.settings.allow_unstable {
+                self.contact_stable(c, dt, (step, t_new))?;
+            }
         }
         let run = &*run;
         if self.ku_stale && !self.ku.is_empty() {
@@ -510,6 +512,10 @@ impl Stepper for CentralDifference {
 
     fn is_explicit(&self) -> bool {
         true
+    }
+
+    fn mass(&self) -> Mass<'_> {
+        Mass::Lumped(&self.mass)
     }
 
     fn mass_kind(&self) -> Option<MassKind> {
@@ -672,7 +678,8 @@ impl CentralDifference {
             "step {step} (t = {t:.6e}): the foundation's contact stiffness c_n m_n δ^(m_n−1) grows \
              with the approach δ for m_n > 1, and at mesh node {} (approach up to {:.4e}) it may \
              make time.dt = {dt:e} unstable: the critical step with it is bounded below by \
-             {limit:.4e}; reduce time.dt below that, or lower cn",
+             {limit:.4e} (a bound, not the limit itself); reduce time.dt below that, lower cn, \
+             or set time.allow_unstable = true to run anyway",
             contact.nodes[f.stiffest].node, f.deepest
         )))
     }

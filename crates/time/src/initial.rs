@@ -1,8 +1,10 @@
 //! The initial state of paper Remark 4.1 (METHOD.md §4): r₀ the
 //! frictionless static equilibrium under the loads present at t = 0⁻ (or
 //! r₀ = 0 for a start at rest, every load then acting from t = 0 on),
-//! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀ − C ṙ₀ (C the Rayleigh
-//! damping), again without friction.
+//! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀ − C ṙ₀ − J(ṙ₀) (C the
+//! Rayleigh damping; J the friction at the slip at t = 0, which is zero
+//! at rest on a foundation at rest, so that Remark 4.1's r̈₀ is
+//! frictionless).
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
@@ -26,6 +28,30 @@ pub(crate) enum Mass<'a> {
 }
 
 impl Mass<'_> {
+    /// x = M⁻¹ b in place (`b` given in `x`); false, `x` unchanged, for
+    /// no mass. A consistent M is factorized for the one solve.
+    ///
+    /// # Errors
+    /// [`TimeError::Static`] where M's factorization fails.
+    pub fn solve_in_place(&self, x: &mut [f64], fill_order: &FillOrder) -> Result<bool, TimeError> {
+        match self {
+            Mass::Lumped(m) => {
+                for (x, m) in x.iter_mut().zip(*m) {
+                    *x /= m;
+                }
+            }
+            Mass::Consistent(m) => {
+                let mut solver = Analysis::of(m, fill_order)
+                    .and_then(SparseCholesky::on)
+                    .map_err(TimeError::Static)?;
+                solver.factorize(m).map_err(TimeError::Static)?;
+                solver.solve_in_place(x);
+            }
+            Mass::Massless => return Ok(false),
+        }
+        Ok(true)
+    }
+
     /// M x into `out`.
     pub fn apply(&self, x: &[f64], out: &mut [f64]) {
         match self {
@@ -312,6 +338,15 @@ pub(crate) fn initial_state(
     let stored = compliant.map_or(0.0, |c| {
         crate::preload_compliance::add_foundation_forces(c, &state.r, &mut rhs)
     });
+    // The friction at t = 0 acts on the slip then, ṙ₀ − V (zero at rest
+    // on a foundation at rest, as in Remark 4.1): M r̈₀ = R(0) − K r₀ −
+    // J(ṙ₀). The first step's ledger books ½(J₁ + J₀)·Δr, which the
+    // dynamics then match.
+    if let Some(c) = contact {
+        c.classify(&state.v, &mut state.classes);
+        c.nodal_forces(&state.v, &mut state.forces);
+        c.subtract_forces(&state.forces, &mut rhs);
+    }
     // With damping and an initial velocity, M r̈₀ = R(0) − K r₀ − C ṙ₀.
     let damping = settings.damping;
     if damping.is_on() && settings.initial_velocity.is_some() {
@@ -340,10 +375,6 @@ pub(crate) fn initial_state(
             solver.solve_in_place(&mut state.a);
         }
         Mass::Massless => {}
-    }
-    if let Some(c) = contact {
-        c.classify(&state.v, &mut state.classes);
-        c.nodal_forces(&state.v, &mut state.forces);
     }
     let mut partials = chunks::partials(n);
     let kinetic = 0.5 * mass.form(&state.v, &mut partials);

@@ -150,11 +150,55 @@ impl Integrator {
         // its bounds follow that approach from t = 0.
         if integrator.run.settings.initial_state == InitialState::Static {
             integrator.comply_at_state();
-            if let Some(c) = integrator.run.contact.as_ref().filter(|c| c.is_compliant()) {
-                c.nodal_forces(&integrator.state.v, &mut integrator.state.forces);
+            if integrator
+                .run
+                .contact
+                .as_ref()
+                .is_some_and(ContactSurface::is_compliant)
+            {
+                integrator.forces_at_start()?;
             }
         }
         Ok(integrator)
+    }
+
+    /// The friction at t = 0 again, for the contact as it now is (its
+    /// bounds or foundation speeds set for t = 0 after the start), and
+    /// r̈₀ with it: M r̈₀ = R(0) − K r₀ − C ṙ₀ − J₀ (initial.rs) gains
+    /// J₀ − J₀'. Nothing changes where the forces do not (at rest on a
+    /// foundation at rest they are zero).
+    fn forces_at_start(&mut self) -> Result<(), TimeError> {
+        let Some(contact) = self.run.contact.as_ref() else {
+            return Ok(());
+        };
+        let before = self.state.forces.clone();
+        contact.classify(&self.state.v, &mut self.state.classes);
+        contact.nodal_forces(&self.state.v, &mut self.state.forces);
+        if before == self.state.forces {
+            return Ok(());
+        }
+        let change: Vec<f64> = self
+            .state
+            .forces
+            .iter()
+            .zip(&before)
+            .map(|(new, old)| new - old)
+            .collect();
+        let mut da = vec![0.0; self.state.a.len()];
+        contact.subtract_forces(&change, &mut da);
+        if !self
+            .stepper
+            .mass()
+            .solve_in_place(&mut da, &self.fill_order)?
+        {
+            return Ok(());
+        }
+        for (a, d) in self.state.a.iter_mut().zip(&da) {
+            *a += d;
+        }
+        // A step formed ahead from r̈₀ must form again.
+        self.stepper.state_replaced();
+        Ok(())
     }
 
     /// How long the setup's parts took: the preload's ordering, factor
@@ -171,16 +215,21 @@ impl Integrator {
     /// (the friction of a step acts at its end, METHOD.md §4). Constant
     /// and step histories change nothing after t = 0 and cost nothing.
     /// Call it on a fresh integrator, before [`Integrator::restore`].
-    pub fn set_pressure_histories(&mut self, histories: &[History]) {
+    ///
+    /// # Errors
+    /// [`TimeError::Static`] where a consistent M fails to factorize for
+    /// r̈₀ (it factorized at the start).
+    pub fn set_pressure_histories(&mut self, histories: &[History]) -> Result<(), TimeError> {
         let Some(contact) = self.run.contact.as_mut() else {
-            return;
+            return Ok(());
         };
         self.bounds = BoundHistories::new(contact, histories);
         if let Some(b) = &mut self.bounds {
             b.apply(self.state.t, contact);
             // The initial forces are w g φ_ε(ṙ₀) with g at t = 0.
-            contact.nodal_forces(&self.state.v, &mut self.state.forces);
+            self.forces_at_start()?;
         }
+        Ok(())
     }
 
     /// Makes each contact surface's foundation speed (built into the
@@ -190,17 +239,20 @@ impl Integrator {
     /// bounds. Nothing is kept where no foundation moves or every history
     /// is constant. Call it on a fresh integrator, before
     /// [`Integrator::restore`].
-    pub fn set_foundation_histories(&mut self, histories: &[History]) {
+    ///
+    /// # Errors
+    /// As [`Integrator::set_pressure_histories`].
+    pub fn set_foundation_histories(&mut self, histories: &[History]) -> Result<(), TimeError> {
         let Some(contact) = self.run.contact.as_mut() else {
-            return;
+            return Ok(());
         };
         self.foundations = FoundationHistories::new(contact, histories);
         if let Some(f) = &mut self.foundations {
             f.apply(self.state.t, contact);
             // The initial classes and forces act on the slip at t = 0.
-            contact.classify(&self.state.v, &mut self.state.classes);
-            contact.nodal_forces(&self.state.v, &mut self.state.forces);
+            self.forces_at_start()?;
         }
+        Ok(())
     }
 
     /// Sets the bounds and the foundation speeds for time `t`, where they

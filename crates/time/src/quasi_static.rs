@@ -38,7 +38,7 @@
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{stick_events, ContactSurface};
 use stickslip_linalg::chunks;
-use stickslip_linalg::csr::{dot, quadratic_form, spmv};
+use stickslip_linalg::csr::{quadratic_form, spmv};
 
 use stickslip_fem::SetupTimes;
 
@@ -103,15 +103,14 @@ pub(crate) fn start(
         Some(first),
     )?;
     if !settings.restoring {
-        // The previous increment's load is the one r₀ equilibrates: the
+        // The total stays the initial state's, strain − rᵀR(0) with R at
+        // t = 0 itself (a load that switches on at t = 0 included, as the
+        // dynamic schemes count it). The previous increment's load is the one r₀ equilibrates: the
         // loads before t = 0, or none for a start at rest (r₀ = 0).
         state.load = match settings.initial_state {
             InitialState::Static => loads.before_start(),
             InitialState::Rest => vec![0.0; n],
         };
-        // strain ≥ +0, so adding no foundation's +0 keeps its bits.
-        state.energy.total =
-            state.energy.strain + state.energy.foundation_stored - dot(&state.r, &state.load);
     }
     let stepper = QuasiStatic {
         k,

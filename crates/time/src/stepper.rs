@@ -6,6 +6,7 @@
 use stickslip_contact::ContactSurface;
 
 use crate::dynamics::Loads;
+use crate::initial::Mass;
 use crate::newmark::ImplicitFriction;
 use crate::settings::{MassKind, Settings, TimeError};
 use crate::state::{State, StepInfo};
@@ -45,6 +46,12 @@ pub(crate) trait Stepper: Send {
 
     /// How a step forms its products with K (for messages and results).
     fn stiffness_product(&self) -> &'static str;
+
+    /// The mass its steps use, for r̈₀ where the friction at t = 0
+    /// changes after the start (no inertia: [`Mass::Massless`]).
+    fn mass(&self) -> Mass<'_> {
+        Mass::Massless
+    }
 
     /// K's stencil types, where the step forms K·x from them.
     fn stencil_types(&self) -> Option<usize> {

@@ -21,7 +21,7 @@ fn belt(speed: Option<f64>, eps: f64, settings: Settings) -> Integrator {
         surface.set_foundation(|_| v);
     }
     let mut i = sdof::with_surface(0.0, surface, settings).unwrap();
-    i.set_foundation_histories(&[History::Constant]);
+    i.set_foundation_histories(&[History::Constant]).unwrap();
     i
 }
 
@@ -45,11 +45,11 @@ fn a_fast_belt_drags_the_mass_by_g() {
             worst = worst.max((i.displacement()[0] - exact).abs());
             assert!(!i.classes()[0].is_stuck(), "{name}: t = {}", i.time());
         }
-        // The start is frictionless (Remark 4.1: r̈₀ = 0, not g), which
-        // leaves the velocity gΔt/2 short after the first step and an
-        // oscillation of amplitude gΔt/(2ω) = 5e-5; beside it both schemes
-        // are second order, (ωΔt)² = 1e-4 of the amplitude per radian over
-        // ten radians, 1e-3 of it.
+        // Both schemes are second order, (ωΔt)² = 1e-4 of the amplitude
+        // per radian over ten radians, 1e-3 of it; the bound also admits a
+        // frictionless start (r̈₀ = 0, not g: the velocity gΔt/2 short
+        // after the first step, an oscillation of gΔt/(2ω) = 5e-5), which
+        // tests/initial_friction.rs rules out.
         let dt = 1e-3;
         let bound = G * dt / (2.0 * OMEGA) + 1e-3 * amplitude;
         assert!(worst < bound, "{name}: {worst:e} > {bound:e}");
@@ -64,8 +64,8 @@ fn a_fast_belt_drags_the_mass_by_g() {
         assert!(e.dissipated > 0.0);
         if newmark {
             // The trapezoidal rule closes the ledger to round-off after the
-            // first step, which books ½(f₁ + f₀)Δr with f₀ = −g, where the
-            // frictionless start (Remark 4.1) had none: at most g x₁.
+            // first step (and from it: r̈₀ carries f₀, tests/
+            // initial_friction.rs); the first step's bound is g x₁.
             assert!(first.abs() <= G * x1, "{name}: first step {first:e}");
             let drift = e.balance - first;
             assert!(drift.abs() < 1e-12, "{name}: balance moved {drift:e}");

@@ -35,7 +35,8 @@ fn slab(ratio: Option<f64>, settings: Settings) -> Integrator {
         c.set_weakening(|_| Some(Weakening { ratio, speed: 0.05 }));
     }
     let mut i = s.integrator(settings).unwrap();
-    i.set_pressure_histories(&[History::Table(vec![(0.0, 1.0), (0.5, 0.2)])]);
+    i.set_pressure_histories(&[History::Table(vec![(0.0, 1.0), (0.5, 0.2)])])
+        .unwrap();
     i
 }
 

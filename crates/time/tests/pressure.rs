@@ -19,7 +19,7 @@ fn ramp() -> History {
 fn run(settings: Settings) -> Integrator {
     let s = paper_slab("slab-q2-8x2.msh", 1e-4, History::Step);
     let mut i = s.integrator(settings).unwrap();
-    i.set_pressure_histories(&[ramp()]);
+    i.set_pressure_histories(&[ramp()]).unwrap();
     i
 }
 

@@ -235,7 +235,8 @@ fn ramp_down(r: &mut Report) {
         let case = format!("pressure ramped down {name}");
         let result = (|| -> Result<f64, String> {
             let mut i = sdof::integrator(p, 1e-5, scheme, dt, 0.8).map_err(|e| e.to_string())?;
-            i.set_pressure_histories(&[History::Table(vec![(0.0, 1.0), (t_ramp, 0.0)])]);
+            i.set_pressure_histories(&[History::Table(vec![(0.0, 1.0), (t_ramp, 0.0)])])
+                .map_err(|e| e.to_string())?;
             while !i.done() {
                 i.step().map_err(|e| e.to_string())?;
                 if !i.classes()[0].is_stuck() {

@@ -787,6 +787,11 @@ impl Stepper for Newmark {
         Some(self.mass_kind)
     }
 
+    fn mass(&self) -> Mass<'_> {
+        // A lumped mass is m's diagonal: its factor is that of a diagonal.
+        Mass::Consistent(&self.m)
+    }
+
     fn stiffness_product(&self) -> &'static str {
         "assembled CSR"
     }
