@@ -227,8 +227,8 @@ pub fn settings(case: &Case) -> Settings {
 }
 
 /// Checks a group the case names against the mesh: it exists (else the
-/// message lists the mesh's groups) and, when `dim` is given, has that
-/// dimension.
+/// message lists the mesh's groups), when `dim` is given has that
+/// dimension, has elements, and (a line group) lies on the boundary.
 fn check_group(
     mesh: &Mesh,
     case: &Case,
@@ -273,6 +273,25 @@ fn check_group(
                      but {name:?} has dimension {}; name the boundary edges in Gmsh with a Physical Curve",
                     case.at(key),
                     g.dim
+                ));
+                false
+            }
+            // Gmsh writes a physical group whose entities are missing
+            // (`Physical Curve("load") = {7};` without a curve 7) as a name
+            // without elements: a load or support there acts on nothing.
+            _ if g.elements == 0 => {
+                let physical = match g.dim {
+                    0 => "Point",
+                    1 => "Curve",
+                    _ => "Surface",
+                };
+                problems.push(format!(
+                    "{}{key} = {name:?}: the physical group {name:?} has no elements in the mesh {}, \
+                     so {purpose} there would act on nothing; check the entities of its Physical \
+                     {physical} in the .geo (Gmsh keeps a group whose entities are missing, empty) \
+                     and mesh again",
+                    case.at(key),
+                    case.mesh.file.display()
                 ));
                 false
             }

@@ -222,9 +222,13 @@ pub(crate) fn check_table(
             (Kind::Str | Kind::Variant(_), _) => wrong("text", "put it in quotes, e.g. \"...\""),
             (Kind::Num, Item::Value(v)) if is_number(v) => {}
             (Kind::Num, _) => wrong("a number", "write numbers without quotes, e.g. 1e-3"),
-            (Kind::Int, Item::Value(Value::Integer(i))) if *i.value() >= 0 => {}
+            (Kind::Int | Kind::Count, Item::Value(Value::Integer(i))) if *i.value() >= 0 => {}
             (Kind::Int, _) => wrong(
                 "a whole number >= 0",
+                "write it without quotes or decimal point, e.g. 10",
+            ),
+            (Kind::Count, _) => wrong(
+                "a whole number >= 1",
                 "write it without quotes or decimal point, e.g. 10",
             ),
             (Kind::Bool, Item::Value(Value::Boolean(_))) => {}
@@ -292,7 +296,7 @@ fn placeholder(kind: &Kind) -> Option<Value> {
         Kind::Variant(valid) => Value::from(*valid),
         Kind::Str => Value::from("placeholder"),
         Kind::Num => Value::from(1.0),
-        Kind::Int => Value::from(1i64),
+        Kind::Int | Kind::Count => Value::from(1i64),
         Kind::Bool => Value::from(false),
         Kind::Vec2 => Value::Array(toml_edit::Array::from_iter([0.0, 0.0])),
         Kind::StrList => Value::Array(toml_edit::Array::new()),

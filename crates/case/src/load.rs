@@ -591,11 +591,14 @@ fn complete(
         );
     }
     // One rule for when the fields are written: a second one is refused
-    // where it stands, rather than one of them silently ignored.
-    let given: Vec<&str> = ["frames", "interval", "every"]
+    // where it stands (the later in the text), rather than one of them
+    // silently ignored.
+    let mut given: Vec<(usize, &str)> = ["frames", "interval", "every"]
         .into_iter()
-        .filter(|k| spans.contains_key(&format!("output.{k}")))
+        .filter_map(|k| Some((spans.get(&format!("output.{k}"))?.start, k)))
         .collect();
+    given.sort_unstable();
+    let given: Vec<&str> = given.into_iter().map(|(_, k)| k).collect();
     if let [first, rest @ ..] = &given[..] {
         for other in rest {
             check(
@@ -941,6 +944,56 @@ t_end = 0.5
             .unwrap_err()
             .0;
         assert!(e.contains("output.frames must be >= 1"), "{e}");
+    }
+
+    #[test]
+    fn the_later_of_two_frame_rules_is_refused_at_its_line() {
+        // `every` before `frames` in the file: the message goes to the
+        // line of `frames`, the one that comes second, naming `every`.
+        let text = format!("{GOOD}[output]\nevery = 3\nframes = 7\n");
+        let e = load_text("two-later", &text, &[]).unwrap_err().0;
+        let l = line_of(&text, "frames = 7");
+        assert!(
+            e.lines().any(|m| m.contains(&format!("case.toml:{l}:"))
+                && m.contains("output.frames and output.every both say")),
+            "not at line {l}:\n{e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+
+    #[test]
+    fn a_negative_count_is_refused_with_its_minimum() {
+        // The counts start at 1; compression, a level, at 0.
+        for (key, min) in [
+            ("frames", 1),
+            ("every", 1),
+            ("flush_every", 1),
+            ("compression", 0),
+        ] {
+            let text = format!("{GOOD}[output]\n{key} = -5\n");
+            let e = load_text(&format!("neg-{key}"), &text, &[]).unwrap_err().0;
+            assert!(
+                e.contains(&format!(
+                    "output.{key}: expected a whole number >= {min}, found the integer -5"
+                )),
+                "{e}"
+            );
+        }
+        let text = GOOD.replace("eps = 1e-4", "eps = 1e-4\nmax_iterations = -1");
+        let e = load_text("neg-iterations", &text, &[]).unwrap_err().0;
+        assert!(
+            e.contains("contact.max_iterations: expected a whole number >= 1"),
+            "{e}"
+        );
+        let text = GOOD.replace(
+            "t_end = 0.5",
+            "t_end = 0.5\nstick_reduction = { dt = 1e-4, steps = -2 }",
+        );
+        let e = load_text("neg-steps", &text, &[]).unwrap_err().0;
+        assert!(
+            e.contains("time.stick_reduction.steps: expected a whole number >= 1"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -2,7 +2,8 @@
 //! fills are the types the rest of the code reads, and the key list that
 //! the key-by-key check walks ([`Section::KEYS`]) is generated from the
 //! same declarations by `section!` (below), each key's [`Kind`] taken
-//! from its field's Rust type ([`Schema`]). docs/case-file.md is tested
+//! from its field's Rust type ([`Schema`]) unless the declaration gives
+//! one (`=> Kind::Count`). docs/case-file.md is tested
 //! against [`key_paths`].
 //!
 //! Values read as written (relative paths, defaults) are completed by
@@ -27,6 +28,11 @@ pub enum Kind {
     Num,
     /// A whole number >= 0.
     Int,
+    /// A whole number >= 1 (a count of steps, frames, iterations), given
+    /// in `section!` as `=> Kind::Count` (the Rust type is `usize` either
+    /// way): what a negative value's message says; the value checks
+    /// refuse 0 in their own words.
+    Count,
     /// true or false.
     Bool,
     /// [x, y], two numbers.
@@ -77,17 +83,27 @@ impl<T: Section> Schema for Vec<T> {
     const KIND: Kind = Kind::Tables(T::KEYS);
 }
 
+/// The [`Kind`] of a key: its type's, or the one given.
+macro_rules! kind_of {
+    ($ty:ty) => {
+        <$ty as Schema>::KIND
+    };
+    ($ty:ty, $kind:expr) => {
+        $kind
+    };
+}
+
 /// Declares a table of the case file: a struct that serde fills (unknown
-/// keys refused), each field given with its TOML key, and its
-/// [`Section::KEYS`]. Fields after `derived` are no keys: loading fills
-/// them.
+/// keys refused), each field given with its TOML key (and, after `=>`, a
+/// [`Kind`] other than its type's), and its [`Section::KEYS`]. Fields
+/// after `derived` are no keys: loading fills them.
 macro_rules! section {
     (
         $(#[$attr:meta])*
         pub struct $name:ident {
             $(
                 $(#[$fattr:meta])*
-                $key:literal $field:ident: $ty:ty,
+                $key:literal $field:ident: $ty:ty $(=> $kind:expr)?,
             )*
         }
         $(derived {
@@ -115,7 +131,7 @@ macro_rules! section {
 
         impl Section for $name {
             const KEYS: &'static [(&'static str, Kind)] =
-                &[$(($key, <$ty as Schema>::KIND)),*];
+                &[$(($key, kind_of!($ty $(, $kind)?))),*];
         }
 
         impl Schema for $name {
@@ -558,7 +574,7 @@ section! {
         "remark_4_2" remark_4_2: bool,
         /// Iteration cap per step (default 100).
         #[serde(default = "default_max_iterations")]
-        "max_iterations" max_iterations: usize,
+        "max_iterations" max_iterations: usize => Kind::Count,
         /// The normal law: a prescribed pressure (default) or a compliant
         /// foundation (METHOD.md §10).
         #[serde(default)]
@@ -701,7 +717,7 @@ section! {
         /// The reduced step.
         "dt" dt: f64,
         /// How many reduced steps follow each sticking event.
-        "steps" steps: usize,
+        "steps" steps: usize => Kind::Count,
     }
 }
 
@@ -759,16 +775,16 @@ section! {
         /// Full fields (u, v, a) at `frames` frames over [0, t_end]: the
         /// first steps at or after k·t_end/frames (default
         /// [`DEFAULT_FRAMES`] when neither `interval` nor `every` is given).
-        "frames" frames: Option<usize>,
+        "frames" frames: Option<usize> => Kind::Count,
         /// ... or at the first steps at or after k·interval.
         "interval" interval: Option<f64>,
         /// ... or at every `every`-th step.
-        "every" every: Option<usize>,
+        "every" every: Option<usize> => Kind::Count,
         /// Flush the file (and rewrite the checkpoint) at least every this
         /// many steps (default: none, by wall time only: a run's steps
         /// may take microseconds or minutes, its wall time is what a crash
         /// loses).
-        "flush_every" flush_every: Option<usize>,
+        "flush_every" flush_every: Option<usize> => Kind::Count,
         /// ... and at least every this many seconds of wall time (default
         /// 5), counted from the start of the run, its setup included.
         #[serde(default = "default_flush_seconds")]

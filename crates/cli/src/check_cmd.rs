@@ -3,32 +3,47 @@
 //! Δt_crit, solver, steps, output) and the warnings a run prints before
 //! its first step, without stepping.
 
-use stickslip_case::{self as case, Case};
+use std::fmt::Write as _;
+
+use stickslip_case::{self as case, Case, InputError};
 use stickslip_fem::NodeOrder;
 use stickslip_time::ImplicitSolver;
 
 use crate::frames::Schedule;
 use crate::run::{friction_off, human_bytes, output_size, prepare, room_for, setup_warnings};
 
-/// `stickslip check`: validate, print the model size, Δt_crit and solver.
+/// `stickslip check`: validate, and say the model size, Δt_crit and
+/// solver: the report is returned for the caller to print, which can fail
+/// (`println!` would panic on a full disk).
 ///
 /// # Errors
 /// Input problems as [`InputError`].
-pub fn check(case: &Case) -> anyhow::Result<()> {
+pub fn check(case: &Case) -> anyhow::Result<String> {
+    // The results file a run of the case writes (without -o), refused
+    // where `run` would refuse it, at its line of the case.
+    crate::results_file::check_output_place(&case.output.file, &[&case.path, &case.mesh.file])
+        .map_err(|e| InputError(format!("{}output.file: {}", case.at("output.file"), e.0)))?;
     let p = prepare(case, true)?;
-    let i = &p.integrator;
-    println!("case        {}", case.path.display());
-    if let Some(t) = &case.title {
-        println!("title       {t}");
+    let mut report = String::new();
+    // A line of the report (writing to a String cannot fail).
+    macro_rules! put {
+        ($($t:tt)*) => {{
+            let _ = writeln!(report, $($t)*);
+        }};
     }
-    println!(
+    let i = &p.integrator;
+    put!("case        {}", case.path.display());
+    if let Some(t) = &case.title {
+        put!("title       {t}");
+    }
+    put!(
         "mesh        {} nodes, {} {} cells ({})",
         p.mesh.nodes.len(),
         p.mesh.n_cells(),
         p.mesh.kind.name(),
         case.mesh.file.display()
     );
-    println!(
+    put!(
         "DOFs        {} free of {}, numbered {}",
         p.model.dofs.n_free(),
         2 * p.mesh.nodes.len(),
@@ -53,14 +68,14 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         } else {
             "nothing holds them: no friction acts"
         };
-        println!(
+        put!(
             "floating    the supports leave free: {} ({held}; the static preload, if any, is \
              solved without those motions)",
             free.join(", ")
         );
     }
     match i.contact() {
-        Some(c) => println!(
+        Some(c) => put!(
             "contact     {}: {} friction nodes ({} left out: tangential motion fixed), eps = {}",
             c.names(),
             c.len(),
@@ -77,10 +92,10 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
                 each.join(" / ")
             }
         ),
-        None => println!("contact     none (no friction code runs)"),
+        None => put!("contact     none (no friction code runs)"),
     }
     if let Some(c) = i.contact().filter(|c| c.is_compliant()) {
-        println!(
+        put!(
             "foundation  {} of them on a compliant foundation (law = \"compliance\"); {}",
             c.compliance.len(),
             if i.is_explicit() {
@@ -91,7 +106,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         );
     }
     if let Some(why) = friction_off(case, i).filter(|_| i.contact().is_some()) {
-        println!("friction    off: {why}; the steps run no friction code");
+        put!("friction    off: {why}; the steps run no friction code");
     }
     // The explicit integrator computed it already (by its own K·x);
     // Newmark's did not.
@@ -103,7 +118,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     });
     let damped = case.material.damping.is_some_and(|d| d.beta > 0.0) && i.is_explicit();
     if !quasi_static {
-        println!(
+        put!(
             "dt_crit     {crit:.6e} (central difference, lumped mass: {})",
             if damped {
                 "(2/omega_max)(sqrt(1+xi^2) - xi), xi = beta omega_max/2"
@@ -120,7 +135,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         // puts the initial state at r₀ = K⁻¹ R(0⁻): one factorization of
         // K, the only one of the run; else r₀ = 0 and there is none.
         let preloaded = i.displacement().iter().any(|&x| x != 0.0);
-        println!(
+        put!(
             "solver      explicit: {}; {}; K·x by {}",
             if preloaded {
                 format!(
@@ -138,7 +153,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
             i.stiffness_product()
         );
     } else if i.implicit_solver() == ImplicitSolver::Direct {
-        println!(
+        put!(
             "solver      implicit Newmark: sparse Cholesky (faer, {}) of A₀ + C, analysed once, refactorized when dt or the stuck set changes; nnz(K) = {}; K·x by {}",
             p.model.fill_order.name(),
             p.model.stiffness.nnz(),
@@ -146,7 +161,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         );
     } else if quasi_static {
         let n_c = i.contact().map_or(0, |c| c.len());
-        println!(
+        put!(
             "solver      quasi-static increments (no inertia): sparse Cholesky (faer, {}) of dt·K, analysed once, factorized once per distinct dt; friction on the {n_c} contact unknowns by the Schur complement; nnz(K) = {}",
             p.model.fill_order.name(),
             p.model.stiffness.nnz(),
@@ -159,20 +174,21 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
             ),
             None => "no friction".to_string(),
         };
-        println!(
+        put!(
             "solver      implicit Newmark: sparse Cholesky (faer, {}) of A₀, analysed once, factorized once per distinct dt; {friction}; nnz(K) = {}; K·x by {}",
             p.model.fill_order.name(),
             p.model.stiffness.nnz(),
             i.stiffness_product()
         );
     }
-    println!(
+    put!(
         "steps       about {steps} to t_end = {} with dt = {:e}",
-        case.time.t_end, case.time.dt
+        case.time.t_end,
+        case.time.dt
     );
     if !i.is_explicit() && !quasi_static {
         // Stability is no guide for an implicit step: say what it resolves.
-        println!(
+        put!(
             "accuracy    Newmark is stable at any dt, but follows a vibration only when its period spans \
              about 10 steps or more: here periods above {:.3e}; the mesh's shortest is {:.3e} (pi dt_crit)",
             10.0 * case.time.dt,
@@ -180,7 +196,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
         );
     }
     let size = output_size(case, p.mesh.nodes.len(), i.contact().map_or(0, |c| c.len()));
-    println!(
+    put!(
         "output      {}: about {} frames of u, v, a ({}) and {} rows of histories (time, energy, contact), {}",
         case.output.file.display(),
         size.frames,
@@ -190,7 +206,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     );
     if let Some(free) = room_for(&case.output.file, true) {
         if size.bytes > free as f64 {
-            println!(
+            put!(
                 "warning     that is more than the {} free on its disk: `run` refuses it; write fewer frames (output.frames, output.interval, output.every) or elsewhere (-o)",
                 human_bytes(free as f64)
             );
@@ -201,7 +217,7 @@ pub fn check(case: &Case) -> anyhow::Result<()> {
     let mut u = vec![0.0; 2 * p.mesh.nodes.len()];
     p.model.dofs.expand(i.displacement(), &mut u);
     for w in setup_warnings(&p.mesh, &p.model.dofs, &u, i) {
-        println!("warning     {w}");
+        put!("warning     {w}");
     }
-    Ok(())
+    Ok(report)
 }

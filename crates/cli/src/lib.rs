@@ -4,7 +4,8 @@
 //! ([`mesh_cmd`]), the `probe` reader ([`probe`]), the results file's
 //! protection ([`results_file`]), the `advise` command ([`advise`]: the
 //! cheapest configuration for a tolerance) and the viewers' files
-//! ([`views_cmd`]). Case files are read by
+//! ([`views_cmd`]); text on stdout and stderr written without panicking
+//! ([`console`]). Case files are read by
 //! `stickslip-case`.
 //!
 //! This crate owns everything that touches the results files and the
@@ -14,7 +15,8 @@
 //!
 //! Exit codes (used by `main.rs`): 0 success; 2 bad input (case, mesh,
 //! arguments: a `stickslip_case::InputError`); 1 a run that failed after it
-//! started; 130 interrupted.
+//! started, or text that could not be written to stdout or stderr
+//! ([`console::WriteError`]); 130 interrupted.
 //!
 //! Its system calls (signals, the results file's lock, free disk space)
 //! are in [`sys`], the one module allowed `unsafe`.
@@ -33,16 +35,9 @@ macro_rules! say {
     }};
 }
 
-/// [`say!`] on stdout.
-macro_rules! say_out {
-    ($($t:tt)*) => {{
-        use std::io::Write;
-        let _ = writeln!(std::io::stdout(), $($t)*);
-    }};
-}
-
 pub mod advise;
 pub mod check_cmd;
+pub mod console;
 pub mod frames;
 pub mod mesh_cmd;
 mod normal_stress;

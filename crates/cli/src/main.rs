@@ -6,8 +6,12 @@
 //!
 //! Exit codes: 0 success; 2 bad input (case, mesh, arguments — clap's usage
 //! errors exit 2 too); 1 a run that failed after it started (the file keeps
-//! every step written); 130 interrupted by SIGINT, SIGTERM or SIGHUP (the file is
-//! valid and holds a checkpoint to `--restart` from).
+//! every step written), or text that could not be written to stdout or
+//! stderr (a full disk behind a redirection: what the command wrote to
+//! files is kept; `run --json` whose summary is lost keeps its complete
+//! file); 130 interrupted by SIGINT, SIGTERM or SIGHUP (the file is
+//! valid and holds a checkpoint to `--restart` from). A closed pipe
+//! (`| head`) ends the commands other than `run` quietly, by SIGPIPE.
 
 // The system calls are in the library's `sys` module.
 #![forbid(unsafe_code)]
@@ -17,6 +21,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use stickslip::console::{self, WriteError};
 use stickslip::{advise, check_cmd, mesh_cmd, probe, run, views_cmd};
 use stickslip_case as case;
 use stickslip_case::InputError;
@@ -38,8 +43,8 @@ enum Command {
     /// Run a case and write the results to HDF5.
     #[command(
         after_help = "Example:\n  stickslip run case.toml -o out.h5 --set time.dt=5e-4 --set contact.eps=1e-2\n\n\
-Exit codes: 0 complete, 1 the run failed midway (the file keeps every step written, complete = false), \
-2 bad input, 130 interrupted by SIGINT, SIGTERM or SIGHUP (the file is valid, complete = false; continue it with --restart OUT.h5).\n\n\
+Exit codes: 0 complete, 1 the run failed midway (the file keeps every step written, complete = false) \
+or its --json summary could not be written to stdout (the file is complete), 2 bad input, 130 interrupted by SIGINT, SIGTERM or SIGHUP (the file is valid, complete = false; continue it with --restart OUT.h5).\n\n\
 A second Ctrl-C while the first is being handled exits at once (the file keeps every step up to its last flush)."
     )]
     Run {
@@ -135,9 +140,12 @@ interrupted or failed run's file; run it again after a --restart (it adds the ne
         #[arg(short, long)]
         quiet: bool,
     },
-    /// Print the time history of one field at the node nearest to a point.
+    /// Print the time history of one field at the node nearest to a point, or one field along a
+    /// boundary group at given times (--along).
     #[command(
-        after_help = "Example:\n  stickslip probe slab.h5 --at 8,0 --field ux --csv > node81.csv"
+        after_help = "Examples:\n  stickslip probe slab.h5 --at 8,0 --field ux --csv > node81.csv\n  \
+stickslip probe slab.h5 --along contact --times 0.1,0.5 --field friction_stress -o contact.csv\n\n\
+-o refuses an existing file unless --force is given, and never writes over the results file it reads."
     )]
     Probe {
         /// A results file written by `stickslip run`.
@@ -156,6 +164,9 @@ interrupted or failed run's file; run it again after a --restart (it adds the ne
         /// Comma-separated values with a header line instead of a table.
         #[arg(long)]
         csv: bool,
+        /// With --along -o FILE: overwrite FILE if it exists (never the results file read).
+        #[arg(long)]
+        force: bool,
         #[command(flatten)]
         along: probe::AlongArgs,
     },
@@ -171,11 +182,23 @@ fn report(msg: &str) {
     }
 }
 
+/// Exit code for text that could not be written to stdout or stderr: 1,
+/// said on stderr unless the reader closed the pipe (or stderr is what
+/// failed: `report` then fails too, quietly).
+fn write_failed(e: &WriteError) -> ExitCode {
+    if !e.broken_pipe() {
+        report(&e.to_string());
+    }
+    ExitCode::from(1)
+}
+
 /// Exit code for an error from a run or a check: 2 for bad input, else 1.
 fn fail(e: &anyhow::Error) -> ExitCode {
     if let Some(input) = e.downcast_ref::<InputError>() {
         report(&input.0);
         ExitCode::from(2)
+    } else if let Some(w) = e.downcast_ref::<WriteError>() {
+        write_failed(w)
     } else {
         report(&format!("{e:#}"));
         ExitCode::from(1)
@@ -211,6 +234,9 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
+            // The case's output.file, where no -o replaces it: its line is
+            // where to change it.
+            let at_case = restart.is_none() && output.is_none();
             let out = match &restart {
                 Some(r) => r.clone(),
                 None => output.unwrap_or_else(|| case.output.file.clone()),
@@ -221,7 +247,11 @@ fn main() -> ExitCode {
                     &[&case_path, &case.mesh.file],
                     force,
                 ) {
-                    report(&e.0);
+                    if at_case {
+                        report(&format!("{}output.file: {}", case.at("output.file"), e.0));
+                    } else {
+                        report(&e.0);
+                    }
                     return ExitCode::from(2);
                 }
             } else if stickslip::results_file::in_use(&out) {
@@ -252,6 +282,7 @@ fn main() -> ExitCode {
                 Ok(run::Outcome::Complete) => ExitCode::SUCCESS,
                 Ok(run::Outcome::Failed) => ExitCode::from(1),
                 Ok(run::Outcome::Interrupted) => ExitCode::from(130),
+                Ok(run::Outcome::SummaryLost) => ExitCode::from(1),
                 Err(e) => fail(&e),
             }
         }
@@ -263,8 +294,9 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            match check_cmd::check(&case) {
-                Ok(()) => ExitCode::SUCCESS,
+            match check_cmd::check(&case).map(|text| console::out(&text)) {
+                Ok(Ok(())) => ExitCode::SUCCESS,
+                Ok(Err(w)) => write_failed(&w),
                 Err(e) => fail(&e),
             }
         }
@@ -311,39 +343,41 @@ fn main() -> ExitCode {
         }
         Command::Stress { file, quiet } => match stickslip::stress_cmd::command(&file, quiet) {
             Ok((rows, nodes, written)) => {
+                let mut said = Ok(());
                 if !quiet {
-                    eprintln!(
-                        "stress: {rows} records of {nodes} nodes into {} (/stress, /von_mises), listed in {}",
+                    said = console::err(&format!(
+                        "stress: {rows} records of {nodes} nodes into {} (/stress, /von_mises), listed in {}\n",
                         stickslip::stress_cmd::stress_path(&file).display(),
                         stickslip::xdmf::xdmf_path(&file).display()
-                    );
+                    ));
                 }
                 if let Some(note) = &written.note {
-                    eprintln!("stress: note: {note}");
+                    said = said.and(console::err(&format!("stress: note: {note}\n")));
                 }
-                ExitCode::SUCCESS
+                said.map_or_else(|w| write_failed(&w), |()| ExitCode::SUCCESS)
             }
             Err(e) => fail(&e),
         },
         Command::Views { file, quiet } => match views_cmd::command(&file) {
             Ok(written) => {
+                let mut said = Ok(());
                 if !quiet {
-                    eprintln!("{}", views_cmd::summary(&file, &written));
+                    said = console::err(&format!("{}\n", views_cmd::summary(&file, &written)));
                 }
                 if let Some(note) = &written.note {
-                    eprintln!("views: note: {note}");
+                    said = said.and(console::err(&format!("views: note: {note}\n")));
                 }
-                ExitCode::SUCCESS
+                said.map_or_else(|w| write_failed(&w), |()| ExitCode::SUCCESS)
             }
             Err(e) => fail(&e),
         },
         Command::Mesh { file, json } => match mesh_cmd::report(&file, json) {
             Ok(text) => {
-                print!("{text}");
-                if json {
-                    println!();
+                let end = if json { "\n" } else { "" };
+                match console::out(&format!("{text}{end}")) {
+                    Ok(()) => ExitCode::SUCCESS,
+                    Err(w) => write_failed(&w),
                 }
-                ExitCode::SUCCESS
             }
             Err(e) => {
                 report(&e.0);
@@ -355,32 +389,32 @@ fn main() -> ExitCode {
             at,
             field,
             csv,
+            force,
             along,
         } => match at {
-            None => match probe::along_command(&file, &along, field) {
+            None => match probe::write_along(&file, &along, field, force) {
                 Ok(()) => ExitCode::SUCCESS,
-                Err(e) => {
-                    report(&e.0);
-                    ExitCode::from(2)
-                }
+                Err(e) => fail(&e),
             },
             // clap's `requires` does not hold across the flattened group.
-            Some(_) if along.output.is_some() || along.times.is_some() => {
+            Some(_) if along.output.is_some() || along.times.is_some() || force => {
                 report(
-                    "probe: -o and --times go with --along GROUP; with --at the history goes to \
+                    "probe: -o, --times and --force go with --along GROUP; with --at the history goes to \
                      stdout (redirect it: > FILE)",
                 );
                 ExitCode::from(2)
             }
             Some(at) => match probe::probe(&file, &at, field, csv) {
                 Ok(p) => {
-                    if csv {
-                        eprint!("{}", p.info);
+                    let info = if csv {
+                        console::err(&p.info)
                     } else {
-                        print!("{}", p.info);
-                    }
-                    print!("{}", p.table);
-                    ExitCode::SUCCESS
+                        console::out(&p.info)
+                    };
+                    // The history even where the note on stderr failed.
+                    let table = console::out(&p.table);
+                    info.and(table)
+                        .map_or_else(|w| write_failed(&w), |()| ExitCode::SUCCESS)
                 }
                 Err(e) => {
                     report(&e.0);

@@ -1,5 +1,5 @@
 //! `stickslip mesh FILE.msh [--json]`: what is in a mesh file, or what is
-//! wrong with it (issue 2, deliverable 3; JSON keys in DESIGN.md).
+//! wrong with it (JSON keys in DESIGN.md).
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -54,7 +54,7 @@ pub fn to_json(mesh: &Mesh) -> serde_json::Value {
         "bbox": mesh.bbox(),
         "reoriented": mesh.source.reoriented,
         "unused_nodes": mesh.source.unused_nodes,
-        "warnings": warnings(mesh),
+        "warnings": warnings(mesh).into_iter().chain(empty_groups(mesh)).collect::<Vec<_>>(),
     })
 }
 
@@ -63,6 +63,29 @@ fn warnings(mesh: &Mesh) -> Vec<String> {
     stickslip_mesh::degenerate_cells(mesh, stickslip_mesh::DEGENERATE_RATIO)
         .map(|d| d.to_string())
         .into_iter()
+        .collect()
+}
+
+/// A note for each physical group without elements: Gmsh keeps a group
+/// whose entities are missing (`Physical Curve("load") = {7};` without a
+/// curve 7) as a name alone, which a case cannot use (it would act on
+/// nothing; `check` and `run` refuse it).
+fn empty_groups(mesh: &Mesh) -> Vec<String> {
+    mesh.groups
+        .iter()
+        .filter(|g| g.elements == 0)
+        .map(|g| {
+            let physical = match g.dim {
+                0 => "Point",
+                1 => "Curve",
+                _ => "Surface",
+            };
+            format!(
+                "group {:?} (dim {}) has no elements: check the entities of its Physical {physical} \
+                 in the .geo; a case cannot use it",
+                g.name, g.dim
+            )
+        })
         .collect()
 }
 
@@ -136,6 +159,9 @@ fn to_table(path: &Path, mesh: &Mesh) -> String {
             g.elements,
             g.nodes.len()
         );
+    }
+    for note in empty_groups(mesh) {
+        let _ = writeln!(s, "  note: {note}");
     }
     // Not an error (an interior line may be meant), but a traction or
     // contact surface there would act inside the body.

@@ -250,6 +250,21 @@ pub(crate) fn stored_model(
     Ok((mesh, material))
 }
 
+/// Where `f` is a results file of `stickslip run` whose run had no
+/// contact surface: the message saying so for a contact field.
+fn no_contact(f: &File, name: &str, field: Field) -> Option<InputError> {
+    let ours = crate::output::text_attr(f, "program").ok().as_deref() == Some("stickslip");
+    (ours && !f.link_exists("contact/nodes")).then(|| {
+        InputError(format!(
+            "{name}: its run had no contact surface (no [contact] in its case, or no node of it free to slip), \
+             so there is no {}; \
+             probe a field of the body (ux, uy, vx, vy, ax, ay, sxx, syy, sxy, von_mises), or run a \
+             case with a [contact] surface",
+            field.name()
+        ))
+    })
+}
+
 /// Component `field` of the stress `s` (von Mises for [`Field::VonMises`]).
 fn component(material: &stickslip_fem::Material, s: [f64; 3], field: Field) -> f64 {
     match field.stress() {
@@ -340,7 +355,11 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
             let contact = f
                 .dataset("contact/nodes")
                 .and_then(|d| d.read_1d::<i64>())
-                .map_err(|e| h5("this file has no contact surface (/contact/nodes)", e))?;
+                .map_err(|e| {
+                    no_contact(&f, &name, field).unwrap_or_else(|| {
+                        h5("this file has no contact surface (/contact/nodes)", e)
+                    })
+                })?;
             let Some(j) = contact.iter().position(|&c| c == node as i64) else {
                 let nearest = contact
                     .iter()
@@ -469,7 +488,8 @@ pub struct AlongArgs {
         allow_hyphen_values = true
     )]
     pub times: Option<String>,
-    /// With --along: write the CSV to this file instead of stdout.
+    /// With --along: write the CSV to this file instead of stdout (an existing one only with
+    /// --force; never the results file read).
     #[arg(short = 'o', long = "output", value_name = "FILE", requires = "along")]
     pub output: Option<std::path::PathBuf>,
 }
@@ -734,13 +754,15 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
         match c {
             Ok(c) => Some(c),
             Err(e) if contact_field => {
-                return Err(h5(
-                    &format!(
-                        "{} needs a contact surface, and this file has none (/contact)",
-                        field.name()
-                    ),
-                    e,
-                ))
+                return Err(no_contact(&f, &name, field).unwrap_or_else(|| {
+                    h5(
+                        &format!(
+                            "{} needs a contact surface, and this file has none (/contact)",
+                            field.name()
+                        ),
+                        e,
+                    )
+                }))
             }
             Err(_) => None,
         }
@@ -904,32 +926,91 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
     })
 }
 
-/// `stickslip probe FILE --along GROUP --times ..`: runs [`along`], prints
-/// the step choices on stderr and the CSV on stdout or into `args.output`.
+/// `stickslip probe FILE --along GROUP --times ..` without `--force`:
+/// [`write_along`], every error an [`InputError`] (a failed write to
+/// stdout or stderr too).
 ///
 /// # Errors
-/// As [`along`]; `--times` missing; the output file not writable.
+/// As [`write_along`].
 pub fn along_command(file: &Path, args: &AlongArgs, field: Field) -> Result<(), InputError> {
+    write_along(file, args, field, false).map_err(|e| match e.downcast::<InputError>() {
+        Ok(input) => input,
+        Err(other) => InputError(format!("{other:#}")),
+    })
+}
+
+/// `stickslip probe FILE --along GROUP --times .. [-o CSV [--force]]`:
+/// runs [`along`], prints the step choices on stderr and the CSV on stdout
+/// or into `args.output`. An existing CSV file is replaced only with
+/// `force`, and never when it is `file` itself (the results read).
+///
+/// # Errors
+/// As [`along`]; `--times` missing; the output file existing (without
+/// `force`), being the results file, or not writable: an [`InputError`].
+/// A failed write to stdout or stderr: a [`crate::console::WriteError`]
+/// (the CSV is written all the same where only stderr failed).
+pub fn write_along(file: &Path, args: &AlongArgs, field: Field, force: bool) -> anyhow::Result<()> {
     let group = args.along.as_deref().unwrap_or_default();
     let times = args.times.as_deref().ok_or_else(|| {
         InputError(format!(
             "--along {group}: give the times too, e.g. --times 0.1,0.25,0.5"
         ))
     })?;
+    // Refused before the reading, which may take a while.
+    if let Some(out) = &args.output {
+        csv_target(out, file, force)?;
+    }
     let a = along(file, group, times, field)?;
-    eprint!("{}", a.info);
+    let info = crate::console::err(&a.info);
     match &args.output {
         Some(out) => std::fs::write(out, &a.csv).map_err(|e| {
             InputError(format!(
                 "-o {}: cannot write the CSV: {e}; check the directory exists and is writable",
                 out.display()
             ))
-        }),
-        None => {
-            print!("{}", a.csv);
-            Ok(())
-        }
+        })?,
+        None => crate::console::out(&a.csv)?,
     }
+    Ok(info?)
+}
+
+/// Refuses `out` as `probe --along`'s CSV file where writing it would lose
+/// something: the results file `results` itself (whatever its name: a
+/// link or another path to it; even with `force`), an existing file
+/// without `force`, or a directory, device, FIFO or socket.
+fn csv_target(out: &Path, results: &Path, force: bool) -> Result<(), InputError> {
+    use std::os::unix::fs::MetadataExt;
+    let name = out.display();
+    let Ok(meta) = std::fs::metadata(out) else {
+        return Ok(());
+    };
+    let same_file =
+        std::fs::metadata(results).is_ok_and(|r| (r.dev(), r.ino()) == (meta.dev(), meta.ino()));
+    if same_file {
+        return Err(InputError(format!(
+            "-o {name} is the results file being read ({}); write the CSV to another file, e.g. -o {}",
+            results.display(),
+            out.with_extension("csv").display()
+        )));
+    }
+    if meta.is_dir() {
+        return Err(InputError(format!(
+            "-o {name} is a directory; give a file in it, e.g. -o {}",
+            out.join("along.csv").display()
+        )));
+    }
+    if !meta.is_file() {
+        return Err(InputError(format!(
+            "-o {name} exists and is not a regular file (a device, FIFO or socket); \
+             give a file, or leave out -o to print the CSV on stdout"
+        )));
+    }
+    if !force {
+        return Err(InputError(format!(
+            "-o {name} already exists; use --force to overwrite it, or -o to write elsewhere"
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

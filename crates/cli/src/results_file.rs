@@ -20,6 +20,49 @@ use crate::sys::{lock_held, ofd_lock};
 /// # Errors
 /// The [`InputError`] naming the file and what to do.
 pub fn check_output(out: &Path, inputs: &[&Path], force: bool) -> Result<(), InputError> {
+    check_output_place(out, inputs)?;
+    let name = out.display();
+    // The viewers' files beside OUT.h5 (`stickslip views`) show its run:
+    // a new run would leave them showing another.
+    let beside = [
+        crate::xdmf::xdmf_path(out),
+        crate::xdmf::contact_xdmf_path(out),
+        crate::views::views_path(out),
+    ];
+    for path in std::iter::once(out).chain(beside.iter().map(|p| p.as_path())) {
+        if !path.exists() {
+            continue;
+        }
+        if !force {
+            let restart = if is_hdf5(out) {
+                format!(", or --restart {name} to continue it")
+            } else {
+                String::new()
+            };
+            return Err(InputError(format!(
+                "{} already exists; use --force to overwrite it, -o to write elsewhere{restart}",
+                path.display(),
+            )));
+        }
+        if in_use(path) {
+            return Err(InputError(format!(
+                "{} is open in another process (a run still writing it, or a reader such as h5py or ParaView); \
+                 wait for it or close it, or write elsewhere with -o",
+                path.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The part of [`check_output`] that does not depend on what exists at
+/// `out` (`stickslip check` calls it, as the run's `--force` is not
+/// known there): an `.xdmf` name, an empty name, a directory, an input
+/// of the case, a symbolic link, a device, a missing directory.
+///
+/// # Errors
+/// The [`InputError`] naming the file and what to do.
+pub fn check_output_place(out: &Path, inputs: &[&Path]) -> Result<(), InputError> {
     let name = out.display();
     if out
         .extension()
@@ -84,36 +127,6 @@ pub fn check_output(out: &Path, inputs: &[&Path], force: bool) -> Result<(), Inp
             return Err(InputError(format!(
                 "{name}: {} {what}; create the directory, or choose another file with -o",
                 dir.display()
-            )));
-        }
-    }
-    // The viewers' files beside OUT.h5 (`stickslip views`) show its run:
-    // a new run would leave them showing another.
-    let beside = [
-        crate::xdmf::xdmf_path(out),
-        crate::xdmf::contact_xdmf_path(out),
-        crate::views::views_path(out),
-    ];
-    for path in std::iter::once(out).chain(beside.iter().map(|p| p.as_path())) {
-        if !path.exists() {
-            continue;
-        }
-        if !force {
-            let restart = if is_hdf5(out) {
-                format!(", or --restart {name} to continue it")
-            } else {
-                String::new()
-            };
-            return Err(InputError(format!(
-                "{} already exists; use --force to overwrite it, -o to write elsewhere{restart}",
-                path.display(),
-            )));
-        }
-        if in_use(path) {
-            return Err(InputError(format!(
-                "{} is open in another process (a run still writing it, or a reader such as h5py or ParaView); \
-                 wait for it or close it, or write elsewhere with -o",
-                path.display()
             )));
         }
     }

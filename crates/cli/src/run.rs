@@ -39,6 +39,10 @@ pub enum Outcome {
     /// Stopped by SIGINT, SIGTERM or SIGHUP after a completed step; the file holds every
     /// output step so far and a checkpoint to `--restart` from.
     Interrupted,
+    /// Reached t_end and the file is complete, but the `--json` summary
+    /// could not be written to stdout (exit 1: a script reading it would
+    /// find nothing, though the file holds the whole run).
+    SummaryLost,
 }
 
 /// Free DOFs from which a run or check says when the model is assembled
@@ -985,6 +989,7 @@ impl Session<'_> {
         };
         let (case, out, i) = (self.case, self.out, &self.integrator);
         let e = i.energy();
+        let mut summary_lost = None;
         if !self.options.quiet {
             let friction = match &friction_off {
                 Some(why) => format!("friction off ({why})"),
@@ -1087,7 +1092,9 @@ impl Session<'_> {
                 "failure": reason,
                 "restarted": self.options.restart,
             });
-            say_out!("{j}");
+            if let Err(e) = crate::console::out(&format!("{j}\n")) {
+                summary_lost = Some(e);
+            }
         }
         if let Some(sig) = interrupted {
             say!(
@@ -1112,7 +1119,20 @@ impl Session<'_> {
             return Ok(Outcome::Interrupted);
         }
         match failure {
-            None => Ok(Outcome::Complete),
+            None => match summary_lost {
+                None => Ok(Outcome::Complete),
+                Some(e) => {
+                    // A reader that closed the pipe wants nothing more.
+                    if !e.broken_pipe() {
+                        say!(
+                            "error: {e}; the run is complete all the same: {} holds every record \
+                             (complete = true)",
+                            out.display()
+                        );
+                    }
+                    Ok(Outcome::SummaryLost)
+                }
+            },
             Some(e) => {
                 say!("error: {}: {e}", case.path.display());
                 say!(

@@ -20,7 +20,6 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::Context;
 use hdf5::File;
 use ndarray::{s, Array1, Array2};
 
@@ -40,6 +39,12 @@ pub fn command(
     let name = path.display().to_string();
     // No run may start on the file while its stresses are formed.
     let (_lock, f) = crate::results_file::open_finished(path, true)?;
+    let target = stress_path(path);
+    let part = part_path(path);
+    // Refused before the stresses are formed, which may take a while.
+    let mut beside = vec![target.clone(), part.clone()];
+    beside.extend(crate::views_cmd::files(path));
+    crate::views_cmd::check_beside(path, "stress", &beside)?;
     let (mesh, material) = crate::probe::stored_model(&f, &name)?;
     let n_nodes = mesh.nodes.len();
     let u = f.dataset("displacement")?;
@@ -51,12 +56,11 @@ pub fn command(
         .and_then(|a| a.read_scalar::<bool>())
         .unwrap_or(false);
     if !complete && !quiet {
-        eprintln!(
+        say!(
             "stress: note: {name} is of a run that did not complete; its {rows} records get their stresses \
              (a --restart of the run removes them: run this again after it)"
         );
     }
-    let target = stress_path(path);
     let old = std::fs::metadata(&target).map_or(0, |m| m.len());
     let need = (rows * n_nodes * 32) as u64 + (1 << 20);
     if let Some(free) = crate::results_file::free_bytes(&target) {
@@ -72,14 +76,14 @@ pub fn command(
         }
     }
     // Written beside and renamed into place: a failure leaves no half file.
-    let part = path.with_extension("stress.h5.part");
-    let written = write_stresses(&part, &u, &mesh, &material, rows, quiet);
+    let written = write_stresses(&part, &u, &mesh, &material, rows, quiet)
+        .and_then(|()| Ok(std::fs::rename(&part, &target)?));
     if let Err(e) = written {
         let _ = std::fs::remove_file(&part);
-        return Err(e.context(format!("cannot write {}", target.display())));
+        return Err(
+            crate::views_cmd::beside_failed(path, "stress", &target, format!("{e:#}")).into(),
+        );
     }
-    std::fs::rename(&part, &target)
-        .with_context(|| format!("cannot rename {} to {}", part.display(), target.display()))?;
     drop((u, f));
     let written = crate::views_cmd::write(path)?;
     Ok((rows, n_nodes, written))
@@ -88,6 +92,11 @@ pub fn command(
 /// The stress file of the results file `out`: OUT.stress.h5 beside it.
 pub fn stress_path(out: &Path) -> std::path::PathBuf {
     out.with_extension("stress.h5")
+}
+
+/// Where [`stress_path`] is written before it is renamed into place.
+fn part_path(out: &Path) -> std::path::PathBuf {
+    out.with_extension("stress.h5.part")
 }
 
 /// `/stress` and `/von_mises` of `rows` records of `u` into a new file at
@@ -138,7 +147,7 @@ fn write_stresses(
         mises.write_slice(&vm, s![k, ..])?;
         if !quiet && last.elapsed().as_secs() >= 10 {
             last = Instant::now();
-            eprintln!(
+            say!(
                 "stress: {} of {rows} records, {:.0} s",
                 k + 1,
                 started.elapsed().as_secs_f64()

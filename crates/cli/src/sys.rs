@@ -1,7 +1,8 @@
 //! The command's system calls, behind safe functions: the one place in the
 //! crate allowed `unsafe` (the crate root denies it). Signals for `run`
-//! and the other commands, the results file's lock, and the free space on
-//! a disk; what each is for is said where it is called.
+//! and the other commands, the results file's lock, the free space on a
+//! disk and whether a directory may be written; what each is for is said
+//! where it is called.
 #![allow(unsafe_code)]
 
 use std::path::Path;
@@ -105,4 +106,16 @@ pub(crate) fn free_bytes_at(dir: &Path) -> Option<u64> {
     let r = unsafe { libc::statvfs(c.as_ptr(), &mut st) };
     #[allow(clippy::useless_conversion)] // u64 here; other platforms differ
     (r == 0).then(|| u64::from(st.f_bavail).saturating_mul(u64::from(st.f_frsize)))
+}
+
+/// Whether this process may create files in the directory `dir`
+/// (access(2) with W_OK: its permissions, and a read-only file system).
+/// Where it cannot be asked, true: the write itself then says.
+pub(crate) fn can_write_in(dir: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    let Ok(c) = std::ffi::CString::new(dir.as_os_str().as_bytes()) else {
+        return true;
+    };
+    // SAFETY: a NUL-terminated path, which access only reads.
+    unsafe { libc::access(c.as_ptr(), libc::W_OK) == 0 }
 }

@@ -13,9 +13,8 @@
 //! so running the command again after a restart adds the new records'
 //! views.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use hdf5::File;
 use stickslip_case::InputError;
 use stickslip_mesh::CellKind;
@@ -53,7 +52,98 @@ pub fn command(path: &Path) -> anyhow::Result<Written> {
     // No run may start on the file while its views are made.
     let (_lock, f) = crate::results_file::open_finished(path, false)?;
     drop(f);
+    check_beside(path, "views", &files(path))?;
     write(path)
+}
+
+/// The files `stickslip views` writes beside the results file `out`, and
+/// the temporary ones it renames into place.
+pub(crate) fn files(out: &Path) -> Vec<PathBuf> {
+    let xml = [
+        crate::xdmf::xdmf_path(out),
+        crate::xdmf::contact_xdmf_path(out),
+    ];
+    let parts = xml.clone().map(|p| {
+        let mut part = p.into_os_string();
+        part.push(".part");
+        PathBuf::from(part)
+    });
+    let mut all = vec![crate::views::views_path(out)];
+    all.extend(xml);
+    all.extend(parts);
+    all
+}
+
+/// What to do where `stickslip COMMAND` cannot write beside the results
+/// file `out`: the files must stay beside it (the views name it by file
+/// name only), so the way out is a writable copy.
+fn elsewhere(out: &Path, command: &str) -> String {
+    format!(
+        "`stickslip {command}` writes its files beside the results file, which they refer to by \
+         name; make that directory writable, or copy {} into a writable directory and run \
+         `stickslip {command}` on the copy there",
+        out.display()
+    )
+}
+
+/// Refuses to start `stickslip COMMAND` on the results file `out` where
+/// `files`, which it writes beside it, cannot be written: a directory (or
+/// a device, FIFO or socket) in the place of one, or a directory this
+/// process may not write. Said before any work, naming the path.
+///
+/// # Errors
+/// The [`InputError`] naming the path and what to do.
+pub(crate) fn check_beside(out: &Path, command: &str, files: &[PathBuf]) -> Result<(), InputError> {
+    for path in files {
+        let Ok(meta) = std::fs::symlink_metadata(path) else {
+            continue;
+        };
+        if meta.is_dir() {
+            return Err(InputError(format!(
+                "{}: a directory of that name is where `stickslip {command}` writes its file for {}; \
+                 remove or rename the directory and run this again",
+                path.display(),
+                out.display()
+            )));
+        }
+        if !meta.is_file() && !meta.file_type().is_symlink() {
+            return Err(InputError(format!(
+                "{} exists and is not a regular file (a device, FIFO or socket), where \
+                 `stickslip {command}` writes its file for {}; remove it and run this again",
+                path.display(),
+                out.display()
+            )));
+        }
+    }
+    let dir = match out.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !crate::sys::can_write_in(dir) {
+        return Err(InputError(format!(
+            "{}: cannot write in the directory {} (read-only, or not yours); {}",
+            out.display(),
+            dir.display(),
+            elsewhere(out, command)
+        )));
+    }
+    Ok(())
+}
+
+/// A failed write of `path` beside the results file `out` (a full disk,
+/// permissions changed under the command) as the [`InputError`] naming it
+/// and what to do.
+pub(crate) fn beside_failed(
+    out: &Path,
+    command: &str,
+    path: &Path,
+    e: impl std::fmt::Display,
+) -> InputError {
+    InputError(format!(
+        "cannot write {}: {e}; {}",
+        path.display(),
+        elsewhere(out, command)
+    ))
 }
 
 /// Writes `OUT.views.h5`, `OUT.xdmf` and `OUT.contact.xdmf` for the
@@ -66,7 +156,17 @@ pub fn command(path: &Path) -> anyhow::Result<Written> {
 /// and file system failures, naming the file.
 pub fn write(out: &Path) -> anyhow::Result<Written> {
     let name = out.display().to_string();
-    let f = File::open(out).with_context(|| format!("cannot open {name}"))?;
+    // The views and the XML name the results file by its file name.
+    crate::views::file_name(out).map_err(|e| {
+        InputError(format!(
+            "{e}; rename it (and its files beside it) with a UTF-8 name"
+        ))
+    })?;
+    let f = File::open(out).map_err(|e| {
+        InputError(format!(
+            "{name}: cannot open it as HDF5: {e}; give a results file written by `stickslip run`"
+        ))
+    })?;
     let bad = |what: &str| {
         InputError(format!(
             "{name}: {what}; give a results file written by `stickslip run`"
@@ -135,7 +235,9 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         contact: contact.as_ref(),
         fields: &fields,
     };
-    crate::views::update(out, &layout, &frames.row[..rows])?;
+    let beside = |path: &Path, e: &dyn std::fmt::Display| beside_failed(out, "views", path, e);
+    crate::views::update(out, &layout, &frames.row[..rows])
+        .map_err(|e| beside(&crate::views::views_path(out), &format!("{e:#}")))?;
     let info = XdmfInfo {
         n_nodes,
         kind,
@@ -144,8 +246,7 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         stress: stress.as_deref(),
     };
     let path = crate::xdmf::xdmf_path(out);
-    crate::xdmf::write_xdmf(out, &info)
-        .with_context(|| format!("cannot write {}", path.display()))?;
+    crate::xdmf::write_xdmf(out, &info).map_err(|e| beside(&path, &e))?;
     // A surface of one node has no line to show.
     let line = contact.filter(|c| !c.lines.is_empty());
     let contact_path = crate::xdmf::contact_xdmf_path(out);
@@ -160,7 +261,7 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
                 fields: &fields,
             },
         )
-        .with_context(|| format!("cannot write {}", contact_path.display()))?,
+        .map_err(|e| beside(&contact_path, &e))?,
         // One of an earlier results file would list other records.
         None => {
             let _ = std::fs::remove_file(&contact_path);

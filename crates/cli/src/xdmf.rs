@@ -288,10 +288,18 @@ fn replace(
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".part");
     let tmp = PathBuf::from(tmp);
-    let mut w = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-    write(&mut w)?;
-    w.into_inner().map_err(|e| e.into_error())?;
-    std::fs::rename(&tmp, path)
+    let written = std::fs::File::create(&tmp).and_then(|f| {
+        let mut w = std::io::BufWriter::new(f);
+        write(&mut w)?;
+        w.into_inner().map_err(|e| e.into_error())?;
+        std::fs::rename(&tmp, path)
+    });
+    // A failed write or rename (a full disk, a directory at `path`)
+    // leaves nothing half written beside the results.
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
 }
 
 #[cfg(test)]
@@ -310,6 +318,24 @@ mod tests {
             times,
             stress: None,
         }
+    }
+
+    #[test]
+    fn a_failed_replace_leaves_no_part_file() {
+        let dir = std::env::temp_dir().join(format!("stickslip-xdmf-part-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("w.xdmf")).unwrap();
+        // The rename onto a directory fails once the part is written.
+        let e = replace(&dir.join("w.xdmf"), |w| w.write_all(b"<Xdmf/>")).unwrap_err();
+        assert!(!dir.join("w.xdmf.part").exists(), "{e}");
+        // So does a write that fails halfway.
+        let e = replace(&dir.join("x.xdmf"), |w| {
+            w.write_all(b"<Xdmf")?;
+            Err(std::io::Error::other("disk full"))
+        })
+        .unwrap_err();
+        assert!(!dir.join("x.xdmf.part").exists(), "{e}");
+        assert!(!dir.join("x.xdmf").exists(), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

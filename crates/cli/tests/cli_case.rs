@@ -310,3 +310,129 @@ fn check_names_the_explicit_preloads_factorization() {
         "{solver}"
     );
 }
+
+#[test]
+fn check_refuses_the_output_file_run_refuses_at_its_line() {
+    for (name, file, words) in [
+        ("out-nodir", "nodir/x.h5", "does not exist"),
+        ("out-empty", "", "directory"),
+    ] {
+        let (case, text) = case_with(name, |t| {
+            t.replace("file = \"slab.h5\"", &format!("file = \"{file}\""))
+        });
+        let line = line_of(&text, &format!("file = \"{file}\""));
+        let at = format!("{}:{line}:", case.display());
+        let o = check(&case, &[]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{file:?}: {e}");
+        assert!(
+            e.contains(&at) && e.contains("output.file") && e.contains(words),
+            "{e}"
+        );
+        // `run` without -o refuses it the same way, at the same line.
+        let o = common::bin().arg("run").arg(&case).output().unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{file:?}: {e}");
+        assert!(e.contains(&at) && e.contains(words), "{e}");
+        // `run -o` names its own file: the case's is not used.
+        let o = run(&case, &case.with_extension("h5"), &["--quiet"]);
+        assert!(o.status.success(), "{file:?}: {}", stderr(&o));
+    }
+}
+
+/// tests/data/slab.toml on a copy of the committed quad9 slab (MSH 2.2)
+/// whose group `emptied` has lost its elements, as Gmsh writes a
+/// `Physical Curve` whose curves are missing: the name alone.
+fn case_on_emptied_mesh(emptied: &str) -> (PathBuf, String) {
+    let text = std::fs::read_to_string(meshes_dir().join("slab-q2-8x2-v22.msh")).unwrap();
+    let tag = text
+        .lines()
+        .find_map(|l| {
+            let l = l.strip_suffix(&format!(" \"{emptied}\""))?;
+            l.strip_prefix("1 ")
+        })
+        .expect("the group in $PhysicalNames")
+        .to_string();
+    // Element lines `id type 2 PHYS GEOM nodes..`: drop the group's.
+    let mut dropped = 0;
+    let mut lines: Vec<String> = Vec::new();
+    for l in text.lines() {
+        let f: Vec<&str> = l.split_whitespace().collect();
+        if f.len() > 4 && f[1] == "8" && f[3] == tag {
+            dropped += 1;
+            continue;
+        }
+        lines.push(l.to_string());
+    }
+    assert!(dropped > 0);
+    let at = lines.iter().position(|l| l == "$Elements").unwrap() + 1;
+    let n: usize = lines[at].parse().unwrap();
+    lines[at] = (n - dropped).to_string();
+    let dir = scratch(&format!("empty-{emptied}"));
+    let mesh = dir.join("slab.msh");
+    std::fs::write(&mesh, lines.join("\n") + "\n").unwrap();
+    let case_text = std::fs::read_to_string(data("slab.toml"))
+        .unwrap()
+        .replace("../../../../cases/meshes/slab-q2-8x2.msh", "slab.msh");
+    let case = dir.join("case.toml");
+    std::fs::write(&case, &case_text).unwrap();
+    (case, case_text)
+}
+
+#[test]
+fn an_empty_group_is_refused_at_the_line_naming_it() {
+    for (group, key, needle) in [
+        ("load", "traction.0.group", "group = \"load\""),
+        ("support", "dirichlet.0.group", "group = \"support\""),
+        ("contact", "contact.group", "group = \"contact\""),
+    ] {
+        let (case, text) = case_on_emptied_mesh(group);
+        let o = check(&case, &[]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{group}: {e}");
+        let line = line_of(&text, needle);
+        assert!(
+            e.lines().any(|m| m.contains(&format!("case.toml:{line}:"))
+                && m.contains(&format!("{key} = \"{group}\""))
+                && m.contains("has no elements")
+                && m.contains("Physical Curve")),
+            "{group}: {e}"
+        );
+    }
+}
+
+#[test]
+fn a_contact_field_of_a_run_without_contact_says_there_was_none() {
+    // The slab held on its bottom in y in place of the friction surface.
+    let (case, _) = case_with("no-contact", |t| {
+        let start = t.find("[contact]").unwrap();
+        let end = t.find("[time]").unwrap();
+        format!(
+            "{}[[dirichlet]]\ngroup = \"contact\"\nuy = 0.0\n\n{}",
+            &t[..start],
+            &t[end..]
+        )
+    });
+    let h5 = case.with_extension("h5");
+    let o = run(&case, &h5, &["--quiet"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for args in [
+        &["--at", "8,0", "--field", "friction_stress"][..],
+        &[
+            "--along",
+            "contact",
+            "--times",
+            "0.01",
+            "--field",
+            "slip_velocity",
+        ][..],
+    ] {
+        let o = probe(&h5, args);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        assert!(
+            e.contains("its run had no contact surface") && !e.contains("give a results file"),
+            "{args:?}: {e}"
+        );
+    }
+}

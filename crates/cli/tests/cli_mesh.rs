@@ -249,3 +249,31 @@ fn mesh_table_notes_a_line_group_inside_the_body() {
         .unwrap();
     assert!(!String::from_utf8(o.stdout).unwrap().contains("note:"));
 }
+
+#[test]
+fn mesh_notes_a_group_without_elements() {
+    // ORPHANS with the named groups "bottom" (its one edge) and "top",
+    // which has none: a Physical Curve whose curve is missing.
+    let text = ORPHANS
+        .replace(
+            "$EndMeshFormat\n",
+            "$EndMeshFormat\n$PhysicalNames\n2\n1 1 \"bottom\"\n1 2 \"top\"\n$EndPhysicalNames\n",
+        )
+        .replace("$Elements\n2\n", "$Elements\n3\n3 1 2 1 1 1 2\n");
+    let p = temp_mesh("empty-group.msh", &text);
+    let o = bin().arg("mesh").arg(&p).output().unwrap();
+    let j = mesh_json(&p);
+    std::fs::remove_file(&p).unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8(o.stdout).unwrap();
+    let notes: Vec<&str> = out.lines().filter(|l| l.contains("note:")).collect();
+    assert_eq!(notes.len(), 1, "{out}");
+    assert!(
+        notes[0].contains("group \"top\" (dim 1) has no elements")
+            && notes[0].contains("Physical Curve"),
+        "{out}"
+    );
+    let warnings = j["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1, "{j}");
+    assert!(warnings[0].as_str().unwrap().contains("\"top\""), "{j}");
+}

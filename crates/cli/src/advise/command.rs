@@ -138,26 +138,26 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
         .filter(|c| c.estimate().is_finite())
         .min_by(|a, b| a.estimate().total_cmp(&b.estimate()));
     if json {
-        report::json(case, o, &est, &what, choice, best);
+        report::json(case, o, &est, &what, choice, best)?;
     } else {
         // The report up to the choice: where no configuration qualifies,
         // the errors per mesh are what tells how much finer the ladder
         // must go.
-        report::measured(case, o, &est, &what);
+        report::measured(case, o, &est, &what)?;
     }
     let Some(c) = choice else {
         report::not_reachable(case, o, &est, &what, best);
         return Ok(Verdict::NotReachable);
     };
     if !json {
-        report::choice(c, &est.ladder);
+        report::choice(c, &est.ladder)?;
     }
     if let Some(w) = &o.write {
         let header = report::write_header(o, c, &est.ladder);
         let text = adjusted_case(case, c, &est.ladder, w, &header)?;
         std::fs::write(w, text).with_context(|| format!("cannot write {}", w.display()))?;
         if !json {
-            println!("written     {}", w.display());
+            crate::console::out(&format!("written     {}\n", w.display()))?;
         }
     }
     Ok(Verdict::Found)

@@ -2,7 +2,11 @@
 //! estimate as text, or everything in one JSON object; the header of the
 //! adjusted case.
 
+use std::fmt::Write as _;
+
 use stickslip_case::{Case, Method};
+
+use crate::console::WriteError;
 
 use super::candidates::Candidate;
 use super::command::Options;
@@ -54,7 +58,7 @@ pub(super) fn json(
     what: &str,
     choice: Option<&Candidate>,
     best: Option<&Candidate>,
-) {
+) -> Result<(), WriteError> {
     let cand = |c: &Candidate| {
         serde_json::json!({
             "order": c.order,
@@ -87,15 +91,22 @@ pub(super) fn json(
         "notes": est.notes,
         "written": o.write.as_ref().filter(|_| choice.is_some()).map(|w| w.display().to_string()),
     });
-    println!("{j}");
+    crate::console::out(&format!("{j}\n"))
 }
 
 /// The text report up to the choice: the case, the measure, the pilots and
 /// what they measured, the notes.
-pub(super) fn measured(case: &Case, o: &Options, est: &Estimates, what: &str) {
-    println!("case        {}", case.path.display());
-    println!("on          {what}, tol {:e}", o.tol);
-    println!(
+pub(super) fn measured(
+    case: &Case,
+    o: &Options,
+    est: &Estimates,
+    what: &str,
+) -> Result<(), WriteError> {
+    let mut t = String::new();
+    let _ = writeln!(t, "case        {}", case.path.display());
+    let _ = writeln!(t, "on          {what}, tol {:e}", o.tol);
+    let _ = writeln!(
+        t,
         "pilots      {} runs in {:.2} s",
         est.pilots.len(),
         est.seconds
@@ -107,11 +118,12 @@ pub(super) fn measured(case: &Case, o: &Options, est: &Estimates, what: &str) {
         } else {
             format!("; order {p:.2}")
         };
-        println!("  {w}: {}{p}", d.join(", "));
+        let _ = writeln!(t, "  {w}: {}{p}", d.join(", "));
     }
     for n in &est.notes {
-        println!("note        {n}");
+        let _ = writeln!(t, "note        {n}");
     }
+    crate::console::out(&t)
 }
 
 /// The error when no configuration meets the tolerance, with the smallest
@@ -135,15 +147,18 @@ pub(super) fn not_reachable(
 }
 
 /// The choice, its estimate and its predicted time.
-pub(super) fn choice(c: &Candidate, ladder: &[LadderMesh]) {
-    println!("choice      {}", describe(c, ladder));
+pub(super) fn choice(c: &Candidate, ladder: &[LadderMesh]) -> Result<(), WriteError> {
+    let mut t = String::new();
+    let _ = writeln!(t, "choice      {}", describe(c, ladder));
     if c.run {
-        println!(
+        let _ = writeln!(
+            t,
             "estimate    {:.3e} (this configuration was a pilot: its distance to the reference, with the reference's error)",
             c.estimate()
         );
     } else {
-        println!(
+        let _ = writeln!(
+            t,
             "estimate    {:.3e} = sqrt(mesh {:.3e}{}^2 + dt {:.3e}^2 + eps {:.3e}^2)",
             c.estimate(),
             c.parts[0],
@@ -152,10 +167,12 @@ pub(super) fn choice(c: &Candidate, ladder: &[LadderMesh]) {
             c.parts[2]
         );
     }
-    println!(
+    let _ = writeln!(
+        t,
         "predicted   {:.3} s ({:.0} steps x {} DOFs; the pilots' seconds per step per entry of K)",
         c.predicted_time, c.steps, c.dofs
     );
+    crate::console::out(&t)
 }
 
 /// The comment that heads the adjusted case (`--write`): the command and

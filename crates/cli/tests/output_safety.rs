@@ -1,0 +1,301 @@
+//! Where the commands write, and what happens when they cannot: `probe
+//! --along -o` never writes over an existing file without `--force` nor
+//! over the results file it reads; a failed write to stdout or stderr
+//! exits 1 with a message, not a panic (101), and `run --json` says so
+//! with its file complete; `views` and `stress` refuse a place beside the
+//! results they cannot write with exit code 2, naming the path, and leave
+//! no `.part` behind.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+mod common;
+use common::{bin, data, probe, run, scratch, stderr};
+
+/// tests/data/slab.toml run into `dir/slab.h5`.
+fn slab_run(dir: &Path) -> PathBuf {
+    let h5 = dir.join("slab.h5");
+    let o = run(&data("slab.toml"), &h5, &["--quiet"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    h5
+}
+
+/// `cmd` with stdout (or stderr, `on_stderr`) sent to /dev/full, where
+/// every write fails with ENOSPC; `None` where the system has no
+/// /dev/full.
+fn into_full(mut cmd: Command, on_stderr: bool) -> Option<Output> {
+    let full = File::options().write(true).open("/dev/full").ok()?;
+    if on_stderr {
+        cmd.stderr(full).stdout(Stdio::null());
+        // stderr is lost: only the exit code can tell.
+        let status = cmd.status().unwrap();
+        Some(Output {
+            status,
+            stdout: Vec::new(),
+            stderr: Vec::new(),
+        })
+    } else {
+        cmd.stdout(full);
+        Some(cmd.output().unwrap())
+    }
+}
+
+/// Exit 1, said on stderr, without a panic.
+fn failed_to_write(o: &Output, what: &str) {
+    let e = stderr(o);
+    assert_eq!(o.status.code(), Some(1), "{what}: {e}");
+    assert!(!e.contains("panicked"), "{what}: {e}");
+    assert!(
+        e.contains("error: cannot write to stdout: No space left on device"),
+        "{what}: {e}"
+    );
+}
+
+#[test]
+fn probe_along_writes_over_no_file_unasked_and_never_the_results() {
+    let dir = scratch("probe-o");
+    let h5 = slab_run(&dir);
+    let results = std::fs::read(&h5).unwrap();
+    let along = |out: &Path, extra: &[&str]| {
+        let mut args = vec!["--along", "contact", "--times", "0.01", "-o"];
+        args.push(out.to_str().unwrap());
+        args.extend(extra);
+        probe(&h5, &args)
+    };
+    // The results file itself, by its name or through a link, even with
+    // --force: refused before it is read, and left as it was.
+    let link = dir.join("link.h5");
+    std::os::unix::fs::symlink(&h5, &link).unwrap();
+    for (out, extra) in [
+        (&h5, &[][..]),
+        (&h5, &["--force"][..]),
+        (&link, &["--force"][..]),
+    ] {
+        let o = along(out, extra);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{} {extra:?}: {e}", out.display());
+        assert!(
+            e.contains("is the results file being read") && e.contains("-o"),
+            "{e}"
+        );
+        assert_eq!(std::fs::read(&h5).unwrap(), results, "{e}");
+    }
+    // Another existing file: only with --force.
+    let csv = dir.join("along.csv");
+    std::fs::write(&csv, "precious").unwrap();
+    let o = along(&csv, &[]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("already exists; use --force"), "{e}");
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), "precious");
+    let o = along(&csv, &["--force"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(
+        text.starts_with("t_asked,t,record,node,x,y,s,ux\n"),
+        "{text}"
+    );
+    // --force goes with --along only.
+    let o = probe(&h5, &["--at", "8,0", "--force"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+#[test]
+fn a_full_stdout_exits_1_without_a_panic() {
+    let dir = scratch("full");
+    let h5 = slab_run(&dir);
+    let mesh = common::root().join("cases/meshes/slab-q2-8x2.msh");
+    let mut check = bin();
+    check.arg("check").arg(data("slab.toml"));
+    let mut table = bin();
+    table.arg("mesh").arg(&mesh);
+    let mut json = bin();
+    json.arg("mesh").arg(&mesh).arg("--json");
+    let mut at = bin();
+    at.arg("probe").arg(&h5).args(["--at", "8,0", "--csv"]);
+    let mut along = bin();
+    along
+        .arg("probe")
+        .arg(&h5)
+        .args(["--along", "contact", "--times", "0.01"]);
+    for (what, cmd) in [
+        ("check", check),
+        ("mesh", table),
+        ("mesh --json", json),
+        ("probe --at", at),
+        ("probe --along", along),
+    ] {
+        let Some(o) = into_full(cmd, false) else {
+            eprintln!("skipped: no /dev/full");
+            return;
+        };
+        failed_to_write(&o, what);
+    }
+    // stderr full: the summary of `views` is lost, which only the exit
+    // code can say; the files are written all the same.
+    let mut views = bin();
+    views.arg("views").arg(&h5);
+    let o = into_full(views, true).unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(dir.join("slab.xdmf").is_file());
+}
+
+#[test]
+fn run_json_into_a_full_stdout_exits_1_with_its_file_complete() {
+    let dir = scratch("json-full");
+    let h5 = dir.join("slab.h5");
+    let mut cmd = bin();
+    cmd.arg("run")
+        .arg(data("slab.toml"))
+        .arg("-o")
+        .arg(&h5)
+        .args(["--quiet", "--json"]);
+    let Some(o) = into_full(cmd, false) else {
+        eprintln!("skipped: no /dev/full");
+        return;
+    };
+    failed_to_write(&o, "run --json");
+    assert!(stderr(&o).contains("the run is complete all the same"));
+    let f = hdf5::File::open(&h5).unwrap();
+    assert!(f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
+}
+
+#[test]
+fn run_json_into_a_closed_pipe_exits_1_quietly() {
+    let dir = scratch("json-pipe");
+    let h5 = dir.join("slab.h5");
+    let mut child = bin()
+        .arg("run")
+        .arg(data("slab.toml"))
+        .arg("-o")
+        .arg(&h5)
+        .args(["--quiet", "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The reader goes before the run ends: its summary meets a closed pipe.
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(!e.contains("panicked") && !e.contains("error"), "{e}");
+    let f = hdf5::File::open(&h5).unwrap();
+    assert!(f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
+}
+
+#[test]
+fn views_and_stress_refuse_a_directory_in_their_place() {
+    let dir = scratch("in-the-way");
+    let h5 = slab_run(&dir);
+    for (command, file) in [
+        ("views", "slab.xdmf"),
+        ("views", "slab.views.h5"),
+        ("stress", "slab.stress.h5"),
+        ("stress", "slab.contact.xdmf"),
+    ] {
+        let in_the_way = dir.join(file);
+        std::fs::create_dir(&in_the_way).unwrap();
+        let o = bin().arg(command).arg(&h5).output().unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{command} with {file}: {e}");
+        assert!(
+            e.contains(&in_the_way.display().to_string())
+                && e.contains("remove or rename the directory"),
+            "{e}"
+        );
+        let left: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|d| d.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".part"))
+            .collect();
+        assert!(left.is_empty(), "{command} left {left:?}");
+        std::fs::remove_dir(&in_the_way).unwrap();
+    }
+    // Nothing in the way: both write.
+    let o = bin().arg("stress").arg(&h5).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// A results file in a directory this process may not write: by its
+/// permissions, or for root (whom permissions do not stop) on a tmpfs
+/// remounted read-only. Where root may not mount one (a container
+/// without CAP_SYS_ADMIN) the test fails under CI and is skipped
+/// elsewhere, as the disk-full test of robustness.rs.
+#[test]
+fn views_in_a_read_only_directory_say_what_to_do() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch("read-only");
+    let h5 = slab_run(&dir);
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let writable = File::create(dir.join("probe")).is_ok();
+    let mut outputs: Vec<Output> = ["views", "stress"]
+        .iter()
+        .map(|c| bin().arg(c).arg(&h5).output().unwrap())
+        .collect();
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+    if writable {
+        // Root: a read-only file system stops it.
+        let ro = dir.join("ro");
+        std::fs::create_dir_all(&ro).unwrap();
+        let mount = |args: &[&str]| {
+            Command::new("mount")
+                .args(args)
+                .arg(&ro)
+                .stderr(Stdio::null())
+                .status()
+                .is_ok_and(|s| s.success())
+        };
+        if !mount(&["-t", "tmpfs", "-o", "size=4M", "tmpfs"]) {
+            assert!(
+                std::env::var_os("CI").is_none(),
+                "cannot mount a tmpfs at {}: run the tests as root, or give the container \
+                 CAP_SYS_ADMIN (docker run --cap-add SYS_ADMIN)",
+                ro.display()
+            );
+            eprintln!("skipped: cannot mount a tmpfs here (needs root or CAP_SYS_ADMIN)");
+            return;
+        }
+        let inside = ro.join("slab.h5");
+        std::fs::copy(&h5, &inside).unwrap();
+        let remounted = mount(&["-o", "remount,ro"]);
+        if remounted {
+            outputs = ["views", "stress"]
+                .iter()
+                .map(|c| bin().arg(c).arg(&inside).output().unwrap())
+                .collect();
+        }
+        let unmounted = Command::new("umount").arg(&ro).status();
+        assert!(remounted, "cannot remount {} read-only", ro.display());
+        assert!(
+            unmounted.is_ok_and(|s| s.success()),
+            "umount {}",
+            ro.display()
+        );
+    }
+    for o in &outputs {
+        let e = stderr(o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(
+            e.contains("cannot write in the directory") && e.contains("copy"),
+            "{e}"
+        );
+    }
+}
+
+/// `advise`'s report into a full stdout: exit 1 with the message, after
+/// its pilots ran (their lines go to stderr).
+#[test]
+fn advise_into_a_full_stdout_exits_1_without_a_panic() {
+    let case = common::root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let mut cmd = bin();
+    cmd.arg("advise")
+        .arg(&case)
+        .args(["--tol", "2e-2", "--on", "ux", "--at", "8,1"]);
+    let Some(o) = into_full(cmd, false) else {
+        eprintln!("skipped: no /dev/full");
+        return;
+    };
+    failed_to_write(&o, "advise");
+}
