@@ -42,13 +42,7 @@ impl std::error::Error for WriteError {}
 /// # Errors
 /// The write failed.
 pub fn out(text: &str) -> Result<(), WriteError> {
-    let mut o = io::stdout().lock();
-    o.write_all(text.as_bytes())
-        .and_then(|()| o.flush())
-        .map_err(|error| WriteError {
-            stream: "stdout",
-            error,
-        })
+    write_all(io::stdout().lock(), "stdout", text)
 }
 
 /// Writes `text` to stderr.
@@ -56,11 +50,11 @@ pub fn out(text: &str) -> Result<(), WriteError> {
 /// # Errors
 /// The write failed.
 pub fn err(text: &str) -> Result<(), WriteError> {
-    let mut e = io::stderr().lock();
-    e.write_all(text.as_bytes())
-        .and_then(|()| e.flush())
-        .map_err(|error| WriteError {
-            stream: "stderr",
-            error,
-        })
+    write_all(io::stderr().lock(), "stderr", text)
+}
+
+fn write_all(mut w: impl Write, stream: &'static str, text: &str) -> Result<(), WriteError> {
+    w.write_all(text.as_bytes())
+        .and_then(|()| w.flush())
+        .map_err(|error| WriteError { stream, error })
 }
