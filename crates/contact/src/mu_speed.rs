@@ -6,10 +6,13 @@
 //! The nodal scalar equation of a diagonal step, w + c m(|w|) φ_ε(w) = q
 //! (c = w_J g τᵀD⁻¹τ, q the step's slip without friction), is no longer
 //! monotone: on the slip branch h(w) = w + c m(w) is convex and falls
-//! near ε where c (1 − r)/vs > 1, so up to three roots exist. The choice
-//! ([`Weakening::solve_nodal`]) is the stuck root when there is one, else
-//! the slip root, which is then unique and has q's sign: h is odd, and on
-//! the slip branch convex from below q at ε to +∞, so it crosses q once.
+//! near ε where c (1 − r)/vs > 1, and where vs is below ε and r small the
+//! stuck branch w (1 + c m(w)/ε) may rise, fall and rise again inside
+//! [0, ε], so several roots may exist. The choice
+//! ([`Weakening::solve_nodal`]) is the least stuck root when there is one
+//! (the one continuous in q from q = 0), else the slip root, which is then
+//! unique and has q's sign: h is odd, and on the slip branch convex from
+//! below q at ε to +∞, so it crosses q once.
 
 use crate::law::FrictionLaw;
 use crate::surface::ContactSurface;
@@ -30,27 +33,29 @@ impl Weakening {
         self.ratio + (1.0 - self.ratio) * (-s / self.speed).exp()
     }
 
-    /// The root of w + c m(|w|) φ_ε(w) = q (c ≥ 0): a stuck one, in
-    /// [−ε, ε], where one exists, else the slip one (module doc).
+    /// The root of w + c m(|w|) φ_ε(w) = q (c ≥ 0): the least stuck one,
+    /// in [−ε, ε], where one exists, else the slip one (module doc).
     pub fn solve_nodal(&self, law: &FrictionLaw, q: f64, c: f64) -> f64 {
         let (a, eps) = (q.abs(), law.eps);
         // The stuck branch h(w) = w (1 + c m(w)/ε) on [0, ε], 0 at 0.
         let stuck = |w: f64| w + c * self.factor(w) * w / eps;
-        let w = if a <= stuck(eps) {
-            // At least a at min(a, ε) (h(w) ≥ w for w ≥ 0).
-            bisect(|w| stuck(w) - a, 0.0, a.min(eps))
-        } else if let Some(peak) = self.stuck_peak(eps, c).filter(|&p| a <= stuck(p)) {
-            // h rises to a peak inside [0, ε] and falls again: a stuck
-            // root below the peak all the same.
-            bisect(|w| stuck(w) - a, 0.0, peak)
-        } else {
+        let w = match self.stuck_peak(eps, c) {
+            // h rises to a peak inside [0, ε], falls, and rises again:
+            // below the peak it rises, and h(w) ≥ w, so the least root of
+            // a ≤ h(peak) is in [0, min(a, peak)] ...
+            Some(peak) if a <= stuck(peak) => bisect(|w| stuck(w) - a, 0.0, a.min(peak)),
+            // ... and of h(peak) < a ≤ h(ε) past the fall, where h rises
+            // from below h(peak) to h(ε), crossing a once.
+            Some(peak) if a <= stuck(eps) => bisect(|w| stuck(w) - a, peak, eps),
+            // h rises on [0, ε].
+            None if a <= stuck(eps) => bisect(|w| stuck(w) - a, 0.0, a.min(eps)),
             // w + c m(w) − a: ≤ 0 at max(ε, a − c) (m ≤ 1, and h(ε) < a),
             // ≥ 0 at a − c r (m ≥ r).
-            bisect(
+            _ => bisect(
                 |w| w + c * self.factor(w) - a,
                 eps.max(a - c),
                 (a - c * self.ratio).max(eps),
-            )
+            ),
         };
         w.copysign(q)
     }
@@ -221,6 +226,46 @@ mod tests {
         // Above the peak only the slip root is left.
         let w = k.solve_nodal(&law, 1.01 * peak, c);
         assert!(w > law.eps && (h(w) - 1.01 * peak).abs() <= 1e-12);
+    }
+
+    /// Where the stuck branch rises, falls and rises again inside [0, ε]
+    /// (r = 0.01, vs = 1e-4, ε = 1e-3, c = 0.1: a peak near w = 1.1e-4, a
+    /// dip near 5.4e-4), a q may have three stuck roots; the least is
+    /// taken, the one that grows continuously with q from 0, found here
+    /// as the first grid point where h reaches q.
+    #[test]
+    fn the_least_of_several_stuck_roots_is_taken() {
+        let law = FrictionLaw { eps: 1e-3 };
+        let k = Weakening {
+            ratio: 0.01,
+            speed: 1e-4,
+        };
+        let c = 0.1;
+        let h = |w: f64| w + c * k.factor(w.abs()) * law.phi(w);
+        let step = 1e-8;
+        let grid: Vec<f64> = (0..=100_000).map(|n| h(f64::from(n) * step)).collect();
+        let top = grid.iter().copied().fold(0.0, f64::max);
+        let mut three = 0;
+        let mut last = 0.0;
+        for i in 1..=200 {
+            let q = top * f64::from(i) / 200.0;
+            let first = grid.iter().position(|&v| v >= q).expect("a stuck root") as f64 * step;
+            let w = k.solve_nodal(&law, q, c);
+            assert!((h(w) - q).abs() <= 1e-12 * (q + c), "q = {q}: residual");
+            assert!(
+                w <= first && w >= first - step,
+                "q = {q}: took {w}, the least root is in [{}, {first}]",
+                first - step
+            );
+            assert!(w >= last, "q = {q}: {w} below the last q's {last}");
+            last = w;
+            let crossings = grid
+                .windows(2)
+                .filter(|p| (p[0] - q).signum() != (p[1] - q).signum())
+                .count();
+            three += usize::from(crossings >= 3);
+        }
+        assert!(three > 0, "some q with three stuck roots");
     }
 
     #[test]

@@ -104,6 +104,16 @@ impl ContactNode {
         (class, self.force_scale() * phi)
     }
 
+    /// Subtracts the force f τ_J from a right-hand side on free DOFs.
+    #[inline]
+    fn subtract_along_tangent(&self, f: f64, rhs: &mut [f64]) {
+        for a in 0..2 {
+            if let Some(i) = self.dofs[a] {
+                rhs[i] -= f * self.tangent[a];
+            }
+        }
+    }
+
     /// The node's tangential velocity at free-DOF velocity `v_new` and its
     /// tangential displacement over a step of `dt` from `v` to `v_new` by
     /// the trapezoid rule, (τ·ṙ_K, τ·½Δt(ṙ_K + ṙ_{K−1})), in one pass.
@@ -306,13 +316,8 @@ impl ContactSurface {
     /// right-hand side on free DOFs; nodes with f_J = 0 leave it as it was.
     pub fn subtract_forces(&self, forces: &[f64], rhs: &mut [f64]) {
         for (n, &f) in self.nodes.iter().zip(forces) {
-            if f == 0.0 {
-                continue;
-            }
-            for a in 0..2 {
-                if let Some(i) = n.dofs[a] {
-                    rhs[i] -= f * n.tangent[a];
-                }
+            if f != 0.0 {
+                n.subtract_along_tangent(f, rhs);
             }
         }
     }
@@ -370,11 +375,7 @@ impl ContactSurface {
             } else {
                 n.slip_force(*c)
             };
-            for a in 0..2 {
-                if let Some(i) = n.dofs[a] {
-                    rhs[i] -= f * n.tangent[a];
-                }
-            }
+            n.subtract_along_tangent(f, rhs);
         }
     }
 

@@ -5,7 +5,7 @@
 
 use stickslip_contact::{iterate, ContactSurface, DiagonalStep, Foundation, SlipState};
 use stickslip_linalg::chunks;
-use stickslip_linalg::{csr, Analysis, Formed, Product};
+use stickslip_linalg::{csr, Analysis, FillOrder, Formed, Product};
 
 use stickslip_fem::SetupTimes;
 
@@ -514,8 +514,10 @@ impl Stepper for CentralDifference {
         true
     }
 
-    fn mass(&self) -> Mass<'_> {
+    fn solve_mass(&self, x: &mut [f64], fill_order: &FillOrder) -> Result<(), TimeError> {
         Mass::Lumped(&self.mass)
+            .solve_in_place(x, fill_order, None)
+            .map(drop)
     }
 
     fn mass_kind(&self) -> Option<MassKind> {

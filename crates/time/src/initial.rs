@@ -28,28 +28,39 @@ pub(crate) enum Mass<'a> {
 }
 
 impl Mass<'_> {
-    /// x = M⁻¹ b in place (`b` given in `x`); false, `x` unchanged, for
-    /// no mass. A consistent M is factorized for the one solve.
+    /// x = M⁻¹ b in place (`b` given in `x`; no mass: r̈ = 0, so x = 0).
+    /// A consistent M is factorized for the one solve, on `shared` (K's
+    /// analysis, which M's pattern shares) where given; the analysis it
+    /// used is returned (`None` for a lumped M or none).
     ///
     /// # Errors
-    /// [`TimeError::Static`] where M's factorization fails.
-    pub fn solve_in_place(&self, x: &mut [f64], fill_order: &FillOrder) -> Result<bool, TimeError> {
+    /// [`TimeError::Static`] where M's analysis or factorization fails.
+    pub fn solve_in_place(
+        &self,
+        x: &mut [f64],
+        fill_order: &FillOrder,
+        shared: SharedAnalysis,
+    ) -> Result<SharedAnalysis, TimeError> {
         match self {
             Mass::Lumped(m) => {
                 for (x, m) in x.iter_mut().zip(*m) {
                     *x /= m;
                 }
+                Ok(None)
             }
             Mass::Consistent(m) => {
-                let mut solver = Analysis::of(m, fill_order)
+                let mut solver = Analysis::shared_or_of(shared, m, fill_order)
                     .and_then(SparseCholesky::on)
                     .map_err(TimeError::Static)?;
                 solver.factorize(m).map_err(TimeError::Static)?;
                 solver.solve_in_place(x);
+                Ok(Some(solver.analysis().clone()))
             }
-            Mass::Massless => return Ok(false),
+            Mass::Massless => {
+                x.fill(0.0);
+                Ok(None)
+            }
         }
-        Ok(true)
     }
 
     /// M x into `out`.
@@ -329,7 +340,7 @@ pub(crate) fn initial_state(
         state.v.copy_from_slice(v0);
     }
     loads.at(0.0, &mut state.load);
-    // r̈₀ from M r̈₀ = R(0) − K r₀.
+    // r̈₀ from M r̈₀ = R(0) − K r₀ − J(ṙ₀) − C ṙ₀, the terms in turn.
     let mut rhs = vec![0.0; n];
     spmv(k, &state.r, &mut rhs);
     for (x, l) in rhs.iter_mut().zip(&state.load) {
@@ -347,7 +358,7 @@ pub(crate) fn initial_state(
         c.nodal_forces(&state.v, &mut state.forces);
         c.subtract_forces(&state.forces, &mut rhs);
     }
-    // With damping and an initial velocity, M r̈₀ = R(0) − K r₀ − C ṙ₀.
+    // With damping and an initial velocity, − C ṙ₀.
     let damping = settings.damping;
     if damping.is_on() && settings.initial_velocity.is_some() {
         let (mut kv, mut mv) = (vec![0.0; n], vec![0.0; n]);
@@ -357,25 +368,13 @@ pub(crate) fn initial_state(
             *x -= damping.alpha * mv + damping.beta * kv;
         }
     }
-    match mass {
-        Mass::Lumped(m) => {
-            for ((a, x), m) in state.a.iter_mut().zip(&rhs).zip(m) {
-                *a = x / m;
-            }
-        }
-        Mass::Consistent(m) => {
-            // M has K's pattern (fem): K's analysis, where made, is M's.
-            let shared = analysis.as_deref().and_then(Option::clone);
-            let mut solver = stickslip_linalg::Analysis::shared_or_of(shared, m, fill_order)
-                .and_then(SparseCholesky::on)
-                .map_err(TimeError::Static)?;
-            keep(&mut analysis, &solver);
-            solver.factorize(m).map_err(TimeError::Static)?;
-            state.a.copy_from_slice(&rhs);
-            solver.solve_in_place(&mut state.a);
-        }
-        Mass::Massless => {}
+    // M has K's pattern (fem): K's analysis, where made, is M's.
+    let shared = analysis.as_deref().and_then(Option::clone);
+    if let (Some(made), Some(slot)) = (mass.solve_in_place(&mut rhs, fill_order, shared)?, analysis)
+    {
+        *slot = Some(made);
     }
+    state.a.copy_from_slice(&rhs);
     let mut partials = chunks::partials(n);
     let kinetic = 0.5 * mass.form(&state.v, &mut partials);
     let strain = 0.5 * quadratic_form(k, &state.r, &mut partials);

@@ -48,7 +48,8 @@ impl std::fmt::Debug for Integrator {
 impl Integrator {
     /// Sets up the run and computes the initial state of Remark 4.1:
     /// r₀ the frictionless static equilibrium under the loads present at
-    /// t = 0⁻, ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀.
+    /// t = 0⁻, ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀ − C ṙ₀ −
+    /// J(ṙ₀) (initial.rs).
     ///
     /// A scheme is a `Stepper` (the crate's internal trait) made by its
     /// module's `start`; this match is the one place that names them.
@@ -186,13 +187,7 @@ impl Integrator {
             .collect();
         let mut da = vec![0.0; self.state.a.len()];
         contact.subtract_forces(&change, &mut da);
-        if !self
-            .stepper
-            .mass()
-            .solve_in_place(&mut da, &self.fill_order)?
-        {
-            return Ok(());
-        }
+        self.stepper.solve_mass(&mut da, &self.fill_order)?;
         for (a, d) in self.state.a.iter_mut().zip(&da) {
             *a += d;
         }

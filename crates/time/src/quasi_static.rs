@@ -105,8 +105,9 @@ pub(crate) fn start(
     if !settings.restoring {
         // The total stays the initial state's, strain − rᵀR(0) with R at
         // t = 0 itself (a load that switches on at t = 0 included, as the
-        // dynamic schemes count it). The previous increment's load is the one r₀ equilibrates: the
-        // loads before t = 0, or none for a start at rest (r₀ = 0).
+        // dynamic schemes count it). The previous increment's load is the
+        // one r₀ equilibrates: the loads before t = 0, or none for a start
+        // at rest (r₀ = 0).
         state.load = match settings.initial_state {
             InitialState::Static => loads.before_start(),
             InitialState::Rest => vec![0.0; n],

@@ -4,6 +4,7 @@
 //! everything else is their own.
 
 use stickslip_contact::ContactSurface;
+use stickslip_linalg::FillOrder;
 
 use crate::dynamics::Loads;
 use crate::initial::Mass;
@@ -47,10 +48,13 @@ pub(crate) trait Stepper: Send {
     /// How a step forms its products with K (for messages and results).
     fn stiffness_product(&self) -> &'static str;
 
-    /// The mass its steps use, for r̈₀ where the friction at t = 0
-    /// changes after the start (no inertia: [`Mass::Massless`]).
-    fn mass(&self) -> Mass<'_> {
-        Mass::Massless
+    /// x = M⁻¹ x with the mass its steps use (no inertia: x = 0), for r̈₀
+    /// where the friction at t = 0 changes after the start.
+    ///
+    /// # Errors
+    /// [`TimeError::Static`] where a consistent M's factorization fails.
+    fn solve_mass(&self, x: &mut [f64], fill_order: &FillOrder) -> Result<(), TimeError> {
+        Mass::Massless.solve_in_place(x, fill_order, None).map(drop)
     }
 
     /// K's stencil types, where the step forms K·x from them.

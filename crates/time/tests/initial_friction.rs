@@ -13,9 +13,11 @@
 //! (its trapezoid books ½(J₁ + J₀)·Δr, which the dynamics now match), and
 //! both schemes are second order from the start: no gΔt/2 velocity lost.
 
+use stickslip_testkit::read_mesh;
+use stickslip_testkit::scene::{Slab, END_LOAD, NU, PRESSURE};
 use stickslip_testkit::sdof::{self, G, K, OMEGA};
 use stickslip_testkit::solvers::every_solver;
-use stickslip_time::{History, Integrator, Scheme, Settings};
+use stickslip_time::{History, Integrator, MassKind, Scheme, Settings};
 
 const DT: f64 = 1e-3;
 
@@ -59,8 +61,8 @@ fn run(name: &str, mut i: Integrator, exact: impl Fn(f64) -> f64, newmark: bool)
 #[test]
 fn a_launched_mass_decelerates_from_the_start() {
     let v0 = 1.0;
-    // It stops where v₀ cos ωt = −(g/(kω))ω sin ωt: tan ωt = −v₀ω k/(gω²)…
-    // simply run a quarter period, well before the stop at ωt ≈ 1.56.
+    // ẋ = v₀ cos ωt − (g/(kω)) ω sin ωt... = 0 where tan ωt = v₀kω/(gω²)
+    // = 10: the stop at ωt ≈ 1.47. One radian, t = 0.1, stays before it.
     let t_end = 0.1;
     let exact = |t: f64| v0 / OMEGA * (OMEGA * t).sin() - G / K * (1.0 - (OMEGA * t).cos());
     for (name, settings) in every_solver(DT, t_end) {
@@ -68,9 +70,10 @@ fn a_launched_mass_decelerates_from_the_start() {
         let i = mass(None, v0, None, settings);
         assert_eq!(i.acceleration()[0], -G, "{name}: r̈₀");
         let worst = run(name, i, exact, newmark);
-        // Second order: (ωΔt)² = 1e-4 of the amplitude v₀/ω per radian,
-        // one radian. A start without the friction leaves ½gΔt² = 5e-7 at
-        // the first step and a velocity gΔt/2 short, 5e-5 by t = 0.1.
+        // Second order: the schemes' phase error, (ωΔt)²/12 ≈ 8e-6 of a
+        // radian per radian, times the amplitude v₀/ω = 0.1, about 1e-6
+        // by t = 0.1. A start without the friction leaves the velocity
+        // gΔt/2 = 5e-4 short, 5e-5 in x by t = 0.1.
         assert!(worst < 2e-6, "{name}: {worst:e}");
     }
 }
@@ -104,5 +107,49 @@ fn a_pressure_history_sets_the_initial_friction_and_acceleration() {
             |t: f64| 1.0 / OMEGA * (OMEGA * t).sin() - 0.5 * G / K * (1.0 - (OMEGA * t).cos());
         let worst = run(name, i, exact, newmark);
         assert!(worst < 2e-6, "{name}: {worst:e}");
+    }
+}
+
+/// On the paper's slab launched at ṙ₀ = (1, 0), a pressure history of 0.5
+/// at t = 0 set after the start corrects r̈₀ (by M's solve of the change
+/// of J₀) to what a start with half the friction bound built in computes
+/// directly (μ = 0.15 against 0.3: g = μp either way, the pressure load
+/// unchanged), for every solver and with Newmark's consistent and lumped
+/// mass: the same r̈₀ to round-off, by two ways of forming it.
+#[test]
+fn the_corrected_acceleration_is_the_direct_one_on_the_slab() {
+    let slab = |mu: f64| {
+        let mesh = read_mesh("slab-q2-8x2.msh").expect("committed mesh reads");
+        Slab::new(mesh, NU, PRESSURE, Some(mu), 1e-4, END_LOAD, History::Step)
+            .expect("the slab builds")
+    };
+    let (full, half) = (slab(0.3), slab(0.15));
+    let mut v0 = vec![0.0; full.n_free()];
+    for node in 0..full.mesh.nodes.len() {
+        if let Some(d) = full.dof(node, 0) {
+            v0[d] = 1.0;
+        }
+    }
+    let mut cases = every_solver(DT, 0.01);
+    let mut lumped = cases[2].1.clone();
+    lumped.mass = Some(MassKind::Lumped);
+    cases.push(("Schur, lumped", lumped));
+    let largest = |x: &[f64]| x.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+    let apart =
+        |x: &[f64], y: &[f64]| largest(&x.iter().zip(y).map(|(a, b)| a - b).collect::<Vec<_>>());
+    for (name, mut settings) in cases {
+        settings.initial_velocity = Some(v0.clone());
+        let uncorrected = full.integrator(settings.clone()).unwrap();
+        let mut corrected = full.integrator(settings.clone()).unwrap();
+        corrected
+            .set_pressure_histories(&[History::Table(vec![(0.0, 0.5), (1.0, 0.5)])])
+            .unwrap();
+        let direct = half.integrator(settings).unwrap();
+        let scale = largest(direct.acceleration());
+        let worst = apart(corrected.acceleration(), direct.acceleration());
+        assert!(worst <= 1e-11 * scale, "{name}: {worst:e} of {scale:e}");
+        // The correction is the friction's change, far above round-off.
+        let change = apart(uncorrected.acceleration(), direct.acceleration());
+        assert!(change > 1e-3 * scale, "{name}: {change:e} of {scale:e}");
     }
 }

@@ -25,8 +25,8 @@ fn the_initial_total_counts_a_load_that_starts_at_zero() {
     };
     // One r₀ (the frictionless static preload), so one strain energy.
     assert_eq!(strain_d.to_bits(), strain_q.to_bits());
-    // The step load's −rᵀR_step is the difference the old total missed:
-    // about 140 of −187 on this slab.
+    // The step load's −rᵀR_step is the difference a total with the loads
+    // before t = 0 would miss.
     assert!(
         (dynamic - quasi).abs() <= 1e-12 * dynamic.abs(),
         "quasi-static {quasi} against central difference {dynamic}"

@@ -32,6 +32,11 @@ pub(crate) struct DirectOperator {
 }
 
 impl DirectOperator {
+    /// The analysis of K's pattern its factor uses.
+    pub(crate) fn analysis(&self) -> &stickslip_linalg::Analysis {
+        self.cholesky.analysis()
+    }
+
     /// Analyses the pattern of K (which M shares) once for the run, or
     /// takes its `analysis`, made already.
     pub fn new(

@@ -62,6 +62,8 @@ pub(crate) struct Newmark {
     k: CsrMatrix<f64>,
     /// The scheme's mass on K's pattern (the lumped one on the diagonal).
     m: CsrMatrix<f64>,
+    /// The lumped mass by DOF, where it is the scheme's.
+    lumped: Option<Vec<f64>>,
     friction: ImplicitFriction,
     /// R̂_K, and M's vector of it.
     b: Vec<f64>,
@@ -151,12 +153,14 @@ pub(crate) fn start(
         }
         _ => None,
     };
+    let lumped = (mass_kind == MassKind::Lumped).then_some(lumped_mass);
     let stepper = Newmark {
         beta,
         gamma,
         mass_kind,
         k,
         m,
+        lumped,
         friction,
         b: vec![0.0; n],
         tmp: vec![0.0; n],
@@ -285,6 +289,14 @@ impl ImplicitFriction {
             _ => ImplicitFriction::new(k, fill_order, shared, contact, settings)?,
         };
         Ok((state, friction))
+    }
+
+    /// The run's analysis of K's pattern (which M and A₀ share).
+    pub(crate) fn analysis(&self) -> SharedAnalysis {
+        match &self.solver {
+            Solver::Schur(op) => Some(op.analysis().clone()),
+            Solver::Direct(op) => Some(op.analysis().clone()),
+        }
     }
 
     /// The settings' solver for K's pattern (which M shares), analysed
@@ -787,9 +799,13 @@ impl Stepper for Newmark {
         Some(self.mass_kind)
     }
 
-    fn mass(&self) -> Mass<'_> {
-        // A lumped mass is m's diagonal: its factor is that of a diagonal.
-        Mass::Consistent(&self.m)
+    fn solve_mass(&self, x: &mut [f64], fill_order: &FillOrder) -> Result<(), TimeError> {
+        let mass = match &self.lumped {
+            Some(m) => Mass::Lumped(m),
+            None => Mass::Consistent(&self.m),
+        };
+        mass.solve_in_place(x, fill_order, self.friction.analysis())
+            .map(drop)
     }
 
     fn stiffness_product(&self) -> &'static str {

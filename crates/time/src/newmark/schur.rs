@@ -126,6 +126,11 @@ pub(crate) struct SchurOperator {
 }
 
 impl SchurOperator {
+    /// The analysis of K's pattern its factors use.
+    pub(crate) fn analysis(&self) -> &stickslip_linalg::Analysis {
+        &self.analysis
+    }
+
     /// Analyses K's pattern (which M shares) once for the run, or takes
     /// its `analysis`, made already.
     pub fn new(
