@@ -280,18 +280,13 @@ fn check_group(
             // (`Physical Curve("load") = {7};` without a curve 7) as a name
             // without elements: a load or support there acts on nothing.
             _ if g.elements == 0 => {
-                let physical = match g.dim {
-                    0 => "Point",
-                    1 => "Curve",
-                    _ => "Surface",
-                };
                 problems.push(format!(
                     "{}{key} = {name:?}: the physical group {name:?} has no elements in the mesh {}, \
-                     so {purpose} there would act on nothing; check the entities of its Physical \
-                     {physical} in the .geo (Gmsh keeps a group whose entities are missing, empty) \
-                     and mesh again",
+                     so {purpose} there would act on nothing; {} (Gmsh keeps a group whose entities \
+                     are missing, empty) and mesh again",
                     case.at(key),
-                    case.mesh.file.display()
+                    case.mesh.file.display(),
+                    g.empty_remedy()
                 ));
                 false
             }

@@ -15,8 +15,9 @@
 //!
 //! Exit codes (used by `main.rs`): 0 success; 2 bad input (case, mesh,
 //! arguments: a `stickslip_case::InputError`); 1 a run that failed after it
-//! started, or text that could not be written to stdout or stderr
-//! ([`console::WriteError`]); 130 interrupted.
+//! started, or a command's text that could not be written to stdout or
+//! stderr ([`console::WriteError`]; not the lines of `say!`, below); 130
+//! interrupted.
 //!
 //! Its system calls (signals, the results file's lock, free disk space)
 //! are in [`sys`], the one module allowed `unsafe`.

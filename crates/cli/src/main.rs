@@ -6,12 +6,16 @@
 //!
 //! Exit codes: 0 success; 2 bad input (case, mesh, arguments — clap's usage
 //! errors exit 2 too); 1 a run that failed after it started (the file keeps
-//! every step written), or text that could not be written to stdout or
-//! stderr (a full disk behind a redirection: what the command wrote to
-//! files is kept; `run --json` whose summary is lost keeps its complete
-//! file); 130 interrupted by SIGINT, SIGTERM or SIGHUP (the file is
-//! valid and holds a checkpoint to `--restart` from). A closed pipe
-//! (`| head`) ends the commands other than `run` quietly, by SIGPIPE.
+//! every step written), or a command's text that could not be written to
+//! stdout or stderr through `console` (a full disk behind a redirection:
+//! what the command wrote to files is kept; `run --json` whose summary is
+//! lost keeps its complete file); 130 interrupted by SIGINT, SIGTERM or
+//! SIGHUP (the file is valid and holds a checkpoint to `--restart` from).
+//! What `run` writes on stderr (progress, warnings, its summary) and
+//! `stress`'s progress lines are written with `say!`, whose failures are
+//! ignored, as are those of the `error:` lines of `report`: they change
+//! no exit code. A closed pipe (`| head`) ends the commands other than
+//! `run` quietly, by SIGPIPE.
 
 // The system calls are in the library's `sys` module.
 #![forbid(unsafe_code)]

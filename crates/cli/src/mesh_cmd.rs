@@ -75,15 +75,11 @@ fn empty_groups(mesh: &Mesh) -> Vec<String> {
         .iter()
         .filter(|g| g.elements == 0)
         .map(|g| {
-            let physical = match g.dim {
-                0 => "Point",
-                1 => "Curve",
-                _ => "Surface",
-            };
             format!(
-                "group {:?} (dim {}) has no elements: check the entities of its Physical {physical} \
-                 in the .geo; a case cannot use it",
-                g.name, g.dim
+                "group {:?} (dim {}) has no elements: {}; a case cannot use it",
+                g.name,
+                g.dim,
+                g.empty_remedy()
             )
         })
         .collect()

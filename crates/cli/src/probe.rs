@@ -537,6 +537,21 @@ fn parse_times(times: &str) -> Result<Vec<f64>, InputError> {
     Ok(out)
 }
 
+/// One edge of a line group as walked: start, end and (quad9) mid-side
+/// node.
+type Side = (usize, usize, Option<usize>);
+
+/// A line group walked along: its nodes in order with their arc lengths,
+/// and its edges in the same order.
+struct Walk {
+    order: Vec<usize>,
+    s: Vec<f64>,
+    edges: Vec<Side>,
+    closed: bool,
+    /// s at the end of the last edge (a closed loop's length).
+    length: f64,
+}
+
 /// The nodes of a line group in order along it, with their arc lengths.
 ///
 /// The group's edges are recovered from the cells: a cell side is a group
@@ -544,15 +559,17 @@ fn parse_times(times: &str) -> Result<Vec<f64>, InputError> {
 /// nodes (the mid-side node too, for quad9) are in the group. Each edge is
 /// taken in its cell's counter-clockwise order, so the walk has the body on
 /// its left (DESIGN.md's tangent convention). An open chain starts at its
-/// free end; a closed loop at its node of least x (then least y). s is
-/// summed over straight segments (through the mid-side node on quad9).
+/// free end; a closed loop at its node of least x (then least y), which
+/// [`along`] moves to the solver's start on the contact group
+/// ([`loop_from_solver_start`]). s is summed over straight segments
+/// (through the mid-side node on quad9).
 fn order_along(
     name: &str,
     group: &str,
     nodes: &ndarray::Array2<f64>,
     cells: &ndarray::Array2<i64>,
     members: &[i64],
-) -> Result<(Vec<usize>, Vec<f64>), InputError> {
+) -> Result<Walk, InputError> {
     use std::collections::{HashMap, HashSet};
     let n = nodes.nrows();
     let bad_index = || {
@@ -632,9 +649,12 @@ fn order_along(
     let len =
         |a: usize, b: usize| (nodes[[b, 0]] - nodes[[a, 0]]).hypot(nodes[[b, 1]] - nodes[[a, 1]]);
     let (mut order, mut s) = (vec![start], vec![0.0]);
+    let mut edges = Vec::with_capacity(next.len());
+    let mut length = 0.0;
     let mut at = start;
     let mut walked = 0;
     while let Some(&(b, mid)) = next.get(&at) {
+        edges.push((at, b, mid));
         let s0 = *s.last().expect("non-empty");
         let s_end = match mid {
             Some(m) => {
@@ -645,6 +665,7 @@ fn order_along(
             None => s0 + len(at, b),
         };
         walked += 1;
+        length = s_end;
         if b == start {
             break;
         }
@@ -662,7 +683,140 @@ fn order_along(
             next.len()
         )));
     }
-    Ok((order, s))
+    let closed = starts.is_empty();
+    Ok(Walk {
+        order,
+        s,
+        edges,
+        closed,
+        length,
+    })
+}
+
+/// A closed loop of a contact group as the solver walks it: from the node
+/// its chain starts at, with the arc length it measures
+/// ([`stickslip_fem::boundary_quadrature`]), so that every node, one
+/// without friction too, has its s on /contact/s's scale and start.
+/// `friction_s` is a node's /contact/s on this group. The solver starts at
+/// the group's first edge, which the file does not keep: the start is the
+/// corner (the friction node of least /contact/s, or one without friction)
+/// whose distance along the walk to that node is nearest its /contact/s;
+/// corners lie an edge apart, far beyond the difference between the
+/// walk's chords and the arc. `None` where no node of the loop carries
+/// friction.
+fn loop_from_solver_start(
+    group: &str,
+    nodes: &ndarray::Array2<f64>,
+    walk: &Walk,
+    friction_s: impl Fn(usize) -> Option<f64>,
+) -> Option<(Vec<usize>, Vec<f64>)> {
+    use std::collections::HashMap;
+    let at: HashMap<usize, f64> = walk
+        .order
+        .iter()
+        .copied()
+        .zip(walk.s.iter().copied())
+        .collect();
+    let (first, first_s) = walk
+        .order
+        .iter()
+        .filter_map(|&v| friction_s(v).map(|cs| (v, cs)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    let ahead = |a: usize| {
+        let d = at[&first] - at[&a];
+        if d < 0.0 {
+            d + walk.length
+        } else {
+            d
+        }
+    };
+    let k = (0..walk.edges.len())
+        .filter(|&k| {
+            let a = walk.edges[k].0;
+            a == first || friction_s(a).is_none()
+        })
+        .min_by(|&i, &j| {
+            let off = |k: usize| (ahead(walk.edges[k].0) - first_s).abs();
+            off(i).total_cmp(&off(j))
+        })?;
+    // The loop alone, its edges from the start: the solver's sums in the
+    // solver's order, so the same bits.
+    let mut local: HashMap<usize, usize> = HashMap::new();
+    let mut ids = Vec::new();
+    let mut id = |v: usize| {
+        *local.entry(v).or_insert_with(|| {
+            ids.push(v);
+            ids.len() - 1
+        })
+    };
+    let edges: Vec<stickslip_mesh::Edge> = walk.edges[k..]
+        .iter()
+        .chain(&walk.edges[..k])
+        .map(|&(a, b, mid)| stickslip_mesh::Edge {
+            nodes: [id(a), id(b)],
+            mid: mid.map(&mut id),
+            cell: 0,
+        })
+        .collect();
+    let kind = if edges.iter().any(|e| e.mid.is_some()) {
+        stickslip_mesh::CellKind::Quad9
+    } else {
+        stickslip_mesh::CellKind::Quad4
+    };
+    let mesh = stickslip_mesh::Mesh {
+        nodes: ids
+            .iter()
+            .map(|&v| [nodes[[v, 0]], nodes[[v, 1]]])
+            .collect(),
+        node_tags: (1..=ids.len() as u64).collect(),
+        kind,
+        cells: Vec::new(),
+        cell_tags: Vec::new(),
+        groups: vec![stickslip_mesh::Group {
+            name: group.to_string(),
+            tag: 1,
+            dim: 1,
+            elements: edges.len(),
+            edges,
+            cells: Vec::new(),
+            points: Vec::new(),
+            nodes: (0..ids.len()).collect(),
+        }],
+        source: Default::default(),
+    };
+    let chain = stickslip_fem::boundary_quadrature(&mesh, group).ok()?;
+    Some(
+        chain
+            .iter()
+            .map(|b| {
+                let v = ids[b.node];
+                (v, friction_s(v).unwrap_or(b.s))
+            })
+            .unzip(),
+    )
+}
+
+/// Whether each node of /contact/nodes carries friction on `group`'s own
+/// surface (by /contact/surface); all of them in a file without it (one
+/// surface).
+fn on_own_surface(f: &File, group: &str, n: usize) -> Vec<bool> {
+    let surface = f
+        .dataset("contact/surface")
+        .and_then(|d| d.read_1d::<i64>())
+        .map(|a| a.to_vec());
+    let groups = contact_groups(f);
+    match surface {
+        Ok(surface) if surface.len() == n => surface
+            .iter()
+            .map(|&k| {
+                usize::try_from(k)
+                    .ok()
+                    .and_then(|k| groups.get(k))
+                    .is_some_and(|g| g == group)
+            })
+            .collect(),
+        _ => vec![true; n],
+    }
 }
 
 /// The contact group of the case stored in the file, if any.
@@ -692,8 +846,8 @@ fn contact_groups(f: &File) -> Vec<String> {
 
 /// `--along GROUP --times T1,..`: `field` at the nodes of `group`, in order
 /// along it (for the contact group: the order of /contact/nodes, the nodes
-/// without friction placed by arc length), at the output steps nearest to
-/// each time.
+/// without friction placed by arc length from the same start, a closed
+/// loop's too), at the output steps nearest to each time.
 ///
 /// # Errors
 /// Bad times, a file that is not a stickslip results file, a group the file
@@ -737,7 +891,8 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
             )));
         }
     };
-    let (mut order, mut s) = order_along(&name, group, &nodes, &cells, &members)?;
+    let walk = order_along(&name, group, &nodes, &cells, &members)?;
+    let (mut order, mut s) = (walk.order.clone(), walk.s.clone());
 
     let contact_field = field.on_contact();
     let is_contact_group = contact_groups(&f).iter().any(|g| g == group);
@@ -781,13 +936,32 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
             .collect()
     };
     if is_contact_group {
-        if let Some((_, cs)) = &contact {
+        if let Some((c, cs)) = &contact {
+            // A node of the group may carry friction on another surface
+            // joined to it, whose s starts elsewhere.
+            let own = on_own_surface(&f, group, c.len());
+            let friction_s: std::collections::HashMap<usize, f64> = c
+                .iter()
+                .zip(cs)
+                .zip(&own)
+                .filter(|(_, &own)| own)
+                .filter_map(|((&v, &s), _)| Some((usize::try_from(v).ok()?, s)))
+                .collect();
+            // A closed loop starts where the solver's chain does.
+            if walk.closed {
+                if let Some((o, w)) =
+                    loop_from_solver_start(group, &nodes, &walk, |v| friction_s.get(&v).copied())
+                {
+                    (order, s) = (o, w);
+                }
+            }
             // The order of /contact/nodes: sort by /contact/s where the node
             // carries friction, by the walk's s elsewhere (both are measured
             // from the same end of the same chain).
-            let slots = slot(&order);
-            let key: Vec<f64> = (0..order.len())
-                .map(|i| slots[i].map_or(s[i], |j| cs[j]))
+            let key: Vec<f64> = order
+                .iter()
+                .zip(&s)
+                .map(|(v, &w)| friction_s.get(v).copied().unwrap_or(w))
                 .collect();
             let mut idx: Vec<usize> = (0..order.len()).collect();
             idx.sort_by(|&a, &b| key[a].total_cmp(&key[b]));
@@ -926,31 +1100,26 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
     })
 }
 
-/// `stickslip probe FILE --along GROUP --times ..` without `--force`:
-/// [`write_along`], every error an [`InputError`] (a failed write to
-/// stdout or stderr too).
-///
-/// # Errors
-/// As [`write_along`].
-pub fn along_command(file: &Path, args: &AlongArgs, field: Field) -> Result<(), InputError> {
-    write_along(file, args, field, false).map_err(|e| match e.downcast::<InputError>() {
-        Ok(input) => input,
-        Err(other) => InputError(format!("{other:#}")),
-    })
-}
-
 /// `stickslip probe FILE --along GROUP --times .. [-o CSV [--force]]`:
 /// runs [`along`], prints the step choices on stderr and the CSV on stdout
 /// or into `args.output`. An existing CSV file is replaced only with
 /// `force`, and never when it is `file` itself (the results read).
 ///
 /// # Errors
-/// As [`along`]; `--times` missing; the output file existing (without
-/// `force`), being the results file, or not writable: an [`InputError`].
-/// A failed write to stdout or stderr: a [`crate::console::WriteError`]
-/// (the CSV is written all the same where only stderr failed).
+/// As [`along`]; `--times` missing; `force` without an output file; the
+/// output file existing (without `force`), being the results file, or not
+/// writable: an [`InputError`]. A failed write to stdout or stderr: a
+/// [`crate::console::WriteError`] (the CSV is written all the same where
+/// only stderr failed).
 pub fn write_along(file: &Path, args: &AlongArgs, field: Field, force: bool) -> anyhow::Result<()> {
     let group = args.along.as_deref().unwrap_or_default();
+    if force && args.output.is_none() {
+        return Err(InputError(format!(
+            "--along {group}: --force applies to -o FILE (it lets the CSV replace an existing FILE), \
+             and there is no -o; give -o FILE, or leave out --force to print the CSV on stdout"
+        ))
+        .into());
+    }
     let times = args.times.as_deref().ok_or_else(|| {
         InputError(format!(
             "--along {group}: give the times too, e.g. --times 0.1,0.25,0.5"

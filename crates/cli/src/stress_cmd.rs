@@ -30,8 +30,14 @@ use stickslip_case::InputError;
 /// written, and what the viewers' files hold.
 ///
 /// # Errors
-/// An [`InputError`] for a file that is missing, being written, or not a
-/// results file of `stickslip run`; other errors for HDF5 failures.
+/// An [`InputError`] (exit 2) for a file that is missing, being written,
+/// or not a results file of `stickslip run`, for a disk without room for
+/// the stresses, and for a place beside it that cannot take the stress
+/// file or the viewers' files (a directory in the way, a directory this
+/// process may not write, a create or rename that fails). Other errors
+/// (exit 1), each naming its file: reading the results file failing
+/// (`/displacement` of a damaged file), and writing into a file once
+/// created failing (a disk filled meanwhile).
 pub fn command(
     path: &Path,
     quiet: bool,
@@ -47,7 +53,7 @@ pub fn command(
     crate::views_cmd::check_beside(path, "stress", &beside)?;
     let (mesh, material) = crate::probe::stored_model(&f, &name)?;
     let n_nodes = mesh.nodes.len();
-    let u = f.dataset("displacement")?;
+    let u = f.dataset("displacement").map_err(|e| unread(path, e))?;
     // A record here is a frame: the rows of /displacement.
     let times = crate::frames::Frames::read(&f, &name)?.time;
     let rows = times.len().min(u.shape().first().copied().unwrap_or(0));
@@ -76,13 +82,13 @@ pub fn command(
         }
     }
     // Written beside and renamed into place: a failure leaves no half file.
-    let written = write_stresses(&part, &u, &mesh, &material, rows, quiet)
-        .and_then(|()| Ok(std::fs::rename(&part, &target)?));
+    let written = write_stresses(path, &u, &mesh, &material, rows, quiet).and_then(|()| {
+        std::fs::rename(&part, &target)
+            .map_err(|e| crate::views_cmd::beside_failed(path, "stress", &target, e).into())
+    });
     if let Err(e) = written {
         let _ = std::fs::remove_file(&part);
-        return Err(
-            crate::views_cmd::beside_failed(path, "stress", &target, format!("{e:#}")).into(),
-        );
+        return Err(e);
     }
     drop((u, f));
     let written = crate::views_cmd::write(path)?;
@@ -99,10 +105,61 @@ fn part_path(out: &Path) -> std::path::PathBuf {
     out.with_extension("stress.h5.part")
 }
 
-/// `/stress` and `/von_mises` of `rows` records of `u` into a new file at
-/// `part`.
+/// A failure to read `/displacement` of the results file: the error of
+/// the work (exit 1), naming the file, and not the stress file's.
+#[derive(Debug)]
+struct Unread(String);
+
+impl std::fmt::Display for Unread {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Unread {}
+
+/// [`Unread`] of the results file `out`.
+fn unread(out: &Path, e: impl std::fmt::Display) -> anyhow::Error {
+    Unread(format!(
+        "{}: cannot read /displacement: {e}; the file may be damaged (h5dump -H shows what HDF5 \
+         can read of it): run the case again for a whole one",
+        out.display()
+    ))
+    .into()
+}
+
+/// `/stress` and `/von_mises` of `rows` records of `u`, the displacement
+/// of the results file `out`, into a new file at [`part_path`], to be
+/// renamed to [`stress_path`].
+///
+/// # Errors
+/// Creating the file failing: an [`InputError`] (its place); reading `u`
+/// failing: an [`Unread`]; writing into the file failing: an error naming
+/// [`stress_path`], the file the user knows.
 fn write_stresses(
-    part: &Path,
+    out: &Path,
+    u: &hdf5::Dataset,
+    mesh: &stickslip_mesh::Mesh,
+    material: &stickslip_fem::Material,
+    rows: usize,
+    quiet: bool,
+) -> anyhow::Result<()> {
+    let (part, target) = (part_path(out), stress_path(out));
+    let g = File::create(&part)
+        .map_err(|e| crate::views_cmd::beside_failed(out, "stress", &target, e))?;
+    fill(&g, out, u, mesh, material, rows, quiet).map_err(|e| {
+        if e.is::<Unread>() {
+            e
+        } else {
+            crate::views_cmd::mid_write(out, "stress", &target, format!("{e:#}"))
+        }
+    })
+}
+
+/// [`write_stresses`] into the file `g` it created.
+fn fill(
+    g: &File,
+    out: &Path,
     u: &hdf5::Dataset,
     mesh: &stickslip_mesh::Mesh,
     material: &stickslip_fem::Material,
@@ -110,7 +167,6 @@ fn write_stresses(
     quiet: bool,
 ) -> anyhow::Result<()> {
     let n_nodes = mesh.nodes.len();
-    let g = File::create(part)?;
     let stress = g
         .new_dataset::<f64>()
         .chunk((1, n_nodes, 3))
@@ -133,7 +189,8 @@ fn write_stresses(
     let mut last = Instant::now();
     for k in 0..rows {
         let row: Vec<f64> = u
-            .read_slice_2d::<f64, _>(s![k, .., ..])?
+            .read_slice_2d::<f64, _>(s![k, .., ..])
+            .map_err(|e| unread(out, e))?
             .iter()
             .copied()
             .collect();

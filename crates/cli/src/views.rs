@@ -144,7 +144,8 @@ pub struct Layout<'a> {
 /// `/contact/*` (its row of `/time`; `rows` has one entry a frame).
 ///
 /// # Errors
-/// `out` without a UTF-8 file name, or HDF5 failing to write the file.
+/// `out` without a UTF-8 file name, or HDF5 failing to create the file
+/// (its place: `stickslip views` says so as bad input) or to write into it.
 pub fn update(out: &Path, layout: &Layout, frame_rows: &[usize]) -> anyhow::Result<()> {
     let rows = frame_rows.len();
     let source = file_name(out)?;
@@ -213,7 +214,7 @@ fn open_matching(path: &Path, source: &str, n_nodes: usize, n_c: usize) -> Optio
 /// segments written whole: they are the mesh's, not a record's).
 fn create(path: &Path, source: &str, layout: &Layout) -> anyhow::Result<File> {
     let _ = std::fs::remove_file(path);
-    let f = File::create(path)?;
+    let f = File::create(path).map_err(|e| crate::views_cmd::Unplaced(e.to_string()))?;
     crate::output::string_attr(
         &f,
         "about",

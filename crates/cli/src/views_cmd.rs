@@ -130,9 +130,45 @@ pub(crate) fn check_beside(out: &Path, command: &str, files: &[PathBuf]) -> Resu
     Ok(())
 }
 
-/// A failed write of `path` beside the results file `out` (a full disk,
-/// permissions changed under the command) as the [`InputError`] naming it
-/// and what to do.
+/// A file beside the results file that could not be put in its place:
+/// created, or renamed into place (a directory it may not write, something
+/// in the way). Bad input (exit 2, [`beside_failed`]), where a failure
+/// while writing into the file once created (a full disk) is not.
+#[derive(Debug)]
+pub(crate) struct Unplaced(pub(crate) String);
+
+impl std::fmt::Display for Unplaced {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Unplaced {}
+
+/// An [`Unplaced`] as an I/O error of `e`'s kind, for the functions that
+/// give I/O errors.
+pub(crate) fn unplaced_io(e: &std::io::Error) -> std::io::Error {
+    std::io::Error::new(e.kind(), Unplaced(e.to_string()))
+}
+
+/// Whether `e`, or an error it wraps (an I/O error's too), is [`Unplaced`].
+fn is_unplaced(e: &(dyn std::error::Error + 'static)) -> bool {
+    let mut at = Some(e);
+    while let Some(e) = at {
+        let io_inner = e
+            .downcast_ref::<std::io::Error>()
+            .and_then(|io| io.get_ref());
+        if e.is::<Unplaced>() || io_inner.is_some_and(|i| i.is::<Unplaced>()) {
+            return true;
+        }
+        at = e.source();
+    }
+    false
+}
+
+/// A failed create or rename of `path` beside the results file `out` (the
+/// directory made read-only, or something put in the way, under the
+/// command) as the [`InputError`] naming it and what to do.
 pub(crate) fn beside_failed(
     out: &Path,
     command: &str,
@@ -144,6 +180,33 @@ pub(crate) fn beside_failed(
         path.display(),
         elsewhere(out, command)
     ))
+}
+
+/// A failed write into `path` beside the results file `out` once it was
+/// created (a full disk, an I/O error): an error of the work (exit 1),
+/// naming it and what to do.
+pub(crate) fn mid_write(
+    out: &Path,
+    command: &str,
+    path: &Path,
+    e: impl std::fmt::Display,
+) -> anyhow::Error {
+    anyhow::anyhow!(
+        "cannot write {}: {e}; make room on its disk if it is full, and run `stickslip {command} {}` again",
+        path.display(),
+        out.display()
+    )
+}
+
+/// `e`, a failed write of `path` beside the results file `out`, as
+/// [`beside_failed`] where the place failed ([`Unplaced`]), else as
+/// [`mid_write`].
+fn place_or_write(out: &Path, command: &str, path: &Path, e: &anyhow::Error) -> anyhow::Error {
+    if is_unplaced(e.as_ref()) {
+        beside_failed(out, command, path, format!("{e:#}")).into()
+    } else {
+        mid_write(out, command, path, format!("{e:#}"))
+    }
 }
 
 /// Writes `OUT.views.h5`, `OUT.xdmf` and `OUT.contact.xdmf` for the
@@ -235,9 +298,9 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         contact: contact.as_ref(),
         fields: &fields,
     };
-    let beside = |path: &Path, e: &dyn std::fmt::Display| beside_failed(out, "views", path, e);
+    let beside = |path: &Path, e: anyhow::Error| place_or_write(out, "views", path, &e);
     crate::views::update(out, &layout, &frames.row[..rows])
-        .map_err(|e| beside(&crate::views::views_path(out), &format!("{e:#}")))?;
+        .map_err(|e| beside(&crate::views::views_path(out), e))?;
     let info = XdmfInfo {
         n_nodes,
         kind,
@@ -246,7 +309,7 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         stress: stress.as_deref(),
     };
     let path = crate::xdmf::xdmf_path(out);
-    crate::xdmf::write_xdmf(out, &info).map_err(|e| beside(&path, &e))?;
+    crate::xdmf::write_xdmf(out, &info).map_err(|e| beside(&path, e.into()))?;
     // A surface of one node has no line to show.
     let line = contact.filter(|c| !c.lines.is_empty());
     let contact_path = crate::xdmf::contact_xdmf_path(out);
@@ -261,7 +324,7 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
                 fields: &fields,
             },
         )
-        .map_err(|e| beside(&contact_path, &e))?,
+        .map_err(|e| beside(&contact_path, e.into()))?,
         // One of an earlier results file would list other records.
         None => {
             let _ = std::fs::remove_file(&contact_path);
@@ -355,4 +418,36 @@ pub fn summary(out: &Path, w: &Written) -> String {
         crate::views::views_path(out).display(),
         xdmf.display()
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A create or rename that fails (however wrapped: in anyhow's context,
+    /// in an I/O error) is the place's, exit 2; any other failure of the
+    /// writing is the work's, exit 1, naming the file.
+    #[test]
+    fn the_place_is_bad_input_and_the_writing_a_failure() {
+        let (out, path) = (Path::new("d/run.h5"), Path::new("d/run.xdmf"));
+        let full = || std::io::Error::from_raw_os_error(libc::ENOSPC);
+        let placed = [
+            anyhow::Error::new(Unplaced("read-only".into())).context("cannot create d/run.xdmf"),
+            anyhow::Error::new(unplaced_io(&std::io::Error::from(
+                std::io::ErrorKind::PermissionDenied,
+            ))),
+        ];
+        for e in placed {
+            let e = place_or_write(out, "views", path, &e);
+            let input = e.downcast_ref::<InputError>().expect("bad input");
+            assert!(input.0.contains("cannot write d/run.xdmf"), "{input}");
+        }
+        let e = place_or_write(out, "views", path, &anyhow::Error::new(full()));
+        assert!(e.downcast_ref::<InputError>().is_none(), "{e}");
+        let e = e.to_string();
+        assert!(
+            e.contains("cannot write d/run.xdmf") && e.contains("stickslip views d/run.h5"),
+            "{e}"
+        );
+    }
 }

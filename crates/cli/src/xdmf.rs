@@ -288,11 +288,12 @@ fn replace(
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".part");
     let tmp = PathBuf::from(tmp);
-    let written = std::fs::File::create(&tmp).and_then(|f| {
+    let unplaced = |e: std::io::Error| crate::views_cmd::unplaced_io(&e);
+    let written = std::fs::File::create(&tmp).map_err(unplaced).and_then(|f| {
         let mut w = std::io::BufWriter::new(f);
         write(&mut w)?;
         w.into_inner().map_err(|e| e.into_error())?;
-        std::fs::rename(&tmp, path)
+        std::fs::rename(&tmp, path).map_err(unplaced)
     });
     // A failed write or rename (a full disk, a directory at `path`)
     // leaves nothing half written beside the results.

@@ -4,7 +4,8 @@
 //! exits 1 with a message, not a panic (101), and `run --json` says so
 //! with its file complete; `views` and `stress` refuse a place beside the
 //! results they cannot write with exit code 2, naming the path, and leave
-//! no `.part` behind.
+//! no `.part` behind; but a results file they cannot read, or a write that
+//! fails once the file is made, exits 1 naming the file involved.
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -99,6 +100,26 @@ fn probe_along_writes_over_no_file_unasked_and_never_the_results() {
     // --force goes with --along only.
     let o = probe(&h5, &["--at", "8,0", "--force"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+/// `--force` without `-o` has nothing to overwrite: refused (exit 2)
+/// before anything is read or printed, rather than ignored.
+#[test]
+fn probe_along_refuses_force_without_o() {
+    let dir = scratch("probe-force");
+    let h5 = slab_run(&dir);
+    let o = probe(&h5, &["--along", "contact", "--times", "0.01", "--force"]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("--force applies to -o FILE") && e.contains("leave out --force"),
+        "{e}"
+    );
+    assert!(
+        o.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
 }
 
 #[test]
@@ -298,4 +319,103 @@ fn advise_into_a_full_stdout_exits_1_without_a_panic() {
         return;
     };
     failed_to_write(&o, "advise");
+}
+
+/// `stickslip COMMAND RESULTS` with writes limited to files of a few KiB (and
+/// SIGXFSZ ignored, so that a write past it fails with EFBIG instead of
+/// killing the process): a write that fails after the file was made.
+fn with_small_files(command: &str, results: &Path) -> Output {
+    Command::new("sh")
+        .args([
+            "-c",
+            "trap '' XFSZ; ulimit -f 16 && exec \"$0\" \"$1\" \"$2\"",
+            env!("CARGO_BIN_EXE_stickslip"),
+            command,
+        ])
+        .arg(results)
+        .output()
+        .unwrap()
+}
+
+/// A write beside the results that fails once its file is made (a disk
+/// filled meanwhile; here a file-size limit) is the work failing, exit 1
+/// naming the file, not a place to change (exit 2); no `.part` is left.
+#[test]
+fn views_and_stress_failing_mid_write_exit_1() {
+    let dir = scratch("mid-write");
+    let h5 = slab_run(&dir);
+    for (command, file) in [("stress", "slab.stress.h5"), ("views", "slab.views.h5")] {
+        let o = with_small_files(command, &h5);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{command}: {e}");
+        assert!(
+            e.contains(&format!("cannot write {}:", dir.join(file).display()))
+                && e.contains("make room")
+                && !e.contains("writable directory"),
+            "{command}: {e}"
+        );
+        assert!(!e.contains("panicked"), "{e}");
+        assert!(!dir.join("slab.stress.h5.part").exists());
+    }
+}
+
+/// `stress` on a results file whose /displacement cannot be read (its
+/// compressed chunks overwritten): exit 1, the message naming the results
+/// file, not the stress file it would have written.
+#[test]
+fn stress_of_a_damaged_results_file_names_it() {
+    let dir = scratch("damaged");
+    let h5 = dir.join("slab.h5");
+    let o = run(
+        &data("slab.toml"),
+        &h5,
+        &["--quiet", "--set", "output.compression=4"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let chunks: Vec<(u64, u64)> = {
+        let f = hdf5::File::open(&h5).unwrap();
+        let u = f.dataset("displacement").unwrap();
+        (0..u.num_chunks().unwrap())
+            .map(|i| u.chunk_info(i).unwrap())
+            .map(|c| (c.addr, c.size))
+            .collect()
+    };
+    assert!(!chunks.is_empty());
+    {
+        use std::io::{Seek, SeekFrom, Write};
+        let mut f = File::options().write(true).open(&h5).unwrap();
+        for (addr, size) in chunks {
+            f.seek(SeekFrom::Start(addr)).unwrap();
+            f.write_all(&vec![0xff; size as usize]).unwrap();
+        }
+    }
+    let o = bin().arg("stress").arg(&h5).output().unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains(&format!("{}: cannot read /displacement", h5.display()))
+            && !e.contains("cannot write"),
+        "{e}"
+    );
+    assert!(!dir.join("slab.stress.h5").exists() && !dir.join("slab.stress.h5.part").exists());
+}
+
+/// `advise` with stderr on a full disk: its pilots' lines are lost, which
+/// exits 1 (not a panic's 101) once the work is done; --write is written.
+#[test]
+fn advise_into_a_full_stderr_exits_1_with_its_case_written() {
+    let dir = scratch("advise-stderr");
+    let written = dir.join("adjusted.toml");
+    let case = common::root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let mut cmd = bin();
+    cmd.arg("advise")
+        .arg(&case)
+        .args(["--tol", "2e-2", "--on", "ux", "--at", "8,1", "--write"])
+        .arg(&written);
+    let Some(o) = into_full(cmd, true) else {
+        eprintln!("skipped: no /dev/full");
+        return;
+    };
+    assert_eq!(o.status.code(), Some(1));
+    assert!(written.is_file());
 }

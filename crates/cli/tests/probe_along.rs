@@ -10,7 +10,7 @@ use std::process::Command;
 
 use hdf5::types::VarLenUnicode;
 use ndarray::{Array1, Array2, Array3};
-use stickslip::probe::{along, along_command, AlongArgs, Field};
+use stickslip::probe::{along, write_along, AlongArgs, Field};
 use stickslip_testkit::{scratch, workspace_root as root};
 
 /// Node index of grid point (gx, gy) of the 4 x 4 fixture grid: a fixed
@@ -202,9 +202,9 @@ fn fixture_orders_follow_the_boundary_with_the_body_on_the_left() {
     let e = along(&h5, "bottom", "0.1,x", Field::Ux).unwrap_err().0;
     assert!(e.contains("\"x\" is not a number"), "{e}");
 
-    // along_command writes the same CSV to -o.
+    // write_along (what main.rs calls) writes the same CSV to -o.
     let out = dir.join("along.csv");
-    along_command(
+    write_along(
         &h5,
         &AlongArgs {
             along: Some("hole".into()),
@@ -212,13 +212,14 @@ fn fixture_orders_follow_the_boundary_with_the_body_on_the_left() {
             output: Some(out.clone()),
         },
         Field::Ux,
+        false,
     )
     .unwrap();
     assert_eq!(
         std::fs::read_to_string(&out).unwrap(),
         along(&h5, "hole", "1", Field::Ux).unwrap().csv
     );
-    let e = along_command(
+    let e = write_along(
         &h5,
         &AlongArgs {
             along: Some("hole".into()),
@@ -226,8 +227,11 @@ fn fixture_orders_follow_the_boundary_with_the_body_on_the_left() {
             output: None,
         },
         Field::Ux,
+        false,
     )
     .unwrap_err()
+    .downcast::<stickslip_case::InputError>()
+    .unwrap()
     .0;
     assert!(e.contains("--times"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
@@ -305,8 +309,8 @@ fn slab_contact_and_support_quad9() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// Through the command line: fails until main.rs flattens
-/// `probe::AlongArgs` into `probe` and calls `probe::along_command`.
+/// Through the command line: main.rs flattens `probe::AlongArgs` into
+/// `probe` and calls `probe::write_along`.
 #[test]
 fn probe_along_through_the_binary() {
     let dir = scratch("binary");

@@ -98,6 +98,28 @@ pub struct Group {
     pub elements: usize,
 }
 
+impl Group {
+    /// The kind of Gmsh physical group it is declared as in a .geo:
+    /// `"Point"`, `"Curve"` or `"Surface"` (`Physical Curve(..) = {..};`).
+    pub fn physical_kind(&self) -> &'static str {
+        match self.dim {
+            0 => "Point",
+            1 => "Curve",
+            _ => "Surface",
+        }
+    }
+
+    /// What to do about a group without elements, which Gmsh writes for a
+    /// physical group whose entities are missing: "check the entities of
+    /// its Physical Curve in the .geo".
+    pub fn empty_remedy(&self) -> String {
+        format!(
+            "check the entities of its Physical {} in the .geo",
+            self.physical_kind()
+        )
+    }
+}
+
 /// Where a mesh came from and what the checks did to it.
 #[derive(Clone, Debug, PartialEq, Eq, Default)]
 pub struct SourceInfo {

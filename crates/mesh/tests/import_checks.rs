@@ -76,6 +76,20 @@ fn nodes_in_no_cell_are_dropped() {
     assert_eq!(m.group("body").unwrap().nodes, [0, 1, 2, 3, 4, 5]);
 }
 
+/// The kind a .geo declares each group as, which the messages about an
+/// empty group (`check`, `mesh`) name.
+#[test]
+fn groups_name_their_physical_kind() {
+    let m = parse_str(ORPHANS_22).unwrap();
+    for (name, kind) in [("pin", "Point"), ("bottom", "Curve"), ("body", "Surface")] {
+        assert_eq!(m.group(name).unwrap().physical_kind(), kind, "{name}");
+    }
+    assert_eq!(
+        m.group("centre").unwrap().empty_remedy(),
+        "check the entities of its Physical Point in the .geo"
+    );
+}
+
 #[test]
 fn a_mesh_without_unused_nodes_reports_none() {
     let m = load("slab_q9_v41_ascii.msh");

@@ -7,6 +7,8 @@ use anyhow::Context;
 
 use stickslip_case::{Case, InputError};
 
+use crate::console::WriteError;
+
 use super::adjusted::adjusted_case;
 use super::candidates::pick;
 use super::estimate::estimate;
@@ -124,9 +126,14 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
         )));
     }
     let json = o.json;
+    // A pilot's line that stderr refuses does not stop the pilots: the
+    // report and --write follow, and the loss exits 1 at the end.
+    let mut lost: Option<WriteError> = None;
     let mut log = |l: &str| {
         if !json {
-            eprintln!("{l}");
+            if let Err(e) = crate::console::err(&format!("{l}\n")) {
+                lost.get_or_insert(e);
+            }
         }
     };
     let est = estimate(case, o.quantity, o.at, &mut log)?;
@@ -146,8 +153,8 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
         report::measured(case, o, &est, &what)?;
     }
     let Some(c) = choice else {
-        report::not_reachable(case, o, &est, &what, best);
-        return Ok(Verdict::NotReachable);
+        report::not_reachable(case, o, &est, &what, best)?;
+        return lost.map_or(Ok(Verdict::NotReachable), |e| Err(e.into()));
     };
     if !json {
         report::choice(c, &est.ladder)?;
@@ -160,7 +167,7 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
             crate::console::out(&format!("written     {}\n", w.display()))?;
         }
     }
-    Ok(Verdict::Found)
+    lost.map_or(Ok(Verdict::Found), |e| Err(e.into()))
 }
 
 #[cfg(test)]

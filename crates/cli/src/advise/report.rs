@@ -134,16 +134,16 @@ pub(super) fn not_reachable(
     est: &Estimates,
     what: &str,
     best: Option<&Candidate>,
-) {
+) -> Result<(), WriteError> {
     let b = best.map_or("none".to_string(), |b| {
         format!("{:.3e} with {}", b.estimate(), describe(b, &est.ladder))
     });
-    eprintln!(
+    crate::console::err(&format!(
         "error: {}: no configuration of the ladder reaches an estimated error of {:e} on {what}; \
-         the smallest estimate is {b}; add finer meshes to mesh.ladder or loosen --tol",
+         the smallest estimate is {b}; add finer meshes to mesh.ladder or loosen --tol\n",
         case.path.display(),
         o.tol
-    );
+    ))
 }
 
 /// The choice, its estimate and its predicted time.
