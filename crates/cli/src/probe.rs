@@ -1107,10 +1107,11 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
 ///
 /// # Errors
 /// As [`along`]; `--times` missing; `force` without an output file; the
-/// output file existing (without `force`), being the results file, or not
-/// writable: an [`InputError`]. A failed write to stdout or stderr: a
-/// [`crate::console::WriteError`] (the CSV is written all the same where
-/// only stderr failed).
+/// output file existing (without `force`), being the results file, or its
+/// place not writable: an [`InputError`]. Writing the output file failing
+/// (a full disk): an error naming it, the file as it was. A failed write
+/// to stdout or stderr: a [`crate::console::WriteError`] (the CSV is
+/// written all the same where only stderr failed).
 pub fn write_along(file: &Path, args: &AlongArgs, field: Field, force: bool) -> anyhow::Result<()> {
     let group = args.along.as_deref().unwrap_or_default();
     if force && args.output.is_none() {
@@ -1132,15 +1133,57 @@ pub fn write_along(file: &Path, args: &AlongArgs, field: Field, force: bool) -> 
     let a = along(file, group, times, field)?;
     let info = crate::console::err(&a.info);
     match &args.output {
-        Some(out) => std::fs::write(out, &a.csv).map_err(|e| {
-            InputError(format!(
-                "-o {}: cannot write the CSV: {e}; check the directory exists and is writable",
-                out.display()
-            ))
-        })?,
+        Some(out) => write_csv(out, &a.csv)?,
         None => crate::console::out(&a.csv)?,
     }
     Ok(info?)
+}
+
+/// Writes `csv` into `out` through `out.part`, renamed into place once
+/// whole: a write that fails leaves `out` as it was (with `--force` the
+/// earlier CSV) and no `.part`. A link at `out` is written through, as
+/// before, by writing beside its target.
+///
+/// # Errors
+/// Creating or renaming refused where the place must change
+/// ([`crate::sys::place_error`]): an [`InputError`]; any other failure (a
+/// full disk, a quota, a file-size limit): an error naming `out`.
+fn write_csv(out: &Path, csv: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let linked = std::fs::symlink_metadata(out).is_ok_and(|m| m.file_type().is_symlink());
+    let target = match std::fs::canonicalize(out) {
+        Ok(t) if linked => t,
+        _ => out.to_path_buf(),
+    };
+    let part = crate::views_cmd::part_of(&target);
+    let failed = |path: &Path, e: std::io::Error| -> anyhow::Error {
+        if crate::sys::place_error(&e) {
+            InputError(format!(
+                "-o {}: cannot write {}: {e}; check the directory exists and is writable, or give \
+                 another file with -o",
+                out.display(),
+                path.display()
+            ))
+            .into()
+        } else {
+            anyhow::anyhow!(
+                "-o {}: cannot write the CSV: {e} (the file is as it was before); make room on its \
+                 disk if it is full, and run this again",
+                out.display()
+            )
+        }
+    };
+    let mut file = std::fs::File::create(&part).map_err(|e| failed(&part, e))?;
+    // The write's own errors are the work's whatever their OS error: only
+    // creating and renaming say whether the place is at fault.
+    let written = file
+        .write_all(csv.as_bytes())
+        .map_err(|e| failed(out, std::io::Error::new(e.kind(), e)))
+        .and_then(|()| std::fs::rename(&part, &target).map_err(|e| failed(out, e)));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&part);
+    }
+    written
 }
 
 /// Refuses `out` as `probe --along`'s CSV file where writing it would lose

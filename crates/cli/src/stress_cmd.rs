@@ -34,10 +34,12 @@ use stickslip_case::InputError;
 /// or not a results file of `stickslip run`, for a disk without room for
 /// the stresses, and for a place beside it that cannot take the stress
 /// file or the viewers' files (a directory in the way, a directory this
-/// process may not write, a create or rename that fails). Other errors
-/// (exit 1), each naming its file: reading the results file failing
-/// (`/displacement` of a damaged file), and writing into a file once
-/// created failing (a disk filled meanwhile).
+/// process may not write: a create or rename that fails by the OS error
+/// [`crate::sys::place_error`]). Other errors (exit 1), each naming its
+/// file: reading the results file failing (`/displacement` of a damaged
+/// file), and writing a file failing (a disk filled meanwhile, a quota, a
+/// file-size limit), its start (HDF5's first write) too. Nothing partial
+/// is left: the stress file is renamed into place once whole.
 pub fn command(
     path: &Path,
     quiet: bool,
@@ -82,10 +84,8 @@ pub fn command(
         }
     }
     // Written beside and renamed into place: a failure leaves no half file.
-    let written = write_stresses(path, &u, &mesh, &material, rows, quiet).and_then(|()| {
-        std::fs::rename(&part, &target)
-            .map_err(|e| crate::views_cmd::beside_failed(path, "stress", &target, e).into())
-    });
+    let written = write_stresses(path, &u, &mesh, &material, rows, quiet)
+        .and_then(|()| crate::views_cmd::rename_beside(path, "stress", &part, &target));
     if let Err(e) = written {
         let _ = std::fs::remove_file(&part);
         return Err(e);
@@ -105,27 +105,14 @@ fn part_path(out: &Path) -> std::path::PathBuf {
     out.with_extension("stress.h5.part")
 }
 
-/// A failure to read `/displacement` of the results file: the error of
-/// the work (exit 1), naming the file, and not the stress file's.
-#[derive(Debug)]
-struct Unread(String);
-
-impl std::fmt::Display for Unread {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for Unread {}
-
-/// [`Unread`] of the results file `out`.
+/// A failure to read `/displacement` of the results file `out`: the
+/// error of the work (exit 1), naming it, and not the stress file.
 fn unread(out: &Path, e: impl std::fmt::Display) -> anyhow::Error {
-    Unread(format!(
+    anyhow::anyhow!(
         "{}: cannot read /displacement: {e}; the file may be damaged (h5dump -H shows what HDF5 \
          can read of it): run the case again for a whole one",
         out.display()
-    ))
-    .into()
+    )
 }
 
 /// `/stress` and `/von_mises` of `rows` records of `u`, the displacement
@@ -133,9 +120,10 @@ fn unread(out: &Path, e: impl std::fmt::Display) -> anyhow::Error {
 /// renamed to [`stress_path`].
 ///
 /// # Errors
-/// Creating the file failing: an [`InputError`] (its place); reading `u`
-/// failing: an [`Unread`]; writing into the file failing: an error naming
-/// [`stress_path`], the file the user knows.
+/// Creating the file failing: [`crate::views_cmd::placed`]'s (the place,
+/// exit 2, or the disk); reading `u` failing: an error naming `out`;
+/// writing into the file failing: an error naming [`stress_path`], the
+/// file the user knows.
 fn write_stresses(
     out: &Path,
     u: &hdf5::Dataset,
@@ -144,16 +132,19 @@ fn write_stresses(
     rows: usize,
     quiet: bool,
 ) -> anyhow::Result<()> {
-    let (part, target) = (part_path(out), stress_path(out));
-    let g = File::create(&part)
-        .map_err(|e| crate::views_cmd::beside_failed(out, "stress", &target, e))?;
-    fill(&g, out, u, mesh, material, rows, quiet).map_err(|e| {
-        if e.is::<Unread>() {
-            e
-        } else {
-            crate::views_cmd::mid_write(out, "stress", &target, format!("{e:#}"))
-        }
-    })
+    let part = part_path(out);
+    crate::views_cmd::create_beside(out, "stress", &part)?;
+    let g = File::create(&part).map_err(|e| write_failed(out, e.into()))?;
+    fill(&g, out, u, mesh, material, rows, quiet)?;
+    // Closed before the rename, so that a failure of its last writes is
+    // seen here.
+    g.close().map_err(|e| write_failed(out, e.into()))
+}
+
+/// A failed write into the stress file of the results file `out`: the
+/// work's (exit 1), naming [`stress_path`].
+fn write_failed(out: &Path, e: anyhow::Error) -> anyhow::Error {
+    crate::views_cmd::mid_write(out, "stress", &stress_path(out), format!("{e:#}"))
 }
 
 /// [`write_stresses`] into the file `g` it created.
@@ -167,6 +158,44 @@ fn fill(
     quiet: bool,
 ) -> anyhow::Result<()> {
     let n_nodes = mesh.nodes.len();
+    let failed = |e: hdf5::Error| write_failed(out, e.into());
+    let (stress, mises) = datasets(g, n_nodes, rows).map_err(|e| write_failed(out, e))?;
+    let started = Instant::now();
+    let mut last = Instant::now();
+    for k in 0..rows {
+        let row: Vec<f64> = u
+            .read_slice_2d::<f64, _>(s![k, .., ..])
+            .map_err(|e| unread(out, e))?
+            .iter()
+            .copied()
+            .collect();
+        let st = stickslip_fem::nodal_stresses(mesh, material, &row);
+        let a = Array2::from_shape_fn((n_nodes, 3), |(i, c)| st[i][c]);
+        stress.write_slice(&a, s![k, .., ..]).map_err(failed)?;
+        let vm: Array1<f64> = st
+            .iter()
+            .map(|&s| stickslip_fem::von_mises(material, s))
+            .collect();
+        mises.write_slice(&vm, s![k, ..]).map_err(failed)?;
+        if !quiet && last.elapsed().as_secs() >= 10 {
+            last = Instant::now();
+            say!(
+                "stress: {} of {rows} records, {:.0} s",
+                k + 1,
+                started.elapsed().as_secs_f64()
+            );
+        }
+    }
+    stress_views(g, n_nodes, rows).map_err(failed)?;
+    g.flush().map_err(failed)
+}
+
+/// The empty `/stress` and `/von_mises` of `rows` records in `g`.
+fn datasets(
+    g: &File,
+    n_nodes: usize,
+    rows: usize,
+) -> anyhow::Result<(hdf5::Dataset, hdf5::Dataset)> {
     let stress = g
         .new_dataset::<f64>()
         .chunk((1, n_nodes, 3))
@@ -185,34 +214,12 @@ fn fill(
         "about",
         "von Mises stress of /stress (plane strain: sigma_zz = nu (sigma_xx + sigma_yy))",
     )?;
-    let started = Instant::now();
-    let mut last = Instant::now();
-    for k in 0..rows {
-        let row: Vec<f64> = u
-            .read_slice_2d::<f64, _>(s![k, .., ..])
-            .map_err(|e| unread(out, e))?
-            .iter()
-            .copied()
-            .collect();
-        let st = stickslip_fem::nodal_stresses(mesh, material, &row);
-        let a = Array2::from_shape_fn((n_nodes, 3), |(i, c)| st[i][c]);
-        stress.write_slice(&a, s![k, .., ..])?;
-        let vm: Array1<f64> = st
-            .iter()
-            .map(|&s| stickslip_fem::von_mises(material, s))
-            .collect();
-        mises.write_slice(&vm, s![k, ..])?;
-        if !quiet && last.elapsed().as_secs() >= 10 {
-            last = Instant::now();
-            say!(
-                "stress: {} of {rows} records, {:.0} s",
-                k + 1,
-                started.elapsed().as_secs_f64()
-            );
-        }
-    }
-    // One view per record and scalar for the XDMF readers (in this file,
-    // which goes with the stresses): "." is this file, whatever its name.
+    Ok((stress, mises))
+}
+
+/// One view per record and scalar for the XDMF readers, in `g` (which
+/// goes with the stresses): "." is that file, whatever its name.
+fn stress_views(g: &File, n_nodes: usize, rows: usize) -> hdf5::Result<()> {
     let views = g.create_group("views")?;
     for (c, name) in crate::xdmf::STRESS_VIEWS.iter().enumerate() {
         let v = views.create_group(name)?;
@@ -224,6 +231,5 @@ fn fill(
             }
         }
     }
-    g.flush()?;
     Ok(())
 }

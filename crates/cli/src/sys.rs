@@ -119,3 +119,27 @@ pub(crate) fn can_write_in(dir: &Path) -> bool {
     // SAFETY: a NUL-terminated path, which access only reads.
     unsafe { libc::access(c.as_ptr(), libc::W_OK) == 0 }
 }
+
+/// Whether `e`, the OS error of creating or renaming a file, is one its
+/// place must change for (bad input, exit 2): a directory this process
+/// may not write, a read-only file system, a directory or another file in
+/// the way, a directory missing. Any other (a full disk, a quota, a
+/// file-size limit, an I/O error) is the work failing (exit 1).
+pub(crate) fn place_error(e: &std::io::Error) -> bool {
+    matches!(
+        e.raw_os_error(),
+        Some(
+            libc::EACCES
+                | libc::EPERM
+                | libc::EROFS
+                | libc::EISDIR
+                | libc::ENOTDIR
+                | libc::ENOENT
+                | libc::ENOTEMPTY
+                | libc::EEXIST
+                | libc::ELOOP
+                | libc::ENAMETOOLONG
+                | libc::ETXTBSY
+        )
+    )
+}

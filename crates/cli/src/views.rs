@@ -29,7 +29,6 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use hdf5::{File, Hyperslab, Selection};
 use ndarray::Array2;
 use stickslip_mesh::Mesh;
@@ -143,49 +142,112 @@ pub struct Layout<'a> {
 /// `/displacement` and the others, its contact fields row `rows[k]` of
 /// `/contact/*` (its row of `/time`; `rows` has one entry a frame).
 ///
+/// The file is written beside, as `OUT.views.h5.part` (a copy of the views
+/// file where it has views to keep), and renamed into place: a failure
+/// midway leaves the views file as it was, or none, and no `.part`.
+///
 /// # Errors
-/// `out` without a UTF-8 file name, or HDF5 failing to create the file
-/// (its place: `stickslip views` says so as bad input) or to write into it.
+/// `out` without a UTF-8 file name; the place beside `out` refusing the
+/// file (an [`InputError`](stickslip_case::InputError), exit 2); writing
+/// it failing (an error naming the views file, exit 1).
 pub fn update(out: &Path, layout: &Layout, frame_rows: &[usize]) -> anyhow::Result<()> {
-    let rows = frame_rows.len();
     let source = file_name(out)?;
     let path = views_path(out);
     let n_c = layout.contact.map_or(0, |c| c.points.len());
-    let f = match open_matching(&path, source, layout.n_nodes, n_c) {
-        Some(f) => f,
-        None => create(&path, source, layout)
-            .with_context(|| format!("cannot create {}", path.display()))?,
-    };
-    let add = || -> hdf5::Result<()> {
-        for name in VECTORS {
-            let g = f.group(name)?;
-            for k in g.len() as usize..rows {
-                vector_view(&g, source, name, layout.n_nodes, k)?;
-            }
+    let held = File::open(&path)
+        .ok()
+        .filter(|f| matching(f, source, layout.n_nodes, n_c));
+    if let Some(f) = &held {
+        if holds_all(f, layout, frame_rows.len()) {
+            return Ok(());
         }
-        if n_c > 0 && f.group("contact").is_ok() {
-            for field in layout.fields {
-                let src = format!("contact/{}", field.name);
-                // A views file made before the results file held the
-                // field (a restart of an older file adds
-                // /contact/normal_stress) gets its group now.
-                let g = match f.group(&src) {
-                    Ok(g) => g,
-                    Err(_) => f.create_group(&src)?,
-                };
-                for k in g.len() as usize..rows {
-                    let at = (k, frame_rows[k]);
-                    if field.small {
-                        row_view::<i8>(&g, source, &src, n_c, at)?;
-                    } else {
-                        row_view::<f64>(&g, source, &src, n_c, at)?;
-                    }
+    }
+    let keep = held.is_some();
+    drop(held);
+    let part = crate::views_cmd::part_of(&path);
+    let written = write_aside(out, &part, keep, layout, frame_rows)
+        .and_then(|()| crate::views_cmd::rename_beside(out, "views", &part, &path));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&part);
+    }
+    written
+}
+
+/// [`update`]'s file at `part`: a copy of the views file with its views
+/// (`keep`), or a new one, with the views it lacks added.
+fn write_aside(
+    out: &Path,
+    part: &Path,
+    keep: bool,
+    layout: &Layout,
+    frame_rows: &[usize],
+) -> anyhow::Result<()> {
+    let source = file_name(out)?;
+    let path = views_path(out);
+    let mut file = crate::views_cmd::create_beside(out, "views", part)?;
+    let failed =
+        |e: anyhow::Error| crate::views_cmd::mid_write(out, "views", &path, format!("{e:#}"));
+    let f = if keep {
+        std::fs::File::open(&path)
+            .and_then(|mut from| std::io::copy(&mut from, &mut file))
+            .map_err(|e| failed(e.into()))?;
+        drop(file);
+        File::open_rw(part).map_err(|e| failed(e.into()))?
+    } else {
+        drop(file);
+        create(part, source, layout).map_err(failed)?
+    };
+    add(&f, source, layout, frame_rows).map_err(|e| failed(e.into()))?;
+    // Closed before the rename, so that a failure of its last writes is
+    // seen here.
+    f.close().map_err(|e| failed(e.into()))
+}
+
+/// Adds to the views file `f` the views of `frame_rows` it lacks.
+fn add(f: &File, source: &str, layout: &Layout, frame_rows: &[usize]) -> hdf5::Result<()> {
+    let rows = frame_rows.len();
+    let n_c = layout.contact.map_or(0, |c| c.points.len());
+    for name in VECTORS {
+        let g = f.group(name)?;
+        for k in g.len() as usize..rows {
+            vector_view(&g, source, name, layout.n_nodes, k)?;
+        }
+    }
+    if n_c > 0 && f.group("contact").is_ok() {
+        for field in layout.fields {
+            let src = format!("contact/{}", field.name);
+            // A views file made before the results file held the field (a
+            // restart of an older file adds /contact/normal_stress) gets
+            // its group now.
+            let g = match f.group(&src) {
+                Ok(g) => g,
+                Err(_) => f.create_group(&src)?,
+            };
+            for k in g.len() as usize..rows {
+                let at = (k, frame_rows[k]);
+                if field.small {
+                    row_view::<i8>(&g, source, &src, n_c, at)?;
+                } else {
+                    row_view::<f64>(&g, source, &src, n_c, at)?;
                 }
             }
         }
-        f.flush()
-    };
-    add().with_context(|| format!("cannot add views to {}", path.display()))
+    }
+    f.flush()
+}
+
+/// Whether the views file `f` has every view [`add`] would make for
+/// `rows` frames: then there is nothing to write.
+fn holds_all(f: &File, layout: &Layout, rows: usize) -> bool {
+    let full = |name: &str| f.group(name).is_ok_and(|g| g.len() as usize >= rows);
+    let n_c = layout.contact.map_or(0, |c| c.points.len());
+    VECTORS.iter().all(|v| full(v))
+        && (n_c == 0
+            || f.group("contact").is_err()
+            || layout
+                .fields
+                .iter()
+                .all(|c| full(&format!("contact/{}", c.name))))
 }
 
 /// `out`'s file name, by which the views and the XML refer to it.
@@ -198,23 +260,19 @@ pub(crate) fn file_name(out: &Path) -> anyhow::Result<&str> {
     })
 }
 
-/// The views file at `path`, open for writing, if it is one of `source`
-/// with these sizes.
-fn open_matching(path: &Path, source: &str, n_nodes: usize, n_c: usize) -> Option<File> {
-    let f = File::open_rw(path).ok()?;
+/// Whether `f` is a views file of `source` with these sizes.
+fn matching(f: &File, source: &str, n_nodes: usize, n_c: usize) -> bool {
     let size = |name: &str| f.attr(name).and_then(|a| a.read_scalar::<u64>()).ok();
-    let same = crate::output::text_attr(&f, "source").ok().as_deref() == Some(source)
+    crate::output::text_attr(f, "source").ok().as_deref() == Some(source)
         && size("n_nodes") == Some(n_nodes as u64)
         && size("n_contact") == Some(n_c as u64)
-        && VECTORS.iter().all(|v| f.group(v).is_ok());
-    same.then_some(f)
+        && VECTORS.iter().all(|v| f.group(v).is_ok())
 }
 
 /// A new, empty views file for `source` (the contact line's points and
 /// segments written whole: they are the mesh's, not a record's).
 fn create(path: &Path, source: &str, layout: &Layout) -> anyhow::Result<File> {
-    let _ = std::fs::remove_file(path);
-    let f = File::create(path).map_err(|e| crate::views_cmd::Unplaced(e.to_string()))?;
+    let f = File::create(path)?;
     crate::output::string_attr(
         &f,
         "about",

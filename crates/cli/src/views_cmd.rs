@@ -8,10 +8,10 @@
 //!
 //! The run writes none of these: their cost grows with the records, and a
 //! run of many cheap records paid several times its own time for them
-//! (docs/performance.md). The results file is only read; the XML files are
-//! written beside and renamed into place, and the views file only grows,
-//! so running the command again after a restart adds the new records'
-//! views.
+//! (docs/performance.md). The results file is only read; each file is
+//! written beside and renamed into place, and the views file only grows
+//! (a copy of it gets the new records' views), so running the command
+//! again after a restart adds the new records' views.
 
 use std::path::{Path, PathBuf};
 
@@ -45,9 +45,8 @@ pub struct Written {
 /// is writing, then writes the viewers' files beside it ([`write()`]).
 ///
 /// # Errors
-/// An [`InputError`] for a file that is missing, being written, or not a
-/// results file of `stickslip run`; other errors for HDF5 or file system
-/// failures.
+/// As [`write()`]; an [`InputError`] too for a file that is missing or
+/// being written.
 pub fn command(path: &Path) -> anyhow::Result<Written> {
     // No run may start on the file while its views are made.
     let (_lock, f) = crate::results_file::open_finished(path, false)?;
@@ -63,15 +62,19 @@ pub(crate) fn files(out: &Path) -> Vec<PathBuf> {
         crate::xdmf::xdmf_path(out),
         crate::xdmf::contact_xdmf_path(out),
     ];
-    let parts = xml.clone().map(|p| {
-        let mut part = p.into_os_string();
-        part.push(".part");
-        PathBuf::from(part)
-    });
-    let mut all = vec![crate::views::views_path(out)];
+    let views = crate::views::views_path(out);
+    let parts = [&views, &xml[0], &xml[1]].map(|p| part_of(p));
+    let mut all = vec![views];
     all.extend(xml);
     all.extend(parts);
     all
+}
+
+/// Where `path` is written before it is renamed into place: `path.part`.
+pub(crate) fn part_of(path: &Path) -> PathBuf {
+    let mut part = path.as_os_str().to_owned();
+    part.push(".part");
+    PathBuf::from(part)
 }
 
 /// What to do where `stickslip COMMAND` cannot write beside the results
@@ -130,40 +133,43 @@ pub(crate) fn check_beside(out: &Path, command: &str, files: &[PathBuf]) -> Resu
     Ok(())
 }
 
-/// A file beside the results file that could not be put in its place:
-/// created, or renamed into place (a directory it may not write, something
-/// in the way). Bad input (exit 2, [`beside_failed`]), where a failure
-/// while writing into the file once created (a full disk) is not.
-#[derive(Debug)]
-pub(crate) struct Unplaced(pub(crate) String);
-
-impl std::fmt::Display for Unplaced {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
+/// Creates (or truncates) `path` beside the results file `out` for
+/// `stickslip COMMAND`, before HDF5 or a writer fills it, so that the OS
+/// says whether the place or the work failed: HDF5's create writes at
+/// once and its error does not say which.
+///
+/// # Errors
+/// [`placed`]'s.
+pub(crate) fn create_beside(
+    out: &Path,
+    command: &str,
+    path: &Path,
+) -> anyhow::Result<std::fs::File> {
+    std::fs::File::create(path).map_err(|e| placed(out, command, path, e))
 }
 
-impl std::error::Error for Unplaced {}
-
-/// An [`Unplaced`] as an I/O error of `e`'s kind, for the functions that
-/// give I/O errors.
-pub(crate) fn unplaced_io(e: &std::io::Error) -> std::io::Error {
-    std::io::Error::new(e.kind(), Unplaced(e.to_string()))
+/// Renames `from` to `to` beside the results file `out`.
+///
+/// # Errors
+/// [`placed`]'s, naming `to`.
+pub(crate) fn rename_beside(
+    out: &Path,
+    command: &str,
+    from: &Path,
+    to: &Path,
+) -> anyhow::Result<()> {
+    std::fs::rename(from, to).map_err(|e| placed(out, command, to, e))
 }
 
-/// Whether `e`, or an error it wraps (an I/O error's too), is [`Unplaced`].
-fn is_unplaced(e: &(dyn std::error::Error + 'static)) -> bool {
-    let mut at = Some(e);
-    while let Some(e) = at {
-        let io_inner = e
-            .downcast_ref::<std::io::Error>()
-            .and_then(|io| io.get_ref());
-        if e.is::<Unplaced>() || io_inner.is_some_and(|i| i.is::<Unplaced>()) {
-            return true;
-        }
-        at = e.source();
+/// `e`, the OS error of creating, renaming or writing `path` beside the
+/// results file `out`: [`beside_failed`] (exit 2) where the place must
+/// change ([`crate::sys::place_error`]), else [`mid_write`] (exit 1).
+pub(crate) fn placed(out: &Path, command: &str, path: &Path, e: std::io::Error) -> anyhow::Error {
+    if crate::sys::place_error(&e) {
+        beside_failed(out, command, path, e).into()
+    } else {
+        mid_write(out, command, path, e)
     }
-    false
 }
 
 /// A failed create or rename of `path` beside the results file `out` (the
@@ -191,22 +197,13 @@ pub(crate) fn mid_write(
     path: &Path,
     e: impl std::fmt::Display,
 ) -> anyhow::Error {
+    // HDF5's messages carry a ctime(3) date with its newline.
+    let e = e.to_string().replace('\n', "");
     anyhow::anyhow!(
         "cannot write {}: {e}; make room on its disk if it is full, and run `stickslip {command} {}` again",
         path.display(),
         out.display()
     )
-}
-
-/// `e`, a failed write of `path` beside the results file `out`, as
-/// [`beside_failed`] where the place failed ([`Unplaced`]), else as
-/// [`mid_write`].
-fn place_or_write(out: &Path, command: &str, path: &Path, e: &anyhow::Error) -> anyhow::Error {
-    if is_unplaced(e.as_ref()) {
-        beside_failed(out, command, path, format!("{e:#}")).into()
-    } else {
-        mid_write(out, command, path, format!("{e:#}"))
-    }
 }
 
 /// Writes `OUT.views.h5`, `OUT.xdmf` and `OUT.contact.xdmf` for the
@@ -215,8 +212,13 @@ fn place_or_write(out: &Path, command: &str, path: &Path, e: &anyhow::Error) -> 
 /// file.
 ///
 /// # Errors
-/// A file without the datasets a run writes, a disk without room, or HDF5
-/// and file system failures, naming the file.
+/// An [`InputError`] (exit 2) for a file without the datasets a run
+/// writes, a disk without room, or a place beside it that cannot take a
+/// file (by the OS error of its create or rename:
+/// [`crate::sys::place_error`]); other errors (exit 1), naming the file,
+/// for a results file that does not read and a write that fails (its
+/// start too). Every file is written beside and renamed into place once
+/// whole, so a failure leaves none partial.
 pub fn write(out: &Path) -> anyhow::Result<Written> {
     let name = out.display().to_string();
     // The views and the XML name the results file by its file name.
@@ -298,9 +300,8 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         contact: contact.as_ref(),
         fields: &fields,
     };
-    let beside = |path: &Path, e: anyhow::Error| place_or_write(out, "views", path, &e);
-    crate::views::update(out, &layout, &frames.row[..rows])
-        .map_err(|e| beside(&crate::views::views_path(out), e))?;
+    let beside = |path: &Path, e: std::io::Error| placed(out, "views", path, e);
+    crate::views::update(out, &layout, &frames.row[..rows])?;
     let info = XdmfInfo {
         n_nodes,
         kind,
@@ -309,7 +310,7 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
         stress: stress.as_deref(),
     };
     let path = crate::xdmf::xdmf_path(out);
-    crate::xdmf::write_xdmf(out, &info).map_err(|e| beside(&path, e.into()))?;
+    crate::xdmf::write_xdmf(out, &info).map_err(|e| beside(&path, e))?;
     // A surface of one node has no line to show.
     let line = contact.filter(|c| !c.lines.is_empty());
     let contact_path = crate::xdmf::contact_xdmf_path(out);
@@ -324,7 +325,7 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
                 fields: &fields,
             },
         )
-        .map_err(|e| beside(&contact_path, e.into()))?,
+        .map_err(|e| beside(&contact_path, e))?,
         // One of an earlier results file would list other records.
         None => {
             let _ = std::fs::remove_file(&contact_path);
@@ -424,30 +425,43 @@ pub fn summary(out: &Path, w: &Written) -> String {
 mod tests {
     use super::*;
 
-    /// A create or rename that fails (however wrapped: in anyhow's context,
-    /// in an I/O error) is the place's, exit 2; any other failure of the
-    /// writing is the work's, exit 1, naming the file.
+    /// A create or rename refused where the place must change is bad
+    /// input, exit 2; the disk, a quota, a file-size limit or an I/O error
+    /// failing it is the work's, exit 1, naming the file.
     #[test]
     fn the_place_is_bad_input_and_the_writing_a_failure() {
         let (out, path) = (Path::new("d/run.h5"), Path::new("d/run.xdmf"));
-        let full = || std::io::Error::from_raw_os_error(libc::ENOSPC);
-        let placed = [
-            anyhow::Error::new(Unplaced("read-only".into())).context("cannot create d/run.xdmf"),
-            anyhow::Error::new(unplaced_io(&std::io::Error::from(
-                std::io::ErrorKind::PermissionDenied,
-            ))),
-        ];
-        for e in placed {
-            let e = place_or_write(out, "views", path, &e);
+        let os = std::io::Error::from_raw_os_error;
+        for errno in [
+            libc::EACCES,
+            libc::EPERM,
+            libc::EROFS,
+            libc::EISDIR,
+            libc::ENOTDIR,
+            libc::ENOENT,
+        ] {
+            let e = placed(out, "views", path, os(errno));
             let input = e.downcast_ref::<InputError>().expect("bad input");
-            assert!(input.0.contains("cannot write d/run.xdmf"), "{input}");
+            assert!(
+                input.0.contains("cannot write d/run.xdmf")
+                    && input.0.contains("writable directory"),
+                "{input}"
+            );
         }
-        let e = place_or_write(out, "views", path, &anyhow::Error::new(full()));
-        assert!(e.downcast_ref::<InputError>().is_none(), "{e}");
-        let e = e.to_string();
-        assert!(
-            e.contains("cannot write d/run.xdmf") && e.contains("stickslip views d/run.h5"),
-            "{e}"
-        );
+        for errno in [libc::ENOSPC, libc::EDQUOT, libc::EFBIG, libc::EIO] {
+            let e = placed(out, "views", path, os(errno));
+            assert!(e.downcast_ref::<InputError>().is_none(), "{e}");
+            let e = e.to_string();
+            assert!(
+                e.contains("cannot write d/run.xdmf") && e.contains("stickslip views d/run.h5"),
+                "{e}"
+            );
+        }
+        // A write's error, as the XML writer gives it, is the work's
+        // whatever its OS error.
+        let written = std::io::Error::new(std::io::ErrorKind::PermissionDenied, os(libc::EACCES));
+        assert!(placed(out, "views", path, written)
+            .downcast_ref::<InputError>()
+            .is_none());
     }
 }

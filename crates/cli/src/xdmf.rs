@@ -259,7 +259,9 @@ fn views_name(h5_name: &str) -> String {
 /// ([`crate::views_cmd::write`]).
 ///
 /// # Errors
-/// `out` without a UTF-8 file name (`InvalidInput`), or the write failing.
+/// `out` without a UTF-8 file name (`InvalidInput`), or the file failing:
+/// creating or renaming it with its OS error (which says whether the place
+/// is at fault: [`crate::views_cmd::placed`]), writing it with none.
 pub fn write_xdmf(out: &Path, info: &XdmfInfo) -> std::io::Result<()> {
     let name = crate::views::file_name(out)
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.to_string()))?;
@@ -285,15 +287,15 @@ fn replace(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".part");
-    let tmp = PathBuf::from(tmp);
-    let unplaced = |e: std::io::Error| crate::views_cmd::unplaced_io(&e);
-    let written = std::fs::File::create(&tmp).map_err(unplaced).and_then(|f| {
+    let tmp = crate::views_cmd::part_of(path);
+    // The write's own errors wrapped, their OS error hidden: only creating
+    // and renaming say whether the place is at fault.
+    let work = |e: std::io::Error| std::io::Error::new(e.kind(), e);
+    let written = std::fs::File::create(&tmp).and_then(|f| {
         let mut w = std::io::BufWriter::new(f);
-        write(&mut w)?;
-        w.into_inner().map_err(|e| e.into_error())?;
-        std::fs::rename(&tmp, path).map_err(unplaced)
+        write(&mut w).map_err(work)?;
+        w.into_inner().map_err(|e| work(e.into_error()))?;
+        std::fs::rename(&tmp, path)
     });
     // A failed write or rename (a full disk, a directory at `path`)
     // leaves nothing half written beside the results.
@@ -336,6 +338,24 @@ mod tests {
         .unwrap_err();
         assert!(!dir.join("x.xdmf.part").exists(), "{e}");
         assert!(!dir.join("x.xdmf").exists(), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// Only creating and renaming give their OS error, which says whether
+    /// the place is at fault: a write's never reads as the place's.
+    #[test]
+    fn a_failed_write_is_never_the_place() {
+        let dir = std::env::temp_dir().join(format!("stickslip-xdmf-os-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let e = replace(&dir.join("w.xdmf"), |_| {
+            Err(std::io::Error::from_raw_os_error(libc::EACCES))
+        })
+        .unwrap_err();
+        assert!(!crate::sys::place_error(&e), "{e}");
+        assert!(e.to_string().contains("Permission denied"), "{e}");
+        // A directory missing under it is the place's.
+        let e = replace(&dir.join("gone/w.xdmf"), |w| w.write_all(b"<Xdmf/>")).unwrap_err();
+        assert!(crate::sys::place_error(&e), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 

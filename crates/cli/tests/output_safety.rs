@@ -5,14 +5,19 @@
 //! with its file complete; `views` and `stress` refuse a place beside the
 //! results they cannot write with exit code 2, naming the path, and leave
 //! no `.part` behind; but a results file they cannot read, or a write that
-//! fails once the file is made, exits 1 naming the file involved.
+//! fails once started (HDF5's first write of a file too), exits 1 naming
+//! the file involved, and leaves no partial file (an earlier views file as
+//! it was); so does `probe --along -o FILE`, FILE as it was.
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
 mod common;
-use common::{bin, data, probe, run, scratch, stderr};
+use common::{bin, data, probe, run, scratch, skip_without, stderr};
+
+/// What to do where /dev/full is missing (a container without /dev).
+const NO_DEV_FULL: &str = "give the container its /dev (docker mounts /dev/full by default)";
 
 /// tests/data/slab.toml run into `dir/slab.h5`.
 fn slab_run(dir: &Path) -> PathBuf {
@@ -148,7 +153,7 @@ fn a_full_stdout_exits_1_without_a_panic() {
         ("probe --along", along),
     ] {
         let Some(o) = into_full(cmd, false) else {
-            eprintln!("skipped: no /dev/full");
+            skip_without("/dev/full", NO_DEV_FULL);
             return;
         };
         failed_to_write(&o, what);
@@ -173,7 +178,7 @@ fn run_json_into_a_full_stdout_exits_1_with_its_file_complete() {
         .arg(&h5)
         .args(["--quiet", "--json"]);
     let Some(o) = into_full(cmd, false) else {
-        eprintln!("skipped: no /dev/full");
+        skip_without("/dev/full", NO_DEV_FULL);
         return;
     };
     failed_to_write(&o, "run --json");
@@ -315,48 +320,152 @@ fn advise_into_a_full_stdout_exits_1_without_a_panic() {
         .arg(&case)
         .args(["--tol", "2e-2", "--on", "ux", "--at", "8,1"]);
     let Some(o) = into_full(cmd, false) else {
-        eprintln!("skipped: no /dev/full");
+        skip_without("/dev/full", NO_DEV_FULL);
         return;
     };
     failed_to_write(&o, "advise");
 }
 
-/// `stickslip COMMAND RESULTS` with writes limited to files of a few KiB (and
-/// SIGXFSZ ignored, so that a write past it fails with EFBIG instead of
-/// killing the process): a write that fails after the file was made.
-fn with_small_files(command: &str, results: &Path) -> Output {
+/// `stickslip ARGS…` with writes limited to files of `blocks` blocks of
+/// 512 bytes (and SIGXFSZ ignored, so that a write past it fails with
+/// EFBIG instead of killing the process): a write that fails after the
+/// file was made, at its first write with 0 blocks.
+fn with_small_files(blocks: u32, args: &[&std::ffi::OsStr]) -> Output {
     Command::new("sh")
         .args([
             "-c",
-            "trap '' XFSZ; ulimit -f 16 && exec \"$0\" \"$1\" \"$2\"",
+            &format!("trap '' XFSZ; ulimit -f {blocks} && exec \"$@\""),
+            "sh",
             env!("CARGO_BIN_EXE_stickslip"),
-            command,
         ])
-        .arg(results)
+        .args(args)
         .output()
         .unwrap()
 }
 
-/// A write beside the results that fails once its file is made (a disk
-/// filled meanwhile; here a file-size limit) is the work failing, exit 1
-/// naming the file, not a place to change (exit 2); no `.part` is left.
+/// The names in `dir` ending in `.part`.
+fn parts_in(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|d| d.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".part"))
+        .collect()
+}
+
+/// A write beside the results that fails once started (a disk filled
+/// meanwhile; here a file-size limit), HDF5's create writing its first
+/// bytes (no room at all) too, is the work failing: exit 1 naming the
+/// file, not a place to change (exit 2); no `.part` and no partial file
+/// is left.
 #[test]
 fn views_and_stress_failing_mid_write_exit_1() {
     let dir = scratch("mid-write");
     let h5 = slab_run(&dir);
-    for (command, file) in [("stress", "slab.stress.h5"), ("views", "slab.views.h5")] {
-        let o = with_small_files(command, &h5);
-        let e = stderr(&o);
-        assert_eq!(o.status.code(), Some(1), "{command}: {e}");
-        assert!(
-            e.contains(&format!("cannot write {}:", dir.join(file).display()))
-                && e.contains("make room")
-                && !e.contains("writable directory"),
-            "{command}: {e}"
-        );
-        assert!(!e.contains("panicked"), "{e}");
-        assert!(!dir.join("slab.stress.h5.part").exists());
+    for blocks in [0, 16] {
+        for (command, file) in [("stress", "slab.stress.h5"), ("views", "slab.views.h5")] {
+            let o = with_small_files(blocks, &[command.as_ref(), h5.as_os_str()]);
+            let e = stderr(&o);
+            let what = format!("{command} with {blocks} blocks");
+            assert_eq!(o.status.code(), Some(1), "{what}: {e}");
+            assert!(
+                e.contains(&format!("cannot write {}:", dir.join(file).display()))
+                    && e.contains("make room")
+                    && !e.contains("writable directory"),
+                "{what}: {e}"
+            );
+            assert!(!e.contains("panicked"), "{what}: {e}");
+            assert_eq!(parts_in(&dir), Vec::<String>::new(), "{what}: {e}");
+            for written in [
+                "slab.stress.h5",
+                "slab.views.h5",
+                "slab.xdmf",
+                "slab.contact.xdmf",
+            ] {
+                assert!(!dir.join(written).exists(), "{what} left {written}: {e}");
+            }
+        }
     }
+}
+
+/// `views` after a restart adds the new records' views to those it made
+/// before; where that fails midway, the views file it had is kept as it
+/// was (not lost, not left half grown), and the command run again adds
+/// them.
+#[test]
+fn views_failing_midway_keep_the_views_file_they_had() {
+    let dir = scratch("views-kept");
+    let h5 = dir.join("slab.h5");
+    let o = run(
+        &data("slab.toml"),
+        &h5,
+        &["--quiet", "--set", "time.t_end=0.01"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let views = dir.join("slab.views.h5");
+    let o = bin().arg("views").arg(&h5).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let before = std::fs::read(&views).unwrap();
+    let o = bin()
+        .arg("run")
+        .arg(data("slab.toml"))
+        .arg("--restart")
+        .arg(&h5)
+        .args(["--quiet", "--set", "time.t_end=0.05"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    for blocks in [0, 120] {
+        let o = with_small_files(blocks, &["views".as_ref(), h5.as_os_str()]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{blocks} blocks: {e}");
+        assert!(
+            e.contains(&format!("cannot write {}:", views.display())),
+            "{blocks} blocks: {e}"
+        );
+        assert!(
+            std::fs::read(&views).unwrap() == before,
+            "{blocks} blocks: {e}"
+        );
+        assert_eq!(parts_in(&dir), Vec::<String>::new(), "{e}");
+    }
+    let o = bin().arg("views").arg(&h5).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let f = hdf5::File::open(&views).unwrap();
+    assert_eq!(f.group("displacement").unwrap().len(), 51);
+}
+
+/// `probe --along -o FILE` whose write fails midway (a disk filled; here a
+/// file-size limit): exit 1 naming FILE, which is left as it was (with
+/// `--force`, the earlier CSV whole), and no `.part`.
+#[test]
+fn probe_along_failing_mid_write_keeps_the_file() {
+    let dir = scratch("probe-mid-write");
+    let h5 = slab_run(&dir);
+    let csv = dir.join("along.csv");
+    let earlier = "t_asked,t,record,node,x,y,s,ux\n".repeat(40);
+    std::fs::write(&csv, &earlier).unwrap();
+    let fresh = dir.join("fresh.csv");
+    for (out, force) in [(&csv, true), (&fresh, false)] {
+        let mut args: Vec<&std::ffi::OsStr> = vec!["probe".as_ref(), h5.as_os_str()];
+        args.extend(
+            ["--along", "contact", "--times", "0.01,0.02,0.03", "-o"].map(std::ffi::OsStr::new),
+        );
+        args.push(out.as_os_str());
+        if force {
+            args.push("--force".as_ref());
+        }
+        let o = with_small_files(1, &args);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{e}");
+        assert!(
+            e.contains(&format!("-o {}: cannot write the CSV", out.display()))
+                && !e.contains("panicked"),
+            "{e}"
+        );
+        assert_eq!(parts_in(&dir), Vec::<String>::new(), "{e}");
+    }
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), earlier);
+    assert!(!fresh.exists());
 }
 
 /// `stress` on a results file whose /displacement cannot be read (its
@@ -413,7 +522,7 @@ fn advise_into_a_full_stderr_exits_1_with_its_case_written() {
         .args(["--tol", "2e-2", "--on", "ux", "--at", "8,1", "--write"])
         .arg(&written);
     let Some(o) = into_full(cmd, true) else {
-        eprintln!("skipped: no /dev/full");
+        skip_without("/dev/full", NO_DEV_FULL);
         return;
     };
     assert_eq!(o.status.code(), Some(1));

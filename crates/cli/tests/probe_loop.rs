@@ -68,9 +68,25 @@ fn contact(h5: &Path) -> (Vec<usize>, Vec<f64>) {
     (nodes.iter().map(|&n| n as usize).collect(), s)
 }
 
-/// Every friction node's s is its /contact/s, bit for bit, and s grows
-/// along the output.
-fn on_the_solver_scale(a: &stickslip::probe::Along, h5: &Path) {
+/// The node indices of /mesh/nodes and their coordinates.
+fn coordinates(h5: &Path) -> ndarray::Array2<f64> {
+    let f = hdf5::File::open(h5).unwrap();
+    f.dataset("mesh/nodes").unwrap().read_2d::<f64>().unwrap()
+}
+
+/// Every friction node's s is its /contact/s, bit for bit; every node's
+/// s, those without friction too, is `arc`'s (the arc length from the
+/// solver's start, which the test computes itself): the first node's
+/// within `tol`, and each step from one node to the next within `tol` of
+/// `arc`'s, so that an error along the way shows where it is made rather
+/// than summed; and s grows along the output. Returns how many nodes
+/// carry no friction.
+fn on_the_solver_scale(
+    a: &stickslip::probe::Along,
+    h5: &Path,
+    arc: impl Fn(usize) -> f64,
+    tol: f64,
+) -> usize {
     let (nodes, s) = contact(h5);
     for (n, cs) in nodes.iter().zip(&s) {
         let j = a
@@ -85,7 +101,38 @@ fn on_the_solver_scale(a: &stickslip::probe::Along, h5: &Path) {
             a.s[j]
         );
     }
+    let held = |n: usize| {
+        if nodes.contains(&n) {
+            ""
+        } else {
+            " (no friction)"
+        }
+    };
+    let first = a.nodes[0];
+    assert!(
+        (a.s[0] - arc(first)).abs() <= tol,
+        "node {first}{}: s = {}, its arc length {}",
+        held(first),
+        a.s[0],
+        arc(first)
+    );
+    for (n, s) in a.nodes.windows(2).zip(a.s.windows(2)) {
+        let (step, arc_step) = (s[1] - s[0], arc(n[1]) - arc(n[0]));
+        assert!(
+            (step - arc_step).abs() <= tol,
+            "node {}{} to node {}{}: s from {} to {}, the arc length from {} to {}",
+            n[0],
+            held(n[0]),
+            n[1],
+            held(n[1]),
+            s[0],
+            s[1],
+            arc(n[0]),
+            arc(n[1])
+        );
+    }
     assert!(a.s.windows(2).all(|w| w[0] < w[1]), "{:?}", a.s);
+    a.nodes.iter().filter(|n| !nodes.contains(n)).count()
 }
 
 #[test]
@@ -100,11 +147,27 @@ fn a_hole_without_friction_at_the_solver_start_and_midway() {
     // Node index = tag − 1: (2, 2) is 10, (2, 1) 6, (1, 1) 5, (1, 2) 9.
     let (nodes, s) = contact(&h5);
     assert_eq!((nodes, s), (vec![6, 9], vec![1.0, 3.0]));
+    // Around the hole from (2, 2), clockwise (the body on the left).
+    let xy = coordinates(&h5);
+    let arc = |n: usize| {
+        let (x, y) = (xy[[n, 0]], xy[[n, 1]]);
+        if x == 2.0 && y == 2.0 {
+            0.0
+        } else if x == 2.0 {
+            2.0 - y
+        } else if y == 1.0 {
+            3.0 - x
+        } else if x == 1.0 {
+            1.0 + y
+        } else {
+            2.0 + x
+        }
+    };
     for field in [Field::Ux, Field::FrictionStress] {
         let a = along(&h5, "hole", "0.005", field).unwrap();
         assert_eq!(a.nodes, [10, 6, 5, 9], "{field:?}");
         assert_eq!(a.s, [0.0, 1.0, 2.0, 3.0], "{field:?}");
-        on_the_solver_scale(&a, &h5);
+        assert_eq!(on_the_solver_scale(&a, &h5, arc, 0.0), 2, "{field:?}");
     }
     let a = along(&h5, "hole", "0.005", Field::FrictionStress).unwrap();
     assert!(a.values[0][0].is_nan() && a.values[0][2].is_nan());
@@ -112,23 +175,21 @@ fn a_hole_without_friction_at_the_solver_start_and_midway() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The reviewer's case: cases/hole.geo meshed with quad9 cells, the hole
-/// the contact surface, its point (2.5, 1) held in y (its tangent there).
-/// Needs the gmsh Python module: under CI a failure without it, elsewhere
-/// a skip.
-#[test]
-fn the_hole_of_hole_geo_with_a_node_held() {
+/// cases/hole.geo with `more` appended, meshed with quad9 cells by the
+/// gmsh Python module into `dir`, run with the hole as the contact surface
+/// and the supports `held`: the results file and the mesh as the run read
+/// it. `None` where gmsh is missing (a failure under CI).
+fn hole_geo_run(dir: &Path, more: &str, held: &str) -> Option<(PathBuf, stickslip_mesh::Mesh)> {
     if !python_has(
         "gmsh",
         "python3 with gmsh is needed to mesh cases/hole.geo (pip install gmsh; cargo xtask test installs it)",
         "skipped: the gmsh Python module is not installed",
     ) {
-        return;
+        return None;
     }
-    let dir = scratch("probe-loop-geo");
     let geo = dir.join("hole.geo");
     let mut text = std::fs::read_to_string(root().join("cases/hole.geo")).unwrap();
-    text.push_str("Physical Point(\"hp\", 20) = {6};\n");
+    text.push_str(more);
     std::fs::write(&geo, text).unwrap();
     let msh = dir.join("hole-q2.msh");
     let script = "import sys, gmsh\n\
@@ -146,32 +207,91 @@ gmsh.finalize()\n";
         .output()
         .unwrap();
     assert!(o.status.success(), "gmsh: {}", stderr(&o));
-    // "hp" held in y only: at (2.5, 1) the hole's tangent is y.
-    let held = "\n[[dirichlet]]\ngroup = \"hp\"\nuy = 0.0\n";
-    let case = case(&dir, "hole-q2.msh", 5e-4, held);
+    let case = case(dir, "hole-q2.msh", 5e-4, held);
     let h5 = dir.join("out.h5");
     run_case(&case, &h5);
+    Some((h5, stickslip_mesh::Mesh::from_file(&msh).unwrap()))
+}
+
+/// The arc length on the hole of hole.geo (the circle of radius 0.5 about
+/// (2, 1)) from the node the solver's chain starts at, the first node of
+/// the group's first edge, clockwise (the body on the left): computed
+/// from the geometry, not by the code under test.
+fn circle_arc(h5: &Path, mesh: &stickslip_mesh::Mesh) -> (usize, impl Fn(usize) -> f64) {
+    let start = mesh.group("hole").unwrap().edges[0].nodes[0];
+    let xy = coordinates(h5);
+    assert_eq!([xy[[start, 0]], xy[[start, 1]]], mesh.nodes[start]);
+    let angle = move |n: usize| (xy[[n, 1]] - 1.0).atan2(xy[[n, 0]] - 2.0);
+    let from = angle(start);
+    let arc = move |n: usize| 0.5 * (from - angle(n)).rem_euclid(std::f64::consts::TAU);
+    (start, arc)
+}
+
+/// A step of s on the hole against the circle's: the run's arc length
+/// over a quad9 side (a parabola through three points of the circle)
+/// comes far nearer the circle's than the straight chord between two of
+/// its nodes does, and this lies between the two.
+const ARC_TOL: f64 = 2e-6;
+
+/// The reviewer's case: cases/hole.geo meshed with quad9 cells, the hole
+/// the contact surface, its point (2.5, 1) held in y (its tangent there).
+/// Needs the gmsh Python module: under CI a failure without it, elsewhere
+/// a skip.
+#[test]
+fn the_hole_of_hole_geo_with_a_node_held() {
+    let dir = scratch("probe-loop-geo");
+    let Some((h5, mesh)) = hole_geo_run(
+        &dir,
+        "Physical Point(\"hp\", 20) = {6};\n",
+        // "hp" held in y only: at (2.5, 1) the hole's tangent is y.
+        "\n[[dirichlet]]\ngroup = \"hp\"\nuy = 0.0\n",
+    ) else {
+        return;
+    };
     let a = along(&h5, "hole", "0.003", Field::Ux).unwrap();
-    on_the_solver_scale(&a, &h5);
-    let f = hdf5::File::open(&h5).unwrap();
-    let xy = f.dataset("mesh/nodes").unwrap().read_2d::<f64>().unwrap();
+    let (_, arc) = circle_arc(&h5, &mesh);
+    assert_eq!(on_the_solver_scale(&a, &h5, arc, ARC_TOL), 1);
+    let xy = coordinates(&h5);
     let held = (0..xy.nrows())
         .find(|&n| xy[[n, 0]] == 2.5 && xy[[n, 1]] == 1.0)
         .unwrap();
     let (nodes, _) = contact(&h5);
     assert!(!nodes.contains(&held), "(2.5, 1) carries no friction");
     assert_eq!(a.nodes.len(), nodes.len() + 1);
-    // Its s is the arc from the chain's start, clockwise (the body on the
-    // left) on the circle of radius 0.5 about (2, 1).
-    let angle = |n: usize| (xy[[n, 1]] - 1.0).atan2(xy[[n, 0]] - 2.0);
-    let start = a.nodes[0];
-    let turn = (angle(start) - angle(held)).rem_euclid(std::f64::consts::TAU);
-    let arc = 0.5 * turn;
-    let j = a.nodes.iter().position(|&n| n == held).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// cases/hole.geo with its whole Curve 5 (the hole's quarter from (2.5, 1)
+/// to (2, 1.5)) held, so that the node the solver's chain starts at, on
+/// that curve, carries no friction, nor do its neighbours either way: the
+/// held nodes at both ends of the chain get the run's arc length from it.
+#[test]
+fn the_hole_of_hole_geo_without_friction_at_the_chain_start() {
+    let dir = scratch("probe-loop-geo-start");
+    let Some((h5, mesh)) = hole_geo_run(
+        &dir,
+        "Physical Curve(\"quarter\", 21) = {5};\n",
+        "\n[[dirichlet]]\ngroup = \"quarter\"\nux = 0.0\nuy = 0.0\n",
+    ) else {
+        return;
+    };
+    let (start, arc) = circle_arc(&h5, &mesh);
+    let (nodes, s) = contact(&h5);
     assert!(
-        (a.s[j] - arc).abs() < 1e-3,
-        "s = {} at (2.5, 1), arc {arc}",
-        a.s[j]
+        !nodes.contains(&start),
+        "the chain's start carries no friction"
     );
+    // The friction nodes' s is measured from the held start.
+    assert!(s.iter().all(|&s| s > 0.1), "{s:?}");
+    for field in [Field::Ux, Field::FrictionStress] {
+        let a = along(&h5, "hole", "0.003", field).unwrap();
+        assert_eq!(a.nodes[0], start, "{field:?}");
+        let quarter = mesh.group("quarter").unwrap().nodes.len();
+        assert_eq!(
+            on_the_solver_scale(&a, &h5, &arc, ARC_TOL),
+            quarter,
+            "{field:?}"
+        );
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

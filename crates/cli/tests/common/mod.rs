@@ -65,6 +65,17 @@ pub fn python_has(modules: &str, missing: &str, skipped: &str) -> bool {
     has
 }
 
+/// A check that cannot run for want of `what`: under CI (where `cargo
+/// xtask test` provides it) a failure saying `remedy`, elsewhere a skip
+/// said on stderr. Call it where the test would return.
+pub fn skip_without(what: &str, remedy: &str) {
+    assert!(
+        std::env::var_os("CI").is_none(),
+        "{what} is missing here, and CI must run this test: {remedy}"
+    );
+    eprintln!("skipped: {what} is missing");
+}
+
 /// `python3 -c SCRIPT ARGS...`, which must succeed: what it printed.
 pub fn python<S: AsRef<OsStr>>(script: &str, args: &[S]) -> String {
     let o = Command::new("python3")
