@@ -65,7 +65,9 @@ impl Schedule {
     }
 
     /// About how many frames (the initial state included) a run of `steps`
-    /// steps of `dt` from t = 0 writes.
+    /// steps of `dt` from t = 0 writes, its last landing on t_end: by
+    /// [`Schedule::is_frame`]'s rule, exact where the steps are (Remark
+    /// 4.3's reduced steps add some).
     pub fn frames(&self, steps: f64, dt: f64) -> f64 {
         let by_steps = match self.fields {
             Fields::Every(n) => {
@@ -75,15 +77,20 @@ impl Schedule {
             _ => steps,
         };
         let by_time = match self.spacing() {
-            // Frames closer than a step fall on the same steps.
+            // Frames no closer than the steps: a step reaches at most one
+            // frame time, so the run writes one a frame time up to t_end,
+            // and its last step besides where that reaches none. Closer
+            // frames fall on every step.
             Some(h) => {
-                let k = (self.t_end / h * (1.0 + 1e-12)).floor();
-                let last = if (k * h - self.t_end).abs() <= 1e-6 * dt {
+                let t_prev = (steps - 1.0).max(0.0) * dt;
+                let tol = 1e-6 * (self.t_end - t_prev).abs();
+                let reached = ((self.t_end + tol) / h).floor();
+                let last = if reached > ((t_prev + tol) / h).floor() {
                     0.0
                 } else {
                     1.0
                 };
-                (k + last).min(steps)
+                (reached + last).min(steps)
             }
             None => by_steps,
         };
@@ -234,6 +241,39 @@ mod tests {
         let s = Schedule::new(Fields::Every(5), 0.02);
         assert_eq!(frames_of(&s, 1e-3, 20), vec![5, 10, 15, 20]);
         assert_eq!(s.frames(20.0, 1e-3), 5.0);
+    }
+
+    /// The count `stickslip check` says is the count a run writes: the
+    /// steps as the integrator takes them (k·Δt, the last landing on
+    /// t_end, shortened where t_end is off the grid), each put to
+    /// [`Schedule::is_frame`].
+    #[test]
+    fn the_frames_said_are_the_frames_written() {
+        for fields in [
+            Fields::Interval(0.003),
+            Fields::Interval(0.0025),
+            Fields::Interval(0.007),
+            Fields::Interval(1e-4),
+            Fields::Frames(7),
+            Fields::Frames(200),
+            Fields::Every(3),
+        ] {
+            for dt in [1e-3, 2.5e-3, 3e-3] {
+                for t_end in [0.1, 0.2, 0.1374, 0.099, 0.0021] {
+                    let s = Schedule::new(fields, t_end);
+                    let n = (t_end / dt - 1e-6).ceil() as u64;
+                    let at = |k: u64| if k == n { t_end } else { k as f64 * dt };
+                    let written = (1..=n)
+                        .filter(|&k| s.is_frame(k, at(k - 1), at(k), k == n))
+                        .count();
+                    assert_eq!(
+                        s.frames(n as f64, dt),
+                        (written + 1) as f64,
+                        "{fields:?}, dt = {dt}, t_end = {t_end}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

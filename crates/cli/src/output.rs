@@ -1113,6 +1113,75 @@ impl ResultsWriter {
         Ok(())
     }
 
+    /// Whether the last row appended is a frame (false without rows).
+    ///
+    /// # Errors
+    /// HDF5 errors reading `/frames/row`.
+    pub fn last_row_is_frame(&self) -> Result<bool> {
+        let Some(last) = self.rows.checked_sub(1) else {
+            return Ok(false);
+        };
+        let row = match self.pending.frame_row.last() {
+            Some(&r) => Some(r),
+            None if self.frames > 0 => {
+                let f = self.frames;
+                Some(
+                    self.series
+                        .frame_row
+                        .read_slice_1d::<u64, _>(s![f - 1..f])?[0],
+                )
+            }
+            None => None,
+        };
+        Ok(row == Some(last as u64))
+    }
+
+    /// Writes the fields of `rec` as a frame of the last row appended,
+    /// which has none (a record's histories are written once).
+    ///
+    /// # Errors
+    /// HDF5 errors, no row to add it to, or fields whose lengths do not
+    /// match the header.
+    pub fn frame_last_row(&mut self, rec: &Record) -> Result<()> {
+        let r = self.write_frame_of_last_row(rec);
+        self.failed_write(r)
+    }
+
+    fn write_frame_of_last_row(&mut self, rec: &Record) -> Result<()> {
+        let n = self.n_nodes;
+        ensure!(self.rows > 0, "no record to add a frame to");
+        for v in [rec.displacement, rec.velocity, rec.acceleration] {
+            ensure!(
+                v.len() == 2 * n,
+                "a frame has {} values a field, expected 2 * {n} nodes",
+                v.len()
+            );
+        }
+        // The frames before it go first, so that /frames stays in order.
+        self.write_pending()?;
+        let (f0, f1) = (self.frames, self.frames + 1);
+        let s = &self.series;
+        s.frame_time.resize(f1)?;
+        s.frame_time
+            .write_slice(ArrayView1::from(&[rec.t][..]), s![f0..f1])?;
+        s.frame_row.resize(f1)?;
+        s.frame_row
+            .write_slice(ArrayView1::from(&[(self.rows - 1) as u64][..]), s![f0..f1])?;
+        for (ds, v) in [
+            (&s.displacement, rec.displacement),
+            (&s.velocity, rec.velocity),
+            (&s.acceleration, rec.acceleration),
+        ] {
+            ds.resize((f1, n, 2))?;
+            ds.write_slice(
+                ndarray::ArrayView3::from_shape((1, n, 2), v)?,
+                s![f0..f1, .., ..],
+            )?;
+        }
+        self.frames = f1;
+        Ok(())
+    }
+
     /// Writes the `/solver` attributes (`wall_time_s`, `steps`,
     /// `factorizations`, `dt_crit` when known), the root attribute `failure`
     /// when the run stopped early, sets root `complete`, and closes the file.

@@ -629,9 +629,7 @@ fn run_scene(
     // ([`crate::results_file::in_use`]).
     let file_started = Instant::now();
     let _lock = if options.restart {
-        let lock = crate::results_file::RunLock::take(out)?;
-        forget_companions(out, quiet);
-        lock
+        crate::results_file::RunLock::take(out)?
     } else {
         crate::results_file::claim(out)?
     };
@@ -945,9 +943,24 @@ impl Session<'_> {
         let Ending {
             failure,
             interrupted,
-            before_last,
+            mut before_last,
         } = ending;
         let complete = failure.is_none() && interrupted.is_none();
+        // A restart at its checkpoint's time takes no step, and the row it
+        // ends on need not be a frame; the last step has its fields all
+        // the same. The state is that row's (the checkpoint's), and the
+        // checkpoint leaves the frame out, as it leaves out a last step,
+        // so that a later restart continues as a run that never stopped.
+        let on_last_row = self
+            .times
+            .last()
+            .is_some_and(|t| t.to_bits() == self.integrator.time().to_bits());
+        if complete && on_last_row && !self.writer.last_row_is_frame()? {
+            let kept = (self.writer.rows(), self.writer.frames());
+            let rec = record(&self.integrator, self.dofs, &mut self.full, (0.0, 0), true);
+            self.writer.frame_last_row(&rec)?;
+            before_last.get_or_insert_with(|| (self.integrator.checkpoint(), kept));
+        }
         if complete || interrupted.is_some() {
             // A failed run keeps the checkpoint of its last flush: the state at
             // the failure is not one to continue from.
@@ -1151,12 +1164,12 @@ fn view_command(out: &Path) -> String {
     format!("stickslip views {}", shell_word(&out.display().to_string()))
 }
 
-/// Before a restart: removes what `stickslip stress` and `stickslip views`
-/// wrote beside `out` for the earlier run (the stresses end where it
-/// ended, the XML lists its records), saying so. The views file stays: a
-/// view of a row is the same whatever run wrote the row, and `views`
-/// then adds only the new records' views.
-fn forget_companions(out: &Path, quiet: bool) {
+/// Once a restart is accepted, before it changes `out`: removes what `stickslip
+/// stress` and `stickslip views` wrote beside it for the earlier run (the
+/// stresses end where it ended, the XML lists its records), saying so.
+/// The views file stays: `views` then keeps the views that still hold
+/// and makes the others.
+pub(crate) fn forget_companions(out: &Path, quiet: bool) {
     let stress = crate::stress_cmd::stress_path(out);
     if stress.is_file() {
         std::fs::remove_file(&stress).ok();

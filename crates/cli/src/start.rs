@@ -170,6 +170,10 @@ pub(crate) fn resume(
     integrator
         .restore(cp)
         .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
+    // Only now that the restart is accepted: a refused one leaves every
+    // file as it was. Before the results change, so that no companion
+    // outlives the records it lists.
+    crate::run::forget_companions(out, quiet);
     let n_c = integrator.contact().map_or(0, |c| c.len());
     let mut writer = ResultsWriter::open_append(
         out,

@@ -21,15 +21,19 @@
 //! than a run writes a record, and six views a record made a run of many
 //! cheap records several times slower (docs/performance.md).
 //!
-//! The file only grows: each update adds the views of the records written
-//! since the last one (a view of a row is the same whatever run wrote the
-//! row), so after a restart only the new records' views are made. A file
-//! that cannot be opened (killed while adding views) or that belongs to
-//! other sizes is made anew.
+//! An update keeps the views that still hold and makes only the others:
+//! a body view names a frame's row of the fields, which no run moves, but
+//! a contact view names the frame's row of the histories, and a restart
+//! moves those (it drops the earlier run's last frame, a step shortened to
+//! land on its t_end, so the frames after it fall on other rows). So each
+//! contact view's row is read back from its mapping and compared with
+//! `/frames/row`; a view of another row, or of a frame the file no longer
+//! holds, is replaced or dropped. A file that cannot be opened (killed
+//! while adding views) or that belongs to other sizes is made anew.
 
 use std::path::{Path, PathBuf};
 
-use hdf5::{File, Hyperslab, Selection};
+use hdf5::{File, Hyperslab, Selection, SliceOrIndex};
 use ndarray::Array2;
 use stickslip_mesh::Mesh;
 
@@ -138,9 +142,10 @@ pub struct Layout<'a> {
 }
 
 /// Makes `OUT.views.h5` hold the views of the frames of the results file
-/// `out`, adding those it lacks: frame k's node vectors are row k of
+/// `out`, and no others: frame k's node vectors are row k of
 /// `/displacement` and the others, its contact fields row `rows[k]` of
-/// `/contact/*` (its row of `/time`; `rows` has one entry a frame).
+/// `/contact/*` (its row of `/time`; `rows` has one entry a frame). Views
+/// that already say so are kept, the others made.
 ///
 /// The file is written beside, as `OUT.views.h5.part` (a copy of the views
 /// file where it has views to keep), and renamed into place: a failure
@@ -154,18 +159,20 @@ pub fn update(out: &Path, layout: &Layout, frame_rows: &[usize]) -> anyhow::Resu
     let source = file_name(out)?;
     let path = views_path(out);
     let n_c = layout.contact.map_or(0, |c| c.points.len());
-    let held = File::open(&path)
+    // A file whose views cannot be read back is made anew.
+    let kept = File::open(&path)
         .ok()
-        .filter(|f| matching(f, source, layout.n_nodes, n_c));
-    if let Some(f) = &held {
-        if holds_all(f, layout, frame_rows.len()) {
-            return Ok(());
-        }
+        .filter(|f| matching(f, source, layout.n_nodes, n_c))
+        .and_then(|f| changes(&f, source, layout, frame_rows).ok());
+    if kept
+        .as_ref()
+        .is_some_and(|c| c.stale.is_empty() && !c.missing)
+    {
+        return Ok(());
     }
-    let keep = held.is_some();
-    drop(held);
     let part = crate::views_cmd::part_of(&path);
-    let written = write_aside(out, &part, keep, layout, frame_rows)
+    let stale = kept.as_ref().map(|c| &c.stale[..]);
+    let written = write_aside(out, &part, stale, layout, frame_rows)
         .and_then(|()| crate::views_cmd::rename_beside(out, "views", &part, &path));
     if written.is_err() {
         let _ = std::fs::remove_file(&part);
@@ -173,12 +180,86 @@ pub fn update(out: &Path, layout: &Layout, frame_rows: &[usize]) -> anyhow::Resu
     written
 }
 
-/// [`update`]'s file at `part`: a copy of the views file with its views
-/// (`keep`), or a new one, with the views it lacks added.
+/// How a views file departs from the views of its results file's frames.
+struct Changes {
+    /// Views to remove: past the last frame, or of a row that is no
+    /// longer their frame's.
+    stale: Vec<String>,
+    /// Some frame lacks a view (stale ones included).
+    missing: bool,
+}
+
+/// [`Changes`] of the views file `f` of `source` against the views of
+/// `frame_rows`.
+fn changes(f: &File, source: &str, layout: &Layout, frame_rows: &[usize]) -> hdf5::Result<Changes> {
+    let rows = frame_rows.len();
+    let mut groups: Vec<(String, bool)> = VECTORS.iter().map(|v| (v.to_string(), false)).collect();
+    let n_c = layout.contact.map_or(0, |c| c.points.len());
+    if n_c > 0 && f.group("contact").is_ok() {
+        groups.extend(
+            layout
+                .fields
+                .iter()
+                .map(|c| (format!("contact/{}", c.name), true)),
+        );
+    }
+    let mut c = Changes {
+        stale: Vec::new(),
+        missing: false,
+    };
+    for (name, by_history) in groups {
+        let Ok(g) = f.group(&name) else {
+            c.missing = true;
+            continue;
+        };
+        let mut good = 0;
+        for member in g.member_names()? {
+            let Ok(k) = member.parse::<usize>() else {
+                continue;
+            };
+            let holds = k < rows
+                && (!by_history
+                    || viewed_row(&g.dataset(&member)?, source, &name) == Some(frame_rows[k]));
+            if holds {
+                good += 1;
+            } else {
+                c.stale.push(format!("{name}/{member}"));
+            }
+        }
+        c.missing |= good < rows;
+    }
+    Ok(c)
+}
+
+/// The row of `src` in `source` that the view `ds` maps ([`row_view`]'s).
+fn viewed_row(ds: &hdf5::Dataset, source: &str, src: &str) -> Option<usize> {
+    let map = ds.create_plist().ok()?.virtual_map();
+    let [m] = &map[..] else {
+        return None;
+    };
+    if m.src_filename != source || m.src_dataset.trim_start_matches('/') != src {
+        return None;
+    }
+    match &m.src_selection {
+        Selection::Hyperslab(h) => match h.first()? {
+            SliceOrIndex::Index(r) => Some(*r),
+            SliceOrIndex::SliceCount {
+                start, count: 1, ..
+            }
+            | SliceOrIndex::SliceTo { start, .. } => Some(*start),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// [`update`]'s file at `part`: a copy of the views file without its
+/// `stale` views (where given), or a new one, with the views it lacks
+/// added.
 fn write_aside(
     out: &Path,
     part: &Path,
-    keep: bool,
+    stale: Option<&[String]>,
     layout: &Layout,
     frame_rows: &[usize],
 ) -> anyhow::Result<()> {
@@ -187,12 +268,16 @@ fn write_aside(
     let mut file = crate::views_cmd::create_beside(out, "views", part)?;
     let failed =
         |e: anyhow::Error| crate::views_cmd::mid_write(out, "views", &path, format!("{e:#}"));
-    let f = if keep {
+    let f = if let Some(stale) = stale {
         std::fs::File::open(&path)
             .and_then(|mut from| std::io::copy(&mut from, &mut file))
             .map_err(|e| failed(e.into()))?;
         drop(file);
-        File::open_rw(part).map_err(|e| failed(e.into()))?
+        let f = File::open_rw(part).map_err(|e| failed(e.into()))?;
+        for view in stale {
+            f.unlink(view).map_err(|e| failed(e.into()))?;
+        }
+        f
     } else {
         drop(file);
         create(part, source, layout).map_err(failed)?
@@ -209,8 +294,10 @@ fn add(f: &File, source: &str, layout: &Layout, frame_rows: &[usize]) -> hdf5::R
     let n_c = layout.contact.map_or(0, |c| c.points.len());
     for name in VECTORS {
         let g = f.group(name)?;
-        for k in g.len() as usize..rows {
-            vector_view(&g, source, name, layout.n_nodes, k)?;
+        for k in 0..rows {
+            if !g.link_exists(&k.to_string()) {
+                vector_view(&g, source, name, layout.n_nodes, k)?;
+            }
         }
     }
     if n_c > 0 && f.group("contact").is_ok() {
@@ -223,31 +310,19 @@ fn add(f: &File, source: &str, layout: &Layout, frame_rows: &[usize]) -> hdf5::R
                 Ok(g) => g,
                 Err(_) => f.create_group(&src)?,
             };
-            for k in g.len() as usize..rows {
-                let at = (k, frame_rows[k]);
+            for (k, &r) in frame_rows.iter().enumerate() {
+                if g.link_exists(&k.to_string()) {
+                    continue;
+                }
                 if field.small {
-                    row_view::<i8>(&g, source, &src, n_c, at)?;
+                    row_view::<i8>(&g, source, &src, n_c, (k, r))?;
                 } else {
-                    row_view::<f64>(&g, source, &src, n_c, at)?;
+                    row_view::<f64>(&g, source, &src, n_c, (k, r))?;
                 }
             }
         }
     }
     f.flush()
-}
-
-/// Whether the views file `f` has every view [`add`] would make for
-/// `rows` frames: then there is nothing to write.
-fn holds_all(f: &File, layout: &Layout, rows: usize) -> bool {
-    let full = |name: &str| f.group(name).is_ok_and(|g| g.len() as usize >= rows);
-    let n_c = layout.contact.map_or(0, |c| c.points.len());
-    VECTORS.iter().all(|v| full(v))
-        && (n_c == 0
-            || f.group("contact").is_err()
-            || layout
-                .fields
-                .iter()
-                .all(|c| full(&format!("contact/{}", c.name))))
 }
 
 /// `out`'s file name, by which the views and the XML refer to it.

@@ -9,9 +9,9 @@
 //! The run writes none of these: their cost grows with the records, and a
 //! run of many cheap records paid several times its own time for them
 //! (docs/performance.md). The results file is only read; each file is
-//! written beside and renamed into place, and the views file only grows
-//! (a copy of it gets the new records' views), so running the command
-//! again after a restart adds the new records' views.
+//! written beside and renamed into place; the views file keeps the views
+//! that still hold (a copy of it gets the others), so running the command
+//! again after a restart makes only the views the restart changed.
 
 use std::path::{Path, PathBuf};
 

@@ -158,3 +158,26 @@ fn a_run_without_friction_says_so() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `check` counts the frames by the run's own rule: a frame time inside
+/// the last step (here 66 · 0.003 = 0.198, in the step from 0.1975 to
+/// 0.2) makes that step a frame once, not twice.
+#[test]
+fn check_counts_the_frames_the_run_writes() {
+    let dir = scratch("frames-check-count");
+    let case = paper_case(&dir);
+    let sets = ["output.interval=0.003", "time.dt=2.5e-3", "time.t_end=0.2"];
+    let said = succeeded(&check(&case, &sets), "check");
+    assert!(said.contains("about 67 frames of u, v, a"), "{said}");
+    let out = dir.join("slab.h5");
+    let mut args = vec!["--quiet"];
+    for kv in &sets {
+        args.extend(["--set", kv]);
+    }
+    succeeded(&run(&case, &out, &args), "run");
+    let f = hdf5::File::open(&out).unwrap();
+    let frame_time: Vec<f64> = read_1d(&f, "frames/time");
+    assert_eq!(frame_time.len(), 67);
+    assert_eq!(*frame_time.last().unwrap(), 0.2);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1118,6 +1118,113 @@ fn restart_refuses_changed_physics_and_an_earlier_t_end() {
     ));
 }
 
+/// A restart refused (exit 2) changes nothing on disk: beside the results
+/// file, the viewers' files and the stresses stay byte for byte. A
+/// restart accepted removes the XML and the stresses, which list the
+/// earlier run's records.
+#[test]
+fn a_refused_restart_keeps_the_viewers_files_and_the_stresses() {
+    let dir = scratch("restart-refused-companions");
+    let (case, _) = slab_case(&dir, "companions", |t| t);
+    let out = dir.join("c.h5");
+    ok(&run(&case, &out, &[]));
+    for command in ["views", "stress"] {
+        ok(&bin()
+            .arg(command)
+            .arg(&out)
+            .arg("--quiet")
+            .output()
+            .unwrap());
+    }
+    let files = [
+        "c.h5",
+        "c.xdmf",
+        "c.contact.xdmf",
+        "c.views.h5",
+        "c.stress.h5",
+    ]
+    .map(|name| dir.join(name));
+    let before: Vec<Vec<u8>> = files.iter().map(|p| std::fs::read(p).unwrap()).collect();
+    for set in ["time.t_end=0.01", "time.dt=5e-4"] {
+        let o = restart(&case, &out, &["--set", set]);
+        assert_eq!(o.status.code(), Some(2), "{set}: {}", stderr(&o));
+        for (path, was) in files.iter().zip(&before) {
+            assert!(
+                std::fs::read(path).is_ok_and(|now| now == *was),
+                "{set}: {} changed",
+                path.display()
+            );
+        }
+    }
+    ok(&restart(&case, &out, &["--set", "time.t_end=0.08"]));
+    for gone in &files[1..3] {
+        assert!(!gone.exists(), "{}", gone.display());
+    }
+    assert!(!files[4].exists());
+    assert!(files[3].exists(), "the views file is kept");
+}
+
+/// A restart to its checkpoint's own time takes no step: the run's last
+/// step is the checkpoint's state, the row it continues after, which need
+/// not be a frame (7 frames of 0.1 / 7 over 3e-3 steps: rows 29 and 34
+/// are, row 33 is not). It ends complete with that row a frame, whose
+/// fields are those of a run that ends there, and a later restart from it
+/// continues as one from the file before.
+#[test]
+fn a_restart_at_the_checkpoint_time_ends_on_a_frame() {
+    let dir = scratch("restart-at-checkpoint");
+    let case = paper_case(&dir, "cd-step-eps1e-4.toml");
+    let sets = |t_end: &'static str| {
+        [
+            "--set",
+            "output.frames=7",
+            "--set",
+            "time.dt=3e-3",
+            "--set",
+            t_end,
+        ]
+    };
+    let part = dir.join("part.h5");
+    ok(&run(&case, &part, &sets("time.t_end=0.1")));
+    assert_eq!(checkpoint_attr::<f64>(&part, "t"), 0.099);
+    let other = dir.join("other.h5");
+    std::fs::copy(&part, &other).unwrap();
+    let rows = |p: &Path| {
+        let f = hdf5::File::open(p).unwrap();
+        f.dataset("frames/row").unwrap().read_raw::<u64>().unwrap()
+    };
+    assert_eq!(rows(&part), [0, 5, 10, 15, 20, 24, 29, 34]);
+    ok(&restart(&case, &part, &sets("time.t_end=0.099")));
+    let direct = dir.join("direct.h5");
+    ok(&run(&case, &direct, &sets("time.t_end=0.099")));
+    let (f, g) = (
+        hdf5::File::open(&part).unwrap(),
+        hdf5::File::open(&direct).unwrap(),
+    );
+    assert!(f.attr("complete").unwrap().read_scalar::<bool>().unwrap());
+    let read = |f: &hdf5::File, name: &str| f.dataset(name).unwrap().read_raw::<f64>().unwrap();
+    let time = read(&f, "time");
+    assert_eq!(time, read(&g, "time"));
+    assert_eq!(time.len(), 34);
+    assert_eq!(rows(&part).last(), Some(&33));
+    assert_eq!(read(&f, "frames/time").last(), Some(&0.099));
+    for name in ["displacement", "velocity", "acceleration"] {
+        let (a, b) = (read(&f, name), read(&g, name));
+        let n = 85 * 2;
+        let last = |v: &[f64]| {
+            v[v.len() - n..]
+                .iter()
+                .map(|x| x.to_bits())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(last(&a), last(&b), "{name} at the last step");
+    }
+    drop((f, g));
+    ok(&restart(&case, &part, &sets("time.t_end=0.2")));
+    ok(&restart(&case, &other, &sets("time.t_end=0.2")));
+    assert_same_datasets(&other, &part);
+}
+
 // ---------------------------------------------------------------------------
 // --json
 

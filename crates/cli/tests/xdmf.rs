@@ -593,3 +593,104 @@ fn views_of_a_file_without_contact_lines_shows_the_body() {
     assert_eq!(xml.matches("GridType=\"Uniform\"").count(), 6);
     assert!(!dir.join("old.contact.xdmf").exists());
 }
+
+/// The views file beside `h5` holds the views of its `frames` frames and
+/// no others: body view k reads frame k of the fields, contact view k the
+/// frame's row `/frames/row[k]` of the histories, bit for bit.
+fn assert_views_hold_the_frames(h5: &Path, frames: usize) {
+    let f = hdf5::File::open(h5).unwrap();
+    let rows = f.dataset("frames/row").unwrap().read_raw::<u64>().unwrap();
+    assert_eq!(rows.len(), frames);
+    let g = hdf5::File::open(h5.with_extension("views.h5")).unwrap();
+    let u = f
+        .dataset("displacement")
+        .unwrap()
+        .read::<f64, ndarray::Ix3>()
+        .unwrap();
+    assert_eq!(g.group("displacement").unwrap().len() as usize, frames);
+    for k in 0..frames {
+        let v = g
+            .dataset(&format!("displacement/{k}"))
+            .unwrap()
+            .read_2d::<f64>()
+            .unwrap();
+        let want = u.slice(ndarray::s![k, .., ..]);
+        assert_eq!(v.slice(ndarray::s![.., ..2]), want, "displacement/{k}");
+    }
+    for name in ["friction_stress", "slip_velocity", "normal_stress"] {
+        let h = f
+            .dataset(&format!("contact/{name}"))
+            .unwrap()
+            .read_2d::<f64>()
+            .unwrap();
+        let views = g.group(&format!("contact/{name}")).unwrap();
+        assert_eq!(views.len() as usize, frames, "{name}");
+        for (k, &r) in rows.iter().enumerate() {
+            let v = views
+                .dataset(&k.to_string())
+                .unwrap()
+                .read_1d::<f64>()
+                .unwrap();
+            let want = h.row(r as usize);
+            assert!(
+                v.iter().zip(want).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "contact/{name}/{k}: not row {r}"
+            );
+        }
+    }
+    let state = f.dataset("contact/state").unwrap().read_2d::<i8>().unwrap();
+    let views = g.group("contact/state").unwrap();
+    assert_eq!(views.len() as usize, frames);
+    for (k, &r) in rows.iter().enumerate() {
+        let v = views
+            .dataset(&k.to_string())
+            .unwrap()
+            .read_1d::<i8>()
+            .unwrap();
+        assert_eq!(v, state.row(r as usize), "contact/state/{k}: not row {r}");
+    }
+    let xml = std::fs::read_to_string(h5.with_extension("contact.xdmf")).unwrap();
+    assert_eq!(xml.matches("GridType=\"Uniform\"").count(), frames);
+}
+
+/// A restart moves frames to other rows of the histories: it drops the
+/// earlier run's last frame, the step shortened to land on its t_end, and
+/// its own frames follow the steps at full length. `views` run again
+/// points every contact view at its frame's row and drops the views of
+/// frames the file no longer holds.
+#[test]
+fn views_follow_the_frames_a_restart_moves() {
+    let dir = scratch("restart-rows");
+    let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let step = |h5: &Path, how: &str, sets: &[&str]| {
+        let mut args: Vec<&std::ffi::OsStr> = vec![
+            "run".as_ref(),
+            case.as_os_str(),
+            how.as_ref(),
+            h5.as_os_str(),
+            "--quiet".as_ref(),
+            "--set".as_ref(),
+            "time.dt=3e-3".as_ref(),
+        ];
+        for s in sets {
+            args.push("--set".as_ref());
+            args.push(s.as_ref());
+        }
+        stickslip(&args);
+        stickslip(&["views".as_ref(), h5.as_os_str(), "--quiet".as_ref()]);
+    };
+    // 3e-3 steps to t_end = 0.1: 33 of them and one of 1e-3 (row 34), a
+    // frame; continued to 0.2 at full length, frame 7 lands on row 39.
+    let h5 = dir.join("frames.h5");
+    step(&h5, "-o", &["output.frames=7", "time.t_end=0.1"]);
+    assert_views_hold_the_frames(&h5, 8);
+    step(&h5, "--restart", &["output.frames=7", "time.t_end=0.2"]);
+    assert_views_hold_the_frames(&h5, 11);
+    // Every step a frame: continued to the checkpoint's time (before the
+    // shortened step), the file keeps 34 of its 35 frames.
+    let h5 = dir.join("every.h5");
+    step(&h5, "-o", &["output.every=1", "time.t_end=0.1"]);
+    assert_views_hold_the_frames(&h5, 35);
+    step(&h5, "--restart", &["output.every=1", "time.t_end=0.099"]);
+    assert_views_hold_the_frames(&h5, 34);
+}
