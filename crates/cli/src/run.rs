@@ -941,11 +941,10 @@ impl Session<'_> {
         steps_before: u64,
     ) -> anyhow::Result<Outcome> {
         let Ending {
-            failure,
+            mut failure,
             interrupted,
             mut before_last,
         } = ending;
-        let complete = failure.is_none() && interrupted.is_none();
         // A restart at its checkpoint's time takes no step, and the row it
         // ends on need not be a frame; the last step has its fields all
         // the same. The state is that row's (the checkpoint's), and the
@@ -955,12 +954,23 @@ impl Session<'_> {
             .times
             .last()
             .is_some_and(|t| t.to_bits() == self.integrator.time().to_bits());
-        if complete && on_last_row && !self.writer.last_row_is_frame()? {
-            let kept = (self.writer.rows(), self.writer.frames());
-            let rec = record(&self.integrator, self.dofs, &mut self.full, (0.0, 0), true);
-            self.writer.frame_last_row(&rec)?;
-            before_last.get_or_insert_with(|| (self.integrator.checkpoint(), kept));
+        if failure.is_none()
+            && interrupted.is_none()
+            && on_last_row
+            && !self.writer.last_row_is_frame()?
+        {
+            // The frame fills a chunk like any row: room first.
+            match self.disk_nearly_full() {
+                Some(why) => failure = Some(why),
+                None => {
+                    let kept = (self.writer.rows(), self.writer.frames());
+                    let rec = record(&self.integrator, self.dofs, &mut self.full, (0.0, 0), true);
+                    self.writer.frame_last_row(&rec)?;
+                    before_last.get_or_insert_with(|| (self.integrator.checkpoint(), kept));
+                }
+            }
         }
+        let complete = failure.is_none() && interrupted.is_none();
         if complete || interrupted.is_some() {
             // A failed run keeps the checkpoint of its last flush: the state at
             // the failure is not one to continue from.

@@ -170,6 +170,22 @@ pub(crate) fn resume(
     integrator
         .restore(cp)
         .map_err(|e| input(format!("--restart {}: {e}", out.display())))?;
+    // A restart to the checkpoint's own time takes no step: it ends on
+    // the checkpoint's state, whose fields need that state's row, which
+    // output.every = n may have left out.
+    let row_there = stored.times.last().map(|t| t.to_bits()) == Some(cp.t.to_bits());
+    if integrator.done() && !row_there {
+        return Err(input(format!(
+            "{}time.t_end = {} ends the run at the checkpoint's t = {} in {}, a step without a \
+             row of its own (output.every), so its last step would have no fields; give a \
+             t_end > {}",
+            case.at("time.t_end"),
+            case.time.t_end,
+            cp.t,
+            out.display(),
+            cp.t
+        )));
+    }
     // Only now that the restart is accepted: a refused one leaves every
     // file as it was. Before the results change, so that no companion
     // outlives the records it lists.

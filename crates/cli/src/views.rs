@@ -24,16 +24,16 @@
 //! An update keeps the views that still hold and makes only the others:
 //! a body view names a frame's row of the fields, which no run moves, but
 //! a contact view names the frame's row of the histories, and a restart
-//! moves those (it drops the earlier run's last frame, a step shortened to
-//! land on its t_end, so the frames after it fall on other rows). So each
-//! contact view's row is read back from its mapping and compared with
-//! `/frames/row`; a view of another row, or of a frame the file no longer
-//! holds, is replaced or dropped. A file that cannot be opened (killed
+//! moves those (it drops the earlier run's last frame, so the frames
+//! after it fall on other rows). So each contact view keeps the row it
+//! maps in its attribute `row`, which is compared with `/frames/row`; a
+//! view of another row, without the attribute, or of a frame the file no
+//! longer holds, is replaced or dropped. A file that cannot be opened (killed
 //! while adding views) or that belongs to other sizes is made anew.
 
 use std::path::{Path, PathBuf};
 
-use hdf5::{File, Hyperslab, Selection, SliceOrIndex};
+use hdf5::{File, Hyperslab, Selection};
 use ndarray::Array2;
 use stickslip_mesh::Mesh;
 
@@ -163,7 +163,7 @@ pub fn update(out: &Path, layout: &Layout, frame_rows: &[usize]) -> anyhow::Resu
     let kept = File::open(&path)
         .ok()
         .filter(|f| matching(f, source, layout.n_nodes, n_c))
-        .and_then(|f| changes(&f, source, layout, frame_rows).ok());
+        .and_then(|f| changes(&f, layout, frame_rows).ok());
     if kept
         .as_ref()
         .is_some_and(|c| c.stale.is_empty() && !c.missing)
@@ -191,7 +191,7 @@ struct Changes {
 
 /// [`Changes`] of the views file `f` of `source` against the views of
 /// `frame_rows`.
-fn changes(f: &File, source: &str, layout: &Layout, frame_rows: &[usize]) -> hdf5::Result<Changes> {
+fn changes(f: &File, layout: &Layout, frame_rows: &[usize]) -> hdf5::Result<Changes> {
     let rows = frame_rows.len();
     let mut groups: Vec<(String, bool)> = VECTORS.iter().map(|v| (v.to_string(), false)).collect();
     let n_c = layout.contact.map_or(0, |c| c.points.len());
@@ -218,8 +218,7 @@ fn changes(f: &File, source: &str, layout: &Layout, frame_rows: &[usize]) -> hdf
                 continue;
             };
             let holds = k < rows
-                && (!by_history
-                    || viewed_row(&g.dataset(&member)?, source, &name) == Some(frame_rows[k]));
+                && (!by_history || viewed_row(&g.dataset(&member)?) == Some(frame_rows[k]));
             if holds {
                 good += 1;
             } else {
@@ -231,26 +230,11 @@ fn changes(f: &File, source: &str, layout: &Layout, frame_rows: &[usize]) -> hdf
     Ok(c)
 }
 
-/// The row of `src` in `source` that the view `ds` maps ([`row_view`]'s).
-fn viewed_row(ds: &hdf5::Dataset, source: &str, src: &str) -> Option<usize> {
-    let map = ds.create_plist().ok()?.virtual_map();
-    let [m] = &map[..] else {
-        return None;
-    };
-    if m.src_filename != source || m.src_dataset.trim_start_matches('/') != src {
-        return None;
-    }
-    match &m.src_selection {
-        Selection::Hyperslab(h) => match h.first()? {
-            SliceOrIndex::Index(r) => Some(*r),
-            SliceOrIndex::SliceCount {
-                start, count: 1, ..
-            }
-            | SliceOrIndex::SliceTo { start, .. } => Some(*start),
-            _ => None,
-        },
-        _ => None,
-    }
+/// The row the view `ds` maps, from its attribute `row` ([`row_view`]'s;
+/// a view written without it is made again).
+fn viewed_row(ds: &hdf5::Dataset) -> Option<usize> {
+    let row = ds.attr("row").and_then(|a| a.read_scalar::<u64>()).ok()?;
+    usize::try_from(row).ok()
 }
 
 /// [`update`]'s file at `part`: a copy of the views file without its
@@ -408,10 +392,17 @@ pub(crate) fn row_view<T: hdf5::H5Type>(
     (k, r): (usize, usize),
 ) -> hdf5::Result<()> {
     let row = Selection::from(Hyperslab::from((r..r + 1, 0..n)));
-    g.new_dataset::<T>()
+    let view = g
+        .new_dataset::<T>()
         .shape(n)
         .virtual_map(source, src, (rows_past(r), n), row, n, ..)
         .create(k.to_string().as_str())?;
+    // The row kept beside the mapping, for an update to compare with the
+    // frames: the mapping's hyperslab read back through hdf5-metno fails
+    // to convert ("blocks can not overlap").
+    view.new_attr::<u64>()
+        .create("row")?
+        .write_scalar(&(r as u64))?;
     Ok(())
 }
 

@@ -387,8 +387,8 @@ fn views_and_stress_failing_mid_write_exit_1() {
     }
 }
 
-/// `views` after a restart adds the new records' views to those it made
-/// before; where that fails midway, the views file it had is kept as it
+/// `views` after a restart brings the views it made before up to the
+/// frames (new ones added, moved ones pointed again); where that fails midway, the views file it had is kept as it
 /// was (not lost, not left half grown), and the command run again adds
 /// them.
 #[test]

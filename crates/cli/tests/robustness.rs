@@ -1225,6 +1225,39 @@ fn a_restart_at_the_checkpoint_time_ends_on_a_frame() {
     assert_same_datasets(&other, &part);
 }
 
+/// With output.every = 4 the checkpoint's step (33, before the last) has
+/// no row: a restart to its time would end complete without fields for
+/// its last step, so it is refused (exit 2, the file as it was).
+#[test]
+fn a_restart_at_a_checkpoint_without_its_row_is_refused() {
+    let dir = scratch("restart-at-checkpoint-every");
+    let case = paper_case(&dir, "cd-step-eps1e-4.toml");
+    let sets = |t_end: &'static str| {
+        [
+            "--set",
+            "output.every=4",
+            "--set",
+            "time.dt=3e-3",
+            "--set",
+            t_end,
+        ]
+    };
+    let part = dir.join("part.h5");
+    ok(&run(&case, &part, &sets("time.t_end=0.1")));
+    assert_eq!(checkpoint_attr::<f64>(&part, "t"), 0.099);
+    let before = std::fs::read(&part).unwrap();
+    let o = restart(&case, &part, &sets("time.t_end=0.099"));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("time.t_end") && e.contains("give a t_end > 0.099"),
+        "{e}"
+    );
+    assert!(std::fs::read(&part).unwrap() == before, "the file changed");
+    // A later t_end continues it.
+    ok(&restart(&case, &part, &sets("time.t_end=0.2")));
+}
+
 // ---------------------------------------------------------------------------
 // --json
 

@@ -694,3 +694,40 @@ fn views_follow_the_frames_a_restart_moves() {
     step(&h5, "--restart", &["output.every=1", "time.t_end=0.099"]);
     assert_views_hold_the_frames(&h5, 34);
 }
+
+/// A views file that holds the frames is left as it is by another
+/// `views`: its contact views' rows are read back and found right, so
+/// nothing is rebuilt (the file's bytes and time of change stay). A
+/// read-back that never found a view right would rebuild them all.
+#[test]
+fn views_again_leave_a_right_views_file_untouched() {
+    let dir = scratch("views-again");
+    let case = root().join("cases/martins-oden/cd-step-eps1e-4.toml");
+    let h5 = dir.join("again.h5");
+    stickslip(&[
+        "run".as_ref(),
+        case.as_os_str(),
+        "-o".as_ref(),
+        h5.as_os_str(),
+        "--quiet".as_ref(),
+        "--set".as_ref(),
+        "output.frames=7".as_ref(),
+    ]);
+    let views = dir.join("again.views.h5");
+    stickslip(&["views".as_ref(), h5.as_os_str(), "--quiet".as_ref()]);
+    let (bytes, changed) = (
+        std::fs::read(&views).unwrap(),
+        std::fs::metadata(&views).unwrap().modified().unwrap(),
+    );
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    stickslip(&["views".as_ref(), h5.as_os_str(), "--quiet".as_ref()]);
+    assert!(
+        std::fs::read(&views).unwrap() == bytes,
+        "the views file changed"
+    );
+    assert_eq!(
+        std::fs::metadata(&views).unwrap().modified().unwrap(),
+        changed,
+        "the views file was written again"
+    );
+}
