@@ -1172,21 +1172,7 @@ fn a_refused_restart_keeps_the_viewers_files_and_the_stresses() {
 /// continues as one from the file before.
 #[test]
 fn a_restart_at_the_checkpoint_time_ends_on_a_frame() {
-    let dir = scratch("restart-at-checkpoint");
-    let case = paper_case(&dir, "cd-step-eps1e-4.toml");
-    let sets = |t_end: &'static str| {
-        [
-            "--set",
-            "output.frames=7",
-            "--set",
-            "time.dt=3e-3",
-            "--set",
-            t_end,
-        ]
-    };
-    let part = dir.join("part.h5");
-    ok(&run(&case, &part, &sets("time.t_end=0.1")));
-    assert_eq!(checkpoint_attr::<f64>(&part, "t"), 0.099);
+    let (dir, case, part, sets) = run_to_a_tenth("restart-at-checkpoint", "output.frames=7");
     let other = dir.join("other.h5");
     std::fs::copy(&part, &other).unwrap();
     let rows = |p: &Path| {
@@ -1225,26 +1211,36 @@ fn a_restart_at_the_checkpoint_time_ends_on_a_frame() {
     assert_same_datasets(&other, &part);
 }
 
+/// The paper's explicit case with `output` (a `--set`) in a scratch
+/// directory `name`, run to t_end = 0.1 by Δt = 3e-3 (33 steps and a
+/// shortened one: the checkpoint, the state before the last step, at t =
+/// 0.099) into `part.h5`: (the directory, the case, the file, the sets
+/// for another t_end).
+fn run_to_a_tenth(
+    name: &str,
+    output: &'static str,
+) -> (
+    PathBuf,
+    PathBuf,
+    PathBuf,
+    impl Fn(&'static str) -> [&'static str; 6],
+) {
+    let dir = scratch(name);
+    let case = paper_case(&dir, "cd-step-eps1e-4.toml");
+    let sets =
+        move |t_end: &'static str| ["--set", output, "--set", "time.dt=3e-3", "--set", t_end];
+    let part = dir.join("part.h5");
+    ok(&run(&case, &part, &sets("time.t_end=0.1")));
+    assert_eq!(checkpoint_attr::<f64>(&part, "t"), 0.099);
+    (dir, case, part, sets)
+}
+
 /// With output.every = 4 the checkpoint's step (33, before the last) has
 /// no row: a restart to its time would end complete without fields for
 /// its last step, so it is refused (exit 2, the file as it was).
 #[test]
 fn a_restart_at_a_checkpoint_without_its_row_is_refused() {
-    let dir = scratch("restart-at-checkpoint-every");
-    let case = paper_case(&dir, "cd-step-eps1e-4.toml");
-    let sets = |t_end: &'static str| {
-        [
-            "--set",
-            "output.every=4",
-            "--set",
-            "time.dt=3e-3",
-            "--set",
-            t_end,
-        ]
-    };
-    let part = dir.join("part.h5");
-    ok(&run(&case, &part, &sets("time.t_end=0.1")));
-    assert_eq!(checkpoint_attr::<f64>(&part, "t"), 0.099);
+    let (_, case, part, sets) = run_to_a_tenth("restart-at-checkpoint-every", "output.every=4");
     let before = std::fs::read(&part).unwrap();
     let o = restart(&case, &part, &sets("time.t_end=0.099"));
     let e = String::from_utf8_lossy(&o.stderr);
