@@ -207,6 +207,29 @@ pub(crate) fn compliant_surface(
         .flat_map(|x| x.iter())
         .fold(0.0_f64, |m, v| m.max(v.abs()));
     let tolerance = 1e-9 * size.max(f.point[0].abs()).max(f.point[1].abs());
+    // The approach is read from a node's free components (a held one does
+    // not move); one held at a value other than 0 along the normal would
+    // move the node into or off the foundation unseen.
+    for k in &s.compliance {
+        let node = s.nodes[k.index].node;
+        for (a, axis) in ["ux", "uy"].iter().enumerate() {
+            let held = dofs.prescribed(node, a).filter(|&v| v != 0.0);
+            if let Some(v) = held.filter(|_| normal[a].abs() > 1e-12) {
+                let x = mesh.nodes[node];
+                problems.push(format!(
+                    "{}[contact]: node {} at ({}, {}) of group {:?} has {axis} = {v} from a \
+                     [[dirichlet]] condition, along the foundation's normal: the compliance law \
+                     measures the approach by the free components only, so it would not see that \
+                     motion; hold the node at {axis} = 0, or prescribe the motion on another group",
+                    at("foundation"),
+                    mesh.node_tags.get(node).copied().unwrap_or(node as u64),
+                    x[0],
+                    x[1],
+                    c.group,
+                ));
+            }
+        }
+    }
     for k in &mut s.compliance {
         if k.gap >= -tolerance {
             k.gap = k.gap.max(0.0);

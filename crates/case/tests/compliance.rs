@@ -359,3 +359,24 @@ foundation_history = { table = [[0.0, 0.0], [1.0, 1.0]] }
         assert_eq!(c.foundation_speed(j), 0.0, "floor node {j}");
     }
 }
+
+/// A contact node held by a [[dirichlet]] condition at a value other than
+/// 0 along the foundation's normal is refused: the approach is measured by
+/// the free components, so the law would not see that motion (the slab's
+/// corner (0, 0) is on "left" and on "contact").
+#[test]
+fn a_node_held_off_zero_along_the_normal_is_refused() {
+    let held = "[[dirichlet]]\ngroup = \"left\"\nuy = -0.01\n";
+    let text = slab(&format!("{held}{FLOOR}"), REST);
+    let e = assemble(&load(&text).unwrap()).unwrap_err().to_string();
+    assert_at(
+        &e,
+        &text,
+        "foundation =",
+        "has uy = -0.01 from a [[dirichlet]]",
+    );
+    assert!(e.contains("node 1 at (0, 0)"), "{e}");
+    // Held at 0 it is a support like any other.
+    let text = slab(&format!("{}{FLOOR}", held.replace("-0.01", "0.0")), REST);
+    assert!(assemble(&load(&text).unwrap()).is_ok());
+}

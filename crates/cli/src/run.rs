@@ -1214,15 +1214,30 @@ pub(crate) fn forget_companions(out: &Path, quiet: bool) {
 fn blow_up_failure(i: &Integrator, bound: f64, case: &Case) -> String {
     let e = i.energy();
     let crit = i.dt_crit().unwrap_or(f64::NAN);
+    // Below Δt_crit only a foundation stiffening with the approach
+    // (m_n > 1, whose bound time.allow_unstable let the run pass) makes
+    // the step unstable.
+    let why = if case.time.dt > crit || crit.is_nan() {
+        format!(
+            "central difference is unstable at time.dt = {:e}, above its critical step dt_crit = \
+             {crit:.6e}: use time.dt < {crit:.4e} (e.g. {:.4e}) and remove time.allow_unstable",
+            case.time.dt,
+            0.9 * crit
+        )
+    } else {
+        format!(
+            "central difference is unstable at time.dt = {:e}, below its critical step dt_crit = \
+             {crit:.6e} without the foundation's growing stiffness c_n m_n δ^(m_n−1): the approach \
+             made it stiffer than the step allows; remove time.allow_unstable to be stopped at the \
+             step the stiffness outgrows, with the time.dt it needs, or lower cn",
+            case.time.dt
+        )
+    };
     format!(
-        "step {} (t = {:.6e}): energy blow-up: kinetic + strain = {:.3e} exceeds {BLOW_UP_FACTOR} x (initial + |work| + dissipated) = {bound:.3e}; \
-         central difference is unstable at time.dt = {:e}, above its critical step dt_crit = {crit:.6e}: \
-         use time.dt < {crit:.4e} (e.g. {:.4e}) and remove time.allow_unstable",
+        "step {} (t = {:.6e}): energy blow-up: kinetic + strain = {:.3e} exceeds {BLOW_UP_FACTOR} x (initial + |work| + dissipated) = {bound:.3e}; {why}",
         i.steps(),
         i.time(),
         e.kinetic + e.strain,
-        case.time.dt,
-        0.9 * crit
     )
 }
 

@@ -514,6 +514,35 @@ fn dt_above_the_critical_step_is_refused_with_dt_crit() {
 // ---------------------------------------------------------------------------
 // 2. A run that fails: exit 1, every step kept, reason in the file.
 
+/// A foundation stiffening with the approach (m_n = 2, c_n = 1e10) run
+/// past its bound by time.allow_unstable blows up at a Δt below Δt_crit:
+/// the message says so, not that Δt is above Δt_crit (which it is not).
+#[test]
+fn a_stiffening_foundation_blow_up_says_what_made_it() {
+    let dir = scratch("stiffening-blowup");
+    let mesh = root().join("cases/meshes/slab-q1-16x4.msh");
+    let text = format!(
+        "[mesh]\nfile = \"{}\"\n[material]\nE = 1000.0\nnu = 0.3\nrho = 1.0\n\
+         [[dirichlet]]\ngroup = \"left\"\nux = 0.0\n\
+         [[traction]]\ngroup = \"support\"\npressure = 300.0\nhistory = \"step\"\n\
+         [contact]\ngroup = \"contact\"\nlaw = \"compliance\"\n\
+         foundation = {{ point = [0.0, 0.0], normal = [0.0, 1.0] }}\ncn = 1e10\nmn = 2.0\nmu = 0.0\neps = 1e-3\n\
+         [initial]\nstate = \"rest\"\n\
+         [time]\nscheme = \"central_difference\"\ndt = 1e-3\nt_end = 0.2\nallow_unstable = true\n",
+        mesh.display()
+    );
+    let case = dir.join("stiff.toml");
+    std::fs::write(&case, text).unwrap();
+    let o = run(&case, &dir.join("stiff.h5"), &[]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("energy blow-up"), "{e}");
+    assert!(
+        e.contains("below its critical step") && !e.contains("above its critical step"),
+        "{e}"
+    );
+}
+
 #[test]
 fn an_unstable_explicit_run_stops_at_the_blow_up_and_keeps_its_steps() {
     // dt = 6e-3 > Δt_crit = 5.6e-3 (printed by `check`): with
