@@ -1155,14 +1155,16 @@ fn write_csv(out: &Path, csv: &str) -> anyhow::Result<()> {
         Ok(t) if linked => t,
         _ => out.to_path_buf(),
     };
-    let part = crate::views_cmd::part_of(&target);
-    let failed = |path: &Path, e: std::io::Error| -> anyhow::Error {
+    // Written beside and renamed into place as the viewers' XML is: only
+    // its create and rename keep their OS error, which says whether the
+    // place is at fault.
+    crate::xdmf::replace(&target, |w| w.write_all(csv.as_bytes())).map_err(|e| {
         if crate::sys::place_error(&e) {
             InputError(format!(
                 "-o {}: cannot write {}: {e}; check the directory exists and is writable, or give \
                  another file with -o",
                 out.display(),
-                path.display()
+                target.display()
             ))
             .into()
         } else {
@@ -1172,18 +1174,7 @@ fn write_csv(out: &Path, csv: &str) -> anyhow::Result<()> {
                 out.display()
             )
         }
-    };
-    let mut file = std::fs::File::create(&part).map_err(|e| failed(&part, e))?;
-    // The write's own errors are the work's whatever their OS error: only
-    // creating and renaming say whether the place is at fault.
-    let written = file
-        .write_all(csv.as_bytes())
-        .map_err(|e| failed(out, std::io::Error::new(e.kind(), e)))
-        .and_then(|()| std::fs::rename(&part, &target).map_err(|e| failed(out, e)));
-    if written.is_err() {
-        let _ = std::fs::remove_file(&part);
-    }
-    written
+    })
 }
 
 /// Refuses `out` as `probe --along`'s CSV file where writing it would lose

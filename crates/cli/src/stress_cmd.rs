@@ -102,7 +102,7 @@ pub fn stress_path(out: &Path) -> std::path::PathBuf {
 
 /// Where [`stress_path`] is written before it is renamed into place.
 fn part_path(out: &Path) -> std::path::PathBuf {
-    out.with_extension("stress.h5.part")
+    crate::views_cmd::part_of(&stress_path(out))
 }
 
 /// A failure to read `/displacement` of the results file `out`: the

@@ -283,7 +283,7 @@ pub fn write_contact_xdmf(out: &Path, times: &[f64], info: &ContactInfo) -> std:
 
 /// Writes `path` beside and renames it over: a reader (or a kill -9
 /// mid-write) never meets half a file.
-fn replace(
+pub(crate) fn replace(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
