@@ -22,8 +22,9 @@ nodes, all of them during the rise.
 How
 ---
 1. Mesh part.geo with the gmsh Python module (16 x 8 quad4 cells).
-2. Run case.toml (central difference: a friction coefficient that changes
-   with the slip speed needs the explicit scheme's nodal closed form).
+2. Run case.toml (central difference, whose nodal closed form takes the
+   friction coefficient at the step's own slip speed; Newmark also runs a
+   speed-dependent mu, at the previous step's slip: docs/case-file.md).
 3. Read part.h5 with h5py: the corner's u_x and v_x and the contact
    states, into OUT/belt.png.
 
