@@ -9,16 +9,20 @@ use stickslip_contact::{Compliance, ContactError, ContactSurface};
 use stickslip_fem::DofMap;
 use stickslip_mesh::Mesh;
 
+use crate::load::Num;
 use crate::schema::{ContactLaw, ContactSection, History, InitialState, Mu};
 
 /// The compliance law's keys, refused on a prescribed-pressure surface.
 const COMPLIANCE_KEYS: [&str; 5] = ["foundation", "cn", "mn", "ct", "mt"];
 
 /// Checks surface `c`'s law keys through `check(ok, key, message)`;
-/// `key` gives a key's dotted path on this surface.
+/// `key` gives a key's dotted path on this surface; `reported(k)`: key `k`
+/// had a value, reported already as wrong and taken out, so it is not
+/// missing (`mu = nan` was also "needs mu = ...").
 pub(crate) fn check_law(
     c: &ContactSection,
     key: &dyn Fn(&str) -> String,
+    reported: &dyn Fn(&str) -> bool,
     check: &mut dyn FnMut(bool, &str, String),
 ) {
     let given = |k: &str| match k {
@@ -46,7 +50,7 @@ pub(crate) fn check_law(
             ("mu", c.mu.is_some(), "the Coulomb coefficient"),
         ] {
             check(
-                v,
+                v || reported(k),
                 &key("group"),
                 format!(
                     "contact (group {:?}) needs {k} = ..., {what}, for its prescribed-pressure law; \
@@ -57,12 +61,13 @@ pub(crate) fn check_law(
         }
         return;
     }
-    check_compliance(c, key, check);
+    check_compliance(c, key, reported, check);
 }
 
 fn check_compliance(
     c: &ContactSection,
     key: &dyn Fn(&str) -> String,
+    reported: &dyn Fn(&str) -> bool,
     check: &mut dyn FnMut(bool, &str, String),
 ) {
     let law = key("law");
@@ -82,7 +87,7 @@ fn check_compliance(
     }
     match &c.foundation {
         None => check(
-            false,
+            reported("foundation"),
             &law,
             "law = \"compliance\" needs foundation = { point = [x, y], normal = [nx, ny] } (a \
              straight rigid foundation, its normal pointing towards the body)"
@@ -101,7 +106,7 @@ fn check_compliance(
     }
     match c.cn {
         None => check(
-            false,
+            reported("cn"),
             &law,
             "law = \"compliance\" needs cn = ..., the foundation's stiffness c_n > 0 (σ_n = c_n δ^mn)"
                 .into(),
@@ -109,7 +114,7 @@ fn check_compliance(
         Some(cn) => check(
             cn > 0.0,
             &key("cn"),
-            format!("contact.cn = {cn} must be > 0: the foundation's stiffness, σ_n = cn δ^mn"),
+            format!("contact.cn = {} must be > 0: the foundation's stiffness, σ_n = cn δ^mn", Num(cn)),
         ),
     }
     for k in ["mn", "mt"] {
@@ -119,8 +124,9 @@ fn check_compliance(
                 m >= 1.0,
                 &key(k),
                 format!(
-                    "contact.{k} = {m} must be >= 1: a power below 1 has an infinite stiffness at \
-                     first touch; 1 is a linear spring"
+                    "contact.{k} = {} must be >= 1: a power below 1 has an infinite stiffness at \
+                     first touch; 1 is a linear spring",
+                    Num(m)
                 ),
             );
         }
@@ -152,7 +158,7 @@ fn check_compliance(
             "contact: give mu (c_T = mu cn, mt = mn) or ct (with mt), not both".into(),
         ),
         (None, None) => check(
-            false,
+            reported("mu") || reported("ct"),
             &law,
             "law = \"compliance\" needs mu = ... (c_T = mu cn, mt = mn) or ct = ... (the friction \
              bound c_T δ^mt); mu = 0 for a frictionless foundation"
@@ -161,7 +167,7 @@ fn check_compliance(
         (_, Some(ct)) => check(
             ct >= 0.0,
             &key("ct"),
-            format!("contact.ct = {ct} must be >= 0: the friction bound is ct δ^mt"),
+            format!("contact.ct = {} must be >= 0: the friction bound is ct δ^mt", Num(ct)),
         ),
         (Some(_), None) => check(
             c.mt.is_none(),

@@ -10,7 +10,7 @@ use std::ops::Range;
 
 use toml_edit::{Item, TableLike, Value};
 
-use crate::schema::{sections, Kind};
+use crate::schema::{sections, Kind, ROOT};
 
 /// A key whose value had the wrong type: its path, the placeholder put in
 /// its place (`None`: removed), and where it was.
@@ -72,18 +72,63 @@ fn nearest<'a>(key: &str, valid: &[(&'a str, Kind)]) -> Option<&'a str> {
         .map(|(_, v)| v)
 }
 
+/// Whether the key at `path`, removed as unknown, stood for `missing`, a
+/// key serde then finds missing: `missing` is a key of the same table,
+/// and its only one or the one nearest the removed key (a typo). Then the
+/// unknown key's message, which names `missing`, says it all
+/// (`pressure_profile = { sin = .. }` was also "missing field `table`").
+pub(crate) fn stood_for(path: &[Seg], missing: &str) -> bool {
+    let Some((Seg::Key(leaf), parent)) = path.split_last() else {
+        return false;
+    };
+    let mut keys = ROOT;
+    for seg in parent {
+        let Seg::Key(k) = seg else { continue };
+        match keys.iter().find(|(n, _)| n == k) {
+            Some((_, Kind::Table(sub) | Kind::Tables(sub) | Kind::OneOrTables(sub))) => keys = sub,
+            _ => return false,
+        }
+    }
+    keys.iter().any(|(k, _)| *k == missing)
+        && (keys.len() == 1 || nearest(leaf, keys) == Some(missing))
+}
+
 /// Describes a TOML value for a message.
 fn found(item: &Item) -> String {
     match item {
-        Item::Value(Value::String(s)) => format!("the string {:?}", s.value()),
-        Item::Value(Value::Integer(i)) => format!("the integer {}", i.value()),
-        Item::Value(Value::Float(f)) => format!("the number {}", f.value()),
-        Item::Value(Value::Boolean(b)) => format!("{}", b.value()),
-        Item::Value(Value::Datetime(_)) => "a date".into(),
-        Item::Value(Value::Array(a)) => format!("an array of {}", a.len()),
-        Item::Value(Value::InlineTable(_)) | Item::Table(_) => "a table".into(),
+        Item::Value(v) => found_value(v),
+        Item::Table(_) => "a table".into(),
         Item::ArrayOfTables(_) => "a list of tables".into(),
         Item::None => "nothing".into(),
+    }
+}
+
+fn found_value(v: &Value) -> String {
+    match v {
+        Value::String(s) => format!("the string {:?}", s.value()),
+        Value::Integer(i) => format!("the integer {}", i.value()),
+        Value::Float(f) => format!("the number {}", f.value()),
+        Value::Boolean(b) => format!("{}", b.value()),
+        Value::Datetime(_) => "a date".into(),
+        Value::Array(a) => format!("an array of {}", a.len()),
+        Value::InlineTable(_) => "a table".into(),
+    }
+}
+
+/// What an [x, y] vector holds instead: "an array of 3", or for an array
+/// of two, which element is not a number ("an array of 2" alone
+/// contradicted "a vector of two numbers").
+fn found_vec2(item: &Item) -> String {
+    let Item::Value(Value::Array(a)) = item else {
+        return found(item);
+    };
+    match a.iter().position(|v| !is_number(v)) {
+        Some(k) if a.len() == 2 => format!(
+            "two values, the {} of them {}",
+            if k == 0 { "first" } else { "second" },
+            a.get(k).map_or(String::new(), found_value)
+        ),
+        _ => found(item),
     }
 }
 
@@ -208,9 +253,13 @@ pub(crate) fn check_table(
             }
         }
         let mut wrong = |want: &str, hint: &str| {
+            let found = match kind {
+                Kind::Vec2 => found_vec2(item),
+                _ => found(item),
+            };
             report(
                 span.clone(),
-                format!("{name}: expected {want}, found {}; {hint}", found(item)),
+                format!("{name}: expected {want}, found {found}; {hint}"),
             );
             // A placeholder of the right type keeps the key (and the table's
             // other checks) alive; problems on its line are not reported.

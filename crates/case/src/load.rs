@@ -21,10 +21,10 @@ use std::ops::Range;
 use std::path::Path;
 
 use crate::error::{listed, InputError};
-use crate::keys::{check_table, dotted, remove_path, seg_name, value_spans};
+use crate::keys::{check_table, dotted, remove_path, seg_name, stood_for, value_spans};
 use crate::locate::{line_col, Locator};
-use crate::schema::{Case, History, MassKind, Mu, Scheme, ROOT};
-use crate::set::apply_set;
+use crate::schema::{Case, ContactLaw, History, MassKind, Mu, Scheme, ROOT};
+use crate::set::{apply_set, field_rule};
 
 /// Reads, overrides (`--set KEY=VALUE`, VALUE parsed as TOML, else taken as a
 /// string) and validates a case file.
@@ -78,7 +78,21 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
             e.message().trim_end()
         ))
     })?;
+    // A --set of one rule for the fields replaces the file's (apply_set),
+    // but two different ones on one command line contradict each other as
+    // two in a file do: refused, not the last taken.
+    let mut rule: Option<(&str, &String)> = None;
     for s in sets {
+        if let Some(r) = field_rule(s) {
+            if let Some((first, by)) = rule.filter(|(first, _)| *first != r) {
+                return Err(InputError(format!(
+                    "--set {s}: output.{r} and output.{first} (--set {by}) both say when the \
+                     fields are written; keep one of them (frames: N over [0, t_end], interval: \
+                     simulated time between frames, every: N steps)"
+                )));
+            }
+            rule = Some((r, s));
+        }
         apply_set(&mut doc, s).map_err(|m| InputError(format!("--set {s}: {m}")))?;
     }
     let source = if sets.is_empty() {
@@ -144,30 +158,32 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
     match toml::from_str::<Case>(text) {
         Err(e) => {
             let msg = e.message().trim_end().to_string();
-            // A required key removed above for its type is already reported.
+            // A required key removed above for its type is already
+            // reported, and so is an unknown key that stood for it.
+            let missing = msg
+                .strip_prefix("missing field `")
+                .and_then(|m| m.split_once('`'))
+                .map(|(k, _)| k);
             let removed_leaf = |m: &str| {
                 removals.iter().any(|r| {
                     r.last()
                         .is_some_and(|k| m.contains(&format!("`{}`", seg_name(k))))
+                        || missing.is_some_and(|k| stood_for(r, k))
                 })
             };
             if !(msg.starts_with("missing field") && removed_leaf(&msg)) {
-                let hint = if msg.starts_with("unknown field") {
-                    "; check the spelling (docs/case-file.md lists the keys)"
+                let hint = if let Some(key) = history_at(text, e.span()) {
+                    history_forms(&key)
+                } else if msg.starts_with("unknown field") {
+                    "; check the spelling (docs/case-file.md lists the keys)".into()
                 } else if msg.starts_with("missing field") {
-                    "; add it (docs/case-file.md lists the keys)"
-                } else if msg.starts_with("wanted string or table")
-                    || msg.starts_with("wanted exactly 1 element")
-                {
-                    // Only a traction's history is a string or a one-key table.
-                    " (a traction's history); write history = \"step\", \
-                     history = { sin = { omega = 25.13 } } or history = { table = [[0.0, 0.0], [0.1, 1.0]] }"
+                    "; add it (docs/case-file.md lists the keys)".into()
                 } else if msg.contains("variant") {
-                    "; use one of the values listed"
+                    "; use one of the values listed".into()
                 } else if msg.starts_with("invalid type") || msg.starts_with("invalid length") {
-                    "; numbers go without quotes, text in quotes, vectors as [x, y]"
+                    "; numbers go without quotes, text in quotes, vectors as [x, y]".into()
                 } else {
-                    ""
+                    String::new()
                 };
                 problems.push(format!("{}: {msg}{hint}", loc_text.at(e.span())));
             }
@@ -178,7 +194,9 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
             if let Ok(doc) = toml_edit::Document::parse(text) {
                 value_spans(doc.as_table(), "", &mut spans);
             }
-            match complete(case, path, source.clone(), &spans, &loc_text) {
+            // Keys whose value was reported and replaced or removed.
+            let placeholders: Vec<String> = typed.iter().map(|(p, _, _)| dotted(p)).collect();
+            match complete(case, path, source.clone(), &spans, &loc_text, &placeholders) {
                 Ok(case) if problems.is_empty() => return Ok(case),
                 Ok(_) => {}
                 Err(bad) => {
@@ -186,8 +204,6 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
                     // is reported): what the checks say of the placeholder
                     // is no problem of the user's, also where the value came
                     // from --set (no line of the file to quiet).
-                    let placeholders: Vec<String> =
-                        typed.iter().map(|(p, _, _)| dotted(p)).collect();
                     // ": key " also matches "[section]: key ".
                     let of_placeholder = |p: &str| {
                         placeholders.iter().any(|k| {
@@ -206,6 +222,34 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
     Err(InputError(listed(problems)))
 }
 
+/// The dotted key of the history (`traction.0.history`,
+/// `contact.pressure_history`, ...) whose value holds `span` of `text`.
+fn history_at(text: &str, span: Option<Range<usize>>) -> Option<String> {
+    let at = span?.start;
+    let doc = toml_edit::Document::parse(text).ok()?;
+    let mut spans = BTreeMap::new();
+    value_spans(doc.as_table(), "", &mut spans);
+    spans
+        .into_iter()
+        .filter(|(k, s)| k.ends_with("history") && s.contains(&at))
+        .min_by_key(|(_, s)| s.len())
+        .map(|(k, _)| k)
+}
+
+/// The forms a history takes, for a message on history `key`.
+fn history_forms(key: &str) -> String {
+    let leaf = key.rsplit('.').next().unwrap_or(key);
+    let forms = "\"constant\", \"step\", { sin = { omega = 25.13 } } (sin(omega t)) or \
+                 { table = [[0.0, 0.0], [0.1, 1.0]] } (linear between [t, f] points)";
+    if leaf == "history" {
+        format!("; a traction's history is {forms}, e.g. history = \"step\"")
+    } else {
+        format!(
+            "; {key} takes the forms of a traction's history: {forms}, e.g. {leaf} = \"constant\""
+        )
+    }
+}
+
 /// [`load_str`] on text alone, named `case.toml` in the current directory
 /// (for fuzzing and property tests: any text gives a case or an error).
 ///
@@ -213,6 +257,26 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
 /// As [`load`].
 pub fn parse_str(text: &str) -> Result<Case, InputError> {
     load_str(Path::new("case.toml"), text, &[])
+}
+
+/// sin(0 t): a factor that is 0 at every t, so its load never acts.
+fn zero_sine(h: &History) -> bool {
+    matches!(h, History::Sin { omega } if *omega == 0.0)
+}
+
+/// A number for a message: as Rust writes it where that is short, else
+/// in exponent form (`{}` wrote 1e99 with a hundred digits).
+pub(crate) struct Num(pub f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let x = self.0;
+        if x == 0.0 || !x.is_finite() || (1e-4..1e6).contains(&x.abs()) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
 }
 
 /// Most steps a case may ask for: 1e12 steps take days even on the paper's
@@ -224,12 +288,15 @@ const MAX_STEPS: f64 = stickslip_time::MAX_STABLE_STEPS;
 /// `output.file` defaulted, where each key is. `spans`: each value's
 /// place in the text serde read, by dotted key. Every number is finite
 /// and moderate here already (`keys::check_table` refused the others).
+/// `reported`: dotted keys whose value was reported already and removed
+/// (or replaced), which no check may call missing.
 fn complete(
     mut case: Case,
     path: &Path,
     source: String,
     spans: &BTreeMap<String, Range<usize>>,
     loc: &Locator,
+    reported: &[String],
 ) -> Result<Case, Vec<String>> {
     let mut bad = Vec::new();
     let span = |key: &str| spans.get(key).cloned();
@@ -280,17 +347,23 @@ fn complete(
     check(
         e > 0.0 && e.is_finite(),
         "material.E",
-        format!("material.E = {e} must be a finite number > 0; give Young's modulus"),
+        format!(
+            "material.E = {} must be a finite number > 0; give Young's modulus",
+            Num(e)
+        ),
     );
     check(
         rho > 0.0 && rho.is_finite(),
         "material.rho",
-        format!("material.rho = {rho} must be a finite number > 0; give the mass density"),
+        format!(
+            "material.rho = {} must be a finite number > 0; give the mass density",
+            Num(rho)
+        ),
     );
     check(
         nu > -1.0 && nu < 0.5,
         "material.nu",
-        format!("material.nu = {nu} must lie in (-1, 0.5); 0.5 (incompressible) cannot be modelled with displacements only"),
+        format!("material.nu = {} must lie in (-1, 0.5); 0.5 (incompressible) cannot be modelled with displacements only", Num(nu)),
     );
 
     if let Some(d) = &m.damping {
@@ -302,8 +375,9 @@ fn complete(
                 value >= 0.0 && value.is_finite(),
                 &format!("material.damping.{key}"),
                 format!(
-                    "material.damping.{key} = {value} must be a finite number >= 0 (Rayleigh damping \
-                     C = alpha M + beta K; {key} is {what}); use 0 for none"
+                    "material.damping.{key} = {} must be a finite number >= 0 (Rayleigh damping \
+                     C = alpha M + beta K; {key} is {what}); use 0 for none",
+                    Num(value)
                 ),
             );
         }
@@ -369,19 +443,32 @@ fn complete(
                 format!("{what}: history table needs at least one [t, f] pair and strictly increasing times; e.g. {{ table = [[0.0, 0.0], [0.1, 1.0]] }}"),
             );
         }
+        check(
+            !zero_sine(&t.history),
+            &history,
+            format!(
+                "{what}: history = {{ sin = {{ omega = 0 }} }} is sin(0) = 0 at every t, so the \
+                 load never acts; give the angular frequency omega (rad per unit time), use \
+                 history = \"step\" or \"constant\" for a steady load, or remove the [[traction]]"
+            ),
+        );
     }
 
     // [contact]
     for (i, c) in case.contact.iter().enumerate() {
         let key = |k: &str| crate::schema::contact_key_in(spans.keys(), i, k);
-        crate::compliance::check_law(c, &key, &mut check);
+        let was_reported = |k: &str| reported.iter().any(|r| *r == key(k));
+        crate::compliance::check_law(c, &key, &was_reported, &mut check);
         // A key the law lacks is refused above; 0 checks nothing here.
         let (p, mu, eps) = (c.pressure.unwrap_or(0.0), c.mu_at_rest(), c.eps);
-        check(p >= 0.0 && p.is_finite(), &key("pressure"), format!("contact.pressure = {p} must be >= 0 and finite (it presses the body onto the surface; g = mu * pressure)"));
+        check(p >= 0.0 && p.is_finite(), &key("pressure"), format!("contact.pressure = {} must be >= 0 and finite (it presses the body onto the surface; g = mu * pressure)", Num(p)));
         check(
             mu >= 0.0 && mu.is_finite(),
             &key("mu"),
-            format!("contact.mu = {mu} must be >= 0 and finite; use 0 for frictionless contact"),
+            format!(
+                "contact.mu = {} must be >= 0 and finite; use 0 for frictionless contact",
+                Num(mu)
+            ),
         );
         if let Some(Mu::Speed {
             stat,
@@ -392,15 +479,15 @@ fn complete(
             check(
                 (0.0..=stat).contains(&kinetic),
                 &key("mu"),
-                format!("contact.mu: kinetic = {kinetic} must be >= 0 and at most static = {stat} (friction falls from static to kinetic as the surface slips); give kinetic <= static, or mu = {stat} for one coefficient"),
+                format!("contact.mu: kinetic = {} must be >= 0 and at most static = {} (friction falls from static to kinetic as the surface slips); give kinetic <= static, or mu = {} for one coefficient", Num(kinetic), Num(stat), Num(stat)),
             );
             check(
                 speed > 0.0 && speed.is_finite(),
                 &key("mu"),
-                format!("contact.mu: speed = {speed} must be > 0 and finite (the slip speed over which mu falls from static towards kinetic, in the model's units)"),
+                format!("contact.mu: speed = {} must be > 0 and finite (the slip speed over which mu falls from static towards kinetic, in the model's units)", Num(speed)),
             );
         }
-        check(eps > 0.0 && eps.is_finite(), &key("eps"), format!("contact.eps = {eps} must be > 0 and finite (the friction law's regularization; the paper uses 1e-4 to 1)"));
+        check(eps > 0.0 && eps.is_finite(), &key("eps"), format!("contact.eps = {} must be > 0 and finite (the friction law's regularization; the paper uses 1e-4 to 1)", Num(eps)));
         check(
             c.max_iterations > 0,
             &key("max_iterations"),
@@ -422,6 +509,25 @@ fn complete(
                 "contact.foundation_history: the table needs at least one [t, f] pair and strictly increasing times; e.g. { table = [[0.0, 0.0], [0.5, 1.0]] }".into(),
             );
         }
+        // (A compliant surface refuses these histories whatever they are.)
+        if c.law == ContactLaw::Pressure {
+            check(
+                !zero_sine(&c.pressure_history),
+                &key("pressure_history"),
+                "contact.pressure_history = { sin = { omega = 0 } } is 0 at every t, so the \
+                 surface is never pressed and carries no friction; give the angular frequency \
+                 omega (rad per unit time), or use \"constant\" (the default) for a steady pressure"
+                    .into(),
+            );
+            check(
+                !zero_sine(&c.foundation_history),
+                &key("foundation_history"),
+                "contact.foundation_history = { sin = { omega = 0 } } is 0 at every t, so the \
+                 foundation never moves; give the angular frequency omega (rad per unit time), or \
+                 remove foundation_velocity and foundation_history for a foundation at rest"
+                    .into(),
+            );
+        }
         if let Some(profile) = &c.pressure_profile {
             let rows = &profile.table;
             let increasing = rows.windows(2).all(|w| w[1][0] > w[0][0]);
@@ -434,7 +540,7 @@ fn complete(
                 check(
                     false,
                     &key("pressure_profile"),
-                    format!("contact.pressure_profile: factor {} at s = {} must be >= 0 and finite (a negative factor would pull the surface off; write 0 where it carries no pressure)", r[1], r[0]),
+                    format!("contact.pressure_profile: factor {} at s = {} must be >= 0 and finite (a negative factor would pull the surface off; write 0 where it carries no pressure)", Num(r[1]), Num(r[0])),
                 );
             }
         }
@@ -461,12 +567,12 @@ fn complete(
     check(
         dt > 0.0 && dt.is_finite(),
         "time.dt",
-        format!("time.dt = {dt} must be a finite number > 0"),
+        format!("time.dt = {} must be a finite number > 0", Num(dt)),
     );
     check(
         t_end > 0.0 && t_end.is_finite(),
         "time.t_end",
-        format!("time.t_end = {t_end} must be a finite number > 0"),
+        format!("time.t_end = {} must be a finite number > 0", Num(t_end)),
     );
     // A run that cannot end (1e300 steps would pass `check` and run on).
     // Blamed on t_end, or on dt where only dt came from --set.
@@ -497,7 +603,7 @@ fn complete(
         check(
             gamma >= 0.5 && 2.0 * beta >= gamma,
             key,
-            format!("newmark with beta = {beta}, gamma = {gamma} is not unconditionally stable (needs 2*beta >= gamma >= 0.5); use e.g. beta = 0.25, gamma = 0.5 (trapezoidal) or beta = 0.3025, gamma = 0.6 (damped)"),
+            format!("newmark with beta = {}, gamma = {} is not unconditionally stable (needs 2*beta >= gamma >= 0.5); use e.g. beta = 0.25, gamma = 0.5 (trapezoidal) or beta = 0.3025, gamma = 0.6 (damped)", Num(beta), Num(gamma)),
         );
     }
     if tm.scheme != Scheme::Newmark {
@@ -525,6 +631,18 @@ fn complete(
             "central_difference needs mass = \"lumped\" (with a consistent mass it is no longer explicit); remove the key or use scheme = \"newmark\"".into(),
         );
     }
+    if tm.scheme != Scheme::CentralDifference && tm.allow_unstable {
+        // As beta on central difference: a key the scheme would ignore.
+        check(
+            false,
+            "time.allow_unstable",
+            format!(
+                "time.allow_unstable lets central difference run above its critical step; \
+                 scheme = \"{}\" has no critical step: remove it, or use scheme = \"central_difference\"",
+                tm.scheme.name()
+            ),
+        );
+    }
     if tm.scheme == Scheme::QuasiStatic {
         // Keys of inertia would be ignored silently by increments without
         // it: refuse each at its line.
@@ -546,6 +664,14 @@ fn complete(
                 "initial.velocities.0.group",
                 "no initial velocity: remove [[initial.velocities]]",
             ),
+            // The increments ran with it and failed at the first reduced
+            // one, advising what does not help.
+            (
+                tm.stick_reduction.is_some(),
+                "time.stick_reduction",
+                "no step reduction after sticking (Remark 4.3 is a cure for the dynamic \
+                 schemes): remove time.stick_reduction",
+            ),
         ];
         for (given, key, what) in inertia {
             check(
@@ -560,8 +686,9 @@ fn complete(
             r.dt > 0.0 && r.dt <= dt,
             "time.stick_reduction.dt",
             format!(
-                "time.stick_reduction.dt = {} must be > 0 and <= time.dt = {dt}",
-                r.dt
+                "time.stick_reduction.dt = {} must be > 0 and <= time.dt = {}",
+                Num(r.dt),
+                Num(dt)
             ),
         );
         check(
@@ -587,7 +714,10 @@ fn complete(
         check(
             dt > 0.0,
             "output.interval",
-            format!("output.interval = {dt} must be > 0 (the simulated time between frames)"),
+            format!(
+                "output.interval = {} must be > 0 (the simulated time between frames)",
+                Num(dt)
+            ),
         );
     }
     // One rule for when the fields are written: a second one is refused
@@ -626,7 +756,7 @@ fn complete(
         "output.flush_seconds",
         format!(
             "output.flush_seconds = {} must be > 0 (seconds between flushes; default 5)",
-            o.flush_seconds
+            Num(o.flush_seconds)
         ),
     );
     if let Some(c) = o.compression {
@@ -1211,5 +1341,333 @@ t_end = 0.5
             .unwrap_err()
             .0;
         assert!(e.contains("unknown variant `ramp`"), "{e}");
+    }
+
+    /// Remark 4.3's step reduction is a cure for the dynamics: quasi-static
+    /// increments ran with it and failed at the first reduced one, advising
+    /// "raise contact.max_iterations, or reduce time.dt", neither of which
+    /// helped. Refused at its line, as the other keys of inertia.
+    #[test]
+    fn quasi_static_refuses_stick_reduction_at_its_line() {
+        let text = GOOD
+            .replace("\"central_difference\"", "\"quasi_static\"")
+            .replace(
+                "t_end = 0.5",
+                "t_end = 0.5\nstick_reduction = { dt = 1e-5, steps = 10 }",
+            );
+        let e = load_text("qs-reduction", &text, &[]).unwrap_err().0;
+        let l = line_of(&text, "stick_reduction");
+        assert!(
+            e.lines().any(|m| m.contains(&format!("case.toml:{l}:"))
+                && m.contains("quasi_static increments have no inertia")
+                && m.contains("remove time.stick_reduction")),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+        // Through --set too; the dynamic schemes keep it.
+        let e = load_text(
+            "qs-reduction-set",
+            GOOD,
+            &[
+                "time.scheme=quasi_static",
+                "time.stick_reduction={dt=1e-5,steps=10}",
+            ],
+        )
+        .unwrap_err()
+        .0;
+        assert!(e.contains("--set time.stick_reduction="), "{e}");
+        for scheme in ["central_difference", "newmark"] {
+            let c = load_text(
+                "reduction-dynamic",
+                GOOD,
+                &[
+                    &format!("time.scheme={scheme}"),
+                    "time.stick_reduction={dt=1e-5,steps=10}",
+                ],
+            );
+            assert!(c.is_ok(), "{scheme}: {c:?}");
+        }
+    }
+
+    /// A run stopped by contact.max_iterations says to raise it, and the
+    /// restart that does was refused as a change of "what the stored run
+    /// computed". The budget may change; the restarted case carries the
+    /// new one into the run's settings.
+    #[test]
+    fn a_restart_may_change_the_iteration_budget() {
+        let stored = load_text("maxit-stored", GOOD, &["contact.max_iterations=2"]).unwrap();
+        let raised = load_text("maxit-raised", GOOD, &["contact.max_iterations=1000"]).unwrap();
+        assert_eq!(
+            restart_changes(&stored.source, &raised.source).unwrap(),
+            Vec::<String>::new()
+        );
+        assert_eq!(crate::settings(&raised).iteration.max_iterations, 1000);
+        // Given in one and left to its default in the other; in a list of
+        // [[contact]] tables.
+        assert!(restart_changes(GOOD, &raised.source).unwrap().is_empty());
+        let listed = GOOD.replace("[contact]", "[[contact]]");
+        let more = listed.replace("eps = 1e-4", "eps = 1e-4\nmax_iterations = 500");
+        assert!(restart_changes(&listed, &more).unwrap().is_empty());
+        // The physics next to it still may not change.
+        let changed = more.replace("mu = 0.3", "mu = 0.2");
+        assert_eq!(
+            restart_changes(&listed, &changed).unwrap(),
+            vec!["contact.0.mu: 0.3 in the stored run, 0.2 now".to_string()]
+        );
+        let other = GOOD.replace("eps = 1e-4", "eps = 1e-4\nremark_4_2 = false");
+        assert_eq!(restart_changes(GOOD, &other).unwrap().len(), 1);
+    }
+
+    /// Serde's words for a history of the wrong form ("invalid type: unit
+    /// variant, expected struct variant; use one of the values listed",
+    /// with none listed; "History::Sin") are replaced by what is wrong and
+    /// the forms a history takes, at the history's line.
+    #[test]
+    fn a_history_of_the_wrong_form_is_named_with_the_forms() {
+        let with = |h: &str| {
+            GOOD.replace(
+                "t = [-150.0, 0.0]   # compressive",
+                &format!("t = [-150.0, 0.0]\nhistory = {h}"),
+            )
+        };
+        for (h, what) in [
+            ("\"sin\"", "\"sin\" alone lacks the angular frequency"),
+            ("\"table\"", "\"table\" alone lacks the points"),
+            (
+                "{ sin = 25.0 }",
+                "found the number 25: write { sin = { omega = 25 } }",
+            ),
+            ("{ sin = { w = 1 } }", "sin has no key `w`"),
+            ("{ table = 3 }", "table takes a list of [t, f] points"),
+            ("{ step = 1 }", "step is written as text"),
+            (
+                "1",
+                "a history is text or a table of one key, found the number 1",
+            ),
+        ] {
+            let text = with(h);
+            let e = load_text("hist-form", &text, &[]).unwrap_err().0;
+            let l = line_of(&text, "history =");
+            assert!(
+                e.contains(&format!("case.toml:{l}:"))
+                    && e.contains(what)
+                    && e.contains("a traction's history is \"constant\", \"step\", { sin = { omega = 25.13 } }")
+                    && e.contains("{ table = [[0.0, 0.0], [0.1, 1.0]] }"),
+                "{h}: {e}"
+            );
+            for jargon in ["variant, expected", "History::", "values listed"] {
+                assert!(!e.contains(jargon), "{h}: {e}");
+            }
+            assert_eq!(e.lines().count(), 1, "{h}: {e}");
+        }
+        // The contact's histories are named as themselves.
+        for key in ["pressure_history", "foundation_history"] {
+            let text = GOOD.replace("eps = 1e-4", &format!("eps = 1e-4\n{key} = \"sin\""));
+            let e = load_text("hist-contact", &text, &[]).unwrap_err().0;
+            assert!(
+                e.contains(&format!("case.toml:{}:", line_of(&text, key)))
+                    && e.contains(&format!(
+                        "contact.{key} takes the forms of a traction's history"
+                    )),
+                "{key}: {e}"
+            );
+        }
+        // The good forms still read.
+        for (h, want) in [
+            ("\"constant\"", History::Constant),
+            ("{ sin = { omega = 2 } }", History::Sin { omega: 2.0 }),
+            (
+                "{ table = [[0, 0], [1.0, 2]] }",
+                History::Table(vec![[0.0, 0.0], [1.0, 2.0]]),
+            ),
+        ] {
+            let c = load_text("hist-good", &with(h), &[]).unwrap();
+            assert_eq!(c.traction[0].history, want, "{h}");
+        }
+    }
+
+    /// A sine of omega = 0 is 0 at every t: the load it scales never acts.
+    #[test]
+    fn a_sine_of_zero_frequency_is_refused() {
+        let e = load_text(
+            "sin0",
+            GOOD,
+            &["traction.0.history={ sin = { omega = 0 } }"],
+        )
+        .unwrap_err()
+        .0;
+        assert!(
+            e.contains("is sin(0) = 0 at every t, so the load never acts"),
+            "{e}"
+        );
+        for (key, what) in [
+            ("pressure_history", "never pressed"),
+            ("foundation_history", "never moves"),
+        ] {
+            let text = GOOD.replace(
+                "eps = 1e-4",
+                &format!("eps = 1e-4\n{key} = {{ sin = {{ omega = 0.0 }} }}"),
+            );
+            let e = load_text("sin0-contact", &text, &[]).unwrap_err().0;
+            assert!(
+                e.contains(&format!("case.toml:{}:", line_of(&text, key))) && e.contains(what),
+                "{key}: {e}"
+            );
+        }
+        assert!(load_text(
+            "sin1",
+            GOOD,
+            &["traction.0.history={ sin = { omega = -3 } }"]
+        )
+        .is_ok());
+    }
+
+    /// `allow_unstable` lets central difference run above its critical
+    /// step; the other schemes have none, and ignored it silently (while
+    /// `beta` on central difference is refused).
+    #[test]
+    fn allow_unstable_is_refused_where_there_is_no_critical_step() {
+        for scheme in ["newmark", "quasi_static"] {
+            let text = GOOD
+                .replace("\"central_difference\"", &format!("\"{scheme}\""))
+                .replace("t_end = 0.5", "t_end = 0.5\nallow_unstable = true");
+            let e = load_text("unstable", &text, &[]).unwrap_err().0;
+            let l = line_of(&text, "allow_unstable");
+            assert!(
+                e.contains(&format!("case.toml:{l}:"))
+                    && e.contains(&format!("scheme = \"{scheme}\" has no critical step")),
+                "{scheme}: {e}"
+            );
+            assert_eq!(e.lines().count(), 1, "{scheme}: {e}");
+            // false, the default, asks for nothing the scheme lacks.
+            let off = text.replace("allow_unstable = true", "allow_unstable = false");
+            assert!(load_text("stable", &off, &[]).is_ok(), "{scheme}");
+        }
+        let c = load_text("cd-unstable", GOOD, &["time.allow_unstable=true"]).unwrap();
+        assert!(c.time.allow_unstable);
+    }
+
+    /// One rule for the fields on the command line: a file's rule is
+    /// replaced by a --set of another, but two different rules set in one
+    /// command contradict each other as in a file (the last one won).
+    #[test]
+    fn two_frame_rules_set_on_one_command_line_are_refused() {
+        let e = load_text("two-sets", GOOD, &["output.frames=10", "output.every=5"])
+            .unwrap_err()
+            .0;
+        assert!(
+            e.contains("--set output.every=5: output.every and output.frames (--set output.frames=10) both say"),
+            "{e}"
+        );
+        // The same rule twice: the last value, as for any key.
+        let c = load_text("same-rule", GOOD, &["output.every=10", "output.every=5"]).unwrap();
+        assert_eq!(c.output.fields(), crate::schema::Fields::Every(5));
+    }
+
+    /// A vector with two values, one of them not a number, was "expected
+    /// a vector of two numbers, found an array of 2".
+    #[test]
+    fn a_vector_names_the_element_that_is_no_number() {
+        for (t, what) in [
+            ("[-150, \"a\"]", "the second of them the string \"a\""),
+            ("[[-150.0], [0.0]]", "the first of them an array of 1"),
+        ] {
+            let e = load_text("vec2", GOOD, &[&format!("traction.0.t={t}")])
+                .unwrap_err()
+                .0;
+            assert!(
+                e.contains("expected a vector of two numbers, found two values")
+                    && e.contains(what)
+                    && !e.contains("an array of 2"),
+                "{t}: {e}"
+            );
+        }
+    }
+
+    /// A value reported as wrong and taken out is not also reported
+    /// missing: `mu = nan` added "needs mu = ...", `foundation = 1`
+    /// "needs foundation = ...", and `pressure_profile = { sin = .. }`
+    /// "missing field `table`" without a line.
+    #[test]
+    fn a_value_reported_is_not_reported_missing_too() {
+        for (sets, what) in [
+            (vec!["contact.mu=nan"], "contact.mu holds NaN"),
+            (
+                vec!["contact.pressure_profile={ sin = { omega = 1 } }"],
+                "unknown field `sin` in [contact.pressure_profile]; the keys here are: table",
+            ),
+            (
+                vec![
+                    "contact.law=compliance",
+                    "contact.cn=1e4",
+                    "contact.foundation=1",
+                ],
+                "contact.foundation: expected a table",
+            ),
+            (
+                vec![
+                    "contact.law=compliance",
+                    "contact.foundation={ point = [0, 0], normal = [0, 1] }",
+                    "contact.cn=\"x\"",
+                ],
+                "contact.cn: expected a number",
+            ),
+        ] {
+            let text = if sets[0].starts_with("contact.law") {
+                GOOD.replace("pressure = 300.0\n", "")
+            } else {
+                GOOD.to_string()
+            };
+            let e = load_text("reported", &text, &sets).unwrap_err().0;
+            assert!(e.contains(what), "{sets:?}: {e}");
+            assert_eq!(e.lines().count(), 1, "{sets:?}: {e}");
+        }
+        // Still missing where nothing was given.
+        let e = load_text("missing-mu", &GOOD.replace("mu = 0.3\n", ""), &[])
+            .unwrap_err()
+            .0;
+        assert!(e.contains("needs mu = ..."), "{e}");
+    }
+
+    /// Numbers in messages are short: `{}` wrote 1e99 with a hundred digits.
+    #[test]
+    fn numbers_in_messages_are_short() {
+        let e = load_text("nu-huge", GOOD, &["material.nu=1e99"])
+            .unwrap_err()
+            .0;
+        assert!(
+            e.contains("material.nu = 1e99 must lie in (-1, 0.5)"),
+            "{e}"
+        );
+        assert!(e.len() < 300, "{e}");
+        let e = load_text("dt-tiny", GOOD, &["time.dt=-2.5e-9"])
+            .unwrap_err()
+            .0;
+        assert!(e.contains("time.dt = -2.5e-9 must be"), "{e}");
+        // Ordinary values as written.
+        let e = load_text("mu-neg", GOOD, &["contact.mu=-0.3"])
+            .unwrap_err()
+            .0;
+        assert!(e.contains("contact.mu = -0.3 must be"), "{e}");
+        assert_eq!(Num(1000.0).to_string(), "1000");
+        assert_eq!(Num(2.1e11).to_string(), "2.1e11");
+        assert_eq!(Num(0.0).to_string(), "0");
+    }
+
+    /// `--set dirichlet=[]` said "dirichlet is a table": it is a list of
+    /// tables, which --set cannot replace as a whole.
+    #[test]
+    fn set_of_a_whole_list_of_tables_names_it_a_list() {
+        let e = load_text("set-list", GOOD, &["dirichlet=[]"])
+            .unwrap_err()
+            .0;
+        assert!(
+            e.contains("dirichlet is a list of 2 tables ([[dirichlet]])")
+                && e.contains("dirichlet.0.KEY=VALUE")
+                && !e.contains("is a table"),
+            "{e}"
+        );
+        let e = load_text("set-table", GOOD, &["time=1"]).unwrap_err().0;
+        assert!(e.contains("time is a table"), "{e}");
     }
 }

@@ -1,10 +1,12 @@
 //! What may change between the run stored in a results file and its
 //! continuation (`run --restart`): the end time, the output settings, the
-//! title and the ladder; anything else would continue another computation.
+//! title, the ladder and the stick/slip iteration's budget; anything else
+//! would continue another computation.
 
 use std::collections::BTreeMap;
 
-/// Keys a restart may change: the end time, the output settings, the title.
+/// Keys a restart may change: the end time, the output settings, the
+/// title, the ladder and `contact.max_iterations`.
 fn restart_may_change(key: &str) -> bool {
     // mesh.ladder is read by `advise` only; a run never sees it.
     key == "title"
@@ -12,6 +14,22 @@ fn restart_may_change(key: &str) -> bool {
         || key == "mesh.ladder"
         || key == "output"
         || key.starts_with("output.")
+        || is_max_iterations(key)
+}
+
+/// `contact.max_iterations` or `contact.N.max_iterations`: a budget, not
+/// physics. The steps that converged did so within the old budget and are
+/// the same under a larger one; a run stopped by it ("raise
+/// contact.max_iterations") must be able to continue with more. The
+/// checkpoint holds no budget: the restarted run takes the case's.
+fn is_max_iterations(key: &str) -> bool {
+    let Some(rest) = key.strip_prefix("contact.") else {
+        return false;
+    };
+    match rest.split_once('.') {
+        None => rest == "max_iterations",
+        Some((i, leaf)) => leaf == "max_iterations" && i.parse::<usize>().is_ok(),
+    }
 }
 
 fn flatten(prefix: &str, v: &toml::Value, out: &mut BTreeMap<String, toml::Value>) {
@@ -59,7 +77,8 @@ fn same_value(a: &toml::Value, b: &toml::Value) -> bool {
 
 /// The keys (dotted, as `--set` writes them) on which the case `new` differs
 /// from the case `stored` in a results file, other than those a restart may
-/// change (`time.t_end`, `output.*`, `title`), each as `key: stored X, now Y`.
+/// change (`time.t_end`, `output.*`, `title`, `mesh.ladder`,
+/// `contact.max_iterations`), each as `key: stored X, now Y`.
 /// A key given in one and left to its default in the other counts as a
 /// change (write it the same way in both).
 ///

@@ -349,8 +349,7 @@ section! {
 
 /// Time factor of a load. TOML: `"constant"`, `"step"`,
 /// `{ sin = { omega = .. } }` or `{ table = [[t0, f0], ..] }`; default `"step"`.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub enum History {
     /// 1 for all t, t < 0 included: part of the initial static state.
     Constant,
@@ -363,12 +362,179 @@ pub enum History {
         omega: f64,
     },
     /// Piecewise linear through (t_i, f_i), constant beyond the ends.
-    #[serde(deserialize_with = "table_points")]
     Table(Vec<[f64; 2]>),
 }
 
 impl Schema for History {
     const KIND: Kind = Kind::Any;
+}
+
+/// A TOML value for a message: "the number 25", "a table".
+fn described(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => format!("the string {s:?}"),
+        toml::Value::Integer(i) => format!("the number {i}"),
+        toml::Value::Float(f) => format!("the number {f}"),
+        toml::Value::Boolean(b) => b.to_string(),
+        toml::Value::Datetime(_) => "a date".into(),
+        toml::Value::Array(a) => format!("an array of {}", a.len()),
+        toml::Value::Table(_) => "a table".into(),
+    }
+}
+
+fn number(v: &toml::Value) -> Option<f64> {
+    match v {
+        toml::Value::Integer(i) => Some(*i as f64),
+        toml::Value::Float(f) => Some(*f),
+        _ => None,
+    }
+}
+
+/// Each history form checked by hand, so that a message says what is wrong
+/// with the form given (serde's derive said "invalid type: unit variant,
+/// expected struct variant"); loading adds the forms a history takes.
+impl<'de> Deserialize<'de> for History {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<History, D::Error> {
+        use serde::de::Error;
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = History;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a history, text or a table of one key")
+            }
+            fn visit_bool<E: Error>(self, v: bool) -> Result<History, E> {
+                Err(not_a_history(&v.to_string()))
+            }
+            fn visit_i64<E: Error>(self, v: i64) -> Result<History, E> {
+                Err(not_a_history(&format!("the number {v}")))
+            }
+            fn visit_u64<E: Error>(self, v: u64) -> Result<History, E> {
+                Err(not_a_history(&format!("the number {v}")))
+            }
+            fn visit_f64<E: Error>(self, v: f64) -> Result<History, E> {
+                Err(not_a_history(&format!("the number {v}")))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, _: A) -> Result<History, A::Error> {
+                Err(not_a_history(
+                    "an array (a table's points go in { table = [...] })",
+                ))
+            }
+            fn visit_str<E: Error>(self, v: &str) -> Result<History, E> {
+                match v {
+                    "constant" => Ok(History::Constant),
+                    "step" => Ok(History::Step),
+                    "sin" => Err(E::custom(
+                        "\"sin\" alone lacks the angular frequency: a sine is a table, { sin = { omega = ... } }",
+                    )),
+                    "table" => Err(E::custom(
+                        "\"table\" alone lacks the points: a table history is { table = [[t, f], ...] }",
+                    )),
+                    other => Err(E::custom(format!(
+                        "unknown variant `{other}`: no history is called that"
+                    ))),
+                }
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut map: A,
+            ) -> Result<History, A::Error> {
+                let Some(key) = map.next_key::<String>()? else {
+                    return Err(A::Error::custom(
+                        "an empty table is no history: a history table has one key, sin or table",
+                    ));
+                };
+                let history = match key.as_str() {
+                    "sin" => sin(&map.next_value::<toml::Value>()?),
+                    "table" => rows(&map.next_value::<toml::Value>()?).map(History::Table),
+                    "constant" | "step" => Err(format!(
+                        "{key} is written as text, \"{key}\", not as a table"
+                    )),
+                    // How toml hands a date to a visitor.
+                    k if k.starts_with("$__toml_private") => return Err(not_a_history("a date")),
+                    other => Err(format!(
+                        "a history table has no key `{other}`; its one key is sin or table"
+                    )),
+                }
+                .map_err(A::Error::custom)?;
+                if let Some(more) = map.next_key::<String>()? {
+                    return Err(A::Error::custom(format!(
+                        "a history table has one key, sin or table; this one has `{key}` and `{more}`"
+                    )));
+                }
+                Ok(history)
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
+fn not_a_history<E: serde::de::Error>(found: &str) -> E {
+    E::custom(format!(
+        "a history is text or a table of one key, found {found}"
+    ))
+}
+
+/// `{ sin = { omega = ω } }`: the value of `sin`.
+fn sin(v: &toml::Value) -> Result<History, String> {
+    let toml::Value::Table(t) = v else {
+        let omega = number(v).map_or("...".into(), |w| w.to_string());
+        return Err(format!(
+            "sin takes a table of its angular frequency, found {}: write {{ sin = {{ omega = {omega} }} }}",
+            described(v)
+        ));
+    };
+    if let Some(k) = t.keys().find(|k| *k != "omega") {
+        return Err(format!(
+            "sin has no key `{k}`; its one key is omega, the angular frequency (sin(omega t))"
+        ));
+    }
+    match t.get("omega") {
+        None => {
+            Err("sin lacks omega, the angular frequency: write { sin = { omega = ... } }".into())
+        }
+        Some(w) => match number(w) {
+            Some(omega) => Ok(History::Sin { omega }),
+            None => Err(format!(
+                "sin's omega must be a number, found {}; write numbers without quotes",
+                described(w)
+            )),
+        },
+    }
+}
+
+/// `{ table = [[t, f], ...] }`: the rows of `table`, each two numbers.
+fn rows(v: &toml::Value) -> Result<Vec<[f64; 2]>, String> {
+    let toml::Value::Array(a) = v else {
+        return Err(format!(
+            "table takes a list of [t, f] points, found {}: write {{ table = [[0.0, 0.0], [0.1, 1.0]] }}",
+            described(v)
+        ));
+    };
+    a.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let row = match r {
+                toml::Value::Array(r) => r.iter().map(number).collect::<Option<Vec<f64>>>(),
+                _ => None,
+            };
+            match row.as_deref() {
+                Some(&[t, f]) => Ok([t, f]),
+                Some(r) => Err(format!(
+                    "table row {} has {} numbers; each row is two: [t, f] in a history, [s, factor] in a profile",
+                    i + 1,
+                    r.len()
+                )),
+                None => Err(format!(
+                    "table row {} is {}, not two numbers [t, f]; write the table as [[0.0, 0.0], [0.1, 1.0]]",
+                    i + 1,
+                    match r {
+                        toml::Value::Array(_) => "an array holding something other than numbers".into(),
+                        other => described(other),
+                    }
+                )),
+            }
+        })
+        .collect()
 }
 
 /// A table's rows, each exactly two numbers (serde's [f64; 2] takes [t, f,

@@ -26,7 +26,7 @@ pub(crate) fn apply_set(doc: &mut toml_edit::DocumentMut, set: &str) -> Result<(
     // one (loading refuses two): the one set on the command line replaces
     // the file's, so that `--set output.frames=50` runs a case that says
     // `every = 1`.
-    if let ["output", rule @ ("frames" | "interval" | "every")] = segs[..] {
+    if let Some(rule) = field_rule(set) {
         if let Some(output) = doc.get_mut("output").and_then(Item::as_table_like_mut) {
             for other in FIELD_RULES.iter().filter(|&&r| r != rule) {
                 output.remove(other);
@@ -39,6 +39,17 @@ pub(crate) fn apply_set(doc: &mut toml_edit::DocumentMut, set: &str) -> Result<(
 /// The `[output]` keys that say when the fields are written.
 const FIELD_RULES: [&str; 3] = ["frames", "interval", "every"];
 
+/// The rule for the fields a `--set` gives (`"frames"` for
+/// `output.frames=10`), if it gives one.
+pub(crate) fn field_rule(set: &str) -> Option<&'static str> {
+    let (key, _) = set.split_once('=')?;
+    let segs: Vec<&str> = key.split('.').map(str::trim).collect();
+    match segs[..] {
+        ["output", rule] => FIELD_RULES.into_iter().find(|r| *r == rule),
+        _ => None,
+    }
+}
+
 fn set_in(t: &mut dyn TableLike, segs: &[&str], mut value: Value, key: &str) -> Result<(), String> {
     let (k, rest) = segs.split_first().expect("non-empty path");
     if rest.is_empty() {
@@ -50,6 +61,14 @@ fn set_in(t: &mut dyn TableLike, segs: &[&str], mut value: Value, key: &str) -> 
             }
             Some(Item::None) | None => {
                 t.insert(k, Item::Value(value));
+            }
+            Some(Item::ArrayOfTables(a)) => {
+                return Err(format!(
+                    "{key} is a list of {} tables ([[{key}]]), which --set cannot replace as a \
+                     whole; set a key of one entry by its number, e.g. {key}.0.KEY=VALUE, or edit \
+                     the list in the case file",
+                    a.len()
+                ))
             }
             Some(_) => {
                 return Err(format!(

@@ -79,7 +79,7 @@ pub(crate) fn surfaces(
                     "{}[contact]: pressure_profile row s = {} runs past the end of surface {:?}, which is {length} \
                      long (s as in /contact/s, from the line's start); end the table at s <= {length}",
                     at("pressure_profile"),
-                    last[0],
+                    crate::load::Num(last[0]),
                     c.group
                 ));
             }

@@ -21,6 +21,13 @@ pub enum MeshErrorKind {
     /// The file could not be read.
     #[error("cannot read the file: {0}")]
     Io(String),
+    /// The path names a directory.
+    #[error("is a directory, not a mesh file; give the .msh file in it")]
+    IsDirectory,
+    /// The path names a device, FIFO or socket: it has no end to read to
+    /// (`/dev/zero` would be read until memory runs out).
+    #[error("not a regular file (a device, FIFO or socket); give the .msh file")]
+    NotRegularFile,
     /// A physical group name that the mesh does not have.
     #[error("the mesh has no physical group {name:?}; it has: {}", available.join(", "))]
     UnknownGroup {
@@ -115,6 +122,27 @@ pub enum MeshErrorKind {
         record: String,
         /// How many numbers its line has.
         found: usize,
+    },
+    /// Binary data in a file whose `$MeshFormat` says ASCII (file-type 0).
+    #[error("binary data in a file whose $MeshFormat says ASCII (file-type 0): the header does not match the content; re-export the mesh from Gmsh, or, if the file was written binary, set its file-type back to 1 (`2.2 1 8` or `4.1 1 8` on the line after $MeshFormat)")]
+    BinaryInAscii,
+    /// ASCII text where a file whose `$MeshFormat` says binary has its
+    /// byte-order integer.
+    #[error("$MeshFormat says binary (file-type 1), but the file is ASCII text: the header does not match the content; set the file-type in $MeshFormat to 0 (the line `2.2 0 8` or `4.1 0 8`), or re-export the mesh from Gmsh")]
+    AsciiInBinary,
+    /// A `(dimension, tag)` named twice in `$PhysicalNames`.
+    #[error("physical group (dim {dim}, tag {tag}) is named {name:?} here, but {} already named it {first_name:?}; a group has one name, so one of the two lines has a wrong tag (or is a copy): name each group once in the .geo (Physical {}(\"name\", TAG) = {{...}};) and mesh again, or fix the tag on one of the lines", place(first), physical_kind(*dim))]
+    DuplicatePhysicalName {
+        /// The group's dimension.
+        dim: u8,
+        /// The group's physical tag.
+        tag: i32,
+        /// The name given here.
+        name: String,
+        /// Where the first name was given.
+        first: Location,
+        /// The first name.
+        first_name: String,
     },
     /// A binary file whose line ends were converted to CR LF.
     #[error("the binary .msh file was transferred in text mode: its line ends were turned into CR LF (\\r\\n), which also changes bytes inside the binary data; copy the file again in binary mode (e.g. FTP `binary`, or `*.msh binary` in .gitattributes) or re-export it from Gmsh")]
@@ -228,6 +256,25 @@ pub enum MeshErrorKind {
         /// The limit.
         limit: u64,
     },
+}
+
+/// "line 8", "byte 120": a place in the file for a message.
+fn place(at: &Location) -> String {
+    match at {
+        Location::Line(l) => format!("line {l}"),
+        Location::Byte(b) => format!("byte {b}"),
+        Location::Nowhere => "an earlier line".into(),
+    }
+}
+
+/// How a .geo declares a physical group of dimension `dim`.
+fn physical_kind(dim: u8) -> &'static str {
+    match dim {
+        0 => "Point",
+        1 => "Curve",
+        2 => "Surface",
+        _ => "Volume",
+    }
 }
 
 /// A mesh error with its file and location.

@@ -172,16 +172,31 @@ impl Mesh {
     /// Reads and checks a `.msh` file.
     ///
     /// # Errors
-    /// Any I/O problem, malformed or unsupported content, or failed check,
+    /// Any I/O problem, a path that is not a regular file (a directory, a
+    /// device, a FIFO), malformed or unsupported content, or failed check,
     /// as a [`MeshError`] naming the file and the line or byte offset.
     pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
+        // Only regular files, as a case's mesh.file: a device has no end
+        // (`/dev/zero` was read until memory ran out) and opening a FIFO
+        // blocks, so both are refused before the file is opened.
+        let not_a_file = |meta: &std::fs::Metadata| {
+            let kind = if meta.is_dir() {
+                MeshErrorKind::IsDirectory
+            } else {
+                MeshErrorKind::NotRegularFile
+            };
+            MeshError::new(kind).with_path(path)
+        };
+        let meta = std::fs::metadata(path).map_err(|e| MeshError::io(path, e))?;
+        if !meta.is_file() {
+            return Err(not_a_file(&meta));
+        }
         let file = std::fs::File::open(path).map_err(|e| MeshError::io(path, e))?;
+        // What was opened, in case the path changed in between.
         let meta = file.metadata().map_err(|e| MeshError::io(path, e))?;
         if !meta.is_file() {
-            // A pipe or device has no length to check counts against: read it whole.
-            let bytes = std::fs::read(path).map_err(|e| MeshError::io(path, e))?;
-            return Mesh::from_bytes(&bytes).map_err(|e| e.with_path(path));
+            return Err(not_a_file(&meta));
         }
         // Streamed through a window of 1 MiB: the file's bytes are never
         // all resident next to the mesh (the reader's peak-memory target,

@@ -211,10 +211,16 @@ fn mesh_format(cur: &mut Cursor<'_>) -> Result<(&'static str, bool)> {
         // the data: say so rather than report what the shifted data looks
         // like (an early end, NaN coordinates).
         let eol = cur.pos();
-        if cur.end_of_line()? {
+        let crlf = cur.end_of_line()?;
+        let p = cur.pos();
+        if cur.peek(4) == b"$End" {
+            // An ASCII file (its lines at their numbers) flagged binary.
+            cur.binary = false;
+            return Err(cur.error(p, MeshErrorKind::AsciiInBinary));
+        }
+        if crlf {
             return Err(cur.error(eol, MeshErrorKind::TextModeTransfer));
         }
-        let p = cur.pos();
         match cur.take::<4>()? {
             [1, 0, 0, 0] => {}
             [b'\r', 1, 0, 0] => return Err(cur.error(p, MeshErrorKind::TextModeTransfer)),
@@ -231,6 +237,14 @@ fn mesh_format(cur: &mut Cursor<'_>) -> Result<(&'static str, bool)> {
             }
         }
     }
+    if !binary {
+        cur.skip_ws();
+        // The byte-order integer of a binary file: the file-type says ASCII
+        // but binary data follows (reported as a wrong count before).
+        if cur.peek(4) == [1, 0, 0, 0] {
+            return Err(cur.error(cur.pos(), MeshErrorKind::BinaryInAscii));
+        }
+    }
     cur.expect_end()?;
     Ok((version, binary))
 }
@@ -240,6 +254,9 @@ fn physical_names(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
     cur.enter("$PhysicalNames", "$EndPhysicalNames");
     let n = cur.u64("the number of physical names")?;
     cur.counts("physical names", n);
+    // Where each (dim, tag) was named: a second name would silently
+    // replace the first (a typo in a tag moves a boundary condition).
+    let mut named_at: std::collections::HashMap<(u8, i32), usize> = Default::default();
     for _ in 0..n {
         cur.skip_ws();
         let p = cur.pos();
@@ -257,6 +274,19 @@ fn physical_names(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
             }
         };
         let name = quoted(cur)?;
+        if let Some(&first) = named_at.get(&(dim, tag)) {
+            return Err(cur.error(
+                p,
+                MeshErrorKind::DuplicatePhysicalName {
+                    dim,
+                    tag,
+                    name,
+                    first: cur.location(first),
+                    first_name: b.names.get(&(dim, tag)).cloned().unwrap_or_default(),
+                },
+            ));
+        }
+        named_at.insert((dim, tag), p);
         b.names.insert((dim, tag), name);
     }
     cur.expect_end()

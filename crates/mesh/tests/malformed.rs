@@ -742,3 +742,111 @@ fn long_values_are_quoted_short() {
     assert!(e.to_string().len() < 300, "{e}");
     assert!(matches!(e.kind, K::MissingEnd { .. }), "{e}");
 }
+
+// ---- a group named twice ----
+
+/// A (dim, tag) named twice was read with the last name: `1 3 "left"`, a
+/// typo for `1 4`, silently moved "left" onto group 3. Refused at the
+/// repeat, naming the line of the first name.
+#[test]
+fn a_group_named_twice_is_refused_at_the_repeat() {
+    let t = replace_line(&text(Q4_22), "1 4 \"support\"", "1 3 \"left\"");
+    let e = err_at_line(&t, "1 3 \"left\"");
+    assert_eq!(
+        e.kind,
+        K::DuplicatePhysicalName {
+            dim: 1,
+            tag: 3,
+            name: "left".into(),
+            first: Location::Line(line_no(&t, "1 3 \"load\"")),
+            first_name: "load".into(),
+        }
+    );
+    let msg = e.to_string();
+    assert!(
+        msg.contains("line 8 already named it \"load\"") && msg.contains("wrong tag"),
+        "{msg}"
+    );
+    // The same line twice too; in a binary file at byte offsets.
+    let t = replace_line(&text(Q4_22), "1 4 \"support\"", "1 3 \"load\"");
+    assert!(matches!(
+        err(&t).kind,
+        K::DuplicatePhysicalName { tag: 3, .. }
+    ));
+    let b = bytes("slab_q4_v41_bin.msh");
+    let at = find(&b, b"1 4 \"support\"");
+    let mut dup = b.clone();
+    dup[at + 2] = b'3';
+    let e = byte_err(&dup, at);
+    assert!(
+        matches!(&e.kind, K::DuplicatePhysicalName { first: Location::Byte(f), .. }
+            if *f == find(&b, b"1 3 \"load\"")),
+        "{e}"
+    );
+    // One name on groups of different dimensions stays readable (Gmsh
+    // allows it; `Mesh::group` asks which one is meant).
+    let t = replace_line(&text(Q4_22), "1 4 \"support\"", "2 4 \"load\"");
+    assert!(Mesh::from_bytes(t.as_bytes()).is_ok());
+}
+
+// ---- the encoding $MeshFormat declares, against the content ----
+
+/// A binary file whose file-type says ASCII was "$MeshFormat declares 0
+/// entries"; an ASCII file flagged binary, "the byte-order check ... is
+/// [36, 69, 110, 100]". Both now say the header does not match the data.
+#[test]
+fn an_encoding_that_does_not_match_the_content_is_named() {
+    for name in ["slab_q4_v22_bin.msh", "slab_q4_v41_bin.msh"] {
+        let mut b = bytes(name);
+        let at = find(&b, b" 1 8\n");
+        b[at + 1] = b'0';
+        let e = err_bytes(&b);
+        assert_eq!(e.kind, K::BinaryInAscii, "{name}: {e}");
+        // The byte-order integer starts line 3.
+        assert_eq!(e.location, Location::Line(3), "{name}");
+        assert!(
+            e.to_string().contains("re-export the mesh from Gmsh"),
+            "{e}"
+        );
+        // Without the integer: the binary node data, where a count was due.
+        let int = find(&b, &[1, 0, 0, 0, b'\n']);
+        b.drain(int..int + 5);
+        let e = err_bytes(&b);
+        assert_eq!(e.kind, K::BinaryInAscii, "{name}: {e}");
+    }
+    for name in [Q4_22, Q4_41] {
+        let t = text(name).replacen(" 0 8\n", " 1 8\n", 1);
+        let e = err(&t);
+        assert_eq!(e.kind, K::AsciiInBinary, "{name}: {e}");
+        assert_eq!(e.location, Location::Line(3), "{name}");
+        // Its lines ending in CR LF: still ASCII, not a text-mode copy.
+        let e = err(&t.replace('\n', "\r\n"));
+        assert_eq!(e.kind, K::AsciiInBinary, "{name}: {e}");
+    }
+}
+
+// ---- paths that are no regular file ----
+
+/// `stickslip mesh /tmp` said only "Is a directory (os error 21)", and a
+/// device was read whole before parsing (`/dev/zero`: without bound).
+/// Both are refused before anything is read, naming the path.
+#[test]
+fn directories_and_devices_are_refused_before_reading() {
+    let dir = std::env::temp_dir();
+    let e = Mesh::from_file(&dir).unwrap_err();
+    assert_eq!(e.kind, K::IsDirectory, "{e}");
+    assert!(
+        e.to_string()
+            .starts_with(&format!("{}: is a directory", dir.display())),
+        "{e}"
+    );
+    assert!(e.to_string().contains("give the .msh file"), "{e}");
+    // /dev/null reads as empty, which was "the file is empty"; /dev/zero
+    // never ends (not read here: without the check it would fill memory).
+    let e = Mesh::from_file("/dev/null").unwrap_err();
+    assert_eq!(e.kind, K::NotRegularFile, "{e}");
+    assert!(
+        e.to_string().starts_with("/dev/null: not a regular file"),
+        "{e}"
+    );
+}

@@ -377,6 +377,10 @@ impl<'a> Cursor<'a> {
     }
 
     fn not_a_number(&self, pos: usize, what: &'static str, tok: &[u8]) -> MeshError {
+        // Control bytes are no text: binary data under an ASCII header.
+        if !self.binary && tok.iter().any(|&c| c < 0x20 || c == 0x7f) {
+            return self.error(pos, MeshErrorKind::BinaryInAscii);
+        }
         let shown = String::from_utf8_lossy(tok.get(..SHOW).unwrap_or(tok)).into_owned();
         self.error(pos, MeshErrorKind::NotANumber { what, found: shown })
     }
