@@ -10,7 +10,7 @@ use stickslip_fem::NodeOrder;
 use stickslip_time::ImplicitSolver;
 
 use crate::frames::Schedule;
-use crate::run::{friction_off, human_bytes, output_size, prepare, room_for, setup_warnings};
+use crate::run::{friction_off, human_bytes, output_size, prepare, setup_warnings};
 
 /// `stickslip check`: validate, and say the model size, Δt_crit and
 /// solver: the report is returned for the caller to print, which can fail
@@ -21,8 +21,11 @@ use crate::run::{friction_off, human_bytes, output_size, prepare, room_for, setu
 pub fn check(case: &Case) -> anyhow::Result<String> {
     // The results file a run of the case writes (without -o), refused
     // where `run` would refuse it, at its line of the case.
-    crate::results_file::check_output_place(&case.output.file, &[&case.path, &case.mesh.file])
-        .map_err(|e| InputError(format!("{}output.file: {}", case.at("output.file"), e.0)))?;
+    crate::results_file::check_output_place(
+        &case.output.file,
+        &crate::results_file::case_inputs(case),
+    )
+    .map_err(|e| InputError(format!("{}output.file: {}", case.at("output.file"), e.0)))?;
     let p = prepare(case, true)?;
     let mut report = String::new();
     // A line of the report (writing to a String cannot fail).
@@ -195,7 +198,12 @@ pub fn check(case: &Case) -> anyhow::Result<String> {
             std::f64::consts::PI * crit
         );
     }
-    let size = output_size(case, p.mesh.nodes.len(), i.contact().map_or(0, |c| c.len()));
+    let size = output_size(
+        case,
+        p.mesh.nodes.len(),
+        i.contact().map_or(0, |c| c.len()),
+        p.model.dofs.n_free(),
+    );
     put!(
         "output      {}: about {} frames of u, v, a ({}) and {} rows of histories (time, energy, contact), {}",
         case.output.file.display(),
@@ -204,13 +212,12 @@ pub fn check(case: &Case) -> anyhow::Result<String> {
         size.rows,
         human_bytes(size.bytes)
     );
-    if let Some(free) = room_for(&case.output.file, true) {
-        if size.bytes > free as f64 {
-            put!(
-                "warning     that is more than the {} free on its disk: `run` refuses it; write fewer frames (output.frames, output.interval, output.every) or elsewhere (-o)",
-                human_bytes(free as f64)
-            );
-        }
+    if let Some(free) = size.short_of_room(&case.output.file) {
+        put!(
+            "warning     with the {} a run keeps free while it writes, that needs more than the {} free on its disk: `run` refuses it; write fewer frames (output.frames, output.interval, output.every) or elsewhere (-o)",
+            human_bytes(size.kept),
+            human_bytes(free as f64)
+        );
     }
     // The integrator holds the initial state already (the static solve of
     // Remark 4.1 ran in its setup): the run's warning, before the run.

@@ -248,7 +248,7 @@ fn main() -> ExitCode {
             if restart.is_none() {
                 if let Err(e) = stickslip::results_file::check_output(
                     &out,
-                    &[&case_path, &case.mesh.file],
+                    &stickslip::results_file::case_inputs(&case),
                     force,
                 ) {
                     if at_case {
@@ -258,6 +258,9 @@ fn main() -> ExitCode {
                     }
                     return ExitCode::from(2);
                 }
+            } else if let Err(e) = stickslip::results_file::check_restart(&out) {
+                report(&e.0);
+                return ExitCode::from(2);
             } else if stickslip::results_file::in_use(&out) {
                 report(&format!(
                     "--restart {}: the file is open in another process (a run still writing it, \

@@ -360,6 +360,22 @@ fn series_2d<T: H5Type>(g: &Group, name: &str, n: usize, level: u8) -> Result<Da
         .create(name)?)
 }
 
+/// [`ResultsWriter::room_needed`] of a file of `n_nodes` nodes, `n_c`
+/// contact nodes and `block_rows` rows a chunk of the node vectors, whose
+/// state has `n_free` values a vector. A new run's file has
+/// [`vector_chunk_rows`] of them: `stickslip run` and `check` count it
+/// before the run, so that a run the disk cannot hold with this room kept
+/// is refused at the start rather than stopped part way.
+pub(crate) fn room_kept(n_nodes: usize, n_c: usize, block_rows: usize, n_free: usize) -> u64 {
+    // The rows go to the datasets a chunk at a time (whole chunks are
+    // allocated), so the next write may take a chunk of every series.
+    let frame_bytes = (6 * n_nodes + 2) * 8;
+    let fields = block_rows.max(PENDING_BYTES / frame_bytes + 1) * frame_bytes;
+    let histories = HISTORY_BLOCK * (4 * n_c + 2 + ENERGY_NAMES.len()) * 8;
+    let checkpoint = 5 * n_free * 8;
+    (2 * (fields + histories + checkpoint) + (1 << 20)) as u64
+}
+
 /// Rows per chunk along time of the node vectors (`/displacement` and the
 /// others) of a mesh of `n` nodes: a run's file grows by whole chunks of
 /// them. At most 64 KiB a chunk (where a row is smaller), as every flush
@@ -823,13 +839,7 @@ impl ResultsWriter {
     /// half way, and rows flushed before, in a chunk it rewrote, read as
     /// zeros.
     pub fn room_needed(&self, n_free: usize) -> u64 {
-        // The rows go to the datasets a chunk at a time (whole chunks are
-        // allocated), so the next write may take a chunk of every series.
-        let frame_bytes = (6 * self.n_nodes + 2) * 8;
-        let fields = self.block_rows.max(PENDING_BYTES / frame_bytes + 1) * frame_bytes;
-        let histories = HISTORY_BLOCK * (4 * self.n_c + 2 + ENERGY_NAMES.len()) * 8;
-        let checkpoint = 5 * n_free * 8;
-        (2 * (fields + histories + checkpoint) + (1 << 20)) as u64
+        room_kept(self.n_nodes, self.n_c, self.block_rows, n_free)
     }
 
     /// Whether the next [`ResultsWriter::append`], of a frame if `frame`,

@@ -151,6 +151,11 @@ pub(crate) fn off_the_body(b: [[f64; 2]; 2], p: [f64; 2]) -> bool {
 /// but its datasets may be caught between two records.
 fn open_results(file: &Path) -> Result<File, InputError> {
     let name = file.display();
+    if file.is_dir() {
+        return Err(InputError(format!(
+            "{name} is a directory; give a results file in it, the OUT.h5 a `stickslip run` wrote"
+        )));
+    }
     if crate::results_file::being_written(file) {
         return Err(InputError(format!(
             "{name}: a run is still writing it; wait for the run to end (or stop it: Ctrl-C \
@@ -214,6 +219,12 @@ pub(crate) fn stored_model(
             )))
         }
     };
+    if nodes.ncols() != 2 || nodes.nrows() == 0 {
+        return Err(bad(format!(
+            "/mesh/nodes has shape {:?}, expected [n, 2] with n > 0",
+            nodes.shape()
+        )));
+    }
     let n = nodes.nrows();
     if cells.ncols() != kind.nodes_per_cell() || cells.iter().any(|&v| v < 0 || v as usize >= n) {
         return Err(bad("/mesh/cells does not fit /mesh/nodes".into()));
@@ -248,6 +259,34 @@ pub(crate) fn stored_model(
     let material = stickslip_fem::Material::new(e, nu, num("rho").unwrap_or(1.0), hypothesis)
         .map_err(|e| bad(format!("its case's material: {e}")))?;
     Ok((mesh, material))
+}
+
+/// The rows of the node vectors `/NAME` (`displacement`, `velocity`,
+/// `acceleration`) of `f`, checked to be `[rows, n_nodes, 2]`: the
+/// stresses and the views read a row of it as the mesh's node vectors.
+///
+/// # Errors
+/// The dataset missing, or of another shape: an [`InputError`] naming
+/// the file.
+pub(crate) fn vector_rows(
+    f: &File,
+    file: &str,
+    name: &str,
+    n_nodes: usize,
+) -> Result<usize, InputError> {
+    let shape = f.dataset(name).map(|d| d.shape()).map_err(|e| {
+        InputError(format!(
+            "{file}: cannot read /{name}: {e}; give a results file written by `stickslip run`"
+        ))
+    })?;
+    match shape[..] {
+        [rows, n, 2] if n == n_nodes => Ok(rows),
+        _ => Err(InputError(format!(
+            "{file}: /{name} has shape {shape:?}, expected [records, {n_nodes}, 2] for the \
+             {n_nodes} nodes of /mesh/nodes; the file is damaged or was not written by \
+             `stickslip run`: run the case again for a whole one"
+        ))),
+    }
 }
 
 /// Where `f` is a results file of `stickslip run` whose run had no
@@ -291,6 +330,7 @@ fn stress_history(
     let mut near: Vec<usize> = cells.iter().flat_map(|&c| mesh.cell(c).to_vec()).collect();
     near.sort_unstable();
     near.dedup();
+    vector_rows(f, name, "displacement", mesh.nodes.len())?;
     let ds = f
         .dataset("displacement")
         .map_err(|e| InputError(format!("{name}: cannot read /displacement: {e}")))?;
@@ -389,6 +429,7 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
             (t, values)
         }
         Some((ds, comp)) => {
+            vector_rows(&f, &name, ds, nodes.nrows())?;
             let t = frame_time()?;
             let values = f
                 .dataset(ds)
@@ -871,6 +912,13 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
             "{name}: /mesh/nodes has shape {:?}, expected [n, 2]",
             nodes.shape()
         )));
+    }
+    // A row of the node vectors is read as the mesh's (the stresses need
+    // every node of it).
+    if let Some((ds, _)) = field.node_dataset() {
+        vector_rows(&f, &name, ds, nodes.nrows())?;
+    } else if field.stress().is_some() {
+        vector_rows(&f, &name, "displacement", nodes.nrows())?;
     }
     let cells = f
         .dataset("mesh/cells")

@@ -3,35 +3,164 @@
 //! (`--force`, `--restart`) or `probe` knows it is being written, whatever
 //! HDF5's own locking.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use stickslip_case::InputError;
+use stickslip_case::{Case, InputError};
 
 use crate::sys::{lock_held, ofd_lock};
 
+/// A file a case reads, which no results may be written over, and what
+/// it is to the case (for the message).
+pub type Input<'a> = (&'a Path, &'static str);
+
+/// The files `case` reads: the case file, its mesh.file and the meshes of
+/// its mesh.ladder (which `advise` reads).
+pub fn case_inputs(case: &Case) -> Vec<Input<'_>> {
+    let mut inputs = vec![
+        (case.path.as_path(), "the case file"),
+        (
+            case.mesh.file.as_path(),
+            "an input of the case (its mesh.file)",
+        ),
+    ];
+    inputs.extend(case.mesh.ladder.iter().map(|m| {
+        (
+            m.as_path(),
+            "an input of the case (a mesh of its mesh.ladder)",
+        )
+    }));
+    inputs
+}
+
+/// A file `stickslip views` or `stickslip stress` writes beside a results
+/// file under its name, which a new run or a restart of that file removes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Companion {
+    /// OUT.views.h5 (`stickslip views`).
+    Views,
+    /// OUT.stress.h5 (`stickslip stress`).
+    Stress,
+}
+
+impl Companion {
+    /// Its path beside the results file `out`.
+    pub fn path(self, out: &Path) -> PathBuf {
+        match self {
+            Companion::Views => crate::views::views_path(out),
+            Companion::Stress => crate::stress_cmd::stress_path(out),
+        }
+    }
+
+    /// What it is, for a message.
+    fn what(self) -> &'static str {
+        match self {
+            Companion::Views => "views file",
+            Companion::Stress => "stress file",
+        }
+    }
+
+    /// The command that writes it.
+    fn command(self) -> &'static str {
+        match self {
+            Companion::Views => "views",
+            Companion::Stress => "stress",
+        }
+    }
+}
+
+/// What the file at `kind`'s path beside `out` is, where it exists and is
+/// not `out`'s companion of that kind: another run's results file, the
+/// views or stresses of another results file, or a file of another
+/// program. Such a file only bears the name; removing or replacing it
+/// would lose what it holds. A companion is known by the attribute
+/// `source` its command writes (`out`'s file name); a stress file of an
+/// earlier version, without it, by its datasets.
+pub fn foreign_companion(out: &Path, kind: Companion) -> Option<String> {
+    let path = kind.path(out);
+    let meta = std::fs::metadata(&path).ok()?;
+    if !meta.is_file() {
+        return Some(if meta.is_dir() {
+            "a directory".into()
+        } else {
+            "not a regular file".into()
+        });
+    }
+    if !is_hdf5(&path) {
+        return Some("not an HDF5 file".into());
+    }
+    let f = match hdf5::File::open(&path) {
+        Ok(f) => f,
+        Err(_) => {
+            return Some("an HDF5 file that cannot be opened (damaged, or being written)".into())
+        }
+    };
+    if crate::output::text_attr(&f, "program").ok().as_deref() == Some("stickslip") {
+        return Some("the results file of another run".into());
+    }
+    let ours = out.file_name().and_then(|n| n.to_str());
+    match crate::output::text_attr(&f, "source").ok() {
+        Some(source) if Some(source.as_str()) == ours => None,
+        Some(source) => Some(format!("the {} of {source}", kind.what())),
+        None if kind == Companion::Stress
+            && f.link_exists("stress")
+            && f.link_exists("von_mises")
+            && f.link_exists("views") =>
+        {
+            None
+        }
+        None => Some(format!(
+            "a file `stickslip {}` did not write",
+            kind.command()
+        )),
+    }
+}
+
+/// The message for [`foreign_companion`]'s file beside `out`, which
+/// `doing` (a run, `stickslip views`) would remove or replace.
+pub(crate) fn foreign_message(out: &Path, kind: Companion, what: &str, doing: &str) -> String {
+    format!(
+        "{} is {what}, not the {} of {}, although named as one: {doing} would remove or replace it; \
+         move or rename it and run this again",
+        kind.path(out).display(),
+        kind.what(),
+        out.display()
+    )
+}
+
 /// Refuses an output path `run` must not write (exit code 2), before
-/// anything is read: an existing OUT.h5, OUT.xdmf, OUT.contact.xdmf or
-/// OUT.views.h5 without `force`, an
-/// empty name, a directory, the case file itself, a missing directory, or
+/// anything is read: an existing OUT.h5, OUT.xdmf, OUT.contact.xdmf,
+/// OUT.views.h5 or OUT.stress.h5 without `force`, a file named as
+/// OUT.h5's views or stresses that is not theirs (even with `force`), an
+/// empty name, a directory, an input of the case, a missing directory, or
 /// a file another process has open (HDF5 locks files it writes: a second
 /// run with `--force` would truncate the first run's file and then fail on
 /// the lock, losing both).
 ///
 /// # Errors
 /// The [`InputError`] naming the file and what to do.
-pub fn check_output(out: &Path, inputs: &[&Path], force: bool) -> Result<(), InputError> {
+pub fn check_output(out: &Path, inputs: &[Input], force: bool) -> Result<(), InputError> {
     check_output_place(out, inputs)?;
     let name = out.display();
-    // The viewers' files beside OUT.h5 (`stickslip views`) show its run:
-    // a new run would leave them showing another.
+    // The viewers' files and the stresses beside OUT.h5 (`stickslip views`,
+    // `stickslip stress`) show its run: a new run would leave them showing
+    // another, and so removes them.
     let beside = [
-        crate::xdmf::xdmf_path(out),
-        crate::xdmf::contact_xdmf_path(out),
-        crate::views::views_path(out),
+        (crate::xdmf::xdmf_path(out), None),
+        (crate::xdmf::contact_xdmf_path(out), None),
+        (Companion::Views.path(out), Some(Companion::Views)),
+        (Companion::Stress.path(out), Some(Companion::Stress)),
     ];
-    for path in std::iter::once(out).chain(beside.iter().map(|p| p.as_path())) {
+    let all = std::iter::once((out, None)).chain(beside.iter().map(|(p, k)| (p.as_path(), *k)));
+    for (path, kind) in all {
         if !path.exists() {
             continue;
+        }
+        if let Some(what) = kind.and_then(|k| foreign_companion(out, k).map(|w| (k, w))) {
+            let (kind, what) = what;
+            return Err(InputError(format!(
+                "{}, or write elsewhere with -o",
+                foreign_message(out, kind, &what, &format!("a run on {name}"))
+            )));
         }
         if !force {
             let restart = if is_hdf5(out) {
@@ -57,12 +186,13 @@ pub fn check_output(out: &Path, inputs: &[&Path], force: bool) -> Result<(), Inp
 
 /// The part of [`check_output`] that does not depend on what exists at
 /// `out` (`stickslip check` calls it, as the run's `--force` is not
-/// known there): an `.xdmf` name, an empty name, a directory, an input
-/// of the case, a symbolic link, a device, a missing directory.
+/// known there): an `.xdmf` or `.part` name, an empty name, a ':' in the name, a
+/// directory, an input of the case, a symbolic link, a device, a missing
+/// directory, a directory this process may not write.
 ///
 /// # Errors
 /// The [`InputError`] naming the file and what to do.
-pub fn check_output_place(out: &Path, inputs: &[&Path]) -> Result<(), InputError> {
+pub fn check_output_place(out: &Path, inputs: &[Input]) -> Result<(), InputError> {
     let name = out.display();
     if out
         .extension()
@@ -86,17 +216,37 @@ pub fn check_output_place(out: &Path, inputs: &[&Path]) -> Result<(), InputError
             out.join("out.h5").display()
         )));
     }
+    // `views` and `stress` write FILE.part beside a results file and
+    // rename it into place, removing it where they fail: a results file of
+    // such a name would be lost to them.
+    if out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("part"))
+    {
+        return Err(InputError(format!(
+            "-o {name}: .part names are the files `stickslip views` and `stickslip stress` write \
+             beside a results file and then rename or remove; give another name, e.g. -o {}",
+            out.with_extension("h5").display()
+        )));
+    }
+    refer_by_name(out).map_err(|why| {
+        InputError(format!(
+            "{name}: {why}; give a name without ':', e.g. -o {}",
+            out.with_file_name(
+                out.file_name()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .replace(':', "_")
+            )
+            .display()
+        ))
+    })?;
     let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
         (Ok(a), Ok(b)) => a == b,
         _ => false,
     };
-    for (k, input) in inputs.iter().enumerate() {
+    for (input, what) in inputs {
         if same(out, input) {
-            let what = if k == 0 {
-                "the case file"
-            } else {
-                "an input of the case (its mesh)"
-            };
             return Err(InputError(format!(
                 "{name} is {what} itself; write the results elsewhere with -o OUT.h5"
             )));
@@ -129,6 +279,70 @@ pub fn check_output_place(out: &Path, inputs: &[&Path]) -> Result<(), InputError
                 dir.display()
             )));
         }
+    }
+    // The run creates the file (and removes an old one) in its directory.
+    let dir = match out.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !crate::sys::can_write_in(dir) {
+        return Err(InputError(format!(
+            "{name}: cannot write in the directory {} (read-only, or not yours); make it writable, \
+             or choose another file with -o",
+            dir.display()
+        )));
+    }
+    Ok(())
+}
+
+/// Why the results file `out` cannot be named in the XDMF files beside
+/// it, if it cannot: they refer to it by file name as `NAME:/dataset`,
+/// which ParaView's and VTK's readers and meshio split at the first ':',
+/// reading an empty mesh or nothing.
+pub(crate) fn refer_by_name(out: &Path) -> Result<(), String> {
+    let colon = out
+        .file_name()
+        .is_some_and(|n| n.as_encoded_bytes().contains(&b':'));
+    if colon {
+        return Err(
+            "a ':' in the results file's name breaks the XDMF files `stickslip views` writes \
+             beside it (they refer to it as NAME:/dataset, which ParaView, VTK and meshio split at \
+             the first ':')"
+                .into(),
+        );
+    }
+    Ok(())
+}
+
+/// Refuses early what `run --restart` cannot continue: a missing file, a
+/// directory, a file that is not HDF5 (the case file given as the results
+/// file, say), before the model is built.
+///
+/// # Errors
+/// The [`InputError`] naming the file and what to give instead.
+pub fn check_restart(path: &Path) -> Result<(), InputError> {
+    let name = path.display();
+    let give = "give the OUT.h5 of the run to continue: `stickslip run CASE.toml --restart \
+                OUT.h5` (`stickslip run CASE.toml -o OUT.h5` starts a new one)";
+    let Ok(meta) = std::fs::metadata(path) else {
+        return Err(InputError(format!(
+            "--restart {name}: no such file; {give}"
+        )));
+    };
+    if meta.is_dir() {
+        return Err(InputError(format!(
+            "--restart {name} is a directory; {give}"
+        )));
+    }
+    if !meta.is_file() {
+        return Err(InputError(format!(
+            "--restart {name} is not a regular file (a device, FIFO or socket); {give}"
+        )));
+    }
+    if !is_hdf5(path) {
+        return Err(InputError(format!(
+            "--restart {name} is not a results file of `stickslip run` (not an HDF5 file); {give}"
+        )));
     }
     Ok(())
 }
@@ -285,6 +499,16 @@ pub(crate) fn open_finished(
             path.with_extension("h5").display()
         )));
     }
+    if path.is_dir() {
+        return Err(InputError(format!(
+            "{name} is a directory; give a results file in it, the OUT.h5 a `stickslip run` wrote"
+        )));
+    }
+    if path.exists() && !path.is_file() {
+        return Err(InputError(format!(
+            "{name} is not a regular file (a device, FIFO or socket); give the OUT.h5 a `stickslip run` wrote"
+        )));
+    }
     if !path.is_file() {
         return Err(InputError(format!(
             "{name}: no such results file; give the OUT.h5 a `stickslip run` wrote"
@@ -338,13 +562,18 @@ pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
     // views`), which the new one does not have (best effort).
     for stale in [
         "xdmf.part",
-        "stress.h5",
         "stress.h5.part",
-        "views.h5",
         "contact.xdmf",
         "contact.xdmf.part",
     ] {
         let _ = std::fs::remove_file(out.with_extension(stale));
+    }
+    // Only files these commands wrote for `out` ([`check_output`] refused
+    // any other by their names).
+    for kind in [Companion::Stress, Companion::Views] {
+        if foreign_companion(out, kind).is_none() {
+            let _ = std::fs::remove_file(kind.path(out));
+        }
     }
     let mut old = None;
     for path in [out.to_path_buf(), out.with_extension("xdmf")] {

@@ -143,6 +143,18 @@ pub(crate) struct OutputSize {
     pub(crate) rows: f64,
     /// Bytes, uncompressed.
     pub(crate) bytes: f64,
+    /// Bytes the run keeps free beside them while it writes
+    /// ([`output::room_kept`]): it stops where the disk has less.
+    pub(crate) kept: f64,
+}
+
+impl OutputSize {
+    /// The disk's free bytes for `out` ([`room_for`], with what `--force`
+    /// removes), where they cannot hold the records and the room the run
+    /// keeps: such a run would stop part way, at a nearly full disk.
+    pub(crate) fn short_of_room(&self, out: &Path) -> Option<u64> {
+        room_for(out, true).filter(|&free| self.bytes + self.kept > free as f64)
+    }
 }
 
 /// Frames, rows and bytes a run of `case` writes from t = 0
@@ -151,8 +163,14 @@ pub(crate) struct OutputSize {
 /// stress and slip (2 doubles) and state (1 byte), and 10 series besides
 /// (time, the ledger, dt, iterations: 68 bytes); the mesh, twice the
 /// checkpoint (its two slots: r, ṙ, r̈ at 2 values a node) and HDF5's own
-/// structures (about 64 kB) besides.
-pub(crate) fn output_size(case: &Case, nodes: usize, contact_nodes: usize) -> OutputSize {
+/// structures (about 64 kB) besides. With the room the run keeps free
+/// while it writes, for a model of `n_free` free DOFs.
+pub(crate) fn output_size(
+    case: &Case,
+    nodes: usize,
+    contact_nodes: usize,
+    n_free: usize,
+) -> OutputSize {
     let steps = (case.time.t_end / case.time.dt - 1e-6).ceil().max(1.0);
     let schedule = Schedule::new(case.output.fields(), case.time.t_end);
     let frames = schedule.frames(steps, case.time.dt);
@@ -172,10 +190,12 @@ pub(crate) fn output_size(case: &Case, nodes: usize, contact_nodes: usize) -> Ou
         + 2.0 * 3.0 * 16.0 * nodes_f
         + 16.0 * nodes_f
         + 65536.0;
+    let block_rows = output::vector_chunk_rows(nodes);
     OutputSize {
         frames,
         rows,
         bytes,
+        kept: output::room_kept(nodes, contact_nodes, block_rows, n_free) as f64,
     }
 }
 
@@ -609,17 +629,19 @@ fn run_scene(
     // off by orders of magnitude filled 14 GB in 75 s): refused before it
     // starts, where the run's own stop at a full disk would come late.
     if !options.restart {
-        let size = output_size(case, mesh.nodes.len(), n_c);
-        if let Some(free) = room_for(out, true).filter(|&f| size.bytes > f as f64) {
+        let size = output_size(case, mesh.nodes.len(), n_c, dofs.n_free());
+        if let Some(free) = size.short_of_room(out) {
             return Err(input(format!(
-                "{}: the run would write about {} frames and {} rows ({}) to {}, whose disk has {} free; \
-                 write fewer frames (output.frames, output.interval, output.every), shorten time.t_end, \
-                 or write elsewhere with -o",
+                "{}: the run would write about {} frames and {} rows ({}) to {} and keeps {} free beside \
+                 them while it writes (it stops at a nearly full disk, before HDF5 fails mid-write), \
+                 but its disk has {} free; write fewer frames (output.frames, output.interval, \
+                 output.every), shorten time.t_end, or write elsewhere with -o",
                 case.path.display(),
                 size.frames,
                 size.rows,
                 human_bytes(size.bytes),
                 out.display(),
+                human_bytes(size.kept),
                 human_bytes(free as f64)
             )));
         }
@@ -1178,10 +1200,12 @@ fn view_command(out: &Path) -> String {
 /// stress` and `stickslip views` wrote beside it for the earlier run (the
 /// stresses end where it ended, the XML lists its records), saying so.
 /// The views file stays: `views` then keeps the views that still hold
-/// and makes the others.
+/// and makes the others. A file only named like the stresses (another
+/// run's results, say) is not this run's and stays too.
 pub(crate) fn forget_companions(out: &Path, quiet: bool) {
-    let stress = crate::stress_cmd::stress_path(out);
-    if stress.is_file() {
+    use crate::results_file::{foreign_companion, Companion};
+    let stress = Companion::Stress.path(out);
+    if stress.is_file() && foreign_companion(out, Companion::Stress).is_none() {
         std::fs::remove_file(&stress).ok();
         if !quiet {
             say!(

@@ -55,6 +55,8 @@ pub fn command(
     crate::views_cmd::check_beside(path, "stress", &beside)?;
     let (mesh, material) = crate::probe::stored_model(&f, &name)?;
     let n_nodes = mesh.nodes.len();
+    // Each row is read as the mesh's displacement.
+    crate::probe::vector_rows(&f, &name, "displacement", n_nodes)?;
     let u = f.dataset("displacement").map_err(|e| unread(path, e))?;
     // A record here is a frame: the rows of /displacement.
     let times = crate::frames::Frames::read(&f, &name)?.time;
@@ -135,6 +137,11 @@ fn write_stresses(
     let part = part_path(out);
     crate::views_cmd::create_beside(out, "stress", &part)?;
     let g = File::create(&part).map_err(|e| write_failed(out, e.into()))?;
+    // Whose stresses these are: a run on another results file whose
+    // companion this file's name would be leaves it alone
+    // ([`crate::results_file::foreign_companion`]).
+    let source = crate::views::file_name(out)?;
+    crate::output::string_attr(&g, "source", source).map_err(|e| write_failed(out, e))?;
     fill(&g, out, u, mesh, material, rows, quiet)?;
     // Closed before the rename, so that a failure of its last writes is
     // seen here.

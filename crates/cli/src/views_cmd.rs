@@ -118,6 +118,21 @@ pub(crate) fn check_beside(out: &Path, command: &str, files: &[PathBuf]) -> Resu
             )));
         }
     }
+    use crate::results_file::{foreign_companion, foreign_message, Companion};
+    for kind in [Companion::Views, Companion::Stress] {
+        if !files.contains(&kind.path(out)) {
+            continue;
+        }
+        if let Some(what) = foreign_companion(out, kind) {
+            return Err(InputError(foreign_message(
+                out,
+                kind,
+                &what,
+                &format!("`stickslip {command}`"),
+            )));
+        }
+    }
+    named_in_xml(out)?;
     let dir = match out.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -131,6 +146,25 @@ pub(crate) fn check_beside(out: &Path, command: &str, files: &[PathBuf]) -> Resu
         )));
     }
     Ok(())
+}
+
+/// Refuses a results file `out` the XDMF files cannot name
+/// ([`crate::results_file::refer_by_name`]).
+///
+/// # Errors
+/// The [`InputError`] saying why and what to do.
+fn named_in_xml(out: &Path) -> Result<(), InputError> {
+    crate::results_file::refer_by_name(out).map_err(|why| {
+        let renamed = out
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .replace(':', "_");
+        InputError(format!(
+            "{}: {why}; rename it without ':' (e.g. to {renamed}) and run this again",
+            out.display()
+        ))
+    })
 }
 
 /// Creates (or truncates) `path` beside the results file `out` for
@@ -227,6 +261,7 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
             "{e}; rename it (and its files beside it) with a UTF-8 name"
         ))
     })?;
+    named_in_xml(out)?;
     let f = File::open(out).map_err(|e| {
         InputError(format!(
             "{name}: cannot open it as HDF5: {e}; give a results file written by `stickslip run`"
@@ -244,6 +279,13 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
     };
     let nodes = shape("mesh/nodes")?;
     let cells = shape("mesh/cells")?;
+    // The views and the XML take these shapes as they are.
+    if !matches!(nodes[..], [n, 2] if n > 0) {
+        return Err(bad(&format!(
+            "/mesh/nodes has shape {nodes:?}, expected [n, 2] with n > 0"
+        ))
+        .into());
+    }
     let kind = match f
         .group("mesh")
         .ok()
@@ -259,15 +301,25 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
             .into())
         }
     };
-    let n_nodes = nodes.first().copied().unwrap_or(0);
+    if !matches!(cells[..], [_, k] if k == kind.nodes_per_cell()) {
+        return Err(bad(&format!(
+            "/mesh/cells has shape {cells:?}, expected [cells, {}] for {} cells",
+            kind.nodes_per_cell(),
+            kind.name()
+        ))
+        .into());
+    }
+    let n_nodes = nodes[0];
+    let mut vector_rows = usize::MAX;
+    for v in crate::views::VECTORS {
+        vector_rows = vector_rows.min(crate::probe::vector_rows(&f, &name, v, n_nodes)?);
+    }
     // A record here is a frame: the fields' rows and their contact rows.
     let frames = crate::frames::Frames::read(&f, &name)?;
     let times = frames.time;
     // A run killed between writing /frames and the vectors: list the
     // frames every dataset holds.
-    let rows = times
-        .len()
-        .min(shape("displacement")?.first().copied().unwrap_or(0));
+    let rows = times.len().min(vector_rows);
     let (contact, note) = contact_line(&f, out)?;
     // The histories' rows the frames name, which every contact field
     // listed must hold.
@@ -389,7 +441,13 @@ fn contact_line(f: &File, out: &Path) -> anyhow::Result<(Option<ContactLine>, Op
 /// at least `rows` records (one of fewer would leave records without
 /// stresses; a run or restart removes it anyway).
 fn stress_name(out: &Path, rows: usize) -> Option<String> {
-    let path = crate::stress_cmd::stress_path(out);
+    use crate::results_file::{foreign_companion, Companion};
+    let path = Companion::Stress.path(out);
+    // A file of that name that is not these stresses (another run's
+    // results, another file's stresses) is not listed.
+    if foreign_companion(out, Companion::Stress).is_some() {
+        return None;
+    }
     let g = File::open(&path).ok()?;
     for v in crate::xdmf::STRESS_VIEWS {
         if (g.group(&format!("views/{v}")).ok()?.len() as usize) < rows {

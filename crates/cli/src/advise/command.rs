@@ -121,7 +121,8 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
         return Err(input(format!(
             "{}time.scheme = \"quasi_static\": advise picks among the dynamic schemes (central \
              difference, Newmark), Δt and ε by pilot runs; a quasi-static case has no such choice. \
-             Advise the dynamic case instead (e.g. --set time.scheme=\"central_difference\")",
+             Advise a dynamic copy of the case instead: in a copy of the case file, set time.scheme = \
+             \"central_difference\" (or \"newmark\") at that line, and give the copy to advise",
             case.at("time.scheme")
         )));
     }

@@ -65,12 +65,17 @@ pub fn read_ladder(
             )));
         }
         // A Newmark set-up never refuses a Δt; the static solve checks the supports.
-        let c = Method::Trapezoidal.configure(case, path, case.time.t_end / 50.0, eps_of(case));
+        let mut c = Method::Trapezoidal.configure(case, path, case.time.t_end / 50.0, eps_of(case));
+        // The mesh read here is the entry's, not mesh.file's: a problem
+        // with it is placed at mesh.ladder, said once.
+        if let Some(at) = case.locations.get("mesh.ladder") {
+            c.locations.insert("mesh.file".into(), at.clone());
+        }
         let p = prepare(&c).map_err(|e| {
+            let at = case.at("mesh.ladder");
             input(format!(
-                "{}mesh.ladder entry {text:?}: {}",
-                case.at("mesh.ladder"),
-                e.0
+                "{at}mesh.ladder entry {text:?}: {}",
+                e.0.strip_prefix(&at).unwrap_or(&e.0)
             ))
         })?;
         let b = p.mesh.bbox();
