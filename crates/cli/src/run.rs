@@ -250,12 +250,18 @@ fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
         .enumerate()
         .fold((0, 0.0_f64), |m, (i, d)| if d > m.1 { (i, d) } else { m });
     (size > 0.0 && max > size).then(|| {
+        // A mix of units makes the ratio huge: short either way.
+        let ratio = max / size;
+        let share = if ratio < 100.0 {
+            format!("{:.0}% of", 100.0 * ratio)
+        } else {
+            format!("{ratio:.1e} times")
+        };
         format!(
-            "the initial static displacement reaches {max:.3e} at ({}, {}), {:.0}% of the part's size {size:.3e}: \
+            "the initial static displacement reaches {max:.3e} at ({}, {}), {share} the part's size {size:.3e}: \
              linear elasticity assumes small strains; check the units of E, the loads and the lengths",
             mesh.nodes[node][0],
             mesh.nodes[node][1],
-            100.0 * max / size
         )
     })
 }
@@ -316,6 +322,16 @@ fn oblique_supports(mesh: &Mesh, c: &ContactSurface) -> Option<String> {
     let mut count = [0usize; 2];
     let mut worst: Option<(f64, usize, usize)> = None;
     for n in &c.nodes {
+        // A node whose free DOFs have no share of τ (a compliant surface
+        // keeps it for its normal force) carries no friction: its support
+        // takes none of it.
+        let free_tangent: f64 = (0..2)
+            .filter(|&a| n.dofs[a].is_some())
+            .map(|a| n.tangent[a] * n.tangent[a])
+            .sum();
+        if free_tangent < 1e-20 {
+            continue;
+        }
         for axis in 0..2 {
             let off = n.tangent[axis].abs();
             if n.dofs[axis].is_none() && off > limit {
@@ -1324,5 +1340,32 @@ mod tests {
         let mixed = held(vec![[Some(0), None], [None, Some(1)], [Some(2), None]]);
         assert!(mixed.contains("have ux or uy fixed"), "{mixed}");
         assert!(mixed.contains("only along the other axis"), "{mixed}");
+        // On a floor (τ along x) a node with ux held moves only along the
+        // normal: no friction, no warning; a free one beside it neither.
+        let floor = vec![
+            node(0, [None, Some(0)], [1.0, 0.0]),
+            node(1, [Some(1), Some(2)], [1.0, 0.0]),
+        ];
+        let c = ContactSurface::from_nodes("floor", floor, 1.0).unwrap();
+        assert_eq!(oblique_supports(&mesh, &c), None);
+    }
+
+    #[test]
+    fn a_huge_static_displacement_is_reported_in_short() {
+        let mesh = stickslip_testkit::rectangle(
+            stickslip_mesh::CellKind::Quad4,
+            1,
+            1,
+            [0.0, 0.0],
+            [1.0, 1.0],
+        );
+        let mut u = vec![0.0; 8];
+        u[3] = -1e99;
+        let said = large_static_displacement(&mesh, &u).expect("a warning");
+        assert!(said.contains("1.0e99 times the part's size"), "{said}");
+        assert!(said.len() < 300, "{said}");
+        u[3] = -3.4;
+        let said = large_static_displacement(&mesh, &u).expect("a warning");
+        assert!(said.contains("340% of the part's size"), "{said}");
     }
 }

@@ -108,7 +108,7 @@ pub(crate) fn resume(
     if !changes.is_empty() {
         return Err(input(format!(
             "{}: --restart {}: the case changes what the stored run computed:\n  {}\n\
-             a restart may change only time.t_end, output.*, title and mesh.ladder; undo those changes, or start a new run with -o NEW.h5",
+             a restart may change only time.t_end, output.*, title, mesh.ladder and contact.max_iterations; undo those changes, or start a new run with -o NEW.h5",
             case.path.display(),
             out.display(),
             changes.join("\n  ")
