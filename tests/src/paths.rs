@@ -30,7 +30,10 @@ pub fn meshes_dir() -> PathBuf {
 /// The file is missing or unreadable (the error names it).
 pub fn read_mesh(name: &str) -> Result<Mesh, SceneError> {
     let path = meshes_dir().join(name);
-    Mesh::from_file(&path).map_err(|source| SceneError::Mesh { path, source })
+    Mesh::from_file(&path).map_err(|source| SceneError::Mesh {
+        path,
+        source: Box::new(source),
+    })
 }
 
 /// A fresh, empty directory for one test's files, `tmp/BINARY-NAME` in the

@@ -50,8 +50,8 @@ pub enum SceneError {
     Mesh {
         /// The file.
         path: PathBuf,
-        /// The reader's error.
-        source: MeshError,
+        /// The reader's error (boxed: it is the largest variant).
+        source: Box<MeshError>,
     },
     /// The model or a load (a missing group, a bad material).
     #[error(transparent)]

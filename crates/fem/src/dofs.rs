@@ -127,8 +127,26 @@ pub struct RigidMode {
     /// "translation in x", "rotation about (x, y)", ... as
     /// [`DofMap::free_rigid_motions`] names it.
     pub label: String,
+    /// What the motion is, for those who combine modes and name the sum
+    /// (`None` for a sum of several parts' motions, which is no one
+    /// motion).
+    pub motion: Option<RigidMotion>,
+    /// The label's ending that names the part of the mesh it moves (" of
+    /// the separate part of the mesh containing node …"; empty where the
+    /// mesh is one part).
+    pub whose: String,
     /// The motion on the free DOFs (zero off its part).
     pub vector: Vec<f64>,
+}
+
+/// A [`RigidMode`]'s motion: a unit translation along a direction, or a
+/// unit rotation about a centre.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RigidMotion {
+    /// Along this unit vector.
+    Translation([f64; 2]),
+    /// About this point.
+    Rotation([f64; 2]),
 }
 
 impl DofMap {
@@ -639,7 +657,12 @@ fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> (Vec<String>, V
             } else {
                 label.clone()
             };
-            modes.push((k, label, vector));
+            let motion = Some(if shape[2] == 1.0 {
+                RigidMotion::Rotation([shape[0], shape[1]])
+            } else {
+                RigidMotion::Translation([shape[0], shape[1]])
+            });
+            modes.push((k, label, motion, vector));
         }
         if n_parts > 1 {
             let v = first_node[k];
@@ -656,18 +679,23 @@ fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> (Vec<String>, V
     }
     let modes = modes
         .into_iter()
-        .map(|(k, label, vector)| RigidMode {
-            label: if n_parts > 1 {
+        .map(|(k, label, motion, vector)| {
+            let whose = if n_parts > 1 {
                 let v = first_node[k];
                 let p = mesh.nodes[v];
                 format!(
-                    "{label} of the separate part of the mesh containing node {v} at ({}, {})",
+                    " of the separate part of the mesh containing node {v} at ({}, {})",
                     p[0], p[1]
                 )
             } else {
-                label
-            },
-            vector,
+                String::new()
+            };
+            RigidMode {
+                label: format!("{label}{whose}"),
+                motion,
+                whose,
+                vector,
+            }
         })
         .collect();
     (motions, modes)

@@ -35,7 +35,7 @@ mod setup_times;
 pub mod statics;
 
 pub use boundary::{boundary_quadrature, BoundaryNode};
-pub use dofs::{Dirichlet, DofMap, NodeOrder, RigidMode};
+pub use dofs::{Dirichlet, DofMap, NodeOrder, RigidMode, RigidMotion};
 pub use error::FemError;
 pub use loads::{
     body_force_load, body_force_load_with, traction_load, traction_load_with, Traction,

@@ -21,7 +21,7 @@ use crate::settings::TimeError;
 /// Loads whose work along a free motion is below this fraction of the sum
 /// of its terms' magnitudes are in equilibrium (round-off of the load
 /// vectors' quadrature).
-const BALANCE_TOLERANCE: f64 = 1e-9;
+pub(crate) const BALANCE_TOLERANCE: f64 = 1e-9;
 
 /// r₀ in place of the loads `r` (see the module's comment).
 ///

@@ -15,18 +15,25 @@
 //! a slide along the straight foundation), on which the preload must be
 //! balanced and which are pinned and taken out as `floating.rs` does, and
 //! those it holds once nodes press into it. While the nodes in contact do
-//! not hold the latter (a part that starts touching the foundation), the
-//! tangent is singular along them: each node out of contact then adds a
-//! spring as stiff as its own diagonal of K, which keeps the step a
-//! descent direction of Π until contact holds the part.
+//! not hold the latter (a part that starts off the foundation, or touches
+//! it at one corner), the tangent is singular along them. Where the
+//! residual does work along such a free motion, the step is that rigid
+//! motion alone: K z = 0, so Π along it changes only by the loads' work
+//! and the foundation's energy, and the line search carries the part as
+//! far as the foundation lets it, however far off it starts (a Newton
+//! step on springs standing in for the foundation would move it by a
+//! fixed fraction of its deformation per step instead). Otherwise each
+//! node out of contact adds a spring as stiff as its own diagonal of K,
+//! which keeps the step a descent direction of Π until contact holds the
+//! part.
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
-use stickslip_fem::{RigidMode, SetupTimes};
+use stickslip_fem::{RigidMode, RigidMotion, SetupTimes};
 use stickslip_linalg::csr::{dot, spmv};
 use stickslip_linalg::{Analysis, FillOrder, SparseCholesky};
 
-use crate::floating;
+use crate::floating::{self, BALANCE_TOLERANCE};
 use crate::initial::Mass;
 use crate::settings::TimeError;
 
@@ -86,8 +93,8 @@ pub(crate) fn solve(
     analyzed: Option<Analysis>,
 ) -> Result<(), TimeError> {
     let preload = r.to_vec();
-    let along = along_normal(contact, modes);
-    let (never, held) = split(modes, &along);
+    let vectors: Vec<&[f64]> = modes.iter().map(|m| m.vector.as_slice()).collect();
+    let (never, held) = split(modes, &along_normal(contact, &vectors));
     floating::balanced(&never, &preload)?;
     let pins = if never.is_empty() {
         Vec::new()
@@ -99,6 +106,7 @@ pub(crate) fn solve(
     let diagonal: Vec<f64> = (0..k.nrows())
         .map(|i| slot(k, i, i).map_or(0.0, |p| k.values()[p]))
         .collect();
+    let free = Held::new(contact, modes, (&held, &never, &pins), &diagonal);
     // Against R₀, or the foundation's push at r = 0 where nodes start
     // inside it (with R₀ = 0 an interference is all that presses).
     let (zero, mut pushed) = (vec![0.0; r.len()], vec![0.0; r.len()]);
@@ -115,13 +123,18 @@ pub(crate) fn solve(
     let (mut g, mut trial, mut gt) = (vec![0.0; r.len()], vec![0.0; r.len()], vec![0.0; r.len()]);
     let x = r;
     x.fill(0.0);
-    let residual = |x: &[f64], g: &mut [f64]| {
+    // The rigid steps' motion z is kept out of x and folded into the gaps
+    // of a copy of the surface: K z = 0, but K (x + z) in floating point
+    // carries z's round-off, which for a part far off the foundation (z
+    // the gap, x its deformation) can exceed the tolerance.
+    let (mut surface, mut rigid) = (contact.clone(), vec![0.0; x.len()]);
+    let residual = |surface: &ContactSurface, x: &[f64], g: &mut [f64]| {
         spmv(k, x, g);
         for (g, p) in g.iter_mut().zip(&preload) {
             *g -= p;
         }
         let mut forces = vec![0.0; x.len()];
-        add_foundation_forces(contact, x, &mut forces);
+        add_foundation_forces(surface, x, &mut forces);
         for (g, f) in g.iter_mut().zip(&forces) {
             *g -= f;
         }
@@ -130,16 +143,48 @@ pub(crate) fn solve(
         }
     };
     for _ in 0..MAX_STEPS {
-        residual(x, &mut g);
+        residual(&surface, x, &mut g);
         if norm(&g) <= TOLERANCE * scale {
+            for (x, z) in x.iter_mut().zip(&rigid) {
+                *x += z;
+            }
             floating::remove_rigid_motion(mass, &never, x);
             return Ok(());
         }
-        // The tangent: K and the springs of the nodes in contact, or of
-        // every node out of it while those do not hold the part.
-        let springs = springs(contact, x, &along, &held, &diagonal);
+        let at = |x: &[f64], g: &mut [f64]| residual(&surface, x, g);
+        let mut springs = contact_springs(&surface, x);
+        if !free.motions.is_empty() && !holds(&springs, &free.along) {
+            // A held motion the nodes in contact leave free: the rigid step
+            // along it where the residual does work along it.
+            let (mut kx, mut terms) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+            spmv(k, x, &mut kx);
+            add_foundation_forces(&surface, x, &mut terms);
+            for ((t, kx), p) in terms.iter_mut().zip(&kx).zip(&preload) {
+                *t = t.abs() + kx.abs() + p.abs();
+            }
+            let threshold = TOLERANCE * scale;
+            if let Some(e) = free.rigid_step(&surface, (x, &g), &springs, (&terms, threshold)) {
+                let Some(alpha) = search(x, &e, &g, (&mut trial, &mut gt), &at) else {
+                    break;
+                };
+                for (z, e) in rigid.iter_mut().zip(&e) {
+                    *z += alpha * e;
+                }
+                for (moved, c) in surface.compliance.iter_mut().zip(&contact.compliance) {
+                    let dofs = contact.nodes[c.index].dofs;
+                    moved.gap = c.gap
+                        + (0..2)
+                            .filter_map(|comp| dofs[comp].map(|d| c.normal[comp] * rigid[d]))
+                            .sum::<f64>();
+                }
+                continue;
+            }
+            // The tangent: K and the springs of the nodes in contact, and
+            // of every node out of it while those do not hold the part.
+            stand_in(&surface, x, &diagonal, &mut springs);
+        }
         tangent.values_mut().copy_from_slice(k.values());
-        for (s, (c, kt)) in slots.iter().zip(contact.compliance.iter().zip(&springs)) {
+        for (s, (c, kt)) in slots.iter().zip(surface.compliance.iter().zip(&springs)) {
             for (a, row) in s.iter().enumerate() {
                 for (b, p) in row.iter().enumerate() {
                     if let Some(p) = p {
@@ -154,7 +199,7 @@ pub(crate) fn solve(
             .map_err(TimeError::Static)?;
         let mut d: Vec<f64> = g.iter().map(|g| -g).collect();
         times.time("preload solve", || solver.solve_in_place(&mut d));
-        let Some(alpha) = search(x, &d, &g, (&mut trial, &mut gt), &residual) else {
+        let Some(alpha) = search(x, &d, &g, (&mut trial, &mut gt), &at) else {
             break;
         };
         for (x, d) in x.iter_mut().zip(&d) {
@@ -162,19 +207,24 @@ pub(crate) fn solve(
         }
     }
     // No equilibrium: Π falls without bound (or the steps ran out) along
-    // the motions the foundation holds, whose load pulls the part off it.
-    residual(x, &mut g);
+    // the motions the foundation holds, whose load pulls the part off it
+    // (those the loads do work along, as `floating::balanced` judges).
+    residual(&surface, x, &mut g);
     let work: Vec<(String, f64)> = held
         .iter()
-        .map(|h| {
+        .filter_map(|h| {
             let z = combine(modes, h);
-            let work = z.iter().zip(&preload).map(|(z, p)| z * p).sum::<f64>();
+            let (work, size) = z
+                .iter()
+                .zip(&preload)
+                .fold((0.0, 0.0), |(w, s), (z, p)| (w + z * p, s + (z * p).abs()));
             let why = format!(
                 ", which the foundation of surface {} holds only against loads pressing the part \
                  into it (it only pushes)",
                 contact.names()
             );
-            (label(modes, h) + &why, work)
+            let (name, amount, _, _) = describe(modes, h);
+            (work.abs() > BALANCE_TOLERANCE * size).then(|| (name + &why, work / amount))
         })
         .collect();
     if work.is_empty() {
@@ -252,81 +302,239 @@ fn search(
     Some(alpha)
 }
 
-/// Each spring's stiffness k_J (the tangent gains k_J ννᵀ at node J): w_J
-/// c_n m_n δ_J^{m_n−1} where δ_J > 0; where the nodes in contact leave a
-/// held motion free, the largest diagonal of K at each node out of
-/// contact.
-fn springs(
-    contact: &ContactSurface,
-    x: &[f64],
-    along: &[Vec<f64>],
-    held: &[Vec<f64>],
-    diagonal: &[f64],
-) -> Vec<f64> {
-    let deltas: Vec<f64> = contact
+/// The held motions as the rigid steps use them.
+struct Held {
+    /// Each held motion's DOF vector, cleared at the pins.
+    motions: Vec<Vec<f64>>,
+    /// Per compliant node, ν·z_J of each of them.
+    along: Vec<Vec<f64>>,
+    /// Per compliant node, its largest diagonal of K: the stand-in spring.
+    stand_in: Vec<f64>,
+}
+
+impl Held {
+    /// The motions `held` (coefficients of `modes`), each cleared at the
+    /// `pins` by never-held motions (which change neither Π nor the
+    /// approaches), so that a step along them keeps the pinned DOFs, where
+    /// the residual is not evaluated, where they are.
+    fn new(
+        contact: &ContactSurface,
+        modes: &[RigidMode],
+        (held, never, pins): (&[Vec<f64>], &[RigidMode], &[usize]),
+        diagonal: &[f64],
+    ) -> Held {
+        let motions: Vec<Vec<f64>> = held
+            .iter()
+            .map(|h| {
+                let mut z = combine(modes, h);
+                if !pins.is_empty() {
+                    let a = pins
+                        .iter()
+                        .map(|&p| never.iter().map(|m| m.vector[p]).collect())
+                        .collect();
+                    let b = pins.iter().map(|&p| z[p]).collect();
+                    let c = solve_small(a, b).unwrap_or_else(|| vec![0.0; never.len()]);
+                    for (m, c) in never.iter().zip(&c) {
+                        for (z, m) in z.iter_mut().zip(&m.vector) {
+                            *z -= c * m;
+                        }
+                    }
+                }
+                z
+            })
+            .collect();
+        let vectors: Vec<&[f64]> = motions.iter().map(Vec::as_slice).collect();
+        let along = along_normal(contact, &vectors);
+        let stand_in = contact
+            .compliance
+            .iter()
+            .map(|c| {
+                contact.nodes[c.index]
+                    .dofs
+                    .iter()
+                    .flatten()
+                    .fold(0.0, |m: f64, &d| m.max(diagonal[d]))
+            })
+            .collect();
+        Held {
+            motions,
+            along,
+            stand_in,
+        }
+    }
+
+    /// The rigid step from `x`, residual `g`, where the nodes in contact
+    /// (stiffness `springs`) leave held motions free: the one of them the
+    /// stand-in springs s_J would balance against the residual, the
+    /// minimum of ½eᵀ(Σ_J s_J ννᵀ)e + gᵀe over the free motions e,
+    /// stretched so that α = 1 brings the nearest node off the foundation
+    /// onto it where that is farther. `None` where contact holds every
+    /// motion or the residual's work along the free ones is round-off:
+    /// below the convergence test's `threshold` per unit motion or, as
+    /// `floating::balanced` judges, against `terms` (|K x| + |R₀| + |F_c|
+    /// per DOF) along it.
+    fn rigid_step(
+        &self,
+        contact: &ContactSurface,
+        (x, g): (&[f64], &[f64]),
+        springs: &[f64],
+        (terms, threshold): (&[f64], f64),
+    ) -> Option<Vec<f64>> {
+        let n = self.motions.len();
+        let (values, vectors) = eigen(&gram(springs, &self.along, n));
+        let largest = values.iter().fold(0.0_f64, |m, v| m.max(*v));
+        // A NaN value (a failed decomposition) is held by nothing, as in
+        // `holds`.
+        let held = |v: f64| v > NULL * largest;
+        let free: Vec<&Vec<f64>> = values
+            .iter()
+            .zip(&vectors)
+            .filter(|(v, _)| !held(**v))
+            .map(|(_, u)| u)
+            .collect();
+        if free.is_empty() {
+            return None;
+        }
+        let metric = gram(&self.stand_in, &self.along, n);
+        let work: Vec<f64> = self.motions.iter().map(|z| dot(z, g)).collect();
+        let times = |u: &[f64], v: &[f64]| (0..n).map(|i| u[i] * v[i]).sum::<f64>();
+        let a = free
+            .iter()
+            .map(|u| {
+                let mu: Vec<f64> = metric.iter().map(|row| times(row, u)).collect();
+                free.iter().map(|v| times(v, &mu)).collect()
+            })
+            .collect();
+        let b = free.iter().map(|u| -times(u, &work)).collect();
+        let c = solve_small(a, b)?;
+        let mut e = vec![0.0; x.len()];
+        for (u, c) in free.iter().zip(&c) {
+            for (z, u) in self.motions.iter().zip(u.iter()) {
+                for (e, z) in e.iter_mut().zip(z) {
+                    *e += c * u * z;
+                }
+            }
+        }
+        let slope = dot(g, &e);
+        let size: f64 = e.iter().zip(terms).map(|(e, t)| e.abs() * t).sum();
+        if !(-slope > BALANCE_TOLERANCE * size && -slope > threshold * norm(&e)) {
+            return None;
+        }
+        // The approach along e grows at −ν·e_J: a node off the foundation,
+        // at signed approach a < 0, reaches it at α = a/(ν·e_J).
+        let nearest = contact
+            .compliance
+            .iter()
+            .filter_map(|c| {
+                let node = &contact.nodes[c.index];
+                let rate: f64 = (0..2)
+                    .filter_map(|comp| node.dofs[comp].map(|d| c.normal[comp] * e[d]))
+                    .sum();
+                let approach = c.signed_approach(node, x);
+                (approach < 0.0 && rate < 0.0).then(|| approach / rate)
+            })
+            .fold(f64::INFINITY, f64::min);
+        if nearest.is_finite() && nearest > 1.0 {
+            e.iter_mut().for_each(|e| *e *= nearest);
+        }
+        Some(e)
+    }
+}
+
+/// Each node's spring stiffness k_J (the tangent gains k_J ννᵀ at node J):
+/// w_J c_n m_n δ_J^{m_n−1} where δ_J > 0, else 0.
+fn contact_springs(contact: &ContactSurface, x: &[f64]) -> Vec<f64> {
+    contact
         .compliance
         .iter()
-        .map(|c| c.approach(&contact.nodes[c.index], x))
-        .collect();
-    let mut springs: Vec<f64> = contact
-        .compliance
-        .iter()
-        .zip(&deltas)
-        .map(|(c, &delta)| {
+        .map(|c| {
+            let delta = c.approach(&contact.nodes[c.index], x);
             if delta > 0.0 {
                 contact.nodes[c.index].weight * c.law.stiffness(delta)
             } else {
                 0.0
             }
         })
-        .collect();
-    if !held.is_empty() && !holds(&springs, along, held) {
-        for ((c, kt), &delta) in contact.compliance.iter().zip(&mut springs).zip(&deltas) {
-            if delta == 0.0 {
-                *kt = contact.nodes[c.index]
-                    .dofs
-                    .iter()
-                    .flatten()
-                    .fold(0.0, |m: f64, &d| m.max(diagonal[d]));
-            }
-        }
-    }
-    springs
+        .collect()
 }
 
-/// True when springs `k_J` along ν hold every motion of `held`: Σ_J k_J
-/// (ν·z_J)(ν·z_J)ᵀ is definite on them.
-fn holds(springs: &[f64], along: &[Vec<f64>], held: &[Vec<f64>]) -> bool {
-    let n = held.len();
+/// The largest diagonal of K at each node out of contact in place of its
+/// spring (where those in contact leave a held motion free).
+fn stand_in(contact: &ContactSurface, x: &[f64], diagonal: &[f64], springs: &mut [f64]) {
+    for (c, kt) in contact.compliance.iter().zip(springs) {
+        let node = &contact.nodes[c.index];
+        if c.approach(node, x) == 0.0 {
+            *kt = node
+                .dofs
+                .iter()
+                .flatten()
+                .fold(0.0, |m: f64, &d| m.max(diagonal[d]));
+        }
+    }
+}
+
+/// True when springs `k_J` along ν hold every held motion (`along`: ν·z_J
+/// of each at each node): Σ_J k_J (ν·z_J)(ν·z_J)ᵀ is definite.
+fn holds(springs: &[f64], along: &[Vec<f64>]) -> bool {
+    let n = along.first().map_or(0, Vec::len);
+    let (values, _) = eigen(&gram(springs, along, n));
+    let largest = values.iter().fold(0.0_f64, |m, v| m.max(*v));
+    largest > 0.0 && values.iter().all(|v| *v > NULL * largest)
+}
+
+/// Σ_J k_J p_J p_Jᵀ (n × n) of the rows p_J of `along`.
+fn gram(weights: &[f64], along: &[Vec<f64>], n: usize) -> Vec<Vec<f64>> {
     let mut b = vec![vec![0.0; n]; n];
-    for (k, a) in springs.iter().zip(along) {
-        let p: Vec<f64> = held
-            .iter()
-            .map(|h| h.iter().zip(a).map(|(h, a)| h * a).sum())
-            .collect();
+    for (k, p) in weights.iter().zip(along) {
         for i in 0..n {
             for j in 0..n {
                 b[i][j] += k * p[i] * p[j];
             }
         }
     }
-    let (values, _) = eigen(&b);
-    let largest = values.iter().fold(0.0_f64, |m, v| m.max(*v));
-    largest > 0.0 && values.iter().all(|v| *v > NULL * largest)
+    b
 }
 
-/// Per compliant node, ν·z_J of each rigid motion z.
-fn along_normal(contact: &ContactSurface, modes: &[RigidMode]) -> Vec<Vec<f64>> {
+/// x of the small square system A x = b by Gaussian elimination with
+/// partial pivoting; `None` where A is singular (a zero pivot) or a result
+/// is not finite.
+fn solve_small(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+    let n = b.len();
+    for col in 0..n {
+        let p = (col..n).max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))?;
+        a.swap(col, p);
+        b.swap(col, p);
+        if a[col][col] == 0.0 {
+            return None;
+        }
+        for row in col + 1..n {
+            let f = a[row][col] / a[col][col];
+            for c in col..n {
+                a[row][c] -= f * a[col][c];
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = vec![0.0; n];
+    for row in (0..n).rev() {
+        let s: f64 = (row + 1..n).map(|j| a[row][j] * x[j]).sum();
+        x[row] = (b[row] - s) / a[row][row];
+    }
+    x.iter().all(|x| x.is_finite()).then_some(x)
+}
+
+/// Per compliant node, ν·z_J of each motion z of `vectors`.
+fn along_normal(contact: &ContactSurface, vectors: &[&[f64]]) -> Vec<Vec<f64>> {
     contact
         .compliance
         .iter()
         .map(|c| {
             let node = &contact.nodes[c.index];
-            modes
+            vectors
                 .iter()
-                .map(|m| {
+                .map(|z| {
                     (0..2)
-                        .filter_map(|comp| node.dofs[comp].map(|d| c.normal[comp] * m.vector[d]))
+                        .filter_map(|comp| node.dofs[comp].map(|d| c.normal[comp] * z[d]))
                         .sum()
                 })
                 .collect()
@@ -342,24 +550,21 @@ fn split(modes: &[RigidMode], along: &[Vec<f64>]) -> (Vec<RigidMode>, Vec<Vec<f6
     if n == 0 {
         return (Vec::new(), Vec::new());
     }
-    let mut a = vec![vec![0.0; n]; n];
-    for p in along {
-        for i in 0..n {
-            for j in 0..n {
-                a[i][j] += p[i] * p[j];
-            }
-        }
-    }
-    let (values, vectors) = eigen(&a);
+    let (values, vectors) = eigen(&gram(&vec![1.0; along.len()], along, n));
     let largest = values.iter().fold(0.0_f64, |m, v| m.max(*v));
     let (mut never, mut held) = (Vec::new(), Vec::new());
     for (value, v) in values.iter().zip(vectors) {
         if *value > NULL * largest {
             held.push(v);
         } else {
+            let (label, amount, motion, whose) = describe(modes, &v);
+            let mut vector = combine(modes, &v);
+            vector.iter_mut().for_each(|z| *z /= amount);
             never.push(RigidMode {
-                label: label(modes, &v),
-                vector: combine(modes, &v),
+                label,
+                motion,
+                whose,
+                vector,
             });
         }
     }
@@ -379,17 +584,69 @@ fn combine(modes: &[RigidMode], v: &[f64]) -> Vec<f64> {
     z
 }
 
-/// The name of Σ_i v_i z_i: the motion's own where one dominates.
-fn label(modes: &[RigidMode], v: &[f64]) -> String {
-    let parts: Vec<&str> = modes
+/// The name of Σ_i v_i z_i and how much of the named motion it is, by
+/// which its work is divided to give the net force along the translation
+/// named or the moment about the centre named: a single motion by its own
+/// name; one part's translations t by the translation along t/|t|, |t| of
+/// it; with that part's rotation ω ρ_p about p, by the rotation about the
+/// point q it turns about, ω of it (t + ω ρ_p = ω ρ_q for q = p + (−t_y,
+/// t_x)/ω); other combinations by their parts, 1 of them.
+/// Also the sum's motion and the part it moves, where it is one motion.
+fn describe(modes: &[RigidMode], v: &[f64]) -> (String, f64, Option<RigidMotion>, String) {
+    let parts: Vec<(&RigidMode, f64)> = modes
         .iter()
         .zip(v)
         .filter(|(_, c)| c.abs() > 1e-9)
-        .map(|(m, _)| m.label.as_str())
+        .map(|(m, c)| (m, *c))
         .collect();
-    match parts.as_slice() {
-        [one] => (*one).to_string(),
-        _ => format!("a combination of {}", parts.join(" and ")),
+    if let [(one, c)] = parts.as_slice() {
+        return (one.label.clone(), *c, one.motion, one.whose.clone());
+    }
+    let combination = || {
+        let names: Vec<&str> = parts.iter().map(|(m, _)| m.label.as_str()).collect();
+        let name = format!("a combination of {}", names.join(" and "));
+        (name, 1.0, None, String::new())
+    };
+    // The translation t, the rotation (centre, ω) if any, and the part.
+    let (mut t, mut rotation, mut whose) = ([0.0; 2], None, None);
+    for (m, c) in &parts {
+        match m.motion {
+            Some(RigidMotion::Translation(d)) => {
+                t[0] += c * d[0];
+                t[1] += c * d[1];
+            }
+            Some(RigidMotion::Rotation(p)) => {
+                if rotation.replace((p, *c)).is_some() {
+                    return combination();
+                }
+            }
+            None => return combination(),
+        }
+        if *whose.get_or_insert(m.whose.as_str()) != m.whose {
+            return combination();
+        }
+    }
+    let whose = whose.unwrap_or("");
+    match rotation {
+        Some((p, omega)) => {
+            let q = [p[0] - t[1] / omega, p[1] + t[0] / omega];
+            (
+                format!("rotation about ({:.6}, {:.6}){whose}", q[0], q[1]),
+                omega,
+                Some(RigidMotion::Rotation(q)),
+                whose.to_string(),
+            )
+        }
+        None => {
+            let size = t[0].hypot(t[1]);
+            let d = [t[0] / size, t[1] / size];
+            (
+                format!("translation along ({:.6}, {:.6}){whose}", d[0], d[1]),
+                size,
+                Some(RigidMotion::Translation(d)),
+                whose.to_string(),
+            )
+        }
     }
 }
 
@@ -443,6 +700,55 @@ fn norm(x: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two nodes, at q = (1, 1.25) and (0, 0), and the motions of a free
+    /// part: translations and the rotation about p = (1, ½). 0.6 t_x +
+    /// 0.8 ρ_p leaves q still (0.8·(−(1.25 − ½), 0) + (0.6, 0) = 0): the
+    /// rotation about q, 0.8 of it; 0.6 t_x − 0.8 t_y is the translation
+    /// along (0.6, −0.8), 1 of it.
+    #[test]
+    fn describe_names_a_combination_by_the_motion_it_is() {
+        let points = [[1.0, 1.25], [0.0, 0.0]];
+        let field = |u: &dyn Fn([f64; 2]) -> [f64; 2]| -> Vec<f64> {
+            points.iter().flat_map(|&x| u(x)).collect()
+        };
+        let modes = [
+            RigidMode {
+                label: "translation in x".into(),
+                motion: Some(RigidMotion::Translation([1.0, 0.0])),
+                whose: String::new(),
+                vector: field(&|_| [1.0, 0.0]),
+            },
+            RigidMode {
+                label: "translation in y".into(),
+                motion: Some(RigidMotion::Translation([0.0, 1.0])),
+                whose: String::new(),
+                vector: field(&|_| [0.0, 1.0]),
+            },
+            RigidMode {
+                label: "rotation about (1.000000, 0.500000)".into(),
+                motion: Some(RigidMotion::Rotation([1.0, 0.5])),
+                whose: String::new(),
+                vector: field(&|[x, y]| [-(y - 0.5), x - 1.0]),
+            },
+        ];
+        let turn = [0.6, 0.0, 0.8];
+        let still = combine(&modes, &turn);
+        assert!(
+            still[0].abs() < 1e-15 && still[1].abs() < 1e-15,
+            "{still:?}"
+        );
+        let (name, amount, motion, _) = describe(&modes, &turn);
+        assert_eq!(name, "rotation about (1.000000, 1.250000)");
+        assert!((amount - 0.8).abs() < 1e-15);
+        assert_eq!(motion, Some(RigidMotion::Rotation([1.0, 1.25])));
+        let (name, amount, _, _) = describe(&modes, &[0.6, -0.8, 0.0]);
+        assert_eq!(name, "translation along (0.600000, -0.800000)");
+        assert!((amount - 1.0).abs() < 1e-15);
+        let (name, amount, _, _) = describe(&modes, &[0.0, -1.0, 0.0]);
+        assert_eq!(name, "translation in y");
+        assert_eq!(amount, -1.0);
+    }
 
     /// The decomposition of [[2, 1, 0], [1, 2, 0], [0, 0, 0]]:
     /// eigenvalues 3, 1, 0 (the closed form of a 2×2 block [[a, b], [b, a]]

@@ -369,9 +369,11 @@ pub enum TimeError {
     },
 }
 
-/// "translation in x: net force F_x = …; rotation about (x, y): moment
-/// about (x, y) M = …": a unit translation's work is the net force along
-/// it, a unit rotation's the moment about its centre.
+/// "translation in x: net force F_x = …; translation along (a, b): net
+/// force along it F = …; rotation about (x, y): moment M = …": a unit
+/// translation's work is the net force along it, a unit rotation's the
+/// moment about its centre; any other combination of motions is given by
+/// the loads' work along it.
 fn unbalanced_list(motions: &[(String, f64)]) -> String {
     motions
         .iter()
@@ -379,8 +381,12 @@ fn unbalanced_list(motions: &[(String, f64)]) -> String {
             if let Some(rest) = label.strip_prefix("translation in ") {
                 let axis = &rest[..1];
                 format!("{label}: net force F_{axis} = {work:.6e}")
-            } else {
+            } else if label.starts_with("translation along ") {
+                format!("{label}: net force along it F = {work:.6e}")
+            } else if label.starts_with("rotation about ") {
                 format!("{label}: moment M = {work:.6e}")
+            } else {
+                format!("{label}: the loads' work along it W = {work:.6e}")
             }
         })
         .collect::<Vec<_>>()

@@ -5,9 +5,12 @@
 //! (p/c_n)^{1/m_n} = 0.01 for both laws below; Q1 cells hold the linear
 //! field exactly, so the closed form holds to the solver's tolerance.
 
-use stickslip_fem::Traction;
+use stickslip_contact::{Compliance, ContactSurface};
+use stickslip_fem::{body_force_load, traction_load, Hypothesis, Material, Model, Traction};
+use stickslip_mesh::{CellKind, Mesh};
 use stickslip_testkit::settle::{preload, Block, P};
-use stickslip_time::{Scheme, Settings, TimeError};
+use stickslip_testkit::{map_nodes, rectangle};
+use stickslip_time::{Dynamics, History, Integrator, Load, Scheme, Settings, TimeError};
 
 const LAWS: [(f64, f64); 2] = [(1e3, 1.0), (1e5, 2.0)];
 
@@ -127,4 +130,176 @@ fn a_preloaded_block_stays_at_the_static_approach_under_newmark() {
         let e = run.energy();
         assert!(e.balance.abs() < 1e-9 * stored, "m_n = {mn}: {e:?}");
     }
+}
+
+/// A block far above the floor, 5 and 500 times the approach (the
+/// preload's own deformation is of that order), is carried onto it and
+/// settles at the approach (p/c_n)^{1/m_n} = 0.01 to 1e-9, both laws: the
+/// Newton steps do not run out however far it starts.
+#[test]
+fn a_preload_carries_a_block_from_far_off_the_foundation_onto_it() {
+    for (cn, mn) in LAWS {
+        for gap in [5.0, 500.0] {
+            let block = Block::loaded(8, cn, mn, Traction::Pressure(P), gap).unwrap();
+            let run = block
+                .integrator(Settings::new(Scheme::CentralDifference, 1e-4, 1.0))
+                .unwrap();
+            let (most, least) = block.approaches(run.displacement());
+            let expected = (P / cn).powf(1.0 / mn);
+            for d in [most, least] {
+                assert!(
+                    (d - expected).abs() < 1e-9,
+                    "m_n = {mn}, gap {gap}: {d} vs {expected}"
+                );
+            }
+        }
+    }
+}
+
+/// The slope's angle θ (20°).
+const THETA: f64 = 20.0 * std::f64::consts::PI / 180.0;
+/// The block's width and height (ρ = 1: its mass is m = W·H).
+const W: f64 = 1.0;
+const H: f64 = 0.5;
+/// Its gap above the slope.
+const D: f64 = 0.5;
+/// Gravity.
+const G: f64 = 9.81;
+
+/// The block W × H (8 × 4 Q1 cells, E = 10⁴) turned by −θ and lifted D
+/// along ν = (sin θ, cos θ) above the frictionless compliant slope through
+/// the origin with normal ν (c_n = 10⁴, m_n = 1), under gravity `g` (per
+/// unit volume) and a uniform traction `top` on its top, both present
+/// before t = 0; its integrator (Newmark, the preload solved at setup) or
+/// the setup's error.
+fn slope_block(
+    g: [f64; 2],
+    top: [f64; 2],
+) -> (Mesh, ContactSurface, Result<Integrator, TimeError>) {
+    let mut mesh = rectangle(CellKind::Quad4, 8, 4, [0.0, 0.0], [W, H]);
+    let (s, c) = THETA.sin_cos();
+    map_nodes(&mut mesh, |[x, y]| {
+        [x * c + y * s + D * s, -x * s + y * c + D * c]
+    });
+    let material = Material::new(1e4, 0.3, 1.0, Hypothesis::PlaneStrain).unwrap();
+    let model = Model::new(&mesh, &material, &[]).unwrap();
+    let law = Compliance {
+        cn: 1e4,
+        mn: 1.0,
+        ct: 0.0,
+        mt: 1.0,
+    };
+    let slope = ([0.0, 0.0], [s, c]);
+    let contact =
+        ContactSurface::on_foundation(&mesh, &model.dofs, "bottom", slope, law, 1e-3).unwrap();
+    let mut full = vec![0.0; 2 * mesh.nodes.len()];
+    body_force_load(&mesh, g, &mut full);
+    traction_load(&mesh, "top", Traction::Vector(top), &mut full).unwrap();
+    let mut vector = vec![0.0; model.dofs.n_free()];
+    model.dofs.restrict(&full, &mut vector);
+    let loads = vec![Load {
+        vector,
+        history: History::Constant,
+    }];
+    let scheme = Scheme::Newmark {
+        beta: 0.25,
+        gamma: 0.5,
+    };
+    let run = Integrator::new(
+        Dynamics::from_model(&model),
+        Some(contact.clone()),
+        loads,
+        Settings::new(scheme, 1e-3, 1.0),
+    );
+    (mesh, contact, run)
+}
+
+/// The block of [`slope_block`] held on the slope: gravity's pull along
+/// the slope, m g sin θ, balanced by a traction of that total on its top,
+/// pointing uphill. The loads' resultant is then m g cos θ against ν, so
+/// the foundation's nodal forces N_J = w_J c_n δ_J sum to m g cos θ; the
+/// traction, a height H above the bottom, and gravity, at H/2, make a
+/// couple, so their moment about the block's uphill bottom corner gives
+/// Σ_J s_J N_J = (W/2) m g cos θ − (H/2) m g sin θ (s_J the distance
+/// along the slope from that corner). Both hold to 1e-9 of m g cos θ in
+/// the discrete statics (the rigid motions are in the elements' space and
+/// the consistent loads integrate their work exactly). The part starts D
+/// = 0.5 off the slope, 250 times its deformation.
+#[test]
+fn a_preload_carries_a_block_onto_a_slope_and_balances_it() {
+    let m = W * H;
+    let (s, c) = THETA.sin_cos();
+    let pull = m * G * s / W;
+    let (mesh, contact, run) = slope_block([0.0, -G], [-pull * c, pull * s]);
+    let run = run.unwrap();
+    let r = run.displacement();
+    let corner = [D * s, D * c];
+    let (mut total, mut moment) = (0.0, 0.0);
+    for k in &contact.compliance {
+        let node = &contact.nodes[k.index];
+        let delta = k.approach(node, r);
+        let force = node.weight * k.law.traction(delta);
+        let x = mesh.nodes[node.node];
+        let along = (x[0] - corner[0]) * c - (x[1] - corner[1]) * s;
+        total += force;
+        moment += along * force;
+    }
+    let weight = m * G * c;
+    assert!(
+        (total - weight).abs() < 1e-9 * weight,
+        "{total} vs {weight}"
+    );
+    let expected = 0.5 * W * weight - 0.5 * H * m * G * s;
+    assert!(
+        (moment - expected).abs() < 1e-9 * weight,
+        "{moment} vs {expected}"
+    );
+}
+
+/// Loads pulling the block of [`slope_block`] off the slope (gravity
+/// reversed, its pull along the slope balanced by the top's traction):
+/// refused naming the translation along ν by its direction, with the
+/// net force along it, m g cos θ (ν·d) for the direction d named, and the
+/// rotation about the block's centre with the couple's moment about it,
+/// −(H/2) m g sin θ (the traction m g sin θ along the slope, H/2 above
+/// the centre).
+#[test]
+fn a_preload_pulling_a_block_off_a_slope_names_the_direction() {
+    let m = W * H;
+    let (s, c) = THETA.sin_cos();
+    let pull = m * G * s / W;
+    let (_, _, run) = slope_block([0.0, G], [pull * c, -pull * s]);
+    let e = run.unwrap_err();
+    let TimeError::Unbalanced(motions) = &e else {
+        panic!("{e}")
+    };
+    let message = e.to_string();
+    let translation = motions
+        .iter()
+        .find(|(l, _)| l.starts_with("translation along ("))
+        .unwrap_or_else(|| panic!("{message}"));
+    let inside = &translation.0["translation along (".len()..];
+    let (dx, rest) = inside.split_once(", ").unwrap();
+    let dy = rest.split_once(')').unwrap().0;
+    let d: [f64; 2] = [dx.parse().unwrap(), dy.parse().unwrap()];
+    let along_normal = d[0] * s + d[1] * c;
+    assert!((along_normal.abs() - 1.0).abs() < 1e-6, "{message}");
+    let expected = m * G * c * along_normal;
+    assert!(
+        (translation.1 - expected).abs() < 1e-6 * m * G,
+        "{message}: {} vs {expected}",
+        translation.1
+    );
+    assert!(message.contains("net force along it F = "), "{message}");
+    let rotation = motions
+        .iter()
+        .find(|(l, _)| l.starts_with("rotation about ("))
+        .unwrap_or_else(|| panic!("{message}"));
+    let expected = -0.5 * H * m * G * s;
+    assert!(
+        (rotation.1 - expected).abs() < 1e-9 * m * G,
+        "{message}: {} vs {expected}",
+        rotation.1
+    );
+    assert!(!message.contains("combination"), "{message}");
 }
