@@ -1111,7 +1111,7 @@ fn restart_refuses_changed_physics_and_an_earlier_t_end() {
             "contact.mu=0.2",
             vec![
                 "contact.mu: 0.3 in the stored run, 0.2 now",
-                "only time.t_end, output.*, title and mesh.ladder",
+                "only time.t_end, output.*, title, mesh.ladder and contact.max_iterations",
             ],
         ),
         (

@@ -4,7 +4,8 @@
 //! ṙ₀ = 0 (or given), r̈₀ from M r̈₀ = R(0) − K r₀ − C ṙ₀ − J(ṙ₀) (C the
 //! Rayleigh damping; J the friction at the slip at t = 0, which is zero
 //! at rest on a foundation at rest, so that Remark 4.1's r̈₀ is
-//! frictionless).
+//! frictionless). Quasi-static increments (no mass) start from the static
+//! state with no friction at all.
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
@@ -352,8 +353,11 @@ pub(crate) fn initial_state(
     // The friction at t = 0 acts on the slip then, ṙ₀ − V (zero at rest
     // on a foundation at rest, as in Remark 4.1): M r̈₀ = R(0) − K r₀ −
     // J(ṙ₀). The first step's ledger books ½(J₁ + J₀)·Δr, which the
-    // dynamics then match.
-    if let Some(c) = contact {
+    // dynamics then match. Without inertia (quasi-static increments,
+    // METHOD.md §11) the start is the static K r₀ = R₀ alone, with r̈₀ = 0:
+    // no friction acts until the first increment applies the law (its
+    // ledger books ½(J₁ + 0)·Δr), whatever the slip at t = 0 (a belt).
+    if let Some(c) = contact.filter(|_| !matches!(mass, Mass::Massless)) {
         c.classify(&state.v, &mut state.classes);
         c.nodal_forces(&state.v, &mut state.forces);
         c.subtract_forces(&state.forces, &mut rhs);

@@ -167,11 +167,15 @@ impl Integrator {
     /// bounds or foundation speeds set for t = 0 after the start), and
     /// r̈₀ with it: M r̈₀ = R(0) − K r₀ − C ṙ₀ − J₀ (initial.rs) gains
     /// J₀ − J₀'. Nothing changes where the forces do not (at rest on a
-    /// foundation at rest they are zero).
+    /// foundation at rest they are zero), nor where the start carries no
+    /// friction (quasi-static increments).
     fn forces_at_start(&mut self) -> Result<(), TimeError> {
         let Some(contact) = self.run.contact.as_ref() else {
             return Ok(());
         };
+        if !self.stepper.friction_at_start() {
+            return Ok(());
+        }
         let before = self.state.forces.clone();
         contact.classify(&self.state.v, &mut self.state.classes);
         contact.nodal_forces(&self.state.v, &mut self.state.forces);
@@ -238,7 +242,9 @@ impl Integrator {
     /// # Errors
     /// As [`Integrator::set_pressure_histories`].
     pub fn set_foundation_histories(&mut self, histories: &[History]) -> Result<(), TimeError> {
-        let Some(contact) = self.run.contact.as_mut() else {
+        // A surface that carries no friction (μ = 0) is kept for the
+        // observers, whose slip w = v_T − V needs the speeds all the same.
+        let Some(contact) = self.run.contact.as_mut().or(self.surface.as_mut()) else {
             return Ok(());
         };
         self.foundations = FoundationHistories::new(contact, histories);
@@ -256,7 +262,8 @@ impl Integrator {
         if let (Some(b), Some(c)) = (&mut self.bounds, &mut self.run.contact) {
             b.apply(t, c);
         }
-        if let (Some(f), Some(c)) = (&mut self.foundations, &mut self.run.contact) {
+        let surface = self.run.contact.as_mut().or(self.surface.as_mut());
+        if let (Some(f), Some(c)) = (&mut self.foundations, surface) {
             f.apply(t, c);
         }
     }
@@ -493,9 +500,14 @@ impl Integrator {
     pub fn mass_kind(&self) -> Option<MassKind> {
         self.stepper.mass_kind()
     }
-    /// Friction stress σ_T = −g φ_ε(v_T) at each contact node.
+    /// Friction stress σ_T = −g φ_ε(v_T) at each contact node: 0 in the
+    /// start of quasi-static increments, which carries no friction.
     pub fn friction_stress(&self, out: &mut [f64]) {
         if let Some(c) = self.contact() {
+            if self.state.steps == 0 && !self.stepper.friction_at_start() {
+                out.iter_mut().take(c.len()).for_each(|o| *o = 0.0);
+                return;
+            }
             c.friction_stress(&self.state.v, out);
         }
     }

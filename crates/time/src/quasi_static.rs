@@ -59,7 +59,8 @@ pub(crate) struct QuasiStatic {
 }
 
 /// Builds the stepper and the initial state: r₀ the frictionless static
-/// state under R(0⁻) (Remark 4.1), ṙ₀ = r̈₀ = 0.
+/// state under R(0⁻) (Remark 4.1), ṙ₀ = r̈₀ = 0, no friction forces (the
+/// ledger's J₀ = 0: K r₀ = R₀ holds without them) and every node stuck.
 ///
 /// # Errors
 /// A singular K (a rigid-body motion the supports leave free).
@@ -210,6 +211,10 @@ impl Stepper for QuasiStatic {
 
     fn mass_kind(&self) -> Option<MassKind> {
         None
+    }
+
+    fn friction_at_start(&self) -> bool {
+        false
     }
 
     fn stiffness_product(&self) -> &'static str {

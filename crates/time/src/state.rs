@@ -72,7 +72,8 @@ pub struct Checkpoint {
     pub forces: Vec<f64>,
     /// The energy ledger.
     pub energy: Energy,
-    /// Kinetic + strain energy at t = 0 (for the balance).
+    /// Kinetic + strain + a compliant foundation's stored energy at t = 0
+    /// (for the balance).
     pub initial_mechanical: f64,
     /// Remark 4.3 step-reduction counter.
     pub reduced_remaining: u64,

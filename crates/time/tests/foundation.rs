@@ -154,3 +154,80 @@ fn a_speed_dependent_mu_runs_with_every_solver_but_the_explicit_iteration() {
         }
     }
 }
+
+/// Quasi-static increments on a belt running from t = 0 (V = 5, Δt =
+/// 0.1): the start is the frictionless static state x₀ = 0 (Remark 4.1,
+/// METHOD.md §11), so no friction acts at t = 0 (its friction stress 0,
+/// the node stuck) and the first increment's trapezoids take J₀ = 0. The
+/// belt outruns the mass (k V Δt = 50 > g), which slips backward, dragged
+/// by g: k x₁ = g, x₁ = 0.01; friction dissipates ½ g (V Δt − x₁) = 0.245
+/// on the slip, the belt works ½ g V Δt = 0.25, and the balance ½ k x₁² +
+/// 0.245 − 0.25 is 0 (to 1e-15: a friction J₀ = −g at t = 0 would book
+/// ½J₀·x₁ = −0.005 more).
+#[test]
+fn quasi_static_increments_start_on_a_belt_without_friction() {
+    let mut i = belt(
+        Some(5.0),
+        1e-2,
+        Settings::new(Scheme::QuasiStatic, 0.1, 1.0),
+    );
+    let (mut stress, mut state) = ([f64::NAN], [9_i8]);
+    i.friction_stress(&mut stress);
+    i.slip_states(&mut state);
+    assert_eq!((stress[0], state[0]), (0.0, 0));
+    i.step().unwrap();
+    let x1 = G / K;
+    assert!(
+        (i.displacement()[0] - x1).abs() < 1e-15,
+        "{}",
+        i.displacement()[0]
+    );
+    let e = i.energy();
+    let (dt, v) = (0.1, 5.0);
+    let dissipated = 0.5 * G * (v * dt - x1);
+    let foundation = 0.5 * G * v * dt;
+    assert!((e.dissipated - dissipated).abs() < 1e-15, "{e:?}");
+    assert!((e.foundation - foundation).abs() < 1e-15, "{e:?}");
+    assert!(e.balance.abs() < 1e-15, "{e:?}");
+    // From the first increment on, the law at its rate: slipping, −g φ = g.
+    i.friction_stress(&mut stress);
+    i.slip_states(&mut state);
+    assert_eq!((stress[0], state[0]), (G, -1));
+}
+
+/// A surface whose friction cannot act (g = 0) is kept for the observers,
+/// and its slip w = v_T − V follows the foundation's speed history all the
+/// same: V(t) = t on [0, 1] (a table on V = 1), the mass unloaded and at
+/// rest, so w = −t at every step (0 at t = 0, stuck there), every scheme.
+#[test]
+fn a_surface_without_friction_slips_at_the_foundations_speed_of_the_time() {
+    let mut settings = solvers(0.1);
+    settings.push((
+        "quasi-static",
+        Settings::new(Scheme::QuasiStatic, 1e-3, 0.1),
+    ));
+    for (name, settings) in settings {
+        let mut surface = sdof::surface(1e-2).unwrap();
+        surface.nodes[0].bound = 0.0;
+        surface.set_foundation(|_| 1.0);
+        let mut i = sdof::with_surface(0.0, surface, settings).unwrap();
+        assert!(!i.friction(), "{name}");
+        i.set_foundation_histories(&[History::Table(vec![(0.0, 0.0), (1.0, 1.0)])])
+            .unwrap();
+        let (mut w, mut state) = ([f64::NAN], [9_i8]);
+        i.slip_velocity(&mut w);
+        i.slip_states(&mut state);
+        assert_eq!((w[0], state[0]), (0.0, 0), "{name}");
+        while !i.done() {
+            i.step().unwrap();
+            i.slip_velocity(&mut w);
+            assert_eq!(i.displacement()[0], 0.0, "{name}");
+            assert!(
+                (w[0] + i.time()).abs() < 1e-15,
+                "{name}: t = {}: w = {}",
+                i.time(),
+                w[0]
+            );
+        }
+    }
+}
