@@ -15,14 +15,6 @@ use stickslip_case::InputError;
 /// # Errors
 /// The mesh reader's error (file, line or byte offset, what to do).
 pub fn report(path: &Path, as_json: bool) -> Result<String, InputError> {
-    // The reader's own words for a directory are the OS error alone.
-    if path.is_dir() {
-        return Err(InputError(format!(
-            "{} is a directory; give a Gmsh mesh file (.msh, MSH 2.2 or 4.1), e.g. `stickslip mesh {}`",
-            path.display(),
-            path.join("part.msh").display()
-        )));
-    }
     let mesh = Mesh::from_file(path)?;
     Ok(if as_json {
         to_json(&mesh).to_string()

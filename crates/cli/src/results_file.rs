@@ -58,23 +58,15 @@ impl Companion {
             Companion::Stress => "stress file",
         }
     }
-
-    /// The command that writes it.
-    fn command(self) -> &'static str {
-        match self {
-            Companion::Views => "views",
-            Companion::Stress => "stress",
-        }
-    }
 }
 
-/// What the file at `kind`'s path beside `out` is, where it exists and is
-/// not `out`'s companion of that kind: another run's results file, the
-/// views or stresses of another results file, or a file of another
-/// program. Such a file only bears the name; removing or replacing it
-/// would lose what it holds. A companion is known by the attribute
-/// `source` its command writes (`out`'s file name); a stress file of an
-/// earlier version, without it, by its datasets.
+/// What the file at `kind`'s path beside `out` is, where it exists and
+/// holds what replacing it would lose: a directory or special file,
+/// another run's results file (named like a companion, e.g. a run written
+/// to `r.views.h5`), or a file of another program. Views and stresses,
+/// whoever's (a renamed results file's, a copy's, an earlier version's,
+/// one left damaged), are made again from a results file: replacing them
+/// loses nothing, so they are `None`, as is an empty file.
 pub fn foreign_companion(out: &Path, kind: Companion) -> Option<String> {
     let path = kind.path(out);
     let meta = std::fs::metadata(&path).ok()?;
@@ -85,34 +77,16 @@ pub fn foreign_companion(out: &Path, kind: Companion) -> Option<String> {
             "not a regular file".into()
         });
     }
+    if meta.len() == 0 {
+        return None;
+    }
     if !is_hdf5(&path) {
         return Some("not an HDF5 file".into());
     }
-    let f = match hdf5::File::open(&path) {
-        Ok(f) => f,
-        Err(_) => {
-            return Some("an HDF5 file that cannot be opened (damaged, or being written)".into())
-        }
-    };
-    if crate::output::text_attr(&f, "program").ok().as_deref() == Some("stickslip") {
-        return Some("the results file of another run".into());
-    }
-    let ours = out.file_name().and_then(|n| n.to_str());
-    match crate::output::text_attr(&f, "source").ok() {
-        Some(source) if Some(source.as_str()) == ours => None,
-        Some(source) => Some(format!("the {} of {source}", kind.what())),
-        None if kind == Companion::Stress
-            && f.link_exists("stress")
-            && f.link_exists("von_mises")
-            && f.link_exists("views") =>
-        {
-            None
-        }
-        None => Some(format!(
-            "a file `stickslip {}` did not write",
-            kind.command()
-        )),
-    }
+    // One that does not open (damaged, or cut short) is replaced.
+    let f = hdf5::File::open(&path).ok()?;
+    (crate::output::text_attr(&f, "program").ok().as_deref() == Some("stickslip"))
+        .then(|| "the results file of another run".into())
 }
 
 /// The message for [`foreign_companion`]'s file beside `out`, which

@@ -137,9 +137,8 @@ fn write_stresses(
     let part = part_path(out);
     crate::views_cmd::create_beside(out, "stress", &part)?;
     let g = File::create(&part).map_err(|e| write_failed(out, e.into()))?;
-    // Whose stresses these are: a run on another results file whose
-    // companion this file's name would be leaves it alone
-    // ([`crate::results_file::foreign_companion`]).
+    // Whose stresses these are, for the reader (a renamed results file's
+    // companion still names the old one).
     let source = crate::views::file_name(out)?;
     crate::output::string_attr(&g, "source", source).map_err(|e| write_failed(out, e))?;
     fill(&g, out, u, mesh, material, rows, quiet)?;

@@ -28,11 +28,11 @@
 //! after it fall on other rows). So each contact view keeps the row it
 //! maps in its attribute `row`, which is compared with `/frames/row`; a
 //! view of another row, without the attribute, or of a frame the file no
-//! longer holds, is replaced or dropped. A views file of this results file
-//! that cannot be read back or belongs to other sizes is made anew; a file
-//! of that name that is no views file of it (its attribute `source` names
-//! the results file) is refused before
-//! ([`crate::results_file::foreign_companion`]).
+//! longer holds, is replaced or dropped. A views file that is not this
+//! results file's (its attribute `source` names the results file: a
+//! renamed or copied one's), cannot be read back or belongs to other sizes
+//! is made anew; a file of that name that holds results of its own is
+//! refused before ([`crate::results_file::foreign_companion`]).
 
 use std::path::{Path, PathBuf};
 
