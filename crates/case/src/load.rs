@@ -1418,6 +1418,34 @@ t_end = 0.5
         assert_eq!(restart_changes(GOOD, &other).unwrap().len(), 1);
     }
 
+    /// A stored run of an earlier version that gave a key which did nothing
+    /// under its scheme, and which this version refuses there, restarts
+    /// from its case with the key dropped; where the key acts it may not
+    /// change.
+    #[test]
+    fn a_restart_drops_keys_its_scheme_never_read() {
+        let with =
+            |scheme: &str, key: &str| format!("[time]\nscheme = \"{scheme}\"\n{key}\ndt = 1e-3\n");
+        let bare = |scheme: &str| with(scheme, "");
+        let inert = [
+            ("newmark", "allow_unstable = true"),
+            ("quasi_static", "allow_unstable = true"),
+            ("quasi_static", "stick_reduction = { dt = 1e-7, steps = 3 }"),
+        ];
+        for (scheme, key) in inert {
+            let changes = restart_changes(&with(scheme, key), &bare(scheme)).unwrap();
+            assert!(changes.is_empty(), "{scheme}, {key}: {changes:?}");
+        }
+        let acting = [
+            ("central_difference", "allow_unstable = true"),
+            ("newmark", "stick_reduction = { dt = 1e-7, steps = 3 }"),
+        ];
+        for (scheme, key) in acting {
+            let changes = restart_changes(&with(scheme, key), &bare(scheme)).unwrap();
+            assert!(!changes.is_empty(), "{scheme}, {key}: {changes:?}");
+        }
+    }
+
     /// Serde's words for a history of the wrong form ("invalid type: unit
     /// variant, expected struct variant; use one of the values listed",
     /// with none listed; "History::Sin") are replaced by what is wrong and

@@ -32,6 +32,20 @@ fn is_max_iterations(key: &str) -> bool {
     }
 }
 
+/// Keys that did nothing under the stored run's `scheme`, which earlier
+/// versions took and this one refuses there: the case must drop them to
+/// be read at all, and dropping them changes nothing computed.
+fn inert(key: &str, scheme: Option<&str>) -> bool {
+    let under = |table: &str| key == table || key.starts_with(&format!("{table}."));
+    if under("time.allow_unstable") {
+        scheme.is_some_and(|s| s != "central_difference")
+    } else if under("time.stick_reduction") {
+        scheme == Some("quasi_static")
+    } else {
+        false
+    }
+}
+
 fn flatten(prefix: &str, v: &toml::Value, out: &mut BTreeMap<String, toml::Value>) {
     let name = |k: &str| {
         if prefix.is_empty() {
@@ -97,9 +111,10 @@ pub fn restart_changes(stored: &str, new: &str) -> Result<Vec<String>, String> {
     keys.sort();
     keys.dedup();
     let show = |v: Option<&toml::Value>| v.map_or("(not given)".to_string(), |v| v.to_string());
+    let scheme = old.get("time.scheme").and_then(toml::Value::as_str);
     Ok(keys
         .into_iter()
-        .filter(|k| !restart_may_change(k))
+        .filter(|k| !restart_may_change(k) && !inert(k, scheme))
         .filter(|k| match (old.get(*k), new.get(*k)) {
             (Some(a), Some(b)) => !same_value(a, b),
             _ => true,

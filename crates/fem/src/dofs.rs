@@ -593,6 +593,17 @@ fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> (Vec<String>, V
         }
     }
     for k in 0..n_parts {
+        // The ending that names part k in its motions' labels.
+        let whose = if n_parts > 1 {
+            let v = first_node[k];
+            let p = mesh.nodes[v];
+            format!(
+                " of the separate part of the mesh containing node {v} at ({}, {})",
+                p[0], p[1]
+            )
+        } else {
+            String::new()
+        };
         let b = bbox[k];
         let (cx, cy) = (0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3]));
         let scale = (b[2] - b[0]).max(b[3] - b[1]).max(f64::MIN_POSITIVE);
@@ -662,42 +673,18 @@ fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> (Vec<String>, V
             } else {
                 RigidMotion::Translation([shape[0], shape[1]])
             });
-            modes.push((k, label, motion, vector));
+            modes.push(RigidMode {
+                label: format!("{label}{whose}"),
+                motion,
+                whose: whose.clone(),
+                vector,
+            });
         }
-        if n_parts > 1 {
-            let v = first_node[k];
-            let p = mesh.nodes[v];
-            let whose = format!(
-                " of the separate part of the mesh containing node {v} at ({}, {})",
-                p[0], p[1]
-            );
-            for m in &mut free {
-                m.push_str(&whose);
-            }
+        for m in &mut free {
+            m.push_str(&whose);
         }
         motions.extend(free);
     }
-    let modes = modes
-        .into_iter()
-        .map(|(k, label, motion, vector)| {
-            let whose = if n_parts > 1 {
-                let v = first_node[k];
-                let p = mesh.nodes[v];
-                format!(
-                    " of the separate part of the mesh containing node {v} at ({}, {})",
-                    p[0], p[1]
-                )
-            } else {
-                String::new()
-            };
-            RigidMode {
-                label: format!("{label}{whose}"),
-                motion,
-                whose,
-                vector,
-            }
-        })
-        .collect();
     (motions, modes)
 }
 

@@ -275,6 +275,10 @@ fn physical_names(cur: &mut Cursor<'_>, b: &mut Builder) -> Result<()> {
         };
         let name = quoted(cur)?;
         if let Some(&first) = named_at.get(&(dim, tag)) {
+            // The same line twice (a copy) names nothing new.
+            if b.names.get(&(dim, tag)) == Some(&name) {
+                continue;
+            }
             return Err(cur.error(
                 p,
                 MeshErrorKind::DuplicatePhysicalName {
