@@ -106,6 +106,12 @@ pub fn verify(root: &Path, opts: &Options, report: &mut Report) -> Result<(), St
     let wants = |s: &str| opts.only.as_deref().is_none_or(|o| o == s);
     if opts.bless {
         let runs = run_cases(root, opts.fault, &opts.cases)?;
+        if runs.is_empty() {
+            return Err(format!(
+                "--bless: no paper case matched --case {:?}",
+                opts.cases
+            ));
+        }
         suites::reference::run(root, &runs, true, report);
         return Ok(());
     }

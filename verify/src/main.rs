@@ -13,8 +13,9 @@ usage: stickslip-verify verify [--quick] [--bless] [--only SUITE] [--case NAME].
        stickslip-verify figures [--out DIR]
 
   verify    closed-form checks, convergence rates, the paper's experiments and
-            the reference runs; one row per check, `N passed, M failed`, exit 1
-            on any failure
+            the reference runs; one row per check, `N passed, M failed,
+            K reported` (K: figures shown for the table only), exit 1 on any
+            failure or when no check matched
     --quick        the CI subset (under 2 minutes)
     --bless        rewrite cases/reference/*.csv from this build, saying what changed
     --only SUITE   analytic, rates, paper or reference
@@ -107,6 +108,15 @@ fn run_verify(opts: &Options) -> ExitCode {
     }
     eprintln!("verify: {:.1} s", start.elapsed().as_secs_f64());
     println!("{}", r.summary());
+    if !opts.bless && r.rows.is_empty() {
+        // `--only reference --case <typo>` runs nothing: that is no proof.
+        eprintln!(
+            "stickslip-verify: no checks matched (--only {}, --case {:?})",
+            opts.only.as_deref().unwrap_or("(all)"),
+            opts.cases
+        );
+        return ExitCode::FAILURE;
+    }
     if r.failed() == 0 {
         ExitCode::SUCCESS
     } else {

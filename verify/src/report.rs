@@ -19,6 +19,10 @@ pub struct Row {
     pub tolerance: String,
     /// True when the check holds.
     pub pass: bool,
+    /// A figure shown for the table only ([`Report::reported`]): it fails
+    /// where it is not a number, and otherwise counts as reported, not as
+    /// a check passed.
+    pub reported: bool,
 }
 
 /// Collects rows, printing each as it comes (a long run shows progress).
@@ -46,6 +50,28 @@ pub fn num(x: f64) -> String {
     }
 }
 
+/// The largest of `values` (−∞ for none), or NaN when any of them is NaN.
+///
+/// `f64::max` returns its other operand when one is NaN, so a plain
+/// `fold(0.0, f64::max)` drops a NaN and a run that produced one would
+/// pass its bound; every "worst of" in the suites goes through here (NaN
+/// then fails `close`, `at_most` and `at_least` alike).
+pub fn max_or_nan(values: impl IntoIterator<Item = f64>) -> f64 {
+    values.into_iter().fold(f64::NEG_INFINITY, |m, v| {
+        if m.is_nan() || v.is_nan() {
+            f64::NAN
+        } else {
+            m.max(v)
+        }
+    })
+}
+
+/// The smallest of `values` (+∞ for none), or NaN when any of them is NaN
+/// ([`max_or_nan`] of the negated values).
+pub fn min_or_nan(values: impl IntoIterator<Item = f64>) -> f64 {
+    -max_or_nan(values.into_iter().map(|v| -v))
+}
+
 impl Report {
     /// A report that prints its rows as they come when `echo`.
     pub fn new(echo: bool) -> Report {
@@ -70,7 +96,7 @@ impl Report {
         tolerance: String,
         pass: bool,
     ) {
-        let row = Row {
+        self.push(Row {
             suite: self.suite.clone(),
             case: case.to_string(),
             quantity: quantity.to_string(),
@@ -78,7 +104,11 @@ impl Report {
             expected,
             tolerance,
             pass,
-        };
+            reported: false,
+        });
+    }
+
+    fn push(&mut self, row: Row) {
         if self.echo {
             println!("{}", format_row(&row));
             let _ = std::io::stdout().flush();
@@ -110,14 +140,16 @@ impl Report {
     /// A figure shown for the table only (`why`: what it is read for); it
     /// fails only where it is not a number.
     pub fn reported(&mut self, case: &str, quantity: &str, measured: f64, why: &str) {
-        self.row(
-            case,
-            quantity,
-            num(measured),
-            why.to_string(),
-            "reported".into(),
-            measured.is_finite(),
-        );
+        self.push(Row {
+            suite: self.suite.clone(),
+            case: case.to_string(),
+            quantity: quantity.to_string(),
+            measured: num(measured),
+            expected: why.to_string(),
+            tolerance: "reported".into(),
+            pass: measured.is_finite(),
+            reported: true,
+        });
     }
 
     /// measured ≤ bound.
@@ -177,14 +209,25 @@ impl Report {
         self.rows.iter().filter(|r| !r.pass).count()
     }
 
-    /// Rows that passed.
+    /// Checks that passed (reported figures not counted).
     pub fn passed(&self) -> usize {
-        self.rows.len() - self.failed()
+        self.rows.iter().filter(|r| r.pass && !r.reported).count()
     }
 
-    /// The closing line: `N passed, M failed`.
+    /// Figures reported for the table only that are numbers (a reported
+    /// NaN counts among the failed).
+    pub fn reported_count(&self) -> usize {
+        self.rows.iter().filter(|r| r.pass && r.reported).count()
+    }
+
+    /// The closing line: `N passed, M failed, K reported`.
     pub fn summary(&self) -> String {
-        format!("{} passed, {} failed", self.passed(), self.failed())
+        format!(
+            "{} passed, {} failed, {} reported",
+            self.passed(),
+            self.failed(),
+            self.reported_count()
+        )
     }
 }
 
@@ -208,4 +251,56 @@ pub fn format_row(r: &Row) -> String {
         r.tolerance,
         if r.pass { "PASS" } else { "FAIL" }
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_nan_anywhere_makes_the_worst_nan() {
+        assert_eq!(max_or_nan([1.0, 3.0, 2.0]), 3.0);
+        assert_eq!(min_or_nan([1.0, 3.0, -2.0]), -2.0);
+        assert_eq!(max_or_nan([]), f64::NEG_INFINITY);
+        // Where f64::max would drop it: first, middle, last, alone.
+        for v in [
+            vec![f64::NAN, 1.0, 2.0],
+            vec![1.0, f64::NAN, 2.0],
+            vec![1.0, 2.0, f64::NAN],
+            vec![f64::NAN],
+        ] {
+            assert!(v.iter().copied().fold(0.0, f64::max).is_finite());
+            assert!(max_or_nan(v.iter().copied()).is_nan(), "{v:?}");
+            assert!(min_or_nan(v.iter().copied()).is_nan(), "{v:?}");
+        }
+    }
+
+    #[test]
+    fn a_nan_fails_every_kind_of_check() {
+        let mut r = Report::new(false);
+        let worst = max_or_nan([1e-14, f64::NAN, 2e-14]);
+        r.at_most("c", "worst", worst, 1e-12, "round-off");
+        r.at_least("c", "order", -worst.log2(), 0.9, "first order");
+        r.close("c", "E(0)", worst, 0.0, "closed form", 1.0);
+        r.reported("c", "figure", worst, "table");
+        assert_eq!(r.failed(), 4, "{:?}", r.rows);
+        assert_eq!(r.summary(), "0 passed, 4 failed, 0 reported");
+        // An all-NaN energy: every step-to-step rise is NaN, not −∞.
+        let energy = [f64::NAN; 4];
+        let rise = max_or_nan(energy.windows(2).map(|w| w[1] - w[0]));
+        r.at_most("c", "largest rise", rise, 0.05, "band");
+        assert_eq!(r.failed(), 5);
+    }
+
+    #[test]
+    fn reported_figures_are_counted_apart_from_checks() {
+        let mut r = Report::new(false);
+        r.at_most("c", "q", 1.0, 2.0, "bound");
+        r.at_most("c", "q", 3.0, 2.0, "bound");
+        r.reported("c", "figure", 0.5, "table");
+        r.reported("c", "figure", 0.7, "table");
+        r.reported("c", "figure", f64::INFINITY, "table");
+        assert_eq!((r.passed(), r.failed(), r.reported_count()), (1, 2, 2));
+        assert_eq!(r.summary(), "1 passed, 2 failed, 2 reported");
+    }
 }

@@ -10,25 +10,32 @@ use stickslip_testkit::case_text::paper_slab_head;
 /// The paper's slab (mass 8) dropped at 0.5 from 0.01 above a floor of
 /// c_n = 1e4: it lands after 0.02 and the floor stores energy while it is
 /// pressed; kinetic + strain + stored − initial stays within 1% of the
-/// initial ½·8·0.5² = 1 (central difference's O(Δt²) and the touches).
+/// initial ½·8·0.5² = 1 (central difference conserves energy only to
+/// O(Δt²), and the touches add their own error: 2.4e-3 measured).
 #[test]
 fn a_dropped_slab_lands_and_the_ledger_books_the_floor() {
     drop_slab(
         "compliance-run",
         "scheme = \"central_difference\"\ndt = 1e-3",
         &[],
+        1e-2,
     );
 }
 
 /// The same drop by Newmark ¼, ½ at Δt = 2e-3: the same landing, the floor
-/// storing energy, and the ledger within 1% (its error is the touches'
-/// alone, docs/results.md); the summary counts the Newton iterations.
+/// storing energy, and the ledger at round-off on every step, the touches
+/// included: frictionless, the energy-consistent normal force makes each
+/// step's ledger exact (docs/results.md, `/energy/balance`). Measured
+/// 1.6e-14 of the initial energy; the bound 1e-12 leaves round-off ~60×
+/// room and fails on any O(Δt²) or touch error (central difference's is
+/// 2.4e-3). The summary counts the Newton iterations.
 #[test]
 fn a_slab_dropped_by_newmark_lands_and_the_ledger_books_the_floor() {
     drop_slab(
         "compliance-newmark",
         "scheme = \"newmark\"\ndt = 2e-3",
         &["compliance Newton iterations"],
+        1e-12,
     );
 }
 
@@ -115,8 +122,9 @@ t_end = 0.2
 }
 
 /// Runs the drop with the `[time]` lines `time` (t_end = 0.2) and checks
-/// it, and that the run's summary says each of `said`.
-fn drop_slab(name: &str, time: &str, said: &[&str]) {
+/// it, that the run's summary says each of `said`, and that |balance| stays
+/// within `balance_tol` of the initial energy on every record.
+fn drop_slab(name: &str, time: &str, said: &[&str], balance_tol: f64) {
     let dir = scratch(name);
     let case = drop_case(&dir, time);
     let out = dir.join("drop.h5");
@@ -154,8 +162,14 @@ fn drop_slab(name: &str, time: &str, said: &[&str]) {
     assert!((first - 0.02).abs() < 2e-3, "first touch at {first}");
     assert!(stored.iter().any(|&s| s > 0.05), "the floor stores energy");
     let balance = read("energy/balance");
+    // f64::max drops NaN: a NaN anywhere must fail, not vanish from `worst`.
+    assert!(balance.iter().all(|b| b.is_finite()), "{balance:?}");
     let worst = balance.iter().fold(0.0_f64, |m, b| m.max(b.abs()));
-    assert!(worst < 1e-2, "largest |balance| {worst}");
+    let initial = kinetic[0] + read("energy/strain")[0] + stored[0];
+    assert!(
+        worst <= balance_tol * initial,
+        "largest |balance| {worst} of initial {initial}"
+    );
 }
 
 /// Quasi-static increments on a floor: the paper's slab held on its top
@@ -223,6 +237,7 @@ t_end = 1.0
     );
     assert_eq!(stored.len(), 21);
     assert!(stored.iter().all(|&s| s > 0.0), "{stored:?}");
+    assert!(balance.iter().chain(&strain).all(|x| x.is_finite()));
     let largest = strain.iter().fold(0.0_f64, |m, s| m.max(*s));
     let worst = balance.iter().fold(0.0_f64, |m, b| m.max(b.abs()));
     assert!(

@@ -41,11 +41,15 @@ fn end_displacement_converges_to_dalembert() {
                 .map(|(k, m)| wave_error(m, scheme, 2e-3 / f64::from(1 << k)))
                 .collect();
             println!("{scheme:?} {order}: relative L2 errors {errors:?}");
-            // Halving h and Δt roughly halves the error of the kinked wave
-            // (dispersion at the kinks limits the rate to about 1).
+            // Halving h and Δt halves the error of the kinked wave or
+            // better: dispersion at the kinks limits the order to about 1.
+            // Measured ratios 0.37-0.50 (orders 1.01-1.43, the lowest Q1 by
+            // Newmark); order ≥ 0.9, ratio ≤ 2^−0.9 = 0.536, claims first
+            // order (a ratio of 0.7 would let order 0.51 pass).
+            let orders: Vec<f64> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
             assert!(
-                errors.windows(2).all(|w| w[1] < 0.7 * w[0]),
-                "{scheme:?} {order}: errors {errors:?} must shrink"
+                orders.iter().all(|&p| p >= 0.9),
+                "{scheme:?} {order}: errors {errors:?}, orders {orders:?}: not first order"
             );
             assert!(
                 errors[2] < 0.01,

@@ -12,7 +12,7 @@ use stickslip_testkit::{add_point_group, map_nodes, rectangle};
 use stickslip_testkit::{sdof, wave, Slab};
 use stickslip_time::{History, Scheme};
 
-use crate::report::Report;
+use crate::report::{max_or_nan, Report};
 use crate::{Options, NEWMARK};
 
 /// The two schemes of the paper.
@@ -101,14 +101,24 @@ fn wave(root: &Path, opts: &Options, r: &mut Report) {
                     continue;
                 }
             };
-            // Halving h and Δt roughly halves the error of the kinked wave
-            // (dispersion at the kinks limits the rate to about 1).
-            let worst_ratio = errors.windows(2).map(|w| w[1] / w[0]).fold(0.0, f64::max);
-            r.at_most(
+            // Halving h and Δt halves the error of the kinked wave or
+            // better: dispersion at the kinks limits the order to about 1.
+            // Measured ratios 0.37-0.50 (orders 1.01-1.43, the lowest Q1
+            // by Newmark); order ≥ 0.9 (ratio ≤ 2^−0.9 = 0.536) claims
+            // first order, where the old ratio ≤ 0.7 let order 0.51 pass.
+            let worst_ratio = max_or_nan(errors.windows(2).map(|w| w[1] / w[0]));
+            r.at_least(
                 &case,
-                "error ratio per halving of h and Δt",
-                worst_ratio,
-                0.7,
+                &format!(
+                    "lowest order per halving of h and Δt (errors {})",
+                    errors
+                        .iter()
+                        .map(|e| format!("{e:.3e}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+                -worst_ratio.log2(),
+                0.9,
                 "first-order convergence at the wave's kinks",
             );
             r.at_most(
@@ -139,13 +149,14 @@ fn static_slab(root: &Path, r: &mut Report) {
             let slab = Slab::new(mesh, 0.3, 300.0, None, 1.0, 0.0, History::Step)
                 .map_err(|e| e.to_string())?;
             let u = static_solve(&slab.model, &slab.loads[0].vector).map_err(|e| e.to_string())?;
-            let mut worst: f64 = 0.0;
-            for (v, p) in slab.mesh.nodes.iter().enumerate() {
-                worst = worst
-                    .max((u[2 * v] - 0.117 * p[0]).abs())
-                    .max((u[2 * v + 1] - 0.273 * (1.0 - p[1])).abs());
-            }
-            Ok(worst)
+            Ok(max_or_nan(slab.mesh.nodes.iter().enumerate().flat_map(
+                |(v, p)| {
+                    [
+                        (u[2 * v] - 0.117 * p[0]).abs(),
+                        (u[2 * v + 1] - 0.273 * (1.0 - p[1])).abs(),
+                    ]
+                },
+            )))
         })();
         match result {
             Ok(w) => r.at_most(
@@ -216,11 +227,10 @@ fn patch(r: &mut Report) {
             .and_then(|m| static_solve(&m, &vec![0.0; m.dofs.n_free()]).map_err(|e| e.to_string()));
         match result {
             Ok(u) => {
-                let worst = mesh.nodes.iter().enumerate().fold(0.0f64, |w, (v, p)| {
+                let worst = max_or_nan(mesh.nodes.iter().enumerate().flat_map(|(v, p)| {
                     let e = linear(*p);
-                    w.max((u[2 * v] - e[0]).abs())
-                        .max((u[2 * v + 1] - e[1]).abs())
-                });
+                    [(u[2 * v] - e[0]).abs(), (u[2 * v + 1] - e[1]).abs()]
+                }));
                 r.at_most(
                     name,
                     "max nodal |u − u_linear|",

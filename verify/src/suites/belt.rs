@@ -16,7 +16,7 @@ use stickslip_contact::Weakening;
 use stickslip_testkit::sdof;
 use stickslip_time::{Integrator, Rayleigh, Scheme, Settings};
 
-use crate::report::Report;
+use crate::report::{max_or_nan, min_or_nan, Report};
 use crate::scene::{integrator_of, paper_slab};
 
 /// Pressure, μ, the belt's speed.
@@ -98,17 +98,13 @@ fn late_against_static(root: &Path, scheme: &str, dt: f64, t_end: f64) -> Result
     if expected.len() != start.len() {
         return Err("the two cases number their DOFs differently".into());
     }
-    let moved = expected
-        .iter()
-        .zip(&start)
-        .map(|(e, s)| (e - s).abs())
-        .fold(0.0, f64::max);
-    let error = run
-        .displacement()
-        .iter()
-        .zip(expected)
-        .map(|(u, e)| (u - e).abs())
-        .fold(0.0, f64::max);
+    let moved = max_or_nan(expected.iter().zip(&start).map(|(e, s)| (e - s).abs()));
+    let error = max_or_nan(
+        run.displacement()
+            .iter()
+            .zip(expected)
+            .map(|(u, e)| (u - e).abs()),
+    );
     Ok(error / moved)
 }
 
@@ -155,10 +151,8 @@ fn cycles(scheme: Scheme, ratio: f64, dt: f64, eps: f64) -> Result<Option<(f64, 
     }
     let last = &sticks[sticks.len() - CYCLES - 1..];
     let period = (last[CYCLES] - last[0]) / CYCLES as f64;
-    let span = xs.iter().filter(|(t, _)| *t >= last[0]).map(|&(_, x)| x);
-    let (lo, hi) = span.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-        (lo.min(x), hi.max(x))
-    });
+    let span = || xs.iter().filter(|(t, _)| *t >= last[0]).map(|&(_, x)| x);
+    let (lo, hi) = (min_or_nan(span()), max_or_nan(span()));
     Ok(Some((period, hi - lo)))
 }
 

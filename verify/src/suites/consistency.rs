@@ -48,7 +48,7 @@ use std::path::Path;
 
 use stickslip_time::Integrator;
 
-use crate::report::Report;
+use crate::report::{max_or_nan, min_or_nan, Report};
 use crate::scene::{integrator_of, paper_slab};
 
 /// The floors' stiffness c_n.
@@ -156,7 +156,7 @@ fn ceiling(root: &Path, r: &mut Report, (reference, nodes): (&[f64], &mut Vec<us
         // and the nodal weights as the law has them), and the ceiling is
         // to stay in contact for the rollers' limit to be the paper's.
         let [low, high] = h.others_at_start;
-        let off = (low - 300.0).abs().max((high - 300.0).abs());
+        let off = max_or_nan([(low - 300.0).abs(), (high - 300.0).abs()]);
         r.at_most(
             &case,
             "max |ceiling's traction − 300| at t = 0 (static preload)",
@@ -372,7 +372,7 @@ fn history(root: &Path, text: &str, nodes: &mut Vec<usize>) -> Result<History, S
     let (mut u_t, mut traction) = (Vec::new(), vec![0.0; c.len()]);
     let range = |t: &[f64], of: &[usize], into: &mut [f64; 2]| {
         for &j in of {
-            *into = [into[0].min(t[j]), into[1].max(t[j])];
+            *into = [min_or_nan([into[0], t[j]]), max_or_nan([into[1], t[j]])];
         }
     };
     let empty = [f64::INFINITY, f64::NEG_INFINITY];

@@ -10,7 +10,7 @@ use stickslip_testkit::manufactured;
 use stickslip_testkit::sdof;
 use stickslip_time::Scheme;
 
-use crate::report::{num, Report};
+use crate::report::{max_or_nan, num, Report};
 use crate::scene::{self, PaperCase};
 use crate::suites::analytic::SCHEMES;
 use crate::{Options, NEWMARK};
@@ -148,9 +148,12 @@ fn dt_rates(root: &Path, opts: &Options, r: &mut Report) {
             dts.iter()
                 .map(|&dt| {
                     let u = final_state(&mut scene, scheme, dt, t_end)?;
-                    Ok(u.iter()
-                        .zip(&reference)
-                        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())))
+                    Ok(max_or_nan(
+                        u.iter()
+                            .zip(&reference)
+                            .map(|(a, b)| (a - b).abs())
+                            .chain([0.0]),
+                    ))
                 })
                 .collect()
         })();
@@ -235,9 +238,12 @@ fn eps_rates(root: &Path, opts: &Options, r: &mut Report) {
             .iter()
             .map(|&e| {
                 let u = history(e)?;
-                Ok(u.iter()
-                    .zip(&reference)
-                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs())))
+                Ok(max_or_nan(
+                    u.iter()
+                        .zip(&reference)
+                        .map(|(a, b)| (a - b).abs())
+                        .chain([0.0]),
+                ))
             })
             .collect::<Result<Vec<f64>, String>>()?;
         Ok((eps, errs))

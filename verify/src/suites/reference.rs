@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::report::{num, Report};
+use crate::report::{max_or_nan, num, Report};
 use crate::scene::Trace;
 use crate::Run;
 
@@ -100,16 +100,14 @@ pub fn parse(text: &str, file: &Path) -> Result<Vec<Vec<f64>>, String> {
     Ok(cols)
 }
 
-/// Largest |a − b| / max|b| per column (steps must match).
+/// Largest |a − b| / max|b| per column (steps must match); NaN where
+/// either side has a NaN.
 fn deviations(run: &[Vec<f64>], reference: &[Vec<f64>]) -> Vec<f64> {
     run.iter()
         .zip(reference)
         .map(|(a, b)| {
-            let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
-            a.iter()
-                .zip(b)
-                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
-                / scale
+            let scale = max_or_nan(b.iter().map(|v| v.abs()).chain([1e-300]));
+            max_or_nan(a.iter().zip(b).map(|(x, y)| (x - y).abs()).chain([0.0])) / scale
         })
         .collect()
 }
@@ -137,7 +135,7 @@ pub fn run(root: &Path, runs: &[Run], bless: bool, r: &mut Report) {
                     let changed: Vec<String> = COLUMNS
                         .iter()
                         .zip(&d)
-                        .filter(|(_, d)| **d > 0.0)
+                        .filter(|(_, d)| **d != 0.0)
                         .map(|(c, d)| format!("{c} {}", num(*d)))
                         .collect();
                     if changed.is_empty() {
@@ -199,5 +197,19 @@ pub fn run(root: &Path, runs: &[Run], bless: bool, r: &mut Report) {
                 &format!("cases/reference/{name}.csv"),
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::deviations;
+
+    #[test]
+    fn a_nan_in_the_run_or_the_reference_is_a_deviation() {
+        let reference = vec![vec![1.0, 2.0, 4.0]];
+        assert_eq!(deviations(&reference, &reference), vec![0.0]);
+        let run = vec![vec![1.0, f64::NAN, 4.0]];
+        assert!(deviations(&run, &reference)[0].is_nan());
+        assert!(deviations(&reference, &run)[0].is_nan());
     }
 }
