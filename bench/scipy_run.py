@@ -22,10 +22,17 @@ plane-strain Lamé parameters), the lumped mass HRZ's, element by element
   numpy), a second solve.
 * The initial state of Remark 4.1: `splu` of K for r₀ under R(0⁻), r̈₀
   from M r̈₀ = R(0) − K r₀ with the scheme's mass.
+* The energy ledger as stickslip writes it (docs/results.md, METHOD.md
+  §6), at the records: `/energy/kinetic` ½ṙᵀMṙ (the scheme's mass),
+  `strain` ½rᵀKr, `external_work` Σ ½(R_K + R_{K−1})·(r_K − r_{K−1})
+  (R_0 = R(0)), `dissipated` Σ_J ½(f_J,K + f_J,K−1) τ_J·½Δt(ṙ_K + ṙ_{K−1})
+  with f_J = w_J g φ_ε(v_TJ), `total` kinetic + strain − rᵀR(t).
 
 It checks nothing itself: `cargo xtask bench run` compares its results
 file with stickslip's (`bench/peer_check.py`, displacements to 1e-8)
-before it times it.
+before it times it, and crates/cli/tests/peer_agreement.rs compares the
+paper's cases field by field (displacement, velocity, acceleration,
+friction stress, states, energies) at round-off.
 """
 import numpy as np
 import scipy.sparse as sp
@@ -128,7 +135,8 @@ a = rhs0 / mass if explicit else spla.splu(M.tocsc()).solve(rhs0)
 def cd_step(r, v, a, load):
     """One central-difference step with the closed-form nodal friction."""
     r_new = r + dt * v + (0.5 * dt * dt) * a
-    b = load - K @ r_new + mass * ((1.0 / (gamma * dt)) * v + (1.0 / gamma - 1.0) * a)
+    kr = K @ r_new
+    b = load - kr + mass * ((1.0 / (gamma * dt)) * v + (1.0 / gamma - 1.0) * a)
     dmass = mass * (1.0 / (gamma * dt))
     v_new = b / dmass
     # Per node: t + w g q φ_ε(t) = p, p = τᵀD⁻¹b, q = τᵀD⁻¹τ (closed form).
@@ -139,7 +147,7 @@ def cd_step(r, v, a, load):
     f = wg * phi(vt)
     v_new[dxm] = (b[dxm] - f[mx] * tx[mx]) / dmass[dxm]
     v_new[dym] = (b[dym] - f[my] * ty[my]) / dmass[dym]
-    return r_new, v_new
+    return r_new, v_new, kr
 
 
 if not explicit:
@@ -190,9 +198,17 @@ def newmark_step(r, v, a, load, classes):
 
 out = peer_case.Results(args.output, sc)
 full = np.zeros(2 * n_nodes)
+ledger = {k: np.zeros(out.n_out) for k in ("kinetic", "strain", "external_work", "dissipated", "total")}
+work = dissipated = 0.0
 
 
-def write(t, r, v, a):
+def write(t, r, v, a, kr):
+    """One record: the fields, the contact's, the ledger (`kr` = K r)."""
+    mv = mass * v if explicit else M @ v
+    e = {"kinetic": 0.5 * (v @ mv), "strain": 0.5 * (r @ kr), "external_work": work, "dissipated": dissipated}
+    e["total"] = e["kinetic"] + e["strain"] - r @ load_after
+    for key, x in e.items():
+        ledger[key][out.k] = x
     fields = []
     for x in (r, v, a):
         full[free] = x
@@ -202,17 +218,28 @@ def write(t, r, v, a):
 
 
 records = set(sc.record_steps())
-classes = classify(tx * v[ix] + ty * v[iy])
-write(0.0, r, v, a)
+vt = tx * v[ix] + ty * v[iy]
+classes = classify(vt)
+forces = wg * phi(vt)
+write(0.0, r, v, a, K @ r)
 for k in range(1, sc.steps + 1):
     if explicit:
-        r_new, v_new = cd_step(r, v, a, load_after)
+        r_new, v_new, kr = cd_step(r, v, a, load_after)
     else:
         r_new, v_new, classes = newmark_step(r, v, a, load_after, classes)
+        kr = None
     a = (v_new - v) / (gamma * dt) - ((1.0 - gamma) / gamma) * a
-    r, v = r_new, v_new
+    # The ledger's increments: R(t) = R(0) from t = 0 on (step and constant
+    # histories), friction's trapezoid on the nodes' tangential motion.
+    work += load_after @ (r_new - r)
+    vt_new = tx * v_new[ix] + ty * v_new[iy]
+    forces_new = wg * phi(vt_new)
+    dissipated += (0.5 * (forces_new + forces)) @ ((0.5 * dt) * (vt_new + vt))
+    r, v, vt, forces = r_new, v_new, vt_new, forces_new
     if k in records:
         if not (np.isfinite(r).all() and np.isfinite(v).all()):
             peer_case.refuse(f"state not finite at step {k}")
-        write(k * dt, r, v, a)
+        write(k * dt, r, v, a, K @ r if kr is None else kr)
+for key, x in ledger.items():
+    out.file[f"energy/{key}"] = x
 out.close()

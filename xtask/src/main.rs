@@ -31,8 +31,9 @@ usage: cargo xtask <command> [args]
   test              install what is missing (HDF5, Python modules, ParaView), then run
                     the whole test suite (what .ci/run and CI run)
   setup             only install what is missing: libhdf5-dev, and h5py, numpy,
-                    gmsh, matplotlib, meshio, pyvista and Debian's paraview for
-                    the tests (and the X/GL libraries gmsh's wheel loads)
+                    gmsh, matplotlib, meshio, pyvista, scipy, scikit-fem and
+                    Debian's paraview for the tests (and the X/GL libraries
+                    gmsh's wheel loads)
   verify            the proof of correctness: closed forms, convergence rates,
                     the paper's experiments, committed reference runs
                     [--quick] [--bless] [--only SUITE]
@@ -196,7 +197,9 @@ pub(crate) fn setup(for_tests: bool) -> Result<(), String> {
     }
     if for_tests {
         // What the end-to-end tests and examples read results and make
-        // meshes and pictures with, as users do.
+        // meshes and pictures with, as users do; scipy and scikit-fem for
+        // the independent numpy/scipy peer (bench/scipy_run.py) that
+        // crates/cli/tests/peer_agreement.rs checks the paper's cases with.
         python::ensure_python_modules(&[
             ("h5py", "h5py"),
             ("numpy", "numpy"),
@@ -204,6 +207,8 @@ pub(crate) fn setup(for_tests: bool) -> Result<(), String> {
             ("matplotlib", "matplotlib"),
             ("meshio", "meshio"),
             ("pyvista", "pyvista"),
+            ("scipy", "scipy"),
+            ("skfem", "scikit-fem"),
         ])?;
         // The XDMF tests open the results in ParaView, as users do; under
         // CI they fail without it.
