@@ -81,9 +81,9 @@ fn a_preload_along_the_foundation_is_refused() {
     }
 }
 
-/// A block 0.05, 5 or 500 above the floor (`[initial] state = "static"` from off the
-/// foundation) is carried onto it by the preload and settles at the same
-/// approach (p/c_n)^{1/m_n} = 0.01 to 1e-9, both laws.
+/// A block 0.05, 5 or 500 above the floor (`[initial] state = "static"`
+/// from off the foundation) is carried onto it by the preload and settles
+/// at the same approach (p/c_n)^{1/m_n} = 0.01 to 1e-9, both laws.
 #[test]
 fn a_preload_carries_a_block_from_off_the_foundation_onto_it() {
     // 5 and 500 are 500 and 50,000 times the approach (the preload's own
