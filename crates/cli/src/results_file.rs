@@ -61,12 +61,13 @@ impl Companion {
 }
 
 /// What the file at `kind`'s path beside `out` is, where it exists and
-/// holds what replacing it would lose: a directory or special file,
-/// another run's results file (named like a companion, e.g. a run written
-/// to `r.views.h5`), or a file of another program. Views and stresses,
-/// whoever's (a renamed results file's, a copy's, an earlier version's,
-/// one left damaged), are made again from a results file: replacing them
-/// loses nothing, so they are `None`, as is an empty file.
+/// holds what replacing it would lose: a directory or special file, a file
+/// in use (a run writing its results under that name, a reader), another
+/// run's results file (e.g. a run written to `r.views.h5`), a file that is
+/// no HDF5 file, or an HDF5 file of another program. Views and stresses,
+/// whoever's (a renamed results file's, a copy's, an earlier version's),
+/// and a damaged or empty file nothing holds open are made again from a
+/// results file: replacing them loses nothing, so they are `None`.
 pub fn foreign_companion(out: &Path, kind: Companion) -> Option<String> {
     let path = kind.path(out);
     let meta = std::fs::metadata(&path).ok()?;
@@ -77,16 +78,29 @@ pub fn foreign_companion(out: &Path, kind: Companion) -> Option<String> {
             "not a regular file".into()
         });
     }
+    // Before anything else: a run's results file is empty, or does not
+    // open, while the run writes it.
+    if in_use(&path) {
+        return Some("in use (a run writing it, or a reader)".into());
+    }
     if meta.len() == 0 {
         return None;
     }
     if !is_hdf5(&path) {
         return Some("not an HDF5 file".into());
     }
-    // One that does not open (damaged, or cut short) is replaced.
-    let f = hdf5::File::open(&path).ok()?;
-    (crate::output::text_attr(&f, "program").ok().as_deref() == Some("stickslip"))
-        .then(|| "the results file of another run".into())
+    let Ok(f) = hdf5::File::open(&path) else {
+        return None;
+    };
+    let text = |name: &str| crate::output::text_attr(&f, name).ok();
+    if text("program").as_deref() == Some("stickslip") {
+        return Some("the results file of another run".into());
+    }
+    // What `views` and `stress` write: `source` (stress files of earlier
+    // versions lack it: their datasets say what they are).
+    let companion = text("source").is_some()
+        || (kind == Companion::Stress && f.link_exists("stress") && f.link_exists("von_mises"));
+    (!companion).then(|| "an HDF5 file of another program".into())
 }
 
 /// The message for [`foreign_companion`]'s file beside `out`, which
@@ -104,7 +118,8 @@ pub(crate) fn foreign_message(out: &Path, kind: Companion, what: &str, doing: &s
 /// Refuses an output path `run` must not write (exit code 2), before
 /// anything is read: an existing OUT.h5, OUT.xdmf, OUT.contact.xdmf,
 /// OUT.views.h5 or OUT.stress.h5 without `force`, a file named as
-/// OUT.h5's views or stresses that is not theirs (even with `force`), an
+/// OUT.h5's views or stresses that holds what replacing it would lose
+/// ([`foreign_companion`]; even with `force`), an
 /// empty name, a directory, an input of the case, a missing directory, or
 /// a file another process has open (HDF5 locks files it writes: a second
 /// run with `--force` would truncate the first run's file and then fail on

@@ -237,10 +237,11 @@ pub(crate) fn room_for(out: &Path, force: bool) -> Option<u64> {
     Some(free.saturating_add(old))
 }
 
-/// The initial (static) displacement, where it exceeds the part's size:
-/// no small strains are left, which is most often a mix of units (E in MPa
-/// with loads in Pa: displacements of 340% of the part went without a
-/// word). The paper's slab itself moves 12% of its length (0.975 of 8).
+/// The initial (static) displacement less its mean translation, where it
+/// exceeds the part's size: no small strains are left, which is most
+/// often a mix of units (E in MPa with loads in Pa: displacements of 340%
+/// of the part went without a word). The paper's slab itself moves 12% of
+/// its length (0.975 of 8).
 fn large_static_displacement(mesh: &Mesh, u: &[f64]) -> Option<String> {
     let [lo, hi] = stickslip_mesh::bounding_box(mesh.nodes.iter().copied());
     let size = (hi[0] - lo[0]).max(hi[1] - lo[1]);

@@ -444,11 +444,17 @@ fn stress_name(out: &Path, rows: usize) -> Option<String> {
     use crate::results_file::{foreign_companion, Companion};
     let path = Companion::Stress.path(out);
     // A file of that name that is not these stresses (another run's
-    // results, another file's stresses) is not listed.
+    // results, another file's stresses: `source` names another file, and
+    // an earlier version's stresses, without it, are this file's only if
+    // nothing says otherwise) is not listed.
     if foreign_companion(out, Companion::Stress).is_some() {
         return None;
     }
     let g = File::open(&path).ok()?;
+    let ours = crate::views::file_name(out).ok()?;
+    if crate::output::text_attr(&g, "source").is_ok_and(|s| s != ours) {
+        return None;
+    }
     for v in crate::xdmf::STRESS_VIEWS {
         if (g.group(&format!("views/{v}")).ok()?.len() as usize) < rows {
             return None;

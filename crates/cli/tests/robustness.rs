@@ -2256,12 +2256,14 @@ fn a_run_its_disk_holds_only_without_the_room_it_keeps_is_refused() {
     assert!(!left, "no results file for a run refused");
 }
 
-/// Files that only bear the names of a results file's companions (another
-/// run's results written as r.views.h5 or r.stress.h5, the views of
-/// another results file) are neither replaced by `views` and `stress` nor
-/// removed by a run, a `--force` or a restart of r.h5: all exit 2 naming
-/// the file (before, each went ahead and the other runs were lost). The
-/// companions themselves are still replaced and removed as before.
+/// Files that only bear the names of a results file's companions and hold
+/// what replacing them would lose (another run's results written as
+/// r.views.h5 or r.stress.h5, a file in use, another program's HDF5 file)
+/// are neither replaced by `views` and `stress` nor removed by a run, a
+/// `--force` or a restart of r.h5: all exit 2 naming the file (before,
+/// each went ahead and the other runs were lost). Views and stresses,
+/// whoever's (a copied or renamed results file's), and a damaged one are
+/// replaced and removed as before.
 #[test]
 fn files_named_like_companions_are_not_taken_for_them() {
     let dir = scratch("foreign-companions");
@@ -2355,6 +2357,33 @@ fn files_named_like_companions_are_not_taken_for_them() {
     )
     .unwrap();
     ok(&command("views", &s));
+    // But not one held open (a run writing its results under that name),
+    // nor another program's HDF5 file.
+    let held = std::fs::File::open(dir.join("s.views.h5")).unwrap();
+    held.lock().unwrap();
+    let o = command("views", &s);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("is in use"), "{}", stderr(&o));
+    drop(held);
+    let theirs = hdf5::File::create(dir.join("s.stress.h5")).unwrap();
+    theirs
+        .new_dataset::<f64>()
+        .shape(3)
+        .create("mydata")
+        .unwrap();
+    drop(theirs);
+    let o = command("stress", &s);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is an HDF5 file of another program"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(hdf5::File::open(dir.join("s.stress.h5"))
+        .unwrap()
+        .link_exists("mydata"));
+    std::fs::remove_file(dir.join("s.stress.h5")).unwrap();
+    ok(&command("stress", &s));
     ok(&run(&case, &s, &["--set", "time.t_end=0.02"]));
     assert!(!dir.join("s.views.h5").exists() && !dir.join("s.stress.h5").exists());
     std::fs::remove_file(&stress).unwrap();
