@@ -117,7 +117,7 @@ pub fn slide(slab: &Slab, mut settings: Settings, v0: f64) -> Result<Slide, Scen
     while !i.done() {
         i.step()?;
         let v = mean_x(slab, i.velocity());
-        top = top.max(v.abs());
+        top = crate::max_or_nan([top, v.abs()]);
         for (t, level) in crossed.iter_mut().zip([0.5, 0.05]) {
             if t.is_nan() && top > 0.0 && v.abs() < top && v.abs() <= level * top {
                 *t = i.time();

@@ -200,7 +200,7 @@ fn measure(
         }
         let t = run.time();
         let e = run.energy();
-        growth = growth.max((e.kinetic + e.strain + e.foundation_stored) / e0);
+        growth = crate::max_or_nan([growth, (e.kinetic + e.strain + e.foundation_stored) / e0]);
         run.normal_traction(&mut sigma);
         let c = run.contact().expect("a contact surface");
         let force: f64 = c.nodes.iter().zip(&sigma).map(|(n, s)| n.weight * s).sum();
@@ -211,7 +211,7 @@ fn measure(
             sum += force / H;
             count += 1;
         }
-        balance = balance.max(run.energy().balance.abs() / e0);
+        balance = crate::max_or_nan([balance, run.energy().balance.abs() / e0]);
     }
     // The mean velocity with the trapezoid weights of the uniform grid
     // (the lumped mass of Q1 cells of one size).

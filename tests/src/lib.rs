@@ -43,8 +43,10 @@ pub mod settle;
 pub mod solvers;
 pub mod strip;
 pub mod wave;
+pub mod worst;
 
 pub use grid::{add_point_group, map_nodes, rectangle, slab, structured_slab};
 pub use paths::{meshes_dir, read_mesh, scratch, workspace_root};
 pub use reference::{on_threads, plain_spmv, spread};
 pub use scene::{paper_material, paper_slab, paper_supports, SceneError, Slab};
+pub use worst::{max_or_nan, min_or_nan};

@@ -119,7 +119,7 @@ pub fn max_error(p: f64, eps: f64, scheme: Scheme, dt: f64) -> Result<(f64, f64)
     let mut err: f64 = 0.0;
     while !i.done() {
         i.step()?;
-        err = err.max((i.displacement()[0] - closed_form(p, i.time())).abs());
+        err = crate::max_or_nan([err, (i.displacement()[0] - closed_form(p, i.time())).abs()]);
     }
     Ok((err, i.displacement()[0]))
 }

@@ -90,7 +90,7 @@ pub fn preload(nx: usize, cn: f64, mn: f64, steps: usize) -> Result<Preload, Sce
     Ok(Preload {
         initial,
         after: block.approaches(run.displacement()),
-        largest_speed: run.velocity().iter().fold(0.0, |m, v| m.max(v.abs())),
+        largest_speed: crate::max_or_nan(run.velocity().iter().map(|v| v.abs()).chain([0.0])),
         run,
     })
 }
@@ -184,8 +184,8 @@ impl Block {
         for n in &self.contact.nodes {
             let d = n.dofs[1].map_or(0.0, |d| -r[d]);
             let d = d - self.contact.compliance[0].gap;
-            most = most.max(d);
-            least = least.min(d);
+            most = crate::max_or_nan([most, d]);
+            least = crate::min_or_nan([least, d]);
         }
         (most, least)
     }

@@ -123,6 +123,10 @@ pub fn verify(root: &Path, opts: &Options, report: &mut Report) -> Result<(), St
     }
     if wants("paper") || wants("reference") {
         let runs = run_cases(root, opts.fault, &opts.cases)?;
+        if runs.is_empty() && !opts.cases.is_empty() {
+            // A mistyped --case would otherwise pass on the other suites.
+            return Err(format!("no paper case matched --case {:?}", opts.cases));
+        }
         if wants("paper") {
             suites::paper::run(&runs, report);
         }

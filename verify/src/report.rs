@@ -50,27 +50,9 @@ pub fn num(x: f64) -> String {
     }
 }
 
-/// The largest of `values` (−∞ for none), or NaN when any of them is NaN.
-///
-/// `f64::max` returns its other operand when one is NaN, so a plain
-/// `fold(0.0, f64::max)` drops a NaN and a run that produced one would
-/// pass its bound; every "worst of" in the suites goes through here (NaN
-/// then fails `close`, `at_most` and `at_least` alike).
-pub fn max_or_nan(values: impl IntoIterator<Item = f64>) -> f64 {
-    values.into_iter().fold(f64::NEG_INFINITY, |m, v| {
-        if m.is_nan() || v.is_nan() {
-            f64::NAN
-        } else {
-            m.max(v)
-        }
-    })
-}
-
-/// The smallest of `values` (+∞ for none), or NaN when any of them is NaN
-/// ([`max_or_nan`] of the negated values).
-pub fn min_or_nan(values: impl IntoIterator<Item = f64>) -> f64 {
-    -max_or_nan(values.into_iter().map(|v| -v))
-}
+/// The NaN-keeping worst of a suite's values (every "worst of" in the
+/// suites and the test kit's helpers goes through them).
+pub use stickslip_testkit::{max_or_nan, min_or_nan};
 
 impl Report {
     /// A report that prints its rows as they come when `echo`.
