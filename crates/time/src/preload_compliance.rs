@@ -94,7 +94,8 @@ pub(crate) fn solve(
 ) -> Result<(), TimeError> {
     let preload = r.to_vec();
     let vectors: Vec<&[f64]> = modes.iter().map(|m| m.vector.as_slice()).collect();
-    let (never, held) = split(modes, &along_normal(contact, &vectors));
+    let along = along_normal(contact, &vectors);
+    let (never, held) = split(modes, &along);
     floating::balanced(&never, &preload)?;
     let pins = if never.is_empty() {
         Vec::new()
@@ -218,6 +219,21 @@ pub(crate) fn solve(
                 .iter()
                 .zip(&preload)
                 .fold((0.0, 0.0), |(w, s), (z, p)| (w + z * p, s + (z * p).abs()));
+            // A motion that moves every compliant node off the foundation
+            // (or every one into it), as a translation towards a floor: a
+            // load pressing the part along it into the foundation is what
+            // the foundation holds, so it is no cause (a part tipped over
+            // is, by the rotation).
+            let approach: Vec<f64> = along
+                .iter()
+                .map(|a| a.iter().zip(h).map(|(a, h)| a * h).sum())
+                .collect();
+            let reach = approach.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+            let off = approach.iter().all(|a| *a > NULL.sqrt() * reach);
+            let into = approach.iter().all(|a| *a < -NULL.sqrt() * reach);
+            if (off && work < 0.0) || (into && work > 0.0) {
+                return None;
+            }
             let why = format!(
                 ", which the foundation of surface {} holds only against loads pressing the part \
                  into it (it only pushes)",

@@ -160,6 +160,16 @@ fn slope_block(
     g: [f64; 2],
     top: [f64; 2],
 ) -> (Mesh, ContactSurface, Result<Integrator, TimeError>) {
+    slope_block_with(g, top, |_, _| {})
+}
+
+/// [`slope_block`] with forces `extra` adds to the full load vector (two
+/// per node) besides.
+fn slope_block_with(
+    g: [f64; 2],
+    top: [f64; 2],
+    extra: impl Fn(&Mesh, &mut [f64]),
+) -> (Mesh, ContactSurface, Result<Integrator, TimeError>) {
     let mut mesh = rectangle(CellKind::Quad4, 8, 4, [0.0, 0.0], [W, H]);
     let (s, c) = THETA.sin_cos();
     map_nodes(&mut mesh, |[x, y]| {
@@ -179,6 +189,7 @@ fn slope_block(
     let mut full = vec![0.0; 2 * mesh.nodes.len()];
     body_force_load(&mesh, g, &mut full);
     traction_load(&mesh, "top", Traction::Vector(top), &mut full).unwrap();
+    extra(&mesh, &mut full);
     let mut vector = vec![0.0; model.dofs.n_free()];
     model.dofs.restrict(&full, &mut vector);
     let loads = vec![Load {
@@ -286,4 +297,39 @@ fn a_preload_pulling_a_block_off_a_slope_names_the_direction() {
         rotation.1
     );
     assert!(!message.contains("combination"), "{message}");
+}
+
+/// A couple that tips the block over its downhill edge while its weight
+/// presses it into the slope: the foundation holds the press, so the
+/// refusal names the rotation alone, not also the translation along ν
+/// (which it did, with the weight's force as if that were the cause).
+#[test]
+fn a_block_tipped_off_a_slope_is_refused_by_its_rotation_alone() {
+    let m = W * H;
+    let (s, c) = THETA.sin_cos();
+    // Gravity along −ν: no share along the frictionless slope.
+    let g = [-G * s, -G * c];
+    // ±P ν at the top corners, P W twice the weight's moment m G W/2 about
+    // either bottom edge: the left lifts.
+    let p = 2.0 * m * G;
+    let corner = |x: f64| [x * c + H * s + D * s, -x * s + H * c + D * c];
+    let (_, _, run) = slope_block_with(g, [0.0, 0.0], |mesh, full| {
+        for (x, sign) in [(0.0, 1.0), (W, -1.0)] {
+            let at = corner(x);
+            let node = mesh
+                .nodes
+                .iter()
+                .position(|q| (q[0] - at[0]).hypot(q[1] - at[1]) < 1e-9)
+                .expect("a corner node");
+            full[2 * node] += sign * p * s;
+            full[2 * node + 1] += sign * p * c;
+        }
+    });
+    let e = run.unwrap_err();
+    let TimeError::Unbalanced(motions) = &e else {
+        panic!("{e}")
+    };
+    let message = e.to_string();
+    assert_eq!(motions.len(), 1, "{message}");
+    assert!(motions[0].0.starts_with("rotation about ("), "{message}");
 }
