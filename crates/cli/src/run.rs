@@ -329,14 +329,10 @@ fn oblique_supports(mesh: &Mesh, c: &ContactSurface) -> Option<String> {
     let mut count = [0usize; 2];
     let mut worst: Option<(f64, usize, usize)> = None;
     for n in &c.nodes {
-        // A node whose free DOFs have no share of τ (a compliant surface
+        // A node whose tangential motion is held (a compliant surface
         // keeps it for its normal force) carries no friction: its support
         // takes none of it.
-        let free_tangent: f64 = (0..2)
-            .filter(|&a| n.dofs[a].is_some())
-            .map(|a| n.tangent[a] * n.tangent[a])
-            .sum();
-        if free_tangent < 1e-20 {
+        if n.tangent_held() {
             continue;
         }
         for axis in 0..2 {

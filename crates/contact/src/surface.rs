@@ -55,6 +55,17 @@ pub struct ContactNode {
 }
 
 impl ContactNode {
+    /// Whether a Dirichlet condition holds the node's tangential motion:
+    /// the tangent has no component along a free DOF, so the node carries
+    /// no friction (BENCHMARK.md, the slab's corner (0, 0)).
+    pub fn tangent_held(&self) -> bool {
+        let free: f64 = (0..2)
+            .filter(|&c| self.dofs[c].is_some())
+            .map(|c| self.tangent[c] * self.tangent[c])
+            .sum();
+        free < 1e-20
+    }
+
     /// Tangential velocity v_T = τ·ṙ_J from a free-DOF velocity vector
     /// (fixed components are prescribed constants, so their velocity is 0).
     #[inline]
@@ -202,26 +213,19 @@ impl ContactSurface {
         let mut nodes = Vec::with_capacity(quadrature.len());
         let mut excluded = Vec::new();
         for b in &quadrature {
-            let node_dofs = [dofs.free(b.node, 0), dofs.free(b.node, 1)];
-            // Tangential motion is fixed when the tangent has no component
-            // along a free DOF: such a node carries no friction (BENCHMARK.md,
-            // the slab's corner (0, 0)).
-            let free_tangent: f64 = (0..2)
-                .filter(|&c| node_dofs[c].is_some())
-                .map(|c| b.tangent[c] * b.tangent[c])
-                .sum();
-            if free_tangent < 1e-20 {
-                excluded.push(b.node);
-                continue;
-            }
-            nodes.push(ContactNode {
+            let node = ContactNode {
                 node: b.node,
-                dofs: node_dofs,
+                dofs: [dofs.free(b.node, 0), dofs.free(b.node, 1)],
                 weight: b.weight,
                 tangent: b.tangent,
                 s: b.s,
                 bound,
-            });
+            };
+            if node.tangent_held() {
+                excluded.push(b.node);
+                continue;
+            }
+            nodes.push(node);
         }
         Ok(ContactSurface {
             group: group.to_string(),
