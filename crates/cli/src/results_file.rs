@@ -221,13 +221,7 @@ pub fn check_output_place(out: &Path, inputs: &[Input]) -> Result<(), InputError
     refer_by_name(out).map_err(|why| {
         InputError(format!(
             "{name}: {why}; give a name without ':', e.g. -o {}",
-            out.with_file_name(
-                out.file_name()
-                    .unwrap_or_default()
-                    .to_string_lossy()
-                    .replace(':', "_")
-            )
-            .display()
+            out.with_file_name(colon_free_name(out)).display()
         ))
     })?;
     let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
@@ -301,6 +295,15 @@ pub(crate) fn refer_by_name(out: &Path) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// `out`'s file name with each ':' made '_': a name [`refer_by_name`]
+/// takes, for a message.
+pub(crate) fn colon_free_name(out: &Path) -> String {
+    out.file_name()
+        .unwrap_or_default()
+        .to_string_lossy()
+        .replace(':', "_")
 }
 
 /// Refuses early what `run --restart` cannot continue: a missing file, a

@@ -155,11 +155,7 @@ pub(crate) fn check_beside(out: &Path, command: &str, files: &[PathBuf]) -> Resu
 /// The [`InputError`] saying why and what to do.
 fn named_in_xml(out: &Path) -> Result<(), InputError> {
     crate::results_file::refer_by_name(out).map_err(|why| {
-        let renamed = out
-            .file_name()
-            .unwrap_or_default()
-            .to_string_lossy()
-            .replace(':', "_");
+        let renamed = crate::results_file::colon_free_name(out);
         InputError(format!(
             "{}: {why}; rename it without ':' (e.g. to {renamed}) and run this again",
             out.display()
