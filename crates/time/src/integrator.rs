@@ -173,7 +173,7 @@ impl Integrator {
         let Some(contact) = self.run.contact.as_ref() else {
             return Ok(());
         };
-        if !self.stepper.friction_at_start() {
+        if !self.friction_at_start() {
             return Ok(());
         }
         let before = self.state.forces.clone();
@@ -500,11 +500,19 @@ impl Integrator {
     pub fn mass_kind(&self) -> Option<MassKind> {
         self.stepper.mass_kind()
     }
+
+    /// Whether the start carries the friction at the slip at t = 0 (in
+    /// r̈₀, initial.rs): not without mass (quasi-static increments), whose
+    /// start is the frictionless static state, the law first applied by
+    /// the first increment.
+    fn friction_at_start(&self) -> bool {
+        self.stepper.mass_kind().is_some()
+    }
     /// Friction stress σ_T = −g φ_ε(v_T) at each contact node: 0 in the
     /// start of quasi-static increments, which carries no friction.
     pub fn friction_stress(&self, out: &mut [f64]) {
         if let Some(c) = self.contact() {
-            if self.state.steps == 0 && !self.stepper.friction_at_start() {
+            if self.state.steps == 0 && !self.friction_at_start() {
                 out.iter_mut().take(c.len()).for_each(|o| *o = 0.0);
                 return;
             }

@@ -213,10 +213,6 @@ impl Stepper for QuasiStatic {
         None
     }
 
-    fn friction_at_start(&self) -> bool {
-        false
-    }
-
     fn stiffness_product(&self) -> &'static str {
         "assembled CSR"
     }

@@ -57,14 +57,6 @@ pub(crate) trait Stepper: Send {
         Mass::Massless.solve_in_place(x, fill_order, None).map(drop)
     }
 
-    /// True when the start carries the friction at the slip at t = 0 (in
-    /// r̈₀, initial.rs); false for quasi-static increments, whose start is
-    /// the frictionless static state, the law first applied by the first
-    /// increment.
-    fn friction_at_start(&self) -> bool {
-        true
-    }
-
     /// K's stencil types, where the step forms K·x from them.
     fn stencil_types(&self) -> Option<usize> {
         None
