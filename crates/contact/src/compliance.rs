@@ -138,6 +138,15 @@ impl CompliantNode {
         self.signed_approach(node, r).max(0.0)
     }
 
+    /// ν·z_J: the share of the motion `z` (on free DOFs) along the
+    /// foundation's normal at `node` (a fixed component does not move).
+    #[inline]
+    pub fn along_normal(&self, node: &ContactNode, z: &[f64]) -> f64 {
+        (0..2)
+            .filter_map(|c| node.dofs[c].map(|d| self.normal[c] * z[d]))
+            .sum()
+    }
+
     /// −(g₀ + ν·r_J): the approach, negative off the foundation (by the
     /// gap).
     #[inline]

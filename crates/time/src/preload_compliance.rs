@@ -172,11 +172,7 @@ pub(crate) fn solve(
                     *z += alpha * e;
                 }
                 for (moved, c) in surface.compliance.iter_mut().zip(&contact.compliance) {
-                    let dofs = contact.nodes[c.index].dofs;
-                    moved.gap = c.gap
-                        + (0..2)
-                            .filter_map(|comp| dofs[comp].map(|d| c.normal[comp] * rigid[d]))
-                            .sum::<f64>();
+                    moved.gap = c.gap + c.along_normal(&contact.nodes[c.index], &rigid);
                 }
                 continue;
             }
@@ -443,9 +439,7 @@ impl Held {
             .iter()
             .filter_map(|c| {
                 let node = &contact.nodes[c.index];
-                let rate: f64 = (0..2)
-                    .filter_map(|comp| node.dofs[comp].map(|d| c.normal[comp] * e[d]))
-                    .sum();
+                let rate = c.along_normal(node, &e);
                 let approach = c.signed_approach(node, x);
                 (approach < 0.0 && rate < 0.0).then(|| approach / rate)
             })
@@ -546,14 +540,7 @@ fn along_normal(contact: &ContactSurface, vectors: &[&[f64]]) -> Vec<Vec<f64>> {
         .iter()
         .map(|c| {
             let node = &contact.nodes[c.index];
-            vectors
-                .iter()
-                .map(|z| {
-                    (0..2)
-                        .filter_map(|comp| node.dofs[comp].map(|d| c.normal[comp] * z[d]))
-                        .sum()
-                })
-                .collect()
+            vectors.iter().map(|z| c.along_normal(node, z)).collect()
         })
         .collect()
 }
