@@ -73,12 +73,8 @@ fn flatten(prefix: &str, v: &toml::Value, out: &mut BTreeMap<String, toml::Value
 
 /// Numbers compare by value (`1000` equals `1000.0`); the rest as written.
 fn same_value(a: &toml::Value, b: &toml::Value) -> bool {
-    let num = |v: &toml::Value| match v {
-        toml::Value::Integer(i) => Some(*i as f64),
-        toml::Value::Float(f) => Some(*f),
-        _ => None,
-    };
-    match (num(a), num(b)) {
+    use crate::schema::number;
+    match (number(a), number(b)) {
         (Some(x), Some(y)) => x.to_bits() == y.to_bits() || x == y,
         _ => match (a, b) {
             (toml::Value::Array(x), toml::Value::Array(y)) => {

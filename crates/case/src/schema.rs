@@ -382,7 +382,8 @@ fn described(v: &toml::Value) -> String {
     }
 }
 
-fn number(v: &toml::Value) -> Option<f64> {
+/// A TOML integer or float as f64 (`1000` and `1000.0` alike).
+pub(crate) fn number(v: &toml::Value) -> Option<f64> {
     match v {
         toml::Value::Integer(i) => Some(*i as f64),
         toml::Value::Float(f) => Some(*f),
