@@ -27,7 +27,7 @@ mod symmetric;
 pub use cholesky::{analyze_symbolic, csc_view, Analysis, SolverError, SparseCholesky};
 pub use fill_order::{FillOrder, AMD_MARGIN};
 pub use product::{Formed, Product};
-pub use refine::{backward_error, Refined, BACKWARD_ERROR, MAX_ITERATIONS};
+pub use refine::{backward_error, solve_by_diagonal, Refined, BACKWARD_ERROR, MAX_ITERATIONS};
 pub use split::SplitSingle;
 pub use stencils::{Stencils, BATCH, TOLERANCE};
 pub use supernodal::{FactorValue, PathOperator, Supernodal};

@@ -32,7 +32,7 @@ use faer::{Accum, Conj, Mat, Par, Side, Spec};
 use nalgebra_sparse::CsrMatrix;
 
 use crate::cholesky::symbolic_in_order;
-use crate::refine::refine;
+use crate::refine::{refine, MAX_ITERATIONS};
 use crate::{Refined, SolverError, Supernodal};
 
 /// One half with the separator: B_h, its factor, and T_h.
@@ -348,7 +348,7 @@ impl SplitSingle {
         x: &mut [f64],
         tolerance: f64,
     ) -> Result<Refined, Refined> {
-        refine(a, x, tolerance, |z| self.solve_in_place(z))
+        refine(a, x, tolerance, MAX_ITERATIONS, |z| self.solve_in_place(z))
     }
 }
 
