@@ -548,4 +548,38 @@ mod tests {
             assert!((x - want).abs() <= 1e-6 * want.abs(), "{x} against {want}");
         }
     }
+
+    /// A chain of springs, 2 + shift on the diagonal and −1 beside: a
+    /// matrix far from its diagonal for a small shift.
+    fn chain(n: usize, shift: f64) -> CsrMatrix<f64> {
+        let mut coo = CooMatrix::new(n, n);
+        for i in 0..n {
+            coo.push(i, i, 2.0 + shift);
+            if i + 1 < n {
+                coo.push(i, i + 1, -1.0);
+                coo.push(i + 1, i, -1.0);
+            }
+        }
+        CsrMatrix::from(&coo)
+    }
+
+    /// A consistent mass is solved by CG on its diagonal, without a
+    /// factorization (no analysis made); a "mass" CG cannot solve in
+    /// [`MASS_ITERATIONS`] (a chain with κ(D⁻¹A) ≈ 4e4) is factorized, and
+    /// the analysis it made is returned. Both to a factor solve's
+    /// backward error.
+    #[test]
+    fn a_consistent_mass_is_solved_by_cg_and_else_factorized() {
+        let b: Vec<f64> = (0..400).map(|i| ((i * 7) % 11) as f64 - 5.0).collect();
+        for (shift, factorized) in [(4.0, false), (1e-4, true)] {
+            let m = chain(400, shift);
+            let mut x = b.clone();
+            let made = Mass::Consistent(&m)
+                .solve_in_place(&mut x, &FillOrder::amd(), None)
+                .unwrap();
+            assert_eq!(made.is_some(), factorized, "shift {shift}");
+            let eta = stickslip_linalg::backward_error(&m, &x, &b);
+            assert!(eta <= 4.0 * BACKWARD_ERROR, "shift {shift}: {eta:e}");
+        }
+    }
 }
