@@ -21,7 +21,7 @@ use crate::state::{Energy, State};
 
 /// CG iterations on a consistent mass's diagonal before its factorization
 /// takes over: about twice the most measured (45, on unstructured Q1
-/// meshes; 16-26 on structured ones, 35-36 on unstructured Q2).
+/// meshes; 9-26 on structured ones, 35-36 on unstructured Q2).
 const MASS_ITERATIONS: usize = 100;
 
 /// The mass a scheme uses, as the initial state needs it.
@@ -120,8 +120,9 @@ pub(crate) struct Statics<'a> {
     /// from [`SINGLE_MIN`] free DOFs the factor is computed in single
     /// precision.
     pub single_factor: bool,
-    /// Where K's analysis is kept once made here (by the preload or the
-    /// consistent mass), for the step's operators (the implicit schemes);
+    /// Where K's analysis is kept once made here (by the preload, or by a
+    /// consistent mass's factorization where CG on its diagonal stalls),
+    /// for the step's operators (the implicit schemes);
     /// `None` where nothing after the initial state factorizes.
     pub analysis: Option<&'a mut SharedAnalysis>,
 }
@@ -565,7 +566,7 @@ mod tests {
 
     /// A consistent mass is solved by CG on its diagonal, without a
     /// factorization (no analysis made); a "mass" CG cannot solve in
-    /// [`MASS_ITERATIONS`] (a chain with κ(D⁻¹A) ≈ 4e4) is factorized, and
+    /// [`MASS_ITERATIONS`] (a chain with κ(D⁻¹A) ≈ 2.5e4) is factorized, and
     /// the analysis it made is returned. Both to a factor solve's
     /// backward error.
     #[test]

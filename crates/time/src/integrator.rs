@@ -217,7 +217,7 @@ impl Integrator {
     ///
     /// # Errors
     /// [`TimeError::Static`] where a consistent M fails to factorize for
-    /// r̈₀ (it factorized at the start).
+    /// r̈₀ (where CG on its diagonal stalls, as at the start).
     pub fn set_pressure_histories(&mut self, histories: &[History]) -> Result<(), TimeError> {
         let Some(contact) = self.run.contact.as_mut() else {
             return Ok(());
