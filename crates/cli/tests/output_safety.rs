@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
 mod common;
-use common::{bin, data, probe, run, scratch, skip_without, stderr};
+use common::{bin, data, probe, run, scratch, skip_without, stderr, tmpfs};
 
 /// What to do where /dev/full is missing (a container without /dev).
 const NO_DEV_FULL: &str = "give the container its /dev (docker mounts /dev/full by default)";
@@ -263,29 +263,17 @@ fn views_in_a_read_only_directory_say_what_to_do() {
     std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o755)).unwrap();
     if writable {
         // Root: a read-only file system stops it.
-        let ro = dir.join("ro");
-        std::fs::create_dir_all(&ro).unwrap();
-        let mount = |args: &[&str]| {
-            Command::new("mount")
-                .args(args)
-                .arg(&ro)
-                .stderr(Stdio::null())
-                .status()
-                .is_ok_and(|s| s.success())
-        };
-        if !mount(&["-t", "tmpfs", "-o", "size=4M", "tmpfs"]) {
-            assert!(
-                std::env::var_os("CI").is_none(),
-                "cannot mount a tmpfs at {}: run the tests as root, or give the container \
-                 CAP_SYS_ADMIN (docker run --cap-add SYS_ADMIN)",
-                ro.display()
-            );
-            eprintln!("skipped: cannot mount a tmpfs here (needs root or CAP_SYS_ADMIN)");
+        let Some(ro) = tmpfs(&dir, "ro", "size=4M") else {
             return;
-        }
+        };
         let inside = ro.join("slab.h5");
         std::fs::copy(&h5, &inside).unwrap();
-        let remounted = mount(&["-o", "remount,ro"]);
+        let remounted = Command::new("mount")
+            .args(["-o", "remount,ro"])
+            .arg(&ro)
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
         if remounted {
             outputs = ["views", "stress"]
                 .iter()

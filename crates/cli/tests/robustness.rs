@@ -17,7 +17,7 @@ use hdf5::types::{FloatSize, IntSize, TypeDescriptor, VarLenUnicode};
 use stickslip_testkit::{scratch, workspace_root as root};
 
 mod common;
-use common::{bin, check, python, python_has, stderr};
+use common::{bin, check, python, python_has, stderr, tmpfs};
 
 /// tests/data/slab.toml (t_end = 0.05, dt = 1e-3, central difference) with
 /// an absolute mesh path, after `edit`, written into `dir`.
@@ -1839,11 +1839,9 @@ fn closed_pipes_neither_panic_nor_end_a_run() {
 /// capability) the test fails under CI and is skipped elsewhere.
 #[test]
 fn a_disk_that_fills_up_stops_the_run_with_its_records() {
-    let dir = scratch("disk-full");
-    let Some(small) = tmpfs(&dir, "small", "size=6M") else {
+    let Some((case, small)) = slab_on_a_small_disk("disk-full") else {
         return;
     };
-    let (case, _) = slab_case(&dir, "slab", |t| t);
     let out = small.join("full.h5");
     // 801 records of 4.6 kB fit the 6 MB, but not with the room each
     // write keeps (4.4 MB here: a MiB of pending rows, twice, and HDF5's
@@ -1893,30 +1891,13 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
     assert_eq!(again.status.code(), Some(0), "{}", stderr(&again));
 }
 
-/// A tmpfs mounted at `dir/name` with the mount `options` (its size;
-/// `ro`), or `None` where this process may not mount one (not root, or a
-/// container without the capability): then a failure under CI, where the
-/// test must run, and a skip elsewhere.
-fn tmpfs(dir: &Path, name: &str, options: &str) -> Option<PathBuf> {
-    let at = dir.join(name);
-    std::fs::create_dir_all(&at).unwrap();
-    let mounted = Command::new("mount")
-        .args(["-t", "tmpfs", "-o", options, "tmpfs"])
-        .arg(&at)
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if !mounted {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "cannot mount a tmpfs at {}: run the tests as root, or give the container \
-             CAP_SYS_ADMIN (docker run --cap-add SYS_ADMIN)",
-            at.display()
-        );
-        eprintln!("skipped: cannot mount a tmpfs here (needs root or CAP_SYS_ADMIN)");
-        return None;
-    }
-    Some(at)
+/// The slab's case in the scratch directory `name` and a 6 MB tmpfs
+/// beside it for its results ([`tmpfs`]; `None`: skipped).
+fn slab_on_a_small_disk(name: &str) -> Option<(PathBuf, PathBuf)> {
+    let dir = scratch(name);
+    let small = tmpfs(&dir, "small", "size=6M")?;
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    Some((case, small))
 }
 
 /// Numbers so large or small that the computation overflows are refused
@@ -2230,11 +2211,9 @@ fn a_support_oblique_to_a_curved_contact_face_is_reported() {
 /// the disk-full test.
 #[test]
 fn a_run_its_disk_holds_only_without_the_room_it_keeps_is_refused() {
-    let dir = scratch("disk-reserve");
-    let Some(small) = tmpfs(&dir, "small", "size=6M") else {
+    let Some((case, small)) = slab_on_a_small_disk("disk-reserve") else {
         return;
     };
-    let (case, _) = slab_case(&dir, "slab", |t| t);
     let out = small.join("x.h5");
     // 801 records of 4.6 kB (3.8 MB) on a 6 MB disk, with 4.4 MB kept.
     let file = format!("output.file={}", toml_str(&out));

@@ -6,7 +6,7 @@
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
 
 /// The stickslip binary under test.
 pub fn bin() -> Command {
@@ -114,4 +114,31 @@ pub fn stickslip_ok<S: AsRef<OsStr>>(args: &[S]) {
         args.iter().map(|a| a.as_ref()).collect::<Vec<_>>(),
         String::from_utf8_lossy(&o.stderr)
     );
+}
+
+/// A tmpfs mounted at `dir/name` with the mount `options` (its size;
+/// `ro`), or `None` where this process may not mount one (not root, or a
+/// container without the capability): then a failure under CI, where the
+/// test must run, and a skip elsewhere (the disk-full and read-only
+/// tests).
+pub fn tmpfs(dir: &Path, name: &str, options: &str) -> Option<PathBuf> {
+    let at = dir.join(name);
+    std::fs::create_dir_all(&at).unwrap();
+    let mounted = Command::new("mount")
+        .args(["-t", "tmpfs", "-o", options, "tmpfs"])
+        .arg(&at)
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !mounted {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "cannot mount a tmpfs at {}: run the tests as root, or give the container \
+             CAP_SYS_ADMIN (docker run --cap-add SYS_ADMIN)",
+            at.display()
+        );
+        eprintln!("skipped: cannot mount a tmpfs here (needs root or CAP_SYS_ADMIN)");
+        return None;
+    }
+    Some(at)
 }
