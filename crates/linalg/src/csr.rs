@@ -209,6 +209,13 @@ pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
 }
 
+/// A's diagonal, 0 where a row stores none.
+pub fn diagonal(a: &CsrMatrix<f64>) -> Vec<f64> {
+    (0..a.nrows())
+        .map(|i| index(a, i, i).map_or(0.0, |k| a.values()[k]))
+        .collect()
+}
+
 /// Index of entry (i, j) in the CSR value array, if stored.
 pub fn index(a: &CsrMatrix<f64>, i: usize, j: usize) -> Option<usize> {
     let start = a.row_offsets()[i];

@@ -24,7 +24,7 @@
 
 use nalgebra_sparse::CsrMatrix;
 
-use crate::csr::{dot, index, spmv};
+use crate::csr::{diagonal, dot, spmv};
 use crate::SparseCholesky;
 
 /// The backward error refined solves stop at: 2u (u = 2⁻⁵³, f64's unit
@@ -119,9 +119,7 @@ pub fn solve_by_diagonal(
     tolerance: f64,
     max_iterations: usize,
 ) -> Result<Refined, Refined> {
-    let diagonal: Vec<f64> = (0..a.nrows())
-        .map(|i| index(a, i, i).map_or(0.0, |k| a.values()[k]))
-        .collect();
+    let diagonal = diagonal(a);
     if diagonal.iter().any(|&d| d.is_nan() || d <= 0.0) {
         return Err(Refined {
             iterations: 0,

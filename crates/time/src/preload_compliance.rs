@@ -30,7 +30,7 @@
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
 use stickslip_fem::{RigidMode, RigidMotion, SetupTimes};
-use stickslip_linalg::csr::{dot, spmv};
+use stickslip_linalg::csr::{diagonal, dot, index, spmv};
 use stickslip_linalg::{Analysis, FillOrder, SparseCholesky};
 
 use crate::floating::{self, BALANCE_TOLERANCE};
@@ -104,9 +104,7 @@ pub(crate) fn solve(
     };
     let mut tangent = k.clone();
     let slots = slots(contact, &tangent);
-    let diagonal: Vec<f64> = (0..k.nrows())
-        .map(|i| slot(k, i, i).map_or(0.0, |p| k.values()[p]))
-        .collect();
+    let diagonal = diagonal(k);
     let free = Held::new(contact, modes, (&held, &never, &pins), &diagonal);
     // Against R₀, or the foundation's push at r = 0 where nodes start
     // inside it (with R₀ = 0 an interference is all that presses).
@@ -679,21 +677,14 @@ fn slots(contact: &ContactSurface, k: &CsrMatrix<f64>) -> Vec<[[Option<usize>; 2
         .iter()
         .map(|c| {
             let dofs = contact.nodes[c.index].dofs;
+            // K's pattern holds every pair of DOFs of one node.
             let at = |a: usize, b: usize| match (dofs[a], dofs[b]) {
-                (Some(i), Some(j)) => slot(k, i, j),
+                (Some(i), Some(j)) => index(k, i, j),
                 _ => None,
             };
             [[at(0, 0), at(0, 1)], [at(1, 0), at(1, 1)]]
         })
         .collect()
-}
-
-/// The position of entry (i, j) in `k`'s values (K's pattern holds every
-/// pair of DOFs of one node).
-fn slot(k: &CsrMatrix<f64>, i: usize, j: usize) -> Option<usize> {
-    let (offsets, cols, _) = k.csr_data();
-    let row = &cols[offsets[i]..offsets[i + 1]];
-    row.binary_search(&j).ok().map(|p| offsets[i] + p)
 }
 
 fn norm(x: &[f64]) -> f64 {

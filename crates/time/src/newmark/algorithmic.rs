@@ -36,6 +36,7 @@
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::ContactSurface;
+use stickslip_linalg::csr::diagonal;
 use stickslip_linalg::{FillOrder, SolverError, SparseCholesky};
 
 use crate::settings::MassKind;
@@ -150,18 +151,4 @@ fn add_along_normal(
             x[*d] += s * n;
         }
     }
-}
-
-/// The diagonal of `m` (its zeros where a row stores none).
-fn diagonal(m: &CsrMatrix<f64>) -> Vec<f64> {
-    (0..m.nrows())
-        .map(|i| {
-            let row = m.row(i);
-            row.col_indices()
-                .iter()
-                .zip(row.values())
-                .find_map(|(&j, &v)| (j == i).then_some(v))
-                .unwrap_or(0.0)
-        })
-        .collect()
 }
