@@ -190,10 +190,7 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
         }
         Ok(case) => {
             // Where each value is, in the text serde read.
-            let mut spans = BTreeMap::new();
-            if let Ok(doc) = toml_edit::Document::parse(text) {
-                value_spans(doc.as_table(), "", &mut spans);
-            }
+            let spans = spans_in(text);
             // Keys whose value was reported and replaced or removed.
             let placeholders: Vec<String> = typed.iter().map(|(p, _, _)| dotted(p)).collect();
             match complete(case, path, source.clone(), &spans, &loc_text, &placeholders) {
@@ -222,14 +219,20 @@ pub fn load_str(path: &Path, original: &str, sets: &[String]) -> Result<Case, In
     Err(InputError(listed(problems)))
 }
 
+/// [`value_spans`] of the TOML `text` (none where it does not parse).
+fn spans_in(text: &str) -> BTreeMap<String, Range<usize>> {
+    let mut spans = BTreeMap::new();
+    if let Ok(doc) = toml_edit::Document::parse(text) {
+        value_spans(doc.as_table(), "", &mut spans);
+    }
+    spans
+}
+
 /// The dotted key of the history (`traction.0.history`,
 /// `contact.pressure_history`, ...) whose value holds `span` of `text`.
 fn history_at(text: &str, span: Option<Range<usize>>) -> Option<String> {
     let at = span?.start;
-    let doc = toml_edit::Document::parse(text).ok()?;
-    let mut spans = BTreeMap::new();
-    value_spans(doc.as_table(), "", &mut spans);
-    spans
+    spans_in(text)
         .into_iter()
         .filter(|(k, s)| k.ends_with("history") && s.contains(&at))
         .min_by_key(|(_, s)| s.len())
@@ -457,7 +460,7 @@ fn complete(
     // [contact]
     for (i, c) in case.contact.iter().enumerate() {
         let key = |k: &str| crate::schema::contact_key_in(spans.keys(), i, k);
-        let was_reported = |k: &str| reported.iter().any(|r| *r == key(k));
+        let was_reported = |k: &str| reported.contains(&key(k));
         crate::compliance::check_law(c, &key, &was_reported, &mut check);
         // A key the law lacks is refused above; 0 checks nothing here.
         let (p, mu, eps) = (c.pressure.unwrap_or(0.0), c.mu_at_rest(), c.eps);

@@ -519,12 +519,7 @@ fn rows(v: &toml::Value) -> Result<Vec<[f64; 2]>, String> {
                 _ => None,
             };
             match row.as_deref() {
-                Some(&[t, f]) => Ok([t, f]),
-                Some(r) => Err(format!(
-                    "table row {} has {} numbers; each row is two: [t, f] in a history, [s, factor] in a profile",
-                    i + 1,
-                    r.len()
-                )),
+                Some(r) => two_numbers(i, r),
                 None => Err(format!(
                     "table row {} is {}, not two numbers [t, f]; write the table as [[0.0, 0.0], [0.1, 1.0]]",
                     i + 1,
@@ -544,15 +539,20 @@ fn table_points<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>,
     let rows = Vec::<Vec<f64>>::deserialize(d)?;
     rows.iter()
         .enumerate()
-        .map(|(i, r)| match r[..] {
-            [t, f] => Ok([t, f]),
-            _ => Err(serde::de::Error::custom(format!(
-                "table row {} has {} numbers; each row is two: [t, f] in a history, [s, factor] in a profile",
-                i + 1,
-                r.len()
-            ))),
-        })
+        .map(|(i, r)| two_numbers(i, r).map_err(serde::de::Error::custom))
         .collect()
+}
+
+/// Table row `i` (from 0) as its two numbers.
+fn two_numbers(i: usize, r: &[f64]) -> Result<[f64; 2], String> {
+    match *r {
+        [t, f] => Ok([t, f]),
+        _ => Err(format!(
+            "table row {} has {} numbers; each row is two: [t, f] in a history, [s, factor] in a profile",
+            i + 1,
+            r.len()
+        )),
+    }
 }
 
 impl History {

@@ -142,22 +142,27 @@ impl CompliantNode {
     /// foundation's normal at `node` (a fixed component does not move).
     #[inline]
     pub fn along_normal(&self, node: &ContactNode, z: &[f64]) -> f64 {
-        (0..2)
-            .filter_map(|c| node.dofs[c].map(|d| self.normal[c] * z[d]))
-            .sum()
+        // From −0.0, as a sum of no terms (a fixed node) is.
+        self.plus_along_normal(-0.0, node, z)
     }
 
     /// −(g₀ + ν·r_J): the approach, negative off the foundation (by the
     /// gap).
     #[inline]
     pub fn signed_approach(&self, node: &ContactNode, r: &[f64]) -> f64 {
-        let mut g = self.gap;
+        -self.plus_along_normal(self.gap, node, r)
+    }
+
+    /// start + ν·z_J, the terms added to `start` in turn.
+    #[inline]
+    fn plus_along_normal(&self, start: f64, node: &ContactNode, z: &[f64]) -> f64 {
+        let mut g = start;
         for c in 0..2 {
             if let Some(d) = node.dofs[c] {
-                g += self.normal[c] * r[d];
+                g += self.normal[c] * z[d];
             }
         }
-        -g
+        g
     }
 }
 

@@ -613,15 +613,15 @@ fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> (Vec<String>, V
             .filter(|&i| largest == 0.0 || values[i] <= 1e-12 * largest)
             .collect();
         let mut free = Vec::new();
-        // Each free motion as (ux, uy) of a node at (x, y).
-        let mut shapes: Vec<[f64; 3]> = Vec::new();
+        // Each free motion, beside its label.
+        let mut shapes: Vec<RigidMotion> = Vec::new();
         if !any[k][0] {
             free.push("translation in x".to_string());
-            shapes.push([1.0, 0.0, f64::NAN]);
+            shapes.push(RigidMotion::Translation([1.0, 0.0]));
         }
         if !any[k][1] {
             free.push("translation in y".to_string());
-            shapes.push([0.0, 1.0, f64::NAN]);
+            shapes.push(RigidMotion::Translation([0.0, 1.0]));
         }
         if null.len() > free.len() {
             // The null vector (a, b, c) with the largest c is a rotation
@@ -646,16 +646,15 @@ fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> (Vec<String>, V
             } else {
                 free.push("rotation".to_string());
             }
-            shapes.push([px, py, 1.0]);
+            shapes.push(RigidMotion::Rotation([px, py]));
         }
         for (label, shape) in free.iter().zip(&shapes) {
             let mut vector = vec![0.0; n_free];
             for v in (0..n_nodes).filter(|&v| part[v] == k) {
                 let [x, y] = mesh.nodes[v];
-                let u = if shape[2] == 1.0 {
-                    [-(y - shape[1]), x - shape[0]]
-                } else {
-                    [shape[0], shape[1]]
+                let u = match *shape {
+                    RigidMotion::Rotation([px, py]) => [-(y - py), x - px],
+                    RigidMotion::Translation(t) => t,
                 };
                 for c in 0..2 {
                     if free_index[2 * v + c] != FIXED {
@@ -663,16 +662,13 @@ fn rigid_motions_left_free(mesh: &Mesh, free_index: &[usize]) -> (Vec<String>, V
                     }
                 }
             }
-            let label = if label == "rotation" {
-                format!("rotation about ({:.6}, {:.6})", shape[0], shape[1])
-            } else {
-                label.clone()
+            let label = match shape {
+                RigidMotion::Rotation([px, py]) if label == "rotation" => {
+                    format!("rotation about ({px:.6}, {py:.6})")
+                }
+                _ => label.clone(),
             };
-            let motion = Some(if shape[2] == 1.0 {
-                RigidMotion::Rotation([shape[0], shape[1]])
-            } else {
-                RigidMotion::Translation([shape[0], shape[1]])
-            });
+            let motion = Some(*shape);
             modes.push(RigidMode {
                 label: format!("{label}{whose}"),
                 motion,
