@@ -63,6 +63,19 @@ pub(crate) fn pin(k: &mut CsrMatrix<f64>, pins: &[usize]) {
     }
 }
 
+/// The work of loads `r` along the motion `z`, and Σ|z_i r_i| (its size
+/// had every term one sign).
+pub(crate) fn work_along(z: &[f64], r: &[f64]) -> (f64, f64) {
+    z.iter()
+        .zip(r)
+        .fold((0.0, 0.0), |(w, s), (z, f)| (w + z * f, s + (z * f).abs()))
+}
+
+/// True where `work` is more than round-off of terms of `size`.
+pub(crate) fn does_work(work: f64, size: f64) -> bool {
+    work.abs() > BALANCE_TOLERANCE * size
+}
+
 /// Loads `r` that do no work along any of `modes`.
 ///
 /// # Errors
@@ -71,12 +84,8 @@ pub(crate) fn balanced(modes: &[RigidMode], r: &[f64]) -> Result<(), TimeError> 
     let unbalanced: Vec<(String, f64)> = modes
         .iter()
         .filter_map(|m| {
-            let (work, size) = m
-                .vector
-                .iter()
-                .zip(r.iter())
-                .fold((0.0, 0.0), |(w, s), (z, f)| (w + z * f, s + (z * f).abs()));
-            (work.abs() > BALANCE_TOLERANCE * size).then(|| (m.label.clone(), work))
+            let (work, size) = work_along(&m.vector, r);
+            does_work(work, size).then(|| (m.label.clone(), work))
         })
         .collect();
     if !unbalanced.is_empty() {

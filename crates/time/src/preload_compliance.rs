@@ -176,7 +176,7 @@ pub(crate) fn solve(
             }
             // The tangent: K and the springs of the nodes in contact, and
             // of every node out of it while those do not hold the part.
-            stand_in(&surface, x, &diagonal, &mut springs);
+            stand_in(&surface, x, &free.stand_in, &mut springs);
         }
         tangent.values_mut().copy_from_slice(k.values());
         for (s, (c, kt)) in slots.iter().zip(surface.compliance.iter().zip(&springs)) {
@@ -209,10 +209,7 @@ pub(crate) fn solve(
         .iter()
         .filter_map(|h| {
             let z = combine(modes, h);
-            let (work, size) = z
-                .iter()
-                .zip(&preload)
-                .fold((0.0, 0.0), |(w, s), (z, p)| (w + z * p, s + (z * p).abs()));
+            let (work, size) = floating::work_along(&z, &preload);
             // A motion that moves every compliant node off the foundation
             // (or every one into it), as a translation towards a floor: a
             // load pressing the part along it into the foundation is what
@@ -234,7 +231,7 @@ pub(crate) fn solve(
                 contact.names()
             );
             let (name, amount, _, _) = describe(modes, h);
-            (work.abs() > BALANCE_TOLERANCE * size).then(|| (name + &why, work / amount))
+            floating::does_work(work, size).then(|| (name + &why, work / amount))
         })
         .collect();
     if work.is_empty() {
@@ -466,17 +463,13 @@ fn contact_springs(contact: &ContactSurface, x: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// The largest diagonal of K at each node out of contact in place of its
-/// spring (where those in contact leave a held motion free).
-fn stand_in(contact: &ContactSurface, x: &[f64], diagonal: &[f64], springs: &mut [f64]) {
-    for (c, kt) in contact.compliance.iter().zip(springs) {
-        let node = &contact.nodes[c.index];
-        if c.approach(node, x) == 0.0 {
-            *kt = node
-                .dofs
-                .iter()
-                .flatten()
-                .fold(0.0, |m: f64, &d| m.max(diagonal[d]));
+/// The stand-in spring (`Held::stand_in`, per compliant node) at each
+/// node out of contact in place of its spring (where those in contact
+/// leave a held motion free).
+fn stand_in(contact: &ContactSurface, x: &[f64], stand: &[f64], springs: &mut [f64]) {
+    for ((c, kt), s) in contact.compliance.iter().zip(springs).zip(stand) {
+        if c.approach(&contact.nodes[c.index], x) == 0.0 {
+            *kt = *s;
         }
     }
 }
