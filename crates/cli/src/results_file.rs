@@ -264,10 +264,7 @@ pub fn check_output_place(out: &Path, inputs: &[Input]) -> Result<(), InputError
         }
     }
     // The run creates the file (and removes an old one) in its directory.
-    let dir = match out.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
+    let dir = dir_of(out);
     if !crate::sys::can_write_in(dir) {
         return Err(InputError(format!(
             "{name}: cannot write in the directory {} (read-only, or not yours); make it writable, \
@@ -622,9 +619,13 @@ pub(crate) fn claim(out: &Path) -> Result<RunLock, InputError> {
 /// Bytes free to an unprivileged writer on the file system of `path`'s
 /// directory, where it can be asked.
 pub fn free_bytes(path: &Path) -> Option<u64> {
-    let dir = match path.parent() {
+    crate::sys::free_bytes_at(dir_of(path))
+}
+
+/// The directory `path` is in (`.` for a bare file name).
+pub(crate) fn dir_of(path: &Path) -> &Path {
+    match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
-    };
-    crate::sys::free_bytes_at(dir)
+    }
 }

@@ -133,10 +133,7 @@ pub(crate) fn check_beside(out: &Path, command: &str, files: &[PathBuf]) -> Resu
         }
     }
     named_in_xml(out)?;
-    let dir = match out.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
+    let dir = crate::results_file::dir_of(out);
     if !crate::sys::can_write_in(dir) {
         return Err(InputError(format!(
             "{}: cannot write in the directory {} (read-only, or not yours); {}",
