@@ -137,35 +137,45 @@ pub(crate) fn remove_rigid_motion(mass: Mass, modes: &[RigidMode], r: &mut [f64]
         })
         .collect();
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-    // The small dense system (ZᵀMZ) c = ZᵀM r by Gaussian elimination with
-    // partial pivoting (ZᵀMZ is symmetric positive definite).
-    let mut a: Vec<Vec<f64>> = (0..n)
-        .map(|i| {
-            let mut row: Vec<f64> = (0..n).map(|j| dot(&mz[i], &modes[j].vector)).collect();
-            row.push(dot(&mz[i], r));
-            row
-        })
+    // (ZᵀMZ) c = ZᵀM r, ZᵀMZ symmetric positive definite (the modes are
+    // independent): no zero pivot. NaNs where one were met, as the
+    // elimination's division by it gave.
+    let a: Vec<Vec<f64>> = (0..n)
+        .map(|i| (0..n).map(|j| dot(&mz[i], &modes[j].vector)).collect())
         .collect();
-    for col in 0..n {
-        let p = (col..n)
-            .max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))
-            .expect("a row");
-        a.swap(col, p);
-        for row in col + 1..n {
-            let f = a[row][col] / a[col][col];
-            for c in col..=n {
-                a[row][c] -= f * a[col][c];
-            }
-        }
-    }
-    let mut c = vec![0.0; n];
-    for row in (0..n).rev() {
-        let s: f64 = (row + 1..n).map(|j| a[row][j] * c[j]).sum();
-        c[row] = (a[row][n] - s) / a[row][row];
-    }
+    let b = (0..n).map(|i| dot(&mz[i], r)).collect();
+    let c = solve_small(a, b).unwrap_or_else(|| vec![f64::NAN; n]);
     for (m, cj) in modes.iter().zip(&c) {
         for (x, z) in r.iter_mut().zip(&m.vector) {
             *x -= cj * z;
         }
     }
+}
+
+/// x of the small square system A x = b by Gaussian elimination with
+/// partial pivoting; `None` where A is singular (a zero pivot) or a result
+/// is not finite.
+pub(crate) fn solve_small(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+    let n = b.len();
+    for col in 0..n {
+        let p = (col..n).max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))?;
+        a.swap(col, p);
+        b.swap(col, p);
+        if a[col][col] == 0.0 {
+            return None;
+        }
+        for row in col + 1..n {
+            let f = a[row][col] / a[col][col];
+            for c in col..n {
+                a[row][c] -= f * a[col][c];
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = vec![0.0; n];
+    for row in (0..n).rev() {
+        let s: f64 = (row + 1..n).map(|j| a[row][j] * x[j]).sum();
+        x[row] = (b[row] - s) / a[row][row];
+    }
+    x.iter().all(|x| x.is_finite()).then_some(x)
 }

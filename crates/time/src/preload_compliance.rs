@@ -340,7 +340,7 @@ impl Held {
                         .map(|&p| never.iter().map(|m| m.vector[p]).collect())
                         .collect();
                     let b = pins.iter().map(|&p| z[p]).collect();
-                    let c = solve_small(a, b).unwrap_or_else(|| vec![0.0; never.len()]);
+                    let c = floating::solve_small(a, b).unwrap_or_else(|| vec![0.0; never.len()]);
                     for (m, c) in never.iter().zip(&c) {
                         for (z, m) in z.iter_mut().zip(&m.vector) {
                             *z -= c * m;
@@ -413,7 +413,7 @@ impl Held {
             })
             .collect();
         let b = free.iter().map(|u| -times(u, &work)).collect();
-        let c = solve_small(a, b)?;
+        let c = floating::solve_small(a, b)?;
         let mut e = vec![0.0; x.len()];
         for (u, c) in free.iter().zip(&c) {
             for (z, u) in self.motions.iter().zip(u.iter()) {
@@ -494,34 +494,6 @@ fn gram(weights: &[f64], along: &[Vec<f64>], n: usize) -> Vec<Vec<f64>> {
         }
     }
     b
-}
-
-/// x of the small square system A x = b by Gaussian elimination with
-/// partial pivoting; `None` where A is singular (a zero pivot) or a result
-/// is not finite.
-fn solve_small(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
-    let n = b.len();
-    for col in 0..n {
-        let p = (col..n).max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))?;
-        a.swap(col, p);
-        b.swap(col, p);
-        if a[col][col] == 0.0 {
-            return None;
-        }
-        for row in col + 1..n {
-            let f = a[row][col] / a[col][col];
-            for c in col..n {
-                a[row][c] -= f * a[col][c];
-            }
-            b[row] -= f * b[col];
-        }
-    }
-    let mut x = vec![0.0; n];
-    for row in (0..n).rev() {
-        let s: f64 = (row + 1..n).map(|j| a[row][j] * x[j]).sum();
-        x[row] = (b[row] - s) / a[row][row];
-    }
-    x.iter().all(|x| x.is_finite()).then_some(x)
 }
 
 /// Per compliant node, ν·z_J of each motion z of `vectors`.
