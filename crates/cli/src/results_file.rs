@@ -69,6 +69,19 @@ impl Companion {
 /// and a damaged or empty file nothing holds open are made again from a
 /// results file: replacing them loses nothing, so they are `None`.
 pub fn foreign_companion(out: &Path, kind: Companion) -> Option<String> {
+    foreign(out, kind, in_use)
+}
+
+/// [`foreign_companion`] for a command that only reads the file (`views`
+/// listing the stresses in OUT.xdmf): a reader's lock (ParaView showing
+/// them) does not stop another reader, so only a run writing under that
+/// name makes it "in use".
+pub fn foreign_to_read(out: &Path, kind: Companion) -> Option<String> {
+    foreign(out, kind, being_written)
+}
+
+/// [`foreign_companion`] with `busy` telling whether the file is in use.
+fn foreign(out: &Path, kind: Companion, busy: fn(&Path) -> bool) -> Option<String> {
     let path = kind.path(out);
     let meta = std::fs::metadata(&path).ok()?;
     if !meta.is_file() {
@@ -80,7 +93,7 @@ pub fn foreign_companion(out: &Path, kind: Companion) -> Option<String> {
     }
     // Before anything else: a run's results file is empty, or does not
     // open, while the run writes it.
-    if in_use(&path) {
+    if busy(&path) {
         return Some("in use (a run writing it, or a reader)".into());
     }
     if meta.len() == 0 {

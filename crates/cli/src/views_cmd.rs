@@ -434,13 +434,13 @@ fn contact_line(f: &File, out: &Path) -> anyhow::Result<(Option<ContactLine>, Op
 /// at least `rows` records (one of fewer would leave records without
 /// stresses; a run or restart removes it anyway).
 fn stress_name(out: &Path, rows: usize) -> Option<String> {
-    use crate::results_file::{foreign_companion, Companion};
+    use crate::results_file::{foreign_to_read, Companion};
     let path = Companion::Stress.path(out);
     // A file of that name that is not these stresses (another run's
     // results, another file's stresses: `source` names another file, and
     // an earlier version's stresses, without it, are this file's only if
-    // nothing says otherwise) is not listed.
-    if foreign_companion(out, Companion::Stress).is_some() {
+    // nothing says otherwise) is not listed; one a viewer holds open is.
+    if foreign_to_read(out, Companion::Stress).is_some() {
         return None;
     }
     let g = File::open(&path).ok()?;

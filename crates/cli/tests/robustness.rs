@@ -2330,6 +2330,15 @@ fn files_named_like_companions_are_not_taken_for_them() {
     ok(&command("stress", &s));
     assert_eq!(source("s.views.h5"), "s.h5");
     assert_eq!(source("s.stress.h5"), "s.h5");
+    // A viewer reading the stresses (HDF5's shared lock of a read-only
+    // open, as ParaView holds it) does not make them another's: `views`
+    // still lists them in s.xdmf.
+    let reader = std::fs::File::open(dir.join("s.stress.h5")).unwrap();
+    reader.lock_shared().unwrap();
+    ok(&command("views", &s));
+    let xdmf = std::fs::read_to_string(dir.join("s.xdmf")).unwrap();
+    assert!(xdmf.contains("s.stress.h5"), "{xdmf}");
+    drop(reader);
     std::fs::write(
         dir.join("s.views.h5"),
         &bytes(&dir.join("s.views.h5"))[..3000],
