@@ -150,12 +150,8 @@ pub(crate) fn off_the_body(b: [[f64; 2]; 2], p: [f64; 2]) -> bool {
 /// (HDF5_USE_FILE_LOCKING=FALSE, as `cargo run` sets it) the file opens,
 /// but its datasets may be caught between two records.
 fn open_results(file: &Path) -> Result<File, InputError> {
+    crate::results_file::check_results_path(file)?;
     let name = file.display();
-    if file.is_dir() {
-        return Err(InputError(format!(
-            "{name} is a directory; give a results file in it, the OUT.h5 a `stickslip run` wrote"
-        )));
-    }
     if crate::results_file::being_written(file) {
         return Err(InputError(format!(
             "{name}: a run is still writing it; wait for the run to end (or stop it: Ctrl-C \

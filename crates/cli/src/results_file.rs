@@ -478,19 +478,14 @@ impl RunLock {
     }
 }
 
-/// Opens the results file `path` for a command that reads it after its
-/// run and writes beside it (`stickslip stress`, `stickslip views`): it
-/// must exist (not be the XDMF beside it), no run may be writing it (nor,
-/// with `readers_too`, a reader hold it open), and it must be HDF5 written
-/// by `stickslip run`. Returns it with a shared lock that keeps runs off it
-/// meanwhile.
+/// What every command that reads a results file checks before opening
+/// it: the file exists and is a regular file (HDF5's open of a FIFO
+/// blocks until a writer comes), and it is not the XDMF beside the
+/// results file.
 ///
 /// # Errors
 /// The [`InputError`] naming the file and what to give instead.
-pub(crate) fn open_finished(
-    path: &Path,
-    readers_too: bool,
-) -> Result<(RunLock, hdf5::File), InputError> {
+pub(crate) fn check_results_path(path: &Path) -> Result<(), InputError> {
     let name = path.display();
     if path
         .extension()
@@ -516,6 +511,24 @@ pub(crate) fn open_finished(
             "{name}: no such results file; give the OUT.h5 a `stickslip run` wrote"
         )));
     }
+    Ok(())
+}
+
+/// Opens the results file `path` for a command that reads it after its
+/// run and writes beside it (`stickslip stress`, `stickslip views`): it
+/// must exist (not be the XDMF beside it), no run may be writing it (nor,
+/// with `readers_too`, a reader hold it open), and it must be HDF5 written
+/// by `stickslip run`. Returns it with a shared lock that keeps runs off it
+/// meanwhile.
+///
+/// # Errors
+/// The [`InputError`] naming the file and what to give instead.
+pub(crate) fn open_finished(
+    path: &Path,
+    readers_too: bool,
+) -> Result<(RunLock, hdf5::File), InputError> {
+    check_results_path(path)?;
+    let name = path.display();
     if readers_too && in_use(path) {
         return Err(InputError(format!(
             "{name}: a run or a reader has it open; wait for the run to end (or close the reader) and run this again"

@@ -2405,6 +2405,49 @@ fn probe_at(file: &Path) -> Output {
         .unwrap()
 }
 
+/// `probe` given a FIFO named like a results file exits 2 naming it (it
+/// waited for a writer before: HDF5's open blocks on a FIFO), as do
+/// `views` and `stress`; given the XDMF, it names the results file.
+#[test]
+fn probe_refuses_a_fifo_and_an_xdmf_for_a_results_file() {
+    let dir = scratch("probe-fifo");
+    let fifo = dir.join("f.h5");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    for command in ["probe", "views", "stress"] {
+        let mut c = bin();
+        c.arg(command).arg(&fifo);
+        if command == "probe" {
+            c.args(["--at", "8,0"]);
+        }
+        // Bounded: the fault this guards against is a wait without end.
+        let mut child = c
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let started = Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if started.elapsed() > Duration::from_secs(30) {
+                child.kill().unwrap();
+                panic!("{command} on a FIFO still waits after 30 s");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let o = child.wait_with_output().unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{command}: {e}");
+        assert!(e.contains("is not a regular file"), "{command}: {e}");
+    }
+    let o = probe_at(&dir.join("r.xdmf"));
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("give the results file the XDMF is written for"),
+        "{e}"
+    );
+}
+
 /// A mesh of mesh.ladder is an input of the case like mesh.file: `run -o`
 /// (even with --force) and `check`'s output.file refuse it (a run wrote
 /// its results over it). A ladder mesh that does not read is placed at
