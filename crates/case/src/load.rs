@@ -35,10 +35,18 @@ use crate::set::{apply_set, field_rule};
 pub fn load(path: &Path, sets: &[String]) -> Result<Case, InputError> {
     let file = path.display().to_string();
     // A device or FIFO would be read forever (`check /dev/zero` would hang).
-    if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
-        return Err(InputError(format!(
-            "{file}: not a regular file (a device, FIFO or socket); give the case's .toml file"
-        )));
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => {
+            return Err(InputError(format!(
+                "{file} is a directory; give the case's .toml file in it"
+            )))
+        }
+        Ok(m) if !m.is_file() => {
+            return Err(InputError(format!(
+                "{file}: not a regular file (a device, FIFO or socket); give the case's .toml file"
+            )))
+        }
+        _ => {}
     }
     let bytes = std::fs::read(path).map_err(|e| {
         InputError(format!(
@@ -1700,5 +1708,19 @@ t_end = 0.5
         );
         let e = load_text("set-table", GOOD, &["time=1"]).unwrap_err().0;
         assert!(e.contains("time is a table"), "{e}");
+    }
+
+    /// A directory or a device given as the case is named for what it is
+    /// (a directory said "cannot read the case file: Is a directory").
+    #[test]
+    fn a_directory_or_a_device_given_as_the_case_is_named() {
+        let dir = std::env::temp_dir();
+        let e = load(&dir, &[]).unwrap_err().0;
+        assert!(
+            e.contains("is a directory; give the case's .toml file in it"),
+            "{e}"
+        );
+        let e = load(Path::new("/dev/null"), &[]).unwrap_err().0;
+        assert!(e.contains("not a regular file"), "{e}");
     }
 }
