@@ -35,7 +35,7 @@ use stickslip_linalg::{Analysis, FillOrder, SparseCholesky};
 
 use crate::floating::{self, BALANCE_TOLERANCE};
 use crate::initial::Mass;
-use crate::settings::TimeError;
+use crate::settings::{TimeError, Unbalanced};
 
 /// The residual ‖K r − R₀ − F_c(r)‖ that ends the iteration, relative to
 /// ‖R₀‖ or, where larger, to ‖F_c(0)‖ (nodes starting inside).
@@ -205,7 +205,7 @@ pub(crate) fn solve(
     // the motions the foundation holds, whose load pulls the part off it
     // (those the loads do work along, as `floating::balanced` judges).
     residual(&surface, x, &mut g);
-    let work: Vec<(String, f64)> = held
+    let work: Vec<Unbalanced> = held
         .iter()
         .filter_map(|h| {
             let z = combine(modes, h);
@@ -230,8 +230,12 @@ pub(crate) fn solve(
                  into it (it only pushes)",
                 contact.names()
             );
-            let (name, amount, _, _) = describe(modes, h);
-            floating::does_work(work, size).then(|| (name + &why, work / amount))
+            let (name, amount, motion, _) = describe(modes, h);
+            floating::does_work(work, size).then(|| Unbalanced {
+                label: name + &why,
+                motion,
+                work: work / amount,
+            })
         })
         .collect();
     if work.is_empty() {

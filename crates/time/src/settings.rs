@@ -3,6 +3,7 @@
 //! failed.
 
 use stickslip_contact::IterationOptions;
+use stickslip_fem::RigidMotion;
 use stickslip_linalg::SolverError;
 
 /// The time-stepping scheme.
@@ -309,7 +310,7 @@ pub enum TimeError {
          [[dirichlet]] conditions)",
         unbalanced_list(.0)
     )]
-    Unbalanced(Vec<(String, f64)>),
+    Unbalanced(Vec<Unbalanced>),
     /// A factorization failed during the run.
     #[error("step {step} (t = {t:.6e}): the linear solve failed: {source}")]
     Solve {
@@ -369,24 +370,41 @@ pub enum TimeError {
     },
 }
 
+/// A rigid motion the loads present before t = 0 do work along
+/// ([`TimeError::Unbalanced`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unbalanced {
+    /// Its name: "translation in x", "rotation about (x, y)", ..., with
+    /// the part of the mesh it moves where there are several.
+    pub label: String,
+    /// What the motion is (`None` for a combination that is no one
+    /// motion).
+    pub motion: Option<RigidMotion>,
+    /// The loads' work along it: the net force along a unit translation,
+    /// the moment about a rotation's centre.
+    pub work: f64,
+}
+
 /// "translation in x: net force F_x = …; translation along (a, b): net
 /// force along it F = …; rotation about (x, y): moment M = …": a unit
 /// translation's work is the net force along it, a unit rotation's the
 /// moment about its centre; any other combination of motions is given by
-/// the loads' work along it.
-fn unbalanced_list(motions: &[(String, f64)]) -> String {
+/// the loads' work along it. A translation along an axis names it.
+fn unbalanced_list(motions: &[Unbalanced]) -> String {
     motions
         .iter()
-        .map(|(label, work)| {
-            if let Some(rest) = label.strip_prefix("translation in ") {
-                let axis = &rest[..1];
-                format!("{label}: net force F_{axis} = {work:.6e}")
-            } else if label.starts_with("translation along ") {
-                format!("{label}: net force along it F = {work:.6e}")
-            } else if label.starts_with("rotation about ") {
-                format!("{label}: moment M = {work:.6e}")
-            } else {
-                format!("{label}: the loads' work along it W = {work:.6e}")
+        .map(|m| {
+            let (label, work) = (&m.label, m.work);
+            match m.motion {
+                Some(RigidMotion::Translation([x, y])) if y == 0.0 || x == 0.0 => {
+                    let axis = if y == 0.0 { "x" } else { "y" };
+                    format!("{label}: net force F_{axis} = {work:.6e}")
+                }
+                Some(RigidMotion::Translation(_)) => {
+                    format!("{label}: net force along it F = {work:.6e}")
+                }
+                Some(RigidMotion::Rotation(_)) => format!("{label}: moment M = {work:.6e}"),
+                None => format!("{label}: the loads' work along it W = {work:.6e}"),
             }
         })
         .collect::<Vec<_>>()

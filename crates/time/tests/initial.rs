@@ -219,8 +219,8 @@ fn unbalanced_preloads_on_a_floating_part_are_refused_with_the_net_force() {
     match &e {
         TimeError::Unbalanced(list) => {
             assert_eq!(list.len(), 1);
-            assert_eq!(list[0].0, "translation in x");
-            assert!((list[0].1 - 50.0).abs() < 1e-9, "{list:?}");
+            assert_eq!(list[0].label, "translation in x");
+            assert!((list[0].work - 50.0).abs() < 1e-9, "{list:?}");
         }
         other => panic!("{other}"),
     }

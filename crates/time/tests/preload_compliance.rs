@@ -6,7 +6,9 @@
 //! field exactly, so the closed form holds to the solver's tolerance.
 
 use stickslip_contact::{Compliance, ContactSurface};
-use stickslip_fem::{body_force_load, traction_load, Hypothesis, Material, Model, Traction};
+use stickslip_fem::{
+    body_force_load, traction_load, Hypothesis, Material, Model, RigidMotion, Traction,
+};
 use stickslip_mesh::{CellKind, Mesh};
 use stickslip_testkit::settle::{preload, Block, P};
 use stickslip_testkit::{map_nodes, rectangle};
@@ -55,7 +57,7 @@ fn a_preload_pulling_off_the_foundation_is_refused() {
     match &e {
         TimeError::Unbalanced(motions) => {
             assert!(
-                motions.iter().any(|(m, _)| m.contains("translation in y")),
+                motions.iter().any(|m| m.label.contains("translation in y")),
                 "{e}"
             );
             assert!(e.to_string().contains("it only pushes"), "{e}");
@@ -75,7 +77,7 @@ fn a_preload_along_the_foundation_is_refused() {
     match &e {
         TimeError::Unbalanced(motions) => {
             assert_eq!(motions.len(), 1, "{e}");
-            assert_eq!(motions[0].0, "translation in x", "{e}");
+            assert_eq!(motions[0].label, "translation in x", "{e}");
         }
         _ => panic!("{e}"),
     }
@@ -271,30 +273,29 @@ fn a_preload_pulling_a_block_off_a_slope_names_the_direction() {
     let message = e.to_string();
     let translation = motions
         .iter()
-        .find(|(l, _)| l.starts_with("translation along ("))
+        .find(|m| m.label.starts_with("translation along ("))
         .unwrap_or_else(|| panic!("{message}"));
-    let inside = &translation.0["translation along (".len()..];
-    let (dx, rest) = inside.split_once(", ").unwrap();
-    let dy = rest.split_once(')').unwrap().0;
-    let d: [f64; 2] = [dx.parse().unwrap(), dy.parse().unwrap()];
+    let Some(RigidMotion::Translation(d)) = translation.motion else {
+        panic!("{message}")
+    };
     let along_normal = d[0] * s + d[1] * c;
     assert!((along_normal.abs() - 1.0).abs() < 1e-6, "{message}");
     let expected = m * G * c * along_normal;
     assert!(
-        (translation.1 - expected).abs() < 1e-6 * m * G,
+        (translation.work - expected).abs() < 1e-6 * m * G,
         "{message}: {} vs {expected}",
-        translation.1
+        translation.work
     );
     assert!(message.contains("net force along it F = "), "{message}");
     let rotation = motions
         .iter()
-        .find(|(l, _)| l.starts_with("rotation about ("))
+        .find(|m| m.label.starts_with("rotation about ("))
         .unwrap_or_else(|| panic!("{message}"));
     let expected = -0.5 * H * m * G * s;
     assert!(
-        (rotation.1 - expected).abs() < 1e-9 * m * G,
+        (rotation.work - expected).abs() < 1e-9 * m * G,
         "{message}: {} vs {expected}",
-        rotation.1
+        rotation.work
     );
     assert!(!message.contains("combination"), "{message}");
 }
@@ -331,5 +332,12 @@ fn a_block_tipped_off_a_slope_is_refused_by_its_rotation_alone() {
     };
     let message = e.to_string();
     assert_eq!(motions.len(), 1, "{message}");
-    assert!(motions[0].0.starts_with("rotation about ("), "{message}");
+    assert!(
+        motions[0].label.starts_with("rotation about ("),
+        "{message}"
+    );
+    assert!(
+        matches!(motions[0].motion, Some(RigidMotion::Rotation(_))),
+        "{message}"
+    );
 }
