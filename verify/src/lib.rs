@@ -104,14 +104,22 @@ pub fn verify(root: &Path, opts: &Options, report: &mut Report) -> Result<(), St
         }
     }
     let wants = |s: &str| opts.only.as_deref().is_none_or(|o| o == s);
-    if opts.bless {
+    // The paper cases first: a mistyped --case is refused before the
+    // other suites run (it would otherwise pass on them).
+    let runs = if opts.bless || wants("paper") || wants("reference") {
         let runs = run_cases(root, opts.fault, &opts.cases)?;
-        if runs.is_empty() {
+        if runs.is_empty() && (opts.bless || !opts.cases.is_empty()) {
+            let bless = if opts.bless { "--bless: " } else { "" };
             return Err(format!(
-                "--bless: no paper case matched --case {:?}",
+                "{bless}no paper case matched --case {:?}",
                 opts.cases
             ));
         }
+        runs
+    } else {
+        Vec::new()
+    };
+    if opts.bless {
         suites::reference::run(root, &runs, true, report);
         return Ok(());
     }
@@ -122,11 +130,6 @@ pub fn verify(root: &Path, opts: &Options, report: &mut Report) -> Result<(), St
         suites::rates::run(root, opts, report);
     }
     if wants("paper") || wants("reference") {
-        let runs = run_cases(root, opts.fault, &opts.cases)?;
-        if runs.is_empty() && !opts.cases.is_empty() {
-            // A mistyped --case would otherwise pass on the other suites.
-            return Err(format!("no paper case matched --case {:?}", opts.cases));
-        }
         if wants("paper") {
             suites::paper::run(&runs, report);
         }

@@ -89,3 +89,23 @@ fn the_wrong_mass_fails_the_mass_row_and_the_references() {
         show(&f)
     );
 }
+
+/// A mistyped --case is refused before any suite runs (the analytic and
+/// rate suites would otherwise pass, and the run prove nothing), with
+/// --bless too (which would rewrite nothing).
+#[test]
+fn a_case_that_matches_nothing_is_refused_before_the_suites_run() {
+    for bless in [false, true] {
+        let opts = stickslip_verify::Options {
+            quick: true,
+            bless,
+            only: None,
+            fault: None,
+            cases: vec!["no-such-case".into()],
+        };
+        let mut report = Report::new(false);
+        let e = stickslip_verify::verify(&root(), &opts, &mut report).unwrap_err();
+        assert!(e.contains("no paper case matched"), "{e}");
+        assert!(report.rows.is_empty(), "{} rows ran", report.rows.len());
+    }
+}
