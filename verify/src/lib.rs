@@ -67,27 +67,40 @@ pub fn cases_dir(root: &Path) -> PathBuf {
 /// # Errors
 /// An unreadable case directory or case file.
 pub fn run_cases(root: &Path, fault: Option<Fault>, only: &[String]) -> Result<Vec<Run>, String> {
-    let cases = PaperCase::read_dir(&cases_dir(root))?;
-    let mut runs = Vec::new();
-    for case in cases {
-        if !only.is_empty() && !only.iter().any(|o| case.name.contains(o.as_str())) {
-            continue;
-        }
-        let trace = match case.scene() {
-            Ok(mut s) => {
-                if let Some(f) = fault {
-                    f.inject(&mut s);
+    Ok(run_selected(select_cases(root, only)?, fault))
+}
+
+/// The cases of `cases/martins-oden` whose names contain one of `only`
+/// (all when empty), read but not run.
+///
+/// # Errors
+/// An unreadable case directory or case file.
+fn select_cases(root: &Path, only: &[String]) -> Result<Vec<PaperCase>, String> {
+    let mut cases = PaperCase::read_dir(&cases_dir(root))?;
+    cases.retain(|case| only.is_empty() || only.iter().any(|o| case.name.contains(o.as_str())));
+    Ok(cases)
+}
+
+/// Runs `cases`, with `fault`.
+fn run_selected(cases: Vec<PaperCase>, fault: Option<Fault>) -> Vec<Run> {
+    cases
+        .into_iter()
+        .map(|case| {
+            let trace = match case.scene() {
+                Ok(mut s) => {
+                    if let Some(f) = fault {
+                        f.inject(&mut s);
+                    }
+                    scene::run(&s)
                 }
-                scene::run(&s)
-            }
-            Err(e) => Trace {
-                error: Some(e),
-                ..Trace::default()
-            },
-        };
-        runs.push(Run { case, trace });
-    }
-    Ok(runs)
+                Err(e) => Trace {
+                    error: Some(e),
+                    ..Trace::default()
+                },
+            };
+            Run { case, trace }
+        })
+        .collect()
 }
 
 /// Runs the selected suites, adding rows to `report`.
@@ -104,22 +117,31 @@ pub fn verify(root: &Path, opts: &Options, report: &mut Report) -> Result<(), St
         }
     }
     let wants = |s: &str| opts.only.as_deref().is_none_or(|o| o == s);
-    // The paper cases first: a mistyped --case is refused before the
-    // other suites run (it would otherwise pass on them).
-    let runs = if opts.bless || wants("paper") || wants("reference") {
-        let runs = run_cases(root, opts.fault, &opts.cases)?;
-        if runs.is_empty() && (opts.bless || !opts.cases.is_empty()) {
-            let bless = if opts.bless { "--bless: " } else { "" };
-            return Err(format!(
-                "{bless}no paper case matched --case {:?}",
-                opts.cases
-            ));
-        }
-        runs
+    let reads_cases = opts.bless || wants("paper") || wants("reference");
+    if !opts.cases.is_empty() && !reads_cases {
+        return Err(format!(
+            "--case selects paper cases, which --only {} does not run; drop --case, or choose \
+             --only paper or --only reference",
+            opts.only.as_deref().unwrap_or_default()
+        ));
+    }
+    // The cases are chosen first and run where a suite reads them: a
+    // mistyped --case is refused before any suite runs (it would
+    // otherwise pass on the others, or bless nothing).
+    let cases = if reads_cases {
+        select_cases(root, &opts.cases)?
     } else {
         Vec::new()
     };
+    if reads_cases && cases.is_empty() && (opts.bless || !opts.cases.is_empty()) {
+        let bless = if opts.bless { "--bless: " } else { "" };
+        return Err(format!(
+            "{bless}no paper case matched --case {:?}",
+            opts.cases
+        ));
+    }
     if opts.bless {
+        let runs = run_selected(cases, opts.fault);
         suites::reference::run(root, &runs, true, report);
         return Ok(());
     }
@@ -129,7 +151,8 @@ pub fn verify(root: &Path, opts: &Options, report: &mut Report) -> Result<(), St
     if wants("rates") {
         suites::rates::run(root, opts, report);
     }
-    if wants("paper") || wants("reference") {
+    if reads_cases {
+        let runs = run_selected(cases, opts.fault);
         if wants("paper") {
             suites::paper::run(&runs, report);
         }

@@ -109,7 +109,8 @@ fn run_verify(opts: &Options) -> ExitCode {
     eprintln!("verify: {:.1} s", start.elapsed().as_secs_f64());
     println!("{}", r.summary());
     if !opts.bless && r.rows.is_empty() {
-        // `--only reference --case <typo>` runs nothing: that is no proof.
+        // A run of no checks proves nothing (lib.rs refuses the ways known
+        // to lead here; this guards any other).
         eprintln!(
             "stickslip-verify: no checks matched (--only {}, --case {:?})",
             opts.only.as_deref().unwrap_or("(all)"),

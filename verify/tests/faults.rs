@@ -108,4 +108,15 @@ fn a_case_that_matches_nothing_is_refused_before_the_suites_run() {
         assert!(e.contains("no paper case matched"), "{e}");
         assert!(report.rows.is_empty(), "{} rows ran", report.rows.len());
     }
+    // --case with a suite that reads no paper case would be ignored.
+    let opts = stickslip_verify::Options {
+        quick: true,
+        only: Some("analytic".into()),
+        cases: vec!["cd-step".into()],
+        ..Default::default()
+    };
+    let mut report = Report::new(false);
+    let e = stickslip_verify::verify(&root(), &opts, &mut report).unwrap_err();
+    assert!(e.contains("--only analytic does not run"), "{e}");
+    assert!(report.rows.is_empty(), "{} rows ran", report.rows.len());
 }
