@@ -16,7 +16,7 @@ use stickslip_fem::{RigidMode, SetupTimes};
 use stickslip_linalg::FillOrder;
 
 use crate::initial::Mass;
-use crate::settings::{TimeError, Unbalanced};
+use crate::settings::{TimeError, UnbalancedMotion};
 
 /// Loads whose work along a free motion is below this fraction of the sum
 /// of its terms' magnitudes are in equilibrium (round-off of the load
@@ -81,11 +81,11 @@ pub(crate) fn does_work(work: f64, size: f64) -> bool {
 /// # Errors
 /// [`TimeError::Unbalanced`] naming each motion they do work along.
 pub(crate) fn balanced(modes: &[RigidMode], r: &[f64]) -> Result<(), TimeError> {
-    let unbalanced: Vec<Unbalanced> = modes
+    let unbalanced: Vec<UnbalancedMotion> = modes
         .iter()
         .filter_map(|m| {
             let (work, size) = work_along(&m.vector, r);
-            does_work(work, size).then(|| Unbalanced {
+            does_work(work, size).then(|| UnbalancedMotion {
                 label: m.label.clone(),
                 motion: m.motion,
                 work,

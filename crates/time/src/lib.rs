@@ -44,6 +44,6 @@ pub use history::History;
 pub use integrator::Integrator;
 pub use settings::{
     ExplicitFriction, ImplicitSolver, InitialState, MassKind, Rayleigh, Scheme, Settings,
-    StickReduction, TimeError, Unbalanced, MAX_STABLE_STEPS,
+    StickReduction, TimeError, UnbalancedMotion, MAX_STABLE_STEPS,
 };
 pub use state::{Checkpoint, Energy, StepInfo};

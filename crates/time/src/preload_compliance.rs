@@ -35,7 +35,7 @@ use stickslip_linalg::{Analysis, FillOrder, SparseCholesky};
 
 use crate::floating::{self, BALANCE_TOLERANCE};
 use crate::initial::Mass;
-use crate::settings::{TimeError, Unbalanced};
+use crate::settings::{TimeError, UnbalancedMotion};
 
 /// The residual ‖K r − R₀ − F_c(r)‖ that ends the iteration, relative to
 /// ‖R₀‖ or, where larger, to ‖F_c(0)‖ (nodes starting inside).
@@ -205,7 +205,7 @@ pub(crate) fn solve(
     // the motions the foundation holds, whose load pulls the part off it
     // (those the loads do work along, as `floating::balanced` judges).
     residual(&surface, x, &mut g);
-    let work: Vec<Unbalanced> = held
+    let work: Vec<UnbalancedMotion> = held
         .iter()
         .filter_map(|h| {
             let z = combine(modes, h);
@@ -231,7 +231,7 @@ pub(crate) fn solve(
                 contact.names()
             );
             let (name, amount, motion, _) = describe(modes, h);
-            floating::does_work(work, size).then(|| Unbalanced {
+            floating::does_work(work, size).then(|| UnbalancedMotion {
                 label: name + &why,
                 motion,
                 work: work / amount,

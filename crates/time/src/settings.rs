@@ -310,7 +310,7 @@ pub enum TimeError {
          [[dirichlet]] conditions)",
         unbalanced_list(.0)
     )]
-    Unbalanced(Vec<Unbalanced>),
+    Unbalanced(Vec<UnbalancedMotion>),
     /// A factorization failed during the run.
     #[error("step {step} (t = {t:.6e}): the linear solve failed: {source}")]
     Solve {
@@ -373,7 +373,7 @@ pub enum TimeError {
 /// A rigid motion the loads present before t = 0 do work along
 /// ([`TimeError::Unbalanced`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Unbalanced {
+pub struct UnbalancedMotion {
     /// Its name: "translation in x", "rotation about (x, y)", ..., with
     /// the part of the mesh it moves where there are several.
     pub label: String,
@@ -389,15 +389,15 @@ pub struct Unbalanced {
 /// force along it F = …; rotation about (x, y): moment M = …": a unit
 /// translation's work is the net force along it, a unit rotation's the
 /// moment about its centre; any other combination of motions is given by
-/// the loads' work along it. A translation along an axis names it.
-fn unbalanced_list(motions: &[Unbalanced]) -> String {
+/// the loads' work along it. A unit translation in x or y names its axis.
+fn unbalanced_list(motions: &[UnbalancedMotion]) -> String {
     motions
         .iter()
         .map(|m| {
             let (label, work) = (&m.label, m.work);
             match m.motion {
-                Some(RigidMotion::Translation([x, y])) if y == 0.0 || x == 0.0 => {
-                    let axis = if y == 0.0 { "x" } else { "y" };
+                Some(RigidMotion::Translation(d)) if d == [1.0, 0.0] || d == [0.0, 1.0] => {
+                    let axis = if d[0] == 1.0 { "x" } else { "y" };
                     format!("{label}: net force F_{axis} = {work:.6e}")
                 }
                 Some(RigidMotion::Translation(_)) => {
@@ -436,5 +436,48 @@ impl TimeError {
             },
             stickslip_contact::IterationFailure::Solve(e) => solve(e),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each motion's work is named by what the motion is: a net force
+    /// along a unit axis (F_x, F_y), along another direction (F, the
+    /// sign of (−1, 0) kept in the label's direction), a moment, or the
+    /// work along a combination.
+    #[test]
+    fn an_unbalanced_motion_is_named_by_its_kind() {
+        let motion = |label: &str, motion, work| UnbalancedMotion {
+            label: label.into(),
+            motion,
+            work,
+        };
+        let list = unbalanced_list(&[
+            motion(
+                "translation in y",
+                Some(RigidMotion::Translation([0.0, 1.0])),
+                2.0,
+            ),
+            motion(
+                "translation along (-1.000000, 0.000000)",
+                Some(RigidMotion::Translation([-1.0, 0.0])),
+                3.0,
+            ),
+            motion(
+                "rotation about (0, 0)",
+                Some(RigidMotion::Rotation([0.0, 0.0])),
+                4.0,
+            ),
+            motion("a combination of a and b", None, 5.0),
+        ]);
+        assert_eq!(
+            list,
+            "translation in y: net force F_y = 2.000000e0; \
+             translation along (-1.000000, 0.000000): net force along it F = 3.000000e0; \
+             rotation about (0, 0): moment M = 4.000000e0; \
+             a combination of a and b: the loads' work along it W = 5.000000e0"
+        );
     }
 }

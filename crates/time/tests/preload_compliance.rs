@@ -278,6 +278,8 @@ fn a_preload_pulling_a_block_off_a_slope_names_the_direction() {
     let Some(RigidMotion::Translation(d)) = translation.motion else {
         panic!("{message}")
     };
+    let named = format!("translation along ({:.6}, {:.6})", d[0], d[1]);
+    assert!(translation.label.starts_with(&named), "{message}");
     let along_normal = d[0] * s + d[1] * c;
     assert!((along_normal.abs() - 1.0).abs() < 1e-6, "{message}");
     let expected = m * G * c * along_normal;
