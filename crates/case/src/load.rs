@@ -34,7 +34,9 @@ use crate::set::{apply_set, field_rule};
 /// `file:line:col: what; what to do` (or `--set KEY=VALUE: ...`).
 pub fn load(path: &Path, sets: &[String]) -> Result<Case, InputError> {
     let file = path.display().to_string();
-    // A device or FIFO would be read forever (`check /dev/zero` would hang).
+    // A device or FIFO would be read forever (`check /dev/zero` would
+    // hang); a directory's read error ("Is a directory") says nothing of
+    // what to give.
     match std::fs::metadata(path) {
         Ok(m) if m.is_dir() => {
             return Err(InputError(format!(
@@ -1714,8 +1716,8 @@ t_end = 0.5
     /// (a directory said "cannot read the case file: Is a directory").
     #[test]
     fn a_directory_or_a_device_given_as_the_case_is_named() {
-        let dir = std::env::temp_dir();
-        let e = load(&dir, &[]).unwrap_err().0;
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let e = load(dir, &[]).unwrap_err().0;
         assert!(
             e.contains("is a directory; give the case's .toml file in it"),
             "{e}"

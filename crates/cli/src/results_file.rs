@@ -1,7 +1,8 @@
 //! The results file's protection (`stickslip run`): what `run` must not
 //! write over, and the lock a run holds on its file so that a second run
 //! (`--force`, `--restart`) or `probe` knows it is being written, whatever
-//! HDF5's own locking.
+//! HDF5's own locking; and what the commands that read a results file
+//! (`probe`, `views`, `stress`, `run --restart`) check of its path first.
 
 use std::path::{Path, PathBuf};
 
@@ -69,7 +70,11 @@ impl Companion {
 /// and a damaged or empty file nothing holds open are made again from a
 /// results file: replacing them loses nothing, so they are `None`.
 pub fn foreign_companion(out: &Path, kind: Companion) -> Option<String> {
-    foreign(out, kind, in_use)
+    foreign(
+        out,
+        kind,
+        (in_use, "in use (a run writing it, or a reader)"),
+    )
 }
 
 /// [`foreign_companion`] for a command that only reads the file (`views`
@@ -77,11 +82,16 @@ pub fn foreign_companion(out: &Path, kind: Companion) -> Option<String> {
 /// them) does not stop another reader, so only a run writing under that
 /// name makes it "in use".
 pub fn foreign_to_read(out: &Path, kind: Companion) -> Option<String> {
-    foreign(out, kind, being_written)
+    foreign(out, kind, (being_written, "in use (a run writing it)"))
 }
 
-/// [`foreign_companion`] with `busy` telling whether the file is in use.
-fn foreign(out: &Path, kind: Companion, busy: fn(&Path) -> bool) -> Option<String> {
+/// [`foreign_companion`] with `busy` telling whether the file is in use,
+/// and saying how.
+fn foreign(
+    out: &Path,
+    kind: Companion,
+    (busy, in_use): (fn(&Path) -> bool, &str),
+) -> Option<String> {
     let path = kind.path(out);
     let meta = std::fs::metadata(&path).ok()?;
     if !meta.is_file() {
@@ -94,7 +104,7 @@ fn foreign(out: &Path, kind: Companion, busy: fn(&Path) -> bool) -> Option<Strin
     // Before anything else: a run's results file is empty, or does not
     // open, while the run writes it.
     if busy(&path) {
-        return Some("in use (a run writing it, or a reader)".into());
+        return Some(in_use.into());
     }
     if meta.len() == 0 {
         return None;
@@ -326,20 +336,13 @@ pub fn check_restart(path: &Path) -> Result<(), InputError> {
     let name = path.display();
     let give = "give the OUT.h5 of the run to continue: `stickslip run CASE.toml --restart \
                 OUT.h5` (`stickslip run CASE.toml -o OUT.h5` starts a new one)";
-    let Ok(meta) = std::fs::metadata(path) else {
-        return Err(InputError(format!(
-            "--restart {name}: no such file; {give}"
-        )));
-    };
-    if meta.is_dir() {
-        return Err(InputError(format!(
-            "--restart {name} is a directory; {give}"
-        )));
-    }
-    if !meta.is_file() {
-        return Err(InputError(format!(
-            "--restart {name} is not a regular file (a device, FIFO or socket); {give}"
-        )));
+    if let Some(kind) = PathKind::of(path) {
+        let what = match kind {
+            PathKind::Missing => ": no such file",
+            PathKind::Directory => " is a directory",
+            PathKind::Special => " is not a regular file (a device, FIFO or socket)",
+        };
+        return Err(InputError(format!("--restart {name}{what}; {give}")));
     }
     if !is_hdf5(path) {
         return Err(InputError(format!(
@@ -478,10 +481,11 @@ impl RunLock {
     }
 }
 
-/// What every command that reads a results file checks before opening
-/// it: the file exists and is a regular file (HDF5's open of a FIFO
-/// blocks until a writer comes), and it is not the XDMF beside the
-/// results file.
+/// What every command that reads a results file checks of its path
+/// before anything opens it: the file exists and is a regular file (an
+/// open of a FIFO, as the lock tests `being_written` and `in_use` make,
+/// waits for a writer), and it is not an XDMF written beside the results
+/// file.
 ///
 /// # Errors
 /// The [`InputError`] naming the file and what to give instead.
@@ -491,27 +495,45 @@ pub(crate) fn check_results_path(path: &Path) -> Result<(), InputError> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("xdmf"))
     {
+        // OUT.xdmf and OUT.contact.xdmf are both written for OUT.h5.
+        let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+        let stem = stem.strip_suffix(".contact").unwrap_or(&stem);
         return Err(InputError(format!(
             "{name}: give the results file the XDMF is written for, {}",
-            path.with_extension("h5").display()
+            path.with_file_name(format!("{stem}.h5")).display()
         )));
     }
-    if path.is_dir() {
-        return Err(InputError(format!(
+    let give = "give the OUT.h5 a `stickslip run` wrote";
+    match PathKind::of(path) {
+        Some(PathKind::Directory) => Err(InputError(format!(
             "{name} is a directory; give a results file in it, the OUT.h5 a `stickslip run` wrote"
-        )));
+        ))),
+        Some(PathKind::Special) => Err(InputError(format!(
+            "{name} is not a regular file (a device, FIFO or socket); {give}"
+        ))),
+        Some(PathKind::Missing) => Err(InputError(format!("{name}: no such results file; {give}"))),
+        None => Ok(()),
     }
-    if path.exists() && !path.is_file() {
-        return Err(InputError(format!(
-            "{name} is not a regular file (a device, FIFO or socket); give the OUT.h5 a `stickslip run` wrote"
-        )));
+}
+
+/// What a path given as a results file is, where it is no regular file.
+enum PathKind {
+    Missing,
+    Directory,
+    /// A device, FIFO or socket.
+    Special,
+}
+
+impl PathKind {
+    /// `None` for a regular file (or a link to one).
+    fn of(path: &Path) -> Option<PathKind> {
+        match std::fs::metadata(path) {
+            Err(_) => Some(PathKind::Missing),
+            Ok(m) if m.is_dir() => Some(PathKind::Directory),
+            Ok(m) if !m.is_file() => Some(PathKind::Special),
+            Ok(_) => None,
+        }
     }
-    if !path.is_file() {
-        return Err(InputError(format!(
-            "{name}: no such results file; give the OUT.h5 a `stickslip run` wrote"
-        )));
-    }
-    Ok(())
 }
 
 /// Opens the results file `path` for a command that reads it after its

@@ -2439,13 +2439,16 @@ fn probe_refuses_a_fifo_and_an_xdmf_for_a_results_file() {
         assert_eq!(o.status.code(), Some(2), "{command}: {e}");
         assert!(e.contains("is not a regular file"), "{command}: {e}");
     }
-    let o = probe_at(&dir.join("r.xdmf"));
-    let e = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{e}");
-    assert!(
-        e.contains("give the results file the XDMF is written for"),
-        "{e}"
-    );
+    for xdmf in ["r.xdmf", "r.contact.xdmf"] {
+        let o = probe_at(&dir.join(xdmf));
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        let named = format!(
+            "give the results file the XDMF is written for, {}",
+            dir.join("r.h5").display()
+        );
+        assert!(e.contains(&named), "{xdmf}: {e}");
+    }
 }
 
 /// A mesh of mesh.ladder is an input of the case like mesh.file: `run -o`
