@@ -155,6 +155,23 @@ impl OutputSize {
     pub(crate) fn short_of_room(&self, out: &Path) -> Option<u64> {
         room_for(out, true).filter(|&free| self.bytes + self.kept > free as f64)
     }
+
+    /// The part `share` of the records (a restart's rest of the run), with
+    /// the same room kept.
+    pub(crate) fn share(&self, share: f64) -> OutputSize {
+        OutputSize {
+            frames: (self.frames * share).ceil(),
+            rows: (self.rows * share).ceil(),
+            bytes: self.bytes * share,
+            kept: self.kept,
+        }
+    }
+
+    /// [`OutputSize::short_of_room`] for records added to `out`, which
+    /// stays (a restart).
+    pub(crate) fn short_of_room_beside(&self, out: &Path) -> Option<u64> {
+        room_for(out, false).filter(|&free| self.bytes + self.kept > free as f64)
+    }
 }
 
 /// Frames, rows and bytes a run of `case` writes from t = 0

@@ -186,11 +186,35 @@ pub(crate) fn resume(
             cp.t
         )));
     }
+    let n_c = integrator.contact().map_or(0, |c| c.len());
+    // As a new run's records: the rest of the run must fit on the disk
+    // with the room the run keeps, or it would stop part way (or HDF5
+    // fail mid-write on a full disk). The records in proportion to the
+    // time left: an estimate, as the new run's.
+    let share = ((case.time.t_end - cp.t) / case.time.t_end).clamp(0.0, 1.0);
+    let size = crate::run::output_size(case, mesh.nodes.len(), n_c, n_free).share(share);
+    if let Some(free) = size.short_of_room_beside(out) {
+        use crate::run::human_bytes;
+        return Err(input(format!(
+            "{}: --restart {}: the rest of the run (t = {} to {}) would add about {} frames and \
+             {} rows ({}) and keeps {} free beside them while it writes, but the disk has {} \
+             free; shorten time.t_end, write fewer frames (output.frames, output.interval, \
+             output.every: a restart may change them), or make room",
+            case.path.display(),
+            out.display(),
+            cp.t,
+            case.time.t_end,
+            size.frames,
+            size.rows,
+            human_bytes(size.bytes),
+            human_bytes(size.kept),
+            human_bytes(free as f64)
+        )));
+    }
     // Only now that the restart is accepted: a refused one leaves every
     // file as it was. Before the results change, so that no companion
     // outlives the records it lists.
     crate::run::forget_companions(out, quiet);
-    let n_c = integrator.contact().map_or(0, |c| c.len());
     let mut writer = ResultsWriter::open_append(
         out,
         (stored.extra.rows, stored.extra.frames),

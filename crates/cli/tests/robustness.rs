@@ -1834,28 +1834,68 @@ fn closed_pipes_neither_panic_nor_end_a_run() {
 /// half way (which left rows of fill values, and turned rows flushed
 /// before, in the chunk it rewrote, into zeros that probe printed as
 /// u = 0), says so and what to do; the file reads to its last record, and
-/// a restart with room continues it. Needs a small tmpfs: where this
-/// process may not mount one (not root, or a container without the
-/// capability) the test fails under CI and is skipped elsewhere.
+/// a restart with room continues it. Runs and restarts are sized against
+/// their disk before they start, so the disk is filled by another file
+/// once the restart has begun (stopped with SIGSTOP meanwhile). Needs a
+/// tmpfs: where this process may not mount one (not root, or a container
+/// without the capability) the test fails under CI and is skipped
+/// elsewhere.
 #[test]
 fn a_disk_that_fills_up_stops_the_run_with_its_records() {
-    let Some((case, small)) = slab_on_a_small_disk("disk-full") else {
+    use std::io::{BufRead, BufReader, Read, Write};
+    let dir = scratch("disk-full");
+    let Some(disk) = tmpfs(&dir, "disk", "size=200M") else {
         return;
     };
-    let out = small.join("full.h5");
-    // 801 records of 4.6 kB fit the 6 MB, but not with the room each
-    // write keeps (4.4 MB here: a MiB of pending rows, twice, and HDF5's
-    // own), so a run of them is refused before it starts; a restart, which
-    // continues a file and is not sized beforehand, meets the full disk.
-    // Its first 51 records fit. Flushes every 100 steps: a run this short
-    // makes none by time, and it is the room a flush needs that stops it,
-    // after flushes that left a checkpoint.
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let out = disk.join("full.h5");
     let first = run(&case, &out, &[]);
-    let o = restart(
-        &case,
-        &out,
-        &["--set", "time.t_end=0.8", "--set", "output.flush_every=100"],
-    );
+    // 20,000 records of 4.6 kB (92 MB): the disk holds them, the filler
+    // leaves 6 MB of it. Flushes every 100 steps: it is the room a flush
+    // needs that stops the run, after flushes that left a checkpoint.
+    let mut child = bin()
+        .arg("run")
+        .arg(&case)
+        .arg("--restart")
+        .arg(&out)
+        .args(["--set", "time.t_end=20", "--set", "output.flush_every=100"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut said = String::new();
+    loop {
+        let mut line = String::new();
+        if err.read_line(&mut line).unwrap() == 0 {
+            break;
+        }
+        said.push_str(&line);
+        if line.contains("restart: continuing") {
+            break;
+        }
+    }
+    signal(&child, "-STOP");
+    let avail = Command::new("df")
+        .args(["--output=avail", "-B1"])
+        .arg(&disk)
+        .output()
+        .unwrap();
+    let avail: u64 = String::from_utf8_lossy(&avail.stdout)
+        .lines()
+        .nth(1)
+        .and_then(|l| l.trim().parse().ok())
+        .unwrap_or(0);
+    let filler = disk.join("filler");
+    let mut f = std::fs::File::create(&filler).unwrap();
+    let block = vec![1u8; 1 << 20];
+    for _ in 0..avail.saturating_sub(6 << 20) >> 20 {
+        f.write_all(&block).unwrap();
+    }
+    drop(f);
+    signal(&child, "-CONT");
+    err.read_to_string(&mut said).unwrap();
+    let status = child.wait().unwrap();
     let read = hdf5::File::open(&out).map(|f| {
         let u = f
             .dataset("displacement")
@@ -1865,29 +1905,25 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
         let t = f.dataset("time").unwrap().size();
         (u, t)
     });
-    let grown = Command::new("mount")
-        .args(["-o", "remount,size=200M"])
-        .arg(&small)
-        .status()
-        .is_ok_and(|s| s.success());
-    let again = restart(&case, &out, &["--set", "time.t_end=5"]);
-    Command::new("umount").arg(&small).status().ok();
+    std::fs::remove_file(&filler).unwrap();
+    let again = restart(&case, &out, &["--set", "time.t_end=21"]);
+    Command::new("umount").arg(&disk).status().ok();
     ok(&first);
-    let e = stderr(&o);
-    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(said.contains("restart: continuing"), "{said}");
+    assert_eq!(status.code(), Some(1), "{said}");
     assert!(
-        e.contains("is nearly full") && e.contains("--restart"),
-        "{e}"
+        said.contains("is nearly full") && said.contains("--restart"),
+        "{said}"
     );
     let (u, rows) = read.expect("the file opens");
     assert!(rows > 100, "it ran a while: {rows} records");
+    assert!(rows < 20_000, "it stopped before t_end: {rows} records");
     let per_row = u.len() / rows;
     // Every record after the first (the slab at rest) moves.
     let zero = (1..rows)
         .filter(|&k| u[k * per_row..(k + 1) * per_row].iter().all(|&x| x == 0.0))
         .count();
     assert_eq!(zero, 0, "records of zeros among {rows}");
-    assert!(grown);
     assert_eq!(again.status.code(), Some(0), "{}", stderr(&again));
 }
 
@@ -2233,6 +2269,37 @@ fn a_run_its_disk_holds_only_without_the_room_it_keeps_is_refused() {
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(e.contains("keeps") && e.contains("output.every"), "{e}");
     assert!(!left, "no results file for a run refused");
+}
+
+/// A restart whose rest of the run the disk cannot hold is refused before
+/// it changes the file, as a new run is: it ran on to a full disk, where
+/// HDF5 failed mid-write and left the file unreadable, every record lost.
+/// Needs a small tmpfs, as the disk-full test.
+#[test]
+fn a_restart_its_disk_cannot_hold_is_refused_and_the_file_kept() {
+    let Some((case, small)) = slab_on_a_small_disk("restart-disk") else {
+        return;
+    };
+    let out = small.join("r.h5");
+    let first = run(&case, &out, &["--set", "time.t_end=0.1"]);
+    let before = std::fs::read(&out).ok();
+    // 2,000 more records of 4.6 kB (9 MB) on a 6 MB disk.
+    let refused = restart(&case, &out, &["--set", "time.t_end=2"]);
+    let after = std::fs::read(&out).ok();
+    let fits = restart(&case, &out, &["--set", "time.t_end=0.2"]);
+    Command::new("umount").arg(&small).status().ok();
+    assert_eq!(first.status.code(), Some(0), "{}", stderr(&first));
+    let e = stderr(&refused);
+    assert_eq!(refused.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("--restart") && e.contains("the rest of the run") && e.contains("time.t_end"),
+        "{e}"
+    );
+    assert!(
+        before.is_some() && before == after,
+        "the refused restart changed the file"
+    );
+    assert_eq!(fits.status.code(), Some(0), "{}", stderr(&fits));
 }
 
 /// Files that only bear the names of a results file's companions and hold
