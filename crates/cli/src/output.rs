@@ -360,6 +360,17 @@ fn series_2d<T: H5Type>(g: &Group, name: &str, n: usize, level: u8) -> Result<Da
         .create(name)?)
 }
 
+/// The name of a physical group's dataset in `/mesh/groups`: '/' (which
+/// would make a nested HDF5 path) as '_', and a name HDF5 takes for no
+/// link name ("" or ".") as "_"; the dataset's `name` attribute keeps the
+/// group's own name.
+pub(crate) fn stored_group_name(name: &str) -> String {
+    match name {
+        "" | "." => "_".to_string(),
+        _ => name.replace('/', "_"),
+    }
+}
+
 /// [`ResultsWriter::room_needed`] of a file of `n_nodes` nodes, `n_c`
 /// contact nodes and `block_rows` rows a chunk of the node vectors, whose
 /// state has `n_free` values a vector. A new run's file has
@@ -542,14 +553,19 @@ impl ResultsWriter {
             .create("node_tags")?;
         let groups = g.create_group("groups")?;
         for grp in &mesh.groups {
-            // '/' would make a nested HDF5 path.
-            let name = grp.name.replace('/', "_");
+            let mut name = stored_group_name(&grp.name);
+            // Two groups of one name (of two dimensions, or named so once
+            // '/' is replaced): the later one by its tag too.
+            if groups.link_exists(&name) {
+                name = format!("{name}#{}", grp.tag);
+            }
             let ds = groups
                 .new_dataset_builder()
                 .with_data(&index_array(grp.nodes.iter().copied()))
                 .create(name.as_str())?;
             scalar_attr(&ds, "dim", grp.dim as i64)?;
             scalar_attr(&ds, "tag", grp.tag as i64)?;
+            string_attr(&ds, "name", &grp.name)?;
         }
 
         let n_c = header.contact_nodes.len();

@@ -923,13 +923,29 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
     let groups = f
         .group("mesh/groups")
         .map_err(|e| h5("cannot read /mesh/groups", e))?;
-    let members = match groups.dataset(group) {
+    // By the `name` attribute (a dataset's name may differ from its
+    // group's: `output::stored_group_name`); files without it by name.
+    let stored: Vec<(String, String)> = groups
+        .member_names()
+        .unwrap_or_default()
+        .into_iter()
+        .map(|m| {
+            let own = groups
+                .dataset(&m)
+                .ok()
+                .and_then(|d| crate::output::text_attr(&d, "name").ok());
+            (own.unwrap_or_else(|| m.clone()), m)
+        })
+        .collect();
+    let named = stored.iter().find(|(own, _)| own == group).map(|(_, m)| m);
+    let members = match groups.dataset(named.map_or(group, String::as_str)) {
         Ok(d) => d
             .read_1d::<i64>()
             .map_err(|e| h5(&format!("cannot read /mesh/groups/{group}"), e))?
             .to_vec(),
         Err(_) => {
-            let have = groups.member_names().unwrap_or_default().join(", ");
+            let have: Vec<&str> = stored.iter().map(|(own, _)| own.as_str()).collect();
+            let have = have.join(", ");
             return Err(InputError(format!(
                 "{name}: no group {group:?} in this file; it has: {have}"
             )));

@@ -2302,6 +2302,50 @@ fn a_restart_its_disk_cannot_hold_is_refused_and_the_file_kept() {
     assert_eq!(fits.status.code(), Some(0), "{}", stderr(&fits));
 }
 
+/// Physical group names HDF5 cannot take as link names ("" and "."), a
+/// '/' that would nest, and two names that meet once '/' is '_' are
+/// stored under names it takes, each dataset with its group's own name as
+/// the attribute `name`, which `probe --along` finds it by. The run
+/// failed with "unknown library error" (exit 1) and left a broken file.
+#[test]
+fn group_names_hdf5_cannot_take_are_stored_under_others() {
+    let dir = scratch("group-names");
+    let shipped = root().join("cases/meshes/slab-q2-8x2.msh");
+    let text = std::fs::read_to_string(&shipped).unwrap();
+    for (body, load, stored) in [
+        ("", "load", "_"),
+        (".", "load", "_"),
+        ("a/b", "a_b", "a_b#10"),
+    ] {
+        let mesh = dir.join("named.msh");
+        let named = text
+            .replace("\"body\"", &format!("{body:?}"))
+            .replace("\"load\"", &format!("{load:?}"));
+        std::fs::write(&mesh, named).unwrap();
+        let (case, _) = slab_case(&dir, "slab", |t| {
+            t.replace(&shipped.display().to_string(), &mesh.display().to_string())
+                .replace("group = \"load\"", &format!("group = {load:?}"))
+        });
+        let out = dir.join("r.h5");
+        ok(&run(&case, &out, &["--set", "time.t_end=0.01"]));
+        let f = hdf5::File::open(&out).unwrap();
+        let ds = f.dataset(&format!("mesh/groups/{stored}")).unwrap();
+        let name = ds.attr("name").unwrap();
+        let name = name.read_scalar::<hdf5::types::VarLenUnicode>().unwrap();
+        assert_eq!(name.as_str(), body, "{stored}");
+        assert_eq!(ds.attr("dim").unwrap().read_scalar::<i64>().unwrap(), 2);
+        let o = bin()
+            .arg("probe")
+            .arg(&out)
+            .args(["--along", load, "--field", "ux", "--times", "0"])
+            .output()
+            .unwrap();
+        let said = String::from_utf8_lossy(&o.stdout).into_owned() + &stderr(&o);
+        assert_eq!(o.status.code(), Some(0), "{said}");
+        assert!(said.contains("5 nodes"), "{said}");
+    }
+}
+
 /// Files that only bear the names of a results file's companions and hold
 /// what replacing them would lose (another run's results written as
 /// r.views.h5 or r.stress.h5, a file in use, another program's HDF5 file)
