@@ -390,10 +390,20 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
 /// before `/contact/lines`).
 fn contact_line(f: &File, out: &Path) -> anyhow::Result<(Option<ContactLine>, Option<String>)> {
     let name = out.display();
+    // A damaged file (a dataset of another shape or type, a flipped
+    // byte) is the user's input: named, exit 2.
+    let unread = |what: &str, e: hdf5::Error| {
+        InputError(format!(
+            "{name}: cannot read {what}: {e}; the file is damaged: give a results file written \
+             by `stickslip run` (or run its case again)"
+        ))
+    };
     let Ok(nodes) = f.dataset("contact/nodes") else {
         return Ok((None, None));
     };
-    let nodes = nodes.read_1d::<i64>()?;
+    let nodes = nodes
+        .read_1d::<i64>()
+        .map_err(|e| unread("/contact/nodes", e))?;
     let Ok(lines) = f.dataset("contact/lines") else {
         return Ok((
             None,
@@ -404,7 +414,10 @@ fn contact_line(f: &File, out: &Path) -> anyhow::Result<(Option<ContactLine>, Op
             )),
         ));
     };
-    let xy = f.dataset("mesh/nodes")?.read_2d::<f64>()?;
+    let xy = f
+        .dataset("mesh/nodes")
+        .and_then(|d| d.read_2d::<f64>())
+        .map_err(|e| unread("/mesh/nodes", e))?;
     let n_c = nodes.len();
     let point = |&n: &i64| {
         usize::try_from(n)
@@ -413,7 +426,9 @@ fn contact_line(f: &File, out: &Path) -> anyhow::Result<(Option<ContactLine>, Op
             .map(|n| [xy[[n, 0]], xy[[n, 1]]])
     };
     let points: Option<Vec<[f64; 2]>> = nodes.iter().map(point).collect();
-    let lines = lines.read_2d::<i64>()?;
+    let lines = lines
+        .read_2d::<i64>()
+        .map_err(|e| unread("/contact/lines", e))?;
     let index = |v: i64| usize::try_from(v).ok().filter(|&i| i < n_c);
     let segments: Option<Vec<[usize; 2]>> = lines
         .rows()

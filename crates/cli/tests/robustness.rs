@@ -2346,6 +2346,39 @@ fn group_names_hdf5_cannot_take_are_stored_under_others() {
     }
 }
 
+/// A results file whose /contact/lines or /mesh/nodes is damaged (another
+/// shape) is named by `views` and `stress` with the dataset, exit 2: for
+/// /contact/lines they printed HDF5's "ndim mismatch" alone and exited 1.
+#[test]
+fn views_and_stress_name_a_damaged_dataset_of_the_file() {
+    let dir = scratch("damaged-dataset");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let r = dir.join("r.h5");
+    ok(&run(&case, &r, &["--set", "time.t_end=0.01"]));
+    for dataset in ["contact/lines", "mesh/nodes"] {
+        let damaged = dir.join("damaged.h5");
+        std::fs::copy(&r, &damaged).unwrap();
+        {
+            let f = hdf5::File::open_rw(&damaged).unwrap();
+            let flat = f.dataset(dataset).unwrap().read_raw::<f64>().unwrap();
+            f.unlink(dataset).unwrap();
+            f.new_dataset_builder()
+                .with_data(&flat)
+                .create(dataset)
+                .unwrap();
+        }
+        for command in ["views", "stress"] {
+            let o = bin().arg(command).arg(&damaged).output().unwrap();
+            let e = stderr(&o);
+            assert_eq!(o.status.code(), Some(2), "{command} {dataset}: {e}");
+            assert!(
+                e.contains(&format!("{}: ", damaged.display())) && e.contains(dataset),
+                "{command} {dataset}: {e}"
+            );
+        }
+    }
+}
+
 /// Files that only bear the names of a results file's companions and hold
 /// what replacing them would lose (another run's results written as
 /// r.views.h5 or r.stress.h5, a file in use, another program's HDF5 file)
