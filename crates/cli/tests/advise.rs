@@ -206,6 +206,35 @@ fn advise_never_writes_over_a_file() {
     assert_eq!(st.status.code(), Some(2), "{err}");
     assert!(err.contains("the file exists"), "{err}");
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "mine");
+    // Nor through a link to nowhere, nor into a directory it may not
+    // write (a read-only mount where one can be made): both said so only
+    // after the pilot runs, exit 1.
+    let link = dir.join("link.toml");
+    let _ = std::fs::remove_file(&link);
+    std::os::unix::fs::symlink(dir.join("nowhere/x.toml"), &link).unwrap();
+    let mut places = vec![(link, "exists")];
+    if let Some(ro) = common::tmpfs(&dir, "ro", "ro,size=1M") {
+        places.push((ro.join("advised.toml"), "cannot write in the directory"));
+    }
+    for (place, says) in &places {
+        let st = bin()
+            .arg("advise")
+            .arg(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
+            .args(["--tol", "3e-2", "--on", "ux", "--at", "8,1", "--write"])
+            .arg(place)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert_eq!(st.status.code(), Some(2), "{}: {err}", place.display());
+        assert!(err.contains(says), "{}: {err}", place.display());
+        assert!(!err.contains("pilot"), "refused before the pilots: {err}");
+    }
+    if places.len() > 1 {
+        std::process::Command::new("umount")
+            .arg(dir.join("ro"))
+            .status()
+            .ok();
+    }
     // A directory, and a negative tolerance (clap took "-1" for a flag).
     for (args, says) in [
         (

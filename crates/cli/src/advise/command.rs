@@ -90,8 +90,9 @@ fn check(o: &Options) -> anyhow::Result<()> {
                 w.join("advised.toml").display()
             )));
         }
-        // Never over a file: it may be the case being advised, or another.
-        if w.exists() {
+        // Never over a file: it may be the case being advised, or another
+        // (nor through a link, even one to nowhere).
+        if std::fs::symlink_metadata(w).is_ok() {
             return Err(input(format!(
                 "--write {}: the file exists; give a new name (advise never overwrites a file)",
                 w.display()
@@ -103,6 +104,16 @@ fn check(o: &Options) -> anyhow::Result<()> {
         {
             return Err(input(format!(
                 "--write {}: the directory {} does not exist; create it or write elsewhere",
+                w.display(),
+                dir.display()
+            )));
+        }
+        // Said before the pilot runs, not after them.
+        let dir = crate::results_file::dir_of(w);
+        if !crate::sys::can_write_in(dir) {
+            return Err(input(format!(
+                "--write {}: cannot write in the directory {} (read-only, or not yours); write \
+                 elsewhere",
                 w.display(),
                 dir.display()
             )));
@@ -163,7 +174,17 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
     if let Some(w) = &o.write {
         let header = report::write_header(o, c, &est.ladder);
         let text = adjusted_case(case, c, &est.ladder, w, &header)?;
-        std::fs::write(w, text).with_context(|| format!("cannot write {}", w.display()))?;
+        match std::fs::write(w, text) {
+            // The place (a read-only file system, a link or directory put
+            // there since): the user's to change, exit 2.
+            Err(e) if crate::sys::place_error(&e) => {
+                return Err(input(format!(
+                    "--write {}: cannot write it: {e}; write elsewhere",
+                    w.display()
+                )))
+            }
+            r => r.with_context(|| format!("cannot write {}", w.display()))?,
+        }
         if !json {
             crate::console::out(&format!("written     {}\n", w.display()))?;
         }
