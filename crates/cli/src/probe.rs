@@ -1374,6 +1374,6 @@ mod tests {
             .contains("expected two numbers"));
         std::fs::remove_file(&path).ok();
         let e = probe(&path, "0,0", Field::Ux, false).unwrap_err().0;
-        assert!(e.contains("cannot open it as HDF5"), "{e}");
+        assert!(e.contains("no such results file"), "{e}");
     }
 }
