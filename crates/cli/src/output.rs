@@ -638,6 +638,66 @@ impl ResultsWriter {
         })
     }
 
+    /// The checks [`ResultsWriter::open_append`] makes before it changes
+    /// `path`: every series it extends is there and extendible along its
+    /// rows (a dataset rewritten by another program, contiguous or of a
+    /// fixed size, made the resize fail after it had cut the others back:
+    /// records lost). Series a file of an earlier version lacks, which
+    /// `open_append` makes, are not asked for.
+    ///
+    /// # Errors
+    /// The [`stickslip_case::InputError`] naming the file, the dataset and
+    /// what to do.
+    pub fn check_appendable(path: &Path) -> std::result::Result<(), stickslip_case::InputError> {
+        let damaged = |what: String| {
+            stickslip_case::InputError(format!(
+                "--restart {}: {what}: the file is damaged (or was changed by another program); \
+                 restart from a copy of the run's own file, or run the case again with -o NEW.h5",
+                path.display()
+            ))
+        };
+        let file = File::open(path).map_err(|e| damaged(format!("cannot open it: {e}")))?;
+        let mut names: Vec<String> = [
+            "time",
+            "displacement",
+            "velocity",
+            "acceleration",
+            "solver/dt",
+            "solver/iterations",
+        ]
+        .map(String::from)
+        .to_vec();
+        let optional = ["damped", "foundation", "foundation_stored"];
+        names.extend(
+            ENERGY_NAMES
+                .iter()
+                .filter(|n| !optional.contains(n) || file.link_exists(&format!("energy/{n}")))
+                .map(|n| format!("energy/{n}")),
+        );
+        if file.link_exists("frames") {
+            names.extend(["frames/time", "frames/row"].map(String::from));
+        }
+        if file.link_exists("contact") {
+            names.extend(
+                ["friction_stress", "slip_velocity", "state"].map(|n| format!("contact/{n}")),
+            );
+            if file.link_exists("contact/normal_stress") {
+                names.push("contact/normal_stress".into());
+            }
+        }
+        for name in &names {
+            let ds = file
+                .dataset(name)
+                .map_err(|_| damaged(format!("/{name} is missing")))?;
+            if !ds.is_chunked() || !ds.is_resizable() {
+                return Err(damaged(format!(
+                    "/{name} cannot grow (it is not a chunked dataset of unlimited rows)"
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// Opens a results file written by [`ResultsWriter::create`] to append
     /// to it after row `rows` and frame `frames` (later rows, written after
     /// the checkpoint, are dropped), marks it `complete = false` and
@@ -655,6 +715,7 @@ impl ResultsWriter {
         n_nodes: usize,
         n_c: usize,
     ) -> Result<ResultsWriter> {
+        ResultsWriter::check_appendable(path)?;
         let file = File::open_rw(path).with_context(|| {
             format!(
                 "cannot open {} for appending (is it open in another program?)",

@@ -211,6 +211,7 @@ pub(crate) fn resume(
             human_bytes(free as f64)
         )));
     }
+    ResultsWriter::check_appendable(out)?;
     // Only now that the restart is accepted: a refused one leaves every
     // file as it was. Before the results change, so that no companion
     // outlives the records it lists.

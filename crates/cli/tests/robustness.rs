@@ -2379,6 +2379,53 @@ fn views_and_stress_name_a_damaged_dataset_of_the_file() {
     }
 }
 
+/// A restart of a file whose series another program rewrote (a contiguous
+/// dataset, which cannot grow) or removed is refused before it changes
+/// the file, exit 2: the first cut every other series back to the
+/// checkpoint and then failed (exit 1, the last records lost), the second
+/// exited 1 with nothing to do.
+#[test]
+fn a_restart_of_a_damaged_file_is_refused_before_it_changes_it() {
+    let dir = scratch("restart-damaged");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let r = dir.join("r.h5");
+    ok(&run(&case, &r, &["--set", "time.t_end=0.02"]));
+    for (removed, says) in [(false, "cannot grow"), (true, "is missing")] {
+        let damaged = dir.join("damaged.h5");
+        std::fs::copy(&r, &damaged).unwrap();
+        {
+            let f = hdf5::File::open_rw(&damaged).unwrap();
+            let a = f
+                .dataset("acceleration")
+                .unwrap()
+                .read_dyn::<f64>()
+                .unwrap();
+            f.unlink("acceleration").unwrap();
+            if !removed {
+                f.new_dataset_builder()
+                    .with_data(&a)
+                    .create("acceleration")
+                    .unwrap();
+            }
+        }
+        let before = std::fs::read(&damaged).unwrap();
+        let o = restart(&case, &damaged, &["--set", "time.t_end=0.04"]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(
+            e.contains(&format!(
+                "--restart {}: /acceleration {says}",
+                damaged.display()
+            )) && e.contains("damaged"),
+            "{e}"
+        );
+        assert!(
+            std::fs::read(&damaged).unwrap() == before,
+            "the file changed"
+        );
+    }
+}
+
 /// Files that only bear the names of a results file's companions and hold
 /// what replacing them would lose (another run's results written as
 /// r.views.h5 or r.stress.h5, a file in use, another program's HDF5 file)
