@@ -434,11 +434,16 @@ fn put_vector<T: H5Type>(g: &Group, name: &str, v: &[T]) -> Result<()> {
 
 /// Writes (or rewrites) a scalar attribute.
 fn put_scalar<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<()> {
-    match loc.attr(name) {
-        Ok(a) => a.write_scalar(&value)?,
-        Err(_) => scalar_attr(loc, name, value)?,
+    if let Ok(a) = loc.attr(name) {
+        if a.write_scalar(&value).is_ok() {
+            return Ok(());
+        }
+        // One of another type (the file changed by another program): a
+        // run that ends writing its summary failed there, after its steps.
+        drop(a);
+        loc.delete_attr(name)?;
     }
-    Ok(())
+    scalar_attr(loc, name, value)
 }
 
 pub(crate) fn get_scalar<T: H5Type>(loc: &hdf5::Location, name: &str) -> Result<T> {

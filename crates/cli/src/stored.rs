@@ -125,6 +125,19 @@ pub fn read_checkpoint(path: &Path) -> Result<Stored> {
             Vec::new()
         },
     };
+    // The clock's steps are read back as they are: one of another value
+    // (a file changed by another program) moved the restart's times, and
+    // the run blew up blaming its Δt.
+    if let Some((t0, dt, k)) = checkpoint.clock {
+        let on_clock = t0 + k as f64 * dt;
+        ensure!(
+            dt > 0.0 && (on_clock - checkpoint.t).abs() <= 0.5 * dt,
+            "/checkpoint: its clock (t0 = {t0}, dt = {dt}, {k} steps: t = {on_clock}) does not \
+             reach its t = {}: the file is damaged; restart from a copy of the run's own file, \
+             or run the case again",
+            checkpoint.t
+        );
+    }
     let rows = get_scalar::<u64>(&g, "rows")? as usize;
     let extra = CheckpointExtra {
         rows,

@@ -2426,6 +2426,54 @@ fn a_restart_of_a_damaged_file_is_refused_before_it_changes_it() {
     }
 }
 
+/// A checkpoint whose clock another program changed is refused as damaged
+/// (exit 2, the file unchanged): the restart ran at the times it gave and
+/// blew up, blaming Δt. A summary attribute of another type (`dt_crit` as
+/// text) is written anew: the restart failed there after its steps, exit 1.
+#[test]
+fn a_restart_reads_its_clock_and_rewrites_a_foreign_attribute() {
+    use hdf5::types::VarLenUnicode;
+    let dir = scratch("restart-clock");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let r = dir.join("r.h5");
+    ok(&run(&case, &r, &["--set", "time.t_end=0.02"]));
+    let clock = dir.join("clock.h5");
+    std::fs::copy(&r, &clock).unwrap();
+    {
+        let f = hdf5::File::open_rw(&clock).unwrap();
+        let cg = f.group("checkpoint").unwrap();
+        for slot in cg.member_names().unwrap() {
+            let g = cg.group(&slot).unwrap();
+            if let Ok(a) = g.attr("clock_steps") {
+                a.write_scalar(&(1u64 << 63)).unwrap();
+            }
+        }
+    }
+    let before = std::fs::read(&clock).unwrap();
+    let o = restart(&case, &clock, &["--set", "time.t_end=0.04"]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("its clock") && e.contains("damaged"), "{e}");
+    assert!(std::fs::read(&clock).unwrap() == before, "the file changed");
+    let text = dir.join("text.h5");
+    std::fs::copy(&r, &text).unwrap();
+    {
+        let f = hdf5::File::open_rw(&text).unwrap();
+        let solver = f.group("solver").unwrap();
+        solver.delete_attr("dt_crit").unwrap();
+        solver
+            .new_attr::<VarLenUnicode>()
+            .create("dt_crit")
+            .unwrap()
+            .write_scalar(&"zz".parse::<VarLenUnicode>().unwrap())
+            .unwrap();
+    }
+    ok(&restart(&case, &text, &["--set", "time.t_end=0.04"]));
+    let f = hdf5::File::open(&text).unwrap();
+    let dt_crit = f.group("solver").unwrap().attr("dt_crit").unwrap();
+    assert!(dt_crit.read_scalar::<f64>().unwrap() > 0.0);
+}
+
 /// Files that only bear the names of a results file's companions and hold
 /// what replacing them would lose (another run's results written as
 /// r.views.h5 or r.stress.h5, a file in use, another program's HDF5 file)
