@@ -92,11 +92,18 @@ fn set_in(t: &mut dyn TableLike, segs: &[&str], mut value: Value, key: &str) -> 
         }
         Item::Value(Value::Array(a)) => {
             let n = a.len();
-            let (i, rest) = index(rest, k, n, key)?;
+            let (i, tail) = entry(rest, k, n, key)?;
             match a.get_mut(i).expect("index checked") {
-                Value::InlineTable(tt) => set_in(tt, rest, value, key),
+                Value::InlineTable(_) if tail.is_empty() => Err(whole_table(key)),
+                Value::InlineTable(tt) => set_in(tt, tail, value, key),
+                // An entry of a list of values (mesh.ladder.0=FILE).
+                _ if tail.is_empty() => {
+                    a.replace(i, value);
+                    Ok(())
+                }
                 _ => Err(format!(
-                    "{k}.{i} is a value, not a table; set {k} as a whole"
+                    "{key}: entry {i} of {k} is a value, not a table; set the entry itself, \
+                     without the keys after .{i}"
                 )),
             }
         }
@@ -105,6 +112,26 @@ fn set_in(t: &mut dyn TableLike, segs: &[&str], mut value: Value, key: &str) -> 
 }
 
 fn index<'a>(
+    rest: &'a [&'a str],
+    k: &str,
+    n: usize,
+    key: &str,
+) -> Result<(usize, &'a [&'a str]), String> {
+    let (i, rest) = entry(rest, k, n, key)?;
+    if rest.is_empty() {
+        return Err(whole_table(key));
+    }
+    Ok((i, rest))
+}
+
+/// "`key` names a whole table": --set sets one key of a table.
+fn whole_table(key: &str) -> String {
+    format!("{key} names a whole table; set one of its keys, e.g. {key}.NAME=VALUE")
+}
+
+/// The entry of a list of `n` that `rest` starts with, and the keys after
+/// it.
+fn entry<'a>(
     rest: &'a [&'a str],
     k: &str,
     n: usize,
@@ -120,10 +147,26 @@ fn index<'a>(
             n.saturating_sub(1)
         ));
     }
-    if rest.is_empty() {
-        return Err(format!(
-            "{key} names a whole table; set one of its keys, e.g. {key}.NAME=VALUE"
-        ));
-    }
     Ok((i, rest))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An entry of a list of values is set by its number (mesh.ladder.0 =
+    /// FILE was refused as "a whole table", and the advice that followed,
+    /// mesh.ladder.0.NAME=VALUE, as "a value, not a table").
+    #[test]
+    fn an_entry_of_a_list_of_values_is_set_by_number() {
+        let mut doc: toml_edit::DocumentMut =
+            "[mesh]\nladder = [\"a.msh\", \"b.msh\"]\n".parse().unwrap();
+        apply_set(&mut doc, "mesh.ladder.1=c.msh").unwrap();
+        assert_eq!(doc["mesh"]["ladder"][1].as_str(), Some("c.msh"));
+        assert_eq!(doc["mesh"]["ladder"][0].as_str(), Some("a.msh"));
+        let e = apply_set(&mut doc, "mesh.ladder.2=d.msh").unwrap_err();
+        assert!(e.contains("has 2 entries"), "{e}");
+        let e = apply_set(&mut doc, "mesh.ladder.0.x=1").unwrap_err();
+        assert!(e.contains("is a value, not a table"), "{e}");
+    }
 }
