@@ -5,7 +5,8 @@
 use toml_edit::{Item, TableLike, Value};
 
 /// Applies one `KEY=VALUE` to the document. Keys are dotted paths; a number
-/// after an array of tables picks an entry (`dirichlet.0.uy=0`). A missing
+/// after an array of tables picks an entry (`dirichlet.0.uy=0`), after a
+/// list of values the entry itself (`mesh.ladder.0=a.msh`). A missing
 /// leaf key is added (serde then rejects it if it is not a case key).
 pub(crate) fn apply_set(doc: &mut toml_edit::DocumentMut, set: &str) -> Result<(), String> {
     let (key, val) = set

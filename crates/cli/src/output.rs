@@ -371,6 +371,21 @@ pub(crate) fn stored_group_name(name: &str) -> String {
     }
 }
 
+/// `base`, or where `taken` (two groups of one name: of two dimensions,
+/// unnamed ones "#TAG" of one tag in several, or named so once '/' is
+/// replaced) `base#TAG`, `base#DIM.TAG`, then a count after it.
+fn free_name(base: &str, (dim, tag): (u8, i32), taken: impl Fn(&str) -> bool) -> String {
+    [
+        base.to_string(),
+        format!("{base}#{tag}"),
+        format!("{base}#{dim}.{tag}"),
+    ]
+    .into_iter()
+    .chain((2..).map(|k| format!("{base}#{dim}.{tag}.{k}")))
+    .find(|n| !taken(n))
+    .expect("a free name")
+}
+
 /// [`ResultsWriter::room_needed`] of a file of `n_nodes` nodes, `n_c`
 /// contact nodes and `block_rows` rows a chunk of the node vectors, whose
 /// state has `n_free` values a vector. A new run's file has
@@ -435,11 +450,17 @@ fn put_vector<T: H5Type>(g: &Group, name: &str, v: &[T]) -> Result<()> {
 /// Writes (or rewrites) a scalar attribute.
 fn put_scalar<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<()> {
     if let Ok(a) = loc.attr(name) {
-        if a.write_scalar(&value).is_ok() {
+        let same = a.ndim() == 0
+            && a.dtype()
+                .and_then(|d| d.to_descriptor())
+                .is_ok_and(|d| d == T::type_descriptor());
+        if same {
+            a.write_scalar(&value)?;
             return Ok(());
         }
-        // One of another type (the file changed by another program): a
-        // run that ends writing its summary failed there, after its steps.
+        // One of another type or shape (the file changed by another
+        // program): written into, it failed (text) or converted the value
+        // (an integer dt_crit read 0). Made anew.
         drop(a);
         loc.delete_attr(name)?;
     }
@@ -558,12 +579,9 @@ impl ResultsWriter {
             .create("node_tags")?;
         let groups = g.create_group("groups")?;
         for grp in &mesh.groups {
-            let mut name = stored_group_name(&grp.name);
-            // Two groups of one name (of two dimensions, or named so once
-            // '/' is replaced): the later one by its tag too.
-            if groups.link_exists(&name) {
-                name = format!("{name}#{}", grp.tag);
-            }
+            let name = free_name(&stored_group_name(&grp.name), (grp.dim, grp.tag), |n| {
+                groups.link_exists(n)
+            });
             let ds = groups
                 .new_dataset_builder()
                 .with_data(&index_array(grp.nodes.iter().copied()))
@@ -694,7 +712,10 @@ impl ResultsWriter {
             let ds = file
                 .dataset(name)
                 .map_err(|_| damaged(format!("/{name} is missing")))?;
-            if !ds.is_chunked() || !ds.is_resizable() {
+            let rows_grow = ds
+                .space()
+                .is_ok_and(|sp| sp.maxdims().first().is_some_and(Option::is_none));
+            if !ds.is_chunked() || !rows_grow {
                 return Err(damaged(format!(
                     "/{name} cannot grow (it is not a chunked dataset of unlimited rows)"
                 )));
@@ -2234,5 +2255,20 @@ print("ok")
             "{what} is missing here, and CI must run this check: pip install h5py (cargo xtask test installs it)"
         );
         eprintln!("skipped the h5py check: {what} is missing");
+    }
+
+    /// Unnamed groups of one tag in three dimensions are all "#1": each
+    /// gets a dataset of its own (the third met a name taken twice, and
+    /// the run failed with HDF5's "unknown library error").
+    #[test]
+    fn groups_of_one_name_get_free_dataset_names() {
+        let mut taken: Vec<String> = Vec::new();
+        for dim in [0, 1, 2, 1] {
+            let n = free_name("#1", (dim, 1), |n| taken.iter().any(|t| t == n));
+            taken.push(n);
+        }
+        assert_eq!(taken, ["#1", "#1#1", "#1#2.1", "#1#1.1"]);
+        let n = free_name("x", (1, 1), |n| ["x", "x#1", "x#1.1"].contains(&n));
+        assert_eq!(n, "x#1.1.2");
     }
 }

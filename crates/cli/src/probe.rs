@@ -937,8 +937,33 @@ pub fn along(file: &Path, group: &str, times: &str, field: Field) -> Result<Alon
             (own.unwrap_or_else(|| m.clone()), m)
         })
         .collect();
-    let named = stored.iter().find(|(own, _)| own == group).map(|(_, m)| m);
-    let members = match groups.dataset(named.map_or(group, String::as_str)) {
+    let named: Vec<&String> = stored
+        .iter()
+        .filter(|(own, _)| own == group)
+        .map(|(_, m)| m)
+        .collect();
+    // Several groups of that name (of several dimensions): as the case
+    // refuses such a name, so does --along, naming them.
+    if let [_, _, ..] = named[..] {
+        let which: Vec<String> = named
+            .iter()
+            .map(|m| {
+                let d = groups.dataset(m).ok();
+                let int = |a: &str| {
+                    d.as_ref()
+                        .and_then(|d| d.attr(a).ok()?.read_scalar::<i64>().ok())
+                        .map_or("?".to_string(), |v| v.to_string())
+                };
+                format!("dim {} tag {}", int("dim"), int("tag"))
+            })
+            .collect();
+        return Err(InputError(format!(
+            "{name}: several groups are called {group:?} ({}), so which one is meant is \
+             unknown; rename all but one in the .geo and run the case again",
+            which.join(", ")
+        )));
+    }
+    let members = match groups.dataset(named.first().map_or(group, |m| m.as_str())) {
         Ok(d) => d
             .read_1d::<i64>()
             .map_err(|e| h5(&format!("cannot read /mesh/groups/{group}"), e))?

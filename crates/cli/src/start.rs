@@ -193,7 +193,12 @@ pub(crate) fn resume(
     // time left: an estimate, as the new run's.
     let share = ((case.time.t_end - cp.t) / case.time.t_end).clamp(0.0, 1.0);
     let size = crate::run::output_size(case, mesh.nodes.len(), n_c, n_free).share(share);
-    if let Some(free) = size.short_of_room_beside(out) {
+    // A restart to the checkpoint's own time adds no step (`conclude`
+    // checks the room where it adds a frame).
+    if let Some(free) = size
+        .short_of_room_beside(out)
+        .filter(|_| !integrator.done())
+    {
         use crate::run::human_bytes;
         return Err(input(format!(
             "{}: --restart {}: the rest of the run (t = {} to {}) would add about {} frames and \

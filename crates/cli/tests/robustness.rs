@@ -1842,7 +1842,7 @@ fn closed_pipes_neither_panic_nor_end_a_run() {
 /// elsewhere.
 #[test]
 fn a_disk_that_fills_up_stops_the_run_with_its_records() {
-    use std::io::{BufRead, BufReader, Read, Write};
+    use std::io::{BufRead, BufReader, Read};
     let dir = scratch("disk-full");
     let Some(disk) = tmpfs(&dir, "disk", "size=200M") else {
         return;
@@ -1876,23 +1876,7 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
         }
     }
     signal(&child, "-STOP");
-    let avail = Command::new("df")
-        .args(["--output=avail", "-B1"])
-        .arg(&disk)
-        .output()
-        .unwrap();
-    let avail: u64 = String::from_utf8_lossy(&avail.stdout)
-        .lines()
-        .nth(1)
-        .and_then(|l| l.trim().parse().ok())
-        .unwrap_or(0);
-    let filler = disk.join("filler");
-    let mut f = std::fs::File::create(&filler).unwrap();
-    let block = vec![1u8; 1 << 20];
-    for _ in 0..avail.saturating_sub(6 << 20) >> 20 {
-        f.write_all(&block).unwrap();
-    }
-    drop(f);
+    let filler = fill_leaving(&disk, 6 << 20);
     signal(&child, "-CONT");
     err.read_to_string(&mut said).unwrap();
     let status = child.wait().unwrap();
@@ -1925,6 +1909,29 @@ fn a_disk_that_fills_up_stops_the_run_with_its_records() {
         .count();
     assert_eq!(zero, 0, "records of zeros among {rows}");
     assert_eq!(again.status.code(), Some(0), "{}", stderr(&again));
+}
+
+/// A file `filler` on `disk` that leaves about `left` bytes of it free
+/// (`df`'s count, in whole MiB).
+fn fill_leaving(disk: &Path, left: u64) -> PathBuf {
+    use std::io::Write;
+    let avail = Command::new("df")
+        .args(["--output=avail", "-B1"])
+        .arg(disk)
+        .output()
+        .unwrap();
+    let avail: u64 = String::from_utf8_lossy(&avail.stdout)
+        .lines()
+        .nth(1)
+        .and_then(|l| l.trim().parse().ok())
+        .unwrap_or(0);
+    let filler = disk.join("filler");
+    let mut f = std::fs::File::create(&filler).unwrap();
+    let block = vec![1u8; 1 << 20];
+    for _ in 0..avail.saturating_sub(left) >> 20 {
+        f.write_all(&block).unwrap();
+    }
+    filler
 }
 
 /// The slab's case in the scratch directory `name` and a 6 MB tmpfs
@@ -2287,6 +2294,11 @@ fn a_restart_its_disk_cannot_hold_is_refused_and_the_file_kept() {
     let refused = restart(&case, &out, &["--set", "time.t_end=2"]);
     let after = std::fs::read(&out).ok();
     let fits = restart(&case, &out, &["--set", "time.t_end=0.2"]);
+    // A restart to its checkpoint's own time adds no step: it needs none
+    // of the room a run keeps (it was refused on a nearly full disk).
+    let filler = fill_leaving(&small, 2 << 20);
+    let no_step = restart(&case, &out, &["--set", "time.t_end=0.199"]);
+    std::fs::remove_file(filler).ok();
     Command::new("umount").arg(&small).status().ok();
     assert_eq!(first.status.code(), Some(0), "{}", stderr(&first));
     let e = stderr(&refused);
@@ -2300,6 +2312,7 @@ fn a_restart_its_disk_cannot_hold_is_refused_and_the_file_kept() {
         "the refused restart changed the file"
     );
     assert_eq!(fits.status.code(), Some(0), "{}", stderr(&fits));
+    assert_eq!(no_step.status.code(), Some(0), "{}", stderr(&no_step));
 }
 
 /// Physical group names HDF5 cannot take as link names ("" and "."), a
@@ -2344,6 +2357,33 @@ fn group_names_hdf5_cannot_take_are_stored_under_others() {
         assert_eq!(o.status.code(), Some(0), "{said}");
         assert!(said.contains("5 nodes"), "{said}");
     }
+    // Two datasets that name one group (a file another program added
+    // to): --along refuses the name, as the case refuses a mesh's.
+    let out = dir.join("r.h5");
+    {
+        let f = hdf5::File::open_rw(&out).unwrap();
+        let g = f.group("mesh/groups").unwrap();
+        let nodes = g.dataset("contact").unwrap().read_raw::<i64>().unwrap();
+        let ds = g
+            .new_dataset_builder()
+            .with_data(&nodes)
+            .create("other")
+            .unwrap();
+        ds.new_attr::<hdf5::types::VarLenUnicode>()
+            .create("name")
+            .unwrap()
+            .write_scalar(&"contact".parse::<hdf5::types::VarLenUnicode>().unwrap())
+            .unwrap();
+    }
+    let o = bin()
+        .arg("probe")
+        .arg(&out)
+        .args(["--along", "contact", "--field", "ux", "--times", "0"])
+        .output()
+        .unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("several groups are called \"contact\""), "{e}");
 }
 
 /// A results file whose /contact/lines or /mesh/nodes is damaged (another

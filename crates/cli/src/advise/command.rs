@@ -174,7 +174,13 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
     if let Some(w) = &o.write {
         let header = report::write_header(o, c, &est.ladder);
         let text = adjusted_case(case, c, &est.ladder, w, &header)?;
-        match std::fs::write(w, text) {
+        // A new file only, even if one appeared while the pilots ran.
+        let written = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(w)
+            .and_then(|mut f| std::io::Write::write_all(&mut f, text.as_bytes()));
+        match written {
             // The place (a read-only file system, a link or directory put
             // there since): the user's to change, exit 2.
             Err(e) if crate::sys::place_error(&e) => {
