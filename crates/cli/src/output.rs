@@ -935,14 +935,20 @@ impl ResultsWriter {
     }
 
     /// Bytes the file may need before the next flush has written its
-    /// records and checkpoint, with room to spare: twice the records since
-    /// the last flush and a checkpoint of `n_free` values a vector, and
-    /// 1 MiB for HDF5's own structures. A run stops while the disk has
-    /// that much free (`stickslip run`): on a full disk HDF5's flush fails
-    /// half way, and rows flushed before, in a chunk it rewrote, read as
-    /// zeros.
+    /// records and checkpoint, with room to spare: [`room_kept`] (the
+    /// next write's chunks and a checkpoint of `n_free` values a vector,
+    /// twice, and 1 MiB for HDF5's own structures) and the records
+    /// appended since the last flush, which that flush may write again
+    /// (HDF5 gives chunks their place in the file there: a restart that
+    /// never flushed wrote 9 MB in its final flush, after a last check of
+    /// 4.4 MB). A run stops while the disk has less free (`stickslip
+    /// run`): on a full disk HDF5's flush fails half way, and rows flushed
+    /// before, in a chunk it rewrote, read as zeros, or the file does not
+    /// open at all.
     pub fn room_needed(&self, n_free: usize) -> u64 {
-        room_kept(self.n_nodes, self.n_c, self.block_rows, n_free)
+        let unflushed = (self.frames - self.flushed.1.min(self.frames)) * self.row_bytes(true)
+            + (self.rows - self.flushed.0.min(self.rows)) * self.row_bytes(false);
+        room_kept(self.n_nodes, self.n_c, self.block_rows, n_free) + unflushed as u64
     }
 
     /// Whether the next [`ResultsWriter::append`], of a frame if `frame`,
