@@ -591,23 +591,28 @@ fn shell_word(s: &str) -> String {
 /// explicit run is declared unstable (see [`blow_up`]).
 const BLOW_UP_FACTOR: f64 = 10.0;
 
-/// Energy blow-up of an explicit run (issue 8).
+/// Energy blow-up of an explicit run.
 ///
-/// The energy ledger (METHOD.md §6) says kinetic + strain = E₀ + W − D with
-/// D ≥ 0, so kinetic + strain ≤ E₀ + |W| + D for any run the scheme follows
-/// faithfully; a stable central-difference run breaks this only by its
+/// The energy ledger (METHOD.md §6) says kinetic + strain = E₀ + W − D +
+/// W_f less what damping and a compliant foundation take, with D ≥ 0 and
+/// W_f the work of a moving foundation (a belt, METHOD.md §9), so the
+/// mechanical energy is at most E₀ + |W| + D + |W_f| for any run the
+/// scheme follows faithfully (without W_f a part a belt carries along,
+/// its work stored as strain, was stopped as unstable); a stable central-difference run breaks this only by its
 /// O(Δt²) energy error. Past Δt_crit the highest mode grows by |λ|² per step,
 /// λ the larger root of λ² − (2 − ω²Δt²)λ + 1 = 0 (|λ|² = 1.8 at ωΔt = 2.02,
 /// 5.9 at ωΔt = 2.2), from round-off: a growth that must cross any fixed
 /// multiple of the physical bound within a few steps of reaching it, while
 /// W grows only linearly in the amplitude (R·Δr) and the energies
-/// quadratically. Hence the test kinetic + strain > 10 (E₀ + |W| + D): the
+/// quadratically. Hence the test kinetic + strain > 10 (E₀ + |W| + D +
+/// |W_f|): the
 /// factor 10 leaves the stable scheme's error far behind and costs about
 /// log(10)/log(|λ|²) ≈ 1.3 to 4 steps of detection delay.
 fn blow_up(i: &Integrator, initial: f64) -> Option<f64> {
     let e = i.energy();
     let mechanical = e.kinetic + e.strain;
-    let bound = BLOW_UP_FACTOR * (initial.abs() + e.external_work.abs() + e.dissipated.abs());
+    let bound = BLOW_UP_FACTOR
+        * (initial.abs() + e.external_work.abs() + e.dissipated.abs() + e.foundation.abs());
     (mechanical > bound && mechanical > f64::MIN_POSITIVE).then_some(bound)
 }
 
@@ -1277,12 +1282,27 @@ fn blow_up_failure(i: &Integrator, bound: f64, case: &Case) -> String {
     // Below Δt_crit only a foundation stiffening with the approach
     // (m_n > 1, whose bound time.allow_unstable let the run pass) makes
     // the step unstable.
+    let compliant = case
+        .contact
+        .iter()
+        .any(|c| c.law == stickslip_case::schema::ContactLaw::Compliance);
     let why = if case.time.dt > crit || crit.is_nan() {
         format!(
             "central difference is unstable at time.dt = {:e}, above its critical step dt_crit = \
              {crit:.6e}: use time.dt < {crit:.4e} (e.g. {:.4e}) and remove time.allow_unstable",
             case.time.dt,
             0.9 * crit
+        )
+    } else if !compliant {
+        // Below Δt_crit and without a foundation that stiffens: no step of
+        // the scheme's own grows; the contact's terms did (a reduced step
+        // far below Δt, a regularization eps far below the slip speeds).
+        format!(
+            "the step time.dt = {:e} is below central difference's critical step dt_crit = \
+             {crit:.6e}, so the growth came from the contact's terms: check contact.eps and \
+             time.stick_reduction (a reduced step far below time.dt), or run the case with \
+             time.scheme = \"newmark\"",
+            case.time.dt
         )
     } else {
         format!(
@@ -1294,7 +1314,7 @@ fn blow_up_failure(i: &Integrator, bound: f64, case: &Case) -> String {
         )
     };
     format!(
-        "step {} (t = {:.6e}): energy blow-up: kinetic + strain = {:.3e} exceeds {BLOW_UP_FACTOR} x (initial + |work| + dissipated) = {bound:.3e}; {why}",
+        "step {} (t = {:.6e}): energy blow-up: kinetic + strain = {:.3e} exceeds {BLOW_UP_FACTOR} x (initial + |work| + dissipated + |foundation work|) = {bound:.3e}; {why}",
         i.steps(),
         i.time(),
         e.kinetic + e.strain,
