@@ -26,6 +26,14 @@ use crate::locate::{line_col, Locator};
 use crate::schema::{Case, ContactLaw, History, MassKind, Mu, Scheme, ROOT};
 use crate::set::{apply_set, field_rule};
 
+/// The shortest reduced step (`time.stick_reduction.dt`) as a fraction of
+/// `time.dt`. Newmark's energy balance on the paper's slab (Δt = 1e-3,
+/// energy about 336) with reduced steps of this fraction of Δt: 4e-10 at
+/// 1e-5, 9e-7 at 1e-9, 7e-3 at 1e-12, 81 at 1e-15, and at 1e-17 the
+/// energy grew to 8e13 while the run went on to its end
+/// (docs/case-file.md).
+pub const REDUCTION_MIN_RATIO: f64 = 1e-9;
+
 /// Reads, overrides (`--set KEY=VALUE`, VALUE parsed as TOML, else taken as a
 /// string) and validates a case file.
 ///
@@ -702,6 +710,20 @@ fn complete(
                 "time.stick_reduction.dt = {} must be > 0 and <= time.dt = {}",
                 Num(r.dt),
                 Num(dt)
+            ),
+        );
+        // A reduced step whose velocity update divides differences at
+        // round-off (REDUCTION_MIN_RATIO).
+        check(
+            !(r.dt > 0.0 && r.dt < REDUCTION_MIN_RATIO * dt),
+            "time.stick_reduction.dt",
+            format!(
+                "time.stick_reduction.dt = {} is below {REDUCTION_MIN_RATIO:e} x time.dt = {}: \
+                 steps that short compute velocities from differences at round-off; use at \
+                 least {:.1e} (the paper's reduced steps are 1e-4 of its Δt)",
+                Num(r.dt),
+                Num(dt),
+                REDUCTION_MIN_RATIO * dt
             ),
         );
         check(
@@ -1724,5 +1746,30 @@ t_end = 0.5
         );
         let e = load(Path::new("/dev/null"), &[]).unwrap_err().0;
         assert!(e.contains("not a regular file"), "{e}");
+    }
+
+    /// A reduced step below REDUCTION_MIN_RATIO of Δt is refused by name
+    /// (1e-20 with Δt = 1e-3 ran Newmark to its end with an energy of
+    /// 8e13); 1e-7, the paper's 1e-4 of Δt, passes.
+    #[test]
+    fn a_reduced_step_at_round_off_is_refused() {
+        let e = load_text(
+            "reduction",
+            GOOD,
+            &["time.stick_reduction={ dt = 1e-20, steps = 10 }"],
+        )
+        .unwrap_err()
+        .0;
+        assert!(
+            e.contains("time.stick_reduction.dt = 1e-20 is below 1e-9")
+                && e.contains("use at least 1.0e-12"),
+            "{e}"
+        );
+        assert!(load_text(
+            "reduction-paper",
+            GOOD,
+            &["time.stick_reduction={ dt = 1e-7, steps = 10 }"],
+        )
+        .is_ok());
     }
 }
