@@ -325,7 +325,8 @@ pub enum TimeError {
     #[error(
         "step {step} (t = {t:.6e}): the stick/slip iteration did not converge in {iterations} \
          iterations ({changing} nodes still changing class); {hint}raise contact.max_iterations, \
-         or reduce time.dt"
+         reduce time.dt, or raise contact.eps (a regularization far below the slip speeds makes \
+         the law a step that the iteration can cycle on)"
     )]
     IterationCap {
         /// Step number (1-based).
@@ -354,7 +355,8 @@ pub enum TimeError {
     #[error(
         "step {step} (t = {t:.6e}): the normal-compliance Newton solve did not converge in \
          {iterations} iterations (residual {residual:.3e} of scale {scale:.3e}); reduce time.dt, \
-         or soften the foundation (contact.cn)"
+         soften the foundation (contact.cn), raise contact.eps, or ramp a load that comes in \
+         whole at its first step (a table history from 0: no step is short enough for it)"
     )]
     NormalSolve {
         /// Step number (1-based).
