@@ -223,7 +223,7 @@ pub fn check(case: &Case) -> anyhow::Result<String> {
     // Remark 4.1 ran in its setup): the run's warning, before the run.
     let mut u = vec![0.0; 2 * p.mesh.nodes.len()];
     p.model.dofs.expand(i.displacement(), &mut u);
-    for w in setup_warnings(&p.mesh, &p.model.dofs, &u, i) {
+    for w in setup_warnings(case, &p.mesh, &p.model.dofs, &u, i) {
         put!("warning     {w}");
     }
     Ok(report)

@@ -75,7 +75,7 @@ pub(crate) fn fresh(
     writer.append(&record(integrator, dofs, full, (0.0, 0), true))?;
     // Kept in the file and printed with --quiet too: quiet silences
     // progress, not what the user should know.
-    let warnings = setup_warnings(mesh, dofs, &full.u, integrator);
+    let warnings = setup_warnings(case, mesh, dofs, &full.u, integrator);
     for w in &warnings {
         say!("{}: warning: {w}", case.path.display());
     }

@@ -2540,6 +2540,37 @@ fn a_belt_that_strains_a_held_part_is_no_blow_up() {
     ok(&run(&case, &dir.join("r.h5"), &[]));
 }
 
+/// Mass-proportional damping the step cannot resolve (alpha·dt > 2) is
+/// warned of by `check` and `run`: a floating slab at alpha = 1e7 kept
+/// 67% of its kinetic energy, its velocity changing sign every step,
+/// without a word. Below, no warning.
+#[test]
+fn damping_the_step_cannot_resolve_is_warned_of() {
+    let dir = scratch("overdamped");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let said = |alpha: &str| {
+        let o = check(&case, &[&format!("material.damping={{ alpha = {alpha} }}")]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let over = said("1e7");
+    assert!(
+        over.contains("warning") && over.contains("alpha·dt = 1.000e4 > 2"),
+        "{over}"
+    );
+    assert!(
+        !said("1e3").contains("alpha·dt"),
+        "no warning at alpha·dt = 1"
+    );
+    let o = run(
+        &case,
+        &dir.join("r.h5"),
+        &["--set", "material.damping={ alpha = 1e7 }"],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("alpha·dt"), "{}", stderr(&o));
+}
+
 /// Files that only bear the names of a results file's companions and hold
 /// what replacing them would lose (another run's results written as
 /// r.views.h5 or r.stress.h5, a file in use, another program's HDF5 file)
