@@ -319,6 +319,11 @@ const HISTORY_BLOCK: usize = SERIES_CHUNK;
 /// than the steps when made at every chunk's end (docs/performance.md).
 const PENDING_BYTES: usize = 1 << 20;
 
+/// The growing series of a results file: time, u, v, a, the frames' time
+/// and row, the energies, dt and the iterations, and four of the contact
+/// (HDF5 keeps up to 1 MiB of each one's chunks in its cache).
+const SERIES_COUNT: usize = 4 + 2 + ENERGY_NAMES.len() + 2 + 4;
+
 /// Rows per chunk along time so that a chunk stays within HDF5's default
 /// 1 MiB chunk cache (a partly written chunk then stays in memory instead of
 /// being re-read and re-compressed on every append).
@@ -388,10 +393,11 @@ fn free_name(base: &str, (dim, tag): (u8, i32), taken: impl Fn(&str) -> bool) ->
 
 /// [`ResultsWriter::room_needed`] of a file of `n_nodes` nodes, `n_c`
 /// contact nodes and `block_rows` rows a chunk of the node vectors, whose
-/// state has `n_free` values a vector. A new run's file has
-/// [`vector_chunk_rows`] of them: `stickslip run` and `check` count it
-/// before the run, so that a run the disk cannot hold with this room kept
-/// is refused at the start rather than stopped part way.
+/// state has `n_free` values a vector, less the records not yet flushed.
+/// A new run's file has [`vector_chunk_rows`] of them: `stickslip run`
+/// and `check` count it before the run, so that a run the disk cannot hold
+/// with this room kept is refused at the start rather than stopped part
+/// way (near a full disk the records not yet flushed may still stop it).
 pub(crate) fn room_kept(n_nodes: usize, n_c: usize, block_rows: usize, n_free: usize) -> u64 {
     // The rows go to the datasets a chunk at a time (whole chunks are
     // allocated), so the next write may take a chunk of every series.
@@ -938,17 +944,24 @@ impl ResultsWriter {
     /// records and checkpoint, with room to spare: [`room_kept`] (the
     /// next write's chunks and a checkpoint of `n_free` values a vector,
     /// twice, and 1 MiB for HDF5's own structures) and the records
-    /// appended since the last flush, which that flush may write again
-    /// (HDF5 gives chunks their place in the file there: a restart that
-    /// never flushed wrote 9 MB in its final flush, after a last check of
-    /// 4.4 MB). A run stops while the disk has less free (`stickslip
+    /// appended since the last flush, up to what HDF5's chunk caches hold,
+    /// which that flush may write again (HDF5 gives cached chunks their
+    /// place in the file there: a restart that never flushed wrote 9 MB in
+    /// its final flush, after a last check of 4.4 MB). The check before a
+    /// run counts [`room_kept`] only: a run it admits on a nearly full
+    /// disk may stop near its end, its records kept. A run stops while the disk has less free (`stickslip
     /// run`): on a full disk HDF5's flush fails half way, and rows flushed
     /// before, in a chunk it rewrote, read as zeros, or the file does not
     /// open at all.
     pub fn room_needed(&self, n_free: usize) -> u64 {
-        let unflushed = (self.frames - self.flushed.1.min(self.frames)) * self.row_bytes(true)
+        // At most what HDF5's chunk caches hold (1 MiB a series; larger
+        // chunks bypass them and are on disk already). A frame's row is
+        // among the rows too: its fields only are added per frame.
+        let fields = self.row_bytes(true) - self.row_bytes(false);
+        let unflushed = (self.frames - self.flushed.1.min(self.frames)) * fields
             + (self.rows - self.flushed.0.min(self.rows)) * self.row_bytes(false);
-        room_kept(self.n_nodes, self.n_c, self.block_rows, n_free) + unflushed as u64
+        let cached = SERIES_COUNT * (1 << 20);
+        room_kept(self.n_nodes, self.n_c, self.block_rows, n_free) + unflushed.min(cached) as u64
     }
 
     /// Whether the next [`ResultsWriter::append`], of a frame if `frame`,

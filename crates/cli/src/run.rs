@@ -144,7 +144,8 @@ pub(crate) struct OutputSize {
     /// Bytes, uncompressed.
     pub(crate) bytes: f64,
     /// Bytes the run keeps free beside them while it writes
-    /// ([`output::room_kept`]): it stops where the disk has less.
+    /// ([`output::room_kept`]): it stops where the disk has less, or less
+    /// than that and the records not yet flushed (`room_needed`).
     pub(crate) kept: f64,
 }
 
@@ -310,25 +311,32 @@ pub(crate) fn setup_warnings(
         .collect()
 }
 
-/// Mass-proportional damping the step cannot resolve, if so: where
-/// alpha·Δt > 2 the schemes' factor (1 − αΔt/2)/(1 + αΔt/2) a step for a
-/// motion alpha damps is negative and tends to −1 as alpha grows, so the
-/// velocity changes sign every step and more alpha decays it less (at
-/// alpha = 1e7, Δt = 1e-3 a floating slab kept 67% of its kinetic energy
-/// where alpha = 1e4 took all of it).
+/// Mass-proportional damping the step cannot resolve, if so: a motion
+/// alpha damps keeps (1 − (1−γ)αΔt)/(1 + γαΔt) of its velocity a step
+/// (γ = ½ in central difference), which is negative where αΔt > 1/(1−γ)
+/// and tends to −(1−γ)/γ as alpha grows, so the velocity changes sign
+/// every step and more alpha decays it less (at alpha = 1e7, Δt = 1e-3 a
+/// floating slab kept 67% of its kinetic energy where alpha = 1e4 took
+/// all of it).
 fn overdamped(case: &Case) -> Option<String> {
     let alpha = case.material.damping.map_or(0.0, |d| d.alpha);
     let dt = case.time.dt;
-    (case.time.scheme != case::Scheme::QuasiStatic && alpha * dt > 2.0).then(|| {
-        let factor = (1.0 - 0.5 * alpha * dt) / (1.0 + 0.5 * alpha * dt);
+    let gamma = match case.time.scheme {
+        case::Scheme::QuasiStatic => return None,
+        case::Scheme::CentralDifference => 0.5,
+        case::Scheme::Newmark => case.time.gamma,
+    };
+    let limit = 1.0 / (1.0 - gamma);
+    (alpha * dt > limit).then(|| {
+        let factor = (1.0 - (1.0 - gamma) * alpha * dt) / (1.0 + gamma * alpha * dt);
         format!(
-            "material.damping alpha = {alpha:e} with time.dt = {dt:e} gives alpha·dt = {:.3e} > 2: \
-             a motion alpha damps changes sign every step and keeps {factor:.3} of its velocity a \
-             step (e^(-alpha·dt) = {:.3e} in the equation); reduce time.dt below 2/alpha = {:.3e}, \
+            "material.damping alpha = {alpha:e} with time.dt = {dt:e} gives alpha·dt = {:.3e} > \
+             {limit}: a motion alpha damps changes sign every step and keeps {factor:.3} of its \
+             velocity a step (e^(-alpha·dt) = {:.3e} in the equation); reduce time.dt below {:.3e}, \
              or lower alpha",
             alpha * dt,
             (-alpha * dt).exp(),
-            2.0 / alpha
+            limit / alpha
         )
     })
 }
@@ -1307,10 +1315,12 @@ fn blow_up_failure(i: &Integrator, bound: f64, case: &Case) -> String {
     // Below Δt_crit only a foundation stiffening with the approach
     // (m_n > 1, whose bound time.allow_unstable let the run pass) makes
     // the step unstable.
-    let compliant = case
-        .contact
-        .iter()
-        .any(|c| c.law == stickslip_case::schema::ContactLaw::Compliance);
+    // Only a foundation stiffening with the approach (m_n > 1), whose
+    // growth time.allow_unstable let pass, outgrows a step below dt_crit.
+    let stiffening = case.time.allow_unstable
+        && case.contact.iter().any(|c| {
+            c.law == stickslip_case::schema::ContactLaw::Compliance && c.mn.unwrap_or(1.0) > 1.0
+        });
     let why = if case.time.dt > crit || crit.is_nan() {
         format!(
             "central difference is unstable at time.dt = {:e}, above its critical step dt_crit = \
@@ -1318,7 +1328,14 @@ fn blow_up_failure(i: &Integrator, bound: f64, case: &Case) -> String {
             case.time.dt,
             0.9 * crit
         )
-    } else if !compliant {
+    } else if !stiffening && case.contact.is_empty() {
+        format!(
+            "the step time.dt = {:e} is below central difference's critical step dt_crit = \
+             {crit:.6e}, so the growth did not come from the step: check the loads and \
+             material.damping",
+            case.time.dt
+        )
+    } else if !stiffening {
         // Below Δt_crit and without a foundation that stiffens: no step of
         // the scheme's own grows; the contact's terms did (a reduced step
         // far below Δt, a regularization eps far below the slip speeds).
