@@ -212,7 +212,7 @@ pub fn check(case: &Case) -> anyhow::Result<String> {
         size.rows,
         human_bytes(size.bytes)
     );
-    if let Some(free) = size.short_of_room(&case.output.file) {
+    if let Some(free) = size.short_of_room(&case.output.file, true) {
         put!(
             "warning     with the {} a run keeps free while it writes, that needs more than the {} free on its disk: `run` refuses it; write fewer frames (output.frames, output.interval, output.every) or elsewhere (-o)",
             human_bytes(size.kept),

@@ -296,6 +296,10 @@ fn scalar_attr<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<
 /// `output.compression = 1..9` turns it on.
 pub const DEFLATE_LEVEL: u8 = 0;
 
+/// The energies files of earlier versions lack (damping, moving and
+/// compliant foundations): a restart makes them, their earlier rows 0.
+const ADDED_ENERGIES: [&str; 3] = ["damped", "foundation", "foundation_stored"];
+
 /// Names of the `/energy` series, in [`Record`] order.
 pub(crate) const ENERGY_NAMES: [&str; 9] = [
     "kinetic",
@@ -696,11 +700,10 @@ impl ResultsWriter {
         ]
         .map(String::from)
         .to_vec();
-        let optional = ["damped", "foundation", "foundation_stored"];
         names.extend(
             ENERGY_NAMES
                 .iter()
-                .filter(|n| !optional.contains(n) || file.link_exists(&format!("energy/{n}")))
+                .filter(|n| !ADDED_ENERGIES.contains(n) || file.link_exists(&format!("energy/{n}")))
                 .map(|n| format!("energy/{n}")),
         );
         if file.link_exists("frames") {
@@ -799,9 +802,7 @@ impl ResultsWriter {
             // before moving foundations /energy/foundation, nor before
             // compliant ones /energy/foundation_stored: made here, the
             // resize below gives their rows the fill value 0.
-            if matches!(name, "damped" | "foundation" | "foundation_stored")
-                && !file.link_exists(&at)
-            {
+            if ADDED_ENERGIES.contains(&name) && !file.link_exists(&at) {
                 energy.push(series_1d::<f64>(&file.group("energy")?, name, 0)?);
                 continue;
             }
@@ -949,10 +950,10 @@ impl ResultsWriter {
     /// place in the file there: a restart that never flushed wrote 9 MB in
     /// its final flush, after a last check of 4.4 MB). The check before a
     /// run counts [`room_kept`] only: a run it admits on a nearly full
-    /// disk may stop near its end, its records kept. A run stops while the disk has less free (`stickslip
-    /// run`): on a full disk HDF5's flush fails half way, and rows flushed
-    /// before, in a chunk it rewrote, read as zeros, or the file does not
-    /// open at all.
+    /// disk may stop near its end, its records kept. A run stops while the
+    /// disk has less free (`stickslip run`): on a full disk HDF5's flush
+    /// fails half way, and rows flushed before, in a chunk it rewrote, read
+    /// as zeros, or the file does not open at all.
     pub fn room_needed(&self, n_free: usize) -> u64 {
         // At most what HDF5's chunk caches hold (1 MiB a series; larger
         // chunks bypass them and are on disk already). A frame's row is

@@ -151,10 +151,11 @@ pub(crate) struct OutputSize {
 
 impl OutputSize {
     /// The disk's free bytes for `out` ([`room_for`], with what `--force`
-    /// removes), where they cannot hold the records and the room the run
-    /// keeps: such a run would stop part way, at a nearly full disk.
-    pub(crate) fn short_of_room(&self, out: &Path) -> Option<u64> {
-        room_for(out, true).filter(|&free| self.bytes + self.kept > free as f64)
+    /// removes where `replacing`, not where the records are added to it,
+    /// as a restart's), where they cannot hold the records and the room
+    /// the run keeps: such a run would stop part way, at a nearly full disk.
+    pub(crate) fn short_of_room(&self, out: &Path, replacing: bool) -> Option<u64> {
+        room_for(out, replacing).filter(|&free| self.bytes + self.kept > free as f64)
     }
 
     /// The part `share` of the records (a restart's rest of the run), with
@@ -166,12 +167,6 @@ impl OutputSize {
             bytes: self.bytes * share,
             kept: self.kept,
         }
-    }
-
-    /// [`OutputSize::short_of_room`] for records added to `out`, which
-    /// stays (a restart).
-    pub(crate) fn short_of_room_beside(&self, out: &Path) -> Option<u64> {
-        room_for(out, false).filter(|&free| self.bytes + self.kept > free as f64)
     }
 }
 
@@ -631,16 +626,15 @@ const BLOW_UP_FACTOR: f64 = 10.0;
 /// W_f the work of a moving foundation (a belt, METHOD.md §9), so the
 /// mechanical energy is at most E₀ + |W| + D + |W_f| for any run the
 /// scheme follows faithfully (without W_f a part a belt carries along,
-/// its work stored as strain, was stopped as unstable); a stable central-difference run breaks this only by its
-/// O(Δt²) energy error. Past Δt_crit the highest mode grows by |λ|² per step,
+/// its work stored as strain, was stopped as unstable); a stable
+/// central-difference run breaks this only by its O(Δt²) energy error. Past Δt_crit the highest mode grows by |λ|² per step,
 /// λ the larger root of λ² − (2 − ω²Δt²)λ + 1 = 0 (|λ|² = 1.8 at ωΔt = 2.02,
 /// 5.9 at ωΔt = 2.2), from round-off: a growth that must cross any fixed
 /// multiple of the physical bound within a few steps of reaching it, while
 /// W grows only linearly in the amplitude (R·Δr) and the energies
 /// quadratically. Hence the test kinetic + strain > 10 (E₀ + |W| + D +
-/// |W_f|): the
-/// factor 10 leaves the stable scheme's error far behind and costs about
-/// log(10)/log(|λ|²) ≈ 1.3 to 4 steps of detection delay.
+/// |W_f|): the factor 10 leaves the stable scheme's error far behind and
+/// costs about log(10)/log(|λ|²) ≈ 1.3 to 4 steps of detection delay.
 fn blow_up(i: &Integrator, initial: f64) -> Option<f64> {
     let e = i.energy();
     let mechanical = e.kinetic + e.strain;
@@ -704,7 +698,7 @@ fn run_scene(
     // starts, where the run's own stop at a full disk would come late.
     if !options.restart {
         let size = output_size(case, mesh.nodes.len(), n_c, dofs.n_free());
-        if let Some(free) = size.short_of_room(out) {
+        if let Some(free) = size.short_of_room(out, true) {
             return Err(input(format!(
                 "{}: the run would write about {} frames and {} rows ({}) to {} and keeps {} free beside \
                  them while it writes (it stops at a nearly full disk, before HDF5 fails mid-write), \
@@ -1312,9 +1306,6 @@ pub(crate) fn forget_companions(out: &Path, quiet: bool) {
 fn blow_up_failure(i: &Integrator, bound: f64, case: &Case) -> String {
     let e = i.energy();
     let crit = i.dt_crit().unwrap_or(f64::NAN);
-    // Below Δt_crit only a foundation stiffening with the approach
-    // (m_n > 1, whose bound time.allow_unstable let the run pass) makes
-    // the step unstable.
     // Only a foundation stiffening with the approach (m_n > 1), whose
     // growth time.allow_unstable let pass, outgrows a step below dt_crit.
     let stiffening = case.time.allow_unstable
@@ -1328,22 +1319,20 @@ fn blow_up_failure(i: &Integrator, bound: f64, case: &Case) -> String {
             case.time.dt,
             0.9 * crit
         )
-    } else if !stiffening && case.contact.is_empty() {
-        format!(
-            "the step time.dt = {:e} is below central difference's critical step dt_crit = \
-             {crit:.6e}, so the growth did not come from the step: check the loads and \
-             material.damping",
-            case.time.dt
-        )
     } else if !stiffening {
-        // Below Δt_crit and without a foundation that stiffens: no step of
-        // the scheme's own grows; the contact's terms did (a reduced step
-        // far below Δt, a regularization eps far below the slip speeds).
+        // Below Δt_crit and without a foundation that stiffens no step of
+        // the scheme's own grows: the contact's terms did (a reduced step
+        // far below Δt, a regularization eps far below the slip speeds), or
+        // without contact the loads or the damping.
+        let from = if case.contact.is_empty() {
+            "did not come from the step: check the loads and material.damping"
+        } else {
+            "came from the contact's terms: check contact.eps and time.stick_reduction (a \
+             reduced step far below time.dt), or run the case with time.scheme = \"newmark\""
+        };
         format!(
             "the step time.dt = {:e} is below central difference's critical step dt_crit = \
-             {crit:.6e}, so the growth came from the contact's terms: check contact.eps and \
-             time.stick_reduction (a reduced step far below time.dt), or run the case with \
-             time.scheme = \"newmark\"",
+             {crit:.6e}, so the growth {from}",
             case.time.dt
         )
     } else {

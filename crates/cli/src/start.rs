@@ -196,7 +196,7 @@ pub(crate) fn resume(
     // A restart to the checkpoint's own time adds no step (`conclude`
     // checks the room where it adds a frame).
     if let Some(free) = size
-        .short_of_room_beside(out)
+        .short_of_room(out, false)
         .filter(|_| !integrator.done())
     {
         use crate::run::human_bytes;
