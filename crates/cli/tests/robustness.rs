@@ -2388,6 +2388,13 @@ fn group_names_hdf5_cannot_take_are_stored_under_others() {
     assert!(e.contains("several groups are called \"contact\""), "{e}");
 }
 
+/// A copy `to` of the results file `from`, changed by `edit` as another
+/// program would change it.
+fn edited_copy(from: &Path, to: &Path, edit: impl FnOnce(&hdf5::File)) {
+    std::fs::copy(from, to).unwrap();
+    edit(&hdf5::File::open_rw(to).unwrap());
+}
+
 /// A results file whose /contact/lines or /mesh/nodes is damaged (another
 /// shape) is named by `views` and `stress` with the dataset, exit 2: for
 /// /contact/lines they printed HDF5's "ndim mismatch" alone and exited 1.
@@ -2399,16 +2406,14 @@ fn views_and_stress_name_a_damaged_dataset_of_the_file() {
     ok(&run(&case, &r, &["--set", "time.t_end=0.01"]));
     for dataset in ["contact/lines", "mesh/nodes"] {
         let damaged = dir.join("damaged.h5");
-        std::fs::copy(&r, &damaged).unwrap();
-        {
-            let f = hdf5::File::open_rw(&damaged).unwrap();
+        edited_copy(&r, &damaged, |f| {
             let flat = f.dataset(dataset).unwrap().read_raw::<f64>().unwrap();
             f.unlink(dataset).unwrap();
             f.new_dataset_builder()
                 .with_data(&flat)
                 .create(dataset)
                 .unwrap();
-        }
+        });
         for command in ["views", "stress"] {
             let o = bin().arg(command).arg(&damaged).output().unwrap();
             let e = stderr(&o);
@@ -2434,9 +2439,7 @@ fn a_restart_of_a_damaged_file_is_refused_before_it_changes_it() {
     ok(&run(&case, &r, &["--set", "time.t_end=0.02"]));
     for (removed, says) in [(false, "cannot grow"), (true, "is missing")] {
         let damaged = dir.join("damaged.h5");
-        std::fs::copy(&r, &damaged).unwrap();
-        {
-            let f = hdf5::File::open_rw(&damaged).unwrap();
+        edited_copy(&r, &damaged, |f| {
             let a = f
                 .dataset("acceleration")
                 .unwrap()
@@ -2449,7 +2452,7 @@ fn a_restart_of_a_damaged_file_is_refused_before_it_changes_it() {
                     .create("acceleration")
                     .unwrap();
             }
-        }
+        });
         let before = std::fs::read(&damaged).unwrap();
         let o = restart(&case, &damaged, &["--set", "time.t_end=0.04"]);
         let e = stderr(&o);
@@ -2480,9 +2483,7 @@ fn a_restart_reads_its_clock_and_rewrites_a_foreign_attribute() {
     let r = dir.join("r.h5");
     ok(&run(&case, &r, &["--set", "time.t_end=0.02"]));
     let clock = dir.join("clock.h5");
-    std::fs::copy(&r, &clock).unwrap();
-    {
-        let f = hdf5::File::open_rw(&clock).unwrap();
+    edited_copy(&r, &clock, |f| {
         let cg = f.group("checkpoint").unwrap();
         for slot in cg.member_names().unwrap() {
             let g = cg.group(&slot).unwrap();
@@ -2490,7 +2491,7 @@ fn a_restart_reads_its_clock_and_rewrites_a_foreign_attribute() {
                 a.write_scalar(&(1u64 << 63)).unwrap();
             }
         }
-    }
+    });
     let before = std::fs::read(&clock).unwrap();
     let o = restart(&case, &clock, &["--set", "time.t_end=0.04"]);
     let e = stderr(&o);
@@ -2498,9 +2499,7 @@ fn a_restart_reads_its_clock_and_rewrites_a_foreign_attribute() {
     assert!(e.contains("its clock") && e.contains("damaged"), "{e}");
     assert!(std::fs::read(&clock).unwrap() == before, "the file changed");
     let text = dir.join("text.h5");
-    std::fs::copy(&r, &text).unwrap();
-    {
-        let f = hdf5::File::open_rw(&text).unwrap();
+    edited_copy(&r, &text, |f| {
         let solver = f.group("solver").unwrap();
         solver.delete_attr("dt_crit").unwrap();
         solver
@@ -2509,7 +2508,7 @@ fn a_restart_reads_its_clock_and_rewrites_a_foreign_attribute() {
             .unwrap()
             .write_scalar(&"zz".parse::<VarLenUnicode>().unwrap())
             .unwrap();
-    }
+    });
     ok(&restart(&case, &text, &["--set", "time.t_end=0.04"]));
     let f = hdf5::File::open(&text).unwrap();
     let dt_crit = f.group("solver").unwrap().attr("dt_crit").unwrap();
