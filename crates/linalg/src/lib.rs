@@ -16,6 +16,7 @@ mod cholesky;
 pub mod chunks;
 pub mod csr;
 mod fill_order;
+mod paired;
 mod product;
 mod refine;
 pub mod simd;
@@ -26,6 +27,7 @@ mod symmetric;
 
 pub use cholesky::{analyze_symbolic, csc_view, Analysis, SolverError, SparseCholesky};
 pub use fill_order::{FillOrder, AMD_MARGIN};
+pub use paired::PairedKm;
 pub use product::{Formed, Product};
 pub use refine::{backward_error, solve_by_diagonal, Refined, BACKWARD_ERROR, MAX_ITERATIONS};
 pub use split::SplitSingle;

@@ -1,13 +1,11 @@
 //! The products and sums of the fixed chunks (chunks.rs, csr.rs,
-//! stencils.rs) against the plain sums over the stored entries, and the
+//! stencils.rs, paired.rs) against the plain sums over the stored entries, and the
 //! same bits on one thread and on two.
 
 use nalgebra_sparse::{CooMatrix, CsrMatrix};
 use stickslip_linalg::chunks::{chunks, partials, sum_chunks, CHUNK};
-use stickslip_linalg::csr::{
-    index, load_minus_k_plus_m, quadratic_form, spmv, two_forms, two_forms_and_products,
-};
-use stickslip_linalg::{Product, Stencils, Symmetric, TOLERANCE};
+use stickslip_linalg::csr::{index, quadratic_form, spmv};
+use stickslip_linalg::{PairedKm, Product, Stencils, Symmetric, TOLERANCE};
 use stickslip_testkit::{on_threads, plain_spmv, spread};
 
 /// The chunked sum of a long vector is the same on one thread and on
@@ -64,40 +62,24 @@ fn products_and_forms_against_plain_sums() {
     let mut partials = partials(n);
     let xax: f64 = x.iter().zip(&plain).map(|(a, b)| a * b).sum();
     assert!((quadratic_form(&a, &x, &mut partials) - xax).abs() <= 1e-12 * xax.abs());
-    let (f1, f2) = two_forms(&a, &x, &a, &y, &mut partials);
-    assert_eq!(
-        f1.to_bits(),
-        quadratic_form(&a, &x, &mut partials).to_bits()
-    );
-    assert_eq!(
-        f2.to_bits(),
-        quadratic_form(&a, &y, &mut partials).to_bits()
-    );
-    let l = vec![1.5; n];
-    let mut out = vec![0.0; n];
-    load_minus_k_plus_m(&l, &a, &x, &a, &y, &mut out);
-    let mut ay = vec![0.0; n];
-    spmv(&a, &y, &mut ay);
-    for i in 0..n {
-        assert_eq!(out[i].to_bits(), (l[i] - ax[i] + ay[i]).to_bits());
-    }
-    // The fused pass: the forms of (x, y) and the products of (y, x), each
-    // with the bits of the passes it replaces, on one thread and on two.
+    // No two rows share their columns: the paired passes sum every row
+    // from the rest's CSR, in storage order, exactly here.
     let mut m = a.clone();
     for v in m.values_mut() {
         *v *= 0.75;
     }
-    let l0 = vec![0.0; n];
-    let mut want = vec![0.0; n];
-    load_minus_k_plus_m(&l0, &a, &y, &m, &x, &mut want);
-    let forms = two_forms(&a, &x, &m, &y, &mut partials);
-    for threads in [1, 2] {
-        let (kx, mx, f) = fused(threads, &a, [&x, &y], &m, [&y, &x]);
-        assert_eq!(f.0.to_bits(), forms.0.to_bits());
-        assert_eq!(f.1.to_bits(), forms.1.to_bits());
-        for i in 0..n {
-            assert_eq!(want[i].to_bits(), (l0[i] - kx[i] + mx[i]).to_bits());
-        }
+    let km = PairedKm::new(&a, &m).expect("one pattern");
+    assert_eq!(km.counts(), (0, a.nnz()));
+    let my = plain_spmv(&m, &y);
+    let (f1, f2) = km.two_forms(&x, &y, &mut partials);
+    let ymy: f64 = y.iter().zip(&my).map(|(a, b)| a * b).sum();
+    assert!((f1 - xax).abs() <= 1e-12 * xax.abs());
+    assert!((f2 - ymy).abs() <= 1e-12 * ymy.abs());
+    let l = vec![1.5; n];
+    let mut out = vec![0.0; n];
+    km.load_minus_k_plus_m(&l, &x, &y, &mut out);
+    for i in 0..n {
+        assert_eq!(out[i], l[i] - plain[i] + my[i]);
     }
     assert_eq!(index(&a, 0, 5), Some(2));
     assert_eq!(index(&a, 0, 2), None);
@@ -154,69 +136,102 @@ fn grid(nx: usize, ny: usize, wobble: f64, fixed: bool) -> CsrMatrix<f64> {
     CsrMatrix::from(&coo)
 }
 
-/// [`two_forms_and_products`] on `threads` threads: K x', M y' and the
-/// forms (xᵀK x, yᵀM y).
+/// [`PairedKm::two_forms_and_products`] on `threads` threads: K x', M y'
+/// and the forms (xᵀK x, yᵀM y).
 fn fused(
     threads: usize,
-    k: &CsrMatrix<f64>,
+    km: &PairedKm,
     x: [&[f64]; 2],
-    m: &CsrMatrix<f64>,
     y: [&[f64]; 2],
 ) -> (Vec<f64>, Vec<f64>, (f64, f64)) {
-    let n = k.nrows();
+    let n = km.n();
     on_threads(threads, || {
         let (mut kx, mut my) = (vec![0.0; n], vec![0.0; n]);
         let mut sums = vec![[0.0; 2]; chunks(n)];
-        let f = two_forms_and_products(k, x, m, y, [&mut kx, &mut my], &mut sums);
+        let f = km.two_forms_and_products(x, y, [&mut kx, &mut my], &mut sums);
         (kx, my, f)
     })
 }
 
-/// On a grid's pattern, where most groups of four columns are consecutive
-/// (runs of nodes along a row, read as one load), the fused rows keep the
-/// bits of the plain row sums (`spmv`, `quadratic_form`), on one thread
-/// and on two.
-#[test]
-fn fused_rows_keep_the_row_sums_bits_on_runs_of_columns() {
-    let k = grid(300, 40, 1e-6, true);
+/// A mass on `k`'s pattern: m_ab·I₂ between the DOFs of nodes a and b
+/// (DOF i is node (i + skip) / 2's component (i + skip) % 2), and with
+/// `skew`, every 37th node block's off-diagonal entries made non-zero.
+fn node_mass(k: &CsrMatrix<f64>, skip: usize, skew: bool) -> CsrMatrix<f64> {
     let mut m = k.clone();
-    for (i, v) in m.values_mut().iter_mut().enumerate() {
-        *v *= 0.5 + (i % 3) as f64 * 0.125;
+    let offsets = m.row_offsets().to_vec();
+    let cols = m.col_indices().to_vec();
+    for (i, vals) in offsets.windows(2).enumerate() {
+        for p in vals[0]..vals[1] {
+            let (r, c) = (i + skip, cols[p] + skip);
+            let (a, b) = (r / 2, c / 2);
+            let value = 1.0 + 0.125 * ((a + b) % 5) as f64 + 1e-3 * (a * b % 7) as f64;
+            m.values_mut()[p] = if r % 2 == c % 2 {
+                value
+            } else if skew && (a + b) % 37 == 0 {
+                0.01 * value
+            } else {
+                0.0
+            };
+        }
     }
+    m
+}
+
+/// On a grid's pattern with a support's single DOF, and chunk seams: the
+/// paired passes agree with the plain row sums within rounding, and with
+/// each other in every bit (the forms of [`PairedKm::two_forms`] and of
+/// the fused pass; K x' and M y' of the fused pass and of
+/// [`PairedKm::load_minus_k_plus_m`]), on one thread and on two. M's
+/// blocks of another shape than m·I₂ go to the rest and still agree.
+#[test]
+fn paired_passes_agree_with_the_row_sums_and_each_other() {
+    let k = grid(300, 40, 1e-6, true);
     let n = k.nrows();
     assert!(chunks(n) > 2);
-    // The case the loads serve must occur: groups of four consecutive
-    // columns at a row's start.
-    let runs = (0..n)
-        .filter(|&i| {
-            let c = &k.col_indices()[k.row_offsets()[i]..k.row_offsets()[i + 1]];
-            c.len() >= 4 && c[3] == c[0] + 3
-        })
-        .count();
-    assert!(runs > n / 2, "{runs} of {n} rows");
     let x = spread(n);
     let y: Vec<f64> = x.iter().map(|v| 1.0 - 0.3 * v).collect();
-    let (mut kx, mut my) = (vec![0.0; n], vec![0.0; n]);
-    spmv(&k, &x, &mut kx);
-    spmv(&m, &y, &mut my);
-    let mut sums = partials(n);
-    let forms = (
-        quadratic_form(&k, &y, &mut sums),
-        quadratic_form(&m, &x, &mut sums),
-    );
     let l: Vec<f64> = (0..n).map(|i| (i % 5) as f64 - 2.0).collect();
-    let mut b = vec![0.0; n];
-    load_minus_k_plus_m(&l, &k, &x, &m, &y, &mut b);
-    for i in 0..n {
-        assert_eq!(b[i].to_bits(), (l[i] - kx[i] + my[i]).to_bits(), "row {i}");
-    }
-    for threads in [1, 2] {
-        let (fk, fm, f) = fused(threads, &k, [&y, &x], &m, [&x, &y]);
-        assert_eq!(f.0.to_bits(), forms.0.to_bits());
-        assert_eq!(f.1.to_bits(), forms.1.to_bits());
-        for i in 0..n {
-            assert_eq!(fk[i].to_bits(), kx[i].to_bits(), "row {i}");
-            assert_eq!(fm[i].to_bits(), my[i].to_bits(), "row {i}");
+    for skew in [false, true] {
+        let m = node_mass(&k, 1, skew);
+        let km = PairedKm::new(&k, &m).expect("one pattern");
+        let (blocks, rest) = km.counts();
+        // Both paths run: most entries in blocks, the single DOF's row and
+        // column (and the skewed blocks) in the rest.
+        assert!(4 * blocks > k.nnz() * 9 / 10, "{blocks} blocks");
+        assert!(rest > 0);
+        let (kx, my) = (plain_spmv(&k, &y), plain_spmv(&m, &x));
+        let scale = |a: &CsrMatrix<f64>, v: &[f64], i: usize| {
+            let r = a.row(i);
+            r.col_indices()
+                .iter()
+                .zip(r.values())
+                .map(|(&j, w)| (w * v[j]).abs())
+                .sum::<f64>()
+        };
+        let mut sums = partials(n);
+        let forms = km.two_forms(&y, &x, &mut sums);
+        let want_k: f64 = y.iter().zip(&kx).map(|(a, b)| a * b).sum();
+        let want_m: f64 = x.iter().zip(&my).map(|(a, b)| a * b).sum();
+        assert!((forms.0 - want_k).abs() <= 1e-12 * want_k.abs());
+        assert!((forms.1 - want_m).abs() <= 1e-12 * want_m.abs());
+        let mut b = vec![0.0; n];
+        km.load_minus_k_plus_m(&l, &x, &y, &mut b);
+        for threads in [1, 2] {
+            let (fk, fm, f) = fused(threads, &km, [&y, &x], [&x, &y]);
+            assert_eq!(f.0.to_bits(), forms.0.to_bits());
+            assert_eq!(f.1.to_bits(), forms.1.to_bits());
+            let (kx2, my2) = (plain_spmv(&k, &x), plain_spmv(&m, &y));
+            for i in 0..n {
+                assert!(
+                    (fk[i] - kx2[i]).abs() <= 1e-14 * scale(&k, &x, i),
+                    "row {i}"
+                );
+                assert!(
+                    (fm[i] - my2[i]).abs() <= 1e-14 * scale(&m, &y, i),
+                    "row {i}"
+                );
+                assert_eq!(b[i].to_bits(), (l[i] - fk[i] + fm[i]).to_bits(), "row {i}");
+            }
         }
     }
 }

@@ -14,7 +14,8 @@ mod schur;
 
 use nalgebra_sparse::CsrMatrix;
 use stickslip_contact::{iterate, stick_events, ContactSurface, SlipState};
-use stickslip_linalg::csr::{load_minus_k_plus_m, same_pattern, two_forms, two_forms_and_products};
+use stickslip_linalg::csr::same_pattern;
+use stickslip_linalg::PairedKm;
 use stickslip_linalg::{chunks, Analysis, FillOrder};
 
 use stickslip_fem::SetupTimes;
@@ -62,6 +63,8 @@ pub(crate) struct Newmark {
     k: CsrMatrix<f64>,
     /// The scheme's mass on K's pattern (the lumped one on the diagonal).
     m: CsrMatrix<f64>,
+    /// K and this M by node blocks, for the passes of every step.
+    km: PairedKm,
     /// The lumped mass by DOF, where it is the scheme's.
     lumped: Option<Vec<f64>>,
     friction: ImplicitFriction,
@@ -126,6 +129,12 @@ pub(crate) fn start(
         }
     };
     assert!(same_pattern(&k, &m), "K and M share one pattern (fem)");
+    let km = PairedKm::new(&k, &m).ok_or_else(|| {
+        TimeError::Settings(format!(
+            "{n} free DOFs: Newmark's products index them with 32 bits; \
+             split the model or use central difference"
+        ))
+    })?;
     let mass = match mass_kind {
         MassKind::Consistent => Mass::Consistent(&m),
         MassKind::Lumped => Mass::Lumped(&lumped_mass),
@@ -160,6 +169,7 @@ pub(crate) fn start(
         mass_kind,
         k,
         m,
+        km,
         lumped,
         friction,
         b: vec![0.0; n],
@@ -632,14 +642,12 @@ impl Newmark {
     /// predictor into `state.r_new`, which the commit freed).
     fn energy_pass(&mut self, state: &mut State, dt: f64, more: bool) -> (f64, f64) {
         if !more {
-            return two_forms(&self.k, &state.r, &self.m, &state.v, &mut self.partials);
+            return self.km.two_forms(&state.r, &state.v, &mut self.partials);
         }
         self.predict(state, dt);
         let [kr, mt] = &mut self.next_products;
-        let forms = two_forms_and_products(
-            &self.k,
+        let forms = self.km.two_forms_and_products(
             [&state.r, &state.r_new],
-            &self.m,
             [&state.v, &self.tmp],
             [kr, mt],
             &mut self.partials,
@@ -660,7 +668,7 @@ impl Newmark {
         for ((t, v), vn) in self.tmp.iter_mut().zip(&state.v).zip(&state.v_new) {
             *t = 0.5 * (v + vn);
         }
-        let (vkv, vmv) = two_forms(&self.k, &self.tmp, &self.m, &self.tmp, &mut self.partials);
+        let (vkv, vmv) = self.km.two_forms(&self.tmp, &self.tmp, &mut self.partials);
         dt * (c.alpha * vmv + c.beta * vkv)
     }
 }
@@ -684,14 +692,8 @@ impl Stepper for Newmark {
             }
         } else {
             self.predict(state, dt);
-            load_minus_k_plus_m(
-                &state.load_new,
-                &self.k,
-                &state.r_new,
-                &self.m,
-                &self.tmp,
-                &mut self.b,
-            );
+            self.km
+                .load_minus_k_plus_m(&state.load_new, &state.r_new, &self.tmp, &mut self.b);
         }
         let energy_consistent = match (&self.algorithmic, &run.contact) {
             (Some(_), Some(c)) => {
