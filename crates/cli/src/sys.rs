@@ -95,7 +95,8 @@ pub(crate) fn lock_held(e: &std::io::Error) -> bool {
 }
 
 /// Bytes free to an unprivileged writer on the file system holding `dir`
-/// (statvfs(3)), or None where it cannot be asked.
+/// (statvfs(3)), or None where it cannot be asked or the file system has
+/// no size (proc, sysfs: 0 blocks of 0, which read as a full disk).
 pub(crate) fn free_bytes_at(dir: &Path) -> Option<u64> {
     use std::os::unix::ffi::OsStrExt;
     let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
@@ -105,7 +106,8 @@ pub(crate) fn free_bytes_at(dir: &Path) -> Option<u64> {
     // the call fills.
     let r = unsafe { libc::statvfs(c.as_ptr(), &mut st) };
     #[allow(clippy::useless_conversion)] // u64 here; other platforms differ
-    (r == 0).then(|| u64::from(st.f_bavail).saturating_mul(u64::from(st.f_frsize)))
+    (r == 0 && st.f_blocks > 0)
+        .then(|| u64::from(st.f_bavail).saturating_mul(u64::from(st.f_frsize)))
 }
 
 /// Whether this process may create files in the directory `dir`

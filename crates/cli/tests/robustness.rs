@@ -3006,6 +3006,25 @@ fn an_output_directory_the_run_cannot_write_is_refused_by_check_and_run() {
     assert!(!created);
 }
 
+/// A results file on a file system without a size (proc, sysfs report 0
+/// blocks, 0 free) is refused as a place it cannot create, not as a disk
+/// too full for the run (which told the user to write fewer frames).
+#[test]
+fn a_file_system_without_a_size_is_not_called_full() {
+    let dir = scratch("sizeless-fs");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    for out in ["/proc/stickslip-x.h5", "/sys/stickslip-x.h5"] {
+        let o = run(&case, Path::new(out), &[]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{out}: {e}");
+        assert!(
+            e.contains("cannot create") && e.contains("-o"),
+            "{out}: {e}"
+        );
+        assert!(!e.contains("free"), "{out}: {e}");
+    }
+}
+
 /// Messages that said the wrong thing, or nothing to do: `views` on a
 /// directory ("no such results file"), `probe` and `mesh` on a directory
 /// (HDF5's text, the OS error alone), `run --restart` given the case file
