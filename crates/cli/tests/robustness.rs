@@ -1031,7 +1031,7 @@ fn restart_in_a_step_reduction_is_bit_identical_newmark() {
     // after a reduced step, so its checkpoint (taken before its shortened
     // last step) has the reduction counter running; written every step and
     // every second step.
-    for (every, product) in [("1", "assembled CSR"), ("2", "assembled CSR")] {
+    for (every, product) in [("1", "paired node blocks"), ("2", "paired node blocks")] {
         let dir = scratch(&format!("restart-nm-{every}"));
         let case = paper_case(&dir, "newmark-step-reduced.toml");
         let every = format!("output.every={every}");

@@ -479,8 +479,9 @@ impl Integrator {
     pub fn fill_order(&self) -> Option<&'static str> {
         self.fill_order.decided_name()
     }
-    /// How the step forms its products with K: "stencil types" or
-    /// "assembled CSR".
+    /// How the step forms its products with K: "stencil types",
+    /// "symmetric node blocks", "paired node blocks" (Newmark's K and M)
+    /// or "assembled CSR".
     pub fn stiffness_product(&self) -> &'static str {
         self.stepper.stiffness_product()
     }

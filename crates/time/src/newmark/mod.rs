@@ -811,7 +811,7 @@ impl Stepper for Newmark {
     }
 
     fn stiffness_product(&self) -> &'static str {
-        "assembled CSR"
+        "paired node blocks"
     }
 
     fn implicit(&self) -> Option<&ImplicitFriction> {
