@@ -458,7 +458,7 @@ fn put_vector<T: H5Type>(g: &Group, name: &str, v: &[T]) -> Result<()> {
 }
 
 /// Writes (or rewrites) a scalar attribute.
-fn put_scalar<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<()> {
+pub(crate) fn put_scalar<T: H5Type>(loc: &hdf5::Location, name: &str, value: T) -> Result<()> {
     if let Ok(a) = loc.attr(name) {
         let same = a.ndim() == 0
             && a.dtype()

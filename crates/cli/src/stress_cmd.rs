@@ -193,7 +193,28 @@ fn fill(
         }
     }
     stress_views(g, n_nodes, rows).map_err(failed)?;
+    // Which displacements these are: a results file copied over OUT.h5
+    // keeps the name `source` gives, not its last record's bits.
+    if let Some(hash) = last_record_hash(u, rows) {
+        crate::output::put_scalar(g, "last_record_hash", hash).map_err(|e| write_failed(out, e))?;
+    }
     g.flush().map_err(failed)
+}
+
+/// FNV-1a of the bits of record `rows − 1` of the displacement `u` (None
+/// where it does not read): what `views` matches a stress file's
+/// `last_record_hash` against.
+pub(crate) fn last_record_hash(u: &hdf5::Dataset, rows: usize) -> Option<u64> {
+    let row = u
+        .read_slice_2d::<f64, _>(s![rows.checked_sub(1)?, .., ..])
+        .ok()?;
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for v in row.iter() {
+        for b in v.to_bits().to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    Some(h)
 }
 
 /// The empty `/stress` and `/von_mises` of `rows` records in `g`.

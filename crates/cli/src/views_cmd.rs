@@ -324,7 +324,14 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
     );
     // Files written before it have no /contact/surface: one surface.
     let surface = f.link_exists("contact/surface");
-    let stress = stress_name(out, rows);
+    let (stress, stale) = match stress_name(out, rows) {
+        Err(stale) => (None, Some(stale)),
+        Ok(name) => (name, None),
+    };
+    let note = match (note, stale) {
+        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+        (a, b) => a.or(b),
+    };
     drop(f);
 
     let need = (rows * BYTES_PER_RECORD) as u64 + (1 << 20);
@@ -447,8 +454,42 @@ fn contact_line(f: &File, out: &Path) -> anyhow::Result<(Option<ContactLine>, Op
 
 /// The file name of `OUT.stress.h5` beside `out`, if it holds the views of
 /// at least `rows` records (one of fewer would leave records without
-/// stresses; a run or restart removes it anyway).
-fn stress_name(out: &Path, rows: usize) -> Option<String> {
+/// stresses; a run or restart removes it anyway); `Err` with a note where
+/// it holds the stresses of other displacements than `out`'s.
+fn stress_name(out: &Path, rows: usize) -> Result<Option<String>, String> {
+    let path = crate::results_file::Companion::Stress.path(out);
+    let Some(name) = stress_listed(out, rows) else {
+        return Ok(None);
+    };
+    match of_these_records(out, &path) {
+        Some(false) => Err(format!(
+            "{} holds the stresses of other displacements than {}'s (a results file copied \
+             over it?): they are left out; `stickslip stress {}` forms them anew",
+            path.display(),
+            out.display(),
+            out.display()
+        )),
+        _ => Ok(Some(name)),
+    }
+}
+
+/// Whether the stress file `path` was formed from the displacements of
+/// `out` (its `last_record_hash` against `out`'s record of that index);
+/// `None` where that cannot be told (stress files of earlier versions).
+fn of_these_records(out: &Path, path: &Path) -> Option<bool> {
+    let g = File::open(path).ok()?;
+    let stored = g.attr("last_record_hash").ok()?.read_scalar::<u64>().ok()?;
+    let records = g.dataset("von_mises").ok()?.shape().first().copied()?;
+    let u = File::open(out)
+        .ok()
+        .and_then(|f| f.dataset("displacement").ok());
+    let now = u.and_then(|u| crate::stress_cmd::last_record_hash(&u, records));
+    Some(now == Some(stored))
+}
+
+/// [`stress_name`]'s file name where the stress file is these stresses by
+/// its name and records.
+fn stress_listed(out: &Path, rows: usize) -> Option<String> {
     use crate::results_file::{foreign_to_read, Companion};
     let path = Companion::Stress.path(out);
     // A file of that name that is not these stresses (another run's
