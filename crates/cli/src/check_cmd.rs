@@ -56,24 +56,16 @@ pub fn check(case: &Case) -> anyhow::Result<String> {
             NodeOrder::Bandwidth => "by reverse Cuthill-McKee (a band around the diagonal)",
         }
     );
-    let free: Vec<&str> = p
-        .model
-        .dofs
-        .rigid_modes()
-        .iter()
-        .map(|m| m.label.as_str())
+    let free: Vec<String> = crate::run::motion_holders(case, &p.model.dofs, i)
+        .into_iter()
+        .map(|(label, held)| format!("{label} ({})", held.describe()))
         .collect();
     if !free.is_empty() {
-        // Friction is all that can hold them; with none acting the run
-        // warns (`setup_warnings`, below).
-        let held = if i.friction() {
-            "held there by friction alone"
-        } else {
-            "nothing holds them: no friction acts"
-        };
+        // With nothing holding one the run warns (`setup_warnings`,
+        // below).
         put!(
-            "floating    the supports leave free: {} ({held}; the static preload, if any, is \
-             solved without those motions)",
+            "floating    the supports leave free: {}; the static preload, if any, is solved \
+             without those motions",
             free.join(", ")
         );
     }

@@ -301,7 +301,7 @@ pub(crate) fn setup_warnings(
         .into_iter()
         .chain(large_static_displacement(mesh, u))
         .chain(integrator.contact().and_then(|c| oblique_supports(mesh, c)))
-        .chain(unheld_motions(dofs, integrator))
+        .chain(unheld_motions(case, dofs, integrator))
         .chain(overdamped(case))
         .collect()
 }
@@ -336,22 +336,93 @@ fn overdamped(case: &Case) -> Option<String> {
     })
 }
 
-/// The rigid-body motions the supports leave free where no friction acts
-/// (μ = 0, no pressure, no `[contact]`), or `None`: friction is all that
-/// holds a floating part, so with none a net load along such a motion
-/// moves the part as a rigid body without bound.
-fn unheld_motions(dofs: &DofMap, integrator: &Integrator) -> Option<String> {
-    let free: Vec<&str> = dofs
-        .rigid_modes()
+/// What can hold a rigid-body motion the supports leave free: friction
+/// on a face the motion slides along, a compliant foundation it presses
+/// on or pulls from (one way: contact opens the other), or nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Holders {
+    pub(crate) friction: bool,
+    pub(crate) foundation: bool,
+}
+
+impl Holders {
+    /// The words `check` gives the motion.
+    pub(crate) fn describe(self) -> &'static str {
+        match (self.friction, self.foundation) {
+            (true, false) => "held by friction alone",
+            (true, true) => "held by friction and the compliant foundation",
+            (false, true) => "held by the compliant foundation",
+            (false, false) => "nothing holds it: no friction acts along it",
+        }
+    }
+}
+
+/// Each rigid-body motion the supports leave free ([`DofMap::rigid_modes`])
+/// with what can hold it: friction where some node of a surface that can
+/// carry friction (μ > 0 with a pressure, or a compliant foundation with
+/// μ or c_T > 0) has a tangent with a share of the motion; the
+/// foundation where some compliant node's normal has one.
+pub(crate) fn motion_holders(
+    case: &Case,
+    dofs: &DofMap,
+    integrator: &Integrator,
+) -> Vec<(String, Holders)> {
+    let carries = |group: &str| {
+        case.contact.iter().any(|s| {
+            s.group == group
+                && match s.law {
+                    case::schema::ContactLaw::Compliance => {
+                        s.ct.map_or(s.mu_at_rest(), |ct| ct) > 0.0
+                    }
+                    _ => s.mu_at_rest() > 0.0 && s.pressure != Some(0.0),
+                }
+        })
+    };
+    dofs.rigid_modes()
         .iter()
-        .map(|m| m.label.as_str())
+        .map(|m| {
+            let r = &m.vector;
+            let tol = 1e-9 * r.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+            let held = integrator.contact().map_or(
+                Holders {
+                    friction: false,
+                    foundation: false,
+                },
+                |c| Holders {
+                    friction: c.parts.iter().any(|p| {
+                        carries(&p.group)
+                            && c.nodes[p.nodes.clone()]
+                                .iter()
+                                .any(|n| n.tangential(r).abs() > tol)
+                    }),
+                    foundation: c
+                        .compliance
+                        .iter()
+                        .any(|f| f.along_normal(&c.nodes[f.index], r).abs() > tol),
+                },
+            );
+            (m.label.clone(), held)
+        })
+        .collect()
+}
+
+/// The rigid-body motions the supports leave free that nothing holds
+/// ([`motion_holders`]), or `None`: a net load along such a motion moves
+/// the part as a rigid body without bound.
+fn unheld_motions(case: &Case, dofs: &DofMap, integrator: &Integrator) -> Option<String> {
+    let unheld: Vec<String> = motion_holders(case, dofs, integrator)
+        .into_iter()
+        .filter(|(_, h)| !h.friction && !h.foundation)
+        .map(|(label, _)| label)
         .collect();
-    (!free.is_empty() && !integrator.friction()).then(|| {
+    let it = if unheld.len() == 1 { "it" } else { "them" };
+    (!unheld.is_empty()).then(|| {
         format!(
-            "the supports leave free {} and no friction acts: nothing holds the part there, and any \
-             net load along those motions moves it as a rigid body; hold them by a [[dirichlet]] \
-             condition, or give the [contact] a friction coefficient mu > 0",
-            free.join(", ")
+            "the supports leave free {} and no friction acts along {it}: nothing holds the part \
+             there, and any net load along {it} moves the part as a rigid body; hold {it} by a \
+             [[dirichlet]] condition, or by friction on a face {it} slides along (a [contact] \
+             with mu > 0 and a pressure, or a compliant foundation)",
+            unheld.join(", ")
         )
     })
 }

@@ -294,7 +294,7 @@ fn a_floating_part_under_unbalanced_preloads_is_refused() {
     assert!(
         o.status.success()
             && out.contains(
-                "floating    the supports leave free: translation in x (held there by friction alone;"
+                "floating    the supports leave free: translation in x (held by friction alone);"
             )
             && !out.contains("nothing holds"),
         "{out}{}",
@@ -304,13 +304,13 @@ fn a_floating_part_under_unbalanced_preloads_is_refused() {
     // `check` says and warns of, and a run warns of before its first step.
     let o = check(&case, &["contact.mu=0.0"]);
     let out = String::from_utf8_lossy(&o.stdout);
-    let warning = "the supports leave free translation in x and no friction acts: nothing holds the part there";
+    let warning = "the supports leave free translation in x and no friction acts along it: nothing holds the part there";
     assert!(
         o.status.success()
             && out.contains(
-                "floating    the supports leave free: translation in x (nothing holds them: no friction acts;"
+                "floating    the supports leave free: translation in x (nothing holds it: no friction acts along it);"
             )
-            && !out.contains("held there by friction")
+            && !out.contains("held by friction")
             && out.contains(&format!("warning     {warning}")),
         "{out}{}",
         stderr(&o)
@@ -356,6 +356,44 @@ fn a_floating_part_under_unbalanced_preloads_is_refused() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
+/// Friction holds a free motion only where it acts along it: the slab
+/// without its top's rollers is free in y, which the friction of its
+/// bottom face (along x) cannot hold, and a compliant floor with μ = 0
+/// holds y but not x. `check` said "held there by friction alone" of
+/// every free motion wherever a contact surface was, and neither it nor
+/// the run warned; the slab then left along y (u_y = ½·300·t²).
+#[test]
+fn a_motion_friction_cannot_hold_is_named_and_warned_of() {
+    let dir = scratch("unheld-y");
+    let (case, _) = slab_case(&dir, "free-y", |t| {
+        t.replace(
+            "[[dirichlet]]        # rollers on the top face\ngroup = \"support\"\nuy = 0.0\n",
+            "",
+        )
+        .replace(
+            "pressure = 300.0",
+            "pressure = 300.0\npressure_history = \"step\"",
+        )
+    });
+    let o = check(&case, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    let warning = "the supports leave free translation in y and no friction acts along it";
+    assert!(
+        o.status.success()
+            && out.contains(
+                "floating    the supports leave free: translation in y (nothing holds it: no friction acts along it);"
+            )
+            && out.contains(&format!("warning     {warning}")),
+        "{out}{}",
+        stderr(&o)
+    );
+    let o = run(&case, &dir.join("free-y.h5"), &["--set", "time.t_end=2e-3"]);
+    assert!(
+        o.status.success() && stderr(&o).contains(warning),
+        "{}",
+        stderr(&o)
+    );
+}
 #[test]
 fn bad_damping_and_initial_velocities_are_refused_at_their_lines() {
     let dir = scratch("damping-input");
