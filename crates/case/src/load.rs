@@ -576,7 +576,7 @@ fn complete(
                 check(
                     false,
                     &key("group"),
-                    format!("contact: group {:?} is already contact surface {}; a node carries the friction of one surface only; give each [[contact]] its own group", c.group, j + 1),
+                    format!("contact: group {:?} is already the group of contact.{j} (the [[contact]] entries count from 0, as --set and /contact/surface do); a node carries the friction of one surface only; give each [[contact]] its own group", c.group),
                 );
             }
         }

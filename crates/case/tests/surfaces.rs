@@ -141,7 +141,7 @@ fn bad_surfaces_are_named_at_their_line() {
     let line = text[..second_bottom].lines().count() + 1;
     assert!(
         e.lines().any(|l| l.contains(&format!("case.toml:{line}:"))
-            && l.contains("already contact surface 1")),
+            && l.contains("already the group of contact.0")),
         "no repeated group at line {line} in:\n{e}"
     );
     assert_at(
