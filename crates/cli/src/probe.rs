@@ -375,7 +375,9 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
             nodes.shape()
         )));
     }
-    let dist = |i: usize| ((nodes[[i, 0]] - p[0]).powi(2) + (nodes[[i, 1]] - p[1]).powi(2)).sqrt();
+    // hypot: squares of a point's coordinates beyond 1e154 overflow, and
+    // every node was then as far (inf), the first the nearest.
+    let dist = |i: usize| (nodes[[i, 0]] - p[0]).hypot(nodes[[i, 1]] - p[1]);
     let node = (0..nodes.nrows())
         .min_by(|&a, &b| dist(a).total_cmp(&dist(b)))
         .expect("n > 0");
@@ -466,8 +468,8 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
         nodes[[node, 0]],
         nodes[[node, 1]],
         dist(node),
-        p[0],
-        p[1],
+        coordinate(p[0]),
+        coordinate(p[1]),
         t.len()
     );
     if !complete {
@@ -480,7 +482,12 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
         let _ = write!(
             info,
             "; note: ({}, {}) lies outside the mesh (x in [{}, {}], y in [{}, {}])",
-            p[0], p[1], lo[0], hi[0], lo[1], hi[1]
+            coordinate(p[0]),
+            coordinate(p[1]),
+            lo[0],
+            hi[0],
+            lo[1],
+            hi[1]
         );
     }
     info.push('\n');
@@ -491,9 +498,18 @@ pub fn probe(file: &Path, at: &str, field: Field, csv: bool) -> Result<Probe, In
             let _ = writeln!(table, "{t:e},{v:e}");
         }
     } else {
-        let _ = writeln!(table, "{:>14}  {:>14}", "t", field.name());
+        // Times to as many digits as tell the rows apart (Remark 4.3's
+        // reduced steps of 1e-7 read as one time at 7 digits).
+        let digits = (6..16)
+            .find(|&d| {
+                t.windows(2)
+                    .all(|w| format!("{:.d$e}", w[0]) != format!("{:.d$e}", w[1]))
+            })
+            .unwrap_or(16);
+        let width = 14.max(digits + 8);
+        let _ = writeln!(table, "{:>width$}  {:>14}", "t", field.name());
         for (t, v) in t.iter().zip(&values) {
-            let _ = writeln!(table, "{t:>14.6e}  {v:>14.6e}");
+            let _ = writeln!(table, "{t:>width$.digits$e}  {v:>14.6e}");
         }
     }
     Ok(Probe {
@@ -1301,6 +1317,17 @@ fn csv_target(out: &Path, results: &Path, force: bool) -> Result<(), InputError>
     Ok(())
 }
 
+/// A coordinate the user gave, as they would write it: in exponent form
+/// where plain digits run long (1e200 printed 201 digits).
+fn coordinate(v: f64) -> String {
+    let plain = v.to_string();
+    if plain.len() > 16 {
+        format!("{v:e}")
+    } else {
+        plain
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1367,6 +1394,16 @@ mod tests {
         assert_eq!(
             probe(&path, "2,0", Field::Vy, false).unwrap().values,
             vec![0.0, 0.5, 1.0, 1.5]
+        );
+        // Far beyond the mesh, where squared distances overflow (every
+        // node was at distance inf), and said in exponent form.
+        let huge = probe(&path, "1e200,-1e200", Field::Ux, false).unwrap();
+        assert!(
+            huge.info
+                .contains("distance 1.414e200 from (1e200, -1e200)")
+                && huge.info.contains("note: (1e200, -1e200) lies outside"),
+            "{}",
+            huge.info
         );
         let far = probe(&path, "20,0.5", Field::Ux, false).unwrap();
         assert!(

@@ -17,7 +17,7 @@ use hdf5::types::{FloatSize, IntSize, TypeDescriptor, VarLenUnicode};
 use stickslip_testkit::{scratch, workspace_root as root};
 
 mod common;
-use common::{bin, check, python, python_has, stderr, tmpfs};
+use common::{bin, check, probe, python, python_has, stderr, tmpfs};
 
 /// tests/data/slab.toml (t_end = 0.05, dt = 1e-3, central difference) with
 /// an absolute mesh path, after `edit`, written into `dir`.
@@ -3042,6 +3042,27 @@ fn an_output_directory_the_run_cannot_write_is_refused_by_check_and_run() {
         );
     }
     assert!(!created);
+}
+
+/// probe's table gives each row a time of its own: Remark 4.3's reduced
+/// steps (1e-7 of a 5e-3 step) printed at 7 digits read as one time over
+/// five and six rows.
+#[test]
+fn probe_tells_the_reduced_steps_times_apart() {
+    let dir = scratch("probe-digits");
+    let case = paper_case(&dir, "newmark-step-reduced.toml");
+    let out = dir.join("r.h5");
+    ok(&run(&case, &out, &["--set", "time.t_end=1.1"]));
+    let o = probe(&out, &["--at", "8,0", "--field", "friction_stress"]);
+    let table = String::from_utf8_lossy(&o.stdout).into_owned();
+    let times: Vec<&str> = table
+        .lines()
+        .skip(2)
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    let distinct: std::collections::HashSet<&&str> = times.iter().collect();
+    assert!(times.len() > 200, "{table}");
+    assert_eq!(distinct.len(), times.len(), "{table}");
 }
 
 /// A results file on a file system without a size (proc, sysfs report 0
