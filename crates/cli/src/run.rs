@@ -880,6 +880,10 @@ struct Ending {
     failure: Option<String>,
     /// The signal that stopped it, if one did.
     interrupted: Option<&'static str>,
+    /// The failure is a step that could not be made (the iteration's cap,
+    /// Newton's): the state is the last completed step's, which a restart
+    /// continues from once the budget or the case's time step changes.
+    resumable: bool,
     /// The state before the last step (and the rows and frames then): that step is
     /// shortened to land on t_end, so a restart with a later t_end must
     /// redo it at full length to match a run that never stopped.
@@ -1029,6 +1033,7 @@ impl Session<'_> {
         let mut ending = Ending {
             failure: None,
             interrupted: None,
+            resumable: false,
             before_last: None,
         };
         while !self.integrator.done() {
@@ -1041,6 +1046,7 @@ impl Session<'_> {
                 Ok(info) => info,
                 Err(e) => {
                     ending.failure = Some(e.to_string());
+                    ending.resumable = true;
                     break;
                 }
             };
@@ -1104,6 +1110,7 @@ impl Session<'_> {
         let Ending {
             mut failure,
             interrupted,
+            mut resumable,
             mut before_last,
         } = ending;
         // A restart at its checkpoint's time takes no step, and the row it
@@ -1132,9 +1139,14 @@ impl Session<'_> {
             }
         }
         let complete = failure.is_none() && interrupted.is_none();
-        if complete || interrupted.is_some() {
-            // A failed run keeps the checkpoint of its last flush: the state at
-            // the failure is not one to continue from.
+        // A step that could not be made left the state at the last one
+        // made: a checkpoint there lets a restart continue (with a larger
+        // contact.max_iterations), unless the disk has no room for it.
+        resumable &= failure.is_some() && self.disk_nearly_full().is_none();
+        if complete || interrupted.is_some() || resumable {
+            // Another failed run (a blow-up, a full disk) keeps the
+            // checkpoint of its last flush: the state at the failure is not
+            // one to continue from.
             self.checkpoint(before_last)?;
         }
         let i = &self.integrator;
@@ -1319,8 +1331,18 @@ impl Session<'_> {
             },
             Some(e) => {
                 say!("error: {}: {e}", case.path.display());
+                let restart = if resumable {
+                    format!(
+                        " and a checkpoint at its last step: continue with `stickslip run {} --restart {}` \
+                         and the run's --set overrides (contact.max_iterations may change on a restart)",
+                        shell_word(&case.path.display().to_string()),
+                        shell_word(&out.display().to_string())
+                    )
+                } else {
+                    String::new()
+                };
                 say!(
-                    "error: {} keeps every step completed before the failure ({rows} records, complete = false, reason in its failure attribute)",
+                    "error: {} keeps every step completed before the failure ({rows} records, complete = false, reason in its failure attribute){restart}",
                     out.display()
                 );
                 Ok(Outcome::Failed)

@@ -3044,6 +3044,35 @@ fn an_output_directory_the_run_cannot_write_is_refused_by_check_and_run() {
     assert!(!created);
 }
 
+/// A run stopped by contact.max_iterations continues with a larger
+/// budget, as the README says: its state is the last completed step's,
+/// now checkpointed (a run that failed before its first flush held no
+/// checkpoint, and the restart was refused), and the continued run is
+/// bit for bit the one that never stopped.
+#[test]
+fn a_run_stopped_by_the_iteration_cap_continues_with_a_larger_one() {
+    let dir = scratch("cap-restart");
+    let case = paper_case(&dir, "newmark-step.toml");
+    let part = dir.join("part.h5");
+    let o = run(&case, &part, &["--set", "contact.max_iterations=2"]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("did not converge in 2 iterations")
+            && e.contains("a checkpoint at its last step")
+            && e.contains("--restart"),
+        "{e}"
+    );
+    ok(&restart(
+        &case,
+        &part,
+        &["--set", "contact.max_iterations=50"],
+    ));
+    let full = dir.join("full.h5");
+    ok(&run(&case, &full, &["--set", "contact.max_iterations=50"]));
+    assert_same_datasets(&full, &part);
+}
+
 /// probe's table gives each row a time of its own: Remark 4.3's reduced
 /// steps (1e-7 of a 5e-3 step) printed at 7 digits read as one time over
 /// five and six rows.
