@@ -158,10 +158,18 @@ fn refused(case: &Case, e: TimeError) -> InputError {
         ),
         TimeError::UnstableDamped { .. } => ("time.dt", "[time]"),
         TimeError::Static(_) => ("dirichlet.0.group", "[time]"),
-        TimeError::Unbalanced(_) => match at("initial.state") {
-            Some(key) => (key, "[initial]"),
-            None => ("dirichlet.0.group", "[[dirichlet]]"),
-        },
+        TimeError::Unbalanced(_) => {
+            // The loads before t = 0 are to blame where no [initial] or
+            // [[dirichlet]] is written: the first surface's pressure.
+            let pressure = case.contact_key(0, "pressure");
+            let (key, table) = match (at("initial.state"), at("dirichlet.0.group")) {
+                (Some(key), _) => (key.to_string(), "[initial]: "),
+                (None, Some(key)) => (key.to_string(), "[[dirichlet]]: "),
+                _ if case.locations.contains_key(&pressure) => (pressure, "[contact]: "),
+                _ => (String::new(), ""),
+            };
+            return InputError(format!("{}{table}{e}", case.at(&key)));
+        }
         _ => ("time.scheme", "[time]"),
     };
     InputError(format!("{}{table}: {e}", case.at(key)))

@@ -356,6 +356,30 @@ fn a_floating_part_under_unbalanced_preloads_is_refused() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
+/// A part with no [[dirichlet]] at all whose preload (the contact
+/// pressure, present before t = 0) is not in equilibrium: the refusal
+/// named a [[dirichlet]] table the case does not have, at no line; it is
+/// now at the pressure's line, under [contact].
+#[test]
+fn an_unbalanced_preload_without_supports_is_placed_at_the_pressure() {
+    let dir = scratch("unbalanced-free");
+    let (case, text) = slab_case(&dir, "free", |t| {
+        t.replace(
+            "[[dirichlet]]        # rollers on the top face\ngroup = \"support\"\nuy = 0.0\n",
+            "",
+        )
+        .replace(
+            "[[dirichlet]]        # the left end is held in x\ngroup = \"left\"\nux = 0.0\n",
+            "",
+        )
+    });
+    assert!(!text.contains("[[dirichlet]]"), "{text}");
+    let e = refused(&case, &[], &["not in equilibrium", "F_y"]);
+    let at = format!("free.toml:{}:", line_of(&text, "pressure = 300.0"));
+    assert!(e.contains(&at) && e.contains("[contact]: "), "{e}");
+    assert!(!e.contains("[[dirichlet]]:"), "{e}");
+}
+
 /// Friction holds a free motion only where it acts along it: the slab
 /// without its top's rollers is free in y, which the friction of its
 /// bottom face (along x) cannot hold, and a compliant floor with μ = 0
