@@ -213,48 +213,73 @@ pub(crate) fn compliant_surface(
         .flat_map(|x| x.iter())
         .fold(0.0_f64, |m, v| m.max(v.abs()));
     let tolerance = 1e-9 * size.max(f.point[0].abs()).max(f.point[1].abs());
+    // The node of a message, and how many others the same problem has:
+    // one message a problem, not one a node.
+    let node_at = |node: usize| {
+        let x = mesh.nodes[node];
+        let tag = mesh.node_tags.get(node).copied().unwrap_or(node as u64);
+        format!("node {tag} at ({}, {})", x[0], x[1])
+    };
+    let others = |n: usize| match n {
+        0 => String::new(),
+        1 => " (and 1 other node of it)".to_string(),
+        n => format!(" (and {n} other nodes of it)"),
+    };
     // The approach is read from a node's free components (a held one does
     // not move); one held at a value other than 0 along the normal would
     // move the node into or off the foundation unseen.
-    for k in &s.compliance {
-        let node = s.nodes[k.index].node;
-        for (a, axis) in ["ux", "uy"].iter().enumerate() {
-            let held = dofs.prescribed(node, a).filter(|&v| v != 0.0);
-            if let Some(v) = held.filter(|_| normal[a].abs() > 1e-12) {
-                let x = mesh.nodes[node];
-                problems.push(format!(
-                    "{}[contact]: node {} at ({}, {}) of group {:?} has {axis} = {v} from a \
-                     [[dirichlet]] condition, along the foundation's normal: the compliance law \
-                     measures the approach by the free components only, so it would not see that \
-                     motion; hold the node at {axis} = 0, or prescribe the motion on another group",
-                    at("foundation"),
-                    mesh.node_tags.get(node).copied().unwrap_or(node as u64),
-                    x[0],
-                    x[1],
-                    c.group,
-                ));
-            }
-        }
+    let held: Vec<(usize, &str, f64)> = s
+        .compliance
+        .iter()
+        .flat_map(|k| {
+            let node = s.nodes[k.index].node;
+            ["ux", "uy"]
+                .into_iter()
+                .enumerate()
+                .filter_map(move |(a, axis)| {
+                    let v = dofs.prescribed(node, a).filter(|&v| v != 0.0)?;
+                    (normal[a].abs() > 1e-12).then_some((node, axis, v))
+                })
+        })
+        .collect();
+    if let Some(&(node, axis, v)) = held.first() {
+        problems.push(format!(
+            "{}[contact]: {} of group {:?}{} has {axis} = {v} from a [[dirichlet]] condition, \
+             along the foundation's normal: the compliance law measures the approach by the free \
+             components only, so it would not see that motion; hold the nodes at 0 along the \
+             normal, or prescribe the motion on another group",
+            at("foundation"),
+            node_at(node),
+            c.group,
+            others(held.len() - 1),
+        ));
     }
+    let mut inside = Vec::new();
     for k in &mut s.compliance {
         if k.gap >= -tolerance {
             k.gap = k.gap.max(0.0);
         } else if start == InitialState::Rest {
-            let node = s.nodes[k.index].node;
-            let x = mesh.nodes[node];
-            problems.push(format!(
-                "{}[contact]: node {} at ({}, {}) of group {:?} starts {:e} inside the foundation \
-                 (a start at rest would release it with the foundation's full push); start the part \
-                 off or touching the foundation (move foundation.point, or the mesh), or start from \
-                 the static state ([initial] state = \"static\"), which settles the interference",
-                at("foundation"),
-                mesh.node_tags.get(node).copied().unwrap_or(node as u64),
-                x[0],
-                x[1],
-                c.group,
-                -k.gap
-            ));
+            inside.push((s.nodes[k.index].node, -k.gap));
         }
+    }
+    // The deepest, the first of equals.
+    let deepest = inside
+        .iter()
+        .fold(None, |best: Option<&(usize, f64)>, x| match best {
+            Some(b) if b.1 >= x.1 => Some(b),
+            _ => Some(x),
+        });
+    if let Some(&(node, depth)) = deepest {
+        problems.push(format!(
+            "{}[contact]: {} of group {:?}{} starts {depth:e} inside the foundation (the deepest; \
+             a start at rest would release it with the foundation's full push); start the part \
+             off or touching the foundation (move foundation.point, or the mesh), or start from \
+             the static state ([initial] state = \"static\"), which settles the interference",
+            at("foundation"),
+            node_at(node),
+            c.group,
+            others(inside.len() - 1),
+        ));
     }
     Ok(s)
 }

@@ -208,7 +208,7 @@ fn the_law_runs_with_newmark() {
 }
 
 /// A node that starts inside the foundation is refused, for a start at
-/// rest, with its place.
+/// rest, with its place and the number of others that do.
 #[test]
 fn a_node_inside_the_foundation_is_refused() {
     let text = slab(
@@ -223,6 +223,9 @@ fn a_node_inside_the_foundation_is_refused() {
         "starts 2e-2 inside the foundation",
     );
     assert!(e.contains("node 1 at (0, 0)"), "{e}");
+    // One message for the face, not one a node (17 lines before).
+    assert_eq!(e.matches("inside the foundation").count(), 1, "{e}");
+    assert!(e.contains("(and 16 other nodes of it)"), "{e}");
 }
 
 /// With `state = "static"` a node inside the foundation is an
