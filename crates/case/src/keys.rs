@@ -272,6 +272,19 @@ pub(crate) fn check_table(
             (Kind::Num, Item::Value(v)) if is_number(v) => {}
             (Kind::Num, _) => wrong("a number", "write numbers without quotes, e.g. 1e-3"),
             (Kind::Int | Kind::Count, Item::Value(Value::Integer(i))) if *i.value() >= 0 => {}
+            // `--set` keeps what TOML cannot read as text: digits beyond
+            // i64 are no quoted string.
+            (Kind::Int | Kind::Count, Item::Value(Value::String(s)))
+                if !s.value().is_empty()
+                    && s.value().bytes().all(|b| b.is_ascii_digit())
+                    && s.value().parse::<i64>().is_err() =>
+            {
+                wrong(
+                    "a whole number",
+                    "that one is beyond the largest a case takes (9223372036854775807); give a \
+                     smaller one",
+                )
+            }
             (Kind::Int, _) => wrong(
                 "a whole number >= 0",
                 "write it without quotes or decimal point, e.g. 10",

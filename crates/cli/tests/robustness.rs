@@ -130,6 +130,26 @@ fn unknown_keys_are_all_reported_with_the_nearest_key() {
     assert_eq!(e.lines().count(), 3, "one line per problem:\n{e}");
 }
 
+/// A whole number beyond i64 given by --set is too large, not text to
+/// unquote: `--set` keeps what TOML cannot read as a string, and the
+/// message said "write it without quotes"; a quoted one still is text.
+#[test]
+fn a_set_whole_number_too_large_is_called_so() {
+    let dir = scratch("set-huge");
+    let (case, _) = slab_case(&dir, "huge", |t| t);
+    let e = refused(
+        &case,
+        &["output.every=18446744073709551615"],
+        &["output.every"],
+    );
+    assert!(
+        e.contains("beyond the largest") && !e.contains("without quotes"),
+        "{e}"
+    );
+    let e = refused(&case, &["output.every=\"12\""], &["output.every"]);
+    assert!(e.contains("without quotes") && !e.contains("beyond"), "{e}");
+}
+
 #[test]
 fn wrong_types_name_the_key_and_the_type() {
     let dir = scratch("types");
