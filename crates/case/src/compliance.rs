@@ -133,21 +133,30 @@ fn check_compliance(
     }
     // A moving compliant foundation and μ(w) against it are not built:
     // the keys would otherwise change nothing, silently.
-    for (k, given) in [
-        ("foundation_velocity", c.foundation_velocity != 0.0),
+    for (k, given, remedy) in [
+        (
+            "foundation_velocity",
+            c.foundation_velocity != 0.0,
+            "remove foundation_velocity",
+        ),
         (
             "foundation_history",
             c.foundation_history != History::Constant,
+            "remove foundation_history",
         ),
-        ("mu", matches!(c.mu, Some(Mu::Speed { .. }))),
+        (
+            "mu",
+            matches!(c.mu, Some(Mu::Speed { .. })),
+            "give a constant mu",
+        ),
     ] {
         check(
             !given,
             &key(k),
             format!(
                 "contact.{k}: law = \"compliance\" takes a foundation at rest and a constant mu \
-                 (a moving or speed-dependent friction runs with prescribed pressures); remove \
-                 {k}, or give a constant mu"
+                 (a moving or speed-dependent friction runs with prescribed pressures); {remedy}, \
+                 or use law = \"pressure\" with a pressure"
             ),
         );
     }

@@ -175,7 +175,7 @@ pub(crate) fn surfaces(
         }) => problems.push(format!(
             "{}[[contact]]: node {} at ({}, {}) carries friction on both surface {first:?} and surface {second:?}; \
              a node carries the friction of one surface only: make the groups disjoint (end one line a node \
-             short of the other), or join them into one group with one pressure and mu",
+             short of the other), or join them into one group with one normal law and mu",
             case.at(&case.contact_key(last, "group")),
             mesh.node_tags.get(node).copied().unwrap_or(node as u64),
             mesh.nodes[node][0],
