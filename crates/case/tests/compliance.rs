@@ -308,11 +308,18 @@ fn a_static_start_lifts_a_free_part_out_of_the_foundation() {
 /// not built: each is refused at its line rather than ignored.
 #[test]
 fn a_compliant_foundation_refuses_motion_and_a_falling_mu() {
-    for (swap, needle) in [
-        ("mu = 0.3\n", "foundation_velocity = 0.5"),
+    // Each with the remedy for its own key (a moving foundation was told
+    // to "give a constant mu").
+    for (swap, needle, remedy) in [
+        (
+            "mu = 0.3\n",
+            "foundation_velocity = 0.5",
+            "remove foundation_velocity, or use",
+        ),
         (
             "mu = 0.3\n",
             "mu = { static = 0.3, kinetic = 0.2, speed = 0.1 }",
+            "give a constant mu, or use",
         ),
     ] {
         let surface = FLOOR.replace(swap, &format!("{needle}\n"));
@@ -329,6 +336,7 @@ fn a_compliant_foundation_refuses_motion_and_a_falling_mu() {
             needle,
             "law = \"compliance\" takes a foundation at rest",
         );
+        assert!(e.contains(remedy), "{e}");
     }
 }
 
