@@ -132,6 +132,21 @@ pub(crate) fn check_beside(out: &Path, command: &str, files: &[PathBuf]) -> Resu
             )));
         }
     }
+    // The viewers' XML files are replaced whole: one of those names that
+    // holds something else (notes, another program's HDF5) is the user's.
+    for xml in [
+        crate::xdmf::xdmf_path(out),
+        crate::xdmf::contact_xdmf_path(out),
+    ] {
+        if files.contains(&xml) && !is_xdmf_or_empty(&xml) {
+            return Err(InputError(format!(
+                "{} is not an XDMF file, although named as the viewers' file of {}: \
+                 `stickslip {command}` would replace it; move or rename it and run this again",
+                xml.display(),
+                out.display()
+            )));
+        }
+    }
     named_in_xml(out)?;
     let dir = crate::results_file::dir_of(out);
     if !crate::sys::can_write_in(dir) {
@@ -158,6 +173,21 @@ fn named_in_xml(out: &Path) -> Result<(), InputError> {
             out.display()
         ))
     })
+}
+
+/// Whether `path` is empty or starts as an XDMF file does (its first
+/// kilobyte holds `<Xdmf`): the viewers' file of some writer, stickslip's
+/// or another's, which a viewers' file may replace.
+fn is_xdmf_or_empty(path: &Path) -> bool {
+    use std::io::Read;
+    let Ok(f) = std::fs::File::open(path) else {
+        return true;
+    };
+    let mut head = Vec::with_capacity(1024);
+    if f.take(1024).read_to_end(&mut head).is_err() {
+        return true;
+    }
+    head.is_empty() || head.windows(5).any(|w| w == b"<Xdmf")
 }
 
 /// Creates (or truncates) `path` beside the results file `out` for

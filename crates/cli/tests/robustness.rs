@@ -3138,6 +3138,41 @@ fn probe_tells_the_reduced_steps_times_apart() {
     assert_eq!(distinct.len(), times.len(), "{table}");
 }
 
+/// views and stress replace the viewers' XML files beside OUT.h5, but
+/// not a file of those names that is no XDMF (notes, another program's
+/// HDF5): it went without a word. Refused with exit 2, the file kept; an
+/// empty one is replaced.
+#[test]
+fn views_keep_a_file_named_as_their_xml_that_is_no_xdmf() {
+    let dir = scratch("foreign-xdmf");
+    let (case, _) = slab_case(&dir, "slab", |t| t);
+    let out = dir.join("a.h5");
+    ok(&run(&case, &out, &[]));
+    for (name, command) in [("a.xdmf", "views"), ("a.contact.xdmf", "stress")] {
+        let xml = dir.join(name);
+        std::fs::write(&xml, "my notes\n").unwrap();
+        let o = bin()
+            .arg(command)
+            .arg(&out)
+            .arg("--quiet")
+            .output()
+            .unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{command}: {e}");
+        assert!(e.contains(name) && e.contains("not an XDMF file"), "{e}");
+        assert_eq!(std::fs::read_to_string(&xml).unwrap(), "my notes\n");
+        std::fs::write(&xml, "").unwrap();
+        let o = bin()
+            .arg(command)
+            .arg(&out)
+            .arg("--quiet")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{command}: {}", stderr(&o));
+        assert!(std::fs::read_to_string(&xml).unwrap().contains("<Xdmf"));
+    }
+}
+
 /// A results file on a file system without a size (proc, sysfs report 0
 /// blocks, 0 free) is refused as a place it cannot create, not as a disk
 /// too full for the run (which told the user to write fewer frames).
