@@ -1122,11 +1122,10 @@ impl Session<'_> {
             .times
             .last()
             .is_some_and(|t| t.to_bits() == self.integrator.time().to_bits());
-        if failure.is_none()
-            && interrupted.is_none()
-            && on_last_row
-            && !self.writer.last_row_is_frame()?
-        {
+        // So too an interrupted run's last step: the file shows the state
+        // it stopped at, and the checkpoint, without that frame, restarts
+        // as the run that never stopped.
+        if failure.is_none() && on_last_row && !self.writer.last_row_is_frame()? {
             // The frame fills a chunk like any row: room first.
             match self.disk_nearly_full() {
                 Some(why) => failure = Some(why),

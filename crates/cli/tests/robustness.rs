@@ -824,6 +824,41 @@ fn sigint_and_sigterm_stop_cleanly_with_a_valid_file() {
     }
 }
 
+/// An interrupted run's last step is a frame, as a completed or failed
+/// run's is, so that probe and the viewers show the state it stopped at
+/// (with output.frames it was not: the frames ended before it); the
+/// checkpoint leaves that frame out, so the continued run is still bit
+/// for bit the run that never stopped.
+#[test]
+fn an_interrupted_run_ends_on_a_frame_and_restarts_as_if_never_stopped() {
+    let dir = scratch("sigterm-frame");
+    let (case, _) = slab_case(&dir, "frames", |t| t);
+    let frames = ["--set", "output.frames=20"];
+    let out = dir.join("part.h5");
+    let child = start_long(&case, &out, &frames, 0.5);
+    signal(&child, "-TERM");
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let f = hdf5::File::open(&out).unwrap();
+    let t = f.dataset("time").unwrap().read_raw::<f64>().unwrap();
+    let ft = f.dataset("frames/time").unwrap().read_raw::<f64>().unwrap();
+    assert!(
+        t.len() > 10 && *t.last().unwrap() < 200.0,
+        "{} rows",
+        t.len()
+    );
+    assert_eq!(
+        ft.last().map(|x| x.to_bits()),
+        t.last().map(|x| x.to_bits())
+    );
+    drop(f);
+    let sets = ["--set", "time.t_end=200", "--set", "output.frames=20"];
+    ok(&restart(&case, &out, &sets));
+    let full = dir.join("full.h5");
+    ok(&run(&case, &full, &sets));
+    assert_same_datasets(&full, &out);
+}
+
 // ---------------------------------------------------------------------------
 // 5. Restart: bit-identical to a run that never stopped.
 
