@@ -611,7 +611,9 @@ impl StopFlags {
     /// the flag (the run
     /// finishes its step, flushes, checkpoints and exits 130); a second
     /// signal of either kind exits at once with 130, as users expect of a
-    /// second Ctrl-C (the file keeps every step up to its last flush).
+    /// second Ctrl-C (the file keeps every step up to its last flush),
+    /// unless it comes within 250 ms of the first: the same signal sent
+    /// twice (GNU timeout's to the process and its group).
     ///
     /// # Errors
     /// The handlers cannot be installed.
@@ -619,6 +621,7 @@ impl StopFlags {
         use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
         let flags = StopFlags::default();
         let any = Arc::new(AtomicBool::new(false));
+        let first = Arc::new(std::sync::atomic::AtomicU64::new(0));
         for (sig, flag) in [
             (SIGINT, &flags.sigint),
             (SIGTERM, &flags.sigterm),
@@ -626,7 +629,7 @@ impl StopFlags {
         ] {
             // Order matters: the shutdown hook must see `any` still false on
             // the first signal (signal-hook's documented pattern).
-            second_signal_exits(sig, Arc::clone(&any))?;
+            second_signal_exits(sig, (Arc::clone(&any), Arc::clone(&first)))?;
             signal_hook::flag::register(sig, Arc::clone(&any))?;
             signal_hook::flag::register(sig, Arc::clone(flag))?;
         }
@@ -651,7 +654,10 @@ impl StopFlags {
 /// exit 130 at once (the file keeps every flushed step). signal-hook's
 /// conditional shutdown exited without a word, which left the user
 /// guessing what was kept.
-fn second_signal_exits(sig: i32, any: Arc<AtomicBool>) -> std::io::Result<()> {
+fn second_signal_exits(
+    sig: i32,
+    any: (Arc<AtomicBool>, Arc<std::sync::atomic::AtomicU64>),
+) -> std::io::Result<()> {
     const MSG: &[u8] = b"\nstopped at once by a second signal: the results file keeps every step \
 up to its last flush (complete = false); continue it with --restart\n";
     crate::sys::exit_on_signal_if(sig, any, MSG, 130)

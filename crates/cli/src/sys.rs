@@ -6,7 +6,7 @@
 #![allow(unsafe_code)]
 
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 
 /// Restores the default action of SIGPIPE (end the process), which the
@@ -37,25 +37,47 @@ pub fn keep_freed_memory() {
     }
 }
 
+/// A signal within this many nanoseconds of the first is the same
+/// signal sent twice (GNU `timeout` signals the process and then its
+/// group), not a user's second Ctrl-C: a quarter second, which a loaded
+/// machine's two sends stay within, and a second Ctrl-C after a stop that
+/// hangs comes later (one sooner is taken as the first, which stops the
+/// run all the same).
+const SAME_SIGNAL_NS: u64 = 250_000_000;
+
+/// CLOCK_MONOTONIC in nanoseconds (clock_gettime is async-signal-safe).
+fn monotonic_ns() -> u64 {
+    // SAFETY: timespec is plain data, all zeros a valid value, and
+    // clock_gettime only writes it.
+    let mut ts: libc::timespec = unsafe { std::mem::zeroed() };
+    unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts) };
+    (ts.tv_sec as u64).saturating_mul(1_000_000_000) + ts.tv_nsec as u64
+}
+
 /// Adds an action on `sig` (beside any others registered with
-/// signal-hook): when it arrives while `armed` is set, writes `msg` to
-/// stderr and ends the process at once with exit code `code` (no
-/// unwinding, no destructors, no buffers flushed).
+/// signal-hook): when it arrives while `armed` is set, and more than
+/// [`SAME_SIGNAL_NS`] after the first signal (whose time it keeps in
+/// `first`, shared by the signals of one set), writes `msg` to stderr
+/// and ends the process at once with exit code `code` (no unwinding, no
+/// destructors, no buffers flushed).
 ///
 /// # Errors
 /// The action cannot be installed.
 pub(crate) fn exit_on_signal_if(
     sig: i32,
-    armed: Arc<AtomicBool>,
+    (armed, first): (Arc<AtomicBool>, Arc<AtomicU64>),
     msg: &'static [u8],
     code: i32,
 ) -> std::io::Result<()> {
-    // SAFETY: the action only loads an atomic and calls write(2) and
-    // _exit(2), which are async-signal-safe; it allocates nothing and
-    // takes no lock.
+    // SAFETY: the action only reads the clock, uses atomics and calls
+    // write(2) and _exit(2), which are async-signal-safe; it allocates
+    // nothing and takes no lock.
     unsafe {
         signal_hook::low_level::register(sig, move || {
-            if armed.load(Ordering::SeqCst) {
+            let now = monotonic_ns();
+            if !armed.load(Ordering::SeqCst) {
+                let _ = first.compare_exchange(0, now, Ordering::SeqCst, Ordering::SeqCst);
+            } else if now.saturating_sub(first.load(Ordering::SeqCst)) >= SAME_SIGNAL_NS {
                 libc::write(2, msg.as_ptr().cast(), msg.len());
                 libc::_exit(code);
             }

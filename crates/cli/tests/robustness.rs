@@ -824,6 +824,32 @@ fn sigint_and_sigterm_stop_cleanly_with_a_valid_file() {
     }
 }
 
+/// The same signal sent twice at once (GNU `timeout -s INT` signals the
+/// process and then its group) is one Ctrl-C: the run stops cleanly with
+/// its checkpoint. It was taken for a second Ctrl-C and exited at once,
+/// leaving a new file with no checkpoint to continue from.
+#[test]
+fn a_signal_sent_twice_at_once_stops_the_run_cleanly() {
+    let dir = scratch("sigint-twice");
+    let (case, _) = slab_case(&dir, "twice", |t| t);
+    let out = dir.join("twice.h5");
+    let child = start_long(&case, &out, &[], 0.3);
+    // Two kills a process start apart (one kill of the pid twice is one
+    // signal: the second finds the first pending). The run may be gone
+    // before the second.
+    signal(&child, "-INT");
+    let _ = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let o = child.wait_with_output().unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{e}");
+    assert!(
+        e.contains("interrupted by SIGINT") && !e.contains("second signal"),
+        "{e}"
+    );
+}
+
 /// An interrupted run's last step is a frame, as a completed or failed
 /// run's is, so that probe and the viewers show the state it stopped at
 /// (with output.frames it was not: the frames ended before it); the
