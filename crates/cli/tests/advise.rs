@@ -304,6 +304,41 @@ fn advise_refuses_a_ladder_of_two_bodies_and_a_point_off_the_body() {
     assert!(!err.contains("pilot"), "refused before any pilot: {err}");
 }
 
+/// Surfaces of different ε: advise gives every surface one ε (its pilots
+/// and --write), so it advised another problem and --write set the second
+/// surface's 1e-2 to the first's 1e-4 without a word. Refused before any
+/// pilot, at the differing ε's line.
+#[test]
+fn advise_refuses_surfaces_of_different_eps() {
+    let dir = scratch("advise-two-eps");
+    let meshes = root().join("cases/meshes");
+    let text = std::fs::read_to_string(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
+        .unwrap()
+        .replace("\"../meshes/", &format!("\"{}/", meshes.display()))
+        .replace("[contact]", "[[contact]]");
+    let text = format!(
+        "{text}\n[[contact]]\ngroup = \"support\"\npressure = 10.0\nmu = 0.1\neps = 1e-2\n"
+    );
+    let case = dir.join("two.toml");
+    std::fs::write(&case, &text).unwrap();
+    let written = dir.join("w.toml");
+    let o = bin()
+        .arg("advise")
+        .arg(&case)
+        .args(["--tol", "8e-1", "--on", "ux", "--at", "8,1", "--write"])
+        .arg(&written)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let line = text.lines().position(|l| l == "eps = 1e-2").unwrap() + 1;
+    assert!(
+        err.contains(&format!("two.toml:{line}:")) && err.contains("contact.1.eps = 1e-2"),
+        "{err}"
+    );
+    assert!(!err.contains("pilot  ") && !written.exists(), "{err}");
+}
+
 /// The README's ranges of advise's estimates over the chart's errors, for
 /// the configurations that were pilots and for the others, on the slab
 /// case (u_x at (8, 1)), with the five farthest of the others:

@@ -137,6 +137,24 @@ pub fn command(case: &Case, o: &Options) -> anyhow::Result<Verdict> {
             case.at("time.scheme")
         )));
     }
+    // The pilots and --write give every surface one ε: surfaces of
+    // different ε would be advised as another problem, their ε lost.
+    if let Some((i, c)) = case
+        .contact
+        .iter()
+        .enumerate()
+        .find(|(_, c)| c.eps != case.contact[0].eps)
+    {
+        return Err(input(format!(
+            "{}contact.{i}.eps = {:e} differs from contact.0.eps = {:e}: advise chooses one ε \
+             for every surface (its pilots run with it, and --write gives it to each), so it \
+             would advise another problem and drop that ε; give every [[contact]] one eps to \
+             advise the case, or advise each ε's surfaces in a case of their own",
+            case.at(&case.contact_key(i, "eps")),
+            c.eps,
+            case.contact[0].eps
+        )));
+    }
     let json = o.json;
     // A pilot's line that stderr refuses does not stop the pilots: the
     // report and --write follow, and the loss exits 1 at the end.
