@@ -270,9 +270,10 @@ fn advise_never_writes_over_a_file() {
     assert!(err.contains("--at goes with"), "{err}");
 }
 
-/// A ladder of two bodies, and a probe point off the body, are bad input
-/// (before: 21 pilots, then "add finer meshes"; and a silent snap to the
-/// nearest node).
+/// A ladder of two bodies, a probe point off the body, and a friction
+/// stress asked at a node that carries none are bad input (before: 21
+/// pilots, then "add finer meshes"; and a silent snap to the nearest
+/// node).
 #[test]
 fn advise_refuses_a_ladder_of_two_bodies_and_a_point_off_the_body() {
     let dir = scratch("advise-bodies");
@@ -294,6 +295,20 @@ fn advise_refuses_a_ladder_of_two_bodies_and_a_point_off_the_body() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("lies outside the mesh"), "{err}");
+    // The friction stress at the corner a support holds, which carries
+    // none: it ran the pilots at another node on each mesh and exited 1.
+    let o = bin()
+        .arg("advise")
+        .arg(&case)
+        .args(["--tol", "5e-1", "--on", "friction_stress", "--at", "0,0"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("carries no friction") && !err.contains("pilot  "),
+        "{err}"
+    );
 
     let bodies = dir.join("bodies.toml");
     std::fs::write(&bodies, text.replace("slab-q2-16x4.msh", "hole-q1.msh")).unwrap();

@@ -76,6 +76,21 @@ pub(super) fn probe_of(
                     case.path.display()
                 ))
             })?;
+            // A node of the group whose tangential motion a support fixes
+            // carries none: the nearest friction node moved with the mesh.
+            let closest = nearest(p.mesh.nodes.iter().copied().enumerate(), at);
+            if let Some((_, pos)) = closest.filter(|(n, _)| c.excluded.contains(n)) {
+                return Err(input(format!(
+                    "--on friction_stress --at {},{}: the nearest node of {} at ({}, {}) carries \
+                     no friction (a [[dirichlet]] condition fixes its tangential motion): nothing \
+                     to estimate there, choose a point at a friction node",
+                    at[0],
+                    at[1],
+                    case.mesh.file.display(),
+                    pos[0],
+                    pos[1]
+                )));
+            }
             let (k, pos) = nearest(
                 c.nodes
                     .iter()
