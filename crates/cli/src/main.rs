@@ -49,7 +49,7 @@ enum Command {
         after_help = "Example:\n  stickslip run case.toml -o out.h5 --set time.dt=5e-4 --set contact.eps=1e-2\n\n\
 Exit codes: 0 complete, 1 the run failed midway (the file keeps every step written, complete = false) \
 or its --json summary could not be written to stdout (the file is complete), 2 bad input, 130 interrupted by SIGINT, SIGTERM or SIGHUP (the file is valid, complete = false; continue it with --restart OUT.h5).\n\n\
-A second Ctrl-C while the first is being handled exits at once (the file keeps every step up to its last flush)."
+A second Ctrl-C while the first is being handled, a quarter second or more after it, exits at once (the file keeps every step up to its last flush)."
     )]
     Run {
         /// The case file (TOML).

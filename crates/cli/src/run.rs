@@ -886,9 +886,9 @@ struct Ending {
     failure: Option<String>,
     /// The signal that stopped it, if one did.
     interrupted: Option<&'static str>,
-    /// The failure is a step that could not be made (the iteration's cap,
-    /// Newton's): the state is the last completed step's, which a restart
-    /// continues from once the budget or the case's time step changes.
+    /// The failure is the stick/slip iteration's cap: the state is the
+    /// last completed step's, which a restart with a larger
+    /// contact.max_iterations continues from.
     resumable: bool,
     /// The state before the last step (and the rows and frames then): that step is
     /// shortened to land on t_end, so a restart with a later t_end must
@@ -1051,8 +1051,11 @@ impl Session<'_> {
             let info = match self.integrator.step() {
                 Ok(info) => info,
                 Err(e) => {
+                    // Only the iteration's cap is a budget a restart may
+                    // raise (contact.max_iterations); Newton's cap and the
+                    // time step are fixed for a restart.
+                    ending.resumable = matches!(e, stickslip_time::TimeError::IterationCap { .. });
                     ending.failure = Some(e.to_string());
-                    ending.resumable = true;
                     break;
                 }
             };
@@ -1128,13 +1131,20 @@ impl Session<'_> {
             .times
             .last()
             .is_some_and(|t| t.to_bits() == self.integrator.time().to_bits());
-        // So too an interrupted run's last step: the file shows the state
-        // it stopped at, and the checkpoint, without that frame, restarts
-        // as the run that never stopped.
-        if failure.is_none() && on_last_row && !self.writer.last_row_is_frame()? {
+        // A step that could not be made left the state at the last one
+        // made: a checkpoint there lets a restart continue (with a larger
+        // contact.max_iterations), unless the disk has no room for it.
+        resumable &= failure.is_some() && self.disk_nearly_full().is_none();
+        // So too the last step of a run interrupted or stopped so: the file
+        // shows the state it stopped at, and the checkpoint, without that
+        // frame, restarts as the run that never stopped.
+        if (failure.is_none() || resumable) && on_last_row && !self.writer.last_row_is_frame()? {
             // The frame fills a chunk like any row: room first.
             match self.disk_nearly_full() {
-                Some(why) => failure = Some(why),
+                Some(why) => {
+                    failure.get_or_insert(why);
+                    resumable = false;
+                }
                 None => {
                     let kept = (self.writer.rows(), self.writer.frames());
                     let rec = record(&self.integrator, self.dofs, &mut self.full, (0.0, 0), true);
@@ -1144,10 +1154,6 @@ impl Session<'_> {
             }
         }
         let complete = failure.is_none() && interrupted.is_none();
-        // A step that could not be made left the state at the last one
-        // made: a checkpoint there lets a restart continue (with a larger
-        // contact.max_iterations), unless the disk has no room for it.
-        resumable &= failure.is_some() && self.disk_nearly_full().is_none();
         if complete || interrupted.is_some() || resumable {
             // Another failed run (a blow-up, a full disk) keeps the
             // checkpoint of its last flush: the state at the failure is not

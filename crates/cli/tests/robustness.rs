@@ -3158,24 +3158,55 @@ fn an_output_directory_the_run_cannot_write_is_refused_by_check_and_run() {
 fn a_run_stopped_by_the_iteration_cap_continues_with_a_larger_one() {
     let dir = scratch("cap-restart");
     let case = paper_case(&dir, "newmark-step.toml");
-    let part = dir.join("part.h5");
-    let o = run(&case, &part, &["--set", "contact.max_iterations=2"]);
+    // Every step a frame (the case's), and 7 frames: the step it stopped
+    // at is made a frame, which the checkpoint leaves out.
+    for frames in ["output.every=1", "output.frames=7"] {
+        let part = dir.join("part.h5");
+        let o = run(
+            &case,
+            &part,
+            &["--set", frames, "--set", "contact.max_iterations=2"],
+        );
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{e}");
+        assert!(
+            e.contains("did not converge in 2 iterations")
+                && e.contains("a checkpoint at its last step")
+                && e.contains("--restart"),
+            "{e}"
+        );
+        let f = hdf5::File::open(&part).unwrap();
+        let t = f.dataset("time").unwrap().read_raw::<f64>().unwrap();
+        let ft = f.dataset("frames/time").unwrap().read_raw::<f64>().unwrap();
+        let last = |v: &[f64]| v.last().map(|x| x.to_bits());
+        assert_eq!(last(&ft), last(&t), "{frames}");
+        drop(f);
+        let more = ["--set", frames, "--set", "contact.max_iterations=50"];
+        ok(&restart(&case, &part, &more));
+        let full = dir.join("full.h5");
+        ok(&run(&case, &full, &more));
+        assert_same_datasets(&full, &part);
+    }
+}
+
+/// A normal-compliance Newton solve that fails is no budget a restart may
+/// raise (its cap is fixed, and time.dt may not change on a restart): the
+/// run is not offered a restart, and keeps its last flush's checkpoint.
+#[test]
+fn a_failed_newton_solve_offers_no_restart() {
+    let dir = scratch("newton-no-restart");
+    let case = paper_case(&dir, "newmark-step.toml");
+    let text = std::fs::read_to_string(&case).unwrap().replace(
+        "pressure = 300.0",
+        "law = \"compliance\"\nfoundation = { point = [0.0, 0.0], normal = [0.0, 1.0] }\ncn = 1e12\nmn = 3.0",
+    );
+    let text = text.replace("t = [-150.0, 0.0]", "t = [-150.0, -3e6]");
+    std::fs::write(&case, text).unwrap();
+    let o = run(&case, &dir.join("n.h5"), &[]);
     let e = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{e}");
-    assert!(
-        e.contains("did not converge in 2 iterations")
-            && e.contains("a checkpoint at its last step")
-            && e.contains("--restart"),
-        "{e}"
-    );
-    ok(&restart(
-        &case,
-        &part,
-        &["--set", "contact.max_iterations=50"],
-    ));
-    let full = dir.join("full.h5");
-    ok(&run(&case, &full, &["--set", "contact.max_iterations=50"]));
-    assert_same_datasets(&full, &part);
+    assert!(e.contains("Newton solve did not converge"), "{e}");
+    assert!(!e.contains("a checkpoint at its last step"), "{e}");
 }
 
 /// probe's table gives each row a time of its own: Remark 4.3's reduced
