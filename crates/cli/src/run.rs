@@ -367,17 +367,7 @@ pub(crate) fn motion_holders(
     dofs: &DofMap,
     integrator: &Integrator,
 ) -> Vec<(String, Holders)> {
-    let carries = |group: &str| {
-        case.contact.iter().any(|s| {
-            s.group == group
-                && match s.law {
-                    case::schema::ContactLaw::Compliance => {
-                        s.ct.map_or(s.mu_at_rest(), |ct| ct) > 0.0
-                    }
-                    _ => s.mu_at_rest() > 0.0 && s.pressure != Some(0.0),
-                }
-        })
-    };
+    let carries = |group: &str| carries_friction(case, group);
     dofs.rigid_modes()
         .iter()
         .map(|m| {
@@ -406,14 +396,135 @@ pub(crate) fn motion_holders(
         .collect()
 }
 
-/// The rigid-body motions the supports leave free that nothing holds
-/// ([`motion_holders`]), or `None`: a net load along such a motion moves
-/// the part as a rigid body without bound.
-fn unheld_motions(case: &Case, dofs: &DofMap, integrator: &Integrator) -> Option<String> {
-    let unheld: Vec<String> = motion_holders(case, dofs, integrator)
+/// Whether the contact surface of `group` can carry friction: μ > 0 with
+/// a pressure, or a compliant foundation with μ or c_T > 0.
+fn carries_friction(case: &Case, group: &str) -> bool {
+    case.contact.iter().any(|s| {
+        s.group == group
+            && match s.law {
+                case::schema::ContactLaw::Compliance => s.ct.map_or(s.mu_at_rest(), |ct| ct) > 0.0,
+                _ => s.mu_at_rest() > 0.0 && s.pressure != Some(0.0),
+            }
+    })
+}
+
+/// The combinations of the free rigid-body motions that nothing holds,
+/// each as its motions' labels: a basis of the null space of the motions'
+/// shares along what can hold them (each friction node's tangent, each
+/// compliant node's normal). A motion friction holds alone may still be
+/// free in combination: with only uy held at the left end, the slab's x
+/// translation and its rotation about the end's middle each slide its
+/// bottom, but their sum, a rotation about the bottom corner, moves the
+/// bottom along its normal only.
+fn unheld_combinations(case: &Case, dofs: &DofMap, integrator: &Integrator) -> Vec<Vec<String>> {
+    let modes = dofs.rigid_modes();
+    let k = modes.len();
+    let mut g = vec![vec![0.0; k]; k];
+    let mut add = |row: &[f64]| {
+        for (a, ga) in g.iter_mut().enumerate() {
+            for (b, gab) in ga.iter_mut().enumerate() {
+                *gab += row[a] * row[b];
+            }
+        }
+    };
+    if let Some(c) = integrator.contact() {
+        for p in c.parts.iter().filter(|p| carries_friction(case, &p.group)) {
+            for n in &c.nodes[p.nodes.clone()] {
+                add(&modes
+                    .iter()
+                    .map(|m| n.tangential(&m.vector))
+                    .collect::<Vec<_>>());
+            }
+        }
+        for f in &c.compliance {
+            let n = &c.nodes[f.index];
+            add(&modes
+                .iter()
+                .map(|m| f.along_normal(n, &m.vector))
+                .collect::<Vec<_>>());
+        }
+    }
+    // Each motion's column scaled to unit length (a rotation's shares grow
+    // with the part's size); one with none is free outright.
+    let scale: Vec<f64> = (0..k)
+        .map(|a| {
+            if g[a][a] > 0.0 {
+                1.0 / g[a][a].sqrt()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    for (a, ga) in g.iter_mut().enumerate() {
+        for (b, gab) in ga.iter_mut().enumerate() {
+            *gab *= scale[a] * scale[b];
+        }
+    }
+    null_space(g, 1e-9)
         .into_iter()
-        .filter(|(_, h)| !h.friction && !h.foundation)
-        .map(|(label, _)| label)
+        .map(|v| {
+            let top = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            v.iter()
+                .zip(modes)
+                .filter(|(x, _)| x.abs() > 1e-6 * top)
+                .map(|(_, m)| m.label.clone())
+                .collect()
+        })
+        .collect()
+}
+
+/// A basis of the null space of the symmetric k × k matrix `g` (Gauss–
+/// Jordan elimination with partial pivoting; pivots below `tol` count as
+/// zero).
+fn null_space(mut g: Vec<Vec<f64>>, tol: f64) -> Vec<Vec<f64>> {
+    let k = g.len();
+    let mut pivots: Vec<usize> = Vec::new();
+    for col in 0..k {
+        let row = pivots.len();
+        let Some((p, best)) = (row..k)
+            .map(|r| (r, g[r][col].abs()))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+        else {
+            break;
+        };
+        if best <= tol {
+            continue;
+        }
+        g.swap(row, p);
+        let pivot = g[row][col];
+        g[row].iter_mut().for_each(|x| *x /= pivot);
+        let pivot_row = g[row].clone();
+        for (r, gr) in g.iter_mut().enumerate() {
+            let f = gr[col];
+            if r != row && f != 0.0 {
+                gr.iter_mut().zip(&pivot_row).for_each(|(x, p)| *x -= f * p);
+            }
+        }
+        pivots.push(col);
+    }
+    (0..k)
+        .filter(|c| !pivots.contains(c))
+        .map(|free| {
+            let mut v = vec![0.0; k];
+            v[free] = 1.0;
+            for (i, &pc) in pivots.iter().enumerate() {
+                v[pc] = -g[i][free];
+            }
+            v
+        })
+        .collect()
+}
+
+/// The rigid-body motions the supports leave free that nothing holds
+/// ([`unheld_combinations`]), or `None`: a net load along such a motion
+/// moves the part as a rigid body without bound.
+fn unheld_motions(case: &Case, dofs: &DofMap, integrator: &Integrator) -> Option<String> {
+    let unheld: Vec<String> = unheld_combinations(case, dofs, integrator)
+        .into_iter()
+        .map(|labels| match &labels[..] {
+            [one] => one.clone(),
+            several => format!("a combination of {}", several.join(" and ")),
+        })
         .collect();
     let it = if unheld.len() == 1 { "it" } else { "them" };
     (!unheld.is_empty()).then(|| {

@@ -437,6 +437,31 @@ fn a_motion_friction_cannot_hold_is_named_and_warned_of() {
         "{}",
         stderr(&o)
     );
+    // Held in y at its left end only: friction holds the x translation and
+    // the rotation about the end's middle each, but not their sum, a
+    // rotation about the bottom corner that moves the bottom along its
+    // normal (the slab left by 39.7 without a word).
+    let (case, _) = slab_case(&dir, "corner", |t| {
+        t.replace(
+            "[[dirichlet]]        # rollers on the top face\ngroup = \"support\"\nuy = 0.0\n",
+            "",
+        )
+        .replace("group = \"left\"\nux = 0.0", "group = \"left\"\nuy = 0.0")
+        .replace(
+            "pressure = 300.0",
+            "pressure = 300.0\npressure_history = \"step\"",
+        )
+    });
+    let o = check(&case, &[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success()
+            && out.contains(
+                "warning     the supports leave free a combination of translation in x and rotation about"
+            ),
+        "{out}{}",
+        stderr(&o)
+    );
 }
 #[test]
 fn bad_damping_and_initial_velocities_are_refused_at_their_lines() {
