@@ -354,6 +354,41 @@ fn advise_refuses_surfaces_of_different_eps() {
     assert!(!err.contains("pilot  ") && !written.exists(), "{err}");
 }
 
+/// A case without [contact] has no ε: advise printed `eps = NaN` in its
+/// choice and in the header it writes, and, NaN being unequal to itself,
+/// did not find its own pilot of the chosen configuration (an estimate
+/// from the sums). The header left out --at, so it could not be run again
+/// as written.
+#[test]
+fn advise_a_case_without_contact() {
+    let dir = scratch("advise-no-contact");
+    let meshes = root().join("cases/meshes");
+    let text = std::fs::read_to_string(root().join("cases/martins-oden/cd-step-eps1e-4.toml"))
+        .unwrap()
+        .replace("\"../meshes/", &format!("\"{}/", meshes.display()));
+    let contact = text.find("[contact]").unwrap();
+    let next = contact + text[contact..].find("\n\n").unwrap();
+    let text = format!("{}{}", &text[..contact], &text[next..]);
+    let case = dir.join("nc.toml");
+    std::fs::write(&case, &text).unwrap();
+    let written = dir.join("w.toml");
+    let o = bin()
+        .arg("advise")
+        .arg(&case)
+        .args(["--tol", "3e-2", "--on", "ux", "--at", "8,1", "--write"])
+        .arg(&written)
+        .output()
+        .unwrap();
+    let out = succeeded(&o, "advise");
+    assert!(!out.contains("NaN") && out.contains("was a pilot"), "{out}");
+    let w = std::fs::read_to_string(&written).unwrap();
+    assert!(
+        w.starts_with("# Adjusted by `stickslip advise --tol 3e-2 --on ux --at 8,1`")
+            && !w.contains("NaN"),
+        "{w}"
+    );
+}
+
 /// The README's ranges of advise's estimates over the chart's errors, for
 /// the configurations that were pilots and for the others, on the slab
 /// case (u_x at (8, 1)), with the five farthest of the others:

@@ -375,10 +375,9 @@ pub fn estimate(
                     for (ke, &eps) in eps_list.iter().enumerate() {
                         // A configuration that was itself run: its error
                         // against R directly.
-                        let own = pilots
-                            .runs
-                            .iter()
-                            .position(|r| r.0 == m && r.1 == method && r.2 == dt && r.3 == eps);
+                        let own = pilots.runs.iter().position(|r| {
+                            r.0 == m && r.1 == method && r.2 == dt && r.3.to_bits() == eps.to_bits()
+                        });
                         let parts = match own {
                             Some(k) => [err_of(&pilots, k), 0.0, 0.0],
                             None => [e_base, d_dt, d_eps[ke]],

@@ -178,7 +178,7 @@ impl Pilots<'_> {
         if let Some(k) = self
             .runs
             .iter()
-            .position(|r| r.0 == m && r.1 == method && r.2 == dt && r.3 == eps)
+            .position(|r| r.0 == m && r.1 == method && r.2 == dt && r.3.to_bits() == eps.to_bits())
         {
             return Ok(k);
         }

@@ -21,14 +21,19 @@ pub(super) fn describe(c: &Candidate, ladder: &[LadderMesh]) -> String {
     } else {
         String::new()
     };
+    // A case without [contact] has no ε (NaN).
+    let eps = if c.eps.is_nan() {
+        String::new()
+    } else {
+        format!(", eps = {:e}", c.eps)
+    };
     format!(
-        "Q{} {} ({} DOFs), {}, dt = {:.4e}{extra}, eps = {:e}",
+        "Q{} {} ({} DOFs), {}, dt = {:.4e}{extra}{eps}",
         c.order,
         c.mesh,
         c.dofs,
         c.method.label(),
         c.dt,
-        c.eps
     )
 }
 
@@ -178,8 +183,10 @@ pub(super) fn choice(c: &Candidate, ladder: &[LadderMesh]) -> Result<(), WriteEr
 /// The comment that heads the adjusted case (`--write`): the command and
 /// the choice.
 pub(super) fn write_header(o: &Options, c: &Candidate, ladder: &[LadderMesh]) -> String {
+    let at =
+        o.at.map_or(String::new(), |[x, y]| format!(" --at {x},{y}"));
     format!(
-        "Adjusted by `stickslip advise --tol {:e} --on {}`: {}\nestimated error {:.3e}, predicted run time {:.3} s",
+        "Adjusted by `stickslip advise --tol {:e} --on {}{at}`: {}\nestimated error {:.3e}, predicted run time {:.3} s",
         o.tol,
         o.quantity.name(),
         describe(c, ladder),
