@@ -387,6 +387,23 @@ fn advise_a_case_without_contact() {
             && !w.contains("NaN"),
         "{w}"
     );
+    // Without its end load nothing moves: every relative error was NaN,
+    // and the advice to add finer meshes (exit 1). Refused after the
+    // first pilot.
+    let still = dir.join("still.toml");
+    std::fs::write(&still, text.replace("t = [-150.0, 0.0]", "t = [0.0, 0.0]")).unwrap();
+    let o = bin()
+        .arg("advise")
+        .arg(&still)
+        .args(["--tol", "3e-2", "--on", "ux", "--at", "8,1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("does not change over the run") && !err.contains("NaN"),
+        "{err}"
+    );
 }
 
 /// The README's ranges of advise's estimates over the chart's errors, for

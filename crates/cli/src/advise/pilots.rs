@@ -190,6 +190,22 @@ impl Pilots<'_> {
                 method.name()
             )
         })?;
+        // The first pilot tells whether the output moves at all: a
+        // relative error of one that does not is undefined (every figure
+        // was NaN, and the advice to add finer meshes).
+        if self.runs.is_empty() {
+            let moved = super::quantity::motion(self.q, &tr, &super::quantity::grid(c.time.t_end));
+            if moved == 0.0 || !moved.is_finite() {
+                return Err(input(format!(
+                    "--on {}{}: it does not change over the run on {} (its motion is {moved:e}), \
+                     so no relative error of it is defined; choose another output or point",
+                    self.q.name(),
+                    self.at
+                        .map_or(String::new(), |[x, y]| format!(" --at {x},{y}")),
+                    self.ladder[m].text,
+                )));
+            }
+        }
         (self.log)(&format!(
             "pilot  {:28} {:20} dt {:.4e} eps {:.0e}: {:6} steps, {:.3} s",
             self.ladder[m].text,

@@ -71,6 +71,22 @@ pub fn distance(q: Quantity, a: &Trace, b: &Trace, grid: &[f64]) -> f64 {
     relative_l2(&sa, &sb, offset)
 }
 
+/// The size [`distance`] divides by, of the trace `b`: its motion
+/// ‖b − b(0)‖ for u_x, u_y, ‖b‖ for σ_T, |E(t_end) − E(0)| for the
+/// energy. Where it is 0 every relative error is undefined.
+pub fn motion(q: Quantity, b: &Trace, grid: &[f64]) -> f64 {
+    if q == Quantity::Energy {
+        return (b.energy_end - b.energy0).abs();
+    }
+    let sb = sample(&b.t, &b.values[0], grid);
+    let offset = if q == Quantity::FrictionStress {
+        0.0
+    } else {
+        sb[0]
+    };
+    sb.iter().map(|y| (y - offset).powi(2)).sum::<f64>().sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
