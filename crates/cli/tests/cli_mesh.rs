@@ -111,6 +111,10 @@ fn bad_meshes_exit_2_naming_the_file() {
         if let Some(l) = line {
             assert!(e.contains(&format!("{name}:{l}:")), "{name}: {e}");
         }
+        // A missing file says what to do, not only the OS's words.
+        if name == "no-such-file.msh" {
+            assert!(e.contains("check the path"), "{e}");
+        }
         assert!(o.stdout.is_empty(), "nothing on stdout for a bad mesh");
     }
 }

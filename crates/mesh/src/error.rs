@@ -307,10 +307,16 @@ impl MeshError {
     }
     /// An I/O error on `path`.
     pub fn io(path: &Path, e: std::io::Error) -> Self {
+        // What to do, where the OS says what is wrong.
+        let next = match e.kind() {
+            std::io::ErrorKind::NotFound => "; check the path, or make the mesh with Gmsh",
+            std::io::ErrorKind::PermissionDenied => "; make it readable, or copy it where it is",
+            _ => "",
+        };
         MeshError {
             path: Some(path.to_path_buf()),
             location: Location::Nowhere,
-            kind: MeshErrorKind::Io(e.to_string()),
+            kind: MeshErrorKind::Io(format!("{e}{next}")),
         }
     }
     /// Attaches the file name.
