@@ -875,8 +875,8 @@ fn a_signal_sent_twice_at_once_stops_the_run_cleanly() {
     );
 }
 
-/// An interrupted run's last step is a frame, as a completed or failed
-/// run's is, so that probe and the viewers show the state it stopped at
+/// An interrupted run's last step is a frame, as a completed run's is,
+/// so that probe and the viewers show the state it stopped at
 /// (with output.frames it was not: the frames ended before it); the
 /// checkpoint leaves that frame out, so the continued run is still bit
 /// for bit the run that never stopped.
