@@ -281,3 +281,22 @@ fn mesh_notes_a_group_without_elements() {
     assert_eq!(warnings.len(), 1, "{j}");
     assert!(warnings[0].as_str().unwrap().contains("\"top\""), "{j}");
 }
+
+/// An element block whose type's dimension is not its entity's (the
+/// paper mesh's quad9 block moved onto curve 1): it was read, its cells
+/// taking the curve's physical group. Refused at the block's line.
+#[test]
+fn a_block_on_an_entity_of_another_dimension_is_refused() {
+    let text = std::fs::read_to_string(root().join("cases/meshes/slab-q2-8x2.msh")).unwrap();
+    let line = text.lines().position(|l| l == "2 1 10 16").unwrap() + 1;
+    let dir = stickslip_testkit::scratch("mesh-block-dim");
+    let path = dir.join("curve.msh");
+    std::fs::write(&path, text.replace("\n2 1 10 16\n", "\n1 1 10 16\n")).unwrap();
+    let o = bin().arg("mesh").arg(&path).output().unwrap();
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains(&format!("curve.msh:{line}:")) && e.contains("quad9 elements (dim 2)"),
+        "{e}"
+    );
+}

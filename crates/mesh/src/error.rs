@@ -176,6 +176,19 @@ pub enum MeshErrorKind {
         /// Entity tag.
         tag: i32,
     },
+    /// An element block whose type's dimension is not its entity's: a
+    /// quad9 block on a curve took that curve's physical groups.
+    #[error("a block of {name} elements (dim {type_dim}) is on entity (dim {dim}, tag {tag}): an element's dimension is its entity's; re-export the mesh from Gmsh")]
+    BlockDimension {
+        /// The block's element type name.
+        name: &'static str,
+        /// That type's dimension.
+        type_dim: i32,
+        /// Entity dimension.
+        dim: i32,
+        /// Entity tag.
+        tag: i32,
+    },
     /// An element type that stickslip cannot use.
     #[error("element {element} has type {type_id} ({name}); stickslip reads 2-D meshes of quad4 or quad9 cells with line2/line3 boundary elements and points: mesh in 2-D (`gmsh -2`) and keep 3-D entities out of the physical groups")]
     UnsupportedElement {

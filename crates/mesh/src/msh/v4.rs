@@ -316,6 +316,23 @@ pub(crate) fn elements(
             let first = peek_tag(cur);
             return Err(unsupported(cur, bp, first, type_id));
         };
+        let type_dim = match nn {
+            1 => 0,
+            2 | 3 => 1,
+            _ => 2,
+        };
+        if type_dim != dim {
+            let name = type_name(type_id);
+            return Err(cur.error(
+                bp,
+                MeshErrorKind::BlockDimension {
+                    name,
+                    type_dim,
+                    dim,
+                    tag: entity,
+                },
+            ));
+        }
         if nn >= 4 {
             let min_bytes = if cur.binary {
                 8 * (1 + nn)
