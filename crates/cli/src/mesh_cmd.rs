@@ -54,7 +54,11 @@ pub fn to_json(mesh: &Mesh) -> serde_json::Value {
         "bbox": mesh.bbox(),
         "reoriented": mesh.source.reoriented,
         "unused_nodes": mesh.source.unused_nodes,
-        "warnings": warnings(mesh).into_iter().chain(empty_groups(mesh)).collect::<Vec<_>>(),
+        "warnings": warnings(mesh)
+            .into_iter()
+            .chain(empty_groups(mesh))
+            .chain(twin_groups(mesh))
+            .collect::<Vec<_>>(),
     })
 }
 
@@ -81,6 +85,27 @@ fn empty_groups(mesh: &Mesh) -> Vec<String> {
                 g.dim,
                 g.empty_remedy()
             )
+        })
+        .collect()
+}
+
+/// A note for each name two physical groups of one dimension share (a
+/// hand-made or merged file: Gmsh gives a name one group a dimension): a
+/// case names a group by its name, so `check` and `run` refuse a case
+/// that names this one.
+fn twin_groups(mesh: &Mesh) -> Vec<String> {
+    mesh.groups
+        .iter()
+        .enumerate()
+        .filter_map(|(i, g)| {
+            let first = mesh.groups[..i]
+                .iter()
+                .find(|h| h.name == g.name && h.dim == g.dim)?;
+            Some(format!(
+                "groups {} and {} (dim {}) are both named {:?}: a case names a group by its name, \
+                 so `check` and `run` refuse a case that names it; rename one of them in the .geo",
+                first.tag, g.tag, g.dim, g.name
+            ))
         })
         .collect()
 }
@@ -156,7 +181,7 @@ fn to_table(path: &Path, mesh: &Mesh) -> String {
             g.nodes.len()
         );
     }
-    for note in empty_groups(mesh) {
+    for note in empty_groups(mesh).into_iter().chain(twin_groups(mesh)) {
         let _ = writeln!(s, "  note: {note}");
     }
     // Not an error (an interior line may be meant), but a traction or

@@ -300,3 +300,29 @@ fn a_block_on_an_entity_of_another_dimension_is_refused() {
         "{e}"
     );
 }
+
+/// Two groups of one dimension and one name (the paper mesh's "load"
+/// renamed "contact"): `mesh` listed both without a word, and --json
+/// only keyed the second by tag, while a case naming it is refused. A
+/// note says so, in the table and in --json's warnings.
+#[test]
+fn mesh_notes_two_groups_of_one_name_and_dimension() {
+    let text = std::fs::read_to_string(root().join("cases/meshes/slab-q2-8x2.msh")).unwrap();
+    let dir = stickslip_testkit::scratch("mesh-twins");
+    let path = dir.join("twins.msh");
+    std::fs::write(&path, text.replace("1 2 \"load\"", "1 2 \"contact\"")).unwrap();
+    let note = "groups 1 and 2 (dim 1) are both named \"contact\"";
+    let o = bin().arg("mesh").arg(&path).output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && out.contains(&format!("note: {note}")),
+        "{out}"
+    );
+    let j = mesh_json(&path);
+    let warned = j["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|w| w.as_str().is_some_and(|w| w.starts_with(note)));
+    assert!(warned, "{j}");
+}
