@@ -357,6 +357,39 @@ impl Holders {
     }
 }
 
+/// Each free rigid-body motion's shares along what can hold it, one value
+/// per motion ([`DofMap::rigid_modes`]) a row: the tangent's share at each
+/// node of a surface that can carry friction, the normal's at each
+/// compliant node.
+struct Shares {
+    friction: Vec<Vec<f64>>,
+    foundation: Vec<Vec<f64>>,
+}
+
+impl Shares {
+    fn of(case: &Case, dofs: &DofMap, integrator: &Integrator) -> Shares {
+        let modes = dofs.rigid_modes();
+        let mut s = Shares {
+            friction: Vec::new(),
+            foundation: Vec::new(),
+        };
+        if let Some(c) = integrator.contact() {
+            for p in c.parts.iter().filter(|p| carries_friction(case, &p.group)) {
+                for n in &c.nodes[p.nodes.clone()] {
+                    s.friction
+                        .push(modes.iter().map(|m| n.tangential(&m.vector)).collect());
+                }
+            }
+            for f in &c.compliance {
+                let n = &c.nodes[f.index];
+                s.foundation
+                    .push(modes.iter().map(|m| f.along_normal(n, &m.vector)).collect());
+            }
+        }
+        s
+    }
+}
+
 /// Each rigid-body motion the supports leave free ([`DofMap::rigid_modes`])
 /// with what can hold it: friction where some node of a surface that can
 /// carry friction (μ > 0 with a pressure, or a compliant foundation with
@@ -367,30 +400,17 @@ pub(crate) fn motion_holders(
     dofs: &DofMap,
     integrator: &Integrator,
 ) -> Vec<(String, Holders)> {
-    let carries = |group: &str| carries_friction(case, group);
+    let shares = Shares::of(case, dofs, integrator);
     dofs.rigid_modes()
         .iter()
-        .map(|m| {
-            let r = &m.vector;
-            let tol = 1e-9 * r.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
-            let held = integrator.contact().map_or(
-                Holders {
-                    friction: false,
-                    foundation: false,
-                },
-                |c| Holders {
-                    friction: c.parts.iter().any(|p| {
-                        carries(&p.group)
-                            && c.nodes[p.nodes.clone()]
-                                .iter()
-                                .any(|n| n.tangential(r).abs() > tol)
-                    }),
-                    foundation: c
-                        .compliance
-                        .iter()
-                        .any(|f| f.along_normal(&c.nodes[f.index], r).abs() > tol),
-                },
-            );
+        .enumerate()
+        .map(|(a, m)| {
+            let tol = 1e-9 * m.vector.iter().fold(0.0_f64, |t, v| t.max(v.abs()));
+            let some = |rows: &[Vec<f64>]| rows.iter().any(|r| r[a].abs() > tol);
+            let held = Holders {
+                friction: some(&shares.friction),
+                foundation: some(&shares.foundation),
+            };
             (m.label.clone(), held)
         })
         .collect()
@@ -410,38 +430,21 @@ fn carries_friction(case: &Case, group: &str) -> bool {
 
 /// The combinations of the free rigid-body motions that nothing holds,
 /// each as its motions' labels: a basis of the null space of the motions'
-/// shares along what can hold them (each friction node's tangent, each
-/// compliant node's normal). A motion friction holds alone may still be
-/// free in combination: with only uy held at the left end, the slab's x
+/// [`Shares`]. A motion friction holds alone may still be free in
+/// combination: with only uy held at the left end, the slab's x
 /// translation and its rotation about the end's middle each slide its
 /// bottom, but their sum, a rotation about the bottom corner, moves the
 /// bottom along its normal only.
 fn unheld_combinations(case: &Case, dofs: &DofMap, integrator: &Integrator) -> Vec<Vec<String>> {
     let modes = dofs.rigid_modes();
     let k = modes.len();
+    let shares = Shares::of(case, dofs, integrator);
     let mut g = vec![vec![0.0; k]; k];
-    let mut add = |row: &[f64]| {
+    for row in shares.friction.iter().chain(&shares.foundation) {
         for (a, ga) in g.iter_mut().enumerate() {
             for (b, gab) in ga.iter_mut().enumerate() {
                 *gab += row[a] * row[b];
             }
-        }
-    };
-    if let Some(c) = integrator.contact() {
-        for p in c.parts.iter().filter(|p| carries_friction(case, &p.group)) {
-            for n in &c.nodes[p.nodes.clone()] {
-                add(&modes
-                    .iter()
-                    .map(|m| n.tangential(&m.vector))
-                    .collect::<Vec<_>>());
-            }
-        }
-        for f in &c.compliance {
-            let n = &c.nodes[f.index];
-            add(&modes
-                .iter()
-                .map(|m| f.along_normal(n, &m.vector))
-                .collect::<Vec<_>>());
         }
     }
     // Each motion's column scaled to unit length (a rotation's shares grow
