@@ -74,6 +74,17 @@ fn restart(case: &Path, out: &Path, args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// A restart of `out` that must be refused (exit 2) leaving the file's
+/// bytes as they were: its stderr.
+fn refused_restart(case: &Path, out: &Path, args: &[&str]) -> String {
+    let before = std::fs::read(out).unwrap();
+    let o = restart(case, out, args);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(std::fs::read(out).unwrap() == before, "the file changed");
+    e
+}
+
 /// Asserts exit 2 from both `check` and `run` (which must not create the
 /// results file), and that the message has each of `words`; returns it.
 fn refused(case: &Path, sets: &[&str], words: &[&str]) -> String {
@@ -1438,15 +1449,11 @@ fn run_to_a_tenth(
 #[test]
 fn a_restart_at_a_checkpoint_without_its_row_is_refused() {
     let (_, case, part, sets) = run_to_a_tenth("restart-at-checkpoint-every", "output.every=4");
-    let before = std::fs::read(&part).unwrap();
-    let o = restart(&case, &part, &sets("time.t_end=0.099"));
-    let e = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{e}");
+    let e = refused_restart(&case, &part, &sets("time.t_end=0.099"));
     assert!(
         e.contains("time.t_end") && e.contains("give a t_end > 0.099"),
         "{e}"
     );
-    assert!(std::fs::read(&part).unwrap() == before, "the file changed");
     // A later t_end continues it.
     ok(&restart(&case, &part, &sets("time.t_end=0.2")));
 }
@@ -2621,20 +2628,13 @@ fn a_restart_of_a_damaged_file_is_refused_before_it_changes_it() {
                     .unwrap();
             }
         });
-        let before = std::fs::read(&damaged).unwrap();
-        let o = restart(&case, &damaged, &["--set", "time.t_end=0.04"]);
-        let e = stderr(&o);
-        assert_eq!(o.status.code(), Some(2), "{e}");
+        let e = refused_restart(&case, &damaged, &["--set", "time.t_end=0.04"]);
         assert!(
             e.contains(&format!(
                 "--restart {}: /acceleration {says}",
                 damaged.display()
             )) && e.contains("damaged"),
             "{e}"
-        );
-        assert!(
-            std::fs::read(&damaged).unwrap() == before,
-            "the file changed"
         );
     }
 }
@@ -2660,12 +2660,8 @@ fn a_restart_reads_its_clock_and_rewrites_a_foreign_attribute() {
             }
         }
     });
-    let before = std::fs::read(&clock).unwrap();
-    let o = restart(&case, &clock, &["--set", "time.t_end=0.04"]);
-    let e = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{e}");
+    let e = refused_restart(&case, &clock, &["--set", "time.t_end=0.04"]);
     assert!(e.contains("its clock") && e.contains("damaged"), "{e}");
-    assert!(std::fs::read(&clock).unwrap() == before, "the file changed");
     let text = dir.join("text.h5");
     edited_copy(&r, &text, |f| {
         let solver = f.group("solver").unwrap();
