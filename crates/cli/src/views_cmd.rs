@@ -354,7 +354,7 @@ pub fn write(out: &Path) -> anyhow::Result<Written> {
     );
     // Files written before it have no /contact/surface: one surface.
     let surface = f.link_exists("contact/surface");
-    let (stress, stale) = match stress_name(out, rows) {
+    let (stress, stale) = match stress_name(&f, out, rows) {
         Err(stale) => (None, Some(stale)),
         Ok(name) => (name, None),
     };
@@ -486,12 +486,12 @@ fn contact_line(f: &File, out: &Path) -> anyhow::Result<(Option<ContactLine>, Op
 /// at least `rows` records (one of fewer would leave records without
 /// stresses; a run or restart removes it anyway); `Err` with a note where
 /// it holds the stresses of other displacements than `out`'s.
-fn stress_name(out: &Path, rows: usize) -> Result<Option<String>, String> {
+fn stress_name(f: &File, out: &Path, rows: usize) -> Result<Option<String>, String> {
     let path = crate::results_file::Companion::Stress.path(out);
-    let Some(name) = stress_listed(out, rows) else {
+    let Some((name, g)) = stress_listed(out, rows) else {
         return Ok(None);
     };
-    match of_these_records(out, &path) {
+    match of_these_records(f, &g) {
         Some(false) => Err(format!(
             "{} holds the stresses of other displacements than {}'s (a results file copied \
              over it?): they are left out; `stickslip stress {}` forms them anew",
@@ -503,23 +503,23 @@ fn stress_name(out: &Path, rows: usize) -> Result<Option<String>, String> {
     }
 }
 
-/// Whether the stress file `path` was formed from the displacements of
-/// `out` (its `last_record_hash` against `out`'s record of that index);
-/// `None` where that cannot be told (stress files of earlier versions).
-fn of_these_records(out: &Path, path: &Path) -> Option<bool> {
-    let g = File::open(path).ok()?;
+/// Whether the stress file `g` was formed from the displacements of the
+/// results file `f` (its `last_record_hash` against `f`'s record of that
+/// index); `None` where that cannot be told (stress files of earlier
+/// versions).
+fn of_these_records(f: &File, g: &File) -> Option<bool> {
     let stored = g.attr("last_record_hash").ok()?.read_scalar::<u64>().ok()?;
     let records = g.dataset("von_mises").ok()?.shape().first().copied()?;
-    let u = File::open(out)
+    let now = f
+        .dataset("displacement")
         .ok()
-        .and_then(|f| f.dataset("displacement").ok());
-    let now = u.and_then(|u| crate::stress_cmd::last_record_hash(&u, records));
+        .and_then(|u| crate::stress_cmd::last_record_hash(&u, records));
     Some(now == Some(stored))
 }
 
-/// [`stress_name`]'s file name where the stress file is these stresses by
-/// its name and records.
-fn stress_listed(out: &Path, rows: usize) -> Option<String> {
+/// [`stress_name`]'s file name, and the file open, where the stress file
+/// is these stresses by its name and records.
+fn stress_listed(out: &Path, rows: usize) -> Option<(String, File)> {
     use crate::results_file::{foreign_to_read, Companion};
     let path = Companion::Stress.path(out);
     // A file of that name that is not these stresses (another run's
@@ -539,7 +539,8 @@ fn stress_listed(out: &Path, rows: usize) -> Option<String> {
             return None;
         }
     }
-    path.file_name()?.to_str().map(str::to_string)
+    let name = path.file_name()?.to_str()?.to_string();
+    Some((name, g))
 }
 
 /// The line `stickslip views` closes with: what it wrote for `out` and
